@@ -1,0 +1,112 @@
+# vsgl-indirect build. `make help` lists the targets.
+#
+# Python: the C library is tested from Debian's /usr/bin/python3 (the one
+# Debian's Blender 3.4 embeds, with python3-numpy/python3-pytest). The
+# newest Blender-as-a-module (`bpy` from PyPI) is tested from $(PIP_PYTHON),
+# the pyenv python3 on PATH, into which tools/ installs bpy with pip.
+SHELL := /bin/bash
+.DEFAULT_GOAL := all
+
+CC      ?= cc
+PYTHON  ?= /usr/bin/python3
+PIP_PYTHON ?= python3
+BUILD   := build
+INCLUDES := -Icsrc/include -Icsrc/src $(shell pkg-config --cflags-only-I OpenEXR 2>/dev/null)
+WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes -Wmissing-prototypes
+CFLAGS_COMMON := -std=c11 -D_POSIX_C_SOURCE=200809L -DVSGL_BUILDING -fPIC -fvisibility=hidden $(WARN) $(INCLUDES)
+OPT     ?= -O2 -g
+LDLIBS  := -lembree3 -lOpenEXRCore-3_1 -lpthread -lm
+
+LIB_SRC  := $(sort $(wildcard csrc/src/*/*.c))
+TEST_SRC := $(sort $(wildcard tests/c/*.c))
+CLI_SRC  := $(sort $(wildcard csrc/cli/*.c))
+HEADERS  := $(sort $(wildcard csrc/include/*.h csrc/include/vsgl/*.h))
+
+LIB_OBJ  := $(LIB_SRC:%.c=$(BUILD)/obj/%.o)
+TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/obj/%.o)
+ASAN_LIB_OBJ  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
+ASAN_TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/asan/%.o)
+
+.PHONY: all help deps test test-c test-python test-blender asan demo bench clean headers-cxx check-exports
+
+all: $(BUILD)/libvsgl.so check-exports headers-cxx $(if $(CLI_SRC),$(BUILD)/vsgl)
+
+help:
+	@echo "make            build build/libvsgl.so (and the CLI build/vsgl)"
+	@echo "make demo       the main job on the bundled demo scene (writes out/demo/)"
+	@echo "make test       every test suite; ends with 'N passed, N failed'"
+	@echo "make asan       C tests under AddressSanitizer + UBSan (clang)"
+	@echo "make bench      speed/memory benchmarks, reported as ratios"
+
+deps:
+	@tools/deps.sh build
+
+$(BUILD)/obj/%.o: %.c $(HEADERS) | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_COMMON) $(OPT) -MMD -c $< -o $@
+
+$(BUILD)/libvsgl.so: $(LIB_OBJ)
+	$(CC) -shared -o $@ $^ $(LDLIBS)
+
+$(BUILD)/vsgl: $(CLI_SRC) $(BUILD)/libvsgl.so
+	$(CC) $(CFLAGS_COMMON) $(OPT) -o $@ $(CLI_SRC) -L$(BUILD) -lvsgl -Wl,-rpath,'$$ORIGIN' -lm
+
+# Only vsgl_-prefixed symbols may leave the library.
+check-exports: $(BUILD)/libvsgl.so
+	@bad=$$(nm -D --defined-only $< | awk '{print $$3}' | grep -v '^vsgl_' | grep -v '^_' || true); \
+	if [ -n "$$bad" ]; then echo "exported symbols without the vsgl_ prefix: $$bad"; exit 1; fi
+
+# Every public header compiles on its own as C and as C++.
+headers-cxx: $(HEADERS)
+	@mkdir -p $(BUILD)
+	@for h in $(HEADERS); do \
+	  echo "#include \"$$(realpath $$h)\"" > $(BUILD)/hdr.c; \
+	  $(CC) -std=c11 $(WARN) -Icsrc/include -fsyntax-only $(BUILD)/hdr.c || exit 1; \
+	  cp $(BUILD)/hdr.c $(BUILD)/hdr.cpp; \
+	  c++ -std=c++11 -Wall -Wextra -Wpedantic -Icsrc/include -fsyntax-only $(BUILD)/hdr.cpp || exit 1; \
+	done; touch $@ 2>/dev/null; true
+
+$(BUILD)/tests/vsgl_tests: $(TEST_OBJ) $(LIB_OBJ)
+	@mkdir -p $(dir $@)
+	$(CC) -o $@ $^ $(LDLIBS)
+
+test:
+	@tools/deps.sh test
+	@$(MAKE) --no-print-directory all $(BUILD)/tests/vsgl_tests >/dev/null
+	@PYTHON=$(PYTHON) PIP_PYTHON=$(PIP_PYTHON) tools/run_tests.sh
+
+test-c: $(BUILD)/tests/vsgl_tests
+	$(BUILD)/tests/vsgl_tests $(T)
+
+test-python: $(BUILD)/libvsgl.so
+	$(PYTHON) -m pytest -q tests/python $(T)
+
+# AddressSanitizer + UndefinedBehaviorSanitizer build of the C tests.
+ASAN_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+$(BUILD)/asan/%.o: %.c $(HEADERS)
+	@mkdir -p $(dir $@)
+	clang $(CFLAGS_COMMON) $(ASAN_FLAGS) -c $< -o $@
+
+$(BUILD)/asan/vsgl_tests: $(ASAN_TEST_OBJ) $(ASAN_LIB_OBJ)
+	clang $(ASAN_FLAGS) -o $@ $^ $(LDLIBS)
+
+asan:
+	@tools/deps.sh asan
+	@$(MAKE) --no-print-directory $(BUILD)/asan/vsgl_tests
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  VSGL_TEST_QUICK=1 $(BUILD)/asan/vsgl_tests $(T)
+
+demo:
+	@tools/deps.sh demo
+	@if [ -x tools/demo.sh ]; then tools/demo.sh; else \
+	  echo "make demo: the demo (issue 5) is not built yet; 'make test' runs what exists."; exit 1; fi
+
+bench:
+	@tools/deps.sh bench
+	@$(MAKE) --no-print-directory all
+	@if [ -x tools/bench.sh ]; then tools/bench.sh; else echo "make bench: no benchmarks yet"; fi
+
+clean:
+	rm -rf $(BUILD)
+
+-include $(LIB_OBJ:.o=.d) $(TEST_OBJ:.o=.d)

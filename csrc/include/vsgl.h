@@ -1,0 +1,22 @@
+/**
+ * @file vsgl.h
+ * @brief Umbrella header of libvsgl: fast, deterministic one-bounce
+ * glossy indirect light from virtual spherical Gaussian lights.
+ *
+ * Quick reference (each header documents units, frames, ownership):
+ * - vsgl/base.h   result codes, version, ::vsgl_context
+ * - vsgl/sg.h     spherical Gaussian operators
+ * - vsgl/asg.h    anisotropic spherical Gaussian operators
+ * - vsgl/lobes.h  BRDF lobes as SG/ASG, spherical warping
+ * - vsgl/scene.h  scene input (triangles, materials, lights, camera)
+ * - vsgl/render.h settings, outputs, ::vsgl_render
+ */
+#ifndef VSGL_H
+#define VSGL_H
+#include "vsgl/base.h"
+#include "vsgl/sg.h"
+#include "vsgl/asg.h"
+#include "vsgl/lobes.h"
+#include "vsgl/scene.h"
+#include "vsgl/render.h"
+#endif

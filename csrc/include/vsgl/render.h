@@ -1,0 +1,108 @@
+/**
+ * @file vsgl/render.h
+ * @brief One-bounce indirect light of a scene as Cycles-compatible planes:
+ * settings (every approximation has a knob), outputs, statistics.
+ *
+ * Pipeline: G-buffer (camera samples) -> one RSM per light (texel = VPL)
+ * -> VSGL fit (2 per light | FIS | k-means) -> SG/ASG shading -> planes.
+ * The brute-force method shades with every RSM texel instead of VSGLs (the
+ * internal ground truth).
+ */
+#ifndef VSGL_RENDER_H
+#define VSGL_RENDER_H
+
+#include "scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define VSGL_METHOD_VSGL        0  /**< VSGL fit + SG/ASG product integrals */
+#define VSGL_METHOD_BRUTE_FORCE 1  /**< every RSM texel as a point light, exact BRDF */
+
+#define VSGL_FIT_TWO    0  /**< poster: one diffuse + one specular VSGL per light */
+#define VSGL_FIT_FIS    1  /**< filtered importance sampling over RSM mips */
+#define VSGL_FIT_KMEANS 2  /**< k-means in image + world space */
+
+#define VSGL_GLOSSY_ASG 0  /**< receiver lobe as a warped ASG (default) */
+#define VSGL_GLOSSY_SG  1  /**< receiver lobe as a warped SG (cheaper) */
+
+#define VSGL_VISIBILITY_NONE 0
+#define VSGL_VISIBILITY_RAY  1  /**< one ray from the shading point to each VSGL centre / VPL */
+
+#define VSGL_PRESET_PREVIEW  0
+#define VSGL_PRESET_BALANCED 1
+#define VSGL_PRESET_QUALITY  2
+
+/**
+ * Render settings. Zero-initialised means "default" for every field, so
+ * the default of each is stated. @p size: sizeof(vsgl_render_settings) or 0.
+ */
+typedef struct vsgl_render_settings {
+    uint32_t size;
+    int32_t method;              /**< VSGL_METHOD_*, default VSGL */
+    uint32_t aa_samples;         /**< samples per pixel per axis (N x N), default 1 */
+    uint32_t rsm_resolution;     /**< RSM side in texels (cube faces: per face), default 256 */
+    int32_t fit_mode;            /**< VSGL_FIT_*, default TWO */
+    uint32_t vsgl_count;         /**< VSGLs per light for FIS/k-means, default 64 */
+    uint32_t fis_iterations;     /**< bisection steps of the mip level, default 8 */
+    int32_t sharpness_estimator; /**< VSGL_SHARPNESS_*, default TOKSVIG */
+    int32_t diffuse_mode;        /**< VSGL_COSINE_*, default ACCURATE */
+    int32_t glossy_mode;         /**< VSGL_GLOSSY_*, default ASG */
+    int32_t visibility;          /**< VSGL_VISIBILITY_*, default NONE */
+    uint32_t seed;               /**< for FIS / k-means sampling, default 0 */
+} vsgl_render_settings;
+
+/** @brief Fill @p out with a preset (VSGL_PRESET_*); unknown presets give BALANCED. */
+VSGL_API void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out);
+
+/**
+ * Output planes, caller-owned, each width*height*3 floats (RGB), rows from
+ * the top of the image down, or NULL if not wanted. Names follow Cycles:
+ * DiffInd/GlossInd are light only (divided by colour); the coloured
+ * contribution is DiffInd*DiffCol + GlossInd*GlossCol = @p combined.
+ */
+typedef struct vsgl_render_output {
+    uint32_t width, height;      /**< must equal the camera's */
+    float *diffuse_light;        /**< DiffInd */
+    float *glossy_light;         /**< GlossInd */
+    float *diffuse_color;        /**< DiffCol */
+    float *glossy_color;         /**< GlossCol */
+    float *diffuse;              /**< DiffInd * DiffCol */
+    float *glossy;               /**< GlossInd * GlossCol */
+    float *combined;             /**< diffuse + glossy */
+    float *alpha;                /**< width*height floats: pixel coverage */
+} vsgl_render_output;
+
+/** What a render did, for logs and the add-on's panel. */
+typedef struct vsgl_render_stats {
+    double seconds_total;
+    double seconds_scene_prep;
+    double seconds_gbuffer;
+    double seconds_rsm;
+    double seconds_fit;
+    double seconds_shade;
+    uint32_t lights_used;
+    uint32_t lights_skipped;
+    uint32_t vsgl_count;         /**< VSGLs shaded, all lights */
+    uint64_t shading_pairs;      /**< sample x VSGL evaluations */
+    char skipped[1024];          /**< what was skipped and why, one item per line */
+} vsgl_render_stats;
+
+/**
+ * @brief Render the indirect AOV planes.
+ * @param[in,out] out planes to fill; every non-NULL plane is written
+ *        completely on success and left untouched on failure.
+ * @param[out] stats may be NULL.
+ * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (settings or output
+ *         sizes; message names the field), ::VSGL_ERROR_OUT_OF_MEMORY,
+ *         ::VSGL_ERROR_CANCELLED.
+ */
+VSGL_API vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene,
+                                 const vsgl_render_settings *settings,
+                                 vsgl_render_output *out, vsgl_render_stats *stats);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* VSGL_RENDER_H */

@@ -1,0 +1,176 @@
+/**
+ * @file vsgl/scene.h
+ * @brief Scene input: triangles, materials, lights and camera as flat,
+ * caller-owned arrays, validated and copied into an opaque ::vsgl_scene
+ * (with its ray-tracing acceleration structure).
+ *
+ * Frames and units: world space is Blender's (+Z up, metres). Matrices are
+ * 3x4 row-major affine transforms "world_from_local", i.e. Blender's
+ * `matrix_world` without its last row: world = M[:, :3] * local + M[:, 3].
+ * A camera looks down its local -Z with +Y up; a spot, area or sun light
+ * emits along its local -Z. Light power follows Cycles (docs/units.md).
+ */
+#ifndef VSGL_SCENE_H
+#define VSGL_SCENE_H
+
+#include "base.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------ */
+/* Materials                                                                  */
+/* ------------------------------------------------------------------------ */
+
+/** Material flags. */
+#define VSGL_MATERIAL_UNSUPPORTED 1u /**< caller could not map the material; shaded as given, reported */
+
+/**
+ * The Principled BSDF subset the method models. Zero-initialised is black.
+ * Specular reflectance at normal incidence of the dielectric layer is
+ * @p specular_f0 (Blender 3.x: 0.08 * Specular; 4.x: from IOR and
+ * "Specular IOR Level"; the add-on converts). Metallic blends towards a
+ * conductor with F0 = base_color.
+ */
+typedef struct vsgl_material {
+    float base_color[3];     /**< linear RGB albedo in [0, 1] */
+    float metallic;          /**< [0, 1] */
+    float roughness;         /**< Blender roughness in [0, 1]; alpha = roughness^2 */
+    float specular_f0;       /**< dielectric F0 in [0, 1], typically 0.04 */
+    float anisotropy;        /**< [0, 1]; Cycles' mapping to alpha_x, alpha_y */
+    float anisotropic_rotation; /**< [0, 1] turns of the tangent about the normal */
+    uint32_t flags;          /**< VSGL_MATERIAL_* */
+    uint32_t reserved;       /**< must be 0 (room for texture slots) */
+} vsgl_material;
+
+/* ------------------------------------------------------------------------ */
+/* Lights                                                                     */
+/* ------------------------------------------------------------------------ */
+
+#define VSGL_LIGHT_POINT 0
+#define VSGL_LIGHT_SPOT  1
+#define VSGL_LIGHT_SUN   2
+#define VSGL_LIGHT_AREA  3
+
+#define VSGL_AREA_SQUARE    0
+#define VSGL_AREA_RECTANGLE 1
+#define VSGL_AREA_DISK      2
+#define VSGL_AREA_ELLIPSE   3
+
+/**
+ * A light with Blender semantics and Cycles units.
+ * - @p power: watts for point, spot and area; irradiance in W/m^2 for sun.
+ *   The caller folds in Blender 4's exposure (2^exposure) and blackbody.
+ * - @p color: linear RGB multiplier of @p power.
+ * - @p world_from_light: the object's matrix; scale is allowed (a spot's
+ *   cone follows its scaled axes, an area's size is scaled by it).
+ */
+typedef struct vsgl_light {
+    int32_t type;            /**< VSGL_LIGHT_* */
+    int32_t area_shape;      /**< VSGL_AREA_* (area lights only) */
+    float color[3];
+    float power;
+    float world_from_light[12];
+    float radius;            /**< point/spot soft radius in metres (>= 0) */
+    float spot_size;         /**< full cone angle in radians, (0, pi] */
+    float spot_blend;        /**< [0, 1] */
+    float sun_angle;         /**< angular diameter in radians, [0, pi] */
+    float size_x, size_y;    /**< area size in metres (size_y ignored for square/disk) */
+    float spread;            /**< area spread in radians, (0, pi] */
+    uint32_t reserved;       /**< must be 0 */
+} vsgl_light;
+
+/* ------------------------------------------------------------------------ */
+/* Camera                                                                     */
+/* ------------------------------------------------------------------------ */
+
+#define VSGL_CAMERA_PERSPECTIVE  0
+#define VSGL_CAMERA_ORTHOGRAPHIC 1
+
+#define VSGL_SENSOR_FIT_AUTO       0
+#define VSGL_SENSOR_FIT_HORIZONTAL 1
+#define VSGL_SENSOR_FIT_VERTICAL   2
+
+/**
+ * Blender camera. @p width/@p height are the final pixel counts (after
+ * resolution percentage). Shift is in units of the larger image side, as
+ * in Blender. Pixel aspect is Blender's (x, y).
+ */
+typedef struct vsgl_camera {
+    int32_t type;            /**< VSGL_CAMERA_* */
+    int32_t sensor_fit;      /**< VSGL_SENSOR_FIT_* */
+    float world_from_camera[12];
+    float lens_mm;           /**< focal length (perspective) */
+    float sensor_width_mm;
+    float sensor_height_mm;
+    float ortho_scale;       /**< orthographic view size in metres */
+    float shift_x, shift_y;
+    float clip_start, clip_end;
+    uint32_t width, height;  /**< pixels */
+    float pixel_aspect_x, pixel_aspect_y;
+} vsgl_camera;
+
+/* ------------------------------------------------------------------------ */
+/* Scene description and handle                                               */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * Everything the library reads, as caller-owned arrays; only read during
+ * ::vsgl_scene_create (copied). Instances arrive flattened by the caller.
+ */
+typedef struct vsgl_scene_desc {
+    uint32_t size;                 /**< sizeof(vsgl_scene_desc) or 0 */
+    uint32_t vertex_count;
+    const float *positions;        /**< vertex_count * 3, world space, metres */
+    uint32_t triangle_count;
+    const uint32_t *indices;       /**< triangle_count * 3 vertex indices */
+    const float *corner_normals;   /**< triangle_count * 9 (split normals); NULL = face normals */
+    const float *corner_uvs;       /**< triangle_count * 6; NULL = none */
+    const float *corner_tangents;  /**< triangle_count * 12 (xyz + bitangent sign); NULL = derived */
+    const uint32_t *material_indices; /**< triangle_count; NULL = all 0 */
+    uint32_t material_count;       /**< >= 1 if triangle_count > 0 */
+    const vsgl_material *materials;
+    uint32_t light_count;
+    const vsgl_light *lights;
+    const vsgl_camera *camera;     /**< required */
+} vsgl_scene_desc;
+
+/** Opaque validated scene with its acceleration structure. Immutable; may be shared by threads. */
+typedef struct vsgl_scene vsgl_scene;
+
+/**
+ * @brief Validate @p desc and build a scene.
+ *
+ * Every array, count and index is checked: NaN/Inf, out-of-range indices,
+ * degenerate triangles (reported as warnings and dropped), zero-length
+ * normals, non-finite or singular matrices, non-positive sizes, unknown
+ * enums. The first error is returned with a message naming the element,
+ * e.g. "light 3: spot size is 0" (see ::vsgl_context_last_error).
+ *
+ * @param[out] out receives the scene, NULL on failure.
+ * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT, ::VSGL_ERROR_OUT_OF_MEMORY,
+ *         ::VSGL_ERROR_INTERNAL (the ray-tracing kernel failed).
+ */
+VSGL_API vsgl_result vsgl_scene_create(vsgl_context *ctx, const vsgl_scene_desc *desc,
+                                       vsgl_scene **out);
+
+/** @brief Release a scene. NULL is allowed. */
+VSGL_API void vsgl_scene_destroy(vsgl_scene *scene);
+
+/** Counts after validation (degenerate triangles dropped). */
+typedef struct vsgl_scene_info {
+    uint32_t triangle_count;
+    uint32_t dropped_triangles;
+    uint32_t light_count;
+    uint32_t material_count;
+    float bounds_min[3], bounds_max[3];
+} vsgl_scene_info;
+
+/** @brief Fill @p info. Both pointers must be non-NULL. */
+VSGL_API vsgl_result vsgl_scene_get_info(const vsgl_scene *scene, vsgl_scene_info *info);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* VSGL_SCENE_H */

@@ -1,0 +1,85 @@
+/* Result codes, version, context lifetime and the deterministic parallel-for. */
+#include "harness.h"
+#include "vsgl.h"
+#include "core/context.h"
+#include "core/parallel.h"
+
+#include <string.h>
+
+VT_TEST(core_result_strings_cover_every_code)
+{
+    for (int c = 0; c < VSGL_RESULT_COUNT; ++c) {
+        const char *s = vsgl_result_string(c);
+        VT_CHECK(s && *s && strcmp(s, "unknown result code") != 0, "code %d", c);
+    }
+    VT_CHECK(strcmp(vsgl_result_string(-1), "unknown result code") == 0, "code -1");
+    VT_CHECK(strcmp(vsgl_result_string(VSGL_RESULT_COUNT), "unknown result code") == 0, "past end");
+}
+
+VT_TEST(core_version_matches_header)
+{
+    VT_CHECK(vsgl_version() == VSGL_VERSION, "runtime %d header %d", vsgl_version(), VSGL_VERSION);
+    char want[32];
+    snprintf(want, sizeof want, "%d.%d.%d", VSGL_VERSION_MAJOR, VSGL_VERSION_MINOR, VSGL_VERSION_PATCH);
+    VT_CHECK(strcmp(vsgl_version_string(), want) == 0, "%s vs %s", vsgl_version_string(), want);
+}
+
+VT_TEST(core_context_create_and_errors)
+{
+    vsgl_context *ctx = NULL;
+    VT_CHECK(vsgl_context_create(NULL, NULL) == VSGL_ERROR_INVALID_ARGUMENT, "NULL out");
+    vsgl_context_desc big;
+    memset(&big, 0, sizeof big);
+    big.size = sizeof big + 64;
+    VT_CHECK(vsgl_context_create(&big, &ctx) == VSGL_ERROR_INVALID_ARGUMENT && ctx == NULL, "desc from the future");
+    VT_CHECK(vsgl_context_create(NULL, &ctx) == VSGL_OK && ctx, "defaults");
+    VT_CHECK(vsgl_context_thread_count(ctx) >= 1, "threads");
+    VT_CHECK(strcmp(vsgl_context_last_error(ctx), "") == 0, "fresh context has no error");
+    VT_CHECK(vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "light %d: spot size is 0", 3) == VSGL_ERROR_INVALID_ARGUMENT, "code passes through");
+    VT_CHECK(strcmp(vsgl_context_last_error(ctx), "light 3: spot size is 0") == 0, "got '%s'", vsgl_context_last_error(ctx));
+    vsgl_context_destroy(ctx);
+    vsgl_context_destroy(NULL);
+}
+
+typedef struct sum_job { const double *v; double *partial; } sum_job;
+static int32_t sum_chunk(void *user, size_t chunk, size_t b, size_t e)
+{
+    sum_job *j = user;
+    double s = 0;
+    for (size_t i = b; i < e; ++i)
+        s += j->v[i];
+    j->partial[chunk] = s;
+    return 0;
+}
+
+VT_TEST(core_parallel_for_is_bit_identical_for_any_thread_count)
+{
+    enum { N = 100003, CH = 997 };
+    static double v[N], partial[N / CH + 1];
+    vt_rng r = {42};
+    for (int i = 0; i < N; ++i)
+        v[i] = vt_uniform(&r) * 1e6 - 5e5;
+    double first = 0;
+    for (uint32_t t = 1; t <= 8; ++t) {
+        sum_job j = {v, partial};
+        VT_CHECK(vsgl__parallel_for(t, N, CH, sum_chunk, &j) == 0, "threads %u", t);
+        double s = 0;
+        for (size_t c = 0; c < vsgl__chunk_count(N, CH); ++c)
+            s += partial[c];
+        if (t == 1)
+            first = s;
+        VT_CHECK(memcmp(&s, &first, sizeof s) == 0, "threads %u: %.17g vs %.17g", t, s, first);
+    }
+}
+
+static int32_t fail_some(void *user, size_t chunk, size_t b, size_t e)
+{
+    (void)user; (void)b; (void)e;
+    return chunk == 5 ? 7 : (chunk == 9 ? 3 : 0);
+}
+
+VT_TEST(core_parallel_for_reports_lowest_failing_chunk)
+{
+    for (uint32_t t = 1; t <= 4; ++t)
+        VT_CHECK(vsgl__parallel_for(t, 100, 7, fail_some, NULL) == 7, "threads %u", t);
+}

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Run every test suite that exists and end with one line "N passed, N failed".
+# Exit non-zero if any suite failed or reported a failure.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+PYTHON=${PYTHON:-/usr/bin/python3}
+total_pass=0; total_fail=0; status=0
+log=$(mktemp -d)
+
+count() {  # count <name> <logfile> <exit code>: add the suite's counts
+  local name=$1 file=$2 rc=$3 p f
+  p=$(grep -Eo '([0-9]+) passed' "$file" | tail -1 | grep -Eo '[0-9]+' || echo 0)
+  f=$(grep -Eo '([0-9]+) (failed|error|errors)' "$file" | tail -1 | grep -Eo '[0-9]+' || echo 0)
+  [ -z "$p" ] && p=0; [ -z "$f" ] && f=0
+  if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi   # crashed or collected nothing
+  echo "== $name: $p passed, $f failed (exit $rc)"
+  total_pass=$((total_pass + p)); total_fail=$((total_fail + f))
+  [ "$rc" -ne 0 ] && status=1
+  return 0
+}
+
+echo "== C unit tests"
+build/tests/vsgl_tests 2>&1 | tee "$log/c.txt"; count "C unit tests" "$log/c.txt" "${PIPESTATUS[0]}"
+
+if [ -d tests/python ] && ls tests/python/test_*.py >/dev/null 2>&1; then
+  echo "== Python binding tests ($PYTHON)"
+  "$PYTHON" -m pytest -q -p no:cacheprovider tests/python 2>&1 | tee "$log/py.txt"
+  count "Python tests" "$log/py.txt" "${PIPESTATUS[0]}"
+fi
+
+for runner in tests/blender/run_*.sh; do
+  [ -x "$runner" ] || continue
+  echo "== $runner"
+  "$runner" 2>&1 | tee "$log/bl.txt"; count "$runner" "$log/bl.txt" "${PIPESTATUS[0]}"
+done
+
+rm -rf "$log"
+echo "$total_pass passed, $total_fail failed"
+exit $status
