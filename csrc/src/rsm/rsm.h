@@ -1,0 +1,31 @@
+/* Internal: reflective shadow maps, one per light; texel = virtual point light.
+ * Owner: csrc/src/rsm. Consumed by the VSGL fit and the brute-force gather. */
+#ifndef VSGL_RSM_H
+#define VSGL_RSM_H
+
+#include "scene/scene_internal.h"
+
+#define VSGL_RSM_EMPTY 0xFFFFFFFFu
+
+/* Structure of arrays; texel index = (face * res + row) * res + col.
+ * faces = 6 for point lights (cube map), 1 otherwise. Each texel's flux is
+ * the RGB power (W) arriving on the surface patch it sees, with the
+ * solid-angle/area Jacobian folded in, so that the sum over a closed box
+ * equals the light's emitted power as Cycles defines it. */
+typedef struct vsgl_rsm {
+    uint32_t light;                /* scene light index */
+    uint32_t faces, res;
+    size_t count;                  /* faces * res * res */
+    float *pos[3];                 /* VPL position, world */
+    float *nrm[3];                 /* shading normal at the VPL, facing the light */
+    float *wi[3];                  /* unit direction from the VPL towards the light */
+    float *flux[3];                /* incident power on the texel's patch, W (RGB) */
+    uint32_t *material;            /* VSGL_RSM_EMPTY where the texel saw nothing */
+    double total_flux[3];          /* sum of flux */
+} vsgl_rsm;
+
+/* Build the RSM of light `light` at `res` texels per side. */
+vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res, vsgl_rsm *out);
+void vsgl__rsm_free(vsgl_rsm *r);
+
+#endif

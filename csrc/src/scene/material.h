@@ -1,0 +1,30 @@
+/* Internal: Principled subset -> BRDF parameters, and the exact BRDF used by
+ * the brute-force gather and as the reference for the SG/ASG lobes.
+ * Owner: csrc/src/scene (material.c). */
+#ifndef VSGL_SCENE_MATERIAL_H
+#define VSGL_SCENE_MATERIAL_H
+
+#include "vsgl/scene.h"
+#include "math/vec.h"
+
+typedef struct vsgl_brdf_params {
+    float diffuse[3];   /* Lambert albedo (DiffCol): base_color * (1 - metallic) */
+    float f0[3];        /* specular reflectance at normal incidence (mix of specular_f0 and base_color by metallic) */
+    float alpha_x, alpha_y; /* GGX alphas (Cycles' anisotropy mapping), >= VSGL_ALPHA_MIN */
+    int glossy;         /* 0 if the specular lobe contributes nothing */
+} vsgl_brdf_params;
+
+void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out);
+
+/* Exact reflectance times cosine, split into diffuse and glossy RGB parts:
+ * f(wi, wo) * max(wi.n, 0), with tangent t for anisotropy. wi, wo unit,
+ * pointing away from the surface. Glossy is GGX with Smith G2 and Schlick
+ * Fresnel (documented in docs/math.md). */
+void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
+                     float diffuse_out[3], float glossy_out[3]);
+
+/* GlossCol of Cycles for this material seen from wo (the split-sum albedo
+ * the GlossInd pass is divided by), approximated. */
+void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3]);
+
+#endif

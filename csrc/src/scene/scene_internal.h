@@ -1,0 +1,42 @@
+/* Internal: the validated scene and the ray queries every stage uses.
+ * Owner: the scene stage (csrc/src/scene). Other stages use only what is
+ * declared here. */
+#ifndef VSGL_SCENE_INTERNAL_H
+#define VSGL_SCENE_INTERNAL_H
+
+#include "vsgl/scene.h"
+#include "math/vec.h"
+
+/* A ray hit: distance along the (unit) ray direction and the triangle. */
+typedef struct vsgl_hit {
+    float t;
+    uint32_t triangle;   /* index into the validated (compacted) triangle list */
+    float u, v;          /* barycentrics of corners 1 and 2 */
+} vsgl_hit;
+
+/* Everything shading needs about a surface point. */
+typedef struct vsgl_surface {
+    v3 position;         /* world, metres */
+    v3 normal;           /* interpolated shading normal, flipped to face the ray origin side */
+    v3 geometric_normal; /* unit face normal, same side as `normal` */
+    v3 tangent;          /* unit, orthogonal to normal, anisotropic rotation applied */
+    uint32_t material;   /* index into the scene's materials */
+} vsgl_surface;
+
+/* Closest hit along org + t*dir for t in (tmin, tmax); dir unit. Returns 1 on hit. Thread-safe. */
+int vsgl__scene_intersect(const vsgl_scene *scene, v3 org, v3 dir, float tmin, float tmax, vsgl_hit *hit);
+
+/* 1 if anything blocks the open segment (tmin, tmax) along dir. Thread-safe. */
+int vsgl__scene_occluded(const vsgl_scene *scene, v3 org, v3 dir, float tmin, float tmax);
+
+/* Surface attributes at a hit seen along ray direction dir. */
+void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, vsgl_surface *out);
+
+/* Validated copies (never NULL when the count is > 0). */
+const vsgl_material *vsgl__scene_materials(const vsgl_scene *scene, uint32_t *count);
+const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count);
+const vsgl_camera *vsgl__scene_camera(const vsgl_scene *scene);
+/* Bounding box of the valid triangles. */
+void vsgl__scene_bounds(const vsgl_scene *scene, v3 *lo, v3 *hi);
+
+#endif
