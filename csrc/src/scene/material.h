@@ -12,19 +12,26 @@ typedef struct vsgl_brdf_params {
     float f0[3];        /* specular reflectance at normal incidence (mix of specular_f0 and base_color by metallic) */
     float alpha_x, alpha_y; /* GGX alphas (Cycles' anisotropy mapping), >= VSGL_ALPHA_MIN */
     int glossy;         /* 0 if the specular lobe contributes nothing */
+    float eta;          /* IOR shaping the Fresnel curve between f0 and 1 (Cycles 3.x: from the
+                         * dielectric F0, also for metals); 1 = constant f0 */
 } vsgl_brdf_params;
 
 void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out);
 
 /* Exact reflectance times cosine, split into diffuse and glossy RGB parts:
  * f(wi, wo) * max(wi.n, 0), with tangent t for anisotropy. wi, wo unit,
- * pointing away from the surface. Glossy is GGX with Smith G2 and Schlick
- * Fresnel (documented in docs/math.md). */
+ * pointing away from the surface; both parts are 0 unless wi.n > 0 and
+ * wo.n > 0. Glossy is GGX with separable Smith G1(i) G1(o) and Blender 3.x's
+ * Principled Fresnel (cspec0 blended to white by the normalised dielectric
+ * Fresnel); choices and differences to Cycles in docs/units.md. */
 void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
                      float diffuse_out[3], float glossy_out[3]);
 
-/* GlossCol of Cycles for this material seen from wo (the split-sum albedo
- * the GlossInd pass is divided by), approximated. */
+/* GlossCol of Cycles for this material seen from wo: what the GlossInd pass
+ * is divided by. Blender 3.x writes the specular closure's weight, i.e.
+ * white (1,1,1) whenever the Principled BSDF has a specular lobe (measured:
+ * metallic 0.3 or 1, any base colour -> GlossCol = 1) and 0 otherwise; the
+ * Fresnel colour stays inside GlossInd. (4.x writes an albedo estimate.) */
 void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3]);
 
 #endif

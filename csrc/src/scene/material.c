@@ -1,0 +1,125 @@
+/* Principled subset -> BRDF parameters and the exact BRDF (Lambert + GGX).
+ *
+ * What Cycles does and what we chose (docs/units.md, "Materials"):
+ * - Alphas: alpha = roughness^2; anisotropy a gives aspect = sqrt(1 - 0.9 a),
+ *   alpha_x = alpha / aspect, alpha_y = alpha * aspect (Blender 3.x and 4.x
+ *   use the same mapping; both clamp alpha to <= 1).
+ * - Fresnel: Blender 3.x's Principled specular closure
+ *   (MICROFACET_GGX_FRESNEL): F = cspec0 (1 - FH) + FH with
+ *   FH = (F_dielectric(h.i, eta) - F0) / (1 - F0), eta = (1 + sqrt(F0)) /
+ *   (1 - sqrt(F0)) from the dielectric F0, cspec0 = lerp(F0, base_color,
+ *   metallic). Specular tint is not modelled (taken as 0).
+ * - Shadowing: separable Smith G1(i) G1(o) for GGX (Cycles 3.x). Cycles 4.x
+ *   uses the height-correlated form 1/(1 + L(i) + L(o)); the two agree at
+ *   normal view and differ in directional albedo by < 0.1 % at alpha 0.09,
+ *   1 % at alpha 0.25, 16 % at alpha 1 (view cosine 0.3).
+ * - Diffuse: Lambert, base_color (1 - metallic), not attenuated by the
+ *   specular layer (3.x). Blender 3.x's Principled diffuse is Burley's
+ *   (retro-reflection, grazing darkening), 4.x's is Lambert attenuated by
+ *   the specular albedo; a Diffuse BSDF with roughness 0 is Lambert.
+ * - Single-scatter GGX only ("GGX" distribution). Multiscatter GGX adds the
+ *   energy single scattering loses (up to ~25 % at roughness 1).
+ */
+#include "material.h"
+
+#include "vsgl/lobes.h"
+
+#define VSGL_PI_F 3.14159265358979323846f
+
+static float saturate(float x) { return x != x ? 0.0f : clampf(x, 0.0f, 1.0f); }
+
+void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out)
+{
+    float metallic = saturate(m->metallic);
+    float rough = saturate(m->roughness);
+    float aniso = saturate(m->anisotropy);
+    float f0 = saturate(m->specular_f0);
+    float a = rough * rough;
+    float aspect = sqrtf(1.0f - 0.9f * aniso);
+    out->alpha_x = clampf(a / aspect, VSGL_ALPHA_MIN, 1.0f);
+    out->alpha_y = clampf(a * aspect, VSGL_ALPHA_MIN, 1.0f);
+    for (int c = 0; c < 3; ++c) {
+        float base = saturate(m->base_color[c]);
+        out->diffuse[c] = base * (1.0f - metallic);
+        out->f0[c] = f0 * (1.0f - metallic) + base * metallic;
+    }
+    /* Cycles 3.x allocates the specular closure when Specular or Metallic
+     * is above its cutoff (1e-5). */
+    out->glossy = (f0 > 0.08f * 1e-5f || metallic > 1e-5f) ? 1 : 0;
+    float s0 = sqrtf(fminf(f0, 0.99f));
+    out->eta = (1.0f + s0) / (1.0f - s0);
+}
+
+/* Unpolarised Fresnel reflectance of a dielectric interface (Cycles'
+ * fresnel_dielectric_cos); 1 under total internal reflection. */
+static float fresnel_dielectric(float cosi, float eta)
+{
+    float c = fabsf(cosi);
+    float g = eta * eta - 1.0f + c * c;
+    if (g <= 0.0f)
+        return 1.0f;
+    g = sqrtf(g);
+    float A = (g - c) / (g + c);
+    float B = (c * (g + c) - 1.0f) / (c * (g - c) + 1.0f);
+    return 0.5f * A * A * (1.0f + B * B);
+}
+
+/* GGX Smith G1 for direction (x, y, z) in the tangent frame, z > 0. */
+static float ggx_g1(float ax, float ay, float x, float y, float z)
+{
+    float a2t2 = (ax * ax * x * x + ay * ay * y * y) / (z * z);
+    return 2.0f / (1.0f + sqrtf(1.0f + a2t2));
+}
+
+void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
+                     float diffuse_out[3], float glossy_out[3])
+{
+    float ci = v3_dot(wi, n), co = v3_dot(wo, n);
+    for (int c = 0; c < 3; ++c)
+        diffuse_out[c] = glossy_out[c] = 0.0f;
+    if (!(ci > 0.0f && co > 0.0f))
+        return;
+    float kd = ci * (1.0f / VSGL_PI_F);
+    for (int c = 0; c < 3; ++c)
+        diffuse_out[c] = p->diffuse[c] * kd;
+    if (!p->glossy)
+        return;
+    /* tangent frame; an unusable tangent falls back to an arbitrary one
+     * (only matters for anisotropic materials) */
+    v3 tx = v3_normalize(v3_sub(t, v3_scale(n, v3_dot(t, n))));
+    v3 ty;
+    if (tx.x == 0.0f && tx.y == 0.0f && tx.z == 0.0f)
+        v3_basis(n, &tx, &ty);
+    else
+        ty = v3_cross(n, tx);
+    v3 h = v3_normalize(v3_add(wi, wo));
+    float hx = v3_dot(h, tx), hy = v3_dot(h, ty), hz = v3_dot(h, n);
+    if (!(hz > 0.0f))
+        return;
+    float ax = p->alpha_x, ay = p->alpha_y;
+    float sx = hx / ax, sy = hy / ay;
+    float q = sx * sx + sy * sy + hz * hz;
+    float D = 1.0f / (VSGL_PI_F * ax * ay * q * q);
+    float G = ggx_g1(ax, ay, v3_dot(wi, tx), v3_dot(wi, ty), ci) *
+              ggx_g1(ax, ay, v3_dot(wo, tx), v3_dot(wo, ty), co);
+    /* f cos(i) = F D G / (4 cos(o)) */
+    float common = D * G / (4.0f * co);
+    if (!(common < INFINITY))
+        common = 3.0e38f;
+    float FH = 0.0f;
+    if (p->eta > 1.0f) {
+        float F0 = fresnel_dielectric(1.0f, p->eta);
+        FH = (fresnel_dielectric(v3_dot(wi, h), p->eta) - F0) / (1.0f - F0);
+        FH = clampf(FH, 0.0f, 1.0f);
+    }
+    for (int c = 0; c < 3; ++c)
+        glossy_out[c] = (p->f0[c] * (1.0f - FH) + FH) * common;
+}
+
+void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3])
+{
+    (void)n;
+    (void)wo;
+    float g = p->glossy ? 1.0f : 0.0f;
+    out[0] = out[1] = out[2] = g;
+}
