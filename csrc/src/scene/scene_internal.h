@@ -29,6 +29,16 @@ int vsgl__scene_intersect(const vsgl_scene *scene, v3 org, v3 dir, float tmin, f
 /* 1 if anything blocks the open segment (tmin, tmax) along dir. Thread-safe. */
 int vsgl__scene_occluded(const vsgl_scene *scene, v3 org, v3 dir, float tmin, float tmax);
 
+/* Batch of n closest-hit queries (Embree ray streams; faster for many rays).
+ * Rays with tmin > tmax, or misses, give hits[i].triangle = VSGL_HIT_NONE
+ * and t = +inf. coherent = 1 for camera-like bundles. Thread-safe. */
+#define VSGL_HIT_NONE 0xFFFFFFFFu
+void vsgl__scene_intersect_many(const vsgl_scene *scene, uint32_t n, const v3 *org, const v3 *dir,
+                                const float *tmin, const float *tmax, int coherent, vsgl_hit *hits);
+
+/* Index in the caller's triangle array of validated triangle `triangle`. */
+uint32_t vsgl__scene_source_triangle(const vsgl_scene *scene, uint32_t triangle);
+
 /* Surface attributes at a hit seen along ray direction dir. */
 void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, vsgl_surface *out);
 

@@ -1,0 +1,170 @@
+/* Ray queries on a built scene (Embree 3) and surface attributes at hits. */
+#include "scene/scene_data.h"
+
+#include <math.h>
+#include <string.h>
+
+#define VSGL_TWO_PI_F 6.28318530717958647692f
+
+static void fill_ray(struct RTCRay *r, v3 org, v3 dir, float tmin, float tmax)
+{
+    r->org_x = org.x;
+    r->org_y = org.y;
+    r->org_z = org.z;
+    r->tnear = tmin;
+    r->dir_x = dir.x;
+    r->dir_y = dir.y;
+    r->dir_z = dir.z;
+    r->time = 0.0f;
+    r->tfar = tmax;
+    r->mask = 0xFFFFFFFFu;
+    r->id = 0;
+    r->flags = 0;
+}
+
+int vsgl__scene_intersect(const vsgl_scene *scene, v3 org, v3 dir, float tmin, float tmax, vsgl_hit *hit)
+{
+    if (scene->triangle_count == 0 || !(tmin <= tmax))
+        return 0;
+    struct RTCIntersectContext ic;
+    rtcInitIntersectContext(&ic);
+    struct RTCRayHit rh;
+    fill_ray(&rh.ray, org, dir, tmin, tmax);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene->rtc, &ic, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return 0;
+    hit->t = rh.ray.tfar;
+    hit->triangle = rh.hit.primID;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    return 1;
+}
+
+int vsgl__scene_occluded(const vsgl_scene *scene, v3 org, v3 dir, float tmin, float tmax)
+{
+    if (scene->triangle_count == 0 || !(tmin <= tmax))
+        return 0;
+    struct RTCIntersectContext ic;
+    rtcInitIntersectContext(&ic);
+    struct RTCRay r;
+    fill_ray(&r, org, dir, tmin, tmax);
+    rtcOccluded1(scene->rtc, &ic, &r);
+    return r.tfar == -INFINITY;
+}
+
+void vsgl__scene_intersect_many(const vsgl_scene *scene, uint32_t n, const v3 *org, const v3 *dir,
+                                const float *tmin, const float *tmax, int coherent, vsgl_hit *hits)
+{
+    enum { BATCH = 64 };
+    struct RTCRayHit rh[BATCH];
+    struct RTCIntersectContext ic;
+    rtcInitIntersectContext(&ic);
+    ic.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    for (uint32_t b = 0; b < n; b += BATCH) {
+        uint32_t m = n - b < BATCH ? n - b : BATCH;
+        for (uint32_t i = 0; i < m; ++i) {
+            float lo = tmin[b + i], hi = tmax[b + i];
+            if (!(lo <= hi) || scene->triangle_count == 0) { /* an empty interval never hits */
+                lo = 0.0f;
+                hi = -INFINITY;
+            }
+            fill_ray(&rh[i].ray, org[b + i], dir[b + i], lo, hi < lo ? lo : hi);
+            if (hi < lo)
+                rh[i].ray.tfar = -INFINITY;
+            rh[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        }
+        if (scene->triangle_count > 0)
+            rtcIntersect1M(scene->rtc, &ic, rh, m, sizeof(struct RTCRayHit));
+        for (uint32_t i = 0; i < m; ++i) {
+            vsgl_hit *h = &hits[b + i];
+            if (rh[i].hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+                h->t = INFINITY;
+                h->triangle = VSGL_HIT_NONE;
+                h->u = h->v = 0.0f;
+            } else {
+                h->t = rh[i].ray.tfar;
+                h->triangle = rh[i].hit.primID;
+                h->u = rh[i].hit.u;
+                h->v = rh[i].hit.v;
+            }
+        }
+    }
+}
+
+static v3 load3(const float *p) { return v3_make(p[0], p[1], p[2]); }
+
+static v3 interp(v3 a, v3 b, v3 c, float w, float u, float v)
+{
+    return v3_add(v3_add(v3_scale(a, w), v3_scale(b, u)), v3_scale(c, v));
+}
+
+/* Component of t orthogonal to unit n, normalised; zero if degenerate. */
+static v3 orthogonalize(v3 t, v3 n)
+{
+    return v3_normalize(v3_sub(t, v3_scale(n, v3_dot(n, t))));
+}
+
+void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, vsgl_surface *out)
+{
+    uint32_t tri = hit->triangle;
+    const uint32_t *ix = scene->indices + (size_t)tri * 3;
+    float u = hit->u, v = hit->v, w = 1.0f - u - v;
+    v3 p0 = load3(scene->positions + (size_t)ix[0] * 3);
+    v3 p1 = load3(scene->positions + (size_t)ix[1] * 3);
+    v3 p2 = load3(scene->positions + (size_t)ix[2] * 3);
+    out->position = interp(p0, p1, p2, w, u, v);
+
+    v3 ng = load3(scene->face_normals + (size_t)tri * 3);
+    const float *cn = scene->corner_normals + (size_t)tri * 9;
+    v3 n = v3_normalize(interp(load3(cn), load3(cn + 3), load3(cn + 6), w, u, v));
+    if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f)
+        n = ng; /* opposite corner normals cancelled: fall back to the face */
+    /* back-facing: flip both to the side the ray came from (as Cycles does) */
+    if (v3_dot(ng, dir) > 0.0f) {
+        ng = v3_neg(ng);
+        n = v3_neg(n);
+    }
+    out->normal = n;
+    out->geometric_normal = ng;
+
+    v3 t = v3_make(0.0f, 0.0f, 0.0f);
+    if (scene->corner_tangents) {
+        const float *ct = scene->corner_tangents + (size_t)tri * 12;
+        t = orthogonalize(interp(load3(ct), load3(ct + 4), load3(ct + 8), w, u, v), n);
+    }
+    if (t.x == 0.0f && t.y == 0.0f && t.z == 0.0f && scene->corner_uvs) {
+        /* dP/du from the triangle's UV parametrisation */
+        const float *uv = scene->corner_uvs + (size_t)tri * 6;
+        float du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1];
+        float du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
+        float det = du1 * dv2 - du2 * dv1;
+        if (det != 0.0f && isfinite(1.0f / det)) {
+            v3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
+            v3 dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), 1.0f / det);
+            t = orthogonalize(dpdu, n);
+        }
+    }
+    if (t.x == 0.0f && t.y == 0.0f && t.z == 0.0f)
+        t = orthogonalize(v3_sub(p1, p0), n);
+    if (t.x == 0.0f && t.y == 0.0f && t.z == 0.0f) {
+        v3 b;
+        v3_basis(n, &t, &b);
+    }
+    uint32_t mat = scene->tri_material[tri];
+    float rot = scene->materials[mat].anisotropic_rotation;
+    if (rot != 0.0f) {
+        /* rotate about n by 2 pi rot, counter-clockwise (Rodrigues, t orthogonal to n) */
+        float a = VSGL_TWO_PI_F * rot;
+        t = v3_normalize(v3_add(v3_scale(t, cosf(a)), v3_scale(v3_cross(n, t), sinf(a))));
+    }
+    out->tangent = t;
+    out->material = mat;
+}
+
+uint32_t vsgl__scene_source_triangle(const vsgl_scene *scene, uint32_t triangle)
+{
+    return scene->source_triangle[triangle];
+}

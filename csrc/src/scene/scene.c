@@ -1,0 +1,283 @@
+/* vsgl_scene: validate, copy, drop degenerate triangles, build the Embree
+ * BVH (one RTCDevice per scene, no global state). */
+#include "scene/scene_data.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* At most this many "dropped" warnings are logged individually. */
+#define VSGL_MAX_DROP_WARNINGS 10
+/* Embree worker threads are capped: BVH builds gain little past this here. */
+#define VSGL_EMBREE_MAX_THREADS 64
+
+static void embree_error(void *user, enum RTCError code, const char *str)
+{
+    vsgl_scene *s = user;
+    if (s->embree_message[0] == '\0')
+        snprintf(s->embree_message, sizeof s->embree_message, "Embree error %d: %s", (int)code,
+                 str ? str : "(no message)");
+}
+
+static vsgl_result embree_check(vsgl_context *ctx, vsgl_scene *s, const char *what)
+{
+    enum RTCError e = rtcGetDeviceError(s->device);
+    if (e == RTC_ERROR_NONE && s->embree_message[0] == '\0')
+        return VSGL_OK;
+    if (e == RTC_ERROR_OUT_OF_MEMORY)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: %s: Embree ran out of memory", what);
+    return vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "scene: %s failed: %s (code %d)", what,
+                      s->embree_message[0] ? s->embree_message : "no message", (int)e);
+}
+
+void vsgl_scene_destroy(vsgl_scene *s)
+{
+    if (!s)
+        return;
+    if (s->rtc)
+        rtcReleaseScene(s->rtc);
+    if (s->device)
+        rtcReleaseDevice(s->device);
+    free(s->corner_normals);
+    free(s->corner_uvs);
+    free(s->corner_tangents);
+    free(s->face_normals);
+    free(s->tri_material);
+    free(s->source_triangle);
+    free(s->materials);
+    free(s->lights);
+    free(s);
+}
+
+/* Unit face normal in double; returns 0 for a zero-area triangle. */
+static int face_normal(const float *p0, const float *p1, const float *p2, float n[3])
+{
+    double e1[3], e2[3], c[3];
+    for (int k = 0; k < 3; ++k) {
+        e1[k] = (double)p1[k] - p0[k];
+        e2[k] = (double)p2[k] - p0[k];
+    }
+    c[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    c[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    c[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double l = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    if (!(l > 0.0) || !isfinite(l))
+        return 0;
+    for (int k = 0; k < 3; ++k)
+        n[k] = (float)(c[k] / l);
+    /* a normal that underflowed in float is as good as degenerate */
+    return (n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f);
+}
+
+static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene *s)
+{
+    uint32_t tc = d->triangle_count;
+    /* pass 1: which triangles survive */
+    uint32_t kept = 0, dropped = 0;
+    unsigned char *keep = tc ? malloc(tc) : NULL;
+    if (tc && !keep)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u triangles", (unsigned)tc);
+    for (uint32_t t = 0; t < tc; ++t) {
+        const uint32_t *ix = d->indices + (size_t)t * 3;
+        float n[3];
+        keep[t] = (unsigned char)face_normal(d->positions + (size_t)ix[0] * 3, d->positions + (size_t)ix[1] * 3,
+                                             d->positions + (size_t)ix[2] * 3, n);
+        if (keep[t]) {
+            ++kept;
+        } else {
+            if (dropped < VSGL_MAX_DROP_WARNINGS)
+                vsgl__log(ctx, VSGL_LOG_WARNING, "triangle %u: zero area (vertices %u, %u, %u), dropped",
+                          (unsigned)t, (unsigned)ix[0], (unsigned)ix[1], (unsigned)ix[2]);
+            ++dropped;
+        }
+    }
+    if (dropped > VSGL_MAX_DROP_WARNINGS)
+        vsgl__log(ctx, VSGL_LOG_WARNING, "scene: %u zero-area triangles dropped in all", (unsigned)dropped);
+    s->triangle_count = kept;
+    s->dropped_triangles = dropped;
+
+    size_t k = kept;
+    s->corner_normals = malloc((k ? k : 1) * 9 * sizeof(float));
+    s->face_normals = malloc((k ? k : 1) * 3 * sizeof(float));
+    s->tri_material = malloc((k ? k : 1) * sizeof(uint32_t));
+    s->source_triangle = malloc((k ? k : 1) * sizeof(uint32_t));
+    if (d->corner_uvs)
+        s->corner_uvs = malloc((k ? k : 1) * 6 * sizeof(float));
+    if (d->corner_tangents)
+        s->corner_tangents = malloc((k ? k : 1) * 12 * sizeof(float));
+    if (!s->corner_normals || !s->face_normals || !s->tri_material || !s->source_triangle ||
+        (d->corner_uvs && !s->corner_uvs) || (d->corner_tangents && !s->corner_tangents)) {
+        free(keep);
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u triangles", (unsigned)kept);
+    }
+
+    /* Embree device and geometry: its buffers hold the positions and indices */
+    char config[96];
+    uint32_t threads = vsgl_context_thread_count(ctx);
+    if (threads > VSGL_EMBREE_MAX_THREADS)
+        threads = VSGL_EMBREE_MAX_THREADS;
+    snprintf(config, sizeof config, "threads=%u,set_affinity=0,verbose=0", (unsigned)threads);
+    s->device = rtcNewDevice(config);
+    if (!s->device) {
+        free(keep);
+        return vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "scene: rtcNewDevice(\"%s\") failed (Embree error %d)", config,
+                          (int)rtcGetDeviceError(NULL));
+    }
+    rtcSetDeviceErrorFunction(s->device, embree_error, s);
+    s->rtc = rtcNewScene(s->device);
+    vsgl_result r = embree_check(ctx, s, "rtcNewScene");
+    if (r != VSGL_OK) {
+        free(keep);
+        return r;
+    }
+    rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_MEDIUM);
+
+    if (kept > 0) {
+        RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        float *vb = g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                3 * sizeof(float), d->vertex_count) : NULL;
+        uint32_t *ib = g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                   3 * sizeof(uint32_t), kept) : NULL;
+        if (!g || !vb || !ib) {
+            if (g)
+                rtcReleaseGeometry(g);
+            free(keep);
+            r = embree_check(ctx, s, "creating the triangle geometry");
+            return r != VSGL_OK ? r : vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "scene: Embree returned no buffer");
+        }
+        memcpy(vb, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
+        s->positions = vb;
+        s->indices = ib;
+        v3 lo = v3_make(INFINITY, INFINITY, INFINITY), hi = v3_make(-INFINITY, -INFINITY, -INFINITY);
+        uint32_t o = 0;
+        for (uint32_t t = 0; t < tc; ++t) {
+            if (!keep[t])
+                continue;
+            const uint32_t *ix = d->indices + (size_t)t * 3;
+            memcpy(ib + (size_t)o * 3, ix, 3 * sizeof(uint32_t));
+            for (int c = 0; c < 3; ++c) {
+                const float *p = d->positions + (size_t)ix[c] * 3;
+                lo = v3_make(fminf(lo.x, p[0]), fminf(lo.y, p[1]), fminf(lo.z, p[2]));
+                hi = v3_make(fmaxf(hi.x, p[0]), fmaxf(hi.y, p[1]), fmaxf(hi.z, p[2]));
+            }
+            float *fn = s->face_normals + (size_t)o * 3;
+            face_normal(d->positions + (size_t)ix[0] * 3, d->positions + (size_t)ix[1] * 3,
+                        d->positions + (size_t)ix[2] * 3, fn);
+            float *cn = s->corner_normals + (size_t)o * 9;
+            for (int c = 0; c < 3; ++c) {
+                v3 n = d->corner_normals
+                           ? v3_make(d->corner_normals[(size_t)t * 9 + c * 3], d->corner_normals[(size_t)t * 9 + c * 3 + 1],
+                                     d->corner_normals[(size_t)t * 9 + c * 3 + 2])
+                           : v3_make(fn[0], fn[1], fn[2]);
+                /* normalise in double: validated lengths may be tiny or large */
+                double l = sqrt((double)n.x * n.x + (double)n.y * n.y + (double)n.z * n.z);
+                cn[c * 3 + 0] = (float)(n.x / l);
+                cn[c * 3 + 1] = (float)(n.y / l);
+                cn[c * 3 + 2] = (float)(n.z / l);
+            }
+            if (s->corner_uvs)
+                memcpy(s->corner_uvs + (size_t)o * 6, d->corner_uvs + (size_t)t * 6, 6 * sizeof(float));
+            if (s->corner_tangents)
+                memcpy(s->corner_tangents + (size_t)o * 12, d->corner_tangents + (size_t)t * 12, 12 * sizeof(float));
+            s->tri_material[o] = d->material_indices ? d->material_indices[t] : 0u;
+            s->source_triangle[o] = t;
+            ++o;
+        }
+        s->lo = lo;
+        s->hi = hi;
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(s->rtc, g);
+        rtcReleaseGeometry(g);
+    }
+    free(keep);
+    s->vertex_count = d->vertex_count;
+    rtcCommitScene(s->rtc);
+    return embree_check(ctx, s, "building the BVH");
+}
+
+vsgl_result vsgl_scene_create(vsgl_context *ctx, const vsgl_scene_desc *desc, vsgl_scene **out)
+{
+    vsgl__clear_error(ctx);
+    if (!out)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: out is NULL");
+    *out = NULL;
+    if (!desc)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: desc is NULL");
+    vsgl_result r = vsgl__validate_scene_desc(ctx, desc);
+    if (r != VSGL_OK)
+        return r;
+    vsgl_scene *s = calloc(1, sizeof *s);
+    if (!s)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory");
+    s->camera = *desc->camera;
+    s->material_count = desc->material_count;
+    s->light_count = desc->light_count;
+    if (desc->material_count) {
+        s->materials = malloc((size_t)desc->material_count * sizeof *s->materials);
+        if (!s->materials) {
+            vsgl_scene_destroy(s);
+            return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u materials", (unsigned)desc->material_count);
+        }
+        memcpy(s->materials, desc->materials, (size_t)desc->material_count * sizeof *s->materials);
+    }
+    if (desc->light_count) {
+        s->lights = malloc((size_t)desc->light_count * sizeof *s->lights);
+        if (!s->lights) {
+            vsgl_scene_destroy(s);
+            return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u lights", (unsigned)desc->light_count);
+        }
+        memcpy(s->lights, desc->lights, (size_t)desc->light_count * sizeof *s->lights);
+    }
+    r = build(ctx, desc, s);
+    if (r != VSGL_OK) {
+        vsgl_scene_destroy(s);
+        return r;
+    }
+    *out = s;
+    return VSGL_OK;
+}
+
+vsgl_result vsgl_scene_get_info(const vsgl_scene *scene, vsgl_scene_info *info)
+{
+    if (!scene || !info)
+        return VSGL_ERROR_INVALID_ARGUMENT;
+    memset(info, 0, sizeof *info);
+    info->triangle_count = scene->triangle_count;
+    info->dropped_triangles = scene->dropped_triangles;
+    info->light_count = scene->light_count;
+    info->material_count = scene->material_count;
+    info->bounds_min[0] = scene->lo.x;
+    info->bounds_min[1] = scene->lo.y;
+    info->bounds_min[2] = scene->lo.z;
+    info->bounds_max[0] = scene->hi.x;
+    info->bounds_max[1] = scene->hi.y;
+    info->bounds_max[2] = scene->hi.z;
+    return VSGL_OK;
+}
+
+const vsgl_material *vsgl__scene_materials(const vsgl_scene *scene, uint32_t *count)
+{
+    if (count)
+        *count = scene->material_count;
+    return scene->materials;
+}
+
+const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count)
+{
+    if (count)
+        *count = scene->light_count;
+    return scene->lights;
+}
+
+const vsgl_camera *vsgl__scene_camera(const vsgl_scene *scene)
+{
+    return &scene->camera;
+}
+
+void vsgl__scene_bounds(const vsgl_scene *scene, v3 *lo, v3 *hi)
+{
+    *lo = scene->lo;
+    *hi = scene->hi;
+}

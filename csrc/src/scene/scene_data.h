@@ -1,0 +1,45 @@
+/* Private to csrc/src/scene: the layout of a validated scene. Other stages
+ * use scene_internal.h only. */
+#ifndef VSGL_SCENE_DATA_H
+#define VSGL_SCENE_DATA_H
+
+#include <embree3/rtcore.h>
+
+#include "scene/scene_internal.h"
+#include "core/context.h"
+
+#define VSGL_SCENE_EMBREE_MESSAGE 256
+
+struct vsgl_scene {
+    RTCDevice device;
+    RTCScene rtc;
+    uint32_t vertex_count;
+    const float *positions;      /* vertex_count * 3, owned by Embree's vertex buffer */
+    uint32_t triangle_count;     /* valid (compacted) triangles */
+    uint32_t dropped_triangles;
+    const uint32_t *indices;     /* triangle_count * 3, owned by Embree's index buffer */
+    float *corner_normals;       /* triangle_count * 9, unit; face normal when the caller gave none */
+    float *corner_uvs;           /* triangle_count * 6 or NULL */
+    float *corner_tangents;      /* triangle_count * 12 or NULL */
+    float *face_normals;         /* triangle_count * 3, unit, (p1-p0)x(p2-p0) */
+    uint32_t *tri_material;      /* triangle_count */
+    uint32_t *source_triangle;   /* triangle_count: index in the caller's array */
+    uint32_t material_count;
+    vsgl_material *materials;
+    uint32_t light_count;
+    vsgl_light *lights;
+    vsgl_camera camera;
+    v3 lo, hi;                   /* bounds of the valid triangles (0,0,0 when empty) */
+    char embree_message[VSGL_SCENE_EMBREE_MESSAGE]; /* first Embree error seen */
+};
+
+/* Validation (validate.c): first error -> vsgl__fail with a message naming the element. */
+vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *d);
+vsgl_result vsgl__validate_camera(vsgl_context *ctx, const vsgl_camera *c);
+vsgl_result vsgl__validate_light(vsgl_context *ctx, uint32_t index, const vsgl_light *l);
+vsgl_result vsgl__validate_material(vsgl_context *ctx, uint32_t index, const vsgl_material *m);
+
+/* Affine 3x4 row-major matrix checks. Returns NULL if fine, else a static reason. */
+const char *vsgl__matrix_problem(const float m[12]);
+
+#endif
