@@ -12,6 +12,7 @@
 #define VSGL_RENDER_H
 
 #include "scene.h"
+#include "sg.h" /* VSGL_COSINE_*, VSGL_SHARPNESS_* */
 
 #ifdef __cplusplus
 extern "C" {

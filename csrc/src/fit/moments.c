@@ -1,0 +1,153 @@
+/* VPL lobes -> moment sums -> VSGL parameters (poster Sec. 2, FIS Sec. 3,
+ * with the errata of GUIDE Sec. 3: the mean direction averages the
+ * *filtered* directions). */
+#include "fit/vsgl_set.h"
+#include "scene/material.h"
+#include "vsgl/lobes.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+vsgl_result vsgl__vsgl_set_push(vsgl_vsgl_set *set, const vsgl_vsgl *v)
+{
+    if (set->count == set->capacity) {
+        size_t cap = set->capacity ? set->capacity * 2 : 64;
+        vsgl_vsgl *p = realloc(set->items, cap * sizeof *p);
+        if (!p)
+            return VSGL_ERROR_OUT_OF_MEMORY;
+        set->items = p;
+        set->capacity = cap;
+    }
+    set->items[set->count++] = *v;
+    return VSGL_OK;
+}
+
+void vsgl__vsgl_set_free(vsgl_vsgl_set *set)
+{
+    free(set->items);
+    memset(set, 0, sizeof *set);
+}
+
+v3 vsgl__rsm_origin(const vsgl_rsm *rsm)
+{
+    for (size_t t = 0; t < rsm->count; ++t)
+        if (rsm->material[t] != VSGL_RSM_EMPTY)
+            return v3_make(rsm->pos[0][t], rsm->pos[1][t], rsm->pos[2][t]);
+    return v3_make(0.0f, 0.0f, 0.0f);
+}
+
+void vsgl__moments_add(vsgl_moments *acc, const vsgl_moments *m, double scale)
+{
+    acc->weight += scale * m->weight;
+    for (int c = 0; c < 3; ++c) {
+        acc->power[c] += scale * m->power[c];
+        acc->dir[c] += scale * m->dir[c];
+        acc->pos[c] += scale * m->pos[c];
+    }
+    acc->pos2 += scale * m->pos2;
+}
+
+static double schlick(double f0, double cos_theta)
+{
+    double m = 1.0 - (cos_theta < 0.0 ? 0.0 : (cos_theta > 1.0 ? 1.0 : cos_theta));
+    double m2 = m * m;
+    return f0 + (1.0 - f0) * m2 * m2 * m;
+}
+
+static void fill(vsgl_moments *m, const double power[3], v3 axis, float mean_length, v3 rel)
+{
+    double w = power[0] + power[1] + power[2];
+    m->weight = w;
+    for (int c = 0; c < 3; ++c)
+        m->power[c] = power[c];
+    m->dir[0] = w * mean_length * axis.x;
+    m->dir[1] = w * mean_length * axis.y;
+    m->dir[2] = w * mean_length * axis.z;
+    m->pos[0] = w * rel.x;
+    m->pos[1] = w * rel.y;
+    m->pos[2] = w * rel.z;
+    m->pos2 = w * ((double)rel.x * rel.x + (double)rel.y * rel.y + (double)rel.z * rel.z);
+}
+
+int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3 origin,
+                      int32_t estimator, vsgl_moments out[2])
+{
+    memset(out, 0, 2 * sizeof *out);
+    uint32_t mat = rsm->material[t];
+    if (mat == VSGL_RSM_EMPTY)
+        return 0;
+    double flux[3] = {rsm->flux[0][t], rsm->flux[1][t], rsm->flux[2][t]};
+    if (!(flux[0] + flux[1] + flux[2] > 0.0))
+        return 0;
+    uint32_t material_count = 0;
+    const vsgl_material *materials = vsgl__scene_materials(scene, &material_count);
+    if (mat >= material_count)
+        return 0;
+    vsgl_brdf_params bp;
+    vsgl__material_params(&materials[mat], &bp);
+
+    v3 p = v3_make(rsm->pos[0][t], rsm->pos[1][t], rsm->pos[2][t]);
+    v3 n = v3_make(rsm->nrm[0][t], rsm->nrm[1][t], rsm->nrm[2][t]);
+    v3 wi = v3_make(rsm->wi[0][t], rsm->wi[1][t], rsm->wi[2][t]);
+    v3 rel = v3_sub(p, origin);
+    int any = 0;
+
+    /* Diffuse lobe: Phi R_d G(w; n, l_d) / A(l_d). */
+    double pd[3];
+    for (int c = 0; c < 3; ++c)
+        pd[c] = flux[c] * bp.diffuse[c];
+    if (pd[0] + pd[1] + pd[2] > 0.0) {
+        float ld = vsgl_sg_cosine_sharpness();
+        fill(&out[VSGL_LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel);
+        any = 1;
+    }
+    /* Specular lobe: Phi R_s G(w; reflect(wi, n), l_h / (4 |wi.n|)) / A(.), with
+     * R_s the Fresnel reflectance at the incident angle. */
+    if (bp.glossy) {
+        float cos_i = v3_dot(wi, n);
+        double ps[3];
+        for (int c = 0; c < 3; ++c)
+            ps[c] = flux[c] * schlick(bp.f0[c], cos_i);
+        if (cos_i > 0.0f && ps[0] + ps[1] + ps[2] > 0.0) {
+            float alpha = sqrtf(bp.alpha_x * bp.alpha_y);
+            vsgl_sg ndf, warped;
+            vsgl_ndf_to_sg(&n, alpha, VSGL_NDF_GGX, &ndf);
+            vsgl_warp_ndf_sg(&ndf, &wi, &warped);
+            fill(&out[VSGL_LOBE_SPECULAR], ps, warped.axis,
+                 vsgl_mean_length_from_sharpness(warped.sharpness, estimator), rel);
+            any = 1;
+        }
+    }
+    return any;
+}
+
+int vsgl__moments_to_vsgl(const vsgl_moments *m, v3 origin, int32_t estimator,
+                          uint32_t light, uint32_t lobe, vsgl_vsgl *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!(m->weight > 0.0) || !(m->power[0] + m->power[1] + m->power[2] > 0.0))
+        return 0;
+    double inv = 1.0 / m->weight;
+    double dx = m->dir[0] * inv, dy = m->dir[1] * inv, dz = m->dir[2] * inv;
+    double r = sqrt(dx * dx + dy * dy + dz * dz);
+    if (r > 1.0)
+        r = 1.0;
+    if (r > 0.0) {
+        out->axis = v3_make((float)(dx / r), (float)(dy / r), (float)(dz / r));
+    } else {
+        out->axis = v3_make(0.0f, 0.0f, 1.0f); /* isotropic: any axis */
+    }
+    out->sharpness = r > 0.0 ? vsgl_sharpness_from_mean_length((float)r, estimator) : 0.0f;
+    double mx = m->pos[0] * inv, my = m->pos[1] * inv, mz = m->pos[2] * inv;
+    out->mean = v3_make((float)(origin.x + mx), (float)(origin.y + my), (float)(origin.z + mz));
+    /* Positions of VPLs lie on surfaces: the spread is 2-D, so the variance
+     * per axis is half the total (GUIDE Sec. 4). Cancellation can make it
+     * slightly negative: clamp. */
+    double var = (m->pos2 * inv - (mx * mx + my * my + mz * mz)) * 0.5;
+    out->variance = var > 0.0 ? (float)var : 0.0f;
+    for (int c = 0; c < 3; ++c)
+        out->power[c] = (float)m->power[c];
+    out->light = light;
+    out->lobe = lobe;
+    return 1;
+}

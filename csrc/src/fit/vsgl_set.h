@@ -1,0 +1,68 @@
+/* Internal: virtual spherical Gaussian lights (VSGLs) and their fit from RSMs.
+ *
+ * A VSGL approximates a cluster of VPLs of one lobe kind (diffuse or
+ * specular) by
+ *   radiant intensity  I(w) = power * G(w; axis, sharpness) / A(sharpness)   [W/sr, RGB]
+ *   position           isotropic Gaussian, mean `mean`, variance `variance` per axis [m^2]
+ * (Tokuyoshi 2015 poster Sec. 2; FIS supplement Sec. 3). */
+#ifndef VSGL_FIT_VSGL_SET_H
+#define VSGL_FIT_VSGL_SET_H
+
+#include "rsm/rsm.h"
+#include "vsgl/render.h"
+
+#define VSGL_LOBE_DIFFUSE  0
+#define VSGL_LOBE_SPECULAR 1
+
+typedef struct vsgl_vsgl {
+    v3 mean;            /* mean VPL position, world */
+    float variance;     /* positional variance per axis of the 2-D spread, m^2 (>= 0) */
+    v3 axis;            /* unit lobe axis of the radiant intensity */
+    float sharpness;    /* lambda_v */
+    float power[3];     /* sum of Phi R over the cluster (RGB, W), after FIS weighting */
+    uint32_t light;     /* scene light index */
+    uint32_t lobe;      /* VSGL_LOBE_* */
+} vsgl_vsgl;
+
+typedef struct vsgl_vsgl_set {
+    vsgl_vsgl *items;
+    size_t count, capacity;
+} vsgl_vsgl_set;
+
+vsgl_result vsgl__vsgl_set_push(vsgl_vsgl_set *set, const vsgl_vsgl *v);
+void vsgl__vsgl_set_free(vsgl_vsgl_set *set);
+
+/* Per-lobe moment sums of a set of VPLs (double precision, positions
+ * relative to `origin` so scenes far from the world origin keep digits). */
+typedef struct vsgl_moments {
+    double weight;      /* sum w_i, w_i = Phi_i R_i summed over RGB */
+    double power[3];    /* sum Phi_i R_i (RGB) */
+    double dir[3];      /* sum w_i * mean_vector_i (filtered directions, GUIDE Sec. 3) */
+    double pos[3];      /* sum w_i (x_i - origin) */
+    double pos2;        /* sum w_i |x_i - origin|^2 */
+} vsgl_moments;
+
+/* One VPL's contribution to the diffuse and specular moments: its lobes'
+ * mean vectors, powers and positions (texel t of rsm). Returns 0 for an
+ * empty or black texel. `estimator` selects the lobe's mean length. */
+int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3 origin,
+                      int32_t estimator, vsgl_moments out[2]);
+
+void vsgl__moments_add(vsgl_moments *acc, const vsgl_moments *m, double scale);
+
+/* Turn moments into a VSGL (returns 0 if the moments carry no power). */
+int vsgl__moments_to_vsgl(const vsgl_moments *m, v3 origin, int32_t estimator,
+                          uint32_t light, uint32_t lobe, vsgl_vsgl *out);
+
+/* Fit the VSGLs of one light's RSM in the settings' mode and append them. */
+vsgl_result vsgl__fit_two(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
+                          const vsgl_render_settings *s, vsgl_vsgl_set *out);
+vsgl_result vsgl__fit_fis(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
+                          const vsgl_render_settings *s, vsgl_vsgl_set *out);
+vsgl_result vsgl__fit_kmeans(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
+                             const vsgl_render_settings *s, vsgl_vsgl_set *out);
+
+/* Reference point for a light's moments (the RSM's first valid texel, or 0). */
+v3 vsgl__rsm_origin(const vsgl_rsm *rsm);
+
+#endif

@@ -1,0 +1,193 @@
+/* vsgl_render: G-buffer -> per-light RSM -> VSGL fit -> shading -> planes.
+ * Lights that contribute nothing are skipped and reported; outputs are
+ * written only when everything succeeded. */
+#include "shade/render_internal.h"
+#include "shade/shade.h"
+#include "core/context.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...) VSGL_PRINTF(3, 4);
+static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...)
+{
+    char line[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    vsgl__log(ctx, VSGL_LOG_INFO, "skipped: %s", line);
+    size_t used = strlen(st->skipped);
+    if (used + strlen(line) + 2 < sizeof st->skipped)
+        snprintf(st->skipped + used, sizeof st->skipped - used, "%s\n", line);
+}
+
+/* Fit the VSGLs of every light, one RSM alive at a time. */
+static vsgl_result fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
+                              vsgl_vsgl_set *set, vsgl_render_stats *st)
+{
+    uint32_t light_count = 0;
+    const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
+    for (uint32_t l = 0; l < light_count; ++l) {
+        const vsgl_light *L = &lights[l];
+        float emitted = L->power * (L->color[0] + L->color[1] + L->color[2]);
+        if (!(emitted > 0.0f)) {
+            note_skip(ctx, st, "light %u: zero power or black colour", l);
+            ++st->lights_skipped;
+            continue;
+        }
+        double t0 = now_seconds();
+        vsgl_rsm rsm;
+        vsgl_result r = vsgl__rsm_build(ctx, scene, l, s->rsm_resolution, &rsm);
+        st->seconds_rsm += now_seconds() - t0;
+        if (r != VSGL_OK)
+            return r;
+        if (!(rsm.total_flux[0] + rsm.total_flux[1] + rsm.total_flux[2] > 0.0)) {
+            note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
+            ++st->lights_skipped;
+            vsgl__rsm_free(&rsm);
+            continue;
+        }
+        t0 = now_seconds();
+        size_t before = set->count;
+        switch (s->fit_mode) {
+        case VSGL_FIT_FIS: r = vsgl__fit_fis(ctx, scene, &rsm, s, set); break;
+        case VSGL_FIT_KMEANS: r = vsgl__fit_kmeans(ctx, scene, &rsm, s, set); break;
+        default: r = vsgl__fit_two(ctx, scene, &rsm, s, set); break;
+        }
+        st->seconds_fit += now_seconds() - t0;
+        vsgl__rsm_free(&rsm);
+        if (r != VSGL_OK)
+            return r;
+        size_t spec = 0;
+        for (size_t k = before; k < set->count; ++k)
+            spec += set->items[k].lobe == VSGL_LOBE_SPECULAR;
+        if (spec == 0)
+            note_skip(ctx, st, "light %u: no glossy surface it lights: specular VSGLs skipped", l);
+        if (set->count == before) {
+            note_skip(ctx, st, "light %u: lit surfaces reflect nothing (black materials)", l);
+            ++st->lights_skipped;
+        } else {
+            ++st->lights_used;
+        }
+        if (vsgl__progress(ctx, "fit", (float)(l + 1) / (float)light_count))
+            return vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "fit: cancelled");
+    }
+    return VSGL_OK;
+}
+
+/* light = contribution / colour, 0 where the colour is 0 (as Cycles). */
+static float divide_or_zero(float num, float den)
+{
+    return den > 1e-8f ? num / den : 0.0f;
+}
+
+static vsgl_result write_outputs(vsgl_context *ctx, const vsgl_pixel_planes *p, size_t pixels,
+                                 vsgl_render_output *out)
+{
+    /* Refuse to hand out a non-finite value: that would be a bug. */
+    for (size_t i = 0; i < pixels * 3; ++i)
+        if (!isfinite(p->diffuse[i]) || !isfinite(p->glossy[i]) || !isfinite(p->diffuse_color[i]) ||
+            !isfinite(p->glossy_color[i]) || p->diffuse[i] < 0.0f || p->glossy[i] < 0.0f)
+            return vsgl__fail(ctx, VSGL_ERROR_INTERNAL,
+                              "render: pixel %zu channel %zu is not finite and non-negative "
+                              "(diffuse %g, glossy %g): please report this scene",
+                              i / 3, i % 3, (double)p->diffuse[i], (double)p->glossy[i]);
+    for (size_t i = 0; i < pixels * 3; ++i) {
+        float dl = divide_or_zero(p->diffuse[i], p->diffuse_color[i]);
+        float gl = divide_or_zero(p->glossy[i], p->glossy_color[i]);
+        if (out->diffuse_light) out->diffuse_light[i] = dl;
+        if (out->glossy_light) out->glossy_light[i] = gl;
+        if (out->diffuse_color) out->diffuse_color[i] = p->diffuse_color[i];
+        if (out->glossy_color) out->glossy_color[i] = p->glossy_color[i];
+        if (out->diffuse) out->diffuse[i] = p->diffuse[i];
+        if (out->glossy) out->glossy[i] = p->glossy[i];
+        if (out->combined) out->combined[i] = p->diffuse[i] + p->glossy[i];
+    }
+    if (out->alpha)
+        memcpy(out->alpha, p->coverage, pixels * sizeof(float));
+    return VSGL_OK;
+}
+
+static vsgl_result check_output(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_output *out)
+{
+    const vsgl_camera *cam = vsgl__scene_camera(scene);
+    if (out->width != cam->width || out->height != cam->height)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT,
+                          "output: planes are %ux%u but the camera renders %ux%u",
+                          out->width, out->height, cam->width, cam->height);
+    if (!out->diffuse_light && !out->glossy_light && !out->diffuse_color && !out->glossy_color &&
+        !out->diffuse && !out->glossy && !out->combined && !out->alpha)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "output: no plane requested (all pointers are NULL)");
+    return VSGL_OK;
+}
+
+vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *settings,
+                        vsgl_render_output *out, vsgl_render_stats *stats)
+{
+    vsgl__clear_error(ctx);
+    if (!ctx || !scene || !out)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "render: %s is NULL",
+                          !ctx ? "context" : (!scene ? "scene" : "output"));
+    vsgl_render_settings s;
+    vsgl_result r = vsgl__settings_resolve(ctx, settings, &s);
+    if (r == VSGL_OK)
+        r = check_output(ctx, scene, out);
+    if (r != VSGL_OK)
+        return r;
+
+    vsgl_render_stats st;
+    memset(&st, 0, sizeof st);
+    double t_start = now_seconds();
+    vsgl_gbuffer g;
+    memset(&g, 0, sizeof g);
+    vsgl_vsgl_set set;
+    memset(&set, 0, sizeof set);
+    size_t pixels = (size_t)out->width * out->height;
+    float *buf = NULL;
+
+    double t0 = now_seconds();
+    r = vsgl__gbuffer_build(ctx, scene, s.aa_samples, &g);
+    st.seconds_gbuffer = now_seconds() - t0;
+    if (r != VSGL_OK)
+        goto done;
+    if (s.method == VSGL_METHOD_BRUTE_FORCE) {
+        r = vsgl__fail(ctx, VSGL_ERROR_UNSUPPORTED, "render: the brute-force method is not wired in yet");
+        goto done;
+    }
+    r = fit_lights(ctx, scene, &s, &set, &st);
+    if (r != VSGL_OK)
+        goto done;
+    st.vsgl_count = (uint32_t)set.count;
+
+    buf = calloc(pixels * 13, sizeof(float));
+    if (!buf) {
+        r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "render: out of memory for %zu pixels", pixels);
+        goto done;
+    }
+    vsgl_pixel_planes planes = {buf, buf + 3 * pixels, buf + 6 * pixels, buf + 9 * pixels, buf + 12 * pixels};
+    t0 = now_seconds();
+    r = vsgl__shade(ctx, scene, &g, &set, &s, &planes, &st.shading_pairs);
+    st.seconds_shade = now_seconds() - t0;
+    if (r == VSGL_OK)
+        r = write_outputs(ctx, &planes, pixels, out);
+done:
+    free(buf);
+    vsgl__vsgl_set_free(&set);
+    vsgl__gbuffer_free(&g);
+    st.seconds_total = now_seconds() - t_start;
+    if (stats)
+        *stats = st;
+    return r;
+}

@@ -1,0 +1,87 @@
+/* Render settings: presets, defaults for zero fields, validation. */
+#include "shade/render_internal.h"
+#include "core/context.h"
+
+#include <string.h>
+
+void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
+{
+    if (!out)
+        return;
+    memset(out, 0, sizeof *out);
+    out->size = sizeof *out;
+    out->method = VSGL_METHOD_VSGL;
+    out->sharpness_estimator = VSGL_SHARPNESS_TOKSVIG;
+    out->glossy_mode = VSGL_GLOSSY_ASG;
+    out->visibility = VSGL_VISIBILITY_NONE;
+    out->fis_iterations = 8;
+    switch (preset) {
+    case VSGL_PRESET_PREVIEW:
+        out->aa_samples = 1;
+        out->rsm_resolution = 128;
+        out->fit_mode = VSGL_FIT_TWO;
+        out->vsgl_count = 1;
+        out->diffuse_mode = VSGL_COSINE_SG; /* smoother with few VSGLs (poster Fig. 1) */
+        break;
+    case VSGL_PRESET_QUALITY:
+        out->aa_samples = 3;
+        out->rsm_resolution = 512;
+        out->fit_mode = VSGL_FIT_FIS;
+        out->vsgl_count = 256;
+        out->diffuse_mode = VSGL_COSINE_ACCURATE;
+        out->visibility = VSGL_VISIBILITY_RAY;
+        break;
+    default: /* BALANCED */
+        out->aa_samples = 2;
+        out->rsm_resolution = 256;
+        out->fit_mode = VSGL_FIT_FIS;
+        out->vsgl_count = 64;
+        out->diffuse_mode = VSGL_COSINE_ACCURATE;
+        break;
+    }
+}
+
+vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings *in,
+                                   vsgl_render_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    if (in) {
+        if (in->size > sizeof *in)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT,
+                              "settings: size %u is larger than this library's %zu (newer header?)",
+                              in->size, sizeof *in);
+        memcpy(s, in, in->size ? in->size : sizeof *in);
+    }
+    s->size = sizeof *s;
+    if (!s->aa_samples)
+        s->aa_samples = 1;
+    if (!s->rsm_resolution)
+        s->rsm_resolution = 256;
+    if (!s->vsgl_count)
+        s->vsgl_count = 64;
+    if (!s->fis_iterations)
+        s->fis_iterations = 8;
+#define CHECK_ENUM(field, lo, hi)                                                         \
+    if (s->field < (lo) || s->field > (hi))                                              \
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: " #field " is %d (valid %d..%d)", \
+                          (int)s->field, (int)(lo), (int)(hi));
+    CHECK_ENUM(method, VSGL_METHOD_VSGL, VSGL_METHOD_BRUTE_FORCE)
+    CHECK_ENUM(fit_mode, VSGL_FIT_TWO, VSGL_FIT_KMEANS)
+    CHECK_ENUM(sharpness_estimator, VSGL_SHARPNESS_TOKSVIG, VSGL_SHARPNESS_BANERJEE)
+    CHECK_ENUM(diffuse_mode, VSGL_COSINE_SG, VSGL_COSINE_ACCURATE)
+    CHECK_ENUM(glossy_mode, VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG)
+    CHECK_ENUM(visibility, VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY)
+#undef CHECK_ENUM
+    if (s->aa_samples > 16)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: aa_samples is %u (valid 1..16)", s->aa_samples);
+    if (s->rsm_resolution < 2 || s->rsm_resolution > 8192)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: rsm_resolution is %u (valid 2..8192)",
+                          s->rsm_resolution);
+    if (s->vsgl_count > 65536)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: vsgl_count is %u (valid 1..65536)",
+                          s->vsgl_count);
+    if (s->fis_iterations > 32)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: fis_iterations is %u (valid 1..32)",
+                          s->fis_iterations);
+    return VSGL_OK;
+}

@@ -1,0 +1,208 @@
+/* Shading with VSGLs: incident radiance as one SG (Eq. 7), diffuse via the
+ * SG x clamped-cosine integral (three modes), glossy via the warped
+ * receiver NDF as an ASG (or SG) convolved with the incident SG, with the
+ * smooth Fresnel/shadowing factor at the integrand's lobe axis. */
+#include "shade/shade.h"
+#include "core/context.h"
+#include "core/parallel.h"
+#include "scene/material.h"
+#include "vsgl/lobes.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define TWO_PI 6.28318530717958647692f
+#define INV_PI 0.31830988618379067154f
+/* Variance floor relative to the squared receiver distance (GUIDE Sec. 4): 2^-41. */
+#define VARIANCE_FLOOR 4.547473508864641e-13f
+
+int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
+{
+    v3 d = v3_sub(v->mean, x);
+    float dist2 = v3_dot(d, d);
+    float var = v->variance;
+    if (var < dist2 * VARIANCE_FLOOR)
+        var = dist2 * VARIANCE_FLOOR;
+    if (!(var > 0.0f) || !(var < INFINITY))
+        return 0;
+    vsgl_sg light_lobe = {v3_neg(v->axis), v->sharpness, 0.0f};
+    vsgl_sg spread;
+    spread.axis = dist2 > 0.0f ? v3_scale(d, 1.0f / sqrtf(dist2)) : v3_neg(v->axis);
+    spread.sharpness = dist2 / var;
+    spread.log_amplitude = 0.0f;
+    vsgl_sg_product(&light_lobe, &spread, sg);
+    /* c_v / (2 pi var) with c_v = power / A(lambda_v); power applied by the caller */
+    sg->log_amplitude -= logf(TWO_PI * var) + logf(vsgl_sg_integral(v->sharpness));
+    return 1;
+}
+
+typedef struct shade_job {
+    const vsgl_scene *scene;
+    const vsgl_gbuffer *g;
+    const vsgl_vsgl_set *set;
+    const vsgl_render_settings *s;
+    const vsgl_pixel_planes *planes;
+    const vsgl_material *materials;
+    float eps;            /* ray offset, metres */
+    size_t base;          /* first pixel of the current batch */
+    uint64_t *pairs;      /* per chunk of the current batch */
+} shade_job;
+
+/* Receiver lobe of one sample, set up once and used for every VSGL. */
+typedef struct receiver {
+    v3 x, n, o;
+    vsgl_brdf_params bp;
+    float alpha;
+    int glossy;
+    vsgl_asg asg;        /* warped NDF (ASG mode) */
+    vsgl_sg sg;          /* warped NDF (SG mode) */
+} receiver;
+
+static void setup_receiver(const shade_job *j, size_t i, receiver *r)
+{
+    const vsgl_gbuffer *g = j->g;
+    r->x = v3_make(g->pos[0][i], g->pos[1][i], g->pos[2][i]);
+    r->n = v3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
+    r->o = v3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
+    vsgl__material_params(&j->materials[g->material[i]], &r->bp);
+    r->alpha = sqrtf(r->bp.alpha_x * r->bp.alpha_y);
+    r->glossy = r->bp.glossy && v3_dot(r->n, r->o) > 0.0f;
+    if (!r->glossy)
+        return;
+    if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
+        vsgl_sg ndf;
+        vsgl_ndf_to_sg(&r->n, r->alpha, VSGL_NDF_GGX, &ndf);
+        vsgl_warp_ndf_sg(&ndf, &r->o, &r->sg);
+    } else {
+        v3 t = v3_make(g->tan[0][i], g->tan[1][i], g->tan[2][i]);
+        vsgl_asg ndf;
+        vsgl_ndf_aniso_to_asg(&r->n, &t, r->bp.alpha_x, r->bp.alpha_y, &ndf);
+        vsgl_warp_ndf_asg(&ndf, &r->o, &r->asg);
+    }
+}
+
+/* Glossy integral of the receiver's lobe with the incident SG, and the
+ * axis of the integrand (where the smooth factor is evaluated). */
+static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_sg *in, v3 *axis)
+{
+    if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
+        vsgl_sg prod;
+        vsgl_sg_product(&r->sg, in, &prod);
+        *axis = prod.axis;
+        return vsgl_sg_product_integral(&r->sg, in);
+    }
+    v3 m = v3_add(v3_scale(in->axis, in->sharpness),
+                  v3_scale(r->asg.z, r->asg.lambda + r->asg.mu));
+    *axis = v3_normalize(m);
+    if (v3_dot(*axis, *axis) == 0.0f)
+        *axis = r->asg.z;
+    return vsgl_asg_sg_product_integral(&r->asg, in);
+}
+
+static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
+{
+    shade_job *j = user;
+    const vsgl_gbuffer *g = j->g;
+    const vsgl_pixel_planes *pl = j->planes;
+    const size_t spp = g->spp;
+    const float inv_spp = 1.0f / (float)spp;
+    uint64_t pairs = 0;
+    for (size_t px = j->base + b; px < j->base + e; ++px) {
+        float acc_d[3] = {0, 0, 0}, acc_g[3] = {0, 0, 0}, col_d[3] = {0, 0, 0}, col_g[3] = {0, 0, 0};
+        float covered = 0.0f;
+        for (size_t sidx = 0; sidx < spp; ++sidx) {
+            size_t i = px * spp + sidx;
+            if (g->material[i] == VSGL_GBUFFER_MISS)
+                continue;
+            covered += 1.0f;
+            receiver r;
+            setup_receiver(j, i, &r);
+            float gcol[3] = {0, 0, 0};
+            if (r.glossy)
+                vsgl__glossy_color(&r.bp, r.n, r.o, gcol);
+            for (int c = 0; c < 3; ++c) {
+                col_d[c] += r.bp.diffuse[c];
+                col_g[c] += gcol[c];
+            }
+            int has_diffuse = r.bp.diffuse[0] + r.bp.diffuse[1] + r.bp.diffuse[2] > 0.0f;
+            float ld[3] = {0, 0, 0}, ls[3] = {0, 0, 0};
+            for (size_t k = 0; k < j->set->count; ++k) {
+                const vsgl_vsgl *v = &j->set->items[k];
+                vsgl_sg in;
+                ++pairs;
+                if (!vsgl__vsgl_incident_sg(v, r.x, &in))
+                    continue;
+                if (j->s->visibility == VSGL_VISIBILITY_RAY) {
+                    v3 org = v3_add(r.x, v3_scale(r.n, j->eps));
+                    v3 d = v3_sub(v->mean, org);
+                    float dist = v3_length(d);
+                    if (dist > j->eps &&
+                        vsgl__scene_occluded(j->scene, org, v3_scale(d, 1.0f / dist), 0.0f, dist - j->eps))
+                        continue;
+                }
+                if (has_diffuse) {
+                    float e_d = vsgl_sg_cosine_integral(&in, &r.n, j->s->diffuse_mode) * INV_PI;
+                    for (int c = 0; c < 3; ++c)
+                        ld[c] += v->power[c] * e_d;
+                }
+                if (r.glossy) {
+                    v3 axis;
+                    float gi = glossy_integral(j, &r, &in, &axis);
+                    if (gi > 0.0f)
+                        for (int c = 0; c < 3; ++c)
+                            ls[c] += v->power[c] * gi *
+                                     vsgl_specular_factor(&r.n, &r.o, &axis, r.alpha, r.bp.f0[c]);
+                }
+            }
+            for (int c = 0; c < 3; ++c) {
+                acc_d[c] += r.bp.diffuse[c] * ld[c];
+                acc_g[c] += ls[c];
+            }
+        }
+        for (int c = 0; c < 3; ++c) {
+            pl->diffuse[px * 3 + c] = acc_d[c] * inv_spp;
+            pl->glossy[px * 3 + c] = acc_g[c] * inv_spp;
+            pl->diffuse_color[px * 3 + c] = col_d[c] * inv_spp;
+            pl->glossy_color[px * 3 + c] = col_g[c] * inv_spp;
+        }
+        pl->coverage[px] = covered * inv_spp;
+    }
+    j->pairs[chunk] = pairs;
+    return 0;
+}
+
+vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
+                        const vsgl_vsgl_set *set, const vsgl_render_settings *s,
+                        const vsgl_pixel_planes *planes, uint64_t *pairs)
+{
+    size_t pixels = (size_t)g->width * g->height;
+    size_t chunk = g->width ? g->width : 1; /* one row per chunk */
+    size_t chunks = vsgl__chunk_count(pixels, chunk);
+    uint64_t *per_chunk = calloc(chunks + 1, sizeof *per_chunk);
+    if (!per_chunk)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
+    v3 lo, hi;
+    vsgl__scene_bounds(scene, &lo, &hi);
+    float extent = v3_length(v3_sub(hi, lo));
+    uint32_t material_count;
+    shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
+                   (extent > 0.0f ? extent : 1.0f) * 1e-5f, 0, per_chunk};
+    /* Rows in batches so progress can be reported and cancellation honoured. */
+    size_t rows_per_batch = g->height / 20 + 1;
+    vsgl_result r = VSGL_OK;
+    for (size_t row = 0; row < g->height && r == VSGL_OK; row += rows_per_batch) {
+        size_t end = row + rows_per_batch < g->height ? row + rows_per_batch : g->height;
+        j.base = row * chunk;
+        j.pairs = per_chunk + row;
+        vsgl__parallel_for(vsgl_context_thread_count(ctx), (end - row) * chunk, chunk, shade_chunk, &j);
+        if (vsgl__progress(ctx, "shade", (float)end / (float)g->height))
+            r = vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "shade: cancelled");
+    }
+    uint64_t total = 0;
+    for (size_t c = 0; c < chunks; ++c)
+        total += per_chunk[c];
+    free(per_chunk);
+    if (pairs)
+        *pairs = total;
+    return r;
+}
