@@ -1,0 +1,239 @@
+/* Reflection lobes as SGs/ASGs: Lambert, NDFs, spherical warping (SG and
+ * ASG, the ASG Hessian derived in docs/math.md), the smooth microfacet
+ * factor, Ward and Ashikhmin-Shirley. */
+#include "vsgl/lobes.h"
+#include "math/sg_internal.h"
+
+#include <float.h>
+
+static float clamp_alpha(float a)
+{
+    if (!(a > VSGL_ALPHA_MIN)) /* NaN, negatives, tiny */
+        return a != a ? 1.0f : VSGL_ALPHA_MIN;
+    return a < 1.0f ? a : 1.0f;
+}
+
+/* Non-negative finite bandwidth, capped. */
+static float clamp_band(float b)
+{
+    return vsgl__sg_clamp_sharpness(b);
+}
+
+static int is_zero(v3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
+
+/* Right-handed orthonormal frame [x, y, z] with z = normalize(n) and x the
+ * tangent made orthogonal to z (any completion if t is degenerate). A zero
+ * n gives z = +Z. */
+static void make_frame(v3 n, v3 t, v3 *x, v3 *y, v3 *z)
+{
+    v3 zz = v3_normalize(n);
+    if (is_zero(zz))
+        zz = v3_make(0.0f, 0.0f, 1.0f);
+    v3 tt = v3_sub(t, v3_scale(zz, v3_dot(t, zz)));
+    float tl = v3_length(tt);
+    v3 xx, yy;
+    if (tl > 1e-6f * v3_length(t) && tl > 0.0f && tl < INFINITY) {
+        xx = v3_scale(tt, 1.0f / tl);
+        yy = v3_normalize(v3_cross(zz, xx));
+        xx = v3_cross(yy, zz); /* re-orthogonalise */
+    } else {
+        v3_basis(zz, &xx, &yy);
+    }
+    *x = xx;
+    *y = yy;
+    *z = zz;
+}
+
+void vsgl_lambert_to_sg(const vsgl_vec3 *n, vsgl_sg *out)
+{
+    vsgl_sg r;
+    r.axis = v3_normalize(*n);
+    r.sharpness = VSGL__COSINE_SHARPNESS;
+    r.log_amplitude = is_zero(r.axis) ? -INFINITY : -vsgl__sg_log_integral(VSGL__COSINE_SHARPNESS);
+    *out = r;
+}
+
+float vsgl_ndf_sharpness(float alpha)
+{
+    float a = clamp_alpha(alpha);
+    return clamp_band(2.0f / (a * a));
+}
+
+void vsgl_ndf_to_sg(const vsgl_vec3 *n, float alpha, int32_t ndf, vsgl_sg *out)
+{
+    (void)ndf; /* GGX and Beckmann share lambda_h = 2/alpha^2 (Wang et al. 2009) */
+    float a = clamp_alpha(alpha);
+    vsgl_sg r;
+    r.axis = v3_normalize(*n);
+    r.sharpness = vsgl_ndf_sharpness(a);
+    r.log_amplitude = is_zero(r.axis) ? -INFINITY : -VSGL__LOG_PI - 2.0f * logf(a);
+    *out = r;
+}
+
+void vsgl_ndf_aniso_to_asg(const vsgl_vec3 *n, const vsgl_vec3 *tangent,
+                           float alpha_x, float alpha_y, vsgl_asg *out)
+{
+    float ax = clamp_alpha(alpha_x), ay = clamp_alpha(alpha_y);
+    vsgl_asg r;
+    make_frame(*n, *tangent, &r.x, &r.y, &r.z);
+    r.lambda = clamp_band(1.0f / (ax * ax));
+    r.mu = clamp_band(1.0f / (ay * ay));
+    r.log_amplitude = is_zero(v3_normalize(*n)) ? -INFINITY : -VSGL__LOG_PI - logf(ax) - logf(ay);
+    *out = r;
+}
+
+/* Unit view, or the fallback if the view is zero/non-finite. */
+static v3 unit_or(v3 v, v3 fallback)
+{
+    v3 u = v3_normalize(v);
+    return is_zero(u) ? fallback : u;
+}
+
+void vsgl_warp_ndf_sg(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_sg *out)
+{
+    v3 n = v3_normalize(ndf->axis);
+    vsgl_sg r;
+    if (is_zero(n)) {
+        r.axis = n;
+        r.sharpness = 0.0f;
+        r.log_amplitude = -INFINITY;
+        *out = r;
+        return;
+    }
+    v3 o = unit_or(*view, n);
+    float on = v3_dot(o, n);
+    r.axis = v3_normalize(v3_reflect(o, n));
+    if (is_zero(r.axis))
+        r.axis = n;
+    float d = fabsf(on);
+    d = d > 1e-6f ? d : 1e-6f;
+    r.sharpness = clamp_band(vsgl__sg_clamp_sharpness(ndf->sharpness) / (4.0f * d));
+    r.log_amplitude = ndf->log_amplitude;
+    *out = r;
+}
+
+/* Double-precision helpers for the warp (2x2 eigen-problem). */
+typedef struct dv { double x, y, z; } dv;
+static dv dv_of(v3 a) { dv r = {a.x, a.y, a.z}; return r; }
+static double dv_dot(dv a, dv b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static dv dv_lin(dv a, double sa, dv b, double sb)
+{
+    dv r = {a.x * sa + b.x * sb, a.y * sa + b.y * sb, a.z * sa + b.z * sb};
+    return r;
+}
+static dv dv_cross(dv a, dv b)
+{
+    dv r = {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+    return r;
+}
+static dv dv_unit(dv a)
+{
+    double l = sqrt(dv_dot(a, a));
+    dv r = {a.x / l, a.y / l, a.z / l};
+    return r;
+}
+static v3 v3_of(dv a) { return v3_make((float)a.x, (float)a.y, (float)a.z); }
+
+void vsgl_warp_ndf_asg(const vsgl_asg *ndf, const vsgl_vec3 *view, vsgl_asg *out)
+{
+    v3 fx, fy, fz;
+    make_frame(ndf->z, ndf->x, &fx, &fy, &fz);
+    vsgl_asg r;
+    if (is_zero(v3_normalize(ndf->z))) {
+        r.x = fx; r.y = fy; r.z = fz;
+        r.lambda = r.mu = 0.0f;
+        r.log_amplitude = -INFINITY;
+        *out = r;
+        return;
+    }
+    dv xh = dv_of(fx), yh = dv_of(fy), zh = dv_of(fz);
+    dv o = dv_of(unit_or(*view, fz));
+    double c = dv_dot(o, zh);
+    /* Lobe axis: the reflection of o about z_h. */
+    dv zi = dv_unit(dv_lin(zh, 2.0 * c, o, -1.0));
+    /* Default tangent frame at z_i: x' perpendicular to o (and z_i). */
+    dv xp = dv_cross(o, zi);
+    double xl = sqrt(dv_dot(xp, xp));
+    if (xl > 1e-9) {
+        xp = dv_lin(xp, 1.0 / xl, xp, 0.0);
+    } else { /* o = z_i = z_h: any tangent; the frame below is re-derived */
+        v3 bx, by;
+        v3_basis(v3_of(zi), &bx, &by);
+        xp = dv_of(bx);
+    }
+    dv yp = dv_cross(zi, xp);
+    /* Half-vector Jacobian at the peak: dh = (t - z_h (z_h.t)) / |i + o| with
+     * |i + o| = 2 (o.z_h). The warped exponent g = l (h.x_h)^2 + m (h.y_h)^2
+     * has zero gradient there, so its quadratic form in the tangent
+     * coordinates (a, b) of i = z_i + a x' + b y' is Q = P^T diag(l, m) P /
+     * (4 c^2), P = [[x_h.x', x_h.y'], [y_h.x', y_h.y']] (docs/math.md). */
+    double cc = fabs(c) > 1e-6 ? fabs(c) : 1e-6;
+    double k = 1.0 / (4.0 * cc * cc);
+    double l = clamp_band(ndf->lambda), m = clamp_band(ndf->mu);
+    double p11 = dv_dot(xh, xp), p12 = dv_dot(xh, yp), p21 = dv_dot(yh, xp), p22 = dv_dot(yh, yp);
+    double q11 = k * (l * p11 * p11 + m * p21 * p21);
+    double q12 = k * (l * p11 * p12 + m * p21 * p22);
+    double q22 = k * (l * p12 * p12 + m * p22 * p22);
+    /* Symmetric 2x2 eigen-decomposition; x_i takes the larger eigenvalue. */
+    double half_diff = 0.5 * (q11 - q22), mean = 0.5 * (q11 + q22);
+    double rad = sqrt(half_diff * half_diff + q12 * q12);
+    double th = 0.5 * atan2(2.0 * q12, q11 - q22);
+    double cs = cos(th), sn = sin(th);
+    dv xi = dv_lin(xp, cs, yp, sn);
+    dv yi = dv_lin(xp, -sn, yp, cs);
+    double e1 = mean + rad, e2 = mean - rad;
+    r.x = v3_of(xi);
+    r.y = v3_of(yi);
+    r.z = v3_of(zi);
+    r.lambda = clamp_band((float)(e1 > 0.0 ? e1 : 0.0));
+    r.mu = clamp_band((float)(e2 > 0.0 ? e2 : 0.0));
+    r.log_amplitude = ndf->log_amplitude;
+    *out = r;
+}
+
+float vsgl_specular_factor(const vsgl_vec3 *n, const vsgl_vec3 *view,
+                           const vsgl_vec3 *light, float alpha, float f0)
+{
+    v3 nn = v3_normalize(*n), o = v3_normalize(*view), i = v3_normalize(*light);
+    float co = v3_dot(nn, o), ci = v3_dot(nn, i);
+    if (!(co > 0.0f) || !(ci > 0.0f))
+        return 0.0f;
+    co = co < 1.0f ? co : 1.0f;
+    ci = ci < 1.0f ? ci : 1.0f;
+    float a = clamp_alpha(alpha);
+    float a2 = a * a;
+    float f = f0 > 0.0f ? (f0 < 1.0f ? f0 : 1.0f) : 0.0f;
+    /* Schlick Fresnel at i.h; h = (i + o)/|i + o|, |i + o| > 0 since both
+     * are above the surface. */
+    v3 h = v3_normalize(v3_add(i, o));
+    float ih = clampf(v3_dot(i, h), 0.0f, 1.0f);
+    float w = 1.0f - ih, w2 = w * w;
+    float fr = f + (1.0f - f) * (w2 * w2 * w);
+    /* Height-correlated Smith GGX: G2 = 2 ci co / (ci So + co Si) with
+     * Sx = sqrt(a^2 + (1 - a^2) cx^2); M = F G2 / (4 co) = F ci / (2 (ci So + co Si)). */
+    float so = sqrtf(a2 + (1.0f - a2) * co * co), si = sqrtf(a2 + (1.0f - a2) * ci * ci);
+    return fr * ci / (2.0f * (ci * so + co * si));
+}
+
+void vsgl_ward_to_asg(const vsgl_vec3 *n, const vsgl_vec3 *x,
+                      float alpha_x, float alpha_y, vsgl_asg *out)
+{
+    float ax = clamp_alpha(alpha_x), ay = clamp_alpha(alpha_y);
+    vsgl_asg r;
+    make_frame(*n, *x, &r.x, &r.y, &r.z);
+    r.lambda = clamp_band(1.0f / (ax * ax));
+    r.mu = clamp_band(1.0f / (ay * ay));
+    r.log_amplitude = is_zero(v3_normalize(*n)) ? -INFINITY : 0.0f;
+    *out = r;
+}
+
+void vsgl_ashikhmin_shirley_to_asg(const vsgl_vec3 *n, const vsgl_vec3 *u,
+                                   float n_u, float n_v, vsgl_asg *out)
+{
+    vsgl_asg r;
+    make_frame(*n, *u, &r.x, &r.y, &r.z);
+    r.lambda = clamp_band(0.5f * n_u);
+    r.mu = clamp_band(0.5f * n_v);
+    r.log_amplitude = is_zero(v3_normalize(*n)) ? -INFINITY : 0.0f;
+    *out = r;
+}

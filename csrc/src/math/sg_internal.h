@@ -1,0 +1,32 @@
+/* Internal SG helpers shared by sg.c, sg_cosine.c, lobes.c and the shading
+ * kernels. Owner: csrc/src/math (sg.c). Formulas: docs/math.md. */
+#ifndef VSGL_MATH_SG_INTERNAL_H
+#define VSGL_MATH_SG_INTERNAL_H
+
+#include "vsgl/sg.h"
+#include "math/vec.h"
+
+#define VSGL__PI      3.14159265358979323846f
+#define VSGL__2PI     6.28318530717958647692f
+#define VSGL__LOG_2PI 1.83787706640934548356f
+#define VSGL__LOG_PI  1.14472988584940017414f
+
+/* Least-squares sharpness of the poster's SG cosine lobe (docs/math.md):
+ * argmin over l of the L2 norm on the sphere of max(w.n,0)/pi - G(w;n,l)/A(l). */
+#define VSGL__COSINE_SHARPNESS 2.29250405f
+
+/* NaN/negative -> 0; +inf and > VSGL_SHARPNESS_MAX -> VSGL_SHARPNESS_MAX. */
+float vsgl__sg_clamp_sharpness(float lambda);
+/* A(lambda) / (2 pi) = (1 - e^{-2 lambda}) / lambda (2 at 0); lambda >= 0. */
+float vsgl__sg_integral_over_2pi(float lambda);
+/* log A(lambda); lambda >= 0. */
+float vsgl__sg_log_integral(float lambda);
+/* Exact vMF mean resultant length coth(l) - 1/l (Taylor below 0.5); l >= 0. */
+float vsgl__sg_mean_length(float l);
+
+/* Integral over the sphere of exp(lambda (w.xi - 1)) max(w.n, 0) for
+ * unit-amplitude SGs, given lambda >= 0 (already clamped) and c = xi.n in
+ * [-1, 1]: the ACCURATE mode of vsgl_sg_cosine_integral. */
+float vsgl__sg_cosine_accurate(float lambda, float c);
+
+#endif
