@@ -1,0 +1,1520 @@
+"""ctypes binding of libvsgl, the only module of the add-on that uses ctypes.
+
+Pure Python + numpy; no ``bpy`` import and no relative imports, so the
+tests can import it directly (``sys.path.insert(0, 'addon/vsgl_indirect')``)
+and the add-on as ``from . import libvsgl``.
+
+Library lookup, first match wins:
+
+1. ``$VSGL_LIBRARY`` (an explicit path; no fallback if it is wrong),
+2. ``libvsgl.so`` beside this module (the add-on zip ships it there),
+3. ``../../build/libvsgl.so`` relative to this module (a dev checkout).
+
+The library is loaded once, on first use, and every ``argtypes``/``restype``
+is set at that moment. A symbol the library does not export (a function not
+written yet) does not stop the load: calling it raises
+:class:`VsglMissingSymbolError` naming it. See docs/python.md.
+"""
+
+import ctypes
+import enum
+import logging
+import math
+import os
+import threading
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "BINDING_VERSION", "VsglLibraryError", "VsglMissingSymbolError", "VsglError",
+    "VsglCancelledError", "library", "load_library", "find_library", "version",
+    "version_string", "result_string", "missing_symbols",
+    "SG", "ASG", "Context", "Scene", "render", "render_settings_preset",
+    "Material", "Light", "Camera", "RenderSettings",
+]
+
+_logger = logging.getLogger("vsgl_indirect.libvsgl")
+
+#: (major, minor) of the C API this binding was written for.
+BINDING_VERSION = (0, 1)
+
+# --------------------------------------------------------------------------
+# Errors
+# --------------------------------------------------------------------------
+
+
+class VsglLibraryError(RuntimeError):
+    """libvsgl could not be found or loaded, or has another major.minor."""
+
+
+class VsglMissingSymbolError(VsglLibraryError, NotImplementedError):
+    """The loaded library does not export a function (not implemented yet)."""
+
+    def __init__(self, symbol, path):
+        self.symbol = symbol
+        self.path = path
+        super().__init__(
+            "%s is not exported by %s (not implemented in this build of libvsgl; "
+            "rebuild with `make` once it is)" % (symbol, path))
+
+
+class VsglError(Exception):
+    """A libvsgl call failed. ``code`` is the vsgl_result, ``message`` the
+    context's last-error message (may be empty), ``function`` the C name."""
+
+    def __init__(self, code, message="", function=""):
+        self.code = int(code)
+        self.message = message or ""
+        self.function = function
+        self.result_string = result_string(self.code)
+        text = "%s (%d)" % (self.result_string, self.code)
+        if function:
+            text = "%s failed: %s" % (function, text)
+        if self.message:
+            text += ": " + self.message
+        super().__init__(text)
+
+
+class VsglCancelledError(VsglError):
+    """The progress callback cancelled the call (VSGL_ERROR_CANCELLED)."""
+
+
+# --------------------------------------------------------------------------
+# Constants (values of the C #defines)
+# --------------------------------------------------------------------------
+
+
+class Result(enum.IntEnum):
+    OK = 0
+    ERROR_INVALID_ARGUMENT = 1
+    ERROR_OUT_OF_MEMORY = 2
+    ERROR_IO = 3
+    ERROR_BAD_FORMAT = 4
+    ERROR_VERSION_MISMATCH = 5
+    ERROR_UNSUPPORTED = 6
+    ERROR_CANCELLED = 7
+    ERROR_INTERNAL = 8
+
+
+class LogLevel(enum.IntEnum):
+    ERROR = 0
+    WARNING = 1
+    INFO = 2
+    DEBUG = 3
+
+
+class CosineMode(enum.IntEnum):
+    SG = 0
+    PULLED_OUT = 1
+    ACCURATE = 2
+
+
+class SharpnessEstimator(enum.IntEnum):
+    TOKSVIG = 0
+    BANERJEE = 1
+
+
+class NDF(enum.IntEnum):
+    GGX = 0
+    BECKMANN = 1
+
+
+class LightType(enum.IntEnum):
+    POINT = 0
+    SPOT = 1
+    SUN = 2
+    AREA = 3
+
+
+class AreaShape(enum.IntEnum):
+    SQUARE = 0
+    RECTANGLE = 1
+    DISK = 2
+    ELLIPSE = 3
+
+
+class CameraType(enum.IntEnum):
+    PERSPECTIVE = 0
+    ORTHOGRAPHIC = 1
+
+
+class SensorFit(enum.IntEnum):
+    AUTO = 0
+    HORIZONTAL = 1
+    VERTICAL = 2
+
+
+class Method(enum.IntEnum):
+    VSGL = 0
+    BRUTE_FORCE = 1
+
+
+class FitMode(enum.IntEnum):
+    TWO = 0
+    FIS = 1
+    KMEANS = 2
+
+
+class GlossyMode(enum.IntEnum):
+    ASG = 0
+    SG = 1
+
+
+class Visibility(enum.IntEnum):
+    NONE = 0
+    RAY = 1
+
+
+class Preset(enum.IntEnum):
+    PREVIEW = 0
+    BALANCED = 1
+    QUALITY = 2
+
+
+class ExrPixelType(enum.IntEnum):
+    FLOAT = 0
+    HALF = 1
+
+
+class ExrCompression(enum.IntEnum):
+    ZIP = 0
+    NONE = 1
+    ZIPS = 2
+    PIZ = 3
+
+
+MATERIAL_UNSUPPORTED = 1
+SHARPNESS_MAX = 2199023255552.0  # 2^41
+ALPHA_MIN = 4.656612873077393e-10  # 2^-31
+EXR_MAX_CHANNELS = 4
+BUNDLE_VERSION = (1, 0)
+
+
+def _enum(value, cls, what):
+    """Accept an IntEnum member, an int or a (case-insensitive) member name."""
+    if isinstance(value, str):
+        try:
+            return int(cls[value.upper()])
+        except KeyError:
+            raise ValueError("%s: unknown %s %r (one of %s)" % (
+                what, cls.__name__, value, ", ".join(m.name for m in cls))) from None
+    return int(value)
+
+
+# --------------------------------------------------------------------------
+# Structures: field order and types exactly as csrc/include/vsgl/*.h
+# --------------------------------------------------------------------------
+
+_f32, _u32, _i32 = ctypes.c_float, ctypes.c_uint32, ctypes.c_int32
+_PF32 = ctypes.POINTER(ctypes.c_float)
+_PU32 = ctypes.POINTER(ctypes.c_uint32)
+
+LOG_FN = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int32, ctypes.c_char_p)
+PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int32, ctypes.c_void_p, ctypes.c_char_p, ctypes.c_float)
+
+_MATRIX_FIELDS = {"world_from_light", "world_from_camera"}
+
+
+class _Struct(ctypes.Structure):
+    """Keyword constructor that accepts numpy arrays, enum names and
+    Blender-style 4x4 / 3x4 matrices for the 12-float matrix fields."""
+
+    _enums = {}
+
+    def __init__(self, **fields):
+        super().__init__()
+        names = [f[0] for f in self._fields_]
+        if "size" in names:
+            self.size = ctypes.sizeof(self)
+        for key, value in fields.items():
+            if key not in names:
+                raise TypeError("%s has no field %r (fields: %s)" % (
+                    type(self).__name__, key, ", ".join(names)))
+            setattr(self, key, self._convert(key, value))
+
+    def _convert(self, key, value):
+        ftype = dict(self._fields_)[key]
+        if key in self._enums:
+            return _enum(value, self._enums[key], key)
+        if issubclass(ftype, ctypes.Array) and not isinstance(value, (bytes, str)):
+            arr = np.asarray(value, dtype=np.float64)
+            if key in _MATRIX_FIELDS and arr.shape in ((4, 4), (3, 4)):
+                arr = arr[:3, :]
+            arr = arr.reshape(-1)
+            if arr.size != ftype._length_:
+                raise ValueError("%s.%s needs %d values, got shape %s" % (
+                    type(self).__name__, key, ftype._length_, np.shape(value)))
+            return ftype(*arr.tolist())
+        return value
+
+    def as_dict(self):
+        out = {}
+        for name, ftype in self._fields_:
+            v = getattr(self, name)
+            if isinstance(v, bytes):
+                v = v.decode("utf-8", "replace")
+            elif isinstance(v, ctypes.Array):
+                v = list(v)
+            out[name] = v
+        return out
+
+    def __repr__(self):
+        return "%s(%s)" % (type(self).__name__, ", ".join(
+            "%s=%r" % kv for kv in self.as_dict().items()))
+
+
+class vsgl_vec3(ctypes.Structure):
+    _fields_ = [("x", _f32), ("y", _f32), ("z", _f32)]
+
+
+class vsgl_context_desc(_Struct):
+    _fields_ = [
+        ("size", _u32),
+        ("thread_count", _u32),
+        ("log_level", _i32),
+        ("log", LOG_FN),
+        ("log_user", ctypes.c_void_p),
+        ("progress", PROGRESS_FN),
+        ("progress_user", ctypes.c_void_p),
+    ]
+
+
+class vsgl_sg(ctypes.Structure):
+    _fields_ = [("axis", vsgl_vec3), ("sharpness", _f32), ("log_amplitude", _f32)]
+
+
+class vsgl_asg(ctypes.Structure):
+    _fields_ = [
+        ("x", vsgl_vec3), ("y", vsgl_vec3), ("z", vsgl_vec3),
+        ("lambda_", _f32), ("mu", _f32), ("log_amplitude", _f32),
+    ]
+
+
+class vsgl_material(_Struct):
+    _fields_ = [
+        ("base_color", _f32 * 3),
+        ("metallic", _f32),
+        ("roughness", _f32),
+        ("specular_f0", _f32),
+        ("anisotropy", _f32),
+        ("anisotropic_rotation", _f32),
+        ("flags", _u32),
+        ("reserved", _u32),
+    ]
+
+
+class vsgl_light(_Struct):
+    _fields_ = [
+        ("type", _i32),
+        ("area_shape", _i32),
+        ("color", _f32 * 3),
+        ("power", _f32),
+        ("world_from_light", _f32 * 12),
+        ("radius", _f32),
+        ("spot_size", _f32),
+        ("spot_blend", _f32),
+        ("sun_angle", _f32),
+        ("size_x", _f32),
+        ("size_y", _f32),
+        ("spread", _f32),
+        ("reserved", _u32),
+    ]
+    _enums = {"type": LightType, "area_shape": AreaShape}
+
+
+class vsgl_camera(_Struct):
+    _fields_ = [
+        ("type", _i32),
+        ("sensor_fit", _i32),
+        ("world_from_camera", _f32 * 12),
+        ("lens_mm", _f32),
+        ("sensor_width_mm", _f32),
+        ("sensor_height_mm", _f32),
+        ("ortho_scale", _f32),
+        ("shift_x", _f32),
+        ("shift_y", _f32),
+        ("clip_start", _f32),
+        ("clip_end", _f32),
+        ("width", _u32),
+        ("height", _u32),
+        ("pixel_aspect_x", _f32),
+        ("pixel_aspect_y", _f32),
+    ]
+    _enums = {"type": CameraType, "sensor_fit": SensorFit}
+
+
+class vsgl_scene_desc(_Struct):
+    _fields_ = [
+        ("size", _u32),
+        ("vertex_count", _u32),
+        ("positions", _PF32),
+        ("triangle_count", _u32),
+        ("indices", _PU32),
+        ("corner_normals", _PF32),
+        ("corner_uvs", _PF32),
+        ("corner_tangents", _PF32),
+        ("material_indices", _PU32),
+        ("material_count", _u32),
+        ("materials", ctypes.POINTER(vsgl_material)),
+        ("light_count", _u32),
+        ("lights", ctypes.POINTER(vsgl_light)),
+        ("camera", ctypes.POINTER(vsgl_camera)),
+    ]
+
+
+class vsgl_scene_info(_Struct):
+    _fields_ = [
+        ("triangle_count", _u32),
+        ("dropped_triangles", _u32),
+        ("light_count", _u32),
+        ("material_count", _u32),
+        ("bounds_min", _f32 * 3),
+        ("bounds_max", _f32 * 3),
+    ]
+
+
+class vsgl_render_settings(_Struct):
+    _fields_ = [
+        ("size", _u32),
+        ("method", _i32),
+        ("aa_samples", _u32),
+        ("rsm_resolution", _u32),
+        ("fit_mode", _i32),
+        ("vsgl_count", _u32),
+        ("fis_iterations", _u32),
+        ("sharpness_estimator", _i32),
+        ("diffuse_mode", _i32),
+        ("glossy_mode", _i32),
+        ("visibility", _i32),
+        ("seed", _u32),
+    ]
+    _enums = {"method": Method, "fit_mode": FitMode,
+              "sharpness_estimator": SharpnessEstimator, "diffuse_mode": CosineMode,
+              "glossy_mode": GlossyMode, "visibility": Visibility}
+
+
+#: The planes of vsgl_render_output, in field order (each H x W x 3 except alpha: H x W).
+PLANES = ("diffuse_light", "glossy_light", "diffuse_color", "glossy_color",
+          "diffuse", "glossy", "combined", "alpha")
+#: Cycles/EXR pass names of the planes (vsgl_exr_write_render).
+PLANE_PASS_NAMES = {"diffuse_light": "DiffInd", "glossy_light": "GlossInd",
+                    "diffuse_color": "DiffCol", "glossy_color": "GlossCol",
+                    "diffuse": "Diff", "glossy": "Gloss", "combined": "Combined",
+                    "alpha": "Combined.A"}
+
+
+class vsgl_render_output(_Struct):
+    _fields_ = [("width", _u32), ("height", _u32)] + [(p, _PF32) for p in PLANES]
+
+
+class vsgl_render_stats(_Struct):
+    _fields_ = [
+        ("seconds_total", ctypes.c_double),
+        ("seconds_scene_prep", ctypes.c_double),
+        ("seconds_gbuffer", ctypes.c_double),
+        ("seconds_rsm", ctypes.c_double),
+        ("seconds_fit", ctypes.c_double),
+        ("seconds_shade", ctypes.c_double),
+        ("lights_used", _u32),
+        ("lights_skipped", _u32),
+        ("vsgl_count", _u32),
+        ("shading_pairs", ctypes.c_uint64),
+        ("skipped", ctypes.c_char * 1024),
+    ]
+
+
+# io.h
+class vsgl_exr_pass(_Struct):
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("channels", ctypes.c_char_p),
+        ("data", _PF32 * EXR_MAX_CHANNELS),
+        ("stride", _u32 * EXR_MAX_CHANNELS),
+    ]
+
+
+class vsgl_exr_metadata(_Struct):
+    _fields_ = [("key", ctypes.c_char_p), ("value", ctypes.c_char_p)]
+
+
+class vsgl_exr_options(_Struct):
+    _fields_ = [
+        ("size", _u32),
+        ("layer", ctypes.c_char_p),
+        ("pixel_type", _i32),
+        ("compression", _i32),
+        ("metadata_count", _u32),
+        ("metadata", ctypes.POINTER(vsgl_exr_metadata)),
+    ]
+    _enums = {"pixel_type": ExrPixelType, "compression": ExrCompression}
+
+
+class vsgl_bundle_options(_Struct):
+    _fields_ = [
+        ("size", _u32),
+        ("output_path", ctypes.c_char_p),
+        ("has_frame", _i32),
+        ("frame", _i32),
+    ]
+
+
+class vsgl_bundle_info(_Struct):
+    _fields_ = [
+        ("version_major", _u32),
+        ("version_minor", _u32),
+        ("output_path", ctypes.c_char_p),
+        ("has_frame", _i32),
+        ("frame", _i32),
+        ("has_settings", _u32),
+    ]
+
+
+# Friendlier names for the structs users fill in.
+Material = vsgl_material
+Light = vsgl_light
+Camera = vsgl_camera
+RenderSettings = vsgl_render_settings
+
+#: Every mirrored struct, by its C name (the layout test checks each).
+STRUCTS = {cls.__name__: cls for cls in (
+    vsgl_vec3, vsgl_context_desc, vsgl_sg, vsgl_asg, vsgl_material, vsgl_light,
+    vsgl_camera, vsgl_scene_desc, vsgl_scene_info, vsgl_render_settings,
+    vsgl_render_output, vsgl_render_stats, vsgl_exr_pass, vsgl_exr_metadata,
+    vsgl_exr_options, vsgl_bundle_options, vsgl_bundle_info)}
+#: Python field names that differ from the C ones.
+FIELD_C_NAMES = {"lambda_": "lambda"}
+#: Header each struct comes from (io.h structs are skipped by the layout test if it is absent).
+STRUCT_HEADERS = {name: ("io.h" if name.startswith(("vsgl_exr", "vsgl_bundle")) else "vsgl.h")
+                  for name in STRUCTS}
+
+# --------------------------------------------------------------------------
+# Prototypes: (name, restype, argtypes), as in the headers
+# --------------------------------------------------------------------------
+
+_P = ctypes.POINTER
+_VP = ctypes.c_void_p
+_PVP = _P(ctypes.c_void_p)
+_PV3, _PSG, _PASG = _P(vsgl_vec3), _P(vsgl_sg), _P(vsgl_asg)
+
+PROTOTYPES = (
+    # base.h
+    ("vsgl_result_string", ctypes.c_char_p, [_i32]),
+    ("vsgl_version", _i32, []),
+    ("vsgl_version_string", ctypes.c_char_p, []),
+    ("vsgl_context_create", _i32, [_P(vsgl_context_desc), _PVP]),
+    ("vsgl_context_destroy", None, [_VP]),
+    ("vsgl_context_last_error", ctypes.c_char_p, [_VP]),
+    ("vsgl_context_thread_count", _u32, [_VP]),
+    # sg.h
+    ("vsgl_sg_eval", _f32, [_PSG, _PV3]),
+    ("vsgl_sg_integral", _f32, [_f32]),
+    ("vsgl_sg_lobe_integral", _f32, [_PSG]),
+    ("vsgl_sg_product", None, [_PSG, _PSG, _PSG]),
+    ("vsgl_sg_product_integral", _f32, [_PSG, _PSG]),
+    ("vsgl_sg_product_integral_iwasaki", _f32, [_PSG, _PSG]),
+    ("vsgl_sg_cosine_sharpness", _f32, []),
+    ("vsgl_sg_cosine_integral", _f32, [_PSG, _PV3, _i32]),
+    ("vsgl_sharpness_from_mean_length", _f32, [_f32, _i32]),
+    ("vsgl_mean_length_from_sharpness", _f32, [_f32, _i32]),
+    # asg.h
+    ("vsgl_asg_eval", _f32, [_PASG, _PV3]),
+    ("vsgl_asg_bessel_f", _f32, [_f32]),
+    ("vsgl_asg_integral", _f32, [_PASG]),
+    ("vsgl_asg_integral_approx", _f32, [_PASG]),
+    ("vsgl_asg_product", None, [_PASG, _PASG, _PASG]),
+    ("vsgl_asg_convolve_sg", None, [_PASG, _PSG, _PASG]),
+    ("vsgl_asg_sg_product_integral", _f32, [_PASG, _PSG]),
+    ("vsgl_sg_to_asg", None, [_PSG, _PASG]),
+    # lobes.h
+    ("vsgl_lambert_to_sg", None, [_PV3, _PSG]),
+    ("vsgl_ndf_sharpness", _f32, [_f32]),
+    ("vsgl_ndf_to_sg", None, [_PV3, _f32, _i32, _PSG]),
+    ("vsgl_ndf_aniso_to_asg", None, [_PV3, _PV3, _f32, _f32, _PASG]),
+    ("vsgl_warp_ndf_sg", None, [_PSG, _PV3, _PSG]),
+    ("vsgl_warp_ndf_asg", None, [_PASG, _PV3, _PASG]),
+    ("vsgl_specular_factor", _f32, [_PV3, _PV3, _PV3, _f32, _f32]),
+    ("vsgl_ward_to_asg", None, [_PV3, _PV3, _f32, _f32, _PASG]),
+    ("vsgl_ashikhmin_shirley_to_asg", None, [_PV3, _PV3, _f32, _f32, _PASG]),
+    # scene.h
+    ("vsgl_scene_create", _i32, [_VP, _P(vsgl_scene_desc), _PVP]),
+    ("vsgl_scene_destroy", None, [_VP]),
+    ("vsgl_scene_get_info", _i32, [_VP, _P(vsgl_scene_info)]),
+    # render.h
+    ("vsgl_render_settings_preset", None, [_i32, _P(vsgl_render_settings)]),
+    ("vsgl_render", _i32, [_VP, _VP, _P(vsgl_render_settings), _P(vsgl_render_output),
+                           _P(vsgl_render_stats)]),
+    # io.h
+    ("vsgl_check_output_path", _i32, [_VP, ctypes.c_char_p]),
+    ("vsgl_exr_write", _i32, [_VP, ctypes.c_char_p, _u32, _u32, _P(vsgl_exr_pass), _u32,
+                              _P(vsgl_exr_options)]),
+    ("vsgl_exr_write_render", _i32, [_VP, ctypes.c_char_p, _P(vsgl_render_output),
+                                     _P(vsgl_exr_options)]),
+    ("vsgl_bundle_write_memory", _i32, [_VP, _P(vsgl_scene_desc), _P(vsgl_render_settings),
+                                        _P(vsgl_bundle_options), _VP, ctypes.c_size_t,
+                                        _P(ctypes.c_size_t)]),
+    ("vsgl_bundle_write", _i32, [_VP, ctypes.c_char_p, _P(vsgl_scene_desc),
+                                 _P(vsgl_render_settings), _P(vsgl_bundle_options)]),
+    ("vsgl_bundle_read", _i32, [_VP, ctypes.c_char_p, _PVP]),
+    ("vsgl_bundle_read_memory", _i32, [_VP, _VP, ctypes.c_size_t, _PVP]),
+    ("vsgl_bundle_destroy", None, [_VP]),
+    ("vsgl_bundle_scene", _P(vsgl_scene_desc), [_VP]),
+    ("vsgl_bundle_settings", _P(vsgl_render_settings), [_VP]),
+    ("vsgl_bundle_get_info", _i32, [_VP, _P(vsgl_bundle_info)]),
+)
+
+# --------------------------------------------------------------------------
+# Loading
+# --------------------------------------------------------------------------
+
+_HERE = os.path.dirname(os.path.abspath(__file__))
+_LIB_NAME = "libvsgl.so"
+
+
+def find_library():
+    """Path of the library to load (see the module docstring for the order).
+    Raises VsglLibraryError listing what was tried if nothing is found."""
+    env = os.environ.get("VSGL_LIBRARY")
+    if env:
+        if not os.path.isfile(env):
+            raise VsglLibraryError(
+                "VSGL_LIBRARY=%s: no such file. Point VSGL_LIBRARY at a built libvsgl.so "
+                "(build it with `make` in the repository root, giving build/libvsgl.so) "
+                "or unset it to use the bundled library." % env)
+        return env
+    tried = [os.path.join(_HERE, _LIB_NAME),
+             os.path.normpath(os.path.join(_HERE, "..", "..", "build", _LIB_NAME))]
+    for path in tried:
+        if os.path.isfile(path):
+            return path
+    raise VsglLibraryError(
+        "libvsgl.so not found (tried %s). Build it with `make` in the repository root "
+        "(it writes build/libvsgl.so), or set VSGL_LIBRARY to its path." % ", ".join(tried))
+
+
+def _undefined_vsgl_symbols(path):
+    """Undefined ``vsgl_*`` symbols in the dynamic symbol table of an ELF64
+    little-endian shared object (pure Python; [] if it cannot be parsed)."""
+    import struct
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+        if data[:4] != b"\x7fELF" or data[4] != 2 or data[5] != 1:
+            return []
+        shoff, = struct.unpack_from("<Q", data, 0x28)
+        shentsize, shnum = struct.unpack_from("<HH", data, 0x3A)
+        sections = [struct.unpack_from("<IIQQQQIIQQ", data, shoff + i * shentsize)
+                    for i in range(shnum)]
+        out = []
+        for sh in sections:
+            if sh[1] != 11:  # SHT_DYNSYM
+                continue
+            stroff = sections[sh[6]][4]
+            for off in range(sh[4], sh[4] + sh[5], sh[9] or 24):
+                name_off, info, other, shndx = struct.unpack_from("<IBBH", data, off)
+                if shndx != 0 or name_off == 0:
+                    continue
+                end = data.index(b"\0", stroff + name_off)
+                name = data[stroff + name_off:end].decode("ascii", "replace")
+                if name.startswith("vsgl_"):
+                    out.append(name)
+        return sorted(set(out))
+    except (OSError, struct.error, ValueError, IndexError):
+        return []
+
+
+class _Library:
+    """A loaded libvsgl: one attribute per exported prototype, argtypes and
+    restype set once here. Immutable after construction."""
+
+    def __init__(self, path):
+        self.path = os.path.abspath(path)
+        #: vsgl_ functions the library calls but does not define (a build
+        #: of a half-written tree); empty for a complete library.
+        self.undefined = ()
+        try:
+            self.cdll = ctypes.CDLL(self.path)
+        except OSError as e:
+            if "undefined symbol" not in str(e):
+                raise VsglLibraryError("cannot load %s: %s (rebuild it with `make`)"
+                                       % (self.path, e)) from None
+            # Incomplete build: load lazily so the defined functions work; a
+            # call that reaches an undefined one would abort the process, so
+            # they are listed (callers such as the tests check `undefined`).
+            self.cdll = ctypes.CDLL(self.path, mode=os.RTLD_LAZY)
+            self.undefined = tuple(_undefined_vsgl_symbols(self.path)) or (str(e),)
+            _logger.warning("%s is incomplete (%s); loaded lazily", self.path,
+                            ", ".join(self.undefined))
+        missing = []
+        for name, restype, argtypes in PROTOTYPES:
+            try:
+                fn = getattr(self.cdll, name)
+            except AttributeError:
+                missing.append(name)
+                continue
+            fn.restype = restype
+            fn.argtypes = argtypes
+            self.__dict__[name] = fn
+        self.missing = tuple(missing)
+        if "vsgl_version" in missing:
+            raise VsglLibraryError("%s does not export vsgl_version: not a libvsgl "
+                                   "(build it with `make`)" % self.path)
+        v = int(self.vsgl_version())
+        self.version = (v // 10000, v // 100 % 100, v % 100)
+        if self.version[:2] != BINDING_VERSION:
+            raise VsglLibraryError(
+                "%s is libvsgl %d.%d.%d but this add-on needs %d.%d.x; rebuild the library "
+                "from the same checkout with `make` (or reinstall the add-on)"
+                % ((self.path,) + self.version + BINDING_VERSION))
+
+    def __getattr__(self, name):  # only reached for names not bound above
+        if name.startswith("vsgl_"):
+            raise VsglMissingSymbolError(name, self.path)
+        raise AttributeError(name)
+
+    def has(self, name):
+        return name in self.__dict__
+
+
+_lib = None
+_lib_lock = threading.Lock()
+
+
+def load_library(path=None):
+    """Load a libvsgl (``path`` or :func:`find_library`) without caching it."""
+    return _Library(path if path is not None else find_library())
+
+
+def library():
+    """The process-wide library, loaded on first use."""
+    global _lib
+    if _lib is None:
+        with _lib_lock:
+            if _lib is None:
+                _lib = load_library()
+    return _lib
+
+
+def missing_symbols():
+    """Names of bound C functions the loaded library does not export."""
+    return library().missing
+
+
+def version():
+    """(major, minor, patch) of the loaded library."""
+    return library().version
+
+
+def version_string():
+    return library().vsgl_version_string().decode()
+
+
+def result_string(code):
+    try:
+        return library().vsgl_result_string(int(code)).decode()
+    except VsglLibraryError:
+        return "result %d" % int(code)
+
+
+# --------------------------------------------------------------------------
+# SG / ASG
+# --------------------------------------------------------------------------
+
+
+def _vec3(v, name="vector"):
+    a = np.asarray(v, dtype=np.float64)
+    if a.shape != (3,):
+        raise ValueError("%s must have 3 components, got shape %s" % (name, a.shape))
+    return vsgl_vec3(float(a[0]), float(a[1]), float(a[2]))
+
+
+def _tuple3(c):
+    return (float(c.x), float(c.y), float(c.z))
+
+
+@dataclass(frozen=True)
+class SG:
+    """exp(log_amplitude + sharpness * (dot(w, axis) - 1))."""
+
+    axis: tuple
+    sharpness: float
+    log_amplitude: float = 0.0
+
+    def __post_init__(self):
+        a = np.asarray(self.axis, dtype=np.float64)
+        if a.shape != (3,):
+            raise ValueError("SG axis must have 3 components, got shape %s" % (a.shape,))
+        object.__setattr__(self, "axis", tuple(float(x) for x in a))
+        object.__setattr__(self, "sharpness", float(self.sharpness))
+        object.__setattr__(self, "log_amplitude", float(self.log_amplitude))
+
+    @classmethod
+    def from_amplitude(cls, axis, sharpness, amplitude=1.0):
+        return cls(axis, sharpness, math.log(amplitude) if amplitude > 0 else -math.inf)
+
+    @property
+    def amplitude(self):
+        return math.exp(self.log_amplitude)
+
+    def to_c(self):
+        return vsgl_sg(vsgl_vec3(*self.axis), self.sharpness, self.log_amplitude)
+
+    @classmethod
+    def from_c(cls, s):
+        return cls(_tuple3(s.axis), s.sharpness, s.log_amplitude)
+
+
+@dataclass(frozen=True)
+class ASG:
+    """exp(log_amplitude) * max(v.z, 0) * exp(-lam (v.x)^2 - mu (v.y)^2)."""
+
+    x: tuple
+    y: tuple
+    z: tuple
+    lam: float
+    mu: float
+    log_amplitude: float = 0.0
+
+    def __post_init__(self):
+        for k in ("x", "y", "z"):
+            a = np.asarray(getattr(self, k), dtype=np.float64)
+            if a.shape != (3,):
+                raise ValueError("ASG %s must have 3 components, got shape %s" % (k, a.shape))
+            object.__setattr__(self, k, tuple(float(c) for c in a))
+        for k in ("lam", "mu", "log_amplitude"):
+            object.__setattr__(self, k, float(getattr(self, k)))
+
+    @classmethod
+    def from_frame(cls, frame, lam, mu, log_amplitude=0.0):
+        """``frame``: 3x3 array whose rows are x, y, z."""
+        f = np.asarray(frame, dtype=np.float64).reshape(3, 3)
+        return cls(f[0], f[1], f[2], lam, mu, log_amplitude)
+
+    @property
+    def frame(self):
+        return np.array([self.x, self.y, self.z])
+
+    @property
+    def amplitude(self):
+        return math.exp(self.log_amplitude)
+
+    def to_c(self):
+        return vsgl_asg(vsgl_vec3(*self.x), vsgl_vec3(*self.y), vsgl_vec3(*self.z),
+                        self.lam, self.mu, self.log_amplitude)
+
+    @classmethod
+    def from_c(cls, a):
+        return cls(_tuple3(a.x), _tuple3(a.y), _tuple3(a.z), a.lambda_, a.mu, a.log_amplitude)
+
+
+def _sg(g):
+    if isinstance(g, vsgl_sg):
+        return g
+    if isinstance(g, SG):
+        return g.to_c()
+    raise TypeError("expected an SG, got %s" % type(g).__name__)
+
+
+def _asg(a):
+    if isinstance(a, vsgl_asg):
+        return a
+    if isinstance(a, ASG):
+        return a.to_c()
+    raise TypeError("expected an ASG, got %s" % type(a).__name__)
+
+
+def _eval_dirs(fn, lobe, dirs):
+    d = np.asarray(dirs, dtype=np.float64)
+    if d.shape == (3,):
+        return float(fn(ctypes.byref(lobe), ctypes.byref(_vec3(d, "dir"))))
+    if d.ndim < 1 or d.shape[-1] != 3:
+        raise ValueError("dir must have shape (3,) or (..., 3), got %s" % (d.shape,))
+    flat = d.reshape(-1, 3)
+    out = np.empty(len(flat))
+    v = vsgl_vec3()
+    ref, vref = ctypes.byref(lobe), ctypes.byref(v)
+    for i, (x, y, z) in enumerate(flat.tolist()):
+        v.x, v.y, v.z = x, y, z
+        out[i] = fn(ref, vref)
+    return out.reshape(d.shape[:-1])
+
+
+def sg_eval(g, dir):
+    """G(dir); ``dir`` of shape (3,) gives a float, (..., 3) an array."""
+    return _eval_dirs(library().vsgl_sg_eval, _sg(g), dir)
+
+
+def sg_integral(sharpness):
+    """Integral over the sphere of exp(sharpness (w.xi - 1)), steradians."""
+    return float(library().vsgl_sg_integral(float(sharpness)))
+
+
+def sg_lobe_integral(g):
+    return float(library().vsgl_sg_lobe_integral(ctypes.byref(_sg(g))))
+
+
+def sg_product(a, b):
+    out = vsgl_sg()
+    library().vsgl_sg_product(ctypes.byref(_sg(a)), ctypes.byref(_sg(b)), ctypes.byref(out))
+    return SG.from_c(out)
+
+
+def sg_product_integral(a, b):
+    return float(library().vsgl_sg_product_integral(ctypes.byref(_sg(a)), ctypes.byref(_sg(b))))
+
+
+def sg_product_integral_iwasaki(a, b):
+    return float(library().vsgl_sg_product_integral_iwasaki(ctypes.byref(_sg(a)),
+                                                            ctypes.byref(_sg(b))))
+
+
+def sg_cosine_sharpness():
+    return float(library().vsgl_sg_cosine_sharpness())
+
+
+def sg_cosine_integral(g, n, mode=CosineMode.ACCURATE):
+    """Integral of G(w) max(w.n, 0); ``mode`` a CosineMode, int or name."""
+    return float(library().vsgl_sg_cosine_integral(
+        ctypes.byref(_sg(g)), ctypes.byref(_vec3(n, "n")), _enum(mode, CosineMode, "mode")))
+
+
+def sharpness_from_mean_length(r, estimator=SharpnessEstimator.TOKSVIG):
+    return float(library().vsgl_sharpness_from_mean_length(
+        float(r), _enum(estimator, SharpnessEstimator, "estimator")))
+
+
+def mean_length_from_sharpness(sharpness, estimator=SharpnessEstimator.TOKSVIG):
+    return float(library().vsgl_mean_length_from_sharpness(
+        float(sharpness), _enum(estimator, SharpnessEstimator, "estimator")))
+
+
+def asg_eval(a, dir):
+    """ASG(dir); ``dir`` of shape (3,) gives a float, (..., 3) an array."""
+    return _eval_dirs(library().vsgl_asg_eval, _asg(a), dir)
+
+
+def asg_bessel_f(a):
+    """F(a) = integral_0^{2pi} exp(-a cos^2 phi) dphi."""
+    return float(library().vsgl_asg_bessel_f(float(a)))
+
+
+def asg_integral(a):
+    return float(library().vsgl_asg_integral(ctypes.byref(_asg(a))))
+
+
+def asg_integral_approx(a):
+    return float(library().vsgl_asg_integral_approx(ctypes.byref(_asg(a))))
+
+
+def asg_product(a, b):
+    out = vsgl_asg()
+    library().vsgl_asg_product(ctypes.byref(_asg(a)), ctypes.byref(_asg(b)), ctypes.byref(out))
+    return ASG.from_c(out)
+
+
+def asg_convolve_sg(a, kernel):
+    out = vsgl_asg()
+    library().vsgl_asg_convolve_sg(ctypes.byref(_asg(a)), ctypes.byref(_sg(kernel)),
+                                   ctypes.byref(out))
+    return ASG.from_c(out)
+
+
+def asg_sg_product_integral(a, g):
+    return float(library().vsgl_asg_sg_product_integral(ctypes.byref(_asg(a)),
+                                                        ctypes.byref(_sg(g))))
+
+
+def sg_to_asg(g):
+    out = vsgl_asg()
+    library().vsgl_sg_to_asg(ctypes.byref(_sg(g)), ctypes.byref(out))
+    return ASG.from_c(out)
+
+
+# lobes.h
+
+def lambert_to_sg(n):
+    out = vsgl_sg()
+    library().vsgl_lambert_to_sg(ctypes.byref(_vec3(n, "n")), ctypes.byref(out))
+    return SG.from_c(out)
+
+
+def ndf_sharpness(alpha):
+    return float(library().vsgl_ndf_sharpness(float(alpha)))
+
+
+def ndf_to_sg(n, alpha, ndf=NDF.GGX):
+    out = vsgl_sg()
+    library().vsgl_ndf_to_sg(ctypes.byref(_vec3(n, "n")), float(alpha),
+                             _enum(ndf, NDF, "ndf"), ctypes.byref(out))
+    return SG.from_c(out)
+
+
+def ndf_aniso_to_asg(n, tangent, alpha_x, alpha_y):
+    out = vsgl_asg()
+    library().vsgl_ndf_aniso_to_asg(ctypes.byref(_vec3(n, "n")),
+                                    ctypes.byref(_vec3(tangent, "tangent")),
+                                    float(alpha_x), float(alpha_y), ctypes.byref(out))
+    return ASG.from_c(out)
+
+
+def warp_ndf_sg(ndf, view):
+    out = vsgl_sg()
+    library().vsgl_warp_ndf_sg(ctypes.byref(_sg(ndf)), ctypes.byref(_vec3(view, "view")),
+                               ctypes.byref(out))
+    return SG.from_c(out)
+
+
+def warp_ndf_asg(ndf, view):
+    out = vsgl_asg()
+    library().vsgl_warp_ndf_asg(ctypes.byref(_asg(ndf)), ctypes.byref(_vec3(view, "view")),
+                                ctypes.byref(out))
+    return ASG.from_c(out)
+
+
+def specular_factor(n, view, light, alpha, f0):
+    return float(library().vsgl_specular_factor(
+        ctypes.byref(_vec3(n, "n")), ctypes.byref(_vec3(view, "view")),
+        ctypes.byref(_vec3(light, "light")), float(alpha), float(f0)))
+
+
+def ward_to_asg(n, x, alpha_x, alpha_y):
+    out = vsgl_asg()
+    library().vsgl_ward_to_asg(ctypes.byref(_vec3(n, "n")), ctypes.byref(_vec3(x, "x")),
+                               float(alpha_x), float(alpha_y), ctypes.byref(out))
+    return ASG.from_c(out)
+
+
+def ashikhmin_shirley_to_asg(n, u, n_u, n_v):
+    out = vsgl_asg()
+    library().vsgl_ashikhmin_shirley_to_asg(ctypes.byref(_vec3(n, "n")),
+                                            ctypes.byref(_vec3(u, "u")),
+                                            float(n_u), float(n_v), ctypes.byref(out))
+    return ASG.from_c(out)
+
+
+# --------------------------------------------------------------------------
+# Context
+# --------------------------------------------------------------------------
+
+
+def _log_trampoline(ctx_ref):
+    def log(user, level, message):
+        ctx = ctx_ref()
+        try:
+            if ctx is not None and ctx._log is not None:
+                ctx._log(int(level), message.decode("utf-8", "replace") if message else "")
+        except KeyboardInterrupt:
+            if ctx is not None:
+                ctx._interrupted = True
+        except BaseException:
+            _logger.exception("vsgl log callback raised (ignored)")
+    return LOG_FN(log)
+
+
+def _progress_trampoline(ctx_ref):
+    def progress(user, stage, fraction):
+        ctx = ctx_ref()
+        if ctx is None:
+            return 0
+        if ctx._interrupted:
+            return 1
+        try:
+            if ctx._progress is not None:
+                return 1 if ctx._progress(stage.decode("utf-8", "replace") if stage else "",
+                                          float(fraction)) else 0
+        except KeyboardInterrupt:
+            ctx._interrupted = True
+            return 1
+        except BaseException:
+            _logger.exception("vsgl progress callback raised (ignored)")
+        return 0
+    return PROGRESS_FN(progress)
+
+
+class Context:
+    """A vsgl_context: thread count, callbacks, last error.
+
+    ``log(level, message)`` receives the library's log lines (levels are
+    LogLevel); ``progress(stage, fraction)`` returns True to cancel. An
+    exception inside a callback never reaches C: it is logged to the
+    ``vsgl_indirect.libvsgl`` logger; a KeyboardInterrupt cancels the
+    running call and is re-raised when it returns. Use as a context manager
+    or call close(); ``__del__`` also destroys it.
+    """
+
+    _handle = None
+
+    def __init__(self, thread_count=0, log=None, log_level=None, progress=None,
+                 desc_size=None):
+        lib = library()
+        self._lib = lib
+        self._log, self._progress = log, progress
+        self._interrupted = False
+        desc = vsgl_context_desc()
+        if int(thread_count) < 0:
+            raise ValueError("thread_count must be >= 0 (0 = all cores), got %r" % thread_count)
+        desc.thread_count = int(thread_count)
+        if log_level is not None:
+            desc.log_level = _enum(log_level, LogLevel, "log_level")
+        if desc_size is not None:  # for tests of the size check
+            desc.size = int(desc_size)
+        ref = weakref.ref(self)
+        self._log_cb = _log_trampoline(ref) if log is not None else None
+        self._progress_cb = _progress_trampoline(ref)  # also carries KeyboardInterrupts
+        if self._log_cb is not None:
+            desc.log = self._log_cb
+        desc.progress = self._progress_cb
+        handle = ctypes.c_void_p()
+        rc = lib.vsgl_context_create(ctypes.byref(desc), ctypes.byref(handle))
+        if rc != 0:
+            raise VsglError(rc, "", "vsgl_context_create")
+        self._handle = handle
+
+    @property
+    def handle(self):
+        if self._handle is None:
+            raise ValueError("the vsgl context is closed")
+        return self._handle
+
+    @property
+    def last_error(self):
+        """Message of the last failed call on this context ("" if none)."""
+        if self._handle is None:
+            return ""
+        return self._lib.vsgl_context_last_error(self._handle).decode("utf-8", "replace")
+
+    @property
+    def thread_count(self):
+        return int(self._lib.vsgl_context_thread_count(self.handle))
+
+    def check(self, rc, function=""):
+        """Raise for a vsgl_result (and re-raise a KeyboardInterrupt from a callback)."""
+        if self._interrupted:
+            self._interrupted = False
+            raise KeyboardInterrupt
+        if rc != 0:
+            cls = VsglCancelledError if rc == Result.ERROR_CANCELLED else VsglError
+            raise cls(rc, self.last_error, function)
+
+    def close(self):
+        h, self._handle = self._handle, None
+        if h is not None:
+            self._lib.vsgl_context_destroy(h)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+# --------------------------------------------------------------------------
+# Scene
+# --------------------------------------------------------------------------
+
+
+def _check_array(a, name, dtype, shapes, required=False):
+    """Validate dtype, shape (one of ``shapes``) and C-contiguity; no copies."""
+    if a is None:
+        if required:
+            raise ValueError("%s is required" % name)
+        return None
+    dt = np.dtype(dtype)
+    if not isinstance(a, np.ndarray):
+        raise TypeError("%s must be a numpy.ndarray of %s, got %s (use np.ascontiguousarray"
+                        "(%s, dtype=np.%s))" % (name, dt.name, type(a).__name__, name, dt.name))
+    if a.dtype != dt:
+        raise TypeError("%s must have dtype %s, got %s (use np.ascontiguousarray(%s, "
+                        "dtype=np.%s))" % (name, dt.name, a.dtype, name, dt.name))
+    if a.shape not in shapes:
+        raise ValueError("%s must have shape %s, got %s" % (
+            name, " or ".join(str(s) for s in shapes), a.shape))
+    if not (a.flags.c_contiguous and a.flags.aligned):
+        raise ValueError("%s must be C-contiguous and aligned (use np.ascontiguousarray(%s))"
+                         % (name, name))
+    return a
+
+
+def _ptr(a, ctype):
+    return None if a is None else a.ctypes.data_as(ctypes.POINTER(ctype))
+
+
+def _struct_array(items, cls, name):
+    items = list(items or ())
+    for i, it in enumerate(items):
+        if not isinstance(it, cls):
+            raise TypeError("%s[%d] must be a libvsgl.%s, got %s"
+                            % (name, i, cls.__name__, type(it).__name__))
+    return (cls * len(items))(*items) if items else None
+
+
+def _u32_count(n, name):
+    if n > 0xFFFFFFFF:
+        raise ValueError("%s: %d exceeds the uint32 limit" % (name, n))
+    return n
+
+
+def _build_scene_desc(positions, indices, corner_normals=None, corner_uvs=None,
+                      corner_tangents=None, material_indices=None, materials=(),
+                      lights=(), camera=None):
+    """Validate numpy inputs and fill a vsgl_scene_desc. Returns (desc, keep)
+    where ``keep`` holds every object the desc points into."""
+    if not isinstance(positions, np.ndarray) or positions.ndim != 2:
+        _check_array(positions, "positions", np.float32, [("V", 3)])
+    V = positions.shape[0]
+    positions = _check_array(positions, "positions", np.float32, [(V, 3)], True)
+    if not isinstance(indices, np.ndarray) or indices.ndim != 2:
+        _check_array(indices, "indices", np.uint32, [("T", 3)], True)
+    T = indices.shape[0]
+    indices = _check_array(indices, "indices", np.uint32, [(T, 3)], True)
+    corner_normals = _check_array(corner_normals, "corner_normals", np.float32,
+                                  [(T, 3, 3), (T, 9)])
+    corner_uvs = _check_array(corner_uvs, "corner_uvs", np.float32, [(T, 3, 2), (T, 6)])
+    corner_tangents = _check_array(corner_tangents, "corner_tangents", np.float32,
+                                   [(T, 3, 4), (T, 12)])
+    material_indices = _check_array(material_indices, "material_indices", np.uint32, [(T,)])
+    mats = _struct_array(materials, vsgl_material, "materials")
+    lits = _struct_array(lights, vsgl_light, "lights")
+    if camera is None:
+        raise ValueError("camera is required (a libvsgl.Camera)")
+    if not isinstance(camera, vsgl_camera):
+        raise TypeError("camera must be a libvsgl.Camera, got %s" % type(camera).__name__)
+    desc = vsgl_scene_desc(
+        vertex_count=_u32_count(V, "vertex count"),
+        triangle_count=_u32_count(T, "triangle count"),
+        material_count=len(mats) if mats is not None else 0,
+        light_count=len(lits) if lits is not None else 0)
+    desc.positions = _ptr(positions, ctypes.c_float)
+    desc.indices = _ptr(indices, ctypes.c_uint32)
+    desc.corner_normals = _ptr(corner_normals, ctypes.c_float)
+    desc.corner_uvs = _ptr(corner_uvs, ctypes.c_float)
+    desc.corner_tangents = _ptr(corner_tangents, ctypes.c_float)
+    desc.material_indices = _ptr(material_indices, ctypes.c_uint32)
+    if mats is not None:
+        desc.materials = ctypes.cast(mats, ctypes.POINTER(vsgl_material))
+    if lits is not None:
+        desc.lights = ctypes.cast(lits, ctypes.POINTER(vsgl_light))
+    desc.camera = ctypes.pointer(camera)
+    keep = (positions, indices, corner_normals, corner_uvs, corner_tangents,
+            material_indices, mats, lits, camera)
+    return desc, keep
+
+
+class Scene:
+    """A validated vsgl_scene built from numpy arrays (zero-copy: read during
+    construction only).
+
+    positions (V,3) float32; indices (T,3) uint32; optional corner_normals
+    (T,3,3) float32, corner_uvs (T,3,2), corner_tangents (T,3,4),
+    material_indices (T,) uint32; materials: sequence of Material; lights:
+    sequence of Light; camera: Camera. Raises TypeError/ValueError for
+    bad arrays and VsglError (with the library's message) for bad content.
+    """
+
+    _handle = None
+
+    def __init__(self, ctx, positions, indices, corner_normals=None, corner_uvs=None,
+                 corner_tangents=None, material_indices=None, materials=(), lights=(),
+                 camera=None):
+        desc, keep = _build_scene_desc(positions, indices, corner_normals, corner_uvs,
+                                       corner_tangents, material_indices, materials,
+                                       lights, camera)
+        self._ctx = ctx  # destroy the scene before its context
+        self._lib = ctx._lib
+        fn = self._lib.vsgl_scene_create  # raises VsglMissingSymbolError if absent
+        handle = ctypes.c_void_p()
+        rc = fn(ctx.handle, ctypes.byref(desc), ctypes.byref(handle))
+        del keep
+        ctx.check(rc, "vsgl_scene_create")
+        self._handle = handle
+        self.width, self.height = int(camera.width), int(camera.height)
+
+    @property
+    def handle(self):
+        if self._handle is None:
+            raise ValueError("the vsgl scene is closed")
+        return self._handle
+
+    def info(self):
+        """Counts after validation, as a dict (bounds as 3-tuples)."""
+        info = vsgl_scene_info()
+        rc = self._lib.vsgl_scene_get_info(self.handle, ctypes.byref(info))
+        self._ctx.check(rc, "vsgl_scene_get_info")
+        d = info.as_dict()
+        d["bounds_min"], d["bounds_max"] = tuple(d["bounds_min"]), tuple(d["bounds_max"])
+        return d
+
+    def close(self):
+        h, self._handle = self._handle, None
+        if h is not None:
+            self._lib.vsgl_scene_destroy(h)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+# --------------------------------------------------------------------------
+# Render
+# --------------------------------------------------------------------------
+
+
+def render_settings_preset(preset=Preset.BALANCED):
+    out = vsgl_render_settings()
+    library().vsgl_render_settings_preset(_enum(preset, Preset, "preset"), ctypes.byref(out))
+    return out
+
+
+def _settings(settings):
+    if settings is None:
+        return vsgl_render_settings()
+    if isinstance(settings, vsgl_render_settings):
+        return settings
+    if isinstance(settings, dict):
+        return vsgl_render_settings(**settings)
+    raise TypeError("settings must be a RenderSettings, a dict of its fields or None")
+
+
+def _stats_dict(stats):
+    d = stats.as_dict()
+    d["skipped"] = stats.skipped.decode("utf-8", "replace")
+    return d
+
+
+def render(ctx, scene, settings=None, planes=PLANES):
+    """Render the indirect planes of ``scene``.
+
+    ``settings``: RenderSettings, a dict of its fields, or None (defaults).
+    ``planes``: names from PLANES. Returns ``(images, stats)``: images maps
+    each plane to a float32 array (H, W, 3) ((H, W) for "alpha"), rows from
+    the top; stats is a dict of vsgl_render_stats (``skipped`` a str).
+    """
+    planes = tuple(planes)
+    for p in planes:
+        if p not in PLANES:
+            raise ValueError("unknown plane %r (one of %s)" % (p, ", ".join(PLANES)))
+    s = _settings(settings)
+    fn = ctx._lib.vsgl_render
+    H, W = scene.height, scene.width
+    images = {p: np.zeros((H, W) if p == "alpha" else (H, W, 3), np.float32) for p in planes}
+    out = vsgl_render_output(width=W, height=H)
+    for p, a in images.items():
+        setattr(out, p, a.ctypes.data_as(_PF32))
+    stats = vsgl_render_stats()
+    rc = fn(ctx.handle, scene.handle, ctypes.byref(s), ctypes.byref(out), ctypes.byref(stats))
+    ctx.check(rc, "vsgl_render")
+    return images, _stats_dict(stats)
+
+
+# --------------------------------------------------------------------------
+# Files (io.h)
+# --------------------------------------------------------------------------
+
+
+def _path(p):
+    return os.fsencode(p)
+
+
+def check_output_path(ctx, path):
+    """Raise VsglError if ``path`` cannot be written by the atomic writers."""
+    rc = ctx._lib.vsgl_check_output_path(ctx.handle, _path(path))
+    ctx.check(rc, "vsgl_check_output_path")
+
+
+def _exr_options(layer=None, pixel_type=ExrPixelType.FLOAT, compression=ExrCompression.ZIP,
+                 metadata=None):
+    keep = []
+    opt = vsgl_exr_options(pixel_type=pixel_type, compression=compression)
+    if layer is not None:
+        opt.layer = layer.encode()
+    if metadata:
+        items = [vsgl_exr_metadata(key=str(k).encode(), value=str(v).encode())
+                 for k, v in dict(metadata).items()]
+        arr = (vsgl_exr_metadata * len(items))(*items)
+        keep.append(arr)
+        opt.metadata_count = len(items)
+        opt.metadata = ctypes.cast(arr, ctypes.POINTER(vsgl_exr_metadata))
+    return opt, keep
+
+
+def exr_write(ctx, path, passes, layer=None, pixel_type="float", compression="zip",
+              metadata=None):
+    """Write a multilayer EXR. ``passes`` maps pass name -> float32 array of
+    shape (H, W, C) with C in 1..4 (or (H, W) for one channel), or to a
+    tuple (array, channels) such as (a, "RGBA"). Default channel letters:
+    "V", "??", "RGB", "RGBA" for 1..4 channels (2 needs explicit names)."""
+    passes = dict(passes)
+    if not passes:
+        raise ValueError("exr_write needs at least one pass")
+    arrays, c_passes, H, W = [], [], None, None
+    for name, spec in passes.items():
+        arr, chans = (spec if isinstance(spec, tuple) else (spec, None))
+        if not isinstance(arr, np.ndarray):
+            raise TypeError("pass %s must be a numpy.ndarray of float32" % name)
+        if arr.ndim == 2:
+            arr = arr[:, :, None]
+        if arr.ndim != 3 or not 1 <= arr.shape[2] <= EXR_MAX_CHANNELS:
+            raise ValueError("pass %s must have shape (H, W) or (H, W, 1..4), got %s"
+                             % (name, arr.shape))
+        _check_array(arr, "pass %s" % name, np.float32, [arr.shape])
+        if H is None:
+            H, W = arr.shape[:2]
+        elif arr.shape[:2] != (H, W):
+            raise ValueError("pass %s is %dx%d, the first pass %dx%d"
+                             % (name, arr.shape[1], arr.shape[0], W, H))
+        C = arr.shape[2]
+        if chans is None:
+            chans = {1: "V", 3: "RGB", 4: "RGBA"}.get(C)
+            if chans is None:
+                raise ValueError("pass %s has 2 channels: give their letters, (array, 'XY')"
+                                 % name)
+        if len(chans) != C:
+            raise ValueError("pass %s: %d channel letters for %d channels" % (name, len(chans), C))
+        p = vsgl_exr_pass(name=name.encode(), channels=chans.encode())
+        base = arr.ctypes.data
+        for c in range(C):
+            p.data[c] = ctypes.cast(base + 4 * c, _PF32)
+            p.stride[c] = C
+        arrays.append(arr)
+        c_passes.append(p)
+    parr = (vsgl_exr_pass * len(c_passes))(*c_passes)
+    opt, keep = _exr_options(layer, pixel_type, compression, metadata)
+    rc = ctx._lib.vsgl_exr_write(ctx.handle, _path(path), W, H, parr, len(c_passes),
+                                 ctypes.byref(opt))
+    del arrays, keep
+    ctx.check(rc, "vsgl_exr_write")
+
+
+def exr_write_render(ctx, path, images, layer=None, pixel_type="float", compression="zip",
+                     metadata=None):
+    """Write the planes returned by :func:`render` with the standard pass names."""
+    H = W = None
+    out = vsgl_render_output()
+    kept = []
+    for p, arr in images.items():
+        if p not in PLANES:
+            raise ValueError("unknown plane %r (one of %s)" % (p, ", ".join(PLANES)))
+        if not isinstance(arr, np.ndarray) or arr.ndim not in (2, 3):
+            raise TypeError("plane %s must be a numpy array (H, W[, 3])" % p)
+        if H is None:
+            H, W = arr.shape[:2]
+        shape = (H, W) if p == "alpha" else (H, W, 3)
+        _check_array(arr, "plane %s" % p, np.float32, [shape])
+        setattr(out, p, arr.ctypes.data_as(_PF32))
+        kept.append(arr)
+    if H is None:
+        raise ValueError("exr_write_render needs at least one plane")
+    out.width, out.height = W, H
+    opt, keep = _exr_options(layer, pixel_type, compression, metadata)
+    rc = ctx._lib.vsgl_exr_write_render(ctx.handle, _path(path), ctypes.byref(out),
+                                        ctypes.byref(opt))
+    del kept, keep
+    ctx.check(rc, "vsgl_exr_write_render")
+
+
+def _bundle_options(output_path=None, frame=None):
+    opt = vsgl_bundle_options()
+    if output_path is not None:
+        opt.output_path = os.fsencode(output_path)
+    if frame is not None:
+        opt.has_frame, opt.frame = 1, int(frame)
+    return opt
+
+
+def bundle_write(ctx, path, scene_arrays, settings=None, output_path=None, frame=None):
+    """Write a scene bundle. ``scene_arrays``: a dict of Scene's keyword
+    arguments (positions, indices, ..., camera)."""
+    desc, keep = _build_scene_desc(**scene_arrays)
+    s = _settings(settings)
+    opt = _bundle_options(output_path, frame)
+    rc = ctx._lib.vsgl_bundle_write(ctx.handle, _path(path), ctypes.byref(desc),
+                                    ctypes.byref(s), ctypes.byref(opt))
+    del keep
+    ctx.check(rc, "vsgl_bundle_write")
+
+
+def bundle_write_memory(ctx, scene_arrays, settings=None, output_path=None, frame=None):
+    """The bundle as bytes (see bundle_write)."""
+    desc, keep = _build_scene_desc(**scene_arrays)
+    s = _settings(settings)
+    opt = _bundle_options(output_path, frame)
+    fn = ctx._lib.vsgl_bundle_write_memory
+    size = ctypes.c_size_t()
+    rc = fn(ctx.handle, ctypes.byref(desc), ctypes.byref(s), ctypes.byref(opt), None, 0,
+            ctypes.byref(size))
+    ctx.check(rc, "vsgl_bundle_write_memory")
+    buf = ctypes.create_string_buffer(size.value)
+    rc = fn(ctx.handle, ctypes.byref(desc), ctypes.byref(s), ctypes.byref(opt), buf,
+            size.value, ctypes.byref(size))
+    del keep
+    ctx.check(rc, "vsgl_bundle_write_memory")
+    return buf.raw[:size.value]
+
+
+def _copy(ptr, count, dtype, shape):
+    if not ptr or count == 0:
+        return None
+    return np.ctypeslib.as_array(ptr, shape=(count,)).astype(dtype, copy=True).reshape(shape)
+
+
+def _read_bundle(ctx, handle):
+    lib = ctx._lib
+    try:
+        d = lib.vsgl_bundle_scene(handle).contents
+        T, V = d.triangle_count, d.vertex_count
+        scene = {
+            "positions": _copy(d.positions, V * 3, np.float32, (V, 3)),
+            "indices": _copy(d.indices, T * 3, np.uint32, (T, 3)),
+            "corner_normals": _copy(d.corner_normals, T * 9, np.float32, (T, 3, 3)),
+            "corner_uvs": _copy(d.corner_uvs, T * 6, np.float32, (T, 3, 2)),
+            "corner_tangents": _copy(d.corner_tangents, T * 12, np.float32, (T, 3, 4)),
+            "material_indices": _copy(d.material_indices, T, np.uint32, (T,)),
+            "materials": [vsgl_material.from_buffer_copy(d.materials[i])
+                          for i in range(d.material_count)],
+            "lights": [vsgl_light.from_buffer_copy(d.lights[i]) for i in range(d.light_count)],
+            "camera": vsgl_camera.from_buffer_copy(d.camera.contents) if d.camera else None,
+        }
+        if scene["positions"] is None:
+            scene["positions"] = np.zeros((0, 3), np.float32)
+        if scene["indices"] is None:
+            scene["indices"] = np.zeros((0, 3), np.uint32)
+        settings = vsgl_render_settings.from_buffer_copy(lib.vsgl_bundle_settings(handle).contents)
+        info = vsgl_bundle_info()
+        ctx.check(lib.vsgl_bundle_get_info(handle, ctypes.byref(info)), "vsgl_bundle_get_info")
+        info = info.as_dict()
+        return scene, settings, info
+    finally:
+        lib.vsgl_bundle_destroy(handle)
+
+
+def bundle_read(ctx, path):
+    """Read a bundle file: returns (scene_arrays, settings, info); the arrays
+    are copies (scene_arrays can be passed to Scene(ctx, **scene_arrays))."""
+    handle = ctypes.c_void_p()
+    rc = ctx._lib.vsgl_bundle_read(ctx.handle, _path(path), ctypes.byref(handle))
+    ctx.check(rc, "vsgl_bundle_read")
+    return _read_bundle(ctx, handle)
+
+
+def bundle_read_memory(ctx, data):
+    """As bundle_read, from bytes."""
+    data = bytes(data)
+    handle = ctypes.c_void_p()
+    rc = ctx._lib.vsgl_bundle_read_memory(ctx.handle, data, len(data), ctypes.byref(handle))
+    ctx.check(rc, "vsgl_bundle_read_memory")
+    return _read_bundle(ctx, handle)
