@@ -19,4 +19,5 @@
 #include "vsgl/lobes.h"
 #include "vsgl/scene.h"
 #include "vsgl/render.h"
+#include "vsgl/io.h"
 #endif

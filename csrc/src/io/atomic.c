@@ -1,0 +1,200 @@
+/* Atomic file replacement: temp file beside the target, fsync, rename, fsync dir. */
+#include "io/atomic.h"
+#include "core/context.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+static char *dup_string(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d)
+        memcpy(d, s, n);
+    return d;
+}
+
+/* Directory part of path ("." if none); caller frees. */
+static char *dir_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        return dup_string(".");
+    if (slash == path)
+        return dup_string("/");
+    size_t n = (size_t)(slash - path);
+    char *d = malloc(n + 1);
+    if (d) {
+        memcpy(d, path, n);
+        d[n] = '\0';
+    }
+    return d;
+}
+
+static void free_file(vsgl__atomic_file *f)
+{
+    free(f->target);
+    free(f->temp);
+    f->target = f->temp = NULL;
+    f->fd = -1;
+}
+
+vsgl_result vsgl__atomic_open(vsgl_context *ctx, const char *path, vsgl__atomic_file *f)
+{
+    f->fd = -1;
+    f->error = 0;
+    f->target = f->temp = NULL;
+    if (!path || !*path)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "output path is empty");
+    size_t len = strlen(path);
+    if (path[len - 1] == '/')
+        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: is a directory", path);
+    struct stat st;
+    if (stat(path, &st) == 0) {
+        if (S_ISDIR(st.st_mode))
+            return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: is a directory", path);
+        if (!S_ISREG(st.st_mode))
+            return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: exists and is not a regular file", path);
+    }
+    char *dir = dir_of(path);
+    if (!dir)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "out of memory");
+    const char *why = NULL;
+    if (stat(dir, &st) != 0)
+        why = strerror(errno);
+    else if (!S_ISDIR(st.st_mode))
+        why = "is not a directory";
+    if (why) {
+        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: directory %s: %s", path, dir, why);
+        free(dir);
+        return r;
+    }
+    free(dir);
+
+    const char *base = strrchr(path, '/');
+    size_t dir_len = base ? (size_t)(base - path) + 1 : 0;
+    base = base ? base + 1 : path;
+    size_t cap = len + 64;
+    f->target = dup_string(path);
+    f->temp = malloc(cap);
+    if (!f->target || !f->temp) {
+        free_file(f);
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "out of memory");
+    }
+    /* ".<name>.tmp-<pid>-<ns>-<try>": unique per process and attempt; O_EXCL guarantees it. */
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    int e = 0;
+    for (unsigned attempt = 0; attempt < 100; ++attempt) {
+        snprintf(f->temp, cap, "%.*s.%s.tmp-%ld-%09ld-%u", (int)dir_len, path, base,
+                 (long)getpid(), (long)ts.tv_nsec, attempt);
+        f->fd = open(f->temp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (f->fd >= 0)
+            return VSGL_OK;
+        e = errno;
+        if (e != EEXIST)
+            break;
+    }
+    vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: cannot create a file in its directory: %s",
+                               path, strerror(e));
+    free_file(f);
+    return r;
+}
+
+int vsgl__atomic_pwrite(vsgl__atomic_file *f, const void *buf, size_t n, uint64_t offset)
+{
+    const unsigned char *p = buf;
+    while (n > 0) {
+        ssize_t w = pwrite(f->fd, p, n, (off_t)offset);
+        if (w < 0) {
+            if (errno == EINTR)
+                continue;
+            if (!f->error)
+                f->error = errno;
+            return -1;
+        }
+        if (w == 0) {
+            if (!f->error)
+                f->error = EIO;
+            return -1;
+        }
+        p += w;
+        n -= (size_t)w;
+        offset += (uint64_t)w;
+    }
+    return 0;
+}
+
+void vsgl__atomic_abort(vsgl__atomic_file *f)
+{
+    if (f->fd >= 0)
+        close(f->fd);
+    if (f->temp)
+        unlink(f->temp);
+    free_file(f);
+}
+
+vsgl_result vsgl__atomic_commit(vsgl_context *ctx, vsgl__atomic_file *f)
+{
+    if (f->error) {
+        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: write failed: %s", f->target, strerror(f->error));
+        vsgl__atomic_abort(f);
+        return r;
+    }
+    if (fsync(f->fd) != 0) {
+        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: fsync failed: %s", f->target, strerror(errno));
+        vsgl__atomic_abort(f);
+        return r;
+    }
+    int fd = f->fd;
+    f->fd = -1;
+    if (close(fd) != 0) {
+        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: close failed: %s", f->target, strerror(errno));
+        vsgl__atomic_abort(f);
+        return r;
+    }
+    if (rename(f->temp, f->target) != 0) {
+        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: cannot replace: %s", f->target, strerror(errno));
+        vsgl__atomic_abort(f);
+        return r;
+    }
+    /* Make the rename durable; a failure here does not undo the (complete) file. */
+    char *dir = dir_of(f->target);
+    if (dir) {
+        int dfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (dfd >= 0) {
+            (void)fsync(dfd);
+            close(dfd);
+        }
+        free(dir);
+    }
+    free_file(f);
+    return VSGL_OK;
+}
+
+vsgl_result vsgl__atomic_write_all(vsgl_context *ctx, const char *path, const void *data, size_t n)
+{
+    vsgl__atomic_file f;
+    vsgl_result r = vsgl__atomic_open(ctx, path, &f);
+    if (r)
+        return r;
+    (void)vsgl__atomic_pwrite(&f, data, n, 0);
+    return vsgl__atomic_commit(ctx, &f);
+}
+
+vsgl_result vsgl_check_output_path(vsgl_context *ctx, const char *path)
+{
+    vsgl__clear_error(ctx);
+    vsgl__atomic_file f;
+    vsgl_result r = vsgl__atomic_open(ctx, path, &f);
+    if (r)
+        return r;
+    vsgl__atomic_abort(&f);
+    return VSGL_OK;
+}

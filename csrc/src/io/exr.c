@@ -1,0 +1,381 @@
+/* Multilayer OpenEXR writer on OpenEXR Core's C API, written atomically. */
+#include "vsgl/io.h"
+#include "core/context.h"
+#include "io/atomic.h"
+
+#include <openexr.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_PASSES 64
+#define MAX_NAME 63
+#define MAX_CHANNELS_TOTAL (MAX_PASSES * VSGL_EXR_MAX_CHANNELS)
+
+/* Round-to-nearest-even float -> half. Finite inputs beyond the half range
+ * are clamped to +/-65504 (the writer never stores an infinity). */
+static uint16_t float_to_half(float f)
+{
+    uint32_t x;
+    memcpy(&x, &f, sizeof x);
+    uint32_t sign = (x >> 16) & 0x8000u;
+    uint32_t ax = x & 0x7fffffffu;
+    if (ax >= 0x477fe000u) /* >= 65520: would round to infinity */
+        return (uint16_t)(sign | 0x7bffu);
+    if (ax < 0x38800000u) { /* below 2^-14: half subnormal (or zero), unit 2^-24 */
+        float a;
+        memcpy(&a, &ax, sizeof a);
+        return (uint16_t)(sign | (uint32_t)rintf(a * 0x1p24f)); /* 1024 = smallest normal, encoded right */
+    }
+    uint32_t h = ((((ax >> 23) - 127u + 15u) << 10) | ((ax & 0x7fffffu) >> 13));
+    uint32_t rem = ax & 0x1fffu;
+    if (rem > 0x1000u || (rem == 0x1000u && (h & 1u)))
+        ++h; /* a carry into the exponent is the right result */
+    return (uint16_t)(sign | h);
+}
+
+static int valid_name(const char *s)
+{
+    if (!s || !*s || strlen(s) > MAX_NAME)
+        return 0;
+    for (; *s; ++s) {
+        char c = *s;
+        if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-'))
+            return 0;
+    }
+    return 1;
+}
+
+/* One file channel: where its samples come from. */
+typedef struct src_channel {
+    char name[2 * MAX_NAME + 4];
+    const float *data;
+    size_t stride;
+    const char *pass;
+    char letter;
+} src_channel;
+
+typedef struct exr_sink {
+    vsgl__atomic_file file;
+    char message[256];
+} exr_sink;
+
+static int64_t sink_write(exr_const_context_t c, void *user, const void *buf, uint64_t sz,
+                          uint64_t offset, exr_stream_error_func_ptr_t err)
+{
+    (void)c;
+    (void)err;
+    exr_sink *s = user;
+    if (vsgl__atomic_pwrite(&s->file, buf, (size_t)sz, offset) != 0)
+        return -1;
+    return (int64_t)sz;
+}
+
+static void sink_error(exr_const_context_t c, exr_result_t code, const char *msg)
+{
+    void *user = NULL;
+    if (exr_get_user_data(c, &user) == EXR_ERR_SUCCESS && user) {
+        exr_sink *s = user;
+        if (!s->message[0])
+            snprintf(s->message, sizeof s->message, "%s (%s)", msg ? msg : "", exr_get_error_code_as_string(code));
+    }
+}
+
+static vsgl_result exr_failed(vsgl_context *ctx, exr_sink *s, const char *path, const char *what, exr_result_t rv)
+{
+    if (s->file.error)
+        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: write failed: %s", path, strerror(s->file.error));
+    return vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "%s: OpenEXR %s failed: %s", path, what,
+                      s->message[0] ? s->message : exr_get_default_error_message(rv));
+}
+
+static vsgl_result check_args(vsgl_context *ctx, uint32_t width, uint32_t height,
+                              const vsgl_exr_pass *passes, uint32_t pass_count,
+                              const vsgl_exr_options *o, src_channel *chans, uint32_t *chan_count)
+{
+    if (width < 1 || width > 65535 || height < 1 || height > 65535)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR size %ux%u: width and height must be in [1, 65535]", width, height);
+    if (!passes || pass_count < 1 || pass_count > MAX_PASSES)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR needs 1 to %d passes, got %u%s", MAX_PASSES, pass_count, passes ? "" : " (NULL)");
+    const char *layer = o->layer ? o->layer : "VSGL";
+    if (!valid_name(layer))
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR layer name '%s' must be 1-%d characters of [A-Za-z0-9_-]", layer, MAX_NAME);
+    if (o->pixel_type != VSGL_EXR_FLOAT && o->pixel_type != VSGL_EXR_HALF)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR pixel type %d is not VSGL_EXR_FLOAT or VSGL_EXR_HALF", o->pixel_type);
+    if (o->compression < VSGL_EXR_ZIP || o->compression > VSGL_EXR_PIZ)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR compression %d is unknown", o->compression);
+    if (o->metadata_count && !o->metadata)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR metadata: %u entries but NULL array", o->metadata_count);
+    for (uint32_t i = 0; i < o->metadata_count; ++i) {
+        const vsgl_exr_metadata *m = &o->metadata[i];
+        if (!m->key || !*m->key || strlen(m->key) > 255 || !m->value || strlen(m->value) > 65535)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR metadata %u: key must be 1-255 characters and value non-NULL, <= 65535 bytes", i);
+    }
+    uint32_t n = 0;
+    for (uint32_t p = 0; p < pass_count; ++p) {
+        const vsgl_exr_pass *ps = &passes[p];
+        if (!valid_name(ps->name))
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR pass %u: name '%s' must be 1-%d characters of [A-Za-z0-9_-]",
+                              p, ps->name ? ps->name : "(null)", MAX_NAME);
+        for (uint32_t q = 0; q < p; ++q)
+            if (strcmp(passes[q].name, ps->name) == 0)
+                return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR pass %u: name '%s' is used twice", p, ps->name);
+        const char *letters = ps->channels ? ps->channels : "RGB";
+        size_t nc = strlen(letters);
+        if (nc < 1 || nc > VSGL_EXR_MAX_CHANNELS)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR pass %s: %zu channels, must be 1 to %d", ps->name, nc, VSGL_EXR_MAX_CHANNELS);
+        for (size_t c = 0; c < nc; ++c) {
+            char l = letters[c];
+            if (!((l >= 'A' && l <= 'Z') || (l >= 'a' && l <= 'z')) || memchr(letters, l, c))
+                return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR pass %s: channel letters '%s' must be distinct letters", ps->name, letters);
+            if (!ps->data[c])
+                return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR pass %s: channel %c has NULL data", ps->name, l);
+            src_channel *s = &chans[n++];
+            snprintf(s->name, sizeof s->name, "%s.%s.%c", layer, ps->name, l);
+            s->data = ps->data[c];
+            s->stride = ps->stride[c] ? ps->stride[c] : nc;
+            s->pass = ps->name;
+            s->letter = l;
+        }
+    }
+    *chan_count = n;
+    /* Refuse non-finite samples before any file exists. */
+    for (uint32_t i = 0; i < n; ++i) {
+        const src_channel *s = &chans[i];
+        for (uint32_t y = 0; y < height; ++y)
+            for (uint32_t x = 0; x < width; ++x) {
+                float v = s->data[((size_t)y * width + x) * s->stride];
+                if (!isfinite(v))
+                    return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "pass %s channel %c pixel (%u, %u): %s",
+                                      s->pass, s->letter, x, y, isnan(v) ? "NaN" : (v > 0 ? "+Inf" : "-Inf"));
+            }
+    }
+    return VSGL_OK;
+}
+
+/* Header and pixels into an open sink. */
+static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path, uint32_t width, uint32_t height,
+                             const src_channel *chans, uint32_t n, const vsgl_exr_options *o)
+{
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = sink_error;
+    init.user_data = sink;
+    init.write_fn = sink_write;
+    exr_context_t e = NULL;
+    exr_result_t rv = exr_start_write(&e, path, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv != EXR_ERR_SUCCESS)
+        return exr_failed(ctx, sink, path, "start", rv);
+
+    static const exr_compression_t comp[] = {EXR_COMPRESSION_ZIP, EXR_COMPRESSION_NONE, EXR_COMPRESSION_ZIPS, EXR_COMPRESSION_PIZ};
+    exr_pixel_type_t ptype = o->pixel_type == VSGL_EXR_HALF ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT;
+    size_t bpe = ptype == EXR_PIXEL_HALF ? 2 : 4;
+    int part = 0;
+    const char *what = "header";
+    vsgl_result result = VSGL_OK;
+    unsigned char *scratch = NULL;
+    exr_encode_pipeline_t enc;
+    memset(&enc, 0, sizeof enc);
+    int enc_live = 0;
+
+    rv = exr_add_part(e, NULL, EXR_STORAGE_SCANLINE, &part);
+    if (!rv)
+        rv = exr_initialize_required_attr_simple(e, part, (int32_t)width, (int32_t)height, comp[o->compression]);
+    for (uint32_t i = 0; i < n && !rv; ++i) {
+        int r = exr_add_channel(e, part, chans[i].name, ptype, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+        rv = r;
+    }
+    if (!rv)
+        rv = exr_attr_set_string(e, part, "vsgl.version", vsgl_version_string());
+    for (uint32_t i = 0; i < o->metadata_count && !rv; ++i) {
+        const exr_attribute_t *a = NULL;
+        if (exr_get_attribute_by_name(e, part, o->metadata[i].key, &a) == EXR_ERR_SUCCESS) {
+            result = vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR metadata key '%s' is used twice or is a standard attribute",
+                                o->metadata[i].key);
+            goto done;
+        }
+        rv = exr_attr_set_string(e, part, o->metadata[i].key, o->metadata[i].value);
+    }
+    if (!rv)
+        rv = exr_write_header(e);
+    if (rv)
+        goto exr_error;
+
+    int32_t lines = 0;
+    what = "pixels";
+    rv = exr_get_scanlines_per_chunk(e, part, &lines);
+    if (rv)
+        goto exr_error;
+    scratch = malloc((size_t)n * width * (size_t)lines * bpe);
+    if (!scratch) {
+        result = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "%s: out of memory for %d scanlines", path, lines);
+        goto done;
+    }
+    for (uint32_t y0 = 0; y0 < height; y0 += (uint32_t)lines) {
+        exr_chunk_info_t ci;
+        rv = exr_write_scanline_chunk_info(e, part, (int)y0, &ci);
+        if (rv)
+            goto exr_error;
+        rv = enc_live ? exr_encoding_update(e, part, &ci, &enc) : exr_encoding_initialize(e, part, &ci, &enc);
+        if (rv)
+            goto exr_error;
+        int first = !enc_live;
+        enc_live = 1;
+        uint32_t rows = (uint32_t)ci.height;
+        for (int16_t c = 0; c < enc.channel_count; ++c) {
+            exr_coding_channel_info_t *ch = &enc.channels[c];
+            uint32_t k = 0;
+            while (k < n && strcmp(chans[k].name, ch->channel_name) != 0)
+                ++k;
+            if (k == n) {
+                result = vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "%s: OpenEXR reported unknown channel %s", path, ch->channel_name);
+                goto done;
+            }
+            unsigned char *dst = scratch + (size_t)k * width * (size_t)lines * bpe;
+            const src_channel *s = &chans[k];
+            for (uint32_t r = 0; r < rows; ++r)
+                for (uint32_t x = 0; x < width; ++x) {
+                    float v = s->data[((size_t)(y0 + r) * width + x) * s->stride];
+                    size_t at = ((size_t)r * width + x) * bpe;
+                    if (bpe == 2) {
+                        uint16_t h = float_to_half(v);
+                        memcpy(dst + at, &h, 2);
+                    } else {
+                        memcpy(dst + at, &v, 4);
+                    }
+                }
+            ch->encode_from_ptr = dst;
+            ch->user_pixel_stride = (int32_t)bpe;
+            ch->user_line_stride = (int32_t)(width * bpe);
+            ch->user_bytes_per_element = (int16_t)bpe;
+            ch->user_data_type = (uint16_t)ptype;
+        }
+        if (first) {
+            rv = exr_encoding_choose_default_routines(e, part, &enc);
+            if (rv)
+                goto exr_error;
+        }
+        rv = exr_encoding_run(e, part, &enc);
+        if (rv)
+            goto exr_error;
+    }
+    if (enc_live) {
+        enc_live = 0;
+        rv = exr_encoding_destroy(e, &enc);
+        if (rv)
+            goto exr_error;
+    }
+    what = "finish";
+    rv = exr_finish(&e);
+    e = NULL;
+    if (rv)
+        goto exr_error;
+    goto done;
+
+exr_error:
+    result = exr_failed(ctx, sink, path, what, rv);
+done:
+    if (enc_live)
+        exr_encoding_destroy(e, &enc);
+    if (e)
+        exr_finish(&e);
+    free(scratch);
+    return result;
+}
+
+vsgl_result vsgl_exr_write(vsgl_context *ctx, const char *path, uint32_t width, uint32_t height,
+                           const vsgl_exr_pass *passes, uint32_t pass_count, const vsgl_exr_options *opt)
+{
+    vsgl__clear_error(ctx);
+    vsgl_exr_options o;
+    memset(&o, 0, sizeof o);
+    if (opt) {
+        if (opt->size > sizeof o)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vsgl_exr_options.size %u is larger than this library knows (%zu)",
+                              opt->size, sizeof o);
+        memcpy(&o, opt, opt->size ? opt->size : sizeof o);
+    }
+    if (!path || !*path)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR path is empty");
+    src_channel *chans = calloc(MAX_CHANNELS_TOTAL, sizeof *chans);
+    if (!chans)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "out of memory");
+    uint32_t n = 0;
+    vsgl_result r = check_args(ctx, width, height, passes, pass_count, &o, chans, &n);
+    if (r) {
+        free(chans);
+        return r;
+    }
+    exr_sink sink;
+    memset(&sink, 0, sizeof sink);
+    r = vsgl__atomic_open(ctx, path, &sink.file);
+    if (r) {
+        free(chans);
+        return r;
+    }
+    r = write_exr(ctx, &sink, path, width, height, chans, n, &o);
+    free(chans);
+    if (r) {
+        vsgl__atomic_abort(&sink.file);
+        return r;
+    }
+    return vsgl__atomic_commit(ctx, &sink.file);
+}
+
+vsgl_result vsgl_exr_write_render(vsgl_context *ctx, const char *path, const vsgl_render_output *out,
+                                  const vsgl_exr_options *opt)
+{
+    vsgl__clear_error(ctx);
+    if (!out)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "render output is NULL");
+    vsgl_exr_pass passes[7];
+    memset(passes, 0, sizeof passes);
+    uint32_t n = 0;
+    const struct { const char *name; const float *data; } rgb[6] = {
+        {"DiffInd", out->diffuse_light}, {"GlossInd", out->glossy_light},
+        {"DiffCol", out->diffuse_color}, {"GlossCol", out->glossy_color},
+        {"Diff", out->diffuse},          {"Gloss", out->glossy},
+    };
+    for (int i = 0; i < 6; ++i) {
+        if (!rgb[i].data)
+            continue;
+        vsgl_exr_pass *p = &passes[n++];
+        p->name = rgb[i].name;
+        p->channels = "RGB";
+        for (int c = 0; c < 3; ++c)
+            p->data[c] = rgb[i].data + c;
+    }
+    /* Combined: RGB from `combined`, A from `alpha` (a buffer of ones when absent). */
+    float *ones = NULL;
+    if (out->combined) {
+        vsgl_exr_pass *p = &passes[n++];
+        p->name = "Combined";
+        p->channels = "RGBA";
+        for (int c = 0; c < 3; ++c) {
+            p->data[c] = out->combined + c;
+            p->stride[c] = 3;
+        }
+        if (!out->alpha) {
+            size_t count = (size_t)out->width * out->height;
+            ones = malloc((count ? count : 1) * sizeof *ones);
+            if (!ones)
+                return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "out of memory");
+            for (size_t i = 0; i < count; ++i)
+                ones[i] = 1.0f;
+        }
+        p->data[3] = out->alpha ? out->alpha : ones;
+        p->stride[3] = 1;
+    } else if (out->alpha) {
+        vsgl_exr_pass *p = &passes[n++];
+        p->name = "Combined";
+        p->channels = "A";
+        p->data[0] = out->alpha;
+        p->stride[0] = 1;
+    }
+    if (n == 0)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "render output has no planes to write");
+    vsgl_result r = vsgl_exr_write(ctx, path, out->width, out->height, passes, n, opt);
+    free(ones);
+    return r;
+}

@@ -1,0 +1,609 @@
+/* Multilayer EXR writer: read back with OpenEXR Core's reader (independent
+ * of the writer's packing code), with OpenImageIO's oiiotool, and with
+ * Blender 3.4; atomicity and failure cases. */
+#include "harness.h"
+#include "vsgl.h"
+
+#include <openexr.h>
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+/* ---- helpers ------------------------------------------------------------ */
+
+static void make_temp_dir(char *dir, size_t cap)
+{
+    snprintf(dir, cap, "/tmp/vsgl_exr_XXXXXX");
+    if (!mkdtemp(dir))
+        dir[0] = '\0';
+}
+
+static void remove_tree(const char *dir)
+{
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd) != 0)
+        fprintf(stderr, "    (could not remove %s)\n", dir);
+}
+
+/* Number of entries in dir other than . and .. */
+static int count_entries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    if (!d)
+        return -1;
+    for (struct dirent *e; (e = readdir(d));)
+        if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+            ++n;
+    closedir(d);
+    return n;
+}
+
+/* Run a shell command, capture up to cap-1 bytes of stdout; returns exit status or -1. */
+static int run_capture(const char *cmd, char *out, size_t cap)
+{
+    FILE *p = popen(cmd, "r");
+    if (!p)
+        return -1;
+    size_t n = fread(out, 1, cap - 1, p);
+    out[n] = '\0';
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static int have_tool(const char *name)
+{
+    char cmd[256], out[256];
+    snprintf(cmd, sizeof cmd, "command -v %s >/dev/null 2>&1 && echo yes", name);
+    return run_capture(cmd, out, sizeof out) == 0 && strncmp(out, "yes", 3) == 0;
+}
+
+static int read_file(const char *path, unsigned char **data, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return -1;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    *data = malloc((size_t)n + 1);
+    *size = fread(*data, 1, (size_t)n, f);
+    fclose(f);
+    return 0;
+}
+
+/* A test image: value of pass p, channel c at (x, y); exactly representable in half. */
+static float pattern(int p, int c, int x, int y)
+{
+    return (float)(p * 16 + c * 4) + (float)x * 0.25f + (float)y * 0.125f;
+}
+
+enum { W = 37, H = 23, NP = 3 };
+
+typedef struct image { float rgb[NP - 1][W * H * 3]; float combined[W * H * 3]; float alpha[W * H]; } image;
+
+static void fill(image *im)
+{
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            for (int p = 0; p < NP - 1; ++p)
+                for (int c = 0; c < 3; ++c)
+                    im->rgb[p][(y * W + x) * 3 + c] = pattern(p, c, x, y);
+            for (int c = 0; c < 3; ++c)
+                im->combined[(y * W + x) * 3 + c] = pattern(2, c, x, y);
+            im->alpha[y * W + x] = pattern(2, 3, x, y);
+        }
+}
+
+static vsgl_render_output output_of(image *im)
+{
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = W;
+    o.height = H;
+    o.diffuse_light = im->rgb[0];
+    o.glossy_light = im->rgb[1];
+    o.combined = im->combined;
+    o.alpha = im->alpha;
+    return o;
+}
+
+/* Decode every channel of part 0 as float into planes[channel][y*w+x] (channel order of the file). */
+typedef struct decoded { int count; char names[16][64]; float *planes[16]; int w, h; } decoded;
+
+static int decode_exr(const char *path, decoded *d)
+{
+    memset(d, 0, sizeof *d);
+    exr_context_t e = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    if (exr_start_read(&e, path, &init) != EXR_ERR_SUCCESS)
+        return -1;
+    const exr_attr_chlist_t *cl = NULL;
+    exr_attr_box2i_t dw;
+    int32_t lines = 0;
+    if (exr_get_channels(e, 0, &cl) || exr_get_data_window(e, 0, &dw) || exr_get_scanlines_per_chunk(e, 0, &lines)) {
+        exr_finish(&e);
+        return -2;
+    }
+    d->w = dw.max.x - dw.min.x + 1;
+    d->h = dw.max.y - dw.min.y + 1;
+    d->count = cl->num_channels < 16 ? cl->num_channels : 16;
+    for (int c = 0; c < d->count; ++c) {
+        snprintf(d->names[c], sizeof d->names[c], "%s", cl->entries[c].name.str);
+        d->planes[c] = calloc((size_t)d->w * d->h, sizeof(float));
+    }
+    exr_decode_pipeline_t dec;
+    memset(&dec, 0, sizeof dec);
+    int live = 0, rc = 0;
+    for (int y = dw.min.y; y <= dw.max.y && !rc; y += lines) {
+        exr_chunk_info_t ci;
+        if (exr_read_scanline_chunk_info(e, 0, y, &ci)) { rc = -3; break; }
+        if ((live ? exr_decoding_update(e, 0, &ci, &dec) : exr_decoding_initialize(e, 0, &ci, &dec))) { rc = -4; break; }
+        int first = !live;
+        live = 1;
+        for (int c = 0; c < dec.channel_count; ++c) {
+            int k = 0;
+            while (k < d->count && strcmp(d->names[k], dec.channels[c].channel_name))
+                ++k;
+            dec.channels[c].decode_to_ptr = (uint8_t *)(d->planes[k] + (size_t)(y - dw.min.y) * d->w);
+            dec.channels[c].user_pixel_stride = 4;
+            dec.channels[c].user_line_stride = 4 * d->w;
+            dec.channels[c].user_bytes_per_element = 4;
+            dec.channels[c].user_data_type = EXR_PIXEL_FLOAT;
+        }
+        if (first && exr_decoding_choose_default_routines(e, 0, &dec)) { rc = -5; break; }
+        if (exr_decoding_run(e, 0, &dec)) rc = -6;
+    }
+    if (live)
+        exr_decoding_destroy(e, &dec);
+    exr_finish(&e);
+    return rc;
+}
+
+static void free_decoded(decoded *d)
+{
+    for (int c = 0; c < d->count; ++c)
+        free(d->planes[c]);
+}
+
+static int channel_index(const decoded *d, const char *name)
+{
+    for (int c = 0; c < d->count; ++c)
+        if (strcmp(d->names[c], name) == 0)
+            return c;
+    return -1;
+}
+
+/* ---- round trips -------------------------------------------------------- */
+
+static void check_roundtrip(int pixel_type, double tol)
+{
+    char dir[64], path[128];
+    make_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/out.exr", dir);
+    static image im;
+    fill(&im);
+    vsgl_render_output o = output_of(&im);
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    vsgl_exr_metadata md[2] = {{"vsgl.settings", "aa=2 rsm=256"}, {"vsgl.seconds", "0.125"}};
+    vsgl_exr_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.size = sizeof opt;
+    opt.pixel_type = pixel_type;
+    opt.metadata = md;
+    opt.metadata_count = 2;
+    vsgl_result r = vsgl_exr_write_render(ctx, path, &o, &opt);
+    VT_CHECK(r == VSGL_OK, "write %s: %s", path, vsgl_context_last_error(ctx));
+
+    decoded d;
+    int rc = decode_exr(path, &d);
+    VT_CHECK(rc == 0, "decode %s: %d", path, rc);
+    VT_CHECK(d.w == W && d.h == H, "size %dx%d want %dx%d", d.w, d.h, W, H);
+    static const char *const want[] = {
+        "VSGL.Combined.A", "VSGL.Combined.B", "VSGL.Combined.G", "VSGL.Combined.R",
+        "VSGL.DiffInd.B", "VSGL.DiffInd.G", "VSGL.DiffInd.R",
+        "VSGL.GlossInd.B", "VSGL.GlossInd.G", "VSGL.GlossInd.R"};
+    VT_CHECK(d.count == 10, "channel count %d", d.count);
+    for (int i = 0; i < 10 && i < d.count; ++i)
+        VT_CHECK(strcmp(d.names[i], want[i]) == 0, "channel %d: %s want %s", i, d.names[i], want[i]);
+    const char *passes[3] = {"DiffInd", "GlossInd", "Combined"};
+    int bad = 0;
+    for (int p = 0; p < 3; ++p)
+        for (int c = 0; c < (p == 2 ? 4 : 3); ++c) {
+            char name[64];
+            snprintf(name, sizeof name, "VSGL.%s.%c", passes[p], "RGBA"[c]);
+            int k = channel_index(&d, name);
+            VT_CHECK(k >= 0, "missing %s", name);
+            if (k < 0)
+                continue;
+            for (int y = 0; y < H && bad < 4; ++y)
+                for (int x = 0; x < W && bad < 4; ++x) {
+                    double got = d.planes[k][y * W + x], w = pattern(p, c, x, y);
+                    if (fabs(got - w) > tol * fabs(w)) {
+                        ++bad;
+                        VT_CHECK_ABS(got, w, tol * fabs(w), "%s pixel (%d, %d) type %d", name, x, y, pixel_type);
+                    }
+                }
+        }
+    free_decoded(&d);
+
+    /* Header attributes. */
+    exr_context_t e = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    if (exr_start_read(&e, path, &init) == EXR_ERR_SUCCESS) {
+        const char *s = NULL;
+        int32_t len = 0;
+        VT_CHECK(exr_attr_get_string(e, 0, "vsgl.settings", &len, &s) == 0 && s && strncmp(s, "aa=2 rsm=256", (size_t)len) == 0,
+                 "vsgl.settings = %.*s", len, s ? s : "");
+        VT_CHECK(exr_attr_get_string(e, 0, "vsgl.version", &len, &s) == 0 && s && strncmp(s, vsgl_version_string(), (size_t)len) == 0,
+                 "vsgl.version = %.*s", len, s ? s : "");
+        exr_compression_t comp;
+        VT_CHECK(exr_get_compression(e, 0, &comp) == 0 && comp == EXR_COMPRESSION_ZIP, "compression %d", (int)comp);
+        const exr_attr_chlist_t *cl = NULL;
+        exr_get_channels(e, 0, &cl);
+        VT_CHECK(cl && cl->entries[0].pixel_type == (pixel_type == VSGL_EXR_HALF ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT),
+                 "pixel type %d", cl ? (int)cl->entries[0].pixel_type : -1);
+        exr_finish(&e);
+    }
+    VT_CHECK(count_entries(dir) == 1, "only out.exr left in %s, found %d entries", dir, count_entries(dir));
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
+
+VT_TEST(exr_float_roundtrip_reads_back_exactly_with_openexr_core)
+{
+    check_roundtrip(VSGL_EXR_FLOAT, 0.0);
+}
+
+VT_TEST(exr_half_roundtrip_reads_back_with_openexr_core)
+{
+    /* The pattern values are multiples of 1/8 below 64: exact in half. */
+    check_roundtrip(VSGL_EXR_HALF, 0.0);
+}
+
+VT_TEST(exr_half_rounding_and_clamping_match_openexr)
+{
+    /* Values chosen across the half range; OpenEXR's decoder converts back. */
+    static const float v[] = {0.0f, -0.0f, 1.0f, 0.1f, 1.0f / 3.0f, 65504.0f, 65519.0f, 65520.0f, 1e6f, -1e30f,
+                              6.1035156e-05f, 5.9604645e-08f, 2.9802322e-08f, 1e-9f, 3.14159265f, -2.71828f};
+    enum { N = sizeof v / sizeof v[0] };
+    /* want: round-to-nearest-even in half, clamped to +/-65504 */
+    static const float want[N] = {0.0f, -0.0f, 1.0f, 0.0999755859375f, 0.333251953125f, 65504.0f, 65504.0f, 65504.0f, 65504.0f, -65504.0f,
+                                  6.1035156e-05f, 5.9604645e-08f, 0.0f, 0.0f, 3.140625f, -2.71875f};
+    char dir[64], path[128];
+    make_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/h.exr", dir);
+    vsgl_exr_pass pass;
+    memset(&pass, 0, sizeof pass);
+    pass.name = "Test";
+    pass.channels = "V";
+    pass.data[0] = v;
+    vsgl_exr_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.pixel_type = VSGL_EXR_HALF;
+    opt.compression = VSGL_EXR_NONE;
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    VT_CHECK(vsgl_exr_write(ctx, path, N, 1, &pass, 1, &opt) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    decoded d;
+    VT_CHECK(decode_exr(path, &d) == 0 && d.count == 1, "decode");
+    if (d.count == 1)
+        for (int i = 0; i < N; ++i)
+            VT_CHECK(memcmp(&d.planes[0][i], &want[i], 4) == 0, "in %.9g: half %.9g want %.9g", v[i], d.planes[0][i], want[i]);
+    free_decoded(&d);
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
+
+VT_TEST(exr_oiiotool_sees_channel_names_and_values)
+{
+    if (!have_tool("oiiotool")) {
+        printf("    SKIP: oiiotool not installed (apt-get install openimageio-tools)\n");
+        return;
+    }
+    char dir[64], path[128], cmd[512];
+    static char out[1 << 20];
+    make_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/o.exr", dir);
+    static image im;
+    fill(&im);
+    vsgl_render_output o = output_of(&im);
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    snprintf(cmd, sizeof cmd, "oiiotool --info -v '%s' 2>&1", path);
+    VT_CHECK(run_capture(cmd, out, sizeof out) == 0, "%s failed: %s", cmd, out);
+    VT_CHECK(strstr(out, "37 x   23, 10 channel, float openexr") != NULL, "oiiotool header line: %.300s", out);
+    /* OpenImageIO lists each pass's channels in RGBA order */
+    VT_CHECK(strstr(out, "channel list: VSGL.Combined.R, VSGL.Combined.G, VSGL.Combined.B, VSGL.Combined.A, VSGL.DiffInd.R, "
+                         "VSGL.DiffInd.G, VSGL.DiffInd.B, VSGL.GlossInd.R, VSGL.GlossInd.G, VSGL.GlossInd.B") != NULL,
+             "channel list in: %.600s", out);
+    VT_CHECK(strstr(out, "compression: \"zip\"") != NULL, "compression in: %.600s", out);
+    /* Pixel values: oiiotool's dump of pixel (5, 7) of every channel. */
+    snprintf(cmd, sizeof cmd, "oiiotool --dumpdata '%s' 2>&1", path);
+    VT_CHECK(run_capture(cmd, out, sizeof out) == 0, "%s failed: %s", cmd, out);
+    const char *line = strstr(out, "Pixel (5, 7):");
+    VT_CHECK(line != NULL, "no pixel line in: %.500s", out);
+    if (line) {
+        /* channel order as oiiotool lists it: Combined R G B A, DiffInd R G B, GlossInd R G B */
+        const int pc[10][2] = {{2, 0}, {2, 1}, {2, 2}, {2, 3}, {0, 0}, {0, 1}, {0, 2}, {1, 0}, {1, 1}, {1, 2}};
+        const char *s = line + strlen("Pixel (5, 7):");
+        for (int i = 0; i < 10; ++i) {
+            char *end;
+            double got = strtod(s, &end);
+            VT_CHECK(end != s, "channel %d unparsable in: %s", i, line);
+            VT_CHECK_ABS(got, pattern(pc[i][0], pc[i][1], 5, 7), 1e-6, "channel %d at (5, 7) from: %.200s", i, line);
+            s = end;
+        }
+    }
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
+
+/* ---- Blender ------------------------------------------------------------ */
+
+VT_TEST(exr_blender_loads_multilayer_with_one_socket_per_pass)
+{
+    if (getenv("VSGL_TEST_QUICK")) {
+        printf("    SKIP: VSGL_TEST_QUICK is set (Blender start-up takes seconds)\n");
+        return;
+    }
+    if (!have_tool("blender")) {
+        printf("    SKIP: blender not installed; cannot check the Image node sockets\n");
+        return;
+    }
+    char dir[64], path[128], script[128], cmd[1024];
+    static char out[65536];
+    make_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/b.exr", dir);
+    snprintf(script, sizeof script, "%s/check.py", dir);
+    static image im;
+    fill(&im);
+    static float dcol[W * H * 3], gcol[W * H * 3], diff[W * H * 3], gloss[W * H * 3];
+    vsgl_render_output o = output_of(&im);
+    o.diffuse_color = dcol;
+    o.glossy_color = gcol;
+    o.diffuse = diff;
+    o.glossy = gloss;
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    FILE *f = fopen(script, "w");
+    fputs("import bpy, sys\n"
+          "path = sys.argv[sys.argv.index('--') + 1]\n"
+          "img = bpy.data.images.load(path)\n"
+          "img.reload()\n"
+          "_ = img.size[0]\n"
+          "scene = bpy.context.scene\n"
+          "scene.use_nodes = True\n"
+          "node = scene.node_tree.nodes.new('CompositorNodeImage')\n"
+          "node.image = img\n"
+          "print('VSGLTYPE', img.type)\n"
+          "print('VSGLLAYER', node.layer)\n"
+          "print('VSGLSOCKETS', ','.join(s.name for s in node.outputs if s.enabled))\n",
+          f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "blender -b --factory-startup --python-exit-code 1 --python '%s' -- '%s' 2>&1", script, path);
+    int rc = run_capture(cmd, out, sizeof out);
+    VT_CHECK(rc == 0, "blender exit %d: %.2000s", rc, out);
+    VT_CHECK(strstr(out, "VSGLTYPE MULTILAYER") != NULL, "image type: %.2000s", out);
+    VT_CHECK(strstr(out, "VSGLLAYER VSGL") != NULL, "node layer: %.2000s", out);
+    const char *sock = strstr(out, "VSGLSOCKETS ");
+    VT_CHECK(sock != NULL, "no socket line: %.2000s", out);
+    if (sock) {
+        static const char *const want[] = {"Combined", "Alpha", "DiffInd", "GlossInd", "DiffCol", "GlossCol", "Diff", "Gloss"};
+        char line[1024];
+        sscanf(sock + strlen("VSGLSOCKETS "), "%1023s", line);
+        for (size_t i = 0; i < sizeof want / sizeof want[0]; ++i) {
+            char tok[64];
+            snprintf(tok, sizeof tok, ",%s,", want[i]);
+            char padded[1100];
+            snprintf(padded, sizeof padded, ",%s,", line);
+            VT_CHECK(strstr(padded, tok) != NULL, "socket %s missing from %s", want[i], line);
+        }
+    }
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
+
+/* ---- invalid input ------------------------------------------------------ */
+
+VT_TEST(exr_refuses_non_finite_samples_naming_pass_and_pixel)
+{
+    char dir[64], path[128];
+    make_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/nan.exr", dir);
+    static image im;
+    fill(&im);
+    im.rgb[1][(7 * W + 3) * 3 + 1] = NAN;
+    vsgl_render_output o = output_of(&im);
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    vsgl_result r = vsgl_exr_write_render(ctx, path, &o, NULL);
+    VT_CHECK(r == VSGL_ERROR_INVALID_ARGUMENT, "result %d", r);
+    VT_CHECK(strcmp(vsgl_context_last_error(ctx), "pass GlossInd channel G pixel (3, 7): NaN") == 0, "message '%s'",
+             vsgl_context_last_error(ctx));
+    im.rgb[1][(7 * W + 3) * 3 + 1] = 0;
+    im.alpha[W * H - 1] = -INFINITY;
+    r = vsgl_exr_write_render(ctx, path, &o, NULL);
+    VT_CHECK(r == VSGL_ERROR_INVALID_ARGUMENT && strcmp(vsgl_context_last_error(ctx), "pass Combined channel A pixel (36, 22): -Inf") == 0,
+             "result %d message '%s'", r, vsgl_context_last_error(ctx));
+    VT_CHECK(count_entries(dir) == 0, "no file may be created, found %d entries", count_entries(dir));
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
+
+VT_TEST(exr_refuses_bad_arguments_with_messages)
+{
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    float px[12] = {0};
+    vsgl_exr_pass p;
+    memset(&p, 0, sizeof p);
+    p.name = "DiffInd";
+    p.data[0] = px; p.data[1] = px + 1; p.data[2] = px + 2;
+    vsgl_exr_pass two[2] = {p, p};
+    vsgl_exr_options bad_layer;
+    memset(&bad_layer, 0, sizeof bad_layer);
+    bad_layer.layer = "View.Layer";
+    vsgl_exr_pass dotted = p;
+    dotted.name = "Diff.Ind";
+    vsgl_exr_pass nulldata = p;
+    nulldata.data[2] = NULL;
+    vsgl_exr_pass dup = p;
+    dup.channels = "RGR";
+    vsgl_exr_metadata md = {"compression", "none"};
+    vsgl_exr_options bad_md;
+    memset(&bad_md, 0, sizeof bad_md);
+    bad_md.metadata = &md;
+    bad_md.metadata_count = 1;
+    struct { const char *what; vsgl_result r; const char *msg; } cases[] = {
+        {"zero width", vsgl_exr_write(ctx, "/tmp/x.exr", 0, 2, &p, 1, NULL), "width and height"},
+        {"no passes", vsgl_exr_write(ctx, "/tmp/x.exr", 2, 2, &p, 0, NULL), "passes"},
+        {"dotted layer", vsgl_exr_write(ctx, "/tmp/x.exr", 2, 2, &p, 1, &bad_layer), "layer name 'View.Layer'"},
+        {"dotted pass", vsgl_exr_write(ctx, "/tmp/x.exr", 2, 2, &dotted, 1, NULL), "name 'Diff.Ind'"},
+        {"duplicate pass", vsgl_exr_write(ctx, "/tmp/x.exr", 2, 2, two, 2, NULL), "used twice"},
+        {"NULL channel", vsgl_exr_write(ctx, "/tmp/x.exr", 2, 2, &nulldata, 1, NULL), "channel B has NULL data"},
+        {"repeated letter", vsgl_exr_write(ctx, "/tmp/x.exr", 2, 2, &dup, 1, NULL), "distinct letters"},
+        {"reserved metadata", vsgl_exr_write(ctx, "/tmp/vsgl_exr_reserved_md.exr", 2, 2, &p, 1, &bad_md), "standard attribute"},
+        {"empty path", vsgl_exr_write(ctx, "", 2, 2, &p, 1, NULL), "empty"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i)
+        VT_CHECK(cases[i].r == VSGL_ERROR_INVALID_ARGUMENT, "%s: result %d", cases[i].what, cases[i].r);
+    /* Messages are checked one call at a time (the context keeps the last). */
+    const char *want[] = {"width and height", "layer name 'View.Layer'", "channel B has NULL data", "standard attribute"};
+    vsgl_exr_write(ctx, "/tmp/x.exr", 0, 2, &p, 1, NULL);
+    VT_CHECK(strstr(vsgl_context_last_error(ctx), want[0]), "'%s'", vsgl_context_last_error(ctx));
+    vsgl_exr_write(ctx, "/tmp/x.exr", 2, 2, &p, 1, &bad_layer);
+    VT_CHECK(strstr(vsgl_context_last_error(ctx), want[1]), "'%s'", vsgl_context_last_error(ctx));
+    vsgl_exr_write(ctx, "/tmp/x.exr", 2, 2, &nulldata, 1, NULL);
+    VT_CHECK(strstr(vsgl_context_last_error(ctx), want[2]), "'%s'", vsgl_context_last_error(ctx));
+    vsgl_exr_write(ctx, "/tmp/vsgl_exr_reserved_md.exr", 2, 2, &p, 1, &bad_md);
+    VT_CHECK(strstr(vsgl_context_last_error(ctx), want[3]), "'%s'", vsgl_context_last_error(ctx));
+    struct stat st;
+    VT_CHECK(stat("/tmp/vsgl_exr_reserved_md.exr", &st) != 0, "a refused write must not leave a file");
+    vsgl_context_destroy(ctx);
+}
+
+/* ---- I/O failures and atomicity ----------------------------------------- */
+
+VT_TEST(exr_io_failures_name_the_path_and_leave_no_files)
+{
+    char dir[64], path[256];
+    make_temp_dir(dir, sizeof dir);
+    static image im;
+    fill(&im);
+    vsgl_render_output o = output_of(&im);
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+
+    snprintf(path, sizeof path, "%s/missing/out.exr", dir);
+    vsgl_result r = vsgl_exr_write_render(ctx, path, &o, NULL);
+    VT_CHECK(r == VSGL_ERROR_IO && strstr(vsgl_context_last_error(ctx), "No such file or directory"), "missing dir: %d '%s'", r,
+             vsgl_context_last_error(ctx));
+    VT_CHECK(vsgl_check_output_path(ctx, path) == VSGL_ERROR_IO, "check: missing dir");
+
+    snprintf(path, sizeof path, "%s/adir", dir);
+    mkdir(path, 0755);
+    r = vsgl_exr_write_render(ctx, path, &o, NULL);
+    VT_CHECK(r == VSGL_ERROR_IO && strstr(vsgl_context_last_error(ctx), "is a directory"), "directory: %d '%s'", r,
+             vsgl_context_last_error(ctx));
+    VT_CHECK(vsgl_check_output_path(ctx, path) == VSGL_ERROR_IO, "check: directory");
+    VT_CHECK(count_entries(path) == 0, "nothing created inside %s", path);
+
+    snprintf(path, sizeof path, "%s/afile", dir);
+    FILE *f = fopen(path, "w");
+    fclose(f);
+    snprintf(path, sizeof path, "%s/afile/out.exr", dir);
+    r = vsgl_exr_write_render(ctx, path, &o, NULL);
+    VT_CHECK(r == VSGL_ERROR_IO && strstr(vsgl_context_last_error(ctx), "ot a directory"), "under a file: %d '%s'", r,
+             vsgl_context_last_error(ctx));
+
+    snprintf(path, sizeof path, "%s/ok.exr", dir);
+    VT_CHECK(vsgl_check_output_path(ctx, path) == VSGL_OK, "check ok: %s", vsgl_context_last_error(ctx));
+    VT_CHECK(count_entries(dir) == 2, "check_output_path leaves nothing behind: %d entries", count_entries(dir));
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
+
+/* In a child: optionally drop root, limit the file size, write; exit with the result. */
+static int write_in_child(const char *path, const vsgl_render_output *o, rlim_t fsize, int drop_root)
+{
+    pid_t pid = fork();
+    if (pid == 0) {
+        if (drop_root && geteuid() == 0 && (setgid(65534) != 0 || setuid(65534) != 0))
+            _exit(100);
+        if (fsize) {
+            signal(SIGXFSZ, SIG_IGN);
+            struct rlimit rl = {fsize, fsize};
+            setrlimit(RLIMIT_FSIZE, &rl);
+        }
+        vsgl_context *ctx = NULL;
+        vsgl_context_create(NULL, &ctx);
+        vsgl_result r = vsgl_exr_write_render(ctx, path, o, NULL);
+        if (r)
+            fprintf(stderr, "    (child, expected failure: %s)\n", vsgl_context_last_error(ctx));
+        _exit((int)r);
+    }
+    int st = 0;
+    waitpid(pid, &st, 0);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+VT_TEST(exr_failed_write_keeps_previous_file_and_deletes_temp)
+{
+    char dir[64], path[128];
+    make_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/keep.exr", dir);
+    static image im;
+    fill(&im);
+    vsgl_render_output o = output_of(&im);
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_OK, "first write: %s", vsgl_context_last_error(ctx));
+    unsigned char *before = NULL, *after = NULL;
+    size_t nb = 0, na = 0;
+    read_file(path, &before, &nb);
+
+    /* A different image whose write fails part way (file size limit 1 KiB). */
+    for (int i = 0; i < W * H * 3; ++i)
+        im.rgb[0][i] = (float)i * 1.37f;
+    int rc = write_in_child(path, &o, 1024, 0);
+    VT_CHECK(rc == VSGL_ERROR_IO, "write over the size limit: exit %d, want %d", rc, VSGL_ERROR_IO);
+    read_file(path, &after, &na);
+    VT_CHECK(nb > 1024 && na == nb && before && after && memcmp(before, after, nb) == 0, "previous file changed: %zu -> %zu bytes", nb, na);
+    VT_CHECK(count_entries(dir) == 1, "temporary file left: %d entries in %s", count_entries(dir), dir);
+    free(after);
+
+    /* A directory the writer may not write into (as nobody when run as root). */
+    char ro[128], ropath[160];
+    snprintf(ro, sizeof ro, "%s/ro", dir);
+    mkdir(ro, 0755);
+    snprintf(ropath, sizeof ropath, "%s/x.exr", ro);
+    chmod(ro, 0555);
+    chmod(dir, 0755);
+    rc = write_in_child(ropath, &o, 0, 1);
+    VT_CHECK(rc == VSGL_ERROR_IO, "unwritable directory: exit %d", rc);
+    VT_CHECK(count_entries(ro) == 0, "nothing created in %s", ro);
+
+    /* A successful second write replaces the file completely. */
+    VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_OK, "second write: %s", vsgl_context_last_error(ctx));
+    decoded d;
+    VT_CHECK(decode_exr(path, &d) == 0, "decode");
+    int k = channel_index(&d, "VSGL.DiffInd.G");
+    VT_CHECK(k >= 0 && d.planes[k][5] == (float)(5 * 3 + 1) * 1.37f, "new value at pixel 5: %g", k >= 0 ? d.planes[k][5] : -1.0);
+    free_decoded(&d);
+    free(before);
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
