@@ -1,0 +1,264 @@
+/* VSGL fit: the two-VSGL mode against a direct double-precision evaluation
+ * of the poster's equations on a hand-built RSM, FIS/k-means invariants. */
+#include "harness.h"
+#include "scene_fixture.h"
+#include "fit/grid.h"
+#include "scene/material.h"
+
+#include <stdlib.h>
+
+typedef struct hand_rsm {
+    vsgl_rsm r;
+    float *mem;
+} hand_rsm;
+
+/* A single-face RSM of res^2 texels with random VPLs around `offset`;
+ * about one texel in six is empty. */
+static void make_rsm(hand_rsm *h, uint32_t res, uint64_t seed, float offset, float spread)
+{
+    memset(h, 0, sizeof *h);
+    vsgl_rsm *r = &h->r;
+    r->faces = 1;
+    r->res = res;
+    r->count = (size_t)res * res;
+    h->mem = calloc(r->count * 12, sizeof(float));
+    for (int c = 0; c < 3; ++c) {
+        r->pos[c] = h->mem + r->count * (size_t)c;
+        r->nrm[c] = h->mem + r->count * (size_t)(3 + c);
+        r->wi[c] = h->mem + r->count * (size_t)(6 + c);
+        r->flux[c] = h->mem + r->count * (size_t)(9 + c);
+    }
+    r->material = calloc(r->count, sizeof(uint32_t));
+    vt_rng rng = {seed};
+    for (size_t t = 0; t < r->count; ++t) {
+        if (vt_uniform(&rng) < 1.0 / 6.0) {
+            r->material[t] = VSGL_RSM_EMPTY;
+            continue;
+        }
+        r->material[t] = (uint32_t)(vt_uniform(&rng) * 4.0) % 4;
+        double n[3] = {vt_uniform(&rng) - 0.5, vt_uniform(&rng) - 0.5, 1.0};
+        double w[3] = {vt_uniform(&rng) - 0.5, vt_uniform(&rng) - 0.5, 0.7};
+        double nl = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        double wl = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        for (int c = 0; c < 3; ++c) {
+            r->pos[c][t] = offset + spread * (float)(vt_uniform(&rng) - 0.5);
+            r->nrm[c][t] = (float)(n[c] / nl);
+            r->wi[c][t] = (float)(w[c] / wl);
+            r->flux[c][t] = (float)(0.1 + vt_uniform(&rng));
+            r->total_flux[c] += r->flux[c][t];
+        }
+    }
+}
+
+static void free_rsm(hand_rsm *h)
+{
+    free(h->mem);
+    free(h->r.material);
+}
+
+static double schlick_d(double f0, double c)
+{
+    double m = 1.0 - (c < 0 ? 0 : (c > 1 ? 1 : c));
+    return f0 + (1.0 - f0) * m * m * m * m * m;
+}
+
+/* The poster's sums (Sec. 2.1-2.2, errata GUIDE Sec. 3) in double. */
+typedef struct ref_vsgl { double power[3], axis[3], sharpness, mean[3], variance; int present; } ref_vsgl;
+
+static void reference_two(const vsgl_scene *scene, const vsgl_rsm *r, int32_t est, ref_vsgl out[2])
+{
+    uint32_t mc;
+    const vsgl_material *mats = vsgl__scene_materials(scene, &mc);
+    double W[2] = {0, 0}, P[2][3] = {{0}}, D[2][3] = {{0}}, X[2][3] = {{0}}, X2[2] = {0, 0};
+    for (size_t t = 0; t < r->count; ++t) {
+        if (r->material[t] == VSGL_RSM_EMPTY)
+            continue;
+        vsgl_brdf_params bp;
+        vsgl__material_params(&mats[r->material[t]], &bp);
+        double n[3] = {r->nrm[0][t], r->nrm[1][t], r->nrm[2][t]};
+        double wi[3] = {r->wi[0][t], r->wi[1][t], r->wi[2][t]};
+        double x[3] = {r->pos[0][t], r->pos[1][t], r->pos[2][t]};
+        double cosi = n[0] * wi[0] + n[1] * wi[1] + n[2] * wi[2];
+        for (int lobe = 0; lobe < 2; ++lobe) {
+            double pw[3], axis[3], lambda;
+            if (lobe == 0) {
+                for (int c = 0; c < 3; ++c) { pw[c] = r->flux[c][t] * (double)bp.diffuse[c]; axis[c] = n[c]; }
+                lambda = vsgl_sg_cosine_sharpness();
+            } else {
+                if (!bp.glossy || cosi <= 0)
+                    continue;
+                for (int c = 0; c < 3; ++c) {
+                    pw[c] = r->flux[c][t] * schlick_d(bp.f0[c], cosi);
+                    axis[c] = 2.0 * cosi * n[c] - wi[c];
+                }
+                double a = sqrt((double)bp.alpha_x * bp.alpha_y);
+                lambda = (2.0 / (a * a)) / (4.0 * fabs(cosi));
+            }
+            double w = pw[0] + pw[1] + pw[2];
+            double mlen = vsgl_mean_length_from_sharpness((float)lambda, est);
+            W[lobe] += w;
+            for (int c = 0; c < 3; ++c) {
+                P[lobe][c] += pw[c];
+                D[lobe][c] += w * mlen * axis[c];
+                X[lobe][c] += w * x[c];
+            }
+            X2[lobe] += w * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        }
+    }
+    for (int lobe = 0; lobe < 2; ++lobe) {
+        ref_vsgl *o = &out[lobe];
+        memset(o, 0, sizeof *o);
+        if (!(W[lobe] > 0))
+            continue;
+        o->present = 1;
+        double len = 0, mu2 = 0;
+        for (int c = 0; c < 3; ++c) {
+            o->power[c] = P[lobe][c];
+            o->mean[c] = X[lobe][c] / W[lobe];
+            len += (D[lobe][c] / W[lobe]) * (D[lobe][c] / W[lobe]);
+            mu2 += o->mean[c] * o->mean[c];
+        }
+        len = sqrt(len);
+        for (int c = 0; c < 3; ++c)
+            o->axis[c] = D[lobe][c] / W[lobe] / len;
+        o->sharpness = vsgl_sharpness_from_mean_length((float)len, est);
+        o->variance = 0.5 * (X2[lobe] / W[lobe] - mu2);
+    }
+}
+
+static vsgl_scene *room_scene(vsgl_context **ctx, fx_scene *fx)
+{
+    fx_room(fx, 32, 24, 0.3f, 100.0f);
+    vsgl_scene *scene = NULL;
+    if (vsgl_context_create(NULL, ctx) != VSGL_OK)
+        return NULL;
+    if (vsgl_scene_create(*ctx, fx_desc(fx), &scene) != VSGL_OK)
+        fprintf(stderr, "scene: %s\n", vsgl_context_last_error(*ctx));
+    return scene;
+}
+
+VT_TEST(fit_two_matches_poster_equations_on_hand_built_rsm)
+{
+    fx_scene fx;
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = room_scene(&ctx, &fx);
+    VT_CHECK(scene != NULL, "scene creation failed");
+    if (!scene) { vsgl_context_destroy(ctx); return; }
+    const float offsets[3] = {0.0f, 40.0f, 1000.0f};
+    for (int est = 0; est < 2; ++est)
+        for (int oi = 0; oi < 3; ++oi) {
+            hand_rsm h;
+            make_rsm(&h, 16, 7 + (uint64_t)oi, offsets[oi], 2.0f);
+            vsgl_render_settings s;
+            vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+            s.sharpness_estimator = est;
+            vsgl_vsgl_set set = {0};
+            VT_CHECK(vsgl__fit_two(ctx, scene, &h.r, &s, &set) == VSGL_OK, "fit");
+            ref_vsgl ref[2];
+            reference_two(scene, &h.r, est, ref);
+            VT_CHECK(set.count == (size_t)(ref[0].present + ref[1].present), "count %zu", set.count);
+            for (size_t k = 0; k < set.count; ++k) {
+                const vsgl_vsgl *v = &set.items[k];
+                const ref_vsgl *w = &ref[v->lobe];
+                for (int c = 0; c < 3; ++c) {
+                    VT_CHECK_REL(v->power[c], w->power[c], 1e-5, "est %d offset %g lobe %u", est, offsets[oi], v->lobe);
+                    VT_CHECK_ABS((&v->axis.x)[c], w->axis[c], 2e-5, "est %d offset %g lobe %u", est, offsets[oi], v->lobe);
+                    VT_CHECK_ABS((&v->mean.x)[c], w->mean[c], 1e-6 * (1.0 + offsets[oi]), "est %d offset %g", est, offsets[oi]);
+                }
+                VT_CHECK_REL(v->sharpness, w->sharpness, 1e-4, "est %d offset %g lobe %u", est, offsets[oi], v->lobe);
+                /* the reference's E|x|^2 - |E x|^2 cancels at large offsets; the fit centres its sums */
+                double tol = offsets[oi] > 100.0f ? 1e-2 : 1e-4;
+                VT_CHECK_REL(v->variance, w->variance, tol, "est %d offset %g lobe %u", est, offsets[oi], v->lobe);
+            }
+            vsgl__vsgl_set_free(&set);
+            free_rsm(&h);
+        }
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
+VT_TEST(fit_fis_single_cluster_equals_two_and_top_mip_equals_total)
+{
+    fx_scene fx;
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = room_scene(&ctx, &fx);
+    VT_CHECK(scene != NULL, "scene creation failed");
+    if (!scene) { vsgl_context_destroy(ctx); return; }
+    hand_rsm h;
+    make_rsm(&h, 32, 3, 5.0f, 1.0f);
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.vsgl_count = 1;
+    vsgl_vsgl_set two = {0}, fis = {0};
+    VT_CHECK(vsgl__fit_two(ctx, scene, &h.r, &s, &two) == VSGL_OK, "two");
+    VT_CHECK(vsgl__fit_fis(ctx, scene, &h.r, &s, &fis) == VSGL_OK, "fis");
+    VT_CHECK(two.count == fis.count && two.count == 2, "counts %zu %zu", two.count, fis.count);
+    for (size_t k = 0; k < two.count && k < fis.count; ++k) {
+        const vsgl_vsgl *a = &two.items[k], *b = &fis.items[k];
+        VT_CHECK(a->lobe == b->lobe, "lobe order");
+        for (int c = 0; c < 3; ++c) {
+            VT_CHECK_REL(b->power[c], a->power[c], 1e-5, "lobe %u", a->lobe);
+            VT_CHECK_ABS((&b->axis.x)[c], (&a->axis.x)[c], 1e-5, "lobe %u", a->lobe);
+            VT_CHECK_ABS((&b->mean.x)[c], (&a->mean.x)[c], 1e-5, "lobe %u", a->lobe);
+        }
+        VT_CHECK_REL(b->sharpness, a->sharpness, 1e-4, "lobe %u", a->lobe);
+        VT_CHECK_REL(b->variance, a->variance, 1e-4, "lobe %u", a->lobe);
+    }
+    /* the pyramid's top level holds the whole map */
+    vsgl_grid g;
+    VT_CHECK(vsgl__grid_build(ctx, scene, &h.r, s.sharpness_estimator, 1, &g) == VSGL_OK, "grid");
+    double top[VSGL_GRID_STRIDE];
+    vsgl__grid_sample(&g, 0, 3.7f, 20.1f, (float)(g.levels - 1), top);
+    for (int k = 0; k < VSGL_GRID_STRIDE; ++k)
+        VT_CHECK_ABS(top[k], g.total[k], 1e-5 * (fabs(g.total[k]) + 1.0), "field %d", k);
+    vsgl__grid_free(&g);
+    vsgl__vsgl_set_free(&two);
+    vsgl__vsgl_set_free(&fis);
+    free_rsm(&h);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
+static double total_weight(const vsgl_vsgl_set *s)
+{
+    double w = 0;
+    for (size_t k = 0; k < s->count; ++k)
+        w += (double)s->items[k].power[0] + s->items[k].power[1] + s->items[k].power[2];
+    return w;
+}
+
+VT_TEST(fit_fis_and_kmeans_conserve_total_power)
+{
+    fx_scene fx;
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = room_scene(&ctx, &fx);
+    VT_CHECK(scene != NULL, "scene creation failed");
+    if (!scene) { vsgl_context_destroy(ctx); return; }
+    hand_rsm h;
+    make_rsm(&h, 64, 11, 0.0f, 1.5f);
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    vsgl_vsgl_set two = {0};
+    vsgl__fit_two(ctx, scene, &h.r, &s, &two);
+    double want = total_weight(&two);
+    const uint32_t counts[4] = {2, 16, 64, 512};
+    for (int i = 0; i < 4; ++i) {
+        s.vsgl_count = counts[i];
+        vsgl_vsgl_set fis = {0}, km = {0};
+        VT_CHECK(vsgl__fit_fis(ctx, scene, &h.r, &s, &fis) == VSGL_OK, "fis N=%u", counts[i]);
+        VT_CHECK(vsgl__fit_kmeans(ctx, scene, &h.r, &s, &km) == VSGL_OK, "kmeans N=%u", counts[i]);
+        /* FIS: sum_i W_i / (N W_i / W) = W exactly; k-means: a partition */
+        VT_CHECK_REL(total_weight(&fis), want, 1e-4, "fis N=%u (%zu VSGLs)", counts[i], fis.count);
+        VT_CHECK_REL(total_weight(&km), want, 1e-5, "kmeans N=%u (%zu VSGLs)", counts[i], km.count);
+        VT_CHECK(fis.count <= 2 * (size_t)counts[i] && km.count <= 2 * (size_t)counts[i], "counts");
+        for (size_t k = 0; k < fis.count; ++k)
+            VT_CHECK(isfinite(fis.items[k].variance) && fis.items[k].variance >= 0 &&
+                     isfinite(fis.items[k].sharpness), "fis VSGL %zu", k);
+        vsgl__vsgl_set_free(&fis);
+        vsgl__vsgl_set_free(&km);
+    }
+    vsgl__vsgl_set_free(&two);
+    free_rsm(&h);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
