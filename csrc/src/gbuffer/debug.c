@@ -1,0 +1,28 @@
+/* vsgl_debug_gbuffer: the G-buffer copied into caller buffers (tests). */
+#include "vsgl/debug.h"
+#include "gbuffer/gbuffer.h"
+#include "core/context.h"
+
+vsgl_result vsgl_debug_gbuffer(vsgl_context *ctx, const vsgl_scene *scene, uint32_t aa,
+                               float *positions, float *normals, uint32_t *materials)
+{
+    vsgl__clear_error(ctx);
+    if (!scene)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "debug_gbuffer: scene is NULL");
+    vsgl_gbuffer g;
+    vsgl_result r = vsgl__gbuffer_build(ctx, scene, aa, &g);
+    if (r != VSGL_OK)
+        return r;
+    for (size_t i = 0; i < g.count; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            if (positions)
+                positions[i * 3 + k] = g.pos[k][i];
+            if (normals)
+                normals[i * 3 + k] = g.nrm[k][i];
+        }
+        if (materials)
+            materials[i] = g.material[i];
+    }
+    vsgl__gbuffer_free(&g);
+    return VSGL_OK;
+}
