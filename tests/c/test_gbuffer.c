@@ -1,0 +1,321 @@
+/* Camera G-buffer against analytic planes: sample positions, normals,
+ * view vectors, misses, clipping, determinism, progress and cancellation. */
+#include "harness.h"
+#include "vsgl.h"
+#include "vsgl/debug.h"
+#include "core/context.h"
+#include "gbuffer/gbuffer.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct plane_scene {
+    float pos[12];
+    uint32_t ix[6];
+    vsgl_material mat;
+    vsgl_camera cam;
+    vsgl_scene_desc desc;
+} plane_scene;
+
+/* Quad z = z0 spanning [-half, half]^2, winding facing +z (or -z if flip). */
+static void plane_init(plane_scene *p, float z0, float half, int flip)
+{
+    memset(p, 0, sizeof *p);
+    float v[12] = {-half, -half, z0, half, -half, z0, half, half, z0, -half, half, z0};
+    memcpy(p->pos, v, sizeof v);
+    uint32_t a[6] = {0, 1, 2, 0, 2, 3}, b[6] = {0, 2, 1, 0, 3, 2};
+    memcpy(p->ix, flip ? b : a, sizeof a);
+    p->mat.base_color[0] = 0.5f;
+    vsgl_camera *c = &p->cam;
+    c->type = VSGL_CAMERA_PERSPECTIVE;
+    c->world_from_camera[0] = c->world_from_camera[5] = c->world_from_camera[10] = 1.0f;
+    c->lens_mm = 50.0f;
+    c->sensor_width_mm = 36.0f;
+    c->sensor_height_mm = 24.0f;
+    c->ortho_scale = 4.0f;
+    c->clip_start = 0.1f;
+    c->clip_end = 100.0f;
+    c->width = 64;
+    c->height = 48;
+    c->pixel_aspect_x = c->pixel_aspect_y = 1.0f;
+    p->desc.vertex_count = 4;
+    p->desc.positions = p->pos;
+    p->desc.triangle_count = 2;
+    p->desc.indices = p->ix;
+    p->desc.material_count = 1;
+    p->desc.materials = &p->mat;
+    p->desc.camera = &p->cam;
+}
+
+static vsgl_context *make_ctx(uint32_t threads)
+{
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.thread_count = threads;
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(&cd, &ctx);
+    return ctx;
+}
+
+/* Analytic hit of sample (col, row, i, j) of the default camera on z = z0:
+ * a horizontal-fit 36 mm sensor at 50 mm, 64 x 48 pixels. */
+static void analytic_point(double z0, uint32_t col, uint32_t row, uint32_t i, uint32_t j, uint32_t aa, double out[3])
+{
+    double px = col + (i + 0.5) / aa, py = row + (j + 0.5) / aa;
+    double hx = 18.0 / 50.0, hy = hx * 48.0 / 64.0;
+    double x = (2.0 * px / 64.0 - 1.0) * hx, y = (1.0 - 2.0 * py / 48.0) * hy;
+    out[0] = x * -z0;
+    out[1] = y * -z0;
+    out[2] = z0;
+}
+
+VT_TEST(gbuffer_perspective_plane_matches_analytic_points)
+{
+    vsgl_context *ctx = make_ctx(2);
+    plane_scene p;
+    plane_init(&p, -5.0f, 100.0f, 0);
+    vsgl_scene *s = NULL;
+    VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    for (uint32_t aa = 1; s && aa <= 3; ++aa) {
+        vsgl_gbuffer g;
+        vsgl_result r = vsgl__gbuffer_build(ctx, s, aa, &g);
+        VT_CHECK(r == VSGL_OK && g.count == 64u * 48u * aa * aa && g.spp == aa * aa && g.width == 64 && g.height == 48,
+                 "aa %u: r %d count %zu", aa, r, g.count);
+        if (r != VSGL_OK)
+            continue;
+        double maxerr = 0, maxn = 0, maxv = 0;
+        for (uint32_t row = 0; row < 48; ++row)
+            for (uint32_t col = 0; col < 64; ++col)
+                for (uint32_t sidx = 0; sidx < aa * aa; ++sidx) {
+                    size_t e = ((size_t)row * 64 + col) * aa * aa + sidx;
+                    double want[3];
+                    analytic_point(-5.0, col, row, sidx % aa, sidx / aa, aa, want);
+                    double err = fabs(g.pos[0][e] - want[0]) + fabs(g.pos[1][e] - want[1]) + fabs(g.pos[2][e] - want[2]);
+                    if (err > maxerr) maxerr = err;
+                    double nerr = fabs(g.nrm[0][e]) + fabs(g.nrm[1][e]) + fabs(g.nrm[2][e] - 1.0);
+                    if (nerr > maxn) maxn = nerr;
+                    double l = sqrt(want[0] * want[0] + want[1] * want[1] + 25.0);
+                    double verr = fabs(g.view[0][e] + want[0] / l) + fabs(g.view[1][e] + want[1] / l) + fabs(g.view[2][e] - 5.0 / l);
+                    if (verr > maxv) maxv = verr;
+                    VT_CHECK(g.material[e] == 0, "aa %u pixel (%u %u) s %u: material %u", aa, col, row, sidx, g.material[e]);
+                    if (err > 1e-4)
+                        VT_CHECK(0, "aa %u pixel (%u %u) s %u: (%g %g %g) want (%g %g %g)", aa, col, row, sidx,
+                                 g.pos[0][e], g.pos[1][e], g.pos[2][e], want[0], want[1], want[2]);
+                    float td = g.tan[0][e] * g.nrm[0][e] + g.tan[1][e] * g.nrm[1][e] + g.tan[2][e] * g.nrm[2][e];
+                    float tl = g.tan[0][e] * g.tan[0][e] + g.tan[1][e] * g.tan[1][e] + g.tan[2][e] * g.tan[2][e];
+                    if (fabsf(td) > 1e-6f || fabsf(tl - 1) > 1e-5f)
+                        VT_CHECK(0, "pixel (%u %u): tangent.n %g |t|^2 %g", col, row, td, tl);
+                }
+        VT_CHECK(maxerr < 1e-4 && maxn < 1e-6 && maxv < 1e-5, "aa %u: max position error %g m, normal %g, view %g", aa,
+                 maxerr, maxn, maxv);
+        vsgl__gbuffer_free(&g);
+        VT_CHECK(g.pos[0] == NULL && g.count == 0, "free clears");
+    }
+    vsgl_scene_destroy(s);
+    vsgl_context_destroy(ctx);
+}
+
+VT_TEST(gbuffer_misses_backfaces_and_clipping)
+{
+    vsgl_context *ctx = make_ctx(2);
+    plane_scene p;
+    /* back-facing quad of half-size 1 at z = -5: covers |x| <= 1 of the +-1.8 view */
+    plane_init(&p, -5.0f, 1.0f, 1);
+    vsgl_scene *s = NULL;
+    VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    vsgl_gbuffer g;
+    if (s && vsgl__gbuffer_build(ctx, s, 1, &g) == VSGL_OK) {
+        size_t hits = 0, want_hits = 0;
+        for (uint32_t row = 0; row < 48; ++row)
+            for (uint32_t col = 0; col < 64; ++col) {
+                size_t e = (size_t)row * 64 + col;
+                double w[3];
+                analytic_point(-5.0, col, row, 0, 0, 1, w);
+                int inside = fabs(w[0]) < 1.0 && fabs(w[1]) < 1.0;
+                int edge = fabs(fabs(w[0]) - 1.0) < 1e-3 || fabs(fabs(w[1]) - 1.0) < 1e-3;
+                int hit = g.material[e] != VSGL_GBUFFER_MISS;
+                want_hits += (size_t)inside;
+                hits += (size_t)hit;
+                if (!edge)
+                    VT_CHECK(hit == inside, "pixel (%u %u) at (%g %g): hit %d", col, row, w[0], w[1], hit);
+                if (hit)
+                    VT_CHECK(g.nrm[2][e] == 1.0f, "pixel (%u %u): back face normal z %g (want +1, facing the camera)",
+                             col, row, g.nrm[2][e]);
+                else
+                    VT_CHECK(g.pos[0][e] == 0 && g.nrm[2][e] == 0 && g.view[2][e] > 0, "pixel (%u %u): miss not cleared", col, row);
+            }
+        VT_CHECK(hits == want_hits && hits > 0, "hits %zu want %zu", hits, want_hits);
+        vsgl__gbuffer_free(&g);
+    }
+    vsgl_scene_destroy(s);
+    /* clip range: depth 5 outside [6, 100] and [0.1, 4.9] -> nothing; [4.9, 5.1] -> everything */
+    float ranges[3][2] = {{6.0f, 100.0f}, {0.1f, 4.9f}, {4.9f, 5.1f}};
+    plane_init(&p, -5.0f, 100.0f, 0);
+    for (int k = 0; k < 3; ++k)
+        for (int type = 0; type < 2; ++type) {
+            p.cam.type = type;
+            p.cam.clip_start = ranges[k][0];
+            p.cam.clip_end = ranges[k][1];
+            s = NULL;
+            VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+            if (s && vsgl__gbuffer_build(ctx, s, 1, &g) == VSGL_OK) {
+                size_t hits = 0;
+                for (size_t e = 0; e < g.count; ++e)
+                    hits += g.material[e] != VSGL_GBUFFER_MISS;
+                VT_CHECK(hits == (k == 2 ? g.count : 0), "type %d clip [%g, %g]: %zu hits of %zu", type, ranges[k][0],
+                         ranges[k][1], hits, g.count);
+                vsgl__gbuffer_free(&g);
+            }
+            vsgl_scene_destroy(s);
+        }
+    vsgl_context_destroy(ctx);
+}
+
+VT_TEST(gbuffer_orthographic_positions)
+{
+    vsgl_context *ctx = make_ctx(2);
+    plane_scene p;
+    plane_init(&p, -3.0f, 10.0f, 0);
+    p.cam.type = VSGL_CAMERA_ORTHOGRAPHIC;
+    p.cam.ortho_scale = 4.0f;
+    p.cam.shift_y = 0.25f;
+    /* camera at (1, 2, 0), axis-aligned */
+    p.cam.world_from_camera[3] = 1.0f;
+    p.cam.world_from_camera[7] = 2.0f;
+    vsgl_scene *s = NULL;
+    VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    vsgl_gbuffer g;
+    if (s && vsgl__gbuffer_build(ctx, s, 2, &g) == VSGL_OK) {
+        double maxerr = 0;
+        for (uint32_t row = 0; row < 48; ++row)
+            for (uint32_t col = 0; col < 64; ++col)
+                for (uint32_t k = 0; k < 4; ++k) {
+                    size_t e = ((size_t)row * 64 + col) * 4 + k;
+                    double px = col + (k % 2 + 0.5) / 2, py = row + (k / 2 + 0.5) / 2;
+                    /* 4 m across 64 px; 3 m across 48 px; shift 0.25 * 4 m up */
+                    double x = 1.0 + (px / 64.0 - 0.5) * 4.0, y = 2.0 + (0.5 - py / 48.0) * 3.0 + 1.0;
+                    double err = fabs(g.pos[0][e] - x) + fabs(g.pos[1][e] - y) + fabs(g.pos[2][e] + 3.0);
+                    if (err > maxerr) maxerr = err;
+                    if (err > 1e-5)
+                        VT_CHECK(0, "pixel (%u %u) s %u: (%g %g %g) want (%g %g -3)", col, row, k, g.pos[0][e], g.pos[1][e],
+                                 g.pos[2][e], x, y);
+                    if (g.view[2][e] != 1.0f)
+                        VT_CHECK(0, "ortho view (%g %g %g)", g.view[0][e], g.view[1][e], g.view[2][e]);
+                }
+        VT_CHECK(maxerr < 1e-5, "max error %g", maxerr);
+        vsgl__gbuffer_free(&g);
+    }
+    vsgl_scene_destroy(s);
+    vsgl_context_destroy(ctx);
+}
+
+/* A random triangle soup: the buffer is bit-identical for 1, 2 and 5 threads. */
+VT_TEST(gbuffer_is_deterministic_across_thread_counts)
+{
+    enum { T = 300 };
+    static float pos[T * 9];
+    static uint32_t ix[T * 3];
+    vt_rng rng = {5};
+    for (int i = 0; i < T * 9; ++i)
+        pos[i] = (float)(vt_uniform(&rng) * 4 - 2) + ((i % 3 == 2) ? -6.0f : 0.0f);
+    for (int i = 0; i < T * 3; ++i)
+        ix[i] = (uint32_t)i;
+    plane_scene p;
+    plane_init(&p, -5.0f, 1.0f, 0);
+    p.desc.vertex_count = T * 3;
+    p.desc.positions = pos;
+    p.desc.triangle_count = T;
+    p.desc.indices = ix;
+    vsgl_gbuffer ref;
+    memset(&ref, 0, sizeof ref);
+    uint32_t threads[3] = {1, 2, 5};
+    for (int k = 0; k < 3; ++k) {
+        vsgl_context *ctx = make_ctx(threads[k]);
+        vsgl_scene *s = NULL;
+        VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+        vsgl_gbuffer g;
+        if (s && vsgl__gbuffer_build(ctx, s, 2, &g) == VSGL_OK) {
+            if (k == 0) {
+                ref = g;
+            } else {
+                int same = memcmp(g.material, ref.material, g.count * 4) == 0;
+                for (int c = 0; c < 3; ++c)
+                    same &= memcmp(g.pos[c], ref.pos[c], g.count * 4) == 0 && memcmp(g.nrm[c], ref.nrm[c], g.count * 4) == 0 &&
+                            memcmp(g.tan[c], ref.tan[c], g.count * 4) == 0 && memcmp(g.view[c], ref.view[c], g.count * 4) == 0;
+                VT_CHECK(same, "threads %u differ from 1 thread", threads[k]);
+                vsgl__gbuffer_free(&g);
+            }
+        }
+        vsgl_scene_destroy(s);
+        vsgl_context_destroy(ctx);
+    }
+    size_t hits = 0;
+    for (size_t e = 0; e < ref.count; ++e)
+        hits += ref.material[e] != VSGL_GBUFFER_MISS;
+    VT_CHECK(hits > ref.count / 10 && hits < ref.count, "soup covers %zu of %zu samples", hits, ref.count);
+    vsgl__gbuffer_free(&ref);
+}
+
+typedef struct progress_log { int calls, cancel_at; float last; int decreasing; } progress_log;
+static int32_t on_progress(void *user, const char *stage, float f)
+{
+    progress_log *l = user;
+    if (strcmp(stage, "gbuffer") != 0 || f < l->last)
+        l->decreasing = 1;
+    l->last = f;
+    return ++l->calls == l->cancel_at;
+}
+
+VT_TEST(gbuffer_progress_cancel_and_debug_copy)
+{
+    progress_log log;
+    memset(&log, 0, sizeof log);
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.thread_count = 2;
+    cd.progress = on_progress;
+    cd.progress_user = &log;
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(&cd, &ctx);
+    plane_scene p;
+    plane_init(&p, -5.0f, 1.0f, 0);
+    vsgl_scene *s = NULL;
+    VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    if (!s) { vsgl_context_destroy(ctx); return; }
+    vsgl_gbuffer g;
+    VT_CHECK(vsgl__gbuffer_build(ctx, s, 1, &g) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    VT_CHECK(log.calls >= 2 && log.last == 1.0f && !log.decreasing, "calls %d last %g decreasing %d", log.calls, log.last,
+             log.decreasing);
+    /* debug copy equals the internal buffer */
+    size_t n = g.count;
+    float *pos = malloc(n * 12), *nrm = malloc(n * 12);
+    uint32_t *mat = malloc(n * 4);
+    VT_CHECK(vsgl_debug_gbuffer(ctx, s, 1, pos, nrm, mat) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    int same = 1;
+    for (size_t e = 0; e < n; ++e)
+        for (int c = 0; c < 3; ++c)
+            same &= pos[e * 3 + c] == g.pos[c][e] && nrm[e * 3 + c] == g.nrm[c][e] && mat[e] == g.material[e];
+    VT_CHECK(same, "debug copy differs");
+    VT_CHECK(vsgl_debug_gbuffer(ctx, s, 1, NULL, NULL, NULL) == VSGL_OK, "all outputs NULL");
+    VT_CHECK(vsgl_debug_gbuffer(ctx, NULL, 1, pos, NULL, NULL) == VSGL_ERROR_INVALID_ARGUMENT, "NULL scene");
+    vsgl__gbuffer_free(&g);
+    /* cancel on the third report */
+    memset(&log, 0, sizeof log);
+    log.cancel_at = 3;
+    memset(&g, 0xAB, sizeof g);
+    vsgl_result r = vsgl__gbuffer_build(ctx, s, 1, &g);
+    VT_CHECK(r == VSGL_ERROR_CANCELLED && g.pos[0] == NULL && g.material == NULL && g.count == 0, "r %d", r);
+    VT_CHECK(strncmp(vsgl_context_last_error(ctx), "gbuffer: cancelled at row ", 26) == 0, "'%s'", vsgl_context_last_error(ctx));
+    memset(&log, 0, sizeof log);
+    log.cancel_at = 1;
+    pos[0] = 42.0f;
+    r = vsgl_debug_gbuffer(ctx, s, 1, pos, NULL, NULL);
+    VT_CHECK(r == VSGL_ERROR_CANCELLED && pos[0] == 42.0f, "debug cancel r %d, output touched %g", r, pos[0]);
+    /* aa out of range */
+    r = vsgl__gbuffer_build(ctx, s, 17, &g);
+    VT_CHECK(r == VSGL_ERROR_INVALID_ARGUMENT && strcmp(vsgl_context_last_error(ctx), "gbuffer: aa_samples is 17 (must be in [1, 16])") == 0,
+             "r %d '%s'", r, vsgl_context_last_error(ctx));
+    free(pos); free(nrm); free(mat);
+    vsgl_scene_destroy(s);
+    vsgl_context_destroy(ctx);
+}
