@@ -562,6 +562,8 @@ PROTOTYPES = (
     ("vsgl_bundle_scene", _P(vsgl_scene_desc), [_VP]),
     ("vsgl_bundle_settings", _P(vsgl_render_settings), [_VP]),
     ("vsgl_bundle_get_info", _i32, [_VP, _P(vsgl_bundle_info)]),
+    # debug.h
+    ("vsgl_debug_gbuffer", _i32, [_VP, _VP, _u32, _PF32, _PF32, _PU32]),
 )
 
 # --------------------------------------------------------------------------
@@ -1518,3 +1520,24 @@ def bundle_read_memory(ctx, data):
     rc = ctx._lib.vsgl_bundle_read_memory(ctx.handle, data, len(data), ctypes.byref(handle))
     ctx.check(rc, "vsgl_bundle_read_memory")
     return _read_bundle(ctx, handle)
+
+
+# --------------------------------------------------------------------------
+# Debugging (debug.h; signatures may change between minor versions)
+# --------------------------------------------------------------------------
+
+
+def debug_gbuffer(ctx, scene, aa=1):
+    """The camera G-buffer of ``scene``: a dict with ``positions`` and
+    ``normals`` float32 (H, W, aa*aa, 3) and ``materials`` uint32
+    (H, W, aa*aa) (0 / 0xFFFFFFFF where a sample missed), samples ordered
+    s = j*aa + i as documented in vsgl/debug.h."""
+    aa = int(aa) or 1
+    H, W, S = scene.height, scene.width, aa * aa
+    pos = np.zeros((H, W, S, 3), np.float32)
+    nrm = np.zeros((H, W, S, 3), np.float32)
+    mat = np.zeros((H, W, S), np.uint32)
+    rc = ctx._lib.vsgl_debug_gbuffer(ctx.handle, scene.handle, aa, pos.ctypes.data_as(_PF32),
+                                     nrm.ctypes.data_as(_PF32), mat.ctypes.data_as(_PU32))
+    ctx.check(rc, "vsgl_debug_gbuffer")
+    return {"positions": pos, "normals": nrm, "materials": mat}

@@ -1,0 +1,139 @@
+"""The ctypes mirrors of the C structs and prototypes match the headers:
+sizeof/offsetof of every field from a compiled C program, field names and
+order parsed from the headers, and every prototype's types."""
+
+import ctypes
+import os
+import shutil
+import subprocess
+
+import pytest
+
+import header_parse
+import libvsgl
+from conftest import REPO
+
+CC = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc") or shutil.which("clang")
+
+
+def _c_name(field):
+    return libvsgl.FIELD_C_NAMES.get(field, field)
+
+
+def _have_io():
+    return os.path.exists(os.path.join(header_parse.INCLUDE, "vsgl", "io.h"))
+
+
+def _structs_to_check():
+    return {n: c for n, c in libvsgl.STRUCTS.items()
+            if libvsgl.STRUCT_HEADERS[n] != "io.h" or _have_io()}
+
+
+@pytest.fixture(scope="module")
+def c_layout(tmp_path_factory):
+    if CC is None:
+        pytest.skip("no C compiler (cc/gcc/clang) to measure the C layout")
+    structs = _structs_to_check()
+    lines = ["#include <stddef.h>", "#include <stdio.h>", '#include "vsgl.h"']
+    if _have_io():
+        lines.append('#include "vsgl/io.h"')
+    lines.append("int main(void) {")
+    for name, cls in structs.items():
+        lines.append('printf("%s %%zu %%zu\\n", sizeof(%s), _Alignof(%s));' % (name, name, name))
+        for field, _ in cls._fields_:
+            c = _c_name(field)
+            lines.append('printf("%s.%s %%zu %%zu\\n", offsetof(%s, %s), sizeof(((%s *)0)->%s));'
+                         % (name, field, name, c, name, c))
+    lines += ["return 0;", "}"]
+    d = tmp_path_factory.mktemp("layout")
+    src, exe = d / "layout.c", d / "layout"
+    src.write_text("\n".join(lines) + "\n")
+    r = subprocess.run([CC, "-std=c11", "-I", header_parse.INCLUDE, str(src), "-o", str(exe)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, ("a Python field does not exist in C (or a header does not "
+                               "compile):\n" + r.stderr)
+    out = subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout
+    res = {}
+    for line in out.splitlines():
+        key, a, b = line.split()
+        res[key] = (int(a), int(b))
+    return res
+
+
+@pytest.mark.parametrize("name", sorted(libvsgl.STRUCTS))
+def test_struct_size_and_offsets_match_c(name, c_layout):
+    if name not in _structs_to_check():
+        pytest.skip("%s: io.h not present" % name)
+    cls = libvsgl.STRUCTS[name]
+    size, align = c_layout[name]
+    assert ctypes.sizeof(cls) == size, "%s: ctypes sizeof %d, C sizeof %d" % (
+        name, ctypes.sizeof(cls), size)
+    assert ctypes.alignment(cls) == align, "%s: alignment %d vs C %d" % (
+        name, ctypes.alignment(cls), align)
+    for field, ftype in cls._fields_:
+        off, fsize = c_layout["%s.%s" % (name, field)]
+        assert getattr(cls, field).offset == off, "%s.%s: offset %d, C %d" % (
+            name, field, getattr(cls, field).offset, off)
+        assert ctypes.sizeof(ftype) == fsize, "%s.%s: size %d, C %d" % (
+            name, field, ctypes.sizeof(ftype), fsize)
+
+
+def test_struct_fields_match_header_order():
+    parsed = header_parse.structs()
+    for name, cls in _structs_to_check().items():
+        assert name in parsed, "%s not found in the headers" % name
+        py = [_c_name(f) for f, _ in cls._fields_]
+        assert py == parsed[name], "%s: binding fields %s, header fields %s" % (
+            name, py, parsed[name])
+    # every public struct of the headers is mirrored
+    unmirrored = sorted(set(parsed) - set(libvsgl.STRUCTS))
+    assert not unmirrored, "structs in the headers without a ctypes mirror: %s" % unmirrored
+
+
+OPAQUE = {"vsgl_context", "vsgl_scene", "vsgl_bundle"}
+SCALARS = {"float": ctypes.c_float, "double": ctypes.c_double, "int32_t": ctypes.c_int32,
+           "uint32_t": ctypes.c_uint32, "size_t": ctypes.c_size_t, "vsgl_result": ctypes.c_int32,
+           "uint64_t": ctypes.c_uint64}
+
+
+def _expected_ctype(text):
+    """ctypes type of a C type text from a header."""
+    t = text.replace("const", " ").split()
+    stars = "".join(t).count("*")
+    base = "".join(t).replace("*", "")
+    if stars == 0:
+        return None if base == "void" else SCALARS[base]
+    if stars == 1 and base == "char":
+        return ctypes.c_char_p
+    if stars == 1 and (base == "void" or base in OPAQUE):
+        return ctypes.c_void_p
+    if stars == 2 and base in OPAQUE:
+        return ctypes.POINTER(ctypes.c_void_p)
+    if stars == 1 and base in libvsgl.STRUCTS:
+        return ctypes.POINTER(libvsgl.STRUCTS[base])
+    if stars == 1 and base in SCALARS:
+        return ctypes.POINTER(SCALARS[base])
+    raise AssertionError("test does not know the C type %r" % text)
+
+
+def test_prototypes_match_headers():
+    parsed = header_parse.prototypes()
+    bound = {name: (res, args) for name, res, args in libvsgl.PROTOTYPES}
+    problems = []
+    for name, (hdr, ret, params) in sorted(parsed.items()):
+        if name not in bound:
+            problems.append("%s (%s) is not bound" % (name, hdr))
+            continue
+        res, args = bound[name]
+        want_res = _expected_ctype(ret)
+        if res is not want_res:
+            problems.append("%s: restype %s, header says %s" % (name, res, ret))
+        want = [_expected_ctype(p) for p in params]
+        if list(args) != want:
+            problems.append("%s: argtypes %s, header says %s" % (name, args, params))
+    for name in bound:
+        if name not in parsed:
+            if name.startswith(("vsgl_exr", "vsgl_bundle", "vsgl_check_output")) and not _have_io():
+                continue
+            problems.append("%s is bound but no header declares it" % name)
+    assert not problems, "\n".join(problems)
