@@ -1,0 +1,186 @@
+/* vsgl_render end to end on the room fixture: every mode gives finite,
+ * non-negative planes with colour bleeding where physics puts it; output
+ * sizes, settings validation and determinism across thread counts. */
+#include "harness.h"
+#include "scene_fixture.h"
+
+#include <stdlib.h>
+
+enum { W = 48, H = 36 };
+
+typedef struct planes {
+    float dl[W * H * 3], gl[W * H * 3], dc[W * H * 3], gc[W * H * 3], comb[W * H * 3], alpha[W * H];
+} planes;
+
+static vsgl_render_output bind(planes *p)
+{
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = W;
+    o.height = H;
+    o.diffuse_light = p->dl;
+    o.glossy_light = p->gl;
+    o.diffuse_color = p->dc;
+    o.glossy_color = p->gc;
+    o.combined = p->comb;
+    o.alpha = p->alpha;
+    return o;
+}
+
+static vsgl_result render_room(uint32_t threads, const vsgl_render_settings *s, planes *p, vsgl_render_stats *st,
+                               char *err, size_t errlen)
+{
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.25f, 200.0f);
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.size = sizeof cd;
+    cd.thread_count = threads;
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    vsgl_result r = vsgl_context_create(&cd, &ctx);
+    if (r == VSGL_OK)
+        r = vsgl_scene_create(ctx, fx_desc(&fx), &scene);
+    vsgl_render_output o = bind(p);
+    if (r == VSGL_OK)
+        r = vsgl_render(ctx, scene, s, &o, st);
+    if (r != VSGL_OK && err)
+        snprintf(err, errlen, "%s", vsgl_context_last_error(ctx));
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+    return r;
+}
+
+/* Mean of channel c of plane v over pixel rectangle [x0,x1) x [y0,y1). */
+static double region_mean(const float *v, int c, int x0, int x1, int y0, int y1)
+{
+    double s = 0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x)
+            s += v[(y * W + x) * 3 + c];
+    return s / ((x1 - x0) * (y1 - y0));
+}
+
+VT_TEST(render_every_mode_is_finite_and_bleeds_colour)
+{
+    static planes p;
+    const int fits[3] = {VSGL_FIT_TWO, VSGL_FIT_FIS, VSGL_FIT_KMEANS};
+    const int diffuse[3] = {VSGL_COSINE_SG, VSGL_COSINE_PULLED_OUT, VSGL_COSINE_ACCURATE};
+    for (int f = 0; f < 3; ++f)
+        for (int d = 0; d < 3; ++d)
+            for (int gm = 0; gm < 2; ++gm) {
+                vsgl_render_settings s;
+                vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+                s.aa_samples = 1;
+                s.rsm_resolution = 64;
+                s.vsgl_count = 16;
+                s.fit_mode = fits[f];
+                s.diffuse_mode = diffuse[d];
+                s.glossy_mode = gm;
+                vsgl_render_stats st;
+                char err[256] = "";
+                memset(&p, 0xff, sizeof p); /* NaN pattern: every pixel must be written */
+                vsgl_result r = render_room(0, &s, &p, &st, err, sizeof err);
+                VT_CHECK(r == VSGL_OK, "fit %d diffuse %d glossy %d: %s", fits[f], diffuse[d], gm, err);
+                if (r != VSGL_OK)
+                    continue;
+                int bad = 0;
+                for (int i = 0; i < W * H * 3; ++i)
+                    bad += !(isfinite(p.dl[i]) && p.dl[i] >= 0 && isfinite(p.gl[i]) && p.gl[i] >= 0 &&
+                             isfinite(p.comb[i]) && p.comb[i] >= 0);
+                VT_CHECK(bad == 0, "fit %d diffuse %d glossy %d: %d bad values", fits[f], diffuse[d], gm, bad);
+                VT_CHECK(st.vsgl_count > 0 && st.lights_used == 1, "fit %d: %u VSGLs", fits[f], st.vsgl_count);
+                /* The spot lights the red wall (left): the right (green) wall receives red
+                 * light, i.e. its DiffInd has more red than green. Right wall: columns near
+                 * the right edge, middle rows. */
+                double red = region_mean(p.dl, 0, W - 8, W - 3, H / 3, 2 * H / 3);
+                double green = region_mean(p.dl, 1, W - 8, W - 3, H / 3, 2 * H / 3);
+                VT_CHECK(red > 1.5 * green && red > 0, "fit %d diffuse %d: right wall DiffInd red %g green %g",
+                         fits[f], diffuse[d], red, green);
+            }
+}
+
+VT_TEST(render_is_bit_identical_for_any_thread_count)
+{
+    static planes a, b;
+    const int fits[3] = {VSGL_FIT_TWO, VSGL_FIT_FIS, VSGL_FIT_KMEANS};
+    for (int f = 0; f < 3; ++f) {
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.aa_samples = 2;
+        s.rsm_resolution = 64;
+        s.vsgl_count = 32;
+        s.fit_mode = fits[f];
+        s.visibility = VSGL_VISIBILITY_RAY;
+        VT_CHECK(render_room(1, &s, &a, NULL, NULL, 0) == VSGL_OK, "1 thread");
+        VT_CHECK(render_room(3, &s, &b, NULL, NULL, 0) == VSGL_OK, "3 threads");
+        VT_CHECK(memcmp(&a, &b, sizeof a) == 0, "fit %d: planes differ between 1 and 3 threads", fits[f]);
+    }
+}
+
+VT_TEST(render_rejects_bad_settings_and_sizes_without_touching_output)
+{
+    static planes p;
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    char err[256];
+    struct { const char *field; int value; const char *want; } cases[] = {
+        {"fit_mode", 7, "settings: fit_mode is 7"},
+        {"diffuse_mode", -1, "settings: diffuse_mode is -1"},
+        {"rsm_resolution", 100000, "settings: rsm_resolution is 100000"},
+        {"aa_samples", 99, "settings: aa_samples is 99"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        vsgl_render_settings bad = s;
+        if (i == 0) bad.fit_mode = cases[i].value;
+        if (i == 1) bad.diffuse_mode = cases[i].value;
+        if (i == 2) bad.rsm_resolution = (uint32_t)cases[i].value;
+        if (i == 3) bad.aa_samples = (uint32_t)cases[i].value;
+        memset(&p, 0x7f, sizeof p);
+        err[0] = 0;
+        VT_CHECK(render_room(0, &bad, &p, NULL, err, sizeof err) == VSGL_ERROR_INVALID_ARGUMENT, "%s", cases[i].field);
+        VT_CHECK(strncmp(err, cases[i].want, strlen(cases[i].want)) == 0, "got '%s' want '%s'", err, cases[i].want);
+        VT_CHECK(p.dl[0] == p.dl[W * H * 3 - 1] && p.alpha[0] == p.alpha[W * H - 1], "output touched");
+    }
+    /* wrong plane size */
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.3f, 10.0f);
+    vsgl_context *ctx;
+    vsgl_scene *scene;
+    vsgl_context_create(NULL, &ctx);
+    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+    vsgl_render_output o = bind(&p);
+    o.width = W + 1;
+    VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_ERROR_INVALID_ARGUMENT, "size mismatch");
+    VT_CHECK(strstr(vsgl_context_last_error(ctx), "camera renders 48x36") != NULL, "%s", vsgl_context_last_error(ctx));
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
+VT_TEST(render_skips_dark_lights_and_says_why)
+{
+    static planes p;
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.3f, 100.0f);
+    fx.lights[1] = fx.lights[0];
+    fx.lights[1].power = 0.0f;                  /* zero power */
+    fx.lights[2] = fx.lights[0];
+    fx_translation(fx.lights[2].world_from_light, 0, 0, 50); /* far above, aimed away? spot points down -Z: at the roof's back */
+    fx.lights[2].world_from_light[10] = -1.0f;  /* flip Z: emits up, into the void */
+    fx.lights[2].world_from_light[5] = -1.0f;
+    fx.light_count = 3;
+    vsgl_context *ctx;
+    vsgl_scene *scene;
+    vsgl_context_create(NULL, &ctx);
+    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene: %s", vsgl_context_last_error(ctx));
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    vsgl_render_output o = bind(&p);
+    vsgl_render_stats st;
+    VT_CHECK(vsgl_render(ctx, scene, &s, &o, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(st.lights_used == 1 && st.lights_skipped == 2, "used %u skipped %u", st.lights_used, st.lights_skipped);
+    VT_CHECK(strstr(st.skipped, "light 1: zero power") != NULL, "skipped: %s", st.skipped);
+    VT_CHECK(strstr(st.skipped, "light 2: lights no geometry") != NULL, "skipped: %s", st.skipped);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
