@@ -7,7 +7,11 @@ and the add-on as ``from . import libvsgl``.
 Library lookup, first match wins:
 
 1. ``$VSGL_LIBRARY`` (an explicit path; no fallback if it is wrong),
-2. ``libvsgl.so`` beside this module (the add-on zip ships it there),
+2. ``lib/libvsgl.so`` beside this module (where the add-on zip should ship
+   it), then ``libvsgl.so`` beside this module. Caution: a ``libvsgl.so``
+   in the same folder as ``libvsgl.py`` shadows it: Python's import system
+   takes ``libvsgl.so`` for an extension module named ``libvsgl`` and
+   ``import libvsgl`` fails. Ship it in ``lib/`` (or under another name).
 3. ``../../build/libvsgl.so`` relative to this module (a dev checkout).
 
 The library is loaded once, on first use, and every ``argtypes``/``restype``
@@ -585,7 +589,8 @@ def find_library():
                 "(build it with `make` in the repository root, giving build/libvsgl.so) "
                 "or unset it to use the bundled library." % env)
         return env
-    tried = [os.path.join(_HERE, _LIB_NAME),
+    tried = [os.path.join(_HERE, "lib", _LIB_NAME),
+             os.path.join(_HERE, _LIB_NAME),
              os.path.normpath(os.path.join(_HERE, "..", "..", "build", _LIB_NAME))]
     for path in tried:
         if os.path.isfile(path):
