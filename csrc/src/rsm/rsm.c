@@ -1,0 +1,146 @@
+/* Reflective shadow maps: one ray per texel from the light, the hit becomes
+ * a VPL carrying the power the light emits into the texel (rsm_light.c).
+ * Rows are traced in parallel (deterministic chunks of one row); progress
+ * is reported between batches of rows from the calling thread. */
+#include "rsm/rsm.h"
+
+#include "core/context.h"
+#include "core/parallel.h"
+#include "rsm/rsm_light.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void vsgl__rsm_free(vsgl_rsm *r)
+{
+    if (!r)
+        return;
+    for (int k = 0; k < 3; ++k) {
+        free(r->pos[k]);
+        free(r->nrm[k]);
+        free(r->wi[k]);
+        free(r->flux[k]);
+    }
+    free(r->material);
+    memset(r, 0, sizeof *r);
+}
+
+typedef struct rsm_job {
+    const vsgl_scene *scene;
+    const vsgl_rsm_light *light;
+    vsgl_rsm *out;
+    size_t first_row;        /* global row (face * res + row) of chunk 0 */
+    double *partial;         /* per row: flux sums (3) */
+} rsm_job;
+
+static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
+{
+    (void)chunk;
+    rsm_job *j = user;
+    const vsgl_rsm_light *l = j->light;
+    vsgl_rsm *o = j->out;
+    uint32_t res = o->res;
+    v3 *org = malloc(res * sizeof *org);
+    v3 *dir = malloc(res * sizeof *dir);
+    float *tmin = malloc(res * sizeof *tmin);
+    float *tmax = malloc(res * sizeof *tmax);
+    vsgl_hit *hits = malloc(res * sizeof *hits);
+    double *fl = malloc(res * 3 * sizeof *fl);
+    if (!org || !dir || !tmin || !tmax || !hits || !fl) {
+        free(org); free(dir); free(tmin); free(tmax); free(hits); free(fl);
+        return VSGL_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t gr = begin; gr < end; ++gr) {
+        size_t grow = j->first_row + gr;
+        uint32_t face = (uint32_t)(grow / res), row = (uint32_t)(grow % res);
+        for (uint32_t c = 0; c < res; ++c) {
+            int lit = vsgl__rsm_light_texel(l, face, row, c, &org[c], &dir[c], &fl[3 * c]);
+            tmin[c] = 0.0f;
+            tmax[c] = lit ? (l->type == VSGL_LIGHT_SUN ? l->sun_tmax : INFINITY) : -1.0f;
+        }
+        vsgl__scene_intersect_many(j->scene, res, org, dir, tmin, tmax, 1, hits);
+        double s[3] = {0, 0, 0};
+        for (uint32_t c = 0; c < res; ++c) {
+            size_t i = grow * res + c;
+            if (hits[c].triangle == VSGL_HIT_NONE || !(tmax[c] >= 0.0f)) {
+                for (int k = 0; k < 3; ++k)
+                    o->pos[k][i] = o->nrm[k][i] = o->wi[k][i] = o->flux[k][i] = 0.0f;
+                o->material[i] = VSGL_RSM_EMPTY;
+                continue;
+            }
+            vsgl_surface sf;
+            vsgl__scene_surface(j->scene, &hits[c], dir[c], &sf);
+            v3 wi = v3_neg(dir[c]);
+            o->pos[0][i] = sf.position.x; o->pos[1][i] = sf.position.y; o->pos[2][i] = sf.position.z;
+            o->nrm[0][i] = sf.normal.x; o->nrm[1][i] = sf.normal.y; o->nrm[2][i] = sf.normal.z;
+            o->wi[0][i] = wi.x; o->wi[1][i] = wi.y; o->wi[2][i] = wi.z;
+            for (int k = 0; k < 3; ++k) {
+                o->flux[k][i] = (float)fl[3 * c + k];
+                s[k] += (double)o->flux[k][i];
+            }
+            o->material[i] = sf.material;
+        }
+        for (int k = 0; k < 3; ++k)
+            j->partial[3 * (grow - j->first_row) + k] = s[k];
+    }
+    free(org); free(dir); free(tmin); free(tmax); free(hits); free(fl);
+    return 0;
+}
+
+vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res, vsgl_rsm *out)
+{
+    memset(out, 0, sizeof *out);
+    uint32_t nl = 0;
+    vsgl__scene_lights(scene, &nl);
+    if (light >= nl)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "rsm: light %u out of range (%u lights)", light, nl);
+    if (res < 1 || res > 16384)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "rsm: resolution %u (valid 1..16384)", res);
+    vsgl_rsm_light l;
+    vsgl__rsm_light_setup(scene, light, res, &l);
+    out->light = light;
+    out->faces = l.faces;
+    out->res = res;
+    out->count = (size_t)l.faces * res * res;
+    size_t n = out->count;
+    int ok = 1;
+    for (int k = 0; k < 3; ++k) {
+        ok &= (out->pos[k] = malloc(n * sizeof(float))) != NULL;
+        ok &= (out->nrm[k] = malloc(n * sizeof(float))) != NULL;
+        ok &= (out->wi[k] = malloc(n * sizeof(float))) != NULL;
+        ok &= (out->flux[k] = malloc(n * sizeof(float))) != NULL;
+    }
+    ok &= (out->material = malloc(n * sizeof(uint32_t))) != NULL;
+    size_t rows = (size_t)l.faces * res;
+    double *partial = ok ? malloc(rows * 3 * sizeof *partial) : NULL;
+    if (!ok || !partial) {
+        vsgl__rsm_free(out);
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "rsm: out of memory for %zu texels", n);
+    }
+    /* batches of rows so that progress and cancel run on this thread */
+    size_t batch = rows / 16 > 0 ? rows / 16 : 1;
+    uint32_t threads = vsgl_context_thread_count(ctx);
+    vsgl_result r = VSGL_OK;
+    for (size_t b = 0; b < rows && r == VSGL_OK; b += batch) {
+        size_t e = b + batch < rows ? b + batch : rows;
+        rsm_job j = {scene, &l, out, b, partial + 3 * b};
+        r = vsgl__parallel_for(threads, e - b, 1, rsm_rows, &j);
+        if (r != VSGL_OK)
+            r = vsgl__fail(ctx, r, "rsm: light %u: %s", light, vsgl_result_string(r));
+        else if (vsgl__progress(ctx, "rsm", (float)e / (float)rows))
+            r = vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "rsm: cancelled");
+    }
+    if (r != VSGL_OK) {
+        free(partial);
+        vsgl__rsm_free(out);
+        return r;
+    }
+    /* sum in row order: bit-identical for any thread count */
+    for (int k = 0; k < 3; ++k)
+        out->total_flux[k] = 0.0;
+    for (size_t i = 0; i < rows; ++i)
+        for (int k = 0; k < 3; ++k)
+            out->total_flux[k] += partial[3 * i + k];
+    free(partial);
+    return VSGL_OK;
+}
