@@ -1,0 +1,41 @@
+"""VSGL Indirect: fast one-bounce diffuse + glossy indirect light as a
+compositor AOV, computed by libvsgl (C) from the evaluated scene."""
+
+bl_info = {
+    "name": "VSGL Indirect Light",
+    "author": "vsgl-indirect contributors",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "Properties > Render > VSGL Indirect Light; File > Export > VSGL scene bundle",
+    "description": "One-bounce indirect light (virtual spherical Gaussian lights) as a "
+                   "multilayer EXR AOV wired into the compositor",
+    "category": "Render",
+}
+
+if "bpy" in locals():   # script reload
+    import importlib
+    for _m in ("compat", "convert", "materials", "config", "exr", "export", "engine",
+               "runner", "compositor", "settings", "operators", "ui", "handlers"):
+        if _m in locals():
+            importlib.reload(locals()[_m])
+
+import bpy  # noqa: E402
+
+from . import settings, operators, ui, handlers  # noqa: E402
+
+_modules = (settings, operators, ui, handlers)
+
+
+def register():
+    for m in _modules:
+        m.register()
+    from . import engine
+    ok, msg = engine.library_status()
+    if not ok:
+        # Still usable (settings, UI); every render reports the same message.
+        print("VSGL WARNING: %s" % msg)
+
+
+def unregister():
+    for m in reversed(_modules):
+        m.unregister()

@@ -1,0 +1,347 @@
+"""Evaluated Blender scene -> flat numpy arrays for ``vsgl_scene_desc``.
+
+Two halves: ``collect()`` reads bpy (depsgraph instances, evaluated meshes,
+lights, camera, materials) into plain values; ``assemble()`` (no bpy) turns
+mesh chunks into world-space arrays. No per-vertex Python loops: every
+array comes from ``foreach_get`` and numpy.
+"""
+import numpy as np
+
+from . import convert, materials
+from .convert import ExportError
+
+MESH_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
+HOLDOUT_KEY = "<holdout>"
+DEFAULT_KEY = "<default>"
+
+
+class SceneData:
+    """Flat arrays and tables ready for the binding; names for messages."""
+
+    def __init__(self):
+        self.positions = np.zeros((0, 3), np.float32)
+        self.indices = np.zeros((0, 3), np.uint32)
+        self.corner_normals = np.zeros((0, 3, 3), np.float32)
+        self.corner_uvs = None
+        self.material_indices = np.zeros(0, np.uint32)
+        self.materials = []        # vsgl_material field dicts
+        self.material_names = []
+        self.lights = []           # vsgl_light field dicts
+        self.light_names = []
+        self.camera = None         # vsgl_camera field dict
+        self.camera_name = ""
+        self.warnings = []
+        self.object_names = []     # one per exported mesh instance
+        self.instance_count = 0    # instances among them
+        self.width = self.height = 0
+
+    @property
+    def triangle_count(self):
+        return int(self.indices.shape[0])
+
+    def summary(self):
+        return ("%d triangles, %d objects (%d instances), %d materials, %d lights, camera '%s' %dx%d"
+                % (self.triangle_count, len(self.object_names), self.instance_count,
+                   len(self.materials), len(self.lights), self.camera_name, self.width, self.height))
+
+
+# --------------------------------------------------------------------------
+# Pure assembly
+# --------------------------------------------------------------------------
+
+class MeshArrays:
+    """Local-space arrays of one evaluated mesh (shared by its instances)."""
+
+    def __init__(self, positions, tri_verts, tri_loops, loop_normals, loop_uvs, tri_material):
+        self.positions = positions        # (V,3) float32
+        self.tri_verts = tri_verts        # (T,3) int
+        self.tri_loops = tri_loops        # (T,3) int
+        self.loop_normals = loop_normals  # (L,3) float32
+        self.loop_uvs = loop_uvs          # (L,2) float32 or None
+        self.tri_material = tri_material  # (T,) int: slot index
+        self.slots = []                   # material per slot (bpy materials)
+
+
+def assemble(chunks, want_uvs=False):
+    """Concatenate ``chunks`` = [(MeshArrays, matrix 4x4, slot_to_global list)]
+    into world-space (positions, indices, corner_normals, corner_uvs,
+    material_indices). Mirrored instances (det < 0) get their winding
+    flipped so geometric normals keep facing the same way as in Blender.
+    """
+    pos, idx, nrm, uvs, mats = [], [], [], [], []
+    base = 0
+    for arr, matrix, slot_map in chunks:
+        t = arr.tri_verts.shape[0]
+        if t == 0:
+            continue
+        m = np.asarray(matrix, np.float64).reshape(4, 4)
+        p = convert.transform_points(m, arr.positions)
+        tv = arr.tri_verts.astype(np.int64)
+        tl = arr.tri_loops.astype(np.int64)
+        if np.linalg.det(m[:3, :3]) < 0:
+            tv = tv[:, [0, 2, 1]]
+            tl = tl[:, [0, 2, 1]]
+        n = convert.transform_normals(m, arr.loop_normals.reshape(-1, 3)[tl.reshape(-1)])
+        pos.append(p)
+        idx.append((tv + base).astype(np.uint32))
+        nrm.append(n.reshape(t, 3, 3))
+        if want_uvs:
+            if arr.loop_uvs is not None:
+                uvs.append(arr.loop_uvs[tl.reshape(-1)].reshape(t, 3, 2).astype(np.float32))
+            else:
+                uvs.append(np.zeros((t, 3, 2), np.float32))
+        sm = np.asarray(slot_map if len(slot_map) else [0], np.uint32)
+        mats.append(sm[np.clip(arr.tri_material, 0, len(sm) - 1)])
+        base += p.shape[0]
+    if not idx:
+        return (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.uint32),
+                np.zeros((0, 3, 3), np.float32), None, np.zeros(0, np.uint32))
+    return (np.concatenate(pos), np.concatenate(idx), np.concatenate(nrm),
+            np.concatenate(uvs) if want_uvs else None, np.concatenate(mats).astype(np.uint32))
+
+
+# --------------------------------------------------------------------------
+# bpy glue
+# --------------------------------------------------------------------------
+
+def _mesh_arrays(mesh, compat):
+    mesh.calc_loop_triangles()
+    lt = mesh.loop_triangles
+    nt, nv = len(lt), len(mesh.vertices)
+    pos = np.empty(nv * 3, np.float32)
+    mesh.vertices.foreach_get("co", pos)
+    tv = np.empty(nt * 3, np.int32)
+    lt.foreach_get("vertices", tv)
+    tl = np.empty(nt * 3, np.int32)
+    lt.foreach_get("loops", tl)
+    mi = np.empty(nt, np.int32)
+    lt.foreach_get("material_index", mi)
+    ln = compat.corner_normals(mesh) if nt else np.zeros((0, 3), np.float32)
+    uv = None
+    layer = mesh.uv_layers.active if len(mesh.uv_layers) else None
+    if layer is not None and nt:
+        uv = np.empty(len(mesh.loops) * 2, np.float32)
+        layer.data.foreach_get("uv", uv)
+        uv = uv.reshape(-1, 2)
+    return MeshArrays(pos.reshape(nv, 3), tv.reshape(nt, 3), tl.reshape(nt, 3), ln, uv,
+                      mi)
+
+
+def _socket_value(s):
+    v = getattr(s, "default_value", None)
+    if v is None:
+        return None
+    try:
+        return tuple(float(x) for x in v)
+    except TypeError:
+        try:
+            return float(v)
+        except (TypeError, ValueError):
+            return None
+
+
+def describe_material(mat, compat):
+    """Read a material into a :class:`materials.ShaderDesc` (bpy glue)."""
+    vp = (tuple(mat.diffuse_color), float(mat.metallic), float(mat.roughness))
+    ver = compat.VERSION
+    name = mat.name
+    if not compat.material_uses_nodes(mat):
+        return materials.ShaderDesc(name, materials.NO_NODES, viewport=vp, version=ver)
+    out = compat.shader_output_node(mat.node_tree)
+    if out is None:
+        return materials.ShaderDesc(name, materials.OTHER, viewport=vp, version=ver,
+                                    reason="no Material Output node")
+    sock = out.inputs.get("Surface")
+    node = None
+    seen = 0
+    while sock is not None and sock.is_linked and seen < 64:
+        node = sock.links[0].from_node
+        seen += 1
+        if node.bl_idname == "NodeReroute":
+            sock = node.inputs[0]
+            node = None
+            continue
+        break
+    if node is None:
+        return materials.ShaderDesc(name, materials.OTHER, viewport=vp, version=ver,
+                                    reason="nothing connected to the Material Output's Surface")
+    kinds = {"ShaderNodeBsdfPrincipled": materials.PRINCIPLED,
+             "ShaderNodeBsdfDiffuse": materials.DIFFUSE,
+             "ShaderNodeBsdfGlossy": materials.GLOSSY,
+             "ShaderNodeBsdfAnisotropic": materials.ANISOTROPIC}
+    kind = kinds.get(node.bl_idname)
+    if kind is None:
+        return materials.ShaderDesc(name, materials.OTHER, viewport=vp, version=ver,
+                                    node=node.name,
+                                    reason="surface is a '%s' node" % node.bl_idname)
+    inputs, linked = {}, set()
+    for s in node.inputs:
+        v = _socket_value(s)
+        if v is not None and s.name not in inputs:
+            inputs[s.name] = v
+        if s.is_linked:
+            linked.add(s.name)
+    return materials.ShaderDesc(name, kind, inputs, linked, node=node.name, viewport=vp,
+                                version=ver)
+
+
+def _holdout_objects(view_layer):
+    """Names of objects in collections marked holdout in ``view_layer``."""
+    names = set()
+
+    def walk(lc, inherited):
+        h = inherited or getattr(lc, "holdout", False)
+        if h and not lc.exclude:
+            names.update(o.name for o in lc.collection.all_objects)
+        for c in lc.children:
+            walk(c, h)
+    walk(view_layer.layer_collection, False)
+    return names
+
+
+def collect(depsgraph, scene=None, require_lights=True):
+    """Export the evaluated ``depsgraph`` (render or viewport) to a SceneData.
+
+    Raises ExportError (naming the element) when the scene cannot give an
+    AOV: no camera, unsupported camera, no geometry, no lights.
+    """
+    from . import compat
+    scene = scene or depsgraph.scene
+    sd = SceneData()
+    view_layer = scene.view_layers.get(depsgraph.view_layer.name) or depsgraph.view_layer
+    holdout_names = _holdout_objects(view_layer)
+    viewport = depsgraph.mode != "RENDER"
+
+    mat_index = {}
+    mat_cache = {}
+
+    def material_global(mat, holdout):
+        if holdout:
+            key = HOLDOUT_KEY
+        elif mat is None:
+            key = DEFAULT_KEY
+        else:
+            key = mat.original.name_full if mat.original else mat.name_full
+        if key in mat_index:
+            return mat_index[key]
+        if key == HOLDOUT_KEY:
+            fields = materials.default_material()
+            fields.update(base_color=(0.0, 0.0, 0.0), specular_f0=0.0)
+            warns = []
+        elif key == DEFAULT_KEY:
+            fields, warns = materials.default_material(), []
+        else:
+            fields, warns = materials.map_material(describe_material(mat, compat))
+        mat_cache[key] = fields
+        sd.warnings.extend(warns)
+        mat_index[key] = len(sd.materials)
+        sd.materials.append(fields)
+        sd.material_names.append(key)
+        return mat_index[key]
+
+    mesh_cache = {}
+    chunks = []
+    for inst in depsgraph.object_instances:
+        obj = inst.object
+        if obj.type not in MESH_TYPES and obj.type != "LIGHT":
+            continue
+        orig = obj.original
+        parent = inst.parent if inst.is_instance else None
+        if viewport:
+            # A viewport depsgraph still contains render-hidden objects.
+            if orig.hide_render or (parent is not None and parent.original.hide_render):
+                continue
+        if obj.type == "LIGHT":
+            _add_light(sd, obj, inst.matrix_world, compat)
+            continue
+        holdout = (compat.is_holdout(orig) or orig.name in holdout_names
+                   or (parent is not None and (compat.is_holdout(parent.original)
+                                               or parent.original.name in holdout_names)))
+        key = ("inst", obj.name, obj.data.as_pointer() if obj.data else 0) if inst.is_instance \
+            else ("obj", obj.name)
+        arr = mesh_cache.get(key)
+        if arr is None:
+            try:
+                mesh = obj.to_mesh()
+            except RuntimeError:
+                mesh = None
+            if mesh is None:
+                mesh_cache[key] = arr = MeshArrays(np.zeros((0, 3), np.float32),
+                                                   np.zeros((0, 3), np.int32),
+                                                   np.zeros((0, 3), np.int32),
+                                                   np.zeros((0, 3), np.float32), None,
+                                                   np.zeros(0, np.int32))
+            else:
+                try:
+                    arr = _mesh_arrays(mesh, compat)
+                    slots = [s.material for s in obj.material_slots] or list(mesh.materials)
+                finally:
+                    obj.to_mesh_clear()
+                arr.slots = slots
+                mesh_cache[key] = arr
+        if arr.tri_verts.shape[0] == 0:
+            continue
+        slot_map = [material_global(m, holdout) for m in (arr.slots or [None])]
+        chunks.append((arr, np.array(inst.matrix_world), slot_map))
+        sd.object_names.append(orig.name if not inst.is_instance
+                               else "%s (instance of %s)" % (orig.name, parent.name if parent else "?"))
+        sd.instance_count += int(inst.is_instance)
+
+    want_uvs = any(a.loop_uvs is not None for a, _, _ in chunks)
+    (sd.positions, sd.indices, sd.corner_normals, sd.corner_uvs,
+     sd.material_indices) = assemble(chunks, want_uvs)
+    if not sd.materials:
+        material_global(None, False)
+
+    _add_camera(sd, scene, depsgraph, compat)
+
+    if sd.triangle_count == 0:
+        raise ExportError("view layer '%s' of scene '%s' has no visible mesh geometry to light"
+                          % (view_layer.name, scene.name))
+    if require_lights and not any(l["power"] > 0 and max(l["color"]) > 0 for l in sd.lights):
+        raise ExportError("scene '%s' (view layer '%s') has no light with non-zero power"
+                          % (scene.name, view_layer.name))
+    return sd
+
+
+def _add_light(sd, obj, matrix, compat):
+    light = obj.data
+    name = obj.original.name if obj.original else obj.name
+    if getattr(light, "use_nodes", False) and light.node_tree is not None:
+        sd.warnings.append("light '%s': its node setup is ignored (colour x power only)" % name)
+    try:
+        f = convert.light_fields(
+            name, light.type, np.array(matrix), light.energy, tuple(light.color),
+            exposure=compat.light_exposure(light), blackbody=compat.light_blackbody(light),
+            radius=getattr(light, "shadow_soft_size", 0.0),
+            spot_size=getattr(light, "spot_size", 0.0), spot_blend=getattr(light, "spot_blend", 0.0),
+            sun_angle=getattr(light, "angle", 0.0), shape=getattr(light, "shape", "SQUARE"),
+            size=getattr(light, "size", 0.0), size_y=getattr(light, "size_y", 0.0),
+            spread=getattr(light, "spread", np.pi))
+    except ExportError as e:
+        sd.warnings.append("%s; skipped" % e)
+        return
+    if f["power"] <= 0 or max(f["color"]) <= 0:
+        sd.warnings.append("light '%s': zero power, skipped" % name)
+        return
+    sd.lights.append(f)
+    sd.light_names.append(name)
+
+
+def _add_camera(sd, scene, depsgraph, compat):
+    cam = scene.camera
+    if cam is None:
+        raise ExportError("scene '%s' has no active camera" % scene.name)
+    if cam.type != "CAMERA":
+        raise ExportError("scene '%s': active camera '%s' is not a camera object"
+                          % (scene.name, cam.name))
+    ev = cam.evaluated_get(depsgraph)
+    c = ev.data
+    r = scene.render
+    w, h = convert.render_size(r.resolution_x, r.resolution_y, r.resolution_percentage)
+    sd.camera = convert.camera_fields(
+        cam.name, c.type, np.array(ev.matrix_world), c.lens, c.sensor_width, c.sensor_height,
+        c.sensor_fit, c.ortho_scale, c.shift_x, c.shift_y, c.clip_start, c.clip_end, w, h,
+        r.pixel_aspect_x, r.pixel_aspect_y)
+    sd.camera_name = cam.name
+    sd.width, sd.height = w, h

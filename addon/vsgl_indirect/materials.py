@@ -1,0 +1,131 @@
+"""Material mapping: Blender shader values -> ``vsgl_material`` fields.
+
+Pure logic (no ``bpy``): the bpy glue in ``export.py`` reads a material's
+node tree into a :class:`ShaderDesc` (plain values) and this module turns it
+into the fields of ``vsgl_material`` (csrc/include/vsgl/scene.h) plus
+warnings naming the material. Unit-testable with plain Python.
+"""
+import math
+
+MATERIAL_UNSUPPORTED = 1  # VSGL_MATERIAL_UNSUPPORTED
+
+# Node kinds the bpy glue reports.
+PRINCIPLED = "PRINCIPLED"
+DIFFUSE = "DIFFUSE"
+GLOSSY = "GLOSSY"          # Glossy BSDF (4.x: also anisotropic)
+ANISOTROPIC = "ANISOTROPIC"  # 3.x Anisotropic BSDF
+NO_NODES = "NO_NODES"      # material.use_nodes is False: Cycles shades diffuse_color
+OTHER = "OTHER"            # anything else: viewport values, flagged
+
+
+class ShaderDesc:
+    """What the glue read from one material (plain Python values).
+
+    kind: one of the constants above; inputs: socket name -> default value
+    (floats or RGB(A) tuples); linked: names of inputs driven by a link
+    (textures etc.); node: name of the shader node found (for messages);
+    viewport: (diffuse_color rgba, metallic, roughness) of the material;
+    version: Blender version tuple (socket names differ at 4.0).
+    """
+
+    def __init__(self, name, kind, inputs=None, linked=(), node="",
+                 viewport=((0.8, 0.8, 0.8, 1.0), 0.0, 0.5), version=(4, 0, 0), reason=""):
+        self.name = name
+        self.kind = kind
+        self.inputs = dict(inputs or {})
+        self.linked = set(linked)
+        self.node = node
+        self.viewport = viewport
+        self.version = tuple(version)
+        self.reason = reason
+
+
+def default_material():
+    """Blender's default surface (no material): 0.8 grey, roughness 0.5, F0 0.04."""
+    return dict(base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5,
+                specular_f0=0.04, anisotropy=0.0, anisotropic_rotation=0.0, flags=0)
+
+
+def _clamp01(x):
+    x = float(x)
+    if not math.isfinite(x):
+        return 0.0
+    return min(max(x, 0.0), 1.0)
+
+
+def _rgb(v):
+    try:
+        seq = list(v)
+    except TypeError:
+        seq = [float(v)] * 3
+    return tuple(_clamp01(c) for c in seq[:3])
+
+
+def f0_from_ior(ior):
+    """Fresnel reflectance at normal incidence of a dielectric, ((n-1)/(n+1))^2."""
+    ior = float(ior)
+    if not math.isfinite(ior) or ior <= 0.0:
+        return 0.0
+    return ((ior - 1.0) / (ior + 1.0)) ** 2
+
+
+def principled_f0(inputs, version):
+    """Dielectric F0 of a Principled BSDF.
+
+    3.x: 0.08 * Specular. 4.x: F0(IOR) * 2 * "Specular IOR Level" (0.5 keeps
+    the IOR's F0), as Cycles does, clamped to [0, 1].
+    """
+    if tuple(version) < (4, 0, 0):
+        return _clamp01(0.08 * float(inputs.get("Specular", 0.5)))
+    f0 = f0_from_ior(inputs.get("IOR", 1.5))
+    level = float(inputs.get("Specular IOR Level", 0.5))
+    return _clamp01(f0 * 2.0 * level)
+
+
+def map_material(desc):
+    """Return (fields, warnings): ``fields`` has the vsgl_material keys."""
+    warnings = []
+    m = default_material()
+    inp = desc.inputs
+    who = "material '%s'" % desc.name
+
+    def note_links(names):
+        used = sorted(n for n in names if n in desc.linked)
+        if used:
+            warnings.append("%s: %s input(s) %s are linked (textures are not supported); "
+                            "their unlinked values are used" % (who, desc.node or desc.kind,
+                                                                ", ".join(repr(u) for u in used)))
+
+    if desc.kind == PRINCIPLED:
+        m["base_color"] = _rgb(inp.get("Base Color", (0.8, 0.8, 0.8)))
+        m["metallic"] = _clamp01(inp.get("Metallic", 0.0))
+        m["roughness"] = _clamp01(inp.get("Roughness", 0.5))
+        m["specular_f0"] = principled_f0(inp, desc.version)
+        m["anisotropy"] = _clamp01(inp.get("Anisotropic", 0.0))
+        m["anisotropic_rotation"] = _clamp01(inp.get("Anisotropic Rotation", 0.0))
+        spec = "Specular" if desc.version < (4, 0, 0) else "Specular IOR Level"
+        note_links(["Base Color", "Metallic", "Roughness", spec, "IOR",
+                    "Anisotropic", "Anisotropic Rotation"])
+        tw = "Transmission" if desc.version < (4, 0, 0) else "Transmission Weight"
+        if float(inp.get(tw, 0.0)) > 0.0:
+            warnings.append("%s: transmission is not modelled (treated as opaque)" % who)
+    elif desc.kind in (DIFFUSE, NO_NODES):
+        col = inp.get("Color", desc.viewport[0]) if desc.kind == DIFFUSE else desc.viewport[0]
+        m.update(base_color=_rgb(col), metallic=0.0, roughness=1.0, specular_f0=0.0)
+        if desc.kind == DIFFUSE:
+            note_links(["Color"])
+    elif desc.kind in (GLOSSY, ANISOTROPIC):
+        # A Glossy BSDF is a conductor whose F0 is its colour.
+        m.update(base_color=_rgb(inp.get("Color", (0.8, 0.8, 0.8))), metallic=1.0,
+                 roughness=_clamp01(inp.get("Roughness", 0.5)), specular_f0=0.0)
+        m["anisotropy"] = _clamp01(inp.get("Anisotropy", 0.0))
+        m["anisotropic_rotation"] = _clamp01(inp.get("Rotation", 0.0))
+        note_links(["Color", "Roughness", "Anisotropy", "Rotation"])
+    else:
+        col, metallic, rough = desc.viewport
+        m.update(base_color=_rgb(col), metallic=_clamp01(metallic), roughness=_clamp01(rough),
+                 specular_f0=0.04, flags=MATERIAL_UNSUPPORTED)
+        why = (": " + desc.reason) if desc.reason else ""
+        warnings.append("%s: unsupported shader%s; using its viewport display colour, "
+                        "metallic and roughness" % (who, why))
+    return m, warnings

@@ -1,0 +1,103 @@
+"""bpy glue around one AOV computation: paths, export, reports, last-run info."""
+import os
+import sys
+import time
+
+import bpy
+
+from . import convert, engine, export
+from .config import Options
+from .convert import ExportError
+
+#: scene name -> dict(status, error, warnings, timings, skipped, summary, path, frame)
+LAST_RUN = {}
+
+
+def options_of(scene):
+    return Options.from_props(scene.vsgl_indirect)
+
+
+def report(scene_name, level, message):
+    """Print to Blender's log (stdout) and keep it for the panel."""
+    line = "VSGL %s: %s" % (level, message)
+    print(line, file=sys.stderr if level == "ERROR" else sys.stdout, flush=True)
+    LAST_RUN.setdefault(scene_name, {}).setdefault("messages", []).append((level, message))
+
+
+def render_dir(scene):
+    d = os.path.dirname(scene.render.filepath) or "//"
+    d = bpy.path.abspath(d)
+    if d.startswith("//"):   # unsaved file and a relative output path
+        d = os.path.join(bpy.app.tempdir or "/tmp", d[2:])
+    return d
+
+
+def output_path(scene, view_layer, frame, options=None):
+    options = options or options_of(scene)
+    p = convert.frame_path(options.output_path or "{render_dir}/vsgl/{scene}_{view_layer}_####.exr",
+                           frame, scene.name, view_layer, render_dir(scene))
+    p = bpy.path.abspath(p)
+    if p.startswith("//"):
+        p = os.path.join(bpy.app.tempdir or "/tmp", p[2:])
+    return os.path.normpath(p)
+
+
+def begin(scene_name, frame):
+    LAST_RUN[scene_name] = {"status": "running", "frame": frame, "messages": [],
+                            "timings": {}, "skipped": "", "summary": "", "path": "", "error": ""}
+
+
+def export_scene(scene, depsgraph):
+    t = time.perf_counter()
+    sd = export.collect(depsgraph, scene)
+    return sd, time.perf_counter() - t
+
+
+def finish(scene_name, result, t_export):
+    info = LAST_RUN.setdefault(scene_name, {})
+    st = result.stats or {}
+    timings = {"export": t_export}
+    timings.update(result.timings)
+    for k in ("scene_prep", "gbuffer", "rsm", "fit", "shade", "total"):
+        if "seconds_" + k in st:
+            timings["lib " + k] = st["seconds_" + k]
+    info.update(status="done", timings=timings, skipped=st.get("skipped", ""),
+                summary=result.summary, path=result.path)
+    for w in result.warnings:
+        report(scene_name, "WARNING", w)
+    for line in (st.get("skipped") or "").splitlines():
+        if line.strip():
+            report(scene_name, "INFO", "skipped: " + line.strip())
+    report(scene_name, "INFO", "wrote %s (%s; export %.3fs, render %.3fs, write %.3fs)"
+           % (result.path, result.summary, t_export, result.timings.get("render", 0),
+              result.timings.get("write", 0)))
+
+
+def fail(scene_name, message):
+    info = LAST_RUN.setdefault(scene_name, {})
+    info.update(status="failed", error=message)
+    report(scene_name, "ERROR", message)
+
+
+def run_frame(scene, depsgraph, frame, options=None, progress=None, keep_planes=False):
+    """Export the depsgraph's view layer, render, write this frame's EXR.
+    Returns the engine Result or None after reporting the error."""
+    options = options or options_of(scene)
+    layer = depsgraph.view_layer.name
+    path = output_path(scene, layer, frame, options)
+    begin(scene.name, frame)
+    try:
+        sd, t_export = export_scene(scene, depsgraph)
+        result = engine.compute(sd, options, path, progress=progress, keep_planes=keep_planes,
+                                metadata={"vsgl.scene": scene.name, "vsgl.view_layer": layer,
+                                          "vsgl.frame": str(frame)})
+    except (ExportError, engine.AovError) as e:
+        fail(scene.name, "frame %d, view layer '%s': %s" % (frame, layer, e))
+        return None
+    except Exception as e:  # never let a bug take the render down silently
+        import traceback
+        traceback.print_exc()
+        fail(scene.name, "frame %d, view layer '%s': internal error: %r" % (frame, layer, e))
+        return None
+    finish(scene.name, result, t_export)
+    return result

@@ -1,0 +1,70 @@
+"""Scene settings of the add-on (``scene.vsgl_indirect``)."""
+import bpy
+from bpy.props import BoolProperty, EnumProperty, IntProperty, PointerProperty, StringProperty
+
+from . import config
+
+
+def _items(names, descriptions=None):
+    descriptions = descriptions or {}
+    return [(n, n.replace("_", " ").title(), descriptions.get(n, "")) for n in names]
+
+
+class VSGLIndirectSettings(bpy.types.PropertyGroup):
+    enabled: BoolProperty(
+        name="Compute on Render", default=True,
+        description="Compute the indirect-light AOV of every rendered frame before it is "
+                    "rendered and composited (F12, -f, -a)")
+    add_to_render: BoolProperty(
+        name="Add to Render", default=True,
+        description="Add the AOV's Combined pass onto the render in the compositor "
+                    "(otherwise only the Image node is set up)")
+    preset: EnumProperty(
+        name="Preset", default="BALANCED",
+        items=[("PREVIEW", "Preview", "Fastest: few samples, small shadow maps"),
+               ("BALANCED", "Balanced", "Default trade of speed and quality"),
+               ("QUALITY", "Quality", "Slowest, closest to Cycles one-bounce")])
+    use_advanced: BoolProperty(name="Advanced", default=False,
+                               description="Use the knobs below instead of the preset's values")
+    method: EnumProperty(name="Method", items=_items(config.KNOBS["method"][0]), default="VSGL")
+    aa_samples: IntProperty(name="AA Samples", default=1, min=1, max=8,
+                            description="Camera samples per pixel per axis (N x N)")
+    rsm_resolution: IntProperty(name="RSM Resolution", default=256, min=8, max=4096,
+                                description="Reflective shadow map side per light (texels)")
+    fit_mode: EnumProperty(name="Fit", items=_items(config.KNOBS["fit_mode"][0]), default="TWO",
+                           description="Two VSGLs per light, filtered importance sampling or k-means")
+    vsgl_count: IntProperty(name="VSGLs per Light", default=64, min=1, max=65536)
+    fis_iterations: IntProperty(name="FIS Iterations", default=8, min=1, max=32)
+    sharpness_estimator: EnumProperty(name="Sharpness",
+                                      items=_items(config.KNOBS["sharpness_estimator"][0]),
+                                      default="TOKSVIG")
+    diffuse_mode: EnumProperty(name="Diffuse Cosine", items=_items(config.KNOBS["diffuse_mode"][0]),
+                               default="ACCURATE")
+    glossy_mode: EnumProperty(name="Glossy Lobe", items=_items(config.KNOBS["glossy_mode"][0]),
+                              default="ASG")
+    visibility: EnumProperty(name="Visibility", items=_items(config.KNOBS["visibility"][0]),
+                             default="NONE", description="Indirect shadows: none, or one ray per VSGL")
+    seed: IntProperty(name="Seed", default=0, min=0)
+    output_path: StringProperty(
+        name="Output", subtype="FILE_PATH", default=config.DEFAULT_TEMPLATE,
+        description="Per-frame multilayer EXR. {render_dir} = the render output's folder, "
+                    "{scene}, {view_layer}; #### = frame number (must be the last digits)")
+    threads: IntProperty(name="Threads", default=0, min=0, max=1024,
+                         description="Worker threads of the library (0 = all cores)")
+    half_float: BoolProperty(name="Half Float", default=False,
+                             description="Write 16-bit half floats instead of 32-bit")
+
+
+classes = (VSGLIndirectSettings,)
+
+
+def register():
+    for c in classes:
+        bpy.utils.register_class(c)
+    bpy.types.Scene.vsgl_indirect = PointerProperty(type=VSGLIndirectSettings)
+
+
+def unregister():
+    del bpy.types.Scene.vsgl_indirect
+    for c in reversed(classes):
+        bpy.utils.unregister_class(c)
