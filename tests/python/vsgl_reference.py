@@ -74,18 +74,19 @@ def axis_rule(axis, width, n_phi=64, n=24):
 def disk_rule(frame, centres_x=(), centres_y=(), n=24):
     """Rule for integrals of the form  int max(v.z, 0) h(v) dv  over the
     sphere, i.e. the double integral of h over the unit disk of (v.x, v.y):
-    v.x = sin t, v.y = cos t * s, weights cos^2 t dt ds (smooth up to the
-    rim). ``centres_x`` are (t, width) pairs, ``centres_y`` (s, width).
+    v.x = sin t, v.y = cos t sin r, v.z = cos t cos r, weights
+    cos^2 t cos r dt dr (every coordinate smooth up to the rim).
+    ``centres_x`` are (t, width) pairs, ``centres_y`` (r, width).
     Returns (dirs (N,3), weights (N,)) with sum(w * h(dirs)) ~ the integral."""
     F = np.asarray(frame, float)
     t, wt = graded_rule(-np.pi / 2, np.pi / 2, list(centres_x) + [(0.0, 1.0)], n)
-    s, ws = graded_rule(-1.0, 1.0, list(centres_y) + [(0.0, 1.0)], n)
+    r, wr = graded_rule(-np.pi / 2, np.pi / 2, list(centres_y) + [(0.0, 1.0)], n)
     ct = np.cos(t)
-    vx = np.sin(t)[:, None] * np.ones_like(s)[None, :]
-    vy = ct[:, None] * s[None, :]
-    vz = ct[:, None] * np.sqrt(np.clip(1.0 - s * s, 0.0, None))[None, :]
+    vx = np.sin(t)[:, None] * np.ones_like(r)[None, :]
+    vy = ct[:, None] * np.sin(r)[None, :]
+    vz = ct[:, None] * np.cos(r)[None, :]
     d = vx[..., None] * F[0] + vy[..., None] * F[1] + vz[..., None] * F[2]
-    w = (wt * ct * ct)[:, None] * ws[None, :]
+    w = (wt * ct * ct)[:, None] * (wr * np.cos(r))[None, :]
     return d.reshape(-1, 3), w.ravel()
 
 
@@ -107,9 +108,10 @@ def disk_centres(frame, direction, width):
         t = math.asin(x)
         ct = math.cos(t)
         s = min(max(y / ct, -1.0), 1.0) if ct > 1e-300 else 0.0
+        r = math.asin(s)
         w = max(width, 1e-12)
-        cx += [(t, w), (t, w * w)]
-        cy += [(s, w), (s, w * w)]
+        cx += [(t, w)]
+        cy += [(r, w)]
     return cx, cy
 
 
