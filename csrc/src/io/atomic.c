@@ -1,5 +1,6 @@
 /* Atomic file replacement: temp file beside the target, fsync, rename, fsync dir. */
 #include "io/atomic.h"
+#include "vsgl/io.h"
 #include "core/context.h"
 
 #include <errno.h>

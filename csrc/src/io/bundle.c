@@ -1,0 +1,759 @@
+/* Scene bundle: versioned little-endian container of a vsgl_scene_desc and
+ * vsgl_render_settings (docs/bundle-format.md). The reader trusts nothing:
+ * every size is checked against the bytes present before allocating. */
+#include "vsgl/io.h"
+#include "core/context.h"
+#include "io/atomic.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define HEADER_SIZE 40u
+#define SECTION_HEADER_SIZE 24u
+#define MAX_OUTPUT_PATH 4096u
+#define MAX_SECTIONS 4096u
+
+static const unsigned char magic[8] = {0x89, 'V', 'S', 'G', 'L', 'B', '\r', '\n'};
+
+/* ---- little-endian helpers and CRC32 (IEEE 802.3, as zlib) -------------- */
+
+static void put_u32(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)v;
+    p[1] = (unsigned char)(v >> 8);
+    p[2] = (unsigned char)(v >> 16);
+    p[3] = (unsigned char)(v >> 24);
+}
+
+static void put_u64(unsigned char *p, uint64_t v)
+{
+    put_u32(p, (uint32_t)v);
+    put_u32(p + 4, (uint32_t)(v >> 32));
+}
+
+static uint32_t get_u32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static uint64_t get_u64(const unsigned char *p)
+{
+    return (uint64_t)get_u32(p) | (uint64_t)get_u32(p + 4) << 32;
+}
+
+typedef struct crc_table { uint32_t t[256]; } crc_table;
+
+static void crc_init(crc_table *c)
+{
+    for (uint32_t i = 0; i < 256; ++i) {
+        uint32_t r = i;
+        for (int k = 0; k < 8; ++k)
+            r = (r >> 1) ^ (0xEDB88320u & (0u - (r & 1u)));
+        c->t[i] = r;
+    }
+}
+
+/* Streaming form: crc32_of(a ++ b) = crc32_more(c, crc32_of(c, a), b). */
+static uint32_t crc32_more(const crc_table *c, uint32_t crc, const unsigned char *p, size_t n)
+{
+    uint32_t r = crc ^ 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; ++i)
+        r = c->t[(r ^ p[i]) & 0xFFu] ^ (r >> 8);
+    return r ^ 0xFFFFFFFFu;
+}
+
+static uint32_t crc32_of(const crc_table *c, const unsigned char *p, size_t n)
+{
+    return crc32_more(c, 0, p, n);
+}
+
+/* ---- record layouts ----------------------------------------------------- */
+
+/* One field of a record: 'f' float (checked finite), 'i' int32, 'u' uint32. */
+typedef struct field { const char *name; char kind; uint8_t count; uint16_t offset; } field;
+
+#define F(type, member, kind, count) {#member, kind, count, (uint16_t)offsetof(type, member)}
+
+static const field material_fields[] = {
+    F(vsgl_material, base_color, 'f', 3), F(vsgl_material, metallic, 'f', 1),
+    F(vsgl_material, roughness, 'f', 1), F(vsgl_material, specular_f0, 'f', 1),
+    F(vsgl_material, anisotropy, 'f', 1), F(vsgl_material, anisotropic_rotation, 'f', 1),
+    F(vsgl_material, flags, 'u', 1), F(vsgl_material, reserved, 'u', 1),
+};
+static const field light_fields[] = {
+    F(vsgl_light, type, 'i', 1), F(vsgl_light, area_shape, 'i', 1), F(vsgl_light, color, 'f', 3),
+    F(vsgl_light, power, 'f', 1), F(vsgl_light, world_from_light, 'f', 12), F(vsgl_light, radius, 'f', 1),
+    F(vsgl_light, spot_size, 'f', 1), F(vsgl_light, spot_blend, 'f', 1), F(vsgl_light, sun_angle, 'f', 1),
+    F(vsgl_light, size_x, 'f', 1), F(vsgl_light, size_y, 'f', 1), F(vsgl_light, spread, 'f', 1),
+    F(vsgl_light, reserved, 'u', 1),
+};
+static const field camera_fields[] = {
+    F(vsgl_camera, type, 'i', 1), F(vsgl_camera, sensor_fit, 'i', 1), F(vsgl_camera, world_from_camera, 'f', 12),
+    F(vsgl_camera, lens_mm, 'f', 1), F(vsgl_camera, sensor_width_mm, 'f', 1), F(vsgl_camera, sensor_height_mm, 'f', 1),
+    F(vsgl_camera, ortho_scale, 'f', 1), F(vsgl_camera, shift_x, 'f', 1), F(vsgl_camera, shift_y, 'f', 1),
+    F(vsgl_camera, clip_start, 'f', 1), F(vsgl_camera, clip_end, 'f', 1), F(vsgl_camera, width, 'u', 1),
+    F(vsgl_camera, height, 'u', 1), F(vsgl_camera, pixel_aspect_x, 'f', 1), F(vsgl_camera, pixel_aspect_y, 'f', 1),
+};
+static const field settings_fields[] = {
+    F(vsgl_render_settings, method, 'i', 1), F(vsgl_render_settings, aa_samples, 'u', 1),
+    F(vsgl_render_settings, rsm_resolution, 'u', 1), F(vsgl_render_settings, fit_mode, 'i', 1),
+    F(vsgl_render_settings, vsgl_count, 'u', 1), F(vsgl_render_settings, fis_iterations, 'u', 1),
+    F(vsgl_render_settings, sharpness_estimator, 'i', 1), F(vsgl_render_settings, diffuse_mode, 'i', 1),
+    F(vsgl_render_settings, glossy_mode, 'i', 1), F(vsgl_render_settings, visibility, 'i', 1),
+    F(vsgl_render_settings, seed, 'u', 1),
+};
+#undef F
+
+typedef struct layout { const field *fields; size_t count; } layout;
+#define LAYOUT(a) {a, sizeof a / sizeof a[0]}
+
+static void encode_record(layout l, const void *rec, unsigned char *out)
+{
+    const unsigned char *base = rec;
+    for (size_t i = 0; i < l.count; ++i)
+        for (unsigned k = 0; k < l.fields[i].count; ++k) {
+            uint32_t v;
+            memcpy(&v, base + l.fields[i].offset + 4u * k, 4);
+            put_u32(out, v);
+            out += 4;
+        }
+}
+
+/* Decode; on a non-finite float return the field index and component. */
+static int decode_record(layout l, const unsigned char *in, void *rec, size_t *bad_field, unsigned *bad_comp)
+{
+    unsigned char *base = rec;
+    for (size_t i = 0; i < l.count; ++i)
+        for (unsigned k = 0; k < l.fields[i].count; ++k) {
+            uint32_t v = get_u32(in);
+            in += 4;
+            memcpy(base + l.fields[i].offset + 4u * k, &v, 4);
+            if (l.fields[i].kind == 'f') {
+                float f;
+                memcpy(&f, &v, 4);
+                if (!isfinite(f)) {
+                    *bad_field = i;
+                    *bad_comp = k;
+                    return -1;
+                }
+            }
+        }
+    return 0;
+}
+
+static int record_finite(layout l, const void *rec, size_t *bad_field, unsigned *bad_comp)
+{
+    const unsigned char *base = rec;
+    for (size_t i = 0; i < l.count; ++i)
+        if (l.fields[i].kind == 'f')
+            for (unsigned k = 0; k < l.fields[i].count; ++k) {
+                float f;
+                memcpy(&f, base + l.fields[i].offset + 4u * k, 4);
+                if (!isfinite(f)) {
+                    *bad_field = i;
+                    *bad_comp = k;
+                    return 0;
+                }
+            }
+    return 1;
+}
+
+static const char *nonfinite_name(float f)
+{
+    return isnan(f) ? "NaN" : (f > 0 ? "+Inf" : "-Inf");
+}
+
+/* "[k]" for array fields, "" for scalars. */
+typedef struct suffix { char s[8]; } suffix;
+static suffix index_suffix(field f, unsigned k)
+{
+    suffix x = {""};
+    if (f.count > 1)
+        snprintf(x.s, sizeof x.s, "[%u]", k);
+    return x;
+}
+
+/* ---- sections ----------------------------------------------------------- */
+
+enum { S_POS, S_IDX, S_NRM, S_UV, S_TAN, S_MIDX, S_MATL, S_LGHT, S_CAM, S_RSET, S_OUTP, S_FRME, S_COUNT };
+
+typedef struct section_kind {
+    char tag[5];
+    const char *what;      /* for messages */
+    const char *element;   /* element noun */
+    uint32_t element_size; /* exact (arrays) or minimum (records) */
+    int is_record;
+    unsigned floats_per_element; /* arrays of floats: checked finite */
+} section_kind;
+
+static const section_kind kinds[S_COUNT] = {
+    {"POS ", "positions", "vertex", 12, 0, 3},
+    {"IDX ", "indices", "triangle", 12, 0, 0},
+    {"NRM ", "corner normals", "triangle", 36, 0, 9},
+    {"UV  ", "corner uvs", "triangle", 24, 0, 6},
+    {"TAN ", "corner tangents", "triangle", 48, 0, 12},
+    {"MIDX", "material indices", "triangle", 4, 0, 0},
+    {"MATL", "materials", "material", 40, 1, 0},
+    {"LGHT", "lights", "light", 104, 1, 0},
+    {"CAM ", "camera", "camera", 104, 1, 0},
+    {"RSET", "render settings", "settings", 44, 1, 0},
+    {"OUTP", "output path", "byte", 1, 0, 0},
+    {"FRME", "frame", "frame", 4, 0, 0},
+};
+
+static uint64_t padded(uint64_t n)
+{
+    return (n + 7u) & ~(uint64_t)7u;
+}
+
+struct vsgl_bundle {
+    vsgl_scene_desc desc;
+    vsgl_camera camera;
+    vsgl_render_settings settings;
+    float *positions;
+    uint32_t *indices;
+    float *corner_normals, *corner_uvs, *corner_tangents;
+    uint32_t *material_indices;
+    vsgl_material *materials;
+    vsgl_light *lights;
+    char *output_path;
+    uint32_t version_major, version_minor;
+    int32_t has_frame, frame;
+    uint32_t has_settings;
+};
+
+/* ---- writer ------------------------------------------------------------- */
+
+typedef struct out_section { int kind; uint64_t count; const void *data; } out_section;
+
+static vsgl_result check_floats(vsgl_context *ctx, int kind, const float *v, uint64_t count)
+{
+    unsigned per = kinds[kind].floats_per_element;
+    for (uint64_t i = 0; i < count * per; ++i)
+        if (!isfinite(v[i]))
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: %s %llu component %u is %s", kinds[kind].what,
+                              kinds[kind].element, (unsigned long long)(i / per), (unsigned)(i % per), nonfinite_name(v[i]));
+    return VSGL_OK;
+}
+
+static vsgl_result check_records(vsgl_context *ctx, int kind, layout l, const void *recs, size_t rec_size, uint64_t count)
+{
+    for (uint64_t i = 0; i < count; ++i) {
+        size_t f;
+        unsigned c;
+        const unsigned char *rec = (const unsigned char *)recs + i * rec_size;
+        if (!record_finite(l, rec, &f, &c)) {
+            float v;
+            memcpy(&v, rec + l.fields[f].offset + 4u * c, 4);
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: %s %llu field %s%s is %s", kinds[kind].what,
+                              kinds[kind].element, (unsigned long long)i, l.fields[f].name, index_suffix(l.fields[f], c).s,
+                              nonfinite_name(v));
+        }
+    }
+    return VSGL_OK;
+}
+
+vsgl_result vsgl_bundle_write_memory(vsgl_context *ctx, const vsgl_scene_desc *scene,
+                                     const vsgl_render_settings *settings, const vsgl_bundle_options *opt,
+                                     void *buffer, size_t capacity, size_t *size)
+{
+    vsgl__clear_error(ctx);
+    if (!scene || !size)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: scene and size must not be NULL");
+    *size = 0;
+    vsgl_scene_desc d;
+    memset(&d, 0, sizeof d);
+    if (scene->size > sizeof d)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vsgl_scene_desc.size %u is larger than this library knows", scene->size);
+    memcpy(&d, scene, scene->size ? scene->size : sizeof d);
+    vsgl_render_settings s;
+    memset(&s, 0, sizeof s);
+    if (settings) {
+        if (settings->size > sizeof s)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vsgl_render_settings.size %u is larger than this library knows", settings->size);
+        memcpy(&s, settings, settings->size ? settings->size : sizeof s);
+        s.size = sizeof s;
+    }
+    vsgl_bundle_options o;
+    memset(&o, 0, sizeof o);
+    if (opt) {
+        if (opt->size > sizeof o)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vsgl_bundle_options.size %u is larger than this library knows", opt->size);
+        memcpy(&o, opt, opt->size ? opt->size : sizeof o);
+    }
+    if (!d.camera)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: scene has no camera");
+    if (d.vertex_count && !d.positions)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u vertices but positions is NULL", d.vertex_count);
+    if (d.triangle_count && !d.indices)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u triangles but indices is NULL", d.triangle_count);
+    if (d.material_count && !d.materials)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u materials but materials is NULL", d.material_count);
+    if (d.light_count && !d.lights)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u lights but lights is NULL", d.light_count);
+    size_t path_len = o.output_path ? strlen(o.output_path) : 0;
+    if (path_len > MAX_OUTPUT_PATH)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: output path longer than %u bytes", MAX_OUTPUT_PATH);
+
+    vsgl_result r;
+    if ((r = check_floats(ctx, S_POS, d.positions, d.vertex_count)))
+        return r;
+    uint32_t nt = d.triangle_count;
+    if (d.corner_normals && (r = check_floats(ctx, S_NRM, d.corner_normals, nt)))
+        return r;
+    if (d.corner_uvs && (r = check_floats(ctx, S_UV, d.corner_uvs, nt)))
+        return r;
+    if (d.corner_tangents && (r = check_floats(ctx, S_TAN, d.corner_tangents, nt)))
+        return r;
+    if ((r = check_records(ctx, S_MATL, (layout)LAYOUT(material_fields), d.materials, sizeof(vsgl_material), d.material_count)))
+        return r;
+    if ((r = check_records(ctx, S_LGHT, (layout)LAYOUT(light_fields), d.lights, sizeof(vsgl_light), d.light_count)))
+        return r;
+    if ((r = check_records(ctx, S_CAM, (layout)LAYOUT(camera_fields), d.camera, sizeof(vsgl_camera), 1)))
+        return r;
+
+    int32_t frame = o.frame;
+    out_section sec[S_COUNT];
+    int ns = 0;
+    sec[ns++] = (out_section){S_POS, d.vertex_count, d.positions};
+    sec[ns++] = (out_section){S_IDX, nt, d.indices};
+    if (d.corner_normals && nt)
+        sec[ns++] = (out_section){S_NRM, nt, d.corner_normals};
+    if (d.corner_uvs && nt)
+        sec[ns++] = (out_section){S_UV, nt, d.corner_uvs};
+    if (d.corner_tangents && nt)
+        sec[ns++] = (out_section){S_TAN, nt, d.corner_tangents};
+    if (d.material_indices && nt)
+        sec[ns++] = (out_section){S_MIDX, nt, d.material_indices};
+    sec[ns++] = (out_section){S_MATL, d.material_count, d.materials};
+    sec[ns++] = (out_section){S_LGHT, d.light_count, d.lights};
+    sec[ns++] = (out_section){S_CAM, 1, d.camera};
+    if (settings)
+        sec[ns++] = (out_section){S_RSET, 1, &s};
+    if (o.output_path)
+        sec[ns++] = (out_section){S_OUTP, path_len, o.output_path};
+    if (o.has_frame)
+        sec[ns++] = (out_section){S_FRME, 1, &frame};
+
+    uint64_t total = HEADER_SIZE;
+    for (int i = 0; i < ns; ++i)
+        total += SECTION_HEADER_SIZE + padded(sec[i].count * kinds[sec[i].kind].element_size);
+    if (total > (uint64_t)SIZE_MAX)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %llu bytes do not fit in memory", (unsigned long long)total);
+    *size = (size_t)total;
+    if (!buffer)
+        return VSGL_OK;
+    if (capacity < total)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: buffer of %zu bytes, need %llu", capacity, (unsigned long long)total);
+
+    crc_table crc;
+    crc_init(&crc);
+    unsigned char *b = buffer;
+    memset(b, 0, (size_t)total);
+    memcpy(b, magic, 8);
+    put_u32(b + 8, VSGL_BUNDLE_VERSION_MAJOR);
+    put_u32(b + 12, VSGL_BUNDLE_VERSION_MINOR);
+    put_u32(b + 16, HEADER_SIZE);
+    put_u32(b + 20, (uint32_t)ns);
+    put_u64(b + 24, total);
+    put_u32(b + 32, 0);
+    put_u32(b + 36, crc32_of(&crc, b, HEADER_SIZE - 4));
+    uint64_t at = HEADER_SIZE;
+    for (int i = 0; i < ns; ++i) {
+        const section_kind *k = &kinds[sec[i].kind];
+        unsigned char *h = b + at, *p = h + SECTION_HEADER_SIZE;
+        uint64_t bytes = sec[i].count * k->element_size;
+        memcpy(h, k->tag, 4);
+        put_u32(h + 4, k->element_size);
+        put_u64(h + 8, sec[i].count);
+        layout l = {NULL, 0};
+        size_t rec_size = 0;
+        switch (sec[i].kind) {
+        case S_MATL: l = (layout)LAYOUT(material_fields); rec_size = sizeof(vsgl_material); break;
+        case S_LGHT: l = (layout)LAYOUT(light_fields); rec_size = sizeof(vsgl_light); break;
+        case S_CAM: l = (layout)LAYOUT(camera_fields); rec_size = sizeof(vsgl_camera); break;
+        case S_RSET: l = (layout)LAYOUT(settings_fields); rec_size = sizeof(vsgl_render_settings); break;
+        default: break;
+        }
+        if (l.fields) {
+            for (uint64_t e = 0; e < sec[i].count; ++e)
+                encode_record(l, (const unsigned char *)sec[i].data + e * rec_size, p + e * k->element_size);
+        } else if (sec[i].kind == S_OUTP) {
+            memcpy(p, sec[i].data, (size_t)bytes);
+        } else { /* arrays of 32-bit words */
+            const unsigned char *src = sec[i].data;
+            for (uint64_t w = 0; w < bytes / 4; ++w) {
+                uint32_t v;
+                memcpy(&v, src + 4 * w, 4);
+                put_u32(p + 4 * w, v);
+            }
+        }
+        put_u32(h + 16, 0); /* reserved */
+        put_u32(h + 20, crc32_more(&crc, crc32_of(&crc, h, 20), p, (size_t)bytes));
+        at += SECTION_HEADER_SIZE + padded(bytes);
+    }
+    return VSGL_OK;
+}
+
+vsgl_result vsgl_bundle_write(vsgl_context *ctx, const char *path, const vsgl_scene_desc *scene,
+                              const vsgl_render_settings *settings, const vsgl_bundle_options *opt)
+{
+    size_t n = 0;
+    vsgl_result r = vsgl_bundle_write_memory(ctx, scene, settings, opt, NULL, 0, &n);
+    if (r)
+        return r;
+    if (!path || !*path)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle path is empty");
+    void *buf = malloc(n);
+    if (!buf)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory for %zu bytes", n);
+    r = vsgl_bundle_write_memory(ctx, scene, settings, opt, buf, n, &n);
+    if (!r)
+        r = vsgl__atomic_write_all(ctx, path, buf, n);
+    free(buf);
+    return r;
+}
+
+/* ---- reader ------------------------------------------------------------- */
+
+void vsgl_bundle_destroy(vsgl_bundle *b)
+{
+    if (!b)
+        return;
+    free(b->positions);
+    free(b->indices);
+    free(b->corner_normals);
+    free(b->corner_uvs);
+    free(b->corner_tangents);
+    free(b->material_indices);
+    free(b->materials);
+    free(b->lights);
+    free(b->output_path);
+    free(b);
+}
+
+#define ULL(x) ((unsigned long long)(x))
+#define BAD(...) vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, __VA_ARGS__)
+
+/* Copy count*words little-endian 32-bit words into a new array; floats checked. */
+static vsgl_result read_words(vsgl_context *ctx, int kind, const unsigned char *p, uint64_t count, void **out)
+{
+    const section_kind *k = &kinds[kind];
+    uint64_t words = count * (k->element_size / 4);
+    uint32_t *a = malloc(words ? (size_t)words * 4 : 4);
+    if (!a)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory for section %s", k->tag);
+    for (uint64_t w = 0; w < words; ++w) {
+        a[w] = get_u32(p + 4 * w);
+        if (k->floats_per_element) {
+            float f;
+            memcpy(&f, &a[w], 4);
+            if (!isfinite(f)) {
+                unsigned per = k->floats_per_element;
+                free(a);
+                return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section %s (%s): %s %llu component %u is %s", k->tag,
+                                  k->what, k->element, (unsigned long long)(w / per), (unsigned)(w % per), nonfinite_name(f));
+            }
+        }
+    }
+    *out = a;
+    return VSGL_OK;
+}
+
+static vsgl_result read_records(vsgl_context *ctx, int kind, layout l, const unsigned char *p, uint64_t count,
+                                uint32_t element_size, void *dst, size_t rec_size)
+{
+    const section_kind *k = &kinds[kind];
+    for (uint64_t e = 0; e < count; ++e) {
+        size_t f;
+        unsigned c;
+        if (decode_record(l, p + e * element_size, (unsigned char *)dst + e * rec_size, &f, &c) != 0) {
+            float v;
+            memcpy(&v, (unsigned char *)dst + e * rec_size + l.fields[f].offset + 4u * c, 4);
+            return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section %s (%s): %s %llu field %s%s is %s", k->tag,
+                              k->what, k->element, (unsigned long long)e, l.fields[f].name, index_suffix(l.fields[f], c).s,
+                              nonfinite_name(v));
+        }
+    }
+    return VSGL_OK;
+}
+
+static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size, vsgl_bundle *out)
+{
+    if (size < 16)
+        return BAD("bundle truncated: %zu bytes, the header alone is %u", size, HEADER_SIZE);
+    if (memcmp(b, magic, 8) != 0)
+        return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "not a VSGL scene bundle (wrong magic number)");
+    uint32_t major = get_u32(b + 8), minor = get_u32(b + 12);
+    if (major != VSGL_BUNDLE_VERSION_MAJOR)
+        return vsgl__fail(ctx, VSGL_ERROR_VERSION_MISMATCH, "bundle format version %u.%u, this library reads %u.x",
+                          major, minor, VSGL_BUNDLE_VERSION_MAJOR);
+    if (size < HEADER_SIZE)
+        return BAD("bundle truncated: %zu bytes, the header alone is %u", size, HEADER_SIZE);
+    uint32_t header_size = get_u32(b + 16);
+    if (header_size < HEADER_SIZE || header_size % 8u || header_size > size)
+        return BAD("bundle header: size %u invalid or beyond the %zu bytes present", header_size, size);
+    crc_table crc;
+    crc_init(&crc);
+    if (crc32_of(&crc, b, header_size - 4) != get_u32(b + header_size - 4))
+        return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle header is corrupt (CRC32 mismatch)");
+    uint32_t section_count = get_u32(b + 20);
+    uint64_t file_size = get_u64(b + 24);
+    if (file_size > size)
+        return BAD("bundle truncated: header says %llu bytes, only %zu present", ULL(file_size), size);
+    if (file_size < size)
+        return BAD("bundle has trailing data: header says %llu bytes, %zu present", ULL(file_size), size);
+    if (section_count > MAX_SECTIONS)
+        return BAD("bundle header: %u sections (at most %u)", section_count, MAX_SECTIONS);
+    out->version_major = major;
+    out->version_minor = minor;
+
+    const unsigned char *where[S_COUNT] = {0};
+    uint64_t counts[S_COUNT] = {0};
+    uint32_t esizes[S_COUNT] = {0};
+    uint64_t at = header_size;
+    for (uint32_t i = 0; i < section_count; ++i) {
+        if (size - at < SECTION_HEADER_SIZE)
+            return BAD("bundle truncated: section %u header at byte %llu", i, ULL(at));
+        const unsigned char *h = b + at;
+        char tag[5];
+        for (int c = 0; c < 4; ++c)
+            tag[c] = (h[c] >= 32 && h[c] < 127) ? (char)h[c] : '?';
+        tag[4] = '\0';
+        uint32_t esize = get_u32(h + 4);
+        uint64_t count = get_u64(h + 8);
+        uint64_t avail = size - at - SECTION_HEADER_SIZE;
+        if (esize == 0 && count != 0)
+            return BAD("bundle section %s: element size 0 with %llu elements", tag, ULL(count));
+        if (esize != 0 && count > avail / esize)
+            return BAD("bundle section %s: %llu elements of %u bytes exceed the file (truncated?)", tag, ULL(count), esize);
+        uint64_t bytes = count * esize;
+        if (padded(bytes) > avail)
+            return BAD("bundle section %s: padding after %llu bytes exceeds the file", tag, ULL(bytes));
+        const unsigned char *p = h + SECTION_HEADER_SIZE;
+        if (crc32_more(&crc, crc32_of(&crc, h, 20), p, (size_t)bytes) != get_u32(h + 20))
+            return BAD("bundle section %s is corrupt (CRC32 mismatch over %llu bytes)", tag, ULL(bytes));
+        for (uint64_t z = bytes; z < padded(bytes); ++z)
+            if (p[z])
+                return BAD("bundle section %s: non-zero padding byte %llu", tag, ULL(z));
+        at += SECTION_HEADER_SIZE + padded(bytes);
+        int kind = -1;
+        for (int k = 0; k < S_COUNT; ++k)
+            if (memcmp(h, kinds[k].tag, 4) == 0)
+                kind = k;
+        if (kind < 0)
+            continue; /* unknown section of a newer minor version: skipped */
+        const section_kind *k = &kinds[kind];
+        if (where[kind])
+            return BAD("bundle section %s (%s) appears twice", k->tag, k->what);
+        if (k->is_record ? esize < k->element_size : esize != k->element_size)
+            return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section %s (%s): element size %u, want %s%u", k->tag, k->what,
+                              esize, k->is_record ? "at least " : "", k->element_size);
+        if (count > UINT32_MAX)
+            return BAD("bundle section %s: %llu elements (at most %u)", k->tag, ULL(count), UINT32_MAX);
+        where[kind] = p;
+        counts[kind] = count;
+        esizes[kind] = esize;
+    }
+    if (at != size)
+        return BAD("bundle: %llu bytes after the last section", ULL(size - at));
+
+    /* Counts that must agree. */
+    if (!where[S_CAM] || counts[S_CAM] != 1)
+        return BAD("bundle has %s camera (want exactly 1, got %llu)", where[S_CAM] ? "a bad" : "no", ULL(counts[S_CAM]));
+    if (where[S_RSET] && counts[S_RSET] != 1)
+        return BAD("bundle section RSET (render settings): %llu elements, want 1", ULL(counts[S_RSET]));
+    if (where[S_FRME] && counts[S_FRME] != 1)
+        return BAD("bundle section FRME (frame): %llu elements, want 1", ULL(counts[S_FRME]));
+    if (where[S_OUTP] && counts[S_OUTP] > MAX_OUTPUT_PATH)
+        return BAD("bundle section OUTP (output path): %llu bytes, at most %u", ULL(counts[S_OUTP]), MAX_OUTPUT_PATH);
+    uint64_t nt = counts[S_IDX];
+    static const int per_triangle[] = {S_NRM, S_UV, S_TAN, S_MIDX};
+    for (size_t i = 0; i < 4; ++i) {
+        int kk = per_triangle[i];
+        if (where[kk] && counts[kk] != nt)
+            return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section %s (%s): %llu elements, want %llu (one per triangle)",
+                              kinds[kk].tag, kinds[kk].what, (unsigned long long)counts[kk], (unsigned long long)nt);
+    }
+
+    /* Copy out. */
+    vsgl_result r;
+    void *a = NULL;
+    if (where[S_POS] && (r = read_words(ctx, S_POS, where[S_POS], counts[S_POS], &a)))
+        return r;
+    out->positions = a;
+    a = NULL;
+    if (where[S_IDX] && (r = read_words(ctx, S_IDX, where[S_IDX], nt, &a)))
+        return r;
+    out->indices = a;
+    a = NULL;
+    if (where[S_NRM] && nt && (r = read_words(ctx, S_NRM, where[S_NRM], nt, &a)))
+        return r;
+    out->corner_normals = a;
+    a = NULL;
+    if (where[S_UV] && nt && (r = read_words(ctx, S_UV, where[S_UV], nt, &a)))
+        return r;
+    out->corner_uvs = a;
+    a = NULL;
+    if (where[S_TAN] && nt && (r = read_words(ctx, S_TAN, where[S_TAN], nt, &a)))
+        return r;
+    out->corner_tangents = a;
+    a = NULL;
+    if (where[S_MIDX] && nt && (r = read_words(ctx, S_MIDX, where[S_MIDX], nt, &a)))
+        return r;
+    out->material_indices = a;
+
+    uint64_t nm = counts[S_MATL], nl = counts[S_LGHT];
+    out->materials = calloc(nm ? (size_t)nm : 1, sizeof(vsgl_material));
+    out->lights = calloc(nl ? (size_t)nl : 1, sizeof(vsgl_light));
+    if (!out->materials || !out->lights)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory for %llu materials and %llu lights",
+                          (unsigned long long)nm, (unsigned long long)nl);
+    if ((r = read_records(ctx, S_MATL, (layout)LAYOUT(material_fields), where[S_MATL], nm, esizes[S_MATL], out->materials, sizeof(vsgl_material))))
+        return r;
+    if ((r = read_records(ctx, S_LGHT, (layout)LAYOUT(light_fields), where[S_LGHT], nl, esizes[S_LGHT], out->lights, sizeof(vsgl_light))))
+        return r;
+    if ((r = read_records(ctx, S_CAM, (layout)LAYOUT(camera_fields), where[S_CAM], 1, esizes[S_CAM], &out->camera, sizeof(vsgl_camera))))
+        return r;
+    if (where[S_RSET]) {
+        if ((r = read_records(ctx, S_RSET, (layout)LAYOUT(settings_fields), where[S_RSET], 1, esizes[S_RSET], &out->settings,
+                              sizeof(vsgl_render_settings))))
+            return r;
+        out->has_settings = 1;
+    }
+    out->settings.size = sizeof out->settings;
+    size_t plen = where[S_OUTP] ? (size_t)counts[S_OUTP] : 0;
+    out->output_path = malloc(plen + 1);
+    if (!out->output_path)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory");
+    if (plen) {
+        if (memchr(where[S_OUTP], 0, plen))
+            return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section OUTP (output path): contains a NUL byte");
+        memcpy(out->output_path, where[S_OUTP], plen);
+    }
+    out->output_path[plen] = '\0';
+    if (where[S_FRME]) {
+        out->has_frame = 1;
+        uint32_t f = get_u32(where[S_FRME]);
+        memcpy(&out->frame, &f, 4);
+    }
+
+    vsgl_scene_desc *d = &out->desc;
+    d->size = sizeof *d;
+    d->vertex_count = (uint32_t)counts[S_POS];
+    d->positions = out->positions;
+    d->triangle_count = (uint32_t)nt;
+    d->indices = out->indices;
+    d->corner_normals = out->corner_normals;
+    d->corner_uvs = out->corner_uvs;
+    d->corner_tangents = out->corner_tangents;
+    d->material_indices = out->material_indices;
+    d->material_count = (uint32_t)nm;
+    d->materials = nm ? out->materials : NULL;
+    d->light_count = (uint32_t)nl;
+    d->lights = nl ? out->lights : NULL;
+    d->camera = &out->camera;
+    return VSGL_OK;
+}
+
+vsgl_result vsgl_bundle_read_memory(vsgl_context *ctx, const void *data, size_t size, vsgl_bundle **out)
+{
+    vsgl__clear_error(ctx);
+    if (!out)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: out is NULL");
+    *out = NULL;
+    if (!data && size)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: data is NULL");
+    vsgl_bundle *b = calloc(1, sizeof *b);
+    if (!b)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory");
+    vsgl_result r = parse(ctx, data ? data : (const void *)"", size, b);
+    if (r) {
+        vsgl_bundle_destroy(b);
+        return r;
+    }
+    *out = b;
+    return VSGL_OK;
+}
+
+vsgl_result vsgl_bundle_read(vsgl_context *ctx, const char *path, vsgl_bundle **out)
+{
+    vsgl__clear_error(ctx);
+    if (!out)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: out is NULL");
+    *out = NULL;
+    if (!path || !*path)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle path is empty");
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: not a regular file", path);
+    }
+    if ((uint64_t)st.st_size > (uint64_t)SIZE_MAX / 2) {
+        close(fd);
+        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: too large (%lld bytes)", path, (long long)st.st_size);
+    }
+    size_t n = (size_t)st.st_size, got = 0;
+    unsigned char *buf = malloc(n ? n : 1);
+    if (!buf) {
+        close(fd);
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "%s: out of memory for %zu bytes", path, n);
+    }
+    while (got < n) {
+        ssize_t k = read(fd, buf + got, n - got);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0)
+            break;
+        got += (size_t)k;
+    }
+    int e = errno;
+    close(fd);
+    if (got < n) {
+        free(buf);
+        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: read failed: %s", path, strerror(e));
+    }
+    vsgl_result r = vsgl_bundle_read_memory(ctx, buf, n, out);
+    free(buf);
+    if (r && ctx) {
+        /* Prefix the file name to the reader's message. */
+        char msg[VSGL_MESSAGE_MAX];
+        snprintf(msg, sizeof msg, "%s", vsgl_context_last_error(ctx));
+        vsgl__fail(ctx, r, "%s: %s", path, msg);
+    }
+    return r;
+}
+
+const vsgl_scene_desc *vsgl_bundle_scene(const vsgl_bundle *b)
+{
+    return b ? &b->desc : NULL;
+}
+
+const vsgl_render_settings *vsgl_bundle_settings(const vsgl_bundle *b)
+{
+    return b ? &b->settings : NULL;
+}
+
+vsgl_result vsgl_bundle_get_info(const vsgl_bundle *b, vsgl_bundle_info *info)
+{
+    if (!b || !info)
+        return VSGL_ERROR_INVALID_ARGUMENT;
+    memset(info, 0, sizeof *info);
+    info->version_major = b->version_major;
+    info->version_minor = b->version_minor;
+    info->output_path = b->output_path;
+    info->has_frame = b->has_frame;
+    info->frame = b->frame;
+    info->has_settings = b->has_settings;
+    return VSGL_OK;
+}
