@@ -110,3 +110,31 @@ clean:
 	rm -rf $(BUILD)
 
 -include $(LIB_OBJ:.o=.d) $(TEST_OBJ:.o=.d)
+
+# The shading kernel: vectorised with ISA clones (kernel.c) and a scalar
+# build of the same source (kernel_scalar.c) for the benchmark baseline.
+$(BUILD)/obj/csrc/src/shade/kernel.o: OPT += -O3 -fno-math-errno -fno-trapping-math
+$(BUILD)/obj/csrc/src/shade/kernel_scalar.o: OPT += -fno-math-errno -fno-trapping-math
+
+# libFuzzer + ASan + UBSan on the scene-bundle reader (tests/fuzz/), for
+# FUZZ_SECONDS seconds from a seed corpus the library writes (CRC checks
+# are skipped in this build so mutations reach the structural checks). Findings are
+# saved as $(BUILD)/fuzz/crash-* and make the target fail.
+.PHONY: fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_LIB_SRC := csrc/src/io/bundle.c csrc/src/io/atomic.c csrc/src/core/context.c csrc/src/core/result.c
+FUZZ_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+$(BUILD)/fuzz/fuzz_bundle: tests/fuzz/fuzz_bundle.c $(FUZZ_LIB_SRC) $(HEADERS)
+	@mkdir -p $(dir $@)
+	clang $(CFLAGS_COMMON) $(FUZZ_FLAGS) -fsanitize=fuzzer -DFUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION -o $@ tests/fuzz/fuzz_bundle.c $(FUZZ_LIB_SRC) -lm
+$(BUILD)/fuzz/make_corpus: tests/fuzz/make_corpus.c $(FUZZ_LIB_SRC) $(HEADERS)
+	@mkdir -p $(dir $@)
+	clang $(CFLAGS_COMMON) $(FUZZ_FLAGS) -o $@ tests/fuzz/make_corpus.c $(FUZZ_LIB_SRC) -lm
+fuzz:
+	@tools/deps.sh asan
+	@$(MAKE) --no-print-directory $(BUILD)/fuzz/fuzz_bundle $(BUILD)/fuzz/make_corpus
+	@mkdir -p $(BUILD)/fuzz/corpus
+	$(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/corpus
+	$(BUILD)/fuzz/fuzz_bundle tests/fuzz/regressions/*
+	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 $(BUILD)/fuzz/fuzz_bundle -max_total_time=$(FUZZ_SECONDS) \
+	  -dict=tests/fuzz/bundle.dict -artifact_prefix=$(BUILD)/fuzz/ -print_final_stats=1 $(BUILD)/fuzz/corpus

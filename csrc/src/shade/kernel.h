@@ -1,0 +1,51 @@
+/* Internal: the vectorised shading kernel. One call shades a block of
+ * receivers (structure of arrays, up to VSGL_KERNEL_BLOCK) with one VSGL
+ * and accumulates diffuse light (irradiance / pi, before albedo) and
+ * glossy radiance per channel. The same source is compiled twice: with
+ * vectorisation and ISA clones (kernel.c) and as a plain scalar build
+ * (kernel_scalar.c) that the benchmark and tests compare against. */
+#ifndef VSGL_SHADE_KERNEL_H
+#define VSGL_SHADE_KERNEL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define VSGL_KERNEL_BLOCK 64
+
+/* Receivers of one block. Non-glossy receivers have camp = 0 (and any
+ * frame); receivers without a diffuse lobe have diffuse = 0. */
+typedef struct vsgl_kernel_block {
+    float x[VSGL_KERNEL_BLOCK], y[VSGL_KERNEL_BLOCK], z[VSGL_KERNEL_BLOCK];
+    float nx[VSGL_KERNEL_BLOCK], ny[VSGL_KERNEL_BLOCK], nz[VSGL_KERNEL_BLOCK];
+    float ox[VSGL_KERNEL_BLOCK], oy[VSGL_KERNEL_BLOCK], oz[VSGL_KERNEL_BLOCK];
+    float diffuse[VSGL_KERNEL_BLOCK];   /* 1 if the diffuse lobe is shaded, else 0 */
+    /* warped NDF lobe: ASG frame (X, Y, Z), bandwidths, linear amplitude */
+    float Xx[VSGL_KERNEL_BLOCK], Xy[VSGL_KERNEL_BLOCK], Xz[VSGL_KERNEL_BLOCK];
+    float Yx[VSGL_KERNEL_BLOCK], Yy[VSGL_KERNEL_BLOCK], Yz[VSGL_KERNEL_BLOCK];
+    float Zx[VSGL_KERNEL_BLOCK], Zy[VSGL_KERNEL_BLOCK], Zz[VSGL_KERNEL_BLOCK];
+    float lam[VSGL_KERNEL_BLOCK], mu[VSGL_KERNEL_BLOCK], camp[VSGL_KERNEL_BLOCK];
+    /* smooth factor inputs: alpha^2, n.o, sqrt(a2 + (1 - a2)(n.o)^2), F0 */
+    float a2[VSGL_KERNEL_BLOCK], co[VSGL_KERNEL_BLOCK], so[VSGL_KERNEL_BLOCK];
+    float f0r[VSGL_KERNEL_BLOCK], f0g[VSGL_KERNEL_BLOCK], f0b[VSGL_KERNEL_BLOCK];
+    /* accumulators */
+    float ld[3][VSGL_KERNEL_BLOCK];     /* diffuse light: sum power * cosine integral / pi */
+    float ls[3][VSGL_KERNEL_BLOCK];     /* glossy radiance */
+} vsgl_kernel_block;
+
+/* One VSGL, with the per-VSGL constants precomputed. */
+typedef struct vsgl_kernel_light {
+    float mx, my, mz;        /* mean position */
+    float var;               /* positional variance per axis */
+    float ax, ay, az;        /* -axis of the radiant intensity (incident direction) */
+    float lv;                /* sharpness of the radiant intensity */
+    float c0;                /* 1 / (2 pi A(lv)) */
+    float pr, pg, pb;        /* power */
+} vsgl_kernel_light;
+
+/* Diffuse modes as in vsgl/sg.h (VSGL_COSINE_*), glossy 0 = ASG only. */
+void vsgl__kernel_shade(vsgl_kernel_block *b, size_t n, const vsgl_kernel_light *L,
+                        const float *visibility, int32_t diffuse_mode);
+void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, size_t n, const vsgl_kernel_light *L,
+                               const float *visibility, int32_t diffuse_mode);
+
+#endif

@@ -1,0 +1,207 @@
+/* Body of the shading kernel, included by kernel.c (vectorised, ISA clones)
+ * and kernel_scalar.c (scalar reference build). Define KERNEL_NAME and
+ * KERNEL_ATTR before including. Branch-free per lane so that GCC can
+ * vectorise the loop over receivers; the formulas are those of
+ * vsgl_sg_product (Eq. 7), vsgl_sg_cosine_integral (three modes) and the
+ * ASG x SG product integral (Xu et al. Eq. 18 with Eq. 11's normalisation)
+ * with vsgl_specular_factor at the integrand's axis (docs/math.md). */
+#include "shade/kernel.h"
+#include "vsgl/sg.h"
+
+#include <math.h>
+#include <string.h>
+
+#define K_PI 3.14159265358979323846f
+#define K_2PI 6.28318530717958647692f
+#define K_VAR_FLOOR 4.547473508864641e-13f /* 2^-41 */
+#define K_SHARP_MAX 2199023255552.0f       /* 2^41 */
+
+/* e^x, 0 below -87 and e^88 above 88: Cephes-style degree-5 polynomial
+ * after range reduction. Written so that GCC vectorises it: the rounding
+ * uses the 1.5*2^23 trick (valid because this file is never built with
+ * -ffast-math, which would delete it; test_kernel checks the accuracy) and
+ * the exponent bits come from a float product, since an int conversion of
+ * the clamped value gets narrowed by value-range propagation and then
+ * cannot be vectorised (GCC 12). */
+static inline __attribute__((always_inline)) float k_exp(float x)
+{
+    float xc = x < -87.0f ? -87.0f : x;
+    xc = xc > 88.0f ? 88.0f : xc;
+    float t = xc * 1.44269504088896341f;
+    float k = (t + 12582912.0f) - 12582912.0f;
+    float r = xc - k * 0.693359375f + k * 2.12194440e-4f;
+    float p = 1.9875691500e-4f;
+    p = p * r + 1.3981999507e-3f;
+    p = p * r + 8.3334519073e-3f;
+    p = p * r + 4.1665795894e-2f;
+    p = p * r + 1.6666665459e-1f;
+    p = p * r + 5.0000001201e-1f;
+    p = p * r * r + r + 1.0f;
+    int32_t bits = (int32_t)((k + 127.0f) * 8388608.0f);
+    float scale;
+    memcpy(&scale, &bits, sizeof scale);
+    return x < -87.0f ? 0.0f : p * scale;
+}
+
+/* 1 - erf(x) = P(x) e^{-x^2}: returns P (Abramowitz & Stegun 7.1.26). */
+static inline __attribute__((always_inline)) float k_erfc_poly(float x)
+{
+    float k = 1.0f / (1.0f + 0.3275911f * x);
+    return k * (0.254829592f + k * (-0.284496736f + k * (1.421413741f + k * (-1.453152027f + k * 1.061405429f))));
+}
+
+/* The ACCURATE SG x clamped-cosine integral of a unit-amplitude SG
+ * (lambda l, cosine c between its axis and the normal); see sg_cosine.c. */
+static inline __attribute__((always_inline)) float k_cosine_accurate(float l, float c)
+{
+    l = l < K_SHARP_MAX ? l : K_SHARP_MAX;
+    float small = l < 0.5f ? 1.0f : 0.0f;
+    float ls = l > 1e-30f ? l : 1e-30f;
+    float e1 = k_exp(-l);
+    /* expm1(-l): Taylor below 0.5 */
+    float em_t = -l * (1.0f - l * 0.5f * (1.0f - l * (1.0f / 3.0f) * (1.0f - l * 0.25f * (1.0f - l * 0.2f * (1.0f - l * (1.0f / 6.0f))))));
+    float em = small > 0.0f ? em_t : e1 - 1.0f;
+    e1 = 1.0f + em;
+    float q_t = 0.5f + l * (-1.0f / 3.0f + l * (1.0f / 8.0f + l * (-1.0f / 30.0f + l * (1.0f / 144.0f + l * (-1.0f / 840.0f + l * (1.0f / 5760.0f))))));
+    float il2 = 1.0f / (ls * ls);
+    float q = small > 0.0f ? q_t : (-em - l * e1) * il2;
+    float low = e1 * q;
+    /* vMF mean length coth(l) - 1/l */
+    float e2 = e1 * e1;
+    float ml_c = (1.0f + e2) / (1.0f - e2 + (small > 0.0f ? 1.0f : 0.0f)) - 1.0f / ls;
+    float l2 = l * l;
+    float ml_t = l * (1.0f / 3.0f - l2 * (1.0f / 45.0f - l2 * (2.0f / 945.0f - l2 * (1.0f / 4725.0f))));
+    float ml = small > 0.0f ? ml_t : ml_c;
+    float u = (-em * (2.0f + em) / ls) * ml;
+    float t = l * sqrtf(0.5f * ((l + 2.60394758f) * l + 19.70572125f) /
+                        (((l + 3.99182425f) * l + 15.73260592f) * l + 87.201855f));
+    t = t > 1e-30f ? t : 1e-30f;
+    float ac = fabsf(c);
+    float x = t * ac;
+    float ex = k_exp(-x * x), et = k_exp(-t * t);
+    float s = (c > 0.0f ? c : 0.0f) - 0.5f * ac * k_erfc_poly(x) * ex + 0.5f * k_erfc_poly(t) * et
+            + (ex - et) * (0.28209479177387814f / t);
+    s = s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f;
+    float r = K_2PI * (low + u * s);
+    float omc2 = (1.0f - ac) * (1.0f + ac);
+    float bound = K_PI * k_exp(-l * c * c / (1.0f + sqrtf(omc2)));
+    float rb = bound < r ? bound : r;
+    r = c < 0.0f ? rb : r; /* no && : a combined mask does not vectorise (GCC 12) */
+    return l > 0.0f ? r : K_PI;
+}
+
+/* A(l) = 2 pi (1 - e^{-2l}) / l, 4 pi at 0. */
+static inline __attribute__((always_inline)) float k_sg_integral(float l)
+{
+    float e = k_exp(-2.0f * l);
+    float taylor = 4.0f * K_PI * (1.0f - l * (1.0f - l * (2.0f / 3.0f)));
+    return l < 1e-3f ? taylor : K_2PI * (1.0f - e) / l;
+}
+
+static inline __attribute__((always_inline)) void
+k_body(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, float vis, int32_t mode, float ld_sharp, float ld_norm)
+{
+    /* incident radiance as one SG (Eq. 7) */
+    float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
+    float d2 = dx * dx + dy * dy + dz * dz;
+    float var = L->var > d2 * K_VAR_FLOOR ? L->var : d2 * K_VAR_FLOOR;
+    float valid = (var > 0.0f ? 1.0f : 0.0f) * vis;
+    float ivar = var > 0.0f ? 1.0f / var : 0.0f;
+    float ls = d2 * ivar;
+    float idist = d2 > 0.0f ? 1.0f / sqrtf(d2) : 0.0f;
+    float ux = dx * idist, uy = dy * idist, uz = dz * idist;
+    if (!(d2 > 0.0f)) { ux = L->ax; uy = L->ay; uz = L->az; }
+    float mx = ls * ux + L->lv * L->ax, my = ls * uy + L->lv * L->ay, mz = ls * uz + L->lv * L->az;
+    float lin = sqrtf(mx * mx + my * my + mz * mz);
+    float ilin = lin > 1e-30f ? 1.0f / lin : 0.0f;
+    float px = mx * ilin, py = my * ilin, pz = mz * ilin;
+    float ddx = L->ax - ux, ddy = L->ay - uy, ddz = L->az - uz;
+    float diff2 = ddx * ddx + ddy * ddy + ddz * ddz;
+    float den = lin + L->lv + ls;
+    float expo = den > 0.0f ? -L->lv * ls * diff2 / den : 0.0f;
+    float amp = valid * k_exp(expo) * ivar * L->c0;
+
+    /* diffuse: integral of the incident SG times max(w.n, 0), / pi */
+    float c = px * b->nx[i] + py * b->ny[i] + pz * b->nz[i];
+    c = c > 1.0f ? 1.0f : (c < -1.0f ? -1.0f : c);
+    float cosint;
+    if (mode == VSGL_COSINE_PULLED_OUT) {
+        cosint = (c > 0.0f ? c : 0.0f) * k_sg_integral(lin);
+    } else if (mode == VSGL_COSINE_SG) {
+        float qx = lin * px + ld_sharp * b->nx[i], qy = lin * py + ld_sharp * b->ny[i], qz = lin * pz + ld_sharp * b->nz[i];
+        float lm = sqrtf(qx * qx + qy * qy + qz * qz);
+        float ex = px - b->nx[i], ey = py - b->ny[i], ez = pz - b->nz[i];
+        float dd = ex * ex + ey * ey + ez * ez;
+        cosint = k_exp(-lin * ld_sharp * dd / (lm + lin + ld_sharp)) * k_sg_integral(lm) * ld_norm;
+    } else {
+        cosint = k_cosine_accurate(lin, c);
+    }
+    float ed = amp * cosint * (1.0f / K_PI) * b->diffuse[i];
+    b->ld[0][i] += L->pr * ed;
+    b->ld[1][i] += L->pg * ed;
+    b->ld[2][i] += L->pb * ed;
+
+    /* glossy: ASG x SG product integral (Eq. 18), nu = lambda_in / 2 */
+    float nu = 0.5f * lin;
+    float lam = b->lam[i], mu = b->mu[i];
+    float gx = px * b->Xx[i] + py * b->Xy[i] + pz * b->Xz[i];
+    float gy = px * b->Yx[i] + py * b->Yy[i] + pz * b->Yz[i];
+    float gz = px * b->Zx[i] + py * b->Zy[i] + pz * b->Zz[i];
+    float hx = nu + lam > 0.0f ? nu * lam / (nu + lam) : 0.0f;
+    float hy = nu + mu > 0.0f ? nu * mu / (nu + mu) : 0.0f;
+    float norm_den = (lam + nu) * (mu + nu);
+    float norm = norm_den > 0.0f ? K_PI / sqrtf(norm_den) : K_PI;
+    float gint = b->camp[i] * (gz > 0.0f ? gz : 0.0f) * k_exp(-hx * gx * gx - hy * gy * gy) * norm * amp;
+    /* smooth factor at the integrand's axis: normalize(l_in p + (lam + mu) Z) */
+    float sw = lam + mu;
+    float ix = lin * px + sw * b->Zx[i], iy = lin * py + sw * b->Zy[i], iz = lin * pz + sw * b->Zz[i];
+    float il = sqrtf(ix * ix + iy * iy + iz * iz);
+    float iil = il > 1e-30f ? 1.0f / il : 0.0f;
+    ix *= iil; iy *= iil; iz *= iil;
+    float ci = ix * b->nx[i] + iy * b->ny[i] + iz * b->nz[i];
+    ci = ci < 1.0f ? ci : 1.0f;
+    float hhx = ix + b->ox[i], hhy = iy + b->oy[i], hhz = iz + b->oz[i];
+    float hl = sqrtf(hhx * hhx + hhy * hhy + hhz * hhz);
+    float ih = hl > 1e-30f ? (ix * hhx + iy * hhy + iz * hhz) / hl : 0.0f;
+    ih = ih > 0.0f ? (ih < 1.0f ? ih : 1.0f) : 0.0f;
+    float w = 1.0f - ih, w2 = w * w, w5 = w2 * w2 * w;
+    float a2 = b->a2[i], co = b->co[i];
+    float si = sqrtf(a2 + (1.0f - a2) * ci * ci);
+    float gden = 2.0f * (ci * b->so[i] + co * si);
+    float geo = ci / (gden > 1e-30f ? gden : 1e-30f);
+    geo = ci > 0.0f ? geo : 0.0f;
+    float gm = gint * geo;
+    b->ls[0][i] += L->pr * gm * (b->f0r[i] + (1.0f - b->f0r[i]) * w5);
+    b->ls[1][i] += L->pg * gm * (b->f0g[i] + (1.0f - b->f0g[i]) * w5);
+    b->ls[2][i] += L->pb * gm * (b->f0b[i] + (1.0f - b->f0b[i]) * w5);
+}
+
+KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, size_t n, const vsgl_kernel_light *light,
+                             const float *restrict visibility, int32_t mode)
+{
+    const vsgl_kernel_light local = *light; /* no aliasing with the block */
+    const vsgl_kernel_light *L = &local;
+    float ld_sharp = vsgl_sg_cosine_sharpness();
+    float ld_norm = K_PI / k_sg_integral(ld_sharp);
+    if (n > VSGL_KERNEL_BLOCK)
+        n = VSGL_KERNEL_BLOCK;
+    if (visibility) {
+        for (size_t i = 0; i < n; ++i)
+            k_body(b, i, L, visibility[i], mode, ld_sharp, ld_norm);
+        return;
+    }
+    switch (mode) {
+    case VSGL_COSINE_SG:
+        for (size_t i = 0; i < n; ++i)
+            k_body(b, i, L, 1.0f, VSGL_COSINE_SG, ld_sharp, ld_norm);
+        break;
+    case VSGL_COSINE_PULLED_OUT:
+        for (size_t i = 0; i < n; ++i)
+            k_body(b, i, L, 1.0f, VSGL_COSINE_PULLED_OUT, ld_sharp, ld_norm);
+        break;
+    default:
+        for (size_t i = 0; i < n; ++i)
+            k_body(b, i, L, 1.0f, VSGL_COSINE_ACCURATE, ld_sharp, ld_norm);
+        break;
+    }
+}
