@@ -11,7 +11,7 @@
  * azimuth uses the n_phi-point trapezoid rule (spectral for smooth periodic
  * integrands). The integrand gets 1 - w.axis without cancellation.
  * sq_line integrates a 1-D function with composite Gauss-Legendre.
- * Independent of the library: only <math.h>. Header-only, static functions. */
+ * Independent of the library: only <math.h>. Header-only, static inline functions. */
 #ifndef VSGL_TEST_SPHERE_QUAD_H
 #define VSGL_TEST_SPHERE_QUAD_H
 
@@ -24,7 +24,7 @@ typedef double (*sq_fn)(const double w[3], double omu, void *user);
 typedef double (*sq_fn1)(double x, void *user);
 
 /* Gauss-Legendre nodes/weights on [-1, 1] (Newton on P_n), n <= SQ_MAX_GL. */
-static void sq_gauss_legendre(int n, double *x, double *w)
+static inline void sq_gauss_legendre(int n, double *x, double *w)
 {
     for (int i = 0; i < n; ++i) {
         double z = cos(SQ_PI * (i + 0.75) / (n + 0.5)), pp = 1.0;
@@ -47,7 +47,7 @@ static void sq_gauss_legendre(int n, double *x, double *w)
 }
 
 /* Orthonormal e1, e2 completing unit a. */
-static void sq_basis(const double a[3], double e1[3], double e2[3])
+static inline void sq_basis(const double a[3], double e1[3], double e2[3])
 {
     double s = a[2] >= 0.0 ? 1.0 : -1.0;
     double p = -1.0 / (s + a[2]);
@@ -56,7 +56,7 @@ static void sq_basis(const double a[3], double e1[3], double e2[3])
     e2[0] = q; e2[1] = s + a[1] * a[1] * p; e2[2] = -a[1];
 }
 
-static double sq_line(sq_fn1 g, void *user, double a, double b, int panels, int n_gl)
+static inline double sq_line(sq_fn1 g, void *user, double a, double b, int panels, int n_gl)
 {
     double x[SQ_MAX_GL], w[SQ_MAX_GL], sum = 0.0;
     sq_gauss_legendre(n_gl, x, w);
@@ -70,7 +70,7 @@ static double sq_line(sq_fn1 g, void *user, double a, double b, int panels, int 
     return sum;
 }
 
-static double sq_sphere(sq_fn f, void *user, const double axis_in[3], double lam, int n_gl, int n_phi)
+static inline double sq_sphere(sq_fn f, void *user, const double axis_in[3], double lam, int n_gl, int n_phi)
 {
     double x[SQ_MAX_GL], wt[SQ_MAX_GL];
     sq_gauss_legendre(n_gl, x, wt);
