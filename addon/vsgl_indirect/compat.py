@@ -53,7 +53,7 @@ def shader_output_node(tree):
 
 # --- compositor -------------------------------------------------------------
 
-HAS_NODE_GROUP_COMPOSITOR = hasattr(bpy.types.Scene, "compositing_node_group")  # 5.0+
+HAS_NODE_GROUP_COMPOSITOR = "compositing_node_group" in bpy.types.Scene.bl_rna.properties  # 5.0+
 
 
 def compositor_tree(scene, create=True):

@@ -13,6 +13,8 @@ from . import compat, engine
 IMAGE_NODE = "VSGL Indirect [%s]"
 ADD_NODE = "VSGL Add [%s]"
 IMAGE_NAME = "VSGL %s %s"   # scene, view layer
+FIRST_FRAME = -500000
+DURATION = 1048574
 
 
 def image_node_name(view_layer):
@@ -53,10 +55,13 @@ def _render_layers_node(tree, scene, view_layer):
     return n
 
 
-def ensure(scene, view_layer, path, frame, add_to_render=True):
-    """Set up (or update) the nodes for ``view_layer`` to read ``path`` (this
-    frame's file) and return the Image node. ``path`` must exist (see
-    :func:`placeholder`) so Blender creates the pass sockets."""
+def ensure(scene, view_layer, path, add_to_render=True):
+    """Set up (or update) the nodes for ``view_layer`` to read the sequence
+    ``path`` belongs to (any frame's file) and return the Image node.
+    ``path`` must exist (see :func:`placeholder`) so Blender creates the pass
+    sockets. Call it before a render starts (render_init, file load, settings
+    change), never from render_pre: changing the node tree there stops Blender
+    3.4 from calling frame_change_post for the following frames of ``-a``."""
     tree = compat.compositor_tree(scene, create=True)
     name = IMAGE_NAME % (scene.name, view_layer)
     img = bpy.data.images.get(name)
@@ -65,8 +70,8 @@ def ensure(scene, view_layer, path, frame, add_to_render=True):
         img.name = name
     if os.path.normpath(bpy.path.abspath(img.filepath)) != os.path.normpath(path):
         img.filepath = path
-    img.source = "SEQUENCE"
-    img.reload()
+    if img.source != "SEQUENCE":
+        img.source = "SEQUENCE"
 
     node = tree.nodes.get(image_node_name(view_layer))
     if node is None:
@@ -75,11 +80,17 @@ def ensure(scene, view_layer, path, frame, add_to_render=True):
         node.label = "VSGL indirect (%s)" % view_layer
         node.location = (-300, -400 - 300 * len([n for n in tree.nodes
                                                  if n.name.startswith("VSGL Indirect")]))
-    # Read exactly this frame's file: file number = frame.
-    node.frame_duration = 1
-    node.frame_start = frame
-    node.frame_offset = frame - 1
-    node.use_auto_refresh = True
+    # File number = scene frame for every frame in [FIRST, FIRST + DURATION):
+    # Blender reads clamp(frame - start + 1, 0, duration) + offset. Static, so
+    # nothing changes in the tree while frames render.
+    if node.frame_start != FIRST_FRAME:
+        node.frame_start = FIRST_FRAME
+    if node.frame_duration != DURATION:
+        node.frame_duration = DURATION
+    if node.frame_offset != FIRST_FRAME - 1:
+        node.frame_offset = FIRST_FRAME - 1
+    if not node.use_auto_refresh:
+        node.use_auto_refresh = True
     if node.image != img or _combined_socket(node) is None or "DiffInd" not in node.outputs:
         node.image = None
         node.image = img
