@@ -1,0 +1,260 @@
+/* Command-line parsing of build/vsgl. */
+#include "options.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char cli_usage[] =
+    "usage: vsgl render SCENE.vsglb [-o OUT.exr] [options]\n"
+    "       vsgl info SCENE.vsglb\n"
+    "       vsgl --version | --help\n"
+    "\n"
+    "Renders one-bounce diffuse + glossy indirect light of a scene bundle into a\n"
+    "multilayer EXR (layer VSGL; passes DiffInd GlossInd DiffCol GlossCol Diff Gloss\n"
+    "Combined). Settings: the bundle's (or --preset), then the options below.\n"
+    "\n"
+    "  -o, --output PATH     EXR to write (default: the bundle's output path)\n"
+    "  --preset NAME         preview | balanced | quality\n"
+    "  --aa N                N x N camera samples per pixel\n"
+    "  --rsm N               reflective shadow map side in texels\n"
+    "  --fit NAME            two | fis | kmeans   (VSGL fit)\n"
+    "  --vsgls N             VSGLs per light (fis, kmeans)\n"
+    "  --sharpness NAME      toksvig | banerjee\n"
+    "  --diffuse NAME        sg | pulled | accurate   (receiver cosine)\n"
+    "  --glossy NAME         asg | sg\n"
+    "  --visibility NAME     none | ray\n"
+    "  --method NAME         vsgl | brute   (brute: every RSM texel, the reference)\n"
+    "  --threads N           worker threads (0 = all cores)\n"
+    "  --seed N              seed of FIS / k-means sampling\n"
+    "  --half                16-bit half EXR (default 32-bit float)\n"
+    "  --dry-run             read, validate and check the output path; do not render\n"
+    "  -v, --verbose         per-stage timings and statistics on stderr\n"
+    "\n"
+    "Exit status: 0 success, 1 failure (one line 'vsgl: reason' on stderr),\n"
+    "2 bad command line, 130 interrupted.\n";
+
+static int set_err(char *err, size_t n, const char *fmt, const char *a, const char *b)
+{
+    snprintf(err, n, fmt, a, b);
+    return 2;
+}
+
+static int parse_u32(const char *s, uint32_t lo, cli_u32 *out)
+{
+    if (!s || !*s || *s == '-' || *s == '+')
+        return -1;
+    errno = 0;
+    char *end = NULL;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno || *end || v > UINT32_MAX || v < lo)
+        return -1;
+    out->set = 1;
+    out->value = (uint32_t)v;
+    return 0;
+}
+
+static int parse_enum(const char *s, const char *const *names, const int *values, int *out)
+{
+    for (int i = 0; names[i]; ++i)
+        if (s && strcmp(s, names[i]) == 0) {
+            *out = values[i];
+            return 0;
+        }
+    return -1;
+}
+
+typedef struct enum_opt { const char *name; const char *const *names; const int *values; size_t offset; } enum_opt;
+typedef struct num_opt { const char *name; uint32_t min; size_t offset; } num_opt;
+
+static const char *const preset_names[] = {"preview", "balanced", "quality", NULL};
+static const int preset_values[] = {VSGL_PRESET_PREVIEW, VSGL_PRESET_BALANCED, VSGL_PRESET_QUALITY};
+static const char *const fit_names[] = {"two", "fis", "kmeans", NULL};
+static const int fit_values[] = {VSGL_FIT_TWO, VSGL_FIT_FIS, VSGL_FIT_KMEANS};
+static const char *const sharp_names[] = {"toksvig", "banerjee", NULL};
+static const int sharp_values[] = {VSGL_SHARPNESS_TOKSVIG, VSGL_SHARPNESS_BANERJEE};
+static const char *const diffuse_names[] = {"sg", "pulled", "accurate", NULL};
+static const int diffuse_values[] = {VSGL_COSINE_SG, VSGL_COSINE_PULLED_OUT, VSGL_COSINE_ACCURATE};
+static const char *const glossy_names[] = {"asg", "sg", NULL};
+static const int glossy_values[] = {VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG};
+static const char *const vis_names[] = {"none", "ray", NULL};
+static const int vis_values[] = {VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY};
+static const char *const method_names[] = {"vsgl", "brute", NULL};
+static const int method_values[] = {VSGL_METHOD_VSGL, VSGL_METHOD_BRUTE_FORCE};
+
+static const enum_opt enum_opts[] = {
+    {"--preset", preset_names, preset_values, offsetof(cli_options, preset)},
+    {"--fit", fit_names, fit_values, offsetof(cli_options, fit)},
+    {"--sharpness", sharp_names, sharp_values, offsetof(cli_options, sharpness)},
+    {"--diffuse", diffuse_names, diffuse_values, offsetof(cli_options, diffuse)},
+    {"--glossy", glossy_names, glossy_values, offsetof(cli_options, glossy)},
+    {"--visibility", vis_names, vis_values, offsetof(cli_options, visibility)},
+    {"--method", method_names, method_values, offsetof(cli_options, method)},
+};
+
+static const num_opt num_opts[] = {
+    {"--aa", 1, offsetof(cli_options, aa)},
+    {"--rsm", 1, offsetof(cli_options, rsm)},
+    {"--vsgls", 1, offsetof(cli_options, vsgls)},
+    {"--threads", 0, offsetof(cli_options, threads)},
+    {"--seed", 0, offsetof(cli_options, seed)},
+};
+
+static void join_names(const char *const *names, char *buf, size_t n)
+{
+    buf[0] = '\0';
+    for (int i = 0; names[i]; ++i)
+        snprintf(buf + strlen(buf), n - strlen(buf), "%s%s", i ? "|" : "", names[i]);
+}
+
+int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
+{
+    memset(o, 0, sizeof *o);
+    o->command = CLI_HELP;
+    o->preset = o->fit = o->sharpness = o->diffuse = o->glossy = o->visibility = o->method = -1;
+    err[0] = '\0';
+    if (argc < 2)
+        return set_err(err, err_size, "no command given%s%s (see vsgl --help)", "", "");
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+        o->command = CLI_HELP;
+        return 0;
+    }
+    if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
+        o->command = CLI_VERSION;
+        return 0;
+    }
+    if (!strcmp(cmd, "render"))
+        o->command = CLI_RENDER;
+    else if (!strcmp(cmd, "info"))
+        o->command = CLI_INFO;
+    else
+        return set_err(err, err_size, "unknown command '%s'%s (see vsgl --help)", cmd, "");
+
+    int only_dashes = 0;
+    for (int i = 2; i < argc; ++i) {
+        const char *a = argv[i];
+        if (only_dashes || a[0] != '-' || a[1] == '\0') {
+            if (o->scene_path)
+                return set_err(err, err_size, "unexpected argument '%s' (the scene is '%s')", a, o->scene_path);
+            o->scene_path = a;
+            continue;
+        }
+        if (!strcmp(a, "--")) {
+            only_dashes = 1;
+            continue;
+        }
+        /* --name=value or --name value */
+        char name[64];
+        const char *value = NULL;
+        const char *eq = strchr(a, '=');
+        if (eq && a[1] == '-') {
+            size_t n = (size_t)(eq - a);
+            if (n >= sizeof name)
+                return set_err(err, err_size, "unknown option '%s'%s (see vsgl --help)", a, "");
+            memcpy(name, a, n);
+            name[n] = '\0';
+            value = eq + 1;
+        } else {
+            snprintf(name, sizeof name, "%s", a);
+        }
+        int is_flag = 1;
+        if (!strcmp(name, "--help") || !strcmp(name, "-h")) {
+            o->command = CLI_HELP;
+            return 0;
+        } else if (!strcmp(name, "-v") || !strcmp(name, "--verbose")) {
+            o->verbose = 1;
+        } else if (!strcmp(name, "--half")) {
+            o->half = 1;
+        } else if (!strcmp(name, "--dry-run")) {
+            o->dry_run = 1;
+        } else {
+            is_flag = 0;
+        }
+        if (is_flag) {
+            if (value)
+                return set_err(err, err_size, "option %s takes no value (got '%s')", name, value);
+            continue;
+        }
+        /* Options with a value. */
+        if (!value) {
+            if (i + 1 >= argc)
+                return set_err(err, err_size, "option %s needs a value%s", name, "");
+            value = argv[++i];
+        }
+        if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
+            if (!*value)
+                return set_err(err, err_size, "option %s needs a non-empty path%s", name, "");
+            o->output_path = value;
+            continue;
+        }
+        int done = 0;
+        for (size_t k = 0; k < sizeof enum_opts / sizeof enum_opts[0] && !done; ++k) {
+            const enum_opt *e = &enum_opts[k];
+            if (strcmp(name, e->name))
+                continue;
+            done = 1;
+            if (parse_enum(value, e->names, e->values, (int *)((char *)o + e->offset)) != 0) {
+                char list[128];
+                join_names(e->names, list, sizeof list);
+                snprintf(err, err_size, "option %s: '%s' is not one of %s", name, value, list);
+                return 2;
+            }
+        }
+        for (size_t k = 0; k < sizeof num_opts / sizeof num_opts[0] && !done; ++k) {
+            const num_opt *n = &num_opts[k];
+            if (strcmp(name, n->name))
+                continue;
+            done = 1;
+            if (parse_u32(value, n->min, (cli_u32 *)((char *)o + n->offset)) != 0) {
+                snprintf(err, err_size, "option %s: '%s' is not a whole number %s %u", name, value,
+                         n->min ? ">=" : "in 0 ..", n->min ? n->min : UINT32_MAX);
+                return 2;
+            }
+        }
+        if (!done)
+            return set_err(err, err_size, "unknown option '%s'%s (see vsgl --help)", name, "");
+    }
+    if (!o->scene_path)
+        return set_err(err, err_size, "%s: no scene bundle given%s (see vsgl --help)", cmd, "");
+    if (o->command == CLI_INFO && (o->output_path || o->half || o->dry_run))
+        return set_err(err, err_size, "info takes only a scene bundle (and -v)%s%s", "", "");
+    return 0;
+}
+
+void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_render_settings *s)
+{
+    if (o->preset >= 0 || !base)
+        vsgl_render_settings_preset(o->preset >= 0 ? o->preset : VSGL_PRESET_BALANCED, s);
+    else
+        *s = *base;
+    s->size = sizeof *s;
+    if (o->aa.set) s->aa_samples = o->aa.value;
+    if (o->rsm.set) s->rsm_resolution = o->rsm.value;
+    if (o->vsgls.set) s->vsgl_count = o->vsgls.value;
+    if (o->seed.set) s->seed = o->seed.value;
+    if (o->fit >= 0) s->fit_mode = o->fit;
+    if (o->sharpness >= 0) s->sharpness_estimator = o->sharpness;
+    if (o->diffuse >= 0) s->diffuse_mode = o->diffuse;
+    if (o->glossy >= 0) s->glossy_mode = o->glossy;
+    if (o->visibility >= 0) s->visibility = o->visibility;
+    if (o->method >= 0) s->method = o->method;
+}
+
+static const char *name_of(const char *const *names, const int *values, int v)
+{
+    for (int i = 0; names[i]; ++i)
+        if (values[i] == v)
+            return names[i];
+    return "?";
+}
+
+void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size)
+{
+    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u",
+             name_of(method_names, method_values, s->method), s->aa_samples, s->rsm_resolution,
+             name_of(fit_names, fit_values, s->fit_mode), s->vsgl_count, s->fis_iterations,
+             name_of(sharp_names, sharp_values, s->sharpness_estimator), name_of(diffuse_names, diffuse_values, s->diffuse_mode),
+             name_of(glossy_names, glossy_values, s->glossy_mode), name_of(vis_names, vis_values, s->visibility), s->seed);
+}

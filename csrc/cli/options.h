@@ -1,0 +1,38 @@
+/* Command-line parsing of build/vsgl (pure: no I/O, no globals). */
+#ifndef VSGL_CLI_OPTIONS_H
+#define VSGL_CLI_OPTIONS_H
+
+#include "vsgl.h"
+
+#define CLI_HELP    0
+#define CLI_VERSION 1
+#define CLI_RENDER  2
+#define CLI_INFO    3
+
+/* An optional unsigned number given on the command line. */
+typedef struct cli_u32 { int set; uint32_t value; } cli_u32;
+
+typedef struct cli_options {
+    int command;              /* CLI_* */
+    const char *scene_path;   /* render/info: the bundle */
+    const char *output_path;  /* -o; NULL = the bundle's output path */
+    int preset;               /* VSGL_PRESET_*, -1 = not given */
+    cli_u32 aa, rsm, vsgls, threads, seed;
+    int fit, sharpness, diffuse, glossy, visibility, method; /* -1 = not given */
+    int half, verbose, dry_run;
+} cli_options;
+
+/* Parse argv. Returns 0, or 2 with a one-line reason in err (no "vsgl: " prefix). */
+int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size);
+
+/* Settings to render with: the preset if given, else the bundle's settings
+ * (base), then every option given on the command line. */
+void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_render_settings *out);
+
+/* "method=vsgl aa=2 rsm=256 ..." for logs and EXR metadata. */
+void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size);
+
+/* The --help text. */
+extern const char cli_usage[];
+
+#endif
