@@ -34,8 +34,10 @@ def is_holdout(obj):
 
 
 def material_uses_nodes(mat):
-    # 5.0 always uses nodes (use_nodes is deprecated but present).
-    return bool(getattr(mat, "use_nodes", True)) and mat.node_tree is not None
+    # 5.0 always uses nodes (use_nodes is deprecated there).
+    if VERSION >= (5, 0, 0):
+        return mat.node_tree is not None
+    return bool(mat.use_nodes) and mat.node_tree is not None
 
 
 def shader_output_node(tree):

@@ -27,7 +27,7 @@ KNOBS = {
 
 @dataclass
 class Options:
-    enabled: bool = True
+    enabled: bool = False
     add_to_render: bool = True
     preset: str = "BALANCED"
     use_advanced: bool = False

@@ -132,7 +132,8 @@ def frame_path(template, frame, scene="Scene", view_layer="ViewLayer", render_di
     def safe(s):
         return re.sub(r"[^A-Za-z0-9_.-]+", "_", s) or "_"
     p = template.replace("{scene}", safe(scene)).replace("{view_layer}", safe(view_layer))
-    p = p.replace("{render_dir}", render_dir.rstrip("/\\") + os.sep if render_dir else "")
+    p = p.replace("{render_dir}", render_dir.rstrip("/\\") if render_dir else ".")
+    p = re.sub(r"(?<!^)/{2,}", "/", p) if not p.startswith("//") else "//" + re.sub(r"/{2,}", "/", p[2:])
     root, ext = os.path.splitext(p)
     if ext.lower() != ".exr":
         root, ext = p, ".exr"

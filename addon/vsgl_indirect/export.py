@@ -251,6 +251,10 @@ def collect(depsgraph, scene=None, require_lights=True):
             # A viewport depsgraph still contains render-hidden objects.
             if orig.hide_render or (parent is not None and parent.original.hide_render):
                 continue
+            # Render mode hides objects instanced on their parent's verts/faces.
+            if not inst.is_instance and orig.parent is not None and \
+                    orig.parent.instance_type in {"VERTS", "FACES"}:
+                continue
         if obj.type == "LIGHT":
             _add_light(sd, obj, inst.matrix_world, compat)
             continue

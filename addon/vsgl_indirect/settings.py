@@ -12,7 +12,7 @@ def _items(names, descriptions=None):
 
 class VSGLIndirectSettings(bpy.types.PropertyGroup):
     enabled: BoolProperty(
-        name="Compute on Render", default=True,
+        name="Compute on Render", default=False,
         description="Compute the indirect-light AOV of every rendered frame before it is "
                     "rendered and composited (F12, -f, -a)")
     add_to_render: BoolProperty(

@@ -1,0 +1,242 @@
+"""Export of the evaluated depsgraph against the scene built in each test and
+Blender's own values (matrix_world, loop counts, light settings)."""
+import math
+
+import bpy
+import numpy as np
+import pytest
+from mathutils import Matrix, Vector
+
+from conftest import VERSION, camera, cube, light, link, mesh_object, plane, principled
+from vsgl_indirect import export, materials
+from vsgl_indirect.convert import ExportError
+
+
+def collect(scene, **kw):
+    return export.collect(bpy.context.evaluated_depsgraph_get(), scene, **kw)
+
+
+def basic(scene):
+    camera(scene)
+    light(scene)
+
+
+def face_normals(sd):
+    p = sd.positions[sd.indices.astype(np.int64)]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def test_counts_transforms_and_flat_normals(scene):
+    basic(scene)
+    ob = link(scene, cube("Box", 2.0))
+    ob.location = (1, 2, 3)
+    ob.rotation_euler = (0.3, 0.2, 0.1)
+    ob.scale = (1, 2, 0.5)
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    assert sd.triangle_count == 12 and sd.positions.shape == (8, 3)
+    mw = ob.matrix_world
+    expect = np.array([tuple(mw @ v.co) for v in ob.data.vertices], np.float32)
+    assert np.allclose(sd.positions, expect, atol=1e-5)
+    # Flat cube: every corner normal is its triangle's geometric normal.
+    fn = face_normals(sd)
+    assert np.allclose(sd.corner_normals, fn[:, None, :].repeat(3, 1), atol=1e-5)
+
+
+def test_negative_scale_keeps_winding(scene):
+    basic(scene)
+    ob = link(scene, cube("Mirror", 2.0))
+    ob.scale = (-1, 1, 1)
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    fn = face_normals(sd)
+    assert np.all(np.einsum("ij,ij->i", fn, sd.corner_normals[:, 0]) > 0.999)
+    # Outward: normal points away from the cube centre.
+    centres = sd.positions[sd.indices.astype(np.int64)].mean(1)
+    assert np.all(np.einsum("ij,ij->i", fn, centres) > 0)
+
+
+def test_smooth_split_normals_and_modifier_applied(scene):
+    basic(scene)
+    ob = link(scene, cube("Smooth", 2.0))
+    for p in ob.data.polygons:
+        p.use_smooth = True
+    mod = ob.modifiers.new("Sub", "SUBSURF")
+    mod.levels = 2
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    assert sd.triangle_count == 6 * 16 * 2
+    # Smooth, centred blob: corner normals point roughly along the position.
+    pos = sd.positions[sd.indices.astype(np.int64)]
+    d = pos / np.linalg.norm(pos, axis=2, keepdims=True)
+    assert np.all(np.einsum("tci,tci->tc", d, sd.corner_normals) > 0.8)
+    assert np.allclose(np.linalg.norm(sd.corner_normals, axis=2), 1, atol=1e-4)
+    assert len(ob.data.vertices) == 8  # the original mesh is untouched
+
+
+def test_instances_collection_and_verts(scene):
+    basic(scene)
+    col = bpy.data.collections.new("Src")
+    scene.collection.children.link(col)
+    link(scene, plane("Tile", 1.0), col)
+    bpy.context.view_layer.layer_collection.children["Src"].exclude = True
+    for i in range(3):
+        e = bpy.data.objects.new("Inst%d" % i, None)
+        e.instance_type = "COLLECTION"
+        e.instance_collection = col
+        e.location = (3 * i, 0, 0)
+        link(scene, e)
+    # Vertex instancing: a 4-vertex carrier instancing a cube 4 times.
+    carrier = link(scene, mesh_object("Carrier", [(0, 5, 0), (2, 5, 0), (4, 5, 0), (6, 5, 0)], []))
+    child = link(scene, cube("Child", 0.2))
+    child.parent = carrier
+    carrier.instance_type = "VERTS"
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    assert sd.instance_count == 3 + 4
+    assert sd.triangle_count == 3 * 2 + 4 * 12
+    xs = sorted(set(np.round(sd.positions[:, 0][sd.positions[:, 1] < 1], 3)))
+    assert xs == [-0.5, 0.5, 2.5, 3.5, 5.5, 6.5]
+
+
+def test_visibility_hide_render_excluded_and_holdout(scene):
+    basic(scene)
+    link(scene, plane("Shown", 1.0))
+    link(scene, plane("NoRender", 1.0, (5, 0, 0))).hide_render = True
+    col = bpy.data.collections.new("Excluded")
+    scene.collection.children.link(col)
+    link(scene, plane("InExcluded", 1.0, (9, 0, 0)), col)
+    bpy.context.view_layer.layer_collection.children["Excluded"].exclude = True
+    hold = link(scene, plane("Hold", 1.0, (0, 4, 0), principled("Red", (1, 0, 0, 1))))
+    hold.is_holdout = True
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    assert sorted(sd.object_names) == ["Hold", "Shown"]
+    hm = sd.materials[sd.material_indices[sd.positions[sd.indices[:, 0], 1] > 3][0]]
+    assert hm["base_color"] == (0.0, 0.0, 0.0) and hm["specular_f0"] == 0.0
+
+
+def test_materials_from_nodes_both_versions(scene):
+    basic(scene)
+    if VERSION >= (4, 0, 0):
+        m1 = principled("P", (0.1, 0.2, 0.3, 1), 0.5, 0.25, **{"IOR": 2.0, "Specular IOR Level": 0.25})
+        f0 = ((2.0 - 1) / 3.0) ** 2 * 0.5
+    else:
+        m1 = principled("P", (0.1, 0.2, 0.3, 1), 0.5, 0.25, Specular=0.25)
+        f0 = 0.02
+    m2 = bpy.data.materials.new("Emit")
+    if m2.node_tree is None:
+        m2.use_nodes = True
+    nt = m2.node_tree
+    for n in list(nt.nodes):
+        if n.bl_idname != "ShaderNodeOutputMaterial":
+            nt.nodes.remove(n)
+    em = nt.nodes.new("ShaderNodeEmission")
+    nt.links.new(em.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    m2.diffuse_color = (0.3, 0.6, 0.9, 1)
+    m3 = bpy.data.materials.new("Diff")
+    if m3.node_tree is None:
+        m3.use_nodes = True
+    nt = m3.node_tree
+    for n in list(nt.nodes):
+        if n.bl_idname != "ShaderNodeOutputMaterial":
+            nt.nodes.remove(n)
+    d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = (0.7, 0.6, 0.5, 1)
+    nt.links.new(d.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    ob = link(scene, cube("Multi", 2.0))
+    for m in (m1, m2, m3):
+        ob.data.materials.append(m)
+    for i, p in enumerate(ob.data.polygons):
+        p.material_index = i % 3
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    by = dict(zip(sd.material_names, sd.materials))
+    assert by["P"]["specular_f0"] == pytest.approx(f0, rel=1e-5)
+    assert by["P"]["base_color"] == pytest.approx((0.1, 0.2, 0.3))
+    assert (by["P"]["metallic"], by["P"]["roughness"]) == pytest.approx((0.5, 0.25))
+    assert by["Emit"]["flags"] & materials.MATERIAL_UNSUPPORTED
+    assert by["Emit"]["base_color"] == pytest.approx((0.3, 0.6, 0.9))
+    assert any("'Emit'" in w for w in sd.warnings)
+    assert by["Diff"]["base_color"] == pytest.approx((0.7, 0.6, 0.5))
+    assert by["Diff"]["specular_f0"] == 0
+    # Per-triangle material: polygon i -> material i % 3 (two triangles each).
+    names = [sd.material_names[i] for i in sd.material_indices]
+    assert names.count("P") == names.count("Emit") == names.count("Diff") == 4
+
+
+def test_lights_units_per_type(scene):
+    camera(scene)
+    link(scene, plane("Floor", 4))
+    p = light(scene, "POINT", "P", 100.0, (0, 0, 2), shadow_soft_size=0.25, color=(1, 0.5, 0.25))
+    s = light(scene, "SPOT", "S", 50.0, (1, 0, 2), spot_size=0.8, spot_blend=0.4)
+    s.rotation_euler = (0.5, 0, 0)
+    light(scene, "SUN", "Sun", 3.0, (0, 0, 5), angle=0.1)
+    light(scene, "AREA", "A", 20.0, (0, 0, 3), shape="RECTANGLE", size=0.5, size_y=2.0, spread=1.0)
+    light(scene, "AREA", "Disk", 20.0, (0, 0, 3), shape="DISK", size=0.7)
+    if VERSION >= (4, 0, 0):
+        p.data.exposure = 1.5
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    L = dict(zip(sd.light_names, sd.lights))
+    expo = 2 ** 1.5 if VERSION >= (4, 0, 0) else 1.0
+    assert L["P"]["power"] == pytest.approx(100 * expo, rel=1e-5)
+    assert L["P"]["color"] == pytest.approx((1, 0.5, 0.25)) and L["P"]["radius"] == pytest.approx(0.25)
+    assert (L["S"]["type"], L["S"]["spot_size"], L["S"]["spot_blend"]) == \
+        (1, pytest.approx(0.8), pytest.approx(0.4))
+    assert np.allclose(np.reshape(L["S"]["world_from_light"], (3, 4)),
+                       np.array(s.matrix_world)[:3], atol=1e-6)
+    assert (L["Sun"]["type"], L["Sun"]["power"], L["Sun"]["sun_angle"]) == \
+        (2, pytest.approx(3.0), pytest.approx(0.1))
+    assert (L["A"]["area_shape"], L["A"]["size_x"], L["A"]["size_y"], L["A"]["spread"]) == \
+        (1, pytest.approx(0.5), pytest.approx(2.0), pytest.approx(1.0))
+    assert (L["Disk"]["area_shape"], L["Disk"]["size_y"]) == (2, pytest.approx(0.7))
+
+
+def test_camera_fields(scene):
+    light(scene)
+    link(scene, plane("Floor", 4))
+    cam = camera(scene, (1, -5, 2), (1.2, 0, 0.3), lens=42.0)
+    c = cam.data
+    c.sensor_fit = "VERTICAL"
+    c.sensor_height = 20.0
+    c.shift_x, c.shift_y = 0.1, -0.05
+    c.clip_start, c.clip_end = 0.5, 50.0
+    cam.scale = (2, 2, 2)
+    scene.render.resolution_x, scene.render.resolution_y = 400, 300
+    scene.render.resolution_percentage = 25
+    scene.render.pixel_aspect_x = 2.0
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    k = sd.camera
+    assert (k["width"], k["height"]) == (100, 75)
+    assert (k["lens_mm"], k["sensor_height_mm"], k["sensor_fit"]) == (pytest.approx(42.0), pytest.approx(20.0), 2)
+    assert (k["shift_x"], k["shift_y"]) == (pytest.approx(0.1), pytest.approx(-0.05))
+    assert (k["clip_start"], k["clip_end"], k["pixel_aspect_x"]) == (0.5, 50.0, 2.0)
+    m = np.reshape(k["world_from_camera"], (3, 4))
+    mw = cam.matrix_world.normalized()
+    assert np.allclose(m[:, :3], np.array(mw.to_3x3()), atol=1e-5)
+    assert np.allclose(m[:, 3], tuple(cam.matrix_world.translation), atol=1e-5)
+
+
+def test_bad_scenes_name_the_problem(scene):
+    link(scene, plane("Floor", 4))
+    with pytest.raises(ExportError, match="no active camera"):
+        collect(scene)
+    camera(scene)
+    with pytest.raises(ExportError, match="no light"):
+        collect(scene)
+    light(scene, energy=0.0, name="Dark")
+    with pytest.raises(ExportError, match="no light"):
+        collect(scene)
+    scene.camera.data.type = "PANO"
+    light(scene, name="Lamp")
+    with pytest.raises(ExportError, match="'Cam'.*PANO"):
+        collect(scene)
+
+
+def test_empty_scene_reports(scene):
+    basic(scene)
+    with pytest.raises(ExportError, match="no visible mesh geometry"):
+        collect(scene)

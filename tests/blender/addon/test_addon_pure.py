@@ -1,0 +1,102 @@
+"""Pure mapping logic: materials (3.x and 4.x Principled), lights, camera,
+paths, EXR writer. Independent facts: Fresnel formula, Blender's rules."""
+import math
+import os
+
+import numpy as np
+import pytest
+
+from vsgl_indirect import convert, materials
+from vsgl_indirect.exr import write_multilayer_exr
+from exr_read import read_exr
+
+
+def desc(kind, inputs, version, linked=()):
+    return materials.ShaderDesc("M", kind, inputs, linked, node="BSDF", version=version)
+
+
+def test_principled_3x_specular_to_f0():
+    m, w = materials.map_material(desc(materials.PRINCIPLED, {
+        "Base Color": (0.2, 0.4, 0.6, 1.0), "Metallic": 0.25, "Roughness": 0.7,
+        "Specular": 0.5, "IOR": 3.0, "Anisotropic": 0.3, "Anisotropic Rotation": 0.1}, (3, 4, 1)))
+    assert m["specular_f0"] == pytest.approx(0.04)  # 0.08 * 0.5; IOR ignored on 3.x
+    assert m["base_color"] == pytest.approx((0.2, 0.4, 0.6))
+    assert (m["metallic"], m["roughness"]) == pytest.approx((0.25, 0.7))
+    assert (m["anisotropy"], m["anisotropic_rotation"]) == pytest.approx((0.3, 0.1))
+    assert m["flags"] == 0 and w == []
+
+
+@pytest.mark.parametrize("ior,level", [(1.5, 0.5), (1.45, 0.5), (2.0, 1.0), (1.5, 0.0)])
+def test_principled_4x_ior_and_level_to_f0(ior, level):
+    m, _ = materials.map_material(desc(materials.PRINCIPLED, {
+        "IOR": ior, "Specular IOR Level": level, "Specular": 0.9}, (4, 2, 0)))
+    expect = ((ior - 1) / (ior + 1)) ** 2 * 2 * level
+    assert m["specular_f0"] == pytest.approx(min(expect, 1.0))
+
+
+def test_diffuse_glossy_and_unsupported():
+    d, _ = materials.map_material(desc(materials.DIFFUSE, {"Color": (0.1, 0.2, 0.3, 1)}, (4, 0, 0)))
+    assert d["base_color"] == pytest.approx((0.1, 0.2, 0.3)) and d["specular_f0"] == 0
+    g, _ = materials.map_material(desc(materials.GLOSSY, {"Color": (0.9, 0.8, 0.7, 1),
+                                                          "Roughness": 0.2}, (3, 4, 0)))
+    assert g["metallic"] == 1 and g["roughness"] == pytest.approx(0.2)
+    o = materials.ShaderDesc("Weird", materials.OTHER, viewport=((0.5, 0.6, 0.7, 1), 0.3, 0.4),
+                             reason="surface is a 'ShaderNodeEmission' node")
+    u, w = materials.map_material(o)
+    assert u["flags"] & materials.MATERIAL_UNSUPPORTED
+    assert u["base_color"] == pytest.approx((0.5, 0.6, 0.7)) and u["roughness"] == pytest.approx(0.4)
+    assert len(w) == 1 and "'Weird'" in w[0] and "ShaderNodeEmission" in w[0]
+
+
+def test_linked_inputs_warn_with_names():
+    _, w = materials.map_material(desc(materials.PRINCIPLED, {"Base Color": (1, 1, 1, 1)},
+                                       (4, 0, 0), linked={"Base Color"}))
+    assert len(w) == 1 and "'Base Color'" in w[0] and "'M'" in w[0]
+
+
+def test_light_units_and_exposure():
+    m = np.eye(4)
+    f = convert.light_fields("L", "POINT", m, 100.0, (1, 0.5, 0.25), exposure=2.0, radius=0.1)
+    assert f["power"] == pytest.approx(400.0) and f["color"] == pytest.approx((1, 0.5, 0.25))
+    assert f["radius"] == pytest.approx(0.1) and f["type"] == 0
+    s = convert.light_fields("S", "SPOT", m, 10.0, (1, 1, 1), spot_size=1.0, spot_blend=0.3)
+    assert (s["type"], s["spot_size"], s["spot_blend"]) == (1, pytest.approx(1.0), pytest.approx(0.3))
+    a = convert.light_fields("A", "AREA", m, 10.0, (1, 1, 1), shape="SQUARE", size=2, size_y=5)
+    assert a["size_x"] == a["size_y"] == 2 and a["area_shape"] == 0
+    e = convert.light_fields("E", "AREA", m, 10.0, (1, 1, 1), shape="ELLIPSE", size=2, size_y=5,
+                             spread=1.0)
+    assert (e["size_x"], e["size_y"], e["area_shape"], e["spread"]) == (2, 5, 3, 1.0)
+    with pytest.raises(convert.ExportError, match="'X'"):
+        convert.light_fields("X", "HEMI", m, 1.0, (1, 1, 1))
+
+
+def test_camera_scale_removed_and_render_size():
+    m = np.diag([2.0, 3.0, 4.0, 1.0])
+    m[:3, 3] = (1, 2, 3)
+    c = convert.camera_fields("C", "PERSP", m, 50, 36, 24, "HORIZONTAL", 7, 0.1, -0.2, 0.1, 100,
+                              *convert.render_size(1920, 1080, 50))
+    w = np.asarray(c["world_from_camera"]).reshape(3, 4)
+    assert np.allclose(w[:, :3], np.eye(3)) and np.allclose(w[:, 3], (1, 2, 3))
+    assert (c["width"], c["height"], c["sensor_fit"]) == (960, 540, 1)
+    with pytest.raises(convert.ExportError, match="'C'.*PANO"):
+        convert.camera_fields("C", "PANO", m, 50, 36, 24, "AUTO", 7, 0, 0, 0.1, 100, 10, 10)
+
+
+def test_frame_path_template():
+    p = convert.frame_path("{render_dir}/vsgl/{scene}_{view_layer}_####.exr", 7, "My Scene",
+                           "View Layer", "/r")
+    assert p == "/r/vsgl/My_Scene_View_Layer_0007.exr"
+    assert convert.frame_path("/a/b", 12) == "/a/b_0012.exr"
+    assert convert.frame_path("/a/x##.exr", 3) != convert.frame_path("/a/x##.exr", 4)
+
+
+def test_exr_writer_layout(tmp_path):
+    a = np.random.RandomState(1).rand(6, 9, 3).astype(np.float32)
+    c = np.random.RandomState(2).rand(6, 9, 4).astype(np.float32)
+    path = write_multilayer_exr(str(tmp_path / "x.exr"), {"DiffInd": a, "Combined": c})
+    ch, attrs = read_exr(path)
+    assert sorted(ch) == ["VSGL.Combined.A", "VSGL.Combined.B", "VSGL.Combined.G",
+                          "VSGL.Combined.R", "VSGL.DiffInd.B", "VSGL.DiffInd.G", "VSGL.DiffInd.R"]
+    assert np.array_equal(ch["VSGL.DiffInd.G"], a[:, :, 1])
+    assert np.array_equal(ch["VSGL.Combined.A"], c[:, :, 3])
+    assert not [f for f in os.listdir(str(tmp_path)) if "tmp" in f]
