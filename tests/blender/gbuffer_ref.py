@@ -4,7 +4,8 @@
         --lib build/libvsgl.so --out build/blender/gbuffer
 
 Builds a tiny scene (ground plane, a rotated non-uniformly scaled box, a
-smooth-shaded UV sphere, a tilted plane seen from behind), and for each
+smooth-shaded UV sphere, a tilted plane seen from behind, an auto-smoothed
+cylinder with split normals), and for each
 camera configuration (perspective with every sensor fit, shift, non-square
 resolution, resolution percentage, pixel aspect; orthographic) renders
 Cycles' Position and Normal passes with one sample through a 0.01-pixel box
@@ -90,7 +91,14 @@ def build_scene():
     bpy.ops.object.shade_smooth()
     bpy.ops.mesh.primitive_plane_add(size=1.5, location=(1.6, -1.4, 0.9), rotation=(1.2, 0.0, 2.6))
     card = bpy.context.object
-    for i, ob in enumerate([ground, box, sphere, card]):
+    # smooth sides, flat caps: split normals from auto smooth (Cycles 3.4 splits them too)
+    bpy.ops.mesh.primitive_cylinder_add(vertices=12, radius=0.45, depth=1.2, location=(-0.4, -1.6, 0.6),
+                                        rotation=(0.0, 0.35, 0.0))
+    cyl = bpy.context.object
+    bpy.ops.object.shade_smooth()
+    cyl.data.use_auto_smooth = True
+    cyl.data.auto_smooth_angle = 0.6
+    for i, ob in enumerate([ground, box, sphere, card, cyl]):
         ob.data.materials.append(emission_material("m%d" % i, (0.2 + 0.2 * i, 0.5, 0.8 - 0.15 * i)))
     cam_data = bpy.data.cameras.new("cam")
     cam = bpy.data.objects.new("cam", cam_data)
@@ -117,7 +125,7 @@ def build_scene():
     s.file_format = "OPEN_EXR_MULTILAYER"
     s.color_depth = "32"
     s.exr_codec = "NONE"
-    return sc, cam, [ground, box, sphere, card]
+    return sc, cam, [ground, box, sphere, card, cyl]
 
 
 def configure(sc, cam, cam_opts, res):
