@@ -13,13 +13,20 @@ typedef struct vsgl_gbuffer {
     uint32_t width, height, spp;   /* spp = aa * aa */
     size_t count;                  /* width * height * spp */
     float *pos[3];                 /* world position */
-    float *nrm[3];                 /* shading normal, facing the camera */
+    float *nrm[3];                 /* unit shading normal on the camera's side of the surface: flipped
+                                      with the geometric normal on back faces, as Cycles' Normal pass;
+                                      n.view may be slightly negative at smooth-shaded silhouettes */
     float *view[3];                /* unit direction from the point towards the camera */
     float *tan[3];                 /* unit tangent (anisotropy frame), orthogonal to nrm */
-    uint32_t *material;            /* material index, VSGL_GBUFFER_MISS where nothing was hit */
+    uint32_t *material;            /* material index, VSGL_GBUFFER_MISS where nothing was hit
+                                      (then pos, nrm, tan are 0; view is still set) */
 } vsgl_gbuffer;
 
-/* Trace the camera's primary rays (aa x aa per pixel) in parallel. */
+/* Trace the camera's primary rays (aa x aa per pixel, aa in 1..16, 0 means 1;
+ * sample s = j*aa + i at raster (col + (i+0.5)/aa, row + (j+0.5)/aa)) in
+ * parallel. Reports progress as stage "gbuffer"; on cancellation returns
+ * VSGL_ERROR_CANCELLED with *out zeroed. Bit-identical for any thread count.
+ * Free with vsgl__gbuffer_free (also safe on a zeroed struct). */
 vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t aa, vsgl_gbuffer *out);
 void vsgl__gbuffer_free(vsgl_gbuffer *g);
 
