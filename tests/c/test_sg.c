@@ -372,10 +372,10 @@ VT_TEST(sg_cosine_reference_matches_sphere_quadrature)
     for (size_t i = 0; i < 5; ++i)
         for (size_t j = 0; j < 7; ++j) {
             cq p = {{0, 0, 1}, {sqrt(1 - cs[j] * cs[j]), 0, cs[j]}, ls[i]};
-            double q2 = sq_sphere(f_cos2, &p, p.axis, ls[i], 48, 1024);
+            double q2 = sq_sphere(f_cos2, &p, p.axis, ls[i], 32, 512);
             double q1 = ref_cosine(ls[i], cs[j]);
             /* the 2-D trapezoid in phi is only O(h^2) across the kink w.n = 0 */
-            VT_CHECK(fabs(q1 - q2) <= 2e-6 * d_A(ls[i]), "l=%g c=%g: 1-D %.12g 2-D %.12g", ls[i], cs[j], q1, q2);
+            VT_CHECK(fabs(q1 - q2) <= 5e-6 * d_A(ls[i]), "l=%g c=%g: 1-D %.12g 2-D %.12g", ls[i], cs[j], q1, q2);
         }
 }
 
