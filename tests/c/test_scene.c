@@ -524,6 +524,25 @@ VT_TEST(scene_ray_queries_match_an_analytic_box)
             ++diff;
     }
     VT_CHECK(diff == 0, "%d of %d stream results differ from rtcIntersect1", diff, n);
+    /* the occlusion stream agrees with single occlusion rays, on half-length segments too */
+    unsigned char *blk = malloc((size_t)n);
+    for (int i = 0; i < n; ++i)
+        t1s[i] = (i & 1) ? 100.0f : 5.0f;
+    vsgl__scene_occluded_many(s, (uint32_t)n, orgs, dirs, t0s, t1s, 0, blk);
+    diff = 0;
+    int blocked = 0;
+    for (int i = 0; i < n; ++i) {
+        int want = vsgl__scene_occluded(s, orgs[i], dirs[i], t0s[i], t1s[i]);
+        diff += want != blk[i];
+        blocked += blk[i];
+    }
+    VT_CHECK(diff == 0 && blocked > n / 8, "%d of %d stream occlusion results differ (%d blocked)", diff, n, blocked);
+    t0s[0] = 5.0f; t1s[0] = 1.0f;
+    vsgl__scene_occluded_many(s, 1, orgs, dirs, t0s, t1s, 0, blk);
+    VT_CHECK(blk[0] == 0, "tmin > tmax blocked");
+    free(blk);
+    for (int i = 0; i < n; ++i)
+        t1s[i] = 100.0f;
     /* empty intervals never hit */
     t0s[0] = 5.0f; t1s[0] = 1.0f;
     vsgl__scene_intersect_many(s, 1, orgs, dirs, t0s, t1s, 0, many);

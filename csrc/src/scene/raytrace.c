@@ -94,6 +94,39 @@ void vsgl__scene_intersect_many(const vsgl_scene *scene, uint32_t n, const v3 *o
     }
 }
 
+void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *org, const v3 *dir,
+                               const float *tmin, const float *tmax, int coherent, unsigned char *blocked)
+{
+    enum { BATCH = 64 };
+    struct RTCRay r[BATCH];
+    struct RTCIntersectContext ic;
+    rtcInitIntersectContext(&ic);
+    ic.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    for (uint32_t b = 0; b < n; b += BATCH) {
+        uint32_t m = n - b < BATCH ? n - b : BATCH;
+        for (uint32_t i = 0; i < m; ++i) {
+            float lo = tmin[b + i], hi = tmax[b + i];
+            fill_ray(&r[i], org[b + i], dir[b + i], lo, hi);
+            if (!(lo <= hi)) { /* empty interval: inactive ray, never blocked */
+                r[i].tnear = 0.0f;
+                r[i].tfar = -INFINITY;
+            }
+        }
+        if (scene->triangle_count > 0) {
+            /* Embree marks a blocked ray with tfar = -inf; remember inactive ones */
+            unsigned char active[BATCH];
+            for (uint32_t i = 0; i < m; ++i)
+                active[i] = r[i].tfar != -INFINITY;
+            rtcOccluded1M(scene->rtc, &ic, r, m, sizeof(struct RTCRay));
+            for (uint32_t i = 0; i < m; ++i)
+                blocked[b + i] = (unsigned char)(active[i] && r[i].tfar == -INFINITY);
+        } else {
+            for (uint32_t i = 0; i < m; ++i)
+                blocked[b + i] = 0;
+        }
+    }
+}
+
 static v3 load3(const float *p) { return v3_make(p[0], p[1], p[2]); }
 
 static v3 interp(v3 a, v3 b, v3 c, float w, float u, float v)

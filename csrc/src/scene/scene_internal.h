@@ -36,6 +36,11 @@ int vsgl__scene_occluded(const vsgl_scene *scene, v3 org, v3 dir, float tmin, fl
 void vsgl__scene_intersect_many(const vsgl_scene *scene, uint32_t n, const v3 *org, const v3 *dir,
                                 const float *tmin, const float *tmax, int coherent, vsgl_hit *hits);
 
+/* Batch of n occlusion queries: blocked[i] = 1 if anything lies on the segment
+ * (tmin[i], tmax[i]) along unit dir[i]; 0 for an empty interval. Thread-safe. */
+void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *org, const v3 *dir,
+                               const float *tmin, const float *tmax, int coherent, unsigned char *blocked);
+
 /* Index in the caller's triangle array of validated triangle `triangle`. */
 uint32_t vsgl__scene_source_triangle(const vsgl_scene *scene, uint32_t triangle);
 
