@@ -42,10 +42,16 @@ typedef struct vsgl_kernel_light {
     float pr, pg, pb;        /* power */
 } vsgl_kernel_light;
 
-/* Diffuse modes as in vsgl/sg.h (VSGL_COSINE_*), glossy 0 = ASG only. */
+/* Lobes a block needs (skip the work for lobes no lane has). */
+#define VSGL_KERNEL_DIFFUSE 1
+#define VSGL_KERNEL_GLOSSY  2
+
+/* Accumulate VSGL L into receivers [0, n) of b. Diffuse modes as in
+ * vsgl/sg.h (VSGL_COSINE_*); the glossy lobe is the block's ASG.
+ * visibility: NULL or n factors in [0, 1]. */
 void vsgl__kernel_shade(vsgl_kernel_block *b, size_t n, const vsgl_kernel_light *L,
-                        const float *visibility, int32_t diffuse_mode);
+                        const float *visibility, int32_t diffuse_mode, int32_t lobes);
 void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, size_t n, const vsgl_kernel_light *L,
-                               const float *visibility, int32_t diffuse_mode);
+                               const float *visibility, int32_t diffuse_mode, int32_t lobes);
 
 #endif

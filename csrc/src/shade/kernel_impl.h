@@ -17,18 +17,17 @@
 #define K_SHARP_MAX 2199023255552.0f       /* 2^41 */
 
 /* e^x, 0 below -87 and e^88 above 88: Cephes-style degree-5 polynomial
- * after range reduction. Written so that GCC vectorises it: the rounding
- * uses the 1.5*2^23 trick (valid because this file is never built with
- * -ffast-math, which would delete it; test_kernel checks the accuracy) and
- * the exponent bits come from a float product, since an int conversion of
- * the clamped value gets narrowed by value-range propagation and then
- * cannot be vectorised (GCC 12). */
+ * after rintf range reduction (not the 1.5*2^23 trick, which the
+ * unsafe-math flags of kernel.c would delete). The exponent bits come from
+ * a float product: an int conversion of the clamped value gets narrowed by
+ * value-range propagation and then cannot be vectorised (GCC 12). The
+ * tests check this exp against libm. */
 static inline __attribute__((always_inline)) float k_exp(float x)
 {
     float xc = x < -87.0f ? -87.0f : x;
     xc = xc > 88.0f ? 88.0f : xc;
     float t = xc * 1.44269504088896341f;
-    float k = (t + 12582912.0f) - 12582912.0f;
+    float k = rintf(t);
     float r = xc - k * 0.693359375f + k * 2.12194440e-4f;
     float p = 1.9875691500e-4f;
     p = p * r + 1.3981999507e-3f;
@@ -99,7 +98,8 @@ static inline __attribute__((always_inline)) float k_sg_integral(float l)
 }
 
 static inline __attribute__((always_inline)) void
-k_body(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, float vis, int32_t mode, float ld_sharp, float ld_norm)
+k_body(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, float vis, int32_t mode,
+       int32_t lobes, float ld_sharp, float ld_norm)
 {
     /* incident radiance as one SG (Eq. 7) */
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
@@ -122,6 +122,7 @@ k_body(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restric
     float amp = valid * k_exp(expo) * ivar * L->c0;
 
     /* diffuse: integral of the incident SG times max(w.n, 0), / pi */
+    if (lobes & VSGL_KERNEL_DIFFUSE) {
     float c = px * b->nx[i] + py * b->ny[i] + pz * b->nz[i];
     c = c > 1.0f ? 1.0f : (c < -1.0f ? -1.0f : c);
     float cosint;
@@ -140,6 +141,9 @@ k_body(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restric
     b->ld[0][i] += L->pr * ed;
     b->ld[1][i] += L->pg * ed;
     b->ld[2][i] += L->pb * ed;
+    }
+    if (!(lobes & VSGL_KERNEL_GLOSSY))
+        return;
 
     /* glossy: ASG x SG product integral (Eq. 18), nu = lambda_in / 2 */
     float nu = 0.5f * lin;
@@ -176,8 +180,20 @@ k_body(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restric
     b->ls[2][i] += L->pb * gm * (b->f0b[i] + (1.0f - b->f0b[i]) * w5);
 }
 
+/* One loop per (lobes, mode) so each is branch-free and vectorised. */
+#define K_LOOP(VIS, MODE, LOBES)                                                   \
+    for (size_t i = 0; i < n; ++i)                                                 \
+        k_body(b, i, L, (VIS), (MODE), (LOBES), ld_sharp, ld_norm)
+
+#define K_MODES(VIS, LOBES)                                                        \
+    switch (mode) {                                                                \
+    case VSGL_COSINE_SG: K_LOOP(VIS, VSGL_COSINE_SG, LOBES); break;                \
+    case VSGL_COSINE_PULLED_OUT: K_LOOP(VIS, VSGL_COSINE_PULLED_OUT, LOBES); break; \
+    default: K_LOOP(VIS, VSGL_COSINE_ACCURATE, LOBES); break;                      \
+    }
+
 KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, size_t n, const vsgl_kernel_light *light,
-                             const float *restrict visibility, int32_t mode)
+                             const float *restrict visibility, int32_t mode, int32_t lobes)
 {
     const vsgl_kernel_light local = *light; /* no aliasing with the block */
     const vsgl_kernel_light *L = &local;
@@ -186,22 +202,14 @@ KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, size_t n, const vsgl
     if (n > VSGL_KERNEL_BLOCK)
         n = VSGL_KERNEL_BLOCK;
     if (visibility) {
-        for (size_t i = 0; i < n; ++i)
-            k_body(b, i, L, visibility[i], mode, ld_sharp, ld_norm);
+        /* rays dominate here: one loop for every case */
+        K_LOOP(visibility[i], mode, lobes);
         return;
     }
-    switch (mode) {
-    case VSGL_COSINE_SG:
-        for (size_t i = 0; i < n; ++i)
-            k_body(b, i, L, 1.0f, VSGL_COSINE_SG, ld_sharp, ld_norm);
-        break;
-    case VSGL_COSINE_PULLED_OUT:
-        for (size_t i = 0; i < n; ++i)
-            k_body(b, i, L, 1.0f, VSGL_COSINE_PULLED_OUT, ld_sharp, ld_norm);
-        break;
-    default:
-        for (size_t i = 0; i < n; ++i)
-            k_body(b, i, L, 1.0f, VSGL_COSINE_ACCURATE, ld_sharp, ld_norm);
-        break;
+    switch (lobes) {
+    case VSGL_KERNEL_DIFFUSE: K_MODES(1.0f, VSGL_KERNEL_DIFFUSE) break;
+    case VSGL_KERNEL_GLOSSY: K_LOOP(1.0f, VSGL_COSINE_ACCURATE, VSGL_KERNEL_GLOSSY); break;
+    case VSGL_KERNEL_DIFFUSE | VSGL_KERNEL_GLOSSY: K_MODES(1.0f, VSGL_KERNEL_DIFFUSE | VSGL_KERNEL_GLOSSY) break;
+    default: break;
     }
 }

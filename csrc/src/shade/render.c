@@ -178,7 +178,7 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
     }
     vsgl_pixel_planes planes = {buf, buf + 3 * pixels, buf + 6 * pixels, buf + 9 * pixels, buf + 12 * pixels};
     t0 = now_seconds();
-    r = vsgl__shade(ctx, scene, &g, &set, &s, &planes, &st.shading_pairs);
+    r = vsgl__shade(ctx, scene, &g, &set, &s, &planes, VSGL_SHADE_KERNEL, &st.shading_pairs);
     st.seconds_shade = now_seconds() - t0;
     if (r == VSGL_OK)
         r = write_outputs(ctx, &planes, pixels, out);

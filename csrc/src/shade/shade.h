@@ -24,10 +24,17 @@ typedef struct vsgl_pixel_planes {
  * with zero spread). */
 int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
 
+/* Shading paths: the vectorised kernel (default), the same kernel built
+ * scalar (benchmark baseline), and the reference path through the public
+ * operator functions (slow; exact ASG normalisation; SG glossy lobes). */
+#define VSGL_SHADE_KERNEL        0
+#define VSGL_SHADE_KERNEL_SCALAR 1
+#define VSGL_SHADE_REFERENCE     2
+
 /* Shade every G-buffer sample with every VSGL; writes `planes`.
  * `pairs` receives the number of sample x VSGL evaluations. */
 vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
                         const vsgl_vsgl_set *set, const vsgl_render_settings *s,
-                        const vsgl_pixel_planes *planes, uint64_t *pairs);
+                        const vsgl_pixel_planes *planes, int path, uint64_t *pairs);
 
 #endif

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# make bench: speed benchmarks, reported as ratios measured in the same run.
+# Builds the benchmark programs against the library's objects (internal
+# stages are timed directly) and runs them. BENCH_QUICK=1 shrinks sizes.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+objs=$(ls build/obj/csrc/src/*/*.o)
+flags="-O2 -Itests/c -Icsrc/include -Icsrc/src"
+libs="-lembree3 -lOpenEXRCore-3_1 -lpthread -lm"
+mkdir -p build/bench
+cc $flags tools/bench/bench_shade.c $objs $libs -o build/bench/bench_shade
+if [ -f tools/bench_gbuffer.c ]; then cc $flags tools/bench_gbuffer.c $objs $libs -o build/bench/bench_gbuffer; fi
+if [ "${BENCH_QUICK:-0}" = 1 ]; then size="480 270 64 1"; else size="1920 1080 256 3"; fi
+echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
+echo "== shading: vectorised kernel vs scalar build of the same code (same run)"
+# shellcheck disable=SC2086
+build/bench/bench_shade $size
+if [ -x build/bench/bench_gbuffer ]; then
+  echo "== scene build and G-buffer"
+  build/bench/bench_gbuffer ${BENCH_GBUFFER_ARGS:-}
+fi
