@@ -1,0 +1,196 @@
+"""The add-on inside real background renders (-f, -a, parallel processes),
+the compositor wiring, error reports, the preview operator and the
+``--addons`` install route. Tiny images, 1 sample: wiring, not quality."""
+import os
+import shutil
+import subprocess
+
+import bpy
+import numpy as np
+import pytest
+
+from conftest import (IS_BINARY, REPO, camera, light, link, plane, real_render_or_skip, render,
+                      room, save)
+from exr_read import read_exr, read_pass
+from vsgl_indirect import compat, compositor, engine, handlers, runner
+
+W, H = 32, 24
+
+
+def setup_blend(scene, tmp, name="t.blend", add=True, **kw):
+    room(scene, str(tmp / "aov" / "{scene}_{view_layer}_####.exr"))
+    scene.vsgl_indirect.add_to_render = add
+    scene.render.filepath = str(tmp / "out" / "beauty_")
+    for k, v in kw.items():
+        setattr(scene.vsgl_indirect, k, v)
+    return save(str(tmp / name))
+
+
+def image(path):
+    im = bpy.data.images.load(path, check_existing=False)
+    px = np.array(im.pixels[:], np.float32).reshape(im.size[1], im.size[0], 4)[::-1]
+    bpy.data.images.remove(im)
+    return px  # rows from the top, like the AOV
+
+
+def aov(tmp, frame):
+    return str(tmp / "aov" / ("Scene_ViewLayer_%04d.exr" % frame))
+
+
+def test_handler_fake_renderer_two_frames_composited(scene, tmp_path):
+    """-a over 2 frames: each frame's own file is written before compositing
+    and the composite equals render + that frame's Combined."""
+    path = setup_blend(scene, tmp_path)
+    scene.objects["Spot"].data.energy = 1e-9   # beauty ~ black (world is None)
+    save(path)
+    r = render(path, (1, 2), env={"VSGL_TEST_FAKE_RENDER": "1"})
+    assert r.returncode == 0, r.stdout
+    assert "VSGL ERROR" not in r.stdout, r.stdout
+    for f in (1, 2):
+        comb = read_pass(aov(tmp_path, f), "VSGL.Combined", "RGBA")
+        assert comb.shape == (H, W, 4)
+        assert np.allclose(comb[..., :3], (0.1 * f, 0.2, 0.3), atol=1e-6)
+        out = image(str(tmp_path / "out" / ("beauty_%04d.exr" % f)))
+        assert np.allclose(out[..., :3], (0.1 * f, 0.2, 0.3), atol=1e-3), (f, out[0, 0])
+
+
+def test_real_render_composite_is_render_plus_aov(scene, tmp_path):
+    real_render_or_skip()
+    path = setup_blend(scene, tmp_path)
+    r = render(path, 1)
+    assert r.returncode == 0 and "VSGL INFO: wrote" in r.stdout, r.stdout
+    comp = image(str(tmp_path / "out" / "beauty_0001.exr"))
+    a = read_pass(aov(tmp_path, 1), "VSGL.Combined", "RGB")
+    assert np.all(np.isfinite(a)) and a.max() > 0 and a.min() >= 0
+    # Same scene without the Add node: the plain render.
+    scene.vsgl_indirect.add_to_render = False
+    scene.render.filepath = str(tmp_path / "plain" / "beauty_")
+    save(path)
+    r = render(path, 1)
+    assert r.returncode == 0, r.stdout
+    plain = image(str(tmp_path / "plain" / "beauty_0001.exr"))
+    assert np.allclose(comp[..., :3] - plain[..., :3], a, atol=2e-3, rtol=1e-3)
+
+
+def test_parallel_processes_write_distinct_identical_files(scene, tmp_path):
+    real_render_or_skip()
+    path = setup_blend(scene, tmp_path, threads=1)
+    env = dict(os.environ)
+    procs = []
+    for f in (3, 4):
+        if IS_BINARY:
+            cmd = [bpy.app.binary_path, "-b", "--factory-startup", path, "--python",
+                   os.path.join(REPO, "tests", "blender", "bootstrap_addon.py"), "-f", str(f)]
+        else:
+            import sys
+            cmd = [sys.executable, os.path.join(os.path.dirname(__file__), "bpy_render.py"),
+                   path, str(f)]
+        procs.append(subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE,
+                                      stderr=subprocess.STDOUT, universal_newlines=True))
+    logs = [p.communicate(timeout=240)[0] for p in procs]
+    assert all(p.returncode == 0 for p in procs), logs
+    a3, a4 = aov(tmp_path, 3), aov(tmp_path, 4)
+    assert os.path.exists(a3) and os.path.exists(a4) and a3 != a4
+    c3, _ = read_exr(a3)
+    c4, _ = read_exr(a4)
+    assert sorted(c3) == sorted(c4)
+    for k in c3:            # static scene, deterministic library: same pixels
+        assert np.array_equal(c3[k], c4[k]), k
+    assert c3["VSGL.Combined.R"].max() > 0
+
+
+def test_bad_scene_reported_render_continues(scene, tmp_path):
+    link(scene, plane("Floor", 4))
+    camera(scene)
+    scene.vsgl_indirect.enabled = True
+    scene.vsgl_indirect.output_path = str(tmp_path / "aov" / "x_####.exr")
+    scene.render.filepath = str(tmp_path / "out" / "beauty_")
+    path = save(str(tmp_path / "nolight.blend"))
+    r = render(path, 1, env={"VSGL_TEST_FAKE_RENDER": "1"})
+    assert r.returncode == 0, r.stdout
+    assert "VSGL ERROR" in r.stdout and "no light with non-zero power" in r.stdout, r.stdout
+    assert os.path.exists(str(tmp_path / "out" / "beauty_0001.exr"))
+    assert not os.path.exists(str(tmp_path / "aov" / "x_0001.exr"))  # no black stand-in
+
+
+def test_library_missing_registers_and_reports(scene, tmp_path):
+    path = setup_blend(scene, tmp_path)
+    r = render(path, 1, env={"VSGL_LIBRARY": str(tmp_path / "nope" / "libvsgl.so")})
+    assert r.returncode == 0, r.stdout
+    assert "VSGL ERROR" in r.stdout and "VSGL_LIBRARY" in r.stdout, r.stdout
+    assert os.path.exists(str(tmp_path / "out" / "beauty_0001.exr"))
+
+
+def test_unwritable_output_path_reported(scene, monkeypatch):
+    room(scene, "/proc/vsgl_cannot_write/x_####.exr")
+    monkeypatch.setattr(engine, "RENDER_OVERRIDE", lambda sd, o: pytest.fail("rendered"))
+    res = runner.run_frame(scene, bpy.context.evaluated_depsgraph_get(), 1)
+    assert res is None
+    err = runner.LAST_RUN[scene.name]["error"]
+    assert "/proc/vsgl_cannot_write" in err and "frame 1" in err
+
+
+def _nodes(tree, prefix):
+    return [n for n in tree.nodes if n.name.startswith(prefix)]
+
+
+def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
+    room(scene, str(tmp_path / "aov" / "{scene}_{view_layer}_####.exr"))
+    scene.render.filepath = str(tmp_path / "out" / "b_")
+    for _ in range(3):
+        assert handlers.setup_scene(scene) == []
+    tree = compat.compositor_tree(scene, create=False)
+    assert len(_nodes(tree, "VSGL Indirect [")) == 1 and len(_nodes(tree, "VSGL Add [")) == 1
+    out = compat.compositor_output_socket(tree)
+    assert out.links[0].from_node.name == "VSGL Add [ViewLayer]"
+    node = tree.nodes["VSGL Indirect [ViewLayer]"]
+    assert {"DiffInd", "GlossInd", "DiffCol", "GlossCol"} <= set(node.outputs.keys())
+    assert node.image.source == "SEQUENCE"
+    scene.vsgl_indirect.add_to_render = False
+    handlers.setup_scene(scene)
+    assert not _nodes(tree, "VSGL Add [")
+    assert out.links[0].from_node.bl_idname == "CompositorNodeRLayers"
+    compositor.remove(scene)
+    assert not _nodes(tree, "VSGL")
+
+
+def test_preview_operator_writes_and_loads_image(scene, monkeypatch):
+    room(scene)
+    calls = []
+
+    def fake(sd, options):
+        calls.append(sd.summary())
+        z = np.full((sd.height, sd.width, 3), 0.5, np.float32)
+        return {p: z for p in engine.PLANES if p != "alpha"}, {"skipped": "light 'X': test"}
+    if engine.render_missing():
+        monkeypatch.setattr(engine, "RENDER_OVERRIDE", fake)
+    assert bpy.ops.vsgl.preview_indirect() == {"FINISHED"}
+    img = bpy.data.images["VSGL Preview"]
+    assert os.path.exists(bpy.path.abspath(img.filepath))
+    info = runner.LAST_RUN[scene.name]
+    assert info["status"] == "done" and info["timings"]["export"] >= 0
+
+
+def test_addons_route_with_user_scripts(scene, tmp_path):
+    """blender -b file --addons vsgl_indirect -f 1 with the add-on installed
+    in BLENDER_USER_SCRIPTS (as from the zip: library in lib/)."""
+    if not IS_BINARY:
+        pytest.skip("--addons is an option of the Blender binary; the pip bpy module has no CLI")
+    dst = tmp_path / "scripts" / "addons" / "vsgl_indirect"
+    shutil.copytree(os.path.join(REPO, "addon", "vsgl_indirect"), str(dst),
+                    ignore=shutil.ignore_patterns("__pycache__", "*.so"))
+    os.makedirs(str(dst / "lib"))
+    shutil.copy(os.path.join(REPO, "build", "libvsgl.so"), str(dst / "lib" / "libvsgl.so"))
+    path = setup_blend(scene, tmp_path)
+    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(tmp_path / "scripts"))
+    env.pop("VSGL_LIBRARY", None)
+    r = subprocess.run([bpy.app.binary_path, "-b", "--factory-startup", path, "--addons",
+                        "vsgl_indirect", "-f", "1"], env=env, stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, universal_newlines=True, timeout=240)
+    assert r.returncode == 0, r.stdout
+    if engine.render_missing():
+        assert "VSGL ERROR" in r.stdout and "vsgl_render" in r.stdout, r.stdout
+    else:
+        assert "VSGL INFO: wrote" in r.stdout and str(dst / "lib") in r.stdout or \
+            os.path.exists(aov(tmp_path, 1)), r.stdout
+        assert os.path.exists(aov(tmp_path, 1))

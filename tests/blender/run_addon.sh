@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Add-on tests (tests/blender/addon) on Debian's Blender 3.4 binary and on the
+# pip `bpy` module (Blender 5.x) in $PIP_PYTHON. Ends with "N passed, N failed".
+set -uo pipefail
+cd "$(dirname "$0")/../.."
+PIP_PYTHON=${PIP_PYTHON:-python3}
+BLENDER=${BLENDER:-blender}
+export PYTHONDONTWRITEBYTECODE=1
+pass=0; fail=0; status=0
+log=$(mktemp)
+
+tally() {  # tally <label> <exit code>: add pytest's counts from $log
+  local p f e
+  p=$(grep -Eo '[0-9]+ passed' "$log" | tail -1 | grep -Eo '[0-9]+' || true)
+  f=$(grep -Eo '[0-9]+ failed' "$log" | tail -1 | grep -Eo '[0-9]+' || true)
+  e=$(grep -Eo '[0-9]+ errors?' "$log" | tail -1 | grep -Eo '[0-9]+' || true)
+  p=${p:-0}; f=$(( ${f:-0} + ${e:-0} ))
+  if [ "$2" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi
+  echo "-- $1: $p passed, $f failed (exit $2)"
+  pass=$((pass + p)); fail=$((fail + f)); [ "$2" -ne 0 ] && status=1
+  return 0
+}
+
+if command -v "$BLENDER" >/dev/null 2>&1; then
+  echo "== add-on tests in $("$BLENDER" --version 2>/dev/null | head -1)"
+  "$BLENDER" -b --factory-startup --python-exit-code 1 \
+    --python tests/blender/pytest_in_blender.py -- -q -rs tests/blender/addon "$@" 2>&1 | tee "$log"
+  tally "Blender binary" "${PIPESTATUS[0]}"
+else
+  echo "run_addon.sh: no '$BLENDER' binary; install Debian's blender (tools/deps.sh test)"; fail=$((fail + 1)); status=1
+fi
+
+if "$PIP_PYTHON" -c 'import bpy, numpy, pytest' >/dev/null 2>&1 || tools/install_bpy.sh; then
+  echo "== add-on tests in bpy $("$PIP_PYTHON" -c 'import bpy; print(bpy.app.version_string)' 2>/dev/null | tail -1)"
+  "$PIP_PYTHON" -m pytest -q -rs -p no:cacheprovider tests/blender/addon "$@" 2>&1 | tee "$log"
+  tally "pip bpy" "${PIPESTATUS[0]}"
+else
+  echo "run_addon.sh: cannot import bpy in $PIP_PYTHON (tools/install_bpy.sh failed)"; fail=$((fail + 1)); status=1
+fi
+rm -f "$log"
+echo "$pass passed, $fail failed"
+exit $status
