@@ -111,6 +111,12 @@ VT_TEST(rsm_closed_box_total_flux_equals_emitted_power)
                          "case %u type %d size %g blend %g spread %g shape %d res %u ch %d", k, L->type,
                          L->spot_size, L->spot_blend, L->spread, L->area_shape, res, c);
         }
+        if (k == 0) { /* footprints of a point light's texels tile the box: 6 faces of 4 m^2 */
+            double area = 0;
+            for (size_t i = 0; i < r.count; ++i)
+                area += r.area[i];
+            VT_CHECK_REL(area, 24.0, 5e-3, "sum of texel footprints, point light in a 2 m box, res %u", res);
+        }
         size_t empty = 0;
         for (size_t i = 0; i < r.count; ++i)
             empty += r.material[i] == VSGL_RSM_EMPTY && r.flux[0][i] > 0;

@@ -8,6 +8,7 @@
 #include "core/parallel.h"
 #include "rsm/rsm_light.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,10 +19,12 @@ void vsgl__rsm_free(vsgl_rsm *r)
     for (int k = 0; k < 3; ++k) {
         free(r->pos[k]);
         free(r->nrm[k]);
+        free(r->tan[k]);
         free(r->wi[k]);
         free(r->flux[k]);
     }
     free(r->material);
+    free(r->area);
     memset(r, 0, sizeof *r);
 }
 
@@ -45,7 +48,7 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
     float *tmin = malloc(res * sizeof *tmin);
     float *tmax = malloc(res * sizeof *tmax);
     vsgl_hit *hits = malloc(res * sizeof *hits);
-    double *fl = malloc(res * 3 * sizeof *fl);
+    double *fl = malloc(res * 4 * sizeof *fl);
     if (!org || !dir || !tmin || !tmax || !hits || !fl) {
         free(org); free(dir); free(tmin); free(tmax); free(hits); free(fl);
         return VSGL_ERROR_OUT_OF_MEMORY;
@@ -54,7 +57,7 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
         size_t grow = j->first_row + gr;
         uint32_t face = (uint32_t)(grow / res), row = (uint32_t)(grow % res);
         for (uint32_t c = 0; c < res; ++c) {
-            int lit = vsgl__rsm_light_texel(l, face, row, c, &org[c], &dir[c], &fl[3 * c]);
+            int lit = vsgl__rsm_light_texel(l, face, row, c, &org[c], &dir[c], &fl[4 * c], &fl[4 * c + 3]);
             tmin[c] = 0.0f;
             tmax[c] = lit ? (l->type == VSGL_LIGHT_SUN ? l->sun_tmax : INFINITY) : -1.0f;
         }
@@ -64,8 +67,9 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
             size_t i = grow * res + c;
             if (hits[c].triangle == VSGL_HIT_NONE || !(tmax[c] >= 0.0f)) {
                 for (int k = 0; k < 3; ++k)
-                    o->pos[k][i] = o->nrm[k][i] = o->wi[k][i] = o->flux[k][i] = 0.0f;
+                    o->pos[k][i] = o->nrm[k][i] = o->tan[k][i] = o->wi[k][i] = o->flux[k][i] = 0.0f;
                 o->material[i] = VSGL_RSM_EMPTY;
+                o->area[i] = 0.0f;
                 continue;
             }
             vsgl_surface sf;
@@ -73,9 +77,14 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
             v3 wi = v3_neg(dir[c]);
             o->pos[0][i] = sf.position.x; o->pos[1][i] = sf.position.y; o->pos[2][i] = sf.position.z;
             o->nrm[0][i] = sf.normal.x; o->nrm[1][i] = sf.normal.y; o->nrm[2][i] = sf.normal.z;
+            o->tan[0][i] = sf.tangent.x; o->tan[1][i] = sf.tangent.y; o->tan[2][i] = sf.tangent.z;
             o->wi[0][i] = wi.x; o->wi[1][i] = wi.y; o->wi[2][i] = wi.z;
+            /* footprint: beam / cos at the surface (times d^2 for a cone) */
+            double cs = fabs((double)v3_dot(sf.geometric_normal, wi));
+            double t2 = l->type == VSGL_LIGHT_SUN ? 1.0 : (double)hits[c].t * hits[c].t;
+            o->area[i] = (float)(fl[4 * c + 3] * t2 / fmax(cs, 1e-3));
             for (int k = 0; k < 3; ++k) {
-                o->flux[k][i] = (float)fl[3 * c + k];
+                o->flux[k][i] = (float)fl[4 * c + k];
                 s[k] += (double)o->flux[k][i];
             }
             o->material[i] = sf.material;
@@ -107,10 +116,12 @@ vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
     for (int k = 0; k < 3; ++k) {
         ok &= (out->pos[k] = malloc(n * sizeof(float))) != NULL;
         ok &= (out->nrm[k] = malloc(n * sizeof(float))) != NULL;
+        ok &= (out->tan[k] = malloc(n * sizeof(float))) != NULL;
         ok &= (out->wi[k] = malloc(n * sizeof(float))) != NULL;
         ok &= (out->flux[k] = malloc(n * sizeof(float))) != NULL;
     }
     ok &= (out->material = malloc(n * sizeof(uint32_t))) != NULL;
+    ok &= (out->area = malloc(n * sizeof(float))) != NULL;
     size_t rows = (size_t)l.faces * res;
     double *partial = ok ? malloc(rows * 3 * sizeof *partial) : NULL;
     if (!ok || !partial) {

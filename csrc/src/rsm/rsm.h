@@ -18,6 +18,9 @@ typedef struct vsgl_rsm {
     size_t count;                  /* faces * res * res */
     float *pos[3];                 /* VPL position, world */
     float *nrm[3];                 /* shading normal at the VPL, facing the light */
+    float *tan[3];                 /* unit tangent at the VPL (anisotropy frame) */
+    float *area;                   /* m^2: the texel's footprint on the surface
+                                    * (solid angle x d^2 / cos, or beam area / cos) */
     float *wi[3];                  /* unit direction from the VPL towards the light */
     float *flux[3];                /* incident power on the texel's patch, W (RGB) */
     uint32_t *material;            /* VSGL_RSM_EMPTY where the texel saw nothing */

@@ -190,9 +190,10 @@ static void concentric(double a, double b, double *x, double *y)
 }
 
 int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, uint32_t col,
-                          v3 *org, v3 *dir, double flux[3])
+                          v3 *org, v3 *dir, double flux[3], double *beam)
 {
     double res = (double)l->res, w = 0.0;
+    *beam = 0.0;
     flux[0] = flux[1] = flux[2] = 0.0;
     switch (l->type) {
     case VSGL_LIGHT_POINT:
@@ -220,8 +221,9 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
         loc[va] = yc;
         *dir = v3_normalize(frame_dir(l, loc[0], loc[1], loc[2]));
         *org = l->pos;
+        *beam = vsgl__rsm_rect_solid_angle(x0, x1, y0, y1);
         if (l->type == VSGL_LIGHT_POINT) {
-            w = vsgl__rsm_rect_solid_angle(x0, x1, y0, y1) / (4.0 * PI_D);
+            w = *beam / (4.0 * PI_D);
         } else {
             for (int j = 0; j < SUB; ++j)
                 for (int i = 0; i < SUB; ++i) {
@@ -244,6 +246,7 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
         *dir = l->sun_dir;
         *org = v3_add(l->sun_origin, v3_add(v3_scale(l->sun_u, (float)(col + 0.5)), v3_scale(l->sun_v, (float)(row + 0.5))));
         w = l->sun_texel_area;
+        *beam = w;
         break;
     }
     case VSGL_LIGHT_AREA: {
@@ -265,6 +268,7 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
             mk = 1.0;
         }
         w = 0.25 * PI_D / (res * res) * mk; /* (P/4) x projected solid angle */
+        *beam = PI_D / (res * res) / fmax(z, 0.5 / res); /* solid angle = projected / cos */
         /* origin on the shape: every 8x8 block of texels (nearly one
          * direction) covers the 64 strata of an 8x8 grid on the light once,
          * jittered by a hash of the texel index. (An R2 sequence over the

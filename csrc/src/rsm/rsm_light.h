@@ -31,11 +31,12 @@ typedef struct vsgl_rsm_light {
 /* Prepare light `index` of the scene for an RSM of `res` texels per side. */
 void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res, vsgl_rsm_light *out);
 
-/* Texel (face, row, col): ray origin and unit direction, and the power
- * (W, RGB) the light emits into the texel's cone / beam. Returns 0 if the
- * texel carries no power (outside a spot cone or a hemisphere). */
+/* Texel (face, row, col): ray origin and unit direction, the power (W,
+ * RGB) the light emits into the texel's cone / beam, and the beam's size:
+ * solid angle (sr) for point/spot/area, cross-section (m^2) for a sun.
+ * Returns 0 if the texel carries no power (outside a spot cone). */
 int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, uint32_t col,
-                          v3 *org, v3 *dir, double flux[3]);
+                          v3 *org, v3 *dir, double flux[3], double *beam);
 
 /* Total power the light emits (W, RGB) as Cycles defines it; for a sun the
  * power crossing the map's footprint. Used by tests and docs/units.md. */
