@@ -552,3 +552,51 @@ VT_TEST(lobes_extremes_never_nan_inf_or_negative)
         VT_CHECK(asg_ok(&as), "ashikhmin-shirley %g %g", nu, nv);
     }
 }
+
+/* ---------------------------------------------------------------- continuity */
+
+static double rel_jump(double a, double b)
+{
+    double d = fabs(a - b), s = fmax(fabs(a), fabs(b));
+    return s > 0 ? d / s : 0.0;
+}
+
+VT_TEST(lobes_continuity_across_branches)
+{
+    /* alpha clamps at 2^-31 and 1, the sharpness cap at alpha = 2^-20 */
+    float ts[] = {VSGL_ALPHA_MIN, 1.0f, 0x1p-20f};
+    vsgl_vec3 n = {0, 0, 1};
+    for (int k = 0; k < 3; ++k) {
+        float lo = nextafterf(ts[k], 0.0f), hi = nextafterf(ts[k], 2.0f);
+        VT_CHECK(rel_jump(vsgl_ndf_sharpness(lo), vsgl_ndf_sharpness(hi)) < 1e-5, "ndf sharpness at alpha=%g: %g %g",
+                 ts[k], vsgl_ndf_sharpness(lo), vsgl_ndf_sharpness(hi));
+        vsgl_sg a, b;
+        vsgl_ndf_to_sg(&n, lo, 0, &a);
+        vsgl_ndf_to_sg(&n, hi, 0, &b);
+        VT_CHECK(rel_jump(exp(a.log_amplitude), exp(b.log_amplitude)) < 1e-5, "ndf amplitude at alpha=%g", ts[k]);
+    }
+    /* the grazing floor |o.n| = 1e-6 of both warps */
+    for (int s = 0; s < 2; ++s) {
+        float d = 1e-6f, dl = nextafterf(d, 0.0f) * (s ? -1.0f : 1.0f), dh = nextafterf(d, 1.0f) * (s ? -1.0f : 1.0f);
+        vsgl_vec3 ol = {sqrtf(1.0f - dl * dl), 0.0f, dl}, oh = {sqrtf(1.0f - dh * dh), 0.0f, dh};
+        vsgl_sg ndf = {{0, 0, 1}, 1000.0f, 0.0f}, wl, wh;
+        vsgl_warp_ndf_sg(&ndf, &ol, &wl);
+        vsgl_warp_ndf_sg(&ndf, &oh, &wh);
+        VT_CHECK(rel_jump(wl.sharpness, wh.sharpness) < 1e-5, "SG warp at |o.n| = 1e-6: %g %g", wl.sharpness, wh.sharpness);
+        vsgl_asg an = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, 10.0f, 3.0f, 0.0f}, al, ah;
+        vsgl_warp_ndf_asg(&an, &ol, &al);
+        vsgl_warp_ndf_asg(&an, &oh, &ah);
+        VT_CHECK(rel_jump(al.lambda, ah.lambda) < 1e-5 && rel_jump(al.mu, ah.mu) < 1e-5, "ASG warp at |o.n| = 1e-6: %g %g / %g %g",
+                 al.lambda, ah.lambda, al.mu, ah.mu);
+    }
+    /* the ASG warp's tangent fallback (o parallel to z_i): bandwidths are
+     * frame independent, so views just off normal incidence agree */
+    vsgl_asg an = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, 40.0f, 7.0f, 0.0f}, a0, a1;
+    vsgl_vec3 o0 = {0, 0, 1}, o1 = {1e-5f, 0, 1};
+    vsgl_warp_ndf_asg(&an, &o0, &a0);
+    vsgl_warp_ndf_asg(&an, &o1, &a1);
+    VT_CHECK(rel_jump(a0.lambda, a1.lambda) < 1e-5 && rel_jump(a0.mu, a1.mu) < 1e-5, "normal incidence: %g %g / %g %g",
+             a0.lambda, a1.lambda, a0.mu, a1.mu);
+    VT_CHECK_REL(a0.lambda, 10.0, 1e-5, "normal incidence halves the angle: l/4");
+    VT_CHECK_REL(a0.mu, 1.75, 1e-5, "normal incidence: m/4");
+}
