@@ -3,6 +3,7 @@
  * written only when everything succeeded. */
 #include "shade/render_internal.h"
 #include "shade/shade.h"
+#include "shade/brute_force.h"
 #include "core/context.h"
 
 #include <math.h>
@@ -87,6 +88,77 @@ static vsgl_result fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const 
     return VSGL_OK;
 }
 
+
+/* The brute-force method: every RSM texel of every light as a VPL with the
+ * exact BRDF (the internal ground truth). All RSMs are kept at once. */
+static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
+                               const vsgl_gbuffer *g, const vsgl_pixel_planes *planes, vsgl_render_stats *st)
+{
+    uint32_t light_count = 0;
+    const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
+    vsgl_rsm *rsms = calloc(light_count + 1, sizeof *rsms);
+    float *sample = calloc(g->count * 12 + 1, sizeof(float));
+    uint32_t used = 0;
+    vsgl_result r = VSGL_OK;
+    if (!rsms || !sample) {
+        r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "render: out of memory for %zu samples", g->count);
+        goto done;
+    }
+    for (uint32_t l = 0; l < light_count && r == VSGL_OK; ++l) {
+        const vsgl_light *L = &lights[l];
+        if (!(L->power * (L->color[0] + L->color[1] + L->color[2]) > 0.0f)) {
+            note_skip(ctx, st, "light %u: zero power or black colour", l);
+            ++st->lights_skipped;
+            continue;
+        }
+        double t0 = now_seconds();
+        r = vsgl__rsm_build(ctx, scene, l, s->rsm_resolution, &rsms[used]);
+        st->seconds_rsm += now_seconds() - t0;
+        if (r != VSGL_OK)
+            break;
+        const vsgl_rsm *m = &rsms[used];
+        if (!(m->total_flux[0] + m->total_flux[1] + m->total_flux[2] > 0.0)) {
+            note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
+            ++st->lights_skipped;
+            vsgl__rsm_free(&rsms[used]);
+            continue;
+        }
+        ++used;
+        ++st->lights_used;
+    }
+    if (r == VSGL_OK) {
+        double t0 = now_seconds();
+        float *dl = sample, *gl = sample + 3 * g->count, *dc = sample + 6 * g->count, *gc = sample + 9 * g->count;
+        r = vsgl__brute_force_shade(ctx, scene, g, rsms, used, s->visibility == VSGL_VISIBILITY_RAY, dl, gl, dc, gc);
+        st->seconds_shade = now_seconds() - t0;
+        if (r == VSGL_OK) {
+            size_t pixels = (size_t)g->width * g->height;
+            /* light planes first into the contribution slots, then colour them */
+            vsgl__brute_force_resolve(g, dl, dc, planes->diffuse, planes->diffuse_color);
+            vsgl__brute_force_resolve(g, gl, gc, planes->glossy, planes->glossy_color);
+            for (size_t i = 0; i < pixels * 3; ++i) {
+                planes->diffuse[i] *= planes->diffuse_color[i];
+                planes->glossy[i] *= planes->glossy_color[i];
+            }
+            for (size_t p = 0; p < pixels; ++p) {
+                size_t hits = 0;
+                for (size_t k = 0; k < g->spp; ++k)
+                    hits += g->material[p * g->spp + k] != VSGL_GBUFFER_MISS;
+                planes->coverage[p] = (float)hits / (float)g->spp;
+            }
+            for (uint32_t k = 0; k < used; ++k)
+                st->shading_pairs += (uint64_t)g->count * rsms[k].count;
+        }
+    }
+done:
+    if (rsms)
+        for (uint32_t k = 0; k < used; ++k)
+            vsgl__rsm_free(&rsms[k]);
+    free(rsms);
+    free(sample);
+    return r;
+}
+
 /* light = contribution / colour, 0 where the colour is 0 (as Cycles). */
 static float divide_or_zero(float num, float den)
 {
@@ -162,24 +234,23 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
     st.seconds_gbuffer = now_seconds() - t0;
     if (r != VSGL_OK)
         goto done;
-    if (s.method == VSGL_METHOD_BRUTE_FORCE) {
-        r = vsgl__fail(ctx, VSGL_ERROR_UNSUPPORTED, "render: the brute-force method is not wired in yet");
-        goto done;
-    }
-    r = fit_lights(ctx, scene, &s, &set, &st);
-    if (r != VSGL_OK)
-        goto done;
-    st.vsgl_count = (uint32_t)set.count;
-
     buf = calloc(pixels * 13, sizeof(float));
     if (!buf) {
         r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "render: out of memory for %zu pixels", pixels);
         goto done;
     }
     vsgl_pixel_planes planes = {buf, buf + 3 * pixels, buf + 6 * pixels, buf + 9 * pixels, buf + 12 * pixels};
-    t0 = now_seconds();
-    r = vsgl__shade(ctx, scene, &g, &set, &s, &planes, VSGL_SHADE_KERNEL, &st.shading_pairs);
-    st.seconds_shade = now_seconds() - t0;
+    if (s.method == VSGL_METHOD_BRUTE_FORCE) {
+        r = brute_force(ctx, scene, &s, &g, &planes, &st);
+    } else {
+        r = fit_lights(ctx, scene, &s, &set, &st);
+        st.vsgl_count = (uint32_t)set.count;
+        if (r == VSGL_OK) {
+            t0 = now_seconds();
+            r = vsgl__shade(ctx, scene, &g, &set, &s, &planes, VSGL_SHADE_KERNEL, &st.shading_pairs);
+            st.seconds_shade = now_seconds() - t0;
+        }
+    }
     if (r == VSGL_OK)
         r = write_outputs(ctx, &planes, pixels, out);
 done:
