@@ -207,6 +207,9 @@ MUT(m_area_spread, f->lights[0].type = VSGL_LIGHT_AREA; f->lights[0].size_x = 1.
 MUT(m_sun_angle, f->lights[0].type = VSGL_LIGHT_SUN; f->lights[0].sun_angle = 4.0f)
 MUT(m_light_reserved, f->lights[1].reserved = 3)
 MUT(m_light_unused_nan, f->lights[0].size_x = NAN)
+MUT(m_light_matrix_inf, f->lights[1].world_from_light[7] = INFINITY)
+MUT(m_cam_matrix_huge, f->camera.world_from_camera[11] = 1e19f)
+MUT(m_light_color_neg, f->lights[0].color[0] = -0.5f)
 MUT(m_mat_rough, f->materials[1].roughness = 2.0f)
 MUT(m_mat_color, f->materials[0].base_color[1] = -0.1f)
 MUT(m_mat_metal_nan, f->materials[0].metallic = NAN)
@@ -262,6 +265,9 @@ static const bad_case bad_cases[] = {
     {"sun angle", m_sun_angle, "light 0: sun_angle is 4 (must be in [0, 3.14159])"},
     {"light reserved", m_light_reserved, "light 1: reserved is 3 (must be 0)"},
     {"light unused NaN", m_light_unused_nan, "light 0: size_x is nan (must be finite, |x| <= 1e18)"},
+    {"light matrix Inf", m_light_matrix_inf, "light 1: world_from_light is not finite"},
+    {"camera matrix huge", m_cam_matrix_huge, "camera: world_from_camera has an element above 1e18"},
+    {"light colour negative", m_light_color_neg, "light 0: color[0] is -0.5 (must be in [0, 3e+38])"},
     {"material roughness", m_mat_rough, "material 1: roughness is 2 (must be in [0, 1])"},
     {"material colour", m_mat_color, "material 0: base_color[1] is -0.1 (must be in [0, 1])"},
     {"material metallic", m_mat_metal_nan, "material 0: metallic is nan (must be in [0, 1])"},
