@@ -143,3 +143,8 @@ fuzz:
 	$(BUILD)/fuzz/fuzz_bundle tests/fuzz/regressions/*
 	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 $(BUILD)/fuzz/fuzz_bundle -max_total_time=$(FUZZ_SECONDS) \
 	  -dict=tests/fuzz/bundle.dict -artifact_prefix=$(BUILD)/fuzz/ -print_final_stats=1 $(BUILD)/fuzz/corpus
+
+# Blender add-on zip (issue 5): build/vsgl_indirect.zip with lib/libvsgl.so inside.
+.PHONY: addon
+addon: $(BUILD)/libvsgl.so
+	@tools/build_addon.sh
