@@ -475,6 +475,18 @@ class vsgl_bundle_info(_Struct):
     ]
 
 
+# reference.h
+class vsgl_reference_stats(_Struct):
+    _fields_ = [
+        ("seconds_gbuffer", ctypes.c_double),
+        ("seconds_rsm", ctypes.c_double),
+        ("seconds_gather", ctypes.c_double),
+        ("rsm_bytes", ctypes.c_uint64),
+        ("vpl_count", ctypes.c_uint64),
+        ("total_flux", ctypes.c_double * 3),
+    ]
+
+
 # Friendlier names for the structs users fill in.
 Material = vsgl_material
 Light = vsgl_light
@@ -486,12 +498,20 @@ STRUCTS = {cls.__name__: cls for cls in (
     vsgl_vec3, vsgl_context_desc, vsgl_sg, vsgl_asg, vsgl_material, vsgl_light,
     vsgl_camera, vsgl_scene_desc, vsgl_scene_info, vsgl_render_settings,
     vsgl_render_output, vsgl_render_stats, vsgl_exr_pass, vsgl_exr_metadata,
-    vsgl_exr_options, vsgl_bundle_options, vsgl_bundle_info)}
+    vsgl_exr_options, vsgl_bundle_options, vsgl_bundle_info, vsgl_reference_stats)}
 #: Python field names that differ from the C ones.
 FIELD_C_NAMES = {"lambda_": "lambda"}
-#: Header each struct comes from (io.h structs are skipped by the layout test if it is absent).
-STRUCT_HEADERS = {name: ("io.h" if name.startswith(("vsgl_exr", "vsgl_bundle")) else "vsgl.h")
-                  for name in STRUCTS}
+
+
+def header_of(name):
+    """The public header declaring a struct or function of the binding."""
+    if name.startswith(("vsgl_exr", "vsgl_bundle", "vsgl_check_output")):
+        return "io.h"
+    if name.startswith("vsgl_debug"):
+        return "debug.h"
+    if name.startswith("vsgl_reference"):
+        return "reference.h"
+    return "vsgl.h"
 
 # --------------------------------------------------------------------------
 # Prototypes: (name, restype, argtypes), as in the headers
@@ -568,6 +588,11 @@ PROTOTYPES = (
     ("vsgl_bundle_get_info", _i32, [_VP, _P(vsgl_bundle_info)]),
     # debug.h
     ("vsgl_debug_gbuffer", _i32, [_VP, _VP, _u32, _PF32, _PF32, _PU32]),
+    # reference.h
+    ("vsgl_reference_rsm", _i32, [_VP, _VP, _u32, _u32, _P(ctypes.c_size_t), _PF32, _PF32,
+                                  _PF32, _PF32, _PU32]),
+    ("vsgl_reference_render", _i32, [_VP, _VP, _u32, _u32, _i32, _PF32, _PF32, _PF32, _PF32,
+                                     _P(vsgl_reference_stats)]),
 )
 
 # --------------------------------------------------------------------------
@@ -1546,3 +1571,46 @@ def debug_gbuffer(ctx, scene, aa=1):
                                      nrm.ctypes.data_as(_PF32), mat.ctypes.data_as(_PU32))
     ctx.check(rc, "vsgl_debug_gbuffer")
     return {"positions": pos, "normals": nrm, "materials": mat}
+
+
+# --------------------------------------------------------------------------
+# Test-only references (reference.h; signatures may change between minors)
+# --------------------------------------------------------------------------
+
+
+def reference_rsm(ctx, scene, light, res):
+    """The RSM of light index ``light`` at ``res`` texels per side, as a dict
+    of arrays over its N texels: positions, normals, flux (N, 3) float32,
+    areas (N,) float32, materials (N,) uint32 (0xFFFFFFFF where empty)."""
+    fn = ctx._lib.vsgl_reference_rsm
+    count = ctypes.c_size_t()
+    rc = fn(ctx.handle, scene.handle, int(light), int(res), ctypes.byref(count),
+            None, None, None, None, None)
+    ctx.check(rc, "vsgl_reference_rsm")
+    N = count.value
+    out = {"positions": np.zeros((N, 3), np.float32), "normals": np.zeros((N, 3), np.float32),
+           "flux": np.zeros((N, 3), np.float32), "areas": np.zeros(N, np.float32),
+           "materials": np.zeros(N, np.uint32)}
+    rc = fn(ctx.handle, scene.handle, int(light), int(res), ctypes.byref(count),
+            out["positions"].ctypes.data_as(_PF32), out["normals"].ctypes.data_as(_PF32),
+            out["flux"].ctypes.data_as(_PF32), out["areas"].ctypes.data_as(_PF32),
+            out["materials"].ctypes.data_as(_PU32))
+    ctx.check(rc, "vsgl_reference_rsm")
+    return out
+
+
+def reference_render(ctx, scene, rsm_res=256, aa=1, visibility=Visibility.NONE):
+    """Brute-force one-bounce reference: (images, stats) with images the
+    planes diffuse_light, glossy_light, diffuse_color, glossy_color
+    (float32 (H, W, 3)) and stats a dict of vsgl_reference_stats."""
+    H, W = scene.height, scene.width
+    names = ("diffuse_light", "glossy_light", "diffuse_color", "glossy_color")
+    images = {p: np.zeros((H, W, 3), np.float32) for p in names}
+    stats = vsgl_reference_stats()
+    rc = ctx._lib.vsgl_reference_render(
+        ctx.handle, scene.handle, int(rsm_res), int(aa), _enum(visibility, Visibility, "visibility"),
+        *[images[p].ctypes.data_as(_PF32) for p in names], ctypes.byref(stats))
+    ctx.check(rc, "vsgl_reference_render")
+    d = stats.as_dict()
+    d["total_flux"] = tuple(d["total_flux"])
+    return images, d

@@ -20,13 +20,12 @@ def _c_name(field):
     return libvsgl.FIELD_C_NAMES.get(field, field)
 
 
-def _have_io():
-    return os.path.exists(os.path.join(header_parse.INCLUDE, "vsgl", "io.h"))
+def _have(header):
+    return header == "vsgl.h" or os.path.exists(os.path.join(header_parse.INCLUDE, "vsgl", header))
 
 
 def _structs_to_check():
-    return {n: c for n, c in libvsgl.STRUCTS.items()
-            if libvsgl.STRUCT_HEADERS[n] != "io.h" or _have_io()}
+    return {n: c for n, c in libvsgl.STRUCTS.items() if _have(libvsgl.header_of(n))}
 
 
 @pytest.fixture(scope="module")
@@ -35,8 +34,8 @@ def c_layout(tmp_path_factory):
         pytest.skip("no C compiler (cc/gcc/clang) to measure the C layout")
     structs = _structs_to_check()
     lines = ["#include <stddef.h>", "#include <stdio.h>", '#include "vsgl.h"']
-    if _have_io():
-        lines.append('#include "vsgl/io.h"')
+    for h in header_parse.headers():
+        lines.append('#include "vsgl/%s"' % os.path.basename(h))
     lines.append("int main(void) {")
     for name, cls in structs.items():
         lines.append('printf("%s %%zu %%zu\\n", sizeof(%s), _Alignof(%s));' % (name, name, name))
@@ -63,7 +62,7 @@ def c_layout(tmp_path_factory):
 @pytest.mark.parametrize("name", sorted(libvsgl.STRUCTS))
 def test_struct_size_and_offsets_match_c(name, c_layout):
     if name not in _structs_to_check():
-        pytest.skip("%s: io.h not present" % name)
+        pytest.skip("%s: %s not present" % (name, libvsgl.header_of(name)))
     cls = libvsgl.STRUCTS[name]
     size, align = c_layout[name]
     assert ctypes.sizeof(cls) == size, "%s: ctypes sizeof %d, C sizeof %d" % (
@@ -133,7 +132,7 @@ def test_prototypes_match_headers():
             problems.append("%s: argtypes %s, header says %s" % (name, args, params))
     for name in bound:
         if name not in parsed:
-            if name.startswith(("vsgl_exr", "vsgl_bundle", "vsgl_check_output")) and not _have_io():
+            if not _have(libvsgl.header_of(name)):
                 continue
             problems.append("%s is bound but no header declares it" % name)
     assert not problems, "\n".join(problems)
