@@ -47,7 +47,7 @@ def setup_scene(scene, frame=None):
     options = runner.options_of(scene)
     errors = []
     w, h = _render_size(scene)
-    for layer in _layers(scene):
+    for i, layer in enumerate(_layers(scene)):
         path = runner.output_path(scene, layer, frame, options)
         try:
             engine.check_output_path(path)
@@ -55,7 +55,9 @@ def setup_scene(scene, frame=None):
                 # Blender creates the pass sockets from a real file.
                 compositor.placeholder(path, w, h)
                 _state["setup_files"].add(path)
-            compositor.ensure(scene, layer, path, options.add_to_render)
+            # One composite output: only the first rendered view layer's AOV is
+            # added onto it; the others get their Image node to wire by hand.
+            compositor.ensure(scene, layer, path, options.add_to_render and i == 0)
         except engine.AovError as e:
             errors.append("view layer '%s': %s" % (layer, e))
         except Exception as e:

@@ -240,3 +240,50 @@ def test_empty_scene_reports(scene):
     basic(scene)
     with pytest.raises(ExportError, match="no visible mesh geometry"):
         collect(scene)
+
+
+def _gn_instances_group(count):
+    ng = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
+    if hasattr(ng, "interface"):   # 4.0+
+        ng.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+        ng.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    else:                          # 3.x
+        ng.inputs.new("NodeSocketGeometry", "Geometry")
+        ng.outputs.new("NodeSocketGeometry", "Geometry")
+    ng.nodes.new("NodeGroupInput")
+    out = ng.nodes.new("NodeGroupOutput")
+    line = ng.nodes.new("GeometryNodeMeshLine")
+    line.inputs["Count"].default_value = count
+    cube_node = ng.nodes.new("GeometryNodeMeshCube")
+    inst = ng.nodes.new("GeometryNodeInstanceOnPoints")
+    ng.links.new(line.outputs["Mesh"], inst.inputs["Points"])
+    ng.links.new(cube_node.outputs["Mesh"], inst.inputs["Instance"])
+    ng.links.new(inst.outputs["Instances"], out.inputs[0])
+    return ng
+
+
+def test_geometry_nodes_and_particle_instances(scene):
+    basic(scene)
+    carrier = link(scene, plane("GNCarrier", 1.0, (0, 0, -5)))
+    mod = carrier.modifiers.new("GN", "NODES")
+    mod.node_group = _gn_instances_group(5)
+    emitter = link(scene, plane("Emitter", 2.0, (10, 0, 0)))
+    emitter.modifiers.new("P", "PARTICLE_SYSTEM")
+    ps = emitter.particle_systems[0].settings
+    ps.type = "HAIR"
+    ps.count = 10
+    ps.render_type = "OBJECT"
+    tiny = link(scene, cube("Tiny", 0.1, (0, 0, 50)))
+    ps.instance_object = tiny
+    ps.particle_size = 1.0
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    inst = [n for n in sd.object_names if "instance of" in n]
+    assert sum("GNCarrier" in n for n in inst) == 5
+    assert sum("Emitter" in n for n in inst) == 10
+    # GN cubes (size 1) stacked along +Z from the carrier at z = -5.
+    gz = sd.positions[(np.abs(sd.positions[:, 0]) <= 0.5 + 1e-6) & (sd.positions[:, 2] < 0)][:, 2]
+    assert gz.min() == pytest.approx(-5.5, abs=1e-5) and gz.max() == pytest.approx(-0.5, abs=1e-5)
+    # Hair instances sit on the emitter (x in [9, 11]).
+    hx = sd.positions[(sd.positions[:, 0] > 8.5)][:, 0]
+    assert hx.min() >= 9 - 0.2 and hx.max() <= 11 + 0.2

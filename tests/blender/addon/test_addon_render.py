@@ -194,3 +194,28 @@ def test_addons_route_with_user_scripts(scene, tmp_path):
         assert "VSGL INFO: wrote" in r.stdout and str(dst / "lib") in r.stdout or \
             os.path.exists(aov(tmp_path, 1)), r.stdout
         assert os.path.exists(aov(tmp_path, 1))
+
+
+def test_render_depsgraph_per_view_layer(scene, tmp_path):
+    """The AOV uses the render depsgraph of each view layer: eye-hidden objects
+    render, subdivision uses its render level, excluded collections do not."""
+    room(scene, str(tmp_path / "aov" / "{view_layer}_####.exr"))
+    scene.render.filepath = str(tmp_path / "out" / "b_")
+    col = bpy.data.collections.new("Extra")
+    scene.collection.children.link(col)
+    from conftest import cube
+    col.objects.link(cube("Box", 1.0, (0, 1, 0.5)))
+    second = scene.view_layers.new("Second")
+    second.layer_collection.children["Extra"].exclude = True
+    ob = link(scene, cube("EyeHidden", 0.5, (1, 0, 0.25)))
+    sub = ob.modifiers.new("S", "SUBSURF")
+    sub.levels, sub.render_levels = 0, 2
+    bpy.context.view_layer.update()
+    ob.hide_set(True)
+    path = save(str(tmp_path / "vl.blend"))
+    r = render(path, 1, env={"VSGL_TEST_FAKE_RENDER": "1"})
+    assert r.returncode == 0, r.stdout
+    # floor 2 + wall 2 + box 12 + subdivided cube at level 2: 6 * 16 * 2
+    assert "ViewLayer_0001.exr (208 triangles" in r.stdout, r.stdout
+    assert "Second_0001.exr (196 triangles" in r.stdout, r.stdout
+    assert os.path.exists(str(tmp_path / "aov" / "Second_0001.exr"))
