@@ -1,0 +1,14 @@
+/* Internal: eigen-decomposition of a real symmetric 3x3 matrix (cyclic Jacobi). */
+#ifndef VSGL_MATH_EIGEN3_H
+#define VSGL_MATH_EIGEN3_H
+
+/* Eigenvalues w[0] >= w[1] >= w[2] of the symmetric matrix a (only its
+ * upper triangle is read; a is not modified) and orthonormal eigenvectors: column k of v,
+ * i.e. (v[0][k], v[1][k], v[2][k]), belongs to w[k]; the columns form a
+ * right-handed frame (v2 = v0 x v1). Repeated eigenvalues are no special
+ * case: Jacobi rotations keep v orthonormal and return some orthonormal
+ * basis of the repeated eigenspace. Returns the number of sweeps used
+ * (<= 32), or -1 if an entry is not finite (then w and v are NaN). */
+int vsgl__eigen_sym3(double a[3][3], double w[3], double v[3][3]);
+
+#endif
