@@ -102,7 +102,8 @@ GATHER_CASE = dict(
     camera=dict(type="PERSP", lens=30.0, loc=(0, -3.6, 1.0), rot=(90, 0, 0), res=(80, 60)),
     samples=2048,
 )
-GATHER_RES = [32, 64, 128, 256]
+GATHER_AA = int(os.environ.get("VSGL_GATHER_AA", "1"))
+GATHER_RES = [int(r) for r in os.environ.get("VSGL_GATHER_RES", "32,64,128").split(",")]
 
 # ---------------------------------------------------------------------------
 # Blender side
@@ -203,15 +204,19 @@ def build_blender(case):
     return ob, lights, co, mats
 
 
-def render_cycles(case, passes, path_prefix, samples):
+def render_cycles(case, passes, path_prefix, samples, seed=1):
     sc = bpy.context.scene
     sc.render.engine = "CYCLES"
     cy = sc.cycles
     cy.device = "CPU"
     cy.samples = samples
+    # one sample position per pixel: its centre (+-0.005 px), as the
+    # library's G-buffer with aa = 1 (edges then compare pixel for pixel)
+    cy.pixel_filter_type = "BOX"
+    cy.filter_width = 0.01
     cy.use_adaptive_sampling = False
     cy.use_denoising = False
-    cy.seed = 1
+    cy.seed = seed
     cy.max_bounces = 1
     cy.diffuse_bounces = 1
     cy.glossy_bounces = 1
@@ -262,15 +267,15 @@ def load_exr_rgb(path):
     return a
 
 
-def cycles_cached(name, case, passes, out_dir, samples):
+def cycles_cached(name, case, passes, out_dir, samples, seed=1):
     key = hashlib.sha1((open(__file__).read() + json.dumps(case, sort_keys=True) + repr(passes)
-                        + bpy.app.version_string + str(samples)).encode()).hexdigest()[:12]
+                        + bpy.app.version_string + str(samples) + str(seed)).encode()).hexdigest()[:12]
     prefix = os.path.join(out_dir, "cycles", "%s_%s" % (name, key))
     files = {p: prefix + "_" + p + "_0001.exr" for p in passes}
     secs = None
     if not all(os.path.exists(f) for f in files.values()):
         os.makedirs(os.path.dirname(prefix), exist_ok=True)
-        secs = render_cycles(case, passes, prefix, samples)
+        secs = render_cycles(case, passes, prefix, samples, seed)
     return {p: load_exr_rgb(f) for p, f in files.items()}, secs
 
 
@@ -489,18 +494,47 @@ def suite_lights(lib, ctx, out_dir, report):
     return passed, failed
 
 
-def relmse(a, b):
-    return float(np.mean((a - b) ** 2 / (b * b + 0.01)))
+def relmse(a, b, mask=None):
+    e = (a - b) ** 2 / (b * b + 0.01)
+    return float(np.mean(e if mask is None else e[mask]))
+
+
+def interior_mask(col):
+    """Pixels whose 3x3 neighbourhood shows one material colour in both
+    colour passes (a proxy for "not on a silhouette or a crease")."""
+    h, w, _ = col.shape
+    pad = np.pad(col, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    same = np.ones((h, w), bool)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            same &= np.all(np.abs(pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] - col) < 1e-3, axis=2)
+    return same
 
 
 def suite_gather(lib, ctx, out_dir, report):
     case = GATHER_CASE
     ob, lights, co, mats = build_blender(case)
     passes = ["DiffInd", "DiffCol", "GlossInd", "GlossCol"]
-    cyc, secs = cycles_cached("gather_room", case, passes, out_dir, case["samples"])
+    # two independent Cycles renders (seeds 1, 2): their mean is the
+    # reference, their difference measures its noise
+    half = case["samples"] // 2
+    c1, s1 = cycles_cached("gather_room", case, passes, out_dir, half, 1)
+    c2, s2 = cycles_cached("gather_room", case, passes, out_dir, half, 2)
+    secs = None if s1 is None or s2 is None else s1 + s2
     W, H = case["camera"]["res"]
-    D_c = cyc["DiffInd"] * cyc["DiffCol"]
-    G_c = cyc["GlossInd"] * cyc["GlossCol"]
+    D1, D2 = c1["DiffInd"] * c1["DiffCol"], c2["DiffInd"] * c2["DiffCol"]
+    G1, G2 = c1["GlossInd"] * c1["GlossCol"], c2["GlossInd"] * c2["GlossCol"]
+    D_c, G_c = 0.5 * (D1 + D2), 0.5 * (G1 + G2)
+    cyc = {p: 0.5 * (c1[p] + c2[p]) for p in passes}
+    # noise of the mean of two renders: relMSE(c1, c2) / 4 (each has variance
+    # s^2, their difference 2 s^2, their mean s^2 / 2)
+    floor_d = relmse(D1, D2) / 4
+    floor_g = relmse(G1, G2) / 4
+    floor_c = relmse(D1 + G1, D2 + G2) / 4
+    inner = interior_mask(np.concatenate([cyc["DiffCol"], cyc["GlossCol"]], axis=2))
+    floor_ci = relmse(D1 + G1, D2 + G2, inner) / 4
+    print("gather: Cycles noise floor (relMSE of the %d-spp mean vs truth): diffuse %.4f glossy %.4f combined %.4f"
+          % (case["samples"], floor_d, floor_g, floor_c))
     scene = library_scene(lib, ctx, ob, lights, co, mats)
     rows = []
     passed = failed = 0
@@ -508,17 +542,18 @@ def suite_gather(lib, ctx, out_dir, report):
         for res in GATHER_RES:
             planes = [np.zeros((H, W, 3), np.float32) for _ in range(4)]
             st = ReferenceStats()
-            rc = lib.vsgl_reference_render(ctx, scene, res, 2, 1, *[fptr(p) for p in planes], ctypes.byref(st))
+            rc = lib.vsgl_reference_render(ctx, scene, res, GATHER_AA, 1, *[fptr(p) for p in planes], ctypes.byref(st))
             if rc != 0:
                 raise RuntimeError("vsgl_reference_render: %s" % lib.vsgl_context_last_error(ctx).decode())
             dl, gl, dc, gc = planes
             D, G = dl * dc, gl * gc
             rows.append(dict(res=res, rd=relmse(D, D_c), rg=relmse(G, G_c), rc=relmse(D + G, D_c + G_c),
+                             rci=relmse(D + G, D_c + G_c, inner),
                              md=float(D.mean() / max(D_c.mean(), 1e-12)), mg=float(G.mean() / max(G_c.mean(), 1e-12)),
                              t_rsm=st.seconds_rsm, t_gather=st.seconds_gather, vpl=st.vpl_count,
                              gcol=float(np.abs(gc - cyc["GlossCol"]).mean()), dcol=float(np.abs(dc - cyc["DiffCol"]).mean())))
-            print("gather res %d: relMSE diffuse %.4f glossy %.4f combined %.4f; mean ratio diffuse %.4f glossy %.4f; "
-                  "VPLs %d, rsm %.2f s, gather %.2f s" % (res, rows[-1]["rd"], rows[-1]["rg"], rows[-1]["rc"],
+            print("gather res %d: relMSE diffuse %.4f glossy %.4f combined %.4f (interior %.4f); mean ratio diffuse %.4f glossy %.4f; "
+                  "VPLs %d, rsm %.2f s, gather %.2f s" % (res, rows[-1]["rd"], rows[-1]["rg"], rows[-1]["rc"], rows[-1]["rci"],
                                                           rows[-1]["md"], rows[-1]["mg"], st.vpl_count,
                                                           st.seconds_rsm, st.seconds_gather))
             np.save(os.path.join(out_dir, "gather_%d.npy" % res), np.stack(planes))
@@ -528,13 +563,19 @@ def suite_gather(lib, ctx, out_dir, report):
     report.append("## Brute force vs Cycles\n")
     report.append("Room 2 x 2 x 2 m (open front), red/green side walls, grey dielectric floor (roughness 0.25), "
                   "GGX metal block (roughness 0.35); spot 300 W + square area 60 W. %dx%d px. Cycles 3.4 one bounce, "
-                  "%d spp%s. Library: brute-force gather, aa 2x2, visibility rays, RSM per light at the given size.\n"
-                  % (W, H, case["samples"], "" if secs is None else " (rendered in %.0f s)" % secs))
-    report.append("| RSM | VPLs | relMSE diffuse | relMSE glossy | relMSE combined | mean D / Cycles | mean G / Cycles | RSM s | gather s |")
-    report.append("|---|---|---|---|---|---|---|---|---|")
+                  "%d spp%s. Library: brute-force gather, aa %d, visibility rays, RSM per light at the given size.\n"
+                  % (W, H, case["samples"], "" if secs is None else " (rendered in %.0f s)" % secs, GATHER_AA))
+    report.append("Cycles reference = mean of two %d-spp renders (seeds 1, 2), pixel centres only (box filter "
+                  "0.01 px, like the G-buffer at aa 1); its own noise, relMSE(c1, c2)/4: diffuse %.4f, "
+                  "glossy %.4f, combined %.4f. relMSE = mean((a-b)^2/(b^2+0.01)) over pixels and channels "
+                  "of the coloured planes DiffInd*DiffCol, GlossInd*GlossCol.\n" % (half, floor_d, floor_g, floor_c))
+    report.append("Interior pixels (3x3 neighbourhood of one material colour, %.0f %% of the image): Cycles "
+                  "noise there %.4f.\n" % (100 * inner.mean(), floor_ci))
+    report.append("| RSM | VPLs | relMSE diffuse | relMSE glossy | relMSE combined | combined, interior | mean D / Cycles | mean G / Cycles | RSM s | gather s |")
+    report.append("|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        report.append("| %d | %d | %.4f | %.4f | %.4f | %.4f | %.4f | %.2f | %.2f |" % (
-            r["res"], r["vpl"], r["rd"], r["rg"], r["rc"], r["md"], r["mg"], r["t_rsm"], r["t_gather"]))
+        report.append("| %d | %d | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | %.2f | %.2f |" % (
+            r["res"], r["vpl"], r["rd"], r["rg"], r["rc"], r["rci"], r["md"], r["mg"], r["t_rsm"], r["t_gather"]))
     report.append("\nDiffCol mean abs diff %.2e, GlossCol %.2e (pixel-filter edges).\n" % (rows[-1]["dcol"], rows[-1]["gcol"]))
     # checks: the finest RSM agrees with Cycles, error falls with RSM size, colours match
     best = rows[-1]
@@ -542,7 +583,8 @@ def suite_gather(lib, ctx, out_dir, report):
         ("colours match Cycles (mean abs DiffCol, GlossCol < 0.02)", best["dcol"] < 0.02 and best["gcol"] < 0.02),
         ("diffuse mean within 3 %% of Cycles at RSM %d" % best["res"], abs(best["md"] - 1) < 0.03),
         ("glossy mean within 5 %% of Cycles at RSM %d" % best["res"], abs(best["mg"] - 1) < 0.05),
-        ("relMSE combined < 0.01 at RSM %d" % best["res"], best["rc"] < 0.01),
+        ("relMSE combined over interior pixels < 2 x Cycles noise + 0.003 at RSM %d" % best["res"],
+         best["rci"] < 2 * floor_ci + 0.003),
         ("relMSE diffuse falls from RSM %d to %d" % (rows[0]["res"], best["res"]), best["rd"] < rows[0]["rd"]),
     ]
     passed = failed = 0

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# RSM light units vs Cycles' DiffDir (tests/blender/cycles_ref.py --suite lights) in Blender 3.4.
+# RSM light units (SUITE=lights, default) or the brute-force gather (SUITE=gather) vs Cycles' DiffDir (tests/blender/cycles_ref.py --suite lights) in Blender 3.4.
 # Cycles renders are cached in build/blender/cycles/cycles/ (keyed by a hash of the script, case, version).
 # Prints one line per light and ends with "N passed, N failed"; exits non-zero on failure.
 set -uo pipefail
