@@ -1178,12 +1178,15 @@ def _ptr(a, ctype):
     return None if a is None else a.ctypes.data_as(ctypes.POINTER(ctype))
 
 
+_FRIENDLY = {"vsgl_material": "Material", "vsgl_light": "Light", "vsgl_camera": "Camera"}
+
+
 def _struct_array(items, cls, name):
     items = list(items or ())
     for i, it in enumerate(items):
         if not isinstance(it, cls):
             raise TypeError("%s[%d] must be a libvsgl.%s, got %s"
-                            % (name, i, cls.__name__, type(it).__name__))
+                            % (name, i, _FRIENDLY[cls.__name__], type(it).__name__))
     return (cls * len(items))(*items) if items else None
 
 

@@ -1,0 +1,224 @@
+"""Scene construction from numpy arrays (validation in Python and in the
+library) and render() outputs."""
+
+import numpy as np
+import pytest
+
+import libvsgl as L
+from conftest import require, require_complete
+from scenes import floor_and_wall
+
+ALL = ("vsgl_scene_create", "vsgl_scene_get_info", "vsgl_render", "vsgl_render_settings_preset")
+
+
+# ---- validation in Python (no library call needed) -------------------------
+
+@pytest.mark.parametrize("field,value,exc,words", [
+    ("positions", np.zeros((4, 3)), TypeError, ["positions", "float32", "float64"]),
+    ("positions", [[0, 0, 0]] * 4, TypeError, ["positions", "ndarray"]),
+    ("positions", np.zeros((4, 2), np.float32), ValueError, ["positions", "shape"]),
+    ("positions", np.zeros((3, 4), np.float32).T, ValueError, ["positions", "contiguous"]),
+    ("indices", np.zeros((2, 3), np.int64), TypeError, ["indices", "uint32"]),
+    ("indices", np.zeros((6,), np.uint32), ValueError, ["indices", "shape"]),
+    ("corner_normals", np.zeros((2, 3, 3), np.float64), TypeError, ["corner_normals", "float32"]),
+    ("corner_normals", np.zeros((5, 9), np.float32), ValueError, ["corner_normals", "(2, 3, 3)"]),
+    ("corner_uvs", np.zeros((2, 3, 3), np.float32), ValueError, ["corner_uvs"]),
+    ("corner_tangents", np.zeros((2, 3, 3), np.float32), ValueError, ["corner_tangents"]),
+    ("material_indices", np.zeros((2,), np.int32), TypeError, ["material_indices", "uint32"]),
+    ("materials", [object()], TypeError, ["materials[0]", "Material"]),
+    ("lights", [L.Material()], TypeError, ["lights[0]", "Light"]),
+    ("camera", None, ValueError, ["camera"]),
+])
+def test_python_side_validation(lib, ctx, field, value, exc, words):
+    s = floor_and_wall(wall=False)
+    s[field] = value
+    with pytest.raises(exc) as e:
+        L.Scene(ctx, **s)
+    for w in words:
+        assert w in str(e.value), (w, str(e.value))
+
+
+def test_struct_keyword_constructors():
+    m = L.Material(base_color=np.array([0.1, 0.2, 0.3]), roughness=0.5)
+    assert list(m.base_color) == pytest.approx([0.1, 0.2, 0.3]) and m.reserved == 0
+    T = np.arange(16.0).reshape(4, 4)
+    light = L.Light(type="area", area_shape="disk", world_from_light=T)
+    assert light.type == L.LightType.AREA and light.area_shape == L.AreaShape.DISK
+    assert list(light.world_from_light) == list(range(12))  # 3x4 row-major, last row dropped
+    with pytest.raises(TypeError):
+        L.Light(colour=(1, 1, 1))
+    with pytest.raises(ValueError):
+        L.Camera(world_from_camera=np.eye(2))
+    with pytest.raises(ValueError):
+        L.Camera(type="fisheye")
+    assert L.RenderSettings().size == L.ctypes.sizeof(L.vsgl_render_settings)
+
+
+# ---- validation in the library ------------------------------------------
+
+def test_library_rejects_bad_content_naming_the_element(lib, ctx):
+    require(lib, "vsgl_scene_create")
+    s = floor_and_wall()
+    s["indices"] = s["indices"].copy()
+    s["indices"][1, 2] = 99
+    with pytest.raises(L.VsglError) as e:
+        L.Scene(ctx, **s)
+    assert e.value.code == L.Result.ERROR_INVALID_ARGUMENT and e.value.message == ctx.last_error
+    assert "triangle 1" in e.value.message or "99" in e.value.message, e.value.message
+    s = floor_and_wall()
+    bad = L.Light.from_buffer_copy(s["lights"][0])
+    bad.spot_size = 0.0
+    s["lights"] = [s["lights"][0], bad]
+    with pytest.raises(L.VsglError) as e:
+        L.Scene(ctx, **s)
+    assert "light 1" in e.value.message, e.value.message
+    s = floor_and_wall()
+    s["positions"] = s["positions"].copy()
+    s["positions"][2, 0] = np.inf
+    with pytest.raises(L.VsglError) as e:
+        L.Scene(ctx, **s)
+    assert "vertex 2" in e.value.message, e.value.message
+
+
+def test_scene_info(lib, ctx):
+    require(lib, "vsgl_scene_create", "vsgl_scene_get_info")
+    s = floor_and_wall()
+    # add a degenerate triangle: it is dropped with a warning
+    s["indices"] = np.vstack([s["indices"], [[0, 0, 1]]]).astype(np.uint32)
+    with L.Scene(ctx, **s) as scene:
+        info = scene.info()
+    assert info["triangle_count"] == 4 and info["dropped_triangles"] == 1
+    assert info["light_count"] == 1 and info["material_count"] == 1
+    P = s["positions"]
+    assert info["bounds_min"] == pytest.approx(tuple(P.min(0))) and \
+        info["bounds_max"] == pytest.approx(tuple(P.max(0)))
+    with pytest.raises(ValueError):
+        scene.info()  # closed
+
+
+def test_scene_arrays_may_be_freed_after_construction(lib, ctx):
+    require(lib, *ALL)
+    require_complete(lib)
+    s = floor_and_wall()
+    scene = L.Scene(ctx, **s)
+    s["positions"][:] = np.nan  # the library copied them
+    del s
+    images, _ = L.render(ctx, scene, L.render_settings_preset("preview"))
+    assert np.all(np.isfinite(images["combined"]))
+
+
+# ---- render ------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def rendered(lib):
+    require(lib, *ALL)
+    require_complete(lib)
+    with L.Context(thread_count=2) as ctx:
+        scene = L.Scene(ctx, **floor_and_wall())
+        a = L.render(ctx, scene, L.render_settings_preset("preview"))
+        b = L.render(ctx, scene, L.render_settings_preset("preview"))
+    return a, b
+
+
+def test_render_planes_shapes_and_ranges(rendered):
+    (images, stats), _ = rendered
+    assert set(images) == set(L.PLANES)
+    for name, a in images.items():
+        assert a.dtype == np.float32
+        assert a.shape == ((12, 16) if name == "alpha" else (12, 16, 3)), name
+        assert np.all(np.isfinite(a)) and np.all(a >= 0), name
+    assert np.all(images["alpha"] <= 1.0)
+    assert images["alpha"].max() == 1.0, "the camera must see the floor"
+    assert images["diffuse_light"].max() > 0, "the wall lights the floor (and back)"
+
+
+def test_render_planes_documented_identities(rendered):
+    (im, _), _ = rendered
+    # combined = diffuse + glossy; with 1 sample per pixel light * colour = coloured
+    np.testing.assert_allclose(im["combined"], im["diffuse"] + im["glossy"], rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(im["diffuse"], im["diffuse_light"] * im["diffuse_color"],
+                               rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(im["glossy"], im["glossy_light"] * im["glossy_color"],
+                               rtol=1e-5, atol=1e-7)
+    # the floor and wall are grey 0.8: DiffCol is 0.8 wherever a surface was hit
+    hit = im["alpha"] > 0
+    np.testing.assert_allclose(im["diffuse_color"][hit], 0.8, rtol=1e-6)
+
+
+def test_render_is_deterministic(rendered):
+    (a, sa), (b, sb) = rendered
+    for k in a:
+        assert np.array_equal(a[k], b[k]), k
+    assert sa["lights_used"] == 1 and sa["lights_skipped"] == 0 and sa["skipped"] == ""
+    assert sa["vsgl_count"] == sb["vsgl_count"] >= 1 and sa["shading_pairs"] > 0
+    for k in ("seconds_total", "seconds_rsm", "seconds_shade"):
+        assert sa[k] >= 0
+
+
+def test_render_plane_subset_and_settings_forms(lib, ctx):
+    require(lib, *ALL)
+    require_complete(lib)
+    scene = L.Scene(ctx, **floor_and_wall())
+    images, _ = L.render(ctx, scene, {"aa_samples": 1, "fit_mode": "two"}, planes=("combined",))
+    assert list(images) == ["combined"]
+    full, _ = L.render(ctx, scene, L.RenderSettings(aa_samples=1, fit_mode=L.FitMode.TWO))
+    np.testing.assert_array_equal(images["combined"], full["combined"])
+    with pytest.raises(ValueError):
+        L.render(ctx, scene, None, planes=("beauty",))
+    with pytest.raises(L.VsglError) as e:
+        L.render(ctx, scene, {"method": 99})
+    assert e.value.code == L.Result.ERROR_INVALID_ARGUMENT and "method" in e.value.message, \
+        e.value.message
+
+
+def test_render_settings_preset(lib):
+    require(lib, "vsgl_render_settings_preset")
+    for p in L.Preset:
+        s = L.render_settings_preset(p)
+        assert s.size == L.ctypes.sizeof(L.vsgl_render_settings)
+    assert L.render_settings_preset(99).as_dict() == L.render_settings_preset("balanced").as_dict()
+
+
+def test_floor_alone_has_no_brute_force_indirect_light(lib, ctx):
+    """Physics, independent of the method: a single plane cannot light
+    itself, so the brute-force reference is exactly black on it."""
+    require(lib, "vsgl_scene_create", "vsgl_reference_render")
+    require_complete(lib)
+    scene = L.Scene(ctx, **floor_and_wall(wall=False))
+    images, stats = L.reference_render(ctx, scene, rsm_res=32)
+    assert stats["vpl_count"] > 0
+    assert np.all(images["diffuse_light"] == 0) and np.all(images["glossy_light"] == 0)
+    scene = L.Scene(ctx, **floor_and_wall(wall=True))
+    images, _ = L.reference_render(ctx, scene, rsm_res=32)
+    assert images["diffuse_light"].max() > 0
+
+
+def test_reference_rsm_flux_is_bounded_by_light_power(lib, ctx):
+    require(lib, "vsgl_scene_create", "vsgl_reference_rsm")
+    require_complete(lib)
+    scene = L.Scene(ctx, **floor_and_wall(wall=False))
+    rsm = L.reference_rsm(ctx, scene, 0, 32)
+    N = len(rsm["areas"])
+    assert N >= 32 * 32 and rsm["positions"].shape == (N, 3)
+    lit = rsm["materials"] != 0xFFFFFFFF
+    assert lit.any()
+    # every lit texel lies on the floor (z = 0) with its normal facing the light (+z)
+    np.testing.assert_allclose(rsm["positions"][lit][:, 2], 0.0, atol=1e-5)
+    np.testing.assert_allclose(rsm["normals"][lit], [[0, 0, 1]] * int(lit.sum()), atol=1e-5)
+    # the flux received cannot exceed the light's 500 W
+    assert 0 < rsm["flux"].sum(0).max() <= 500.0 * 1.001
+
+
+def test_debug_gbuffer_hits_the_scene(lib, ctx):
+    require(lib, "vsgl_scene_create", "vsgl_debug_gbuffer")
+    require_complete(lib)
+    scene = L.Scene(ctx, **floor_and_wall())
+    g = L.debug_gbuffer(ctx, scene, aa=2)
+    assert g["positions"].shape == (12, 16, 4, 3) and g["materials"].shape == (12, 16, 4)
+    hit = g["materials"] != 0xFFFFFFFF
+    assert hit.any()
+    p, n = g["positions"][hit], g["normals"][hit]
+    on_floor = np.abs(p[:, 2]) < 1e-4
+    on_wall = np.abs(p[:, 1] - 2) < 1e-4
+    assert np.all(on_floor | on_wall)
+    np.testing.assert_allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-5)
