@@ -31,6 +31,17 @@ extern "C" {
 #define VSGL_VISIBILITY_NONE 0
 #define VSGL_VISIBILITY_RAY  1  /**< one ray from the shading point to each VSGL centre / VPL */
 
+/* Emitter-hemisphere (light-leak) correction: VPLs on a surface emit only
+ * above it, but a VSGL's lobe and its spherical projection leak light to
+ * receivers in or below the cluster's plane (a floor lighting itself). The
+ * correction fades a VSGL's light out as the emission cosine towards the
+ * receiver, softened by the cluster's spread, goes below 0.1, weighted by
+ * how coplanar the cluster's normals are. docs/accuracy.md measures it:
+ * it helps with many VSGLs and hurts with two. */
+#define VSGL_LEAK_AUTO 0  /**< on for FIS and k-means, off for two VSGLs per light */
+#define VSGL_LEAK_OFF  1  /**< the papers' model */
+#define VSGL_LEAK_ON   2
+
 #define VSGL_PRESET_PREVIEW  0
 #define VSGL_PRESET_BALANCED 1
 #define VSGL_PRESET_QUALITY  2
@@ -52,6 +63,7 @@ typedef struct vsgl_render_settings {
     int32_t glossy_mode;         /**< VSGL_GLOSSY_*, default ASG */
     int32_t visibility;          /**< VSGL_VISIBILITY_*, default NONE */
     uint32_t seed;               /**< for FIS / k-means sampling, default 0 */
+    int32_t leak_correction;     /**< VSGL_LEAK_*, default AUTO */
 } vsgl_render_settings;
 
 /** @brief Fill @p out with a preset (VSGL_PRESET_*); unknown presets give BALANCED. */

@@ -23,6 +23,8 @@ static void pack(const vsgl_moments *m, float *f)
         f[7 + c] = (float)m->pos[c];
     }
     f[10] = (float)m->pos2;
+    for (int c = 0; c < 3; ++c)
+        f[11 + c] = (float)m->nrm[c];
 }
 
 void vsgl__grid_moments(const double *f, vsgl_moments *m)
@@ -34,6 +36,8 @@ void vsgl__grid_moments(const double *f, vsgl_moments *m)
         m->pos[c] = f[7 + c];
     }
     m->pos2 = f[10];
+    for (int c = 0; c < 3; ++c)
+        m->nrm[c] = f[11 + c];
 }
 
 static int32_t level0_chunk(void *user, size_t chunk, size_t b, size_t e)

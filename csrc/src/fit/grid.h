@@ -5,7 +5,7 @@
 
 #include "fit/vsgl_set.h"
 
-#define VSGL_GRID_FIELDS 11 /* weight, power[3], dir[3], pos[3], pos2 */
+#define VSGL_GRID_FIELDS 14 /* weight, power[3], dir[3], pos[3], pos2, nrm[3] */
 #define VSGL_GRID_STRIDE (2 * VSGL_GRID_FIELDS) /* diffuse then specular */
 
 typedef struct vsgl_grid_level {

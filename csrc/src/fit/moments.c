@@ -43,6 +43,7 @@ void vsgl__moments_add(vsgl_moments *acc, const vsgl_moments *m, double scale)
         acc->power[c] += scale * m->power[c];
         acc->dir[c] += scale * m->dir[c];
         acc->pos[c] += scale * m->pos[c];
+        acc->nrm[c] += scale * m->nrm[c];
     }
     acc->pos2 += scale * m->pos2;
 }
@@ -54,7 +55,7 @@ static double schlick(double f0, double cos_theta)
     return f0 + (1.0 - f0) * m2 * m2 * m;
 }
 
-static void fill(vsgl_moments *m, const double power[3], v3 axis, float mean_length, v3 rel)
+static void fill(vsgl_moments *m, const double power[3], v3 axis, float mean_length, v3 rel, v3 n)
 {
     double w = power[0] + power[1] + power[2];
     m->weight = w;
@@ -67,6 +68,9 @@ static void fill(vsgl_moments *m, const double power[3], v3 axis, float mean_len
     m->pos[1] = w * rel.y;
     m->pos[2] = w * rel.z;
     m->pos2 = w * ((double)rel.x * rel.x + (double)rel.y * rel.y + (double)rel.z * rel.z);
+    m->nrm[0] = w * n.x;
+    m->nrm[1] = w * n.y;
+    m->nrm[2] = w * n.z;
 }
 
 int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3 origin,
@@ -98,7 +102,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
         pd[c] = flux[c] * bp.diffuse[c];
     if (pd[0] + pd[1] + pd[2] > 0.0) {
         float ld = vsgl_sg_cosine_sharpness();
-        fill(&out[VSGL_LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel);
+        fill(&out[VSGL_LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel, n);
         any = 1;
     }
     /* Specular lobe: Phi R_s G(w; reflect(wi, n), l_h / (4 |wi.n|)) / A(.), with
@@ -114,7 +118,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
             vsgl_ndf_to_sg(&n, alpha, VSGL_NDF_GGX, &ndf);
             vsgl_warp_ndf_sg(&ndf, &wi, &warped);
             fill(&out[VSGL_LOBE_SPECULAR], ps, warped.axis,
-                 vsgl_mean_length_from_sharpness(warped.sharpness, estimator), rel);
+                 vsgl_mean_length_from_sharpness(warped.sharpness, estimator), rel, n);
             any = 1;
         }
     }
@@ -147,6 +151,10 @@ int vsgl__moments_to_vsgl(const vsgl_moments *m, v3 origin, int32_t estimator,
     out->variance = var > 0.0 ? (float)var : 0.0f;
     for (int c = 0; c < 3; ++c)
         out->power[c] = (float)m->power[c];
+    double nx = m->nrm[0] * inv, ny = m->nrm[1] * inv, nz = m->nrm[2] * inv;
+    double nl = sqrt(nx * nx + ny * ny + nz * nz);
+    out->coherence = (float)(nl < 1.0 ? nl : 1.0);
+    out->normal = nl > 0.0 ? v3_make((float)(nx / nl), (float)(ny / nl), (float)(nz / nl)) : out->axis;
     out->light = light;
     out->lobe = lobe;
     return 1;

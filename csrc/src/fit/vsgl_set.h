@@ -20,6 +20,8 @@ typedef struct vsgl_vsgl {
     v3 axis;            /* unit lobe axis of the radiant intensity */
     float sharpness;    /* lambda_v */
     float power[3];     /* sum of Phi R over the cluster (RGB, W), after FIS weighting */
+    v3 normal;          /* unit mean surface normal of the cluster's VPLs */
+    float coherence;    /* |weighted mean normal| in [0, 1]: 1 = all VPLs coplanar-facing */
     uint32_t light;     /* scene light index */
     uint32_t lobe;      /* VSGL_LOBE_* */
 } vsgl_vsgl;
@@ -40,6 +42,7 @@ typedef struct vsgl_moments {
     double dir[3];      /* sum w_i * mean_vector_i (filtered directions, GUIDE Sec. 3) */
     double pos[3];      /* sum w_i (x_i - origin) */
     double pos2;        /* sum w_i |x_i - origin|^2 */
+    double nrm[3];      /* sum w_i n_i (surface normals) */
 } vsgl_moments;
 
 /* One VPL's contribution to the diffuse and specular moments: its lobes'

@@ -40,6 +40,9 @@ typedef struct vsgl_kernel_light {
     float lv;                /* sharpness of the radiant intensity */
     float c0;                /* 1 / (2 pi A(lv)) */
     float pr, pg, pb;        /* power */
+    float nx, ny, nz;        /* mean surface normal of the cluster */
+    float hemi_weight;       /* coherence^2 of the normals times the correction switch (0 = off) */
+    float hemi_scale;        /* 1 / the emission cosine below which the correction fades light out */
 } vsgl_kernel_light;
 
 /* Lobes a block needs (skip the work for lobes no lane has). */

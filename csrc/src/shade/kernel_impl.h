@@ -120,6 +120,14 @@ k_body(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restric
     float den = lin + L->lv + ls;
     float expo = den > 0.0f ? -L->lv * ls * diff2 / den : 0.0f;
     float amp = valid * k_exp(expo) * ivar * L->c0;
+    /* Emitter-hemisphere correction: VPLs on a surface emit only above it.
+     * h / sqrt(d^2 + 2 var) is the emission cosine towards x softened over
+     * the cluster's spread; light fades out as it goes to 0 (below the
+     * cluster's plane or grazing it), weighted by how coplanar the cluster is. */
+    float ce = -(dx * L->nx + dy * L->ny + dz * L->nz) / sqrtf(d2 + 2.0f * L->var + 1e-30f);
+    float st = ce * L->hemi_scale;
+    st = st < 0.0f ? 0.0f : (st > 1.0f ? 1.0f : st);
+    amp *= 1.0f - L->hemi_weight * (1.0f - st * st * (3.0f - 2.0f * st));
 
     /* diffuse: integral of the incident SG times max(w.n, 0), / pi */
     if (lobes & VSGL_KERNEL_DIFFUSE) {

@@ -61,6 +61,7 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
         s->vsgl_count = 64;
     if (!s->fis_iterations)
         s->fis_iterations = 8;
+
 #define CHECK_ENUM(field, lo, hi)                                                         \
     if (s->field < (lo) || s->field > (hi))                                              \
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: " #field " is %d (valid %d..%d)", \
@@ -71,6 +72,7 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     CHECK_ENUM(diffuse_mode, VSGL_COSINE_SG, VSGL_COSINE_ACCURATE)
     CHECK_ENUM(glossy_mode, VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG)
     CHECK_ENUM(visibility, VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY)
+    CHECK_ENUM(leak_correction, VSGL_LEAK_AUTO, VSGL_LEAK_ON)
 #undef CHECK_ENUM
     if (s->aa_samples > 16)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: aa_samples is %u (valid 1..16)", s->aa_samples);

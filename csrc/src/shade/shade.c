@@ -40,6 +40,14 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
     return 1;
 }
 
+float vsgl__leak_factor(const vsgl_vsgl *v, v3 x)
+{
+    v3 d = v3_sub(x, v->mean);
+    float ce = v3_dot(d, v->normal) / sqrtf(v3_dot(d, d) + 2.0f * v->variance + 1e-30f);
+    float t = clampf(ce / VSGL_LEAK_COSINE, 0.0f, 1.0f);
+    return 1.0f - v->coherence * v->coherence * (1.0f - t * t * (3.0f - 2.0f * t));
+}
+
 typedef struct shade_job {
     const vsgl_scene *scene;
     const vsgl_gbuffer *g;
@@ -52,6 +60,7 @@ typedef struct shade_job {
     uint64_t *pairs;      /* per chunk of the current batch */
     const vsgl_kernel_light *klights; /* the VSGLs, kernel layout */
     int path;             /* VSGL_SHADE_* */
+    int leak;             /* apply the emitter-hemisphere correction */
 } shade_job;
 
 /* Receiver lobe of one sample, set up once and used for every VSGL. */
@@ -138,6 +147,8 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 ++pairs;
                 if (!vsgl__vsgl_incident_sg(v, r.x, &in))
                     continue;
+                if (j->leak)
+                    in.log_amplitude += logf(fmaxf(vsgl__leak_factor(v, r.x), 1e-30f));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
                     v3 org = v3_add(r.x, v3_scale(r.n, j->eps));
                     v3 d = v3_sub(v->mean, org);
@@ -339,6 +350,8 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
     /* The kernel models the ASG glossy lobe; the SG lobe uses the reference path. */
     if (s->glossy_mode == VSGL_GLOSSY_SG)
         path = VSGL_SHADE_REFERENCE;
+    int leak = s->leak_correction == VSGL_LEAK_ON ||
+               (s->leak_correction == VSGL_LEAK_AUTO && s->fit_mode != VSGL_FIT_TWO);
     vsgl_kernel_light *kl = NULL;
     if (path != VSGL_SHADE_REFERENCE) {
         kl = malloc((set->count + 1) * sizeof *kl);
@@ -355,10 +368,13 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
             o->lv = v->sharpness;
             o->c0 = 1.0f / (TWO_PI * vsgl_sg_integral(v->sharpness));
             o->pr = v->power[0]; o->pg = v->power[1]; o->pb = v->power[2];
+            o->nx = v->normal.x; o->ny = v->normal.y; o->nz = v->normal.z;
+            o->hemi_weight = leak ? v->coherence * v->coherence : 0.0f;
+            o->hemi_scale = 1.0f / VSGL_LEAK_COSINE;
         }
     }
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
-                   (extent > 0.0f ? extent : 1.0f) * 1e-5f, 0, per_chunk, kl, path};
+                   (extent > 0.0f ? extent : 1.0f) * 1e-5f, 0, per_chunk, kl, path, leak};
     /* Rows in batches so progress can be reported and cancellation honoured. */
     size_t rows_per_batch = g->height / 20 + 1;
     vsgl_result r = VSGL_OK;

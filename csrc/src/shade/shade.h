@@ -31,6 +31,13 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
 #define VSGL_SHADE_KERNEL_SCALAR 1
 #define VSGL_SHADE_REFERENCE     2
 
+/* Emission cosine below which the leak correction fades a VSGL out. */
+#define VSGL_LEAK_COSINE 0.1f
+
+/* Emitter-hemisphere (leak) correction factor of VSGL v at receiver x, in
+ * [0, 1] (the kernel computes the same inline). */
+float vsgl__leak_factor(const vsgl_vsgl *v, v3 x);
+
 /* Shade every G-buffer sample with every VSGL; writes `planes`.
  * `pairs` receives the number of sample x VSGL evaluations. */
 vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
