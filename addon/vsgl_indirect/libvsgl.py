@@ -171,6 +171,12 @@ class Visibility(enum.IntEnum):
     RAY = 1
 
 
+class LeakCorrection(enum.IntEnum):
+    AUTO = 0
+    OFF = 1
+    ON = 2
+
+
 class Preset(enum.IntEnum):
     PREVIEW = 0
     BALANCED = 1
@@ -393,8 +399,9 @@ class vsgl_render_settings(_Struct):
         ("glossy_mode", _i32),
         ("visibility", _i32),
         ("seed", _u32),
+        ("leak_correction", _i32),
     ]
-    _enums = {"method": Method, "fit_mode": FitMode,
+    _enums = {"leak_correction": LeakCorrection, "method": Method, "fit_mode": FitMode,
               "sharpness_estimator": SharpnessEstimator, "diffuse_mode": CosineMode,
               "glossy_mode": GlossyMode, "visibility": Visibility}
 

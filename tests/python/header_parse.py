@@ -63,3 +63,20 @@ def structs():
                     fields.append(re.match(r"\s*\**\s*(\w+)", extra).group(1))
             out[name] = fields
     return out
+
+
+def defines():
+    """{name: value} of every integer/float #define VSGL_* in the headers."""
+    import re as _re
+    out = {}
+    for h in headers():
+        for m in _re.finditer(r"^#define\s+(VSGL_\w+)\s+([-+0-9.eExXa-fA-Fu]+)f?\b", open(h).read(), _re.M):
+            txt = m.group(2).rstrip("uU")
+            try:
+                out[m.group(1)] = int(txt, 0)
+            except ValueError:
+                try:
+                    out[m.group(1)] = float(txt.rstrip("fF"))
+                except ValueError:
+                    pass
+    return out

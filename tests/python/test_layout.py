@@ -136,3 +136,61 @@ def test_prototypes_match_headers():
                 continue
             problems.append("%s is bound but no header declares it" % name)
     assert not problems, "\n".join(problems)
+
+
+ENUM_PREFIXES = [
+    ("VSGL_LOG_", "LogLevel"), ("VSGL_COSINE_", "CosineMode"), ("VSGL_NDF_", "NDF"),
+    ("VSGL_LIGHT_", "LightType"), ("VSGL_AREA_", "AreaShape"), ("VSGL_CAMERA_", "CameraType"),
+    ("VSGL_SENSOR_FIT_", "SensorFit"), ("VSGL_METHOD_", "Method"), ("VSGL_FIT_", "FitMode"),
+    ("VSGL_GLOSSY_", "GlossyMode"), ("VSGL_VISIBILITY_", "Visibility"),
+    ("VSGL_PRESET_", "Preset"), ("VSGL_LEAK_", "LeakCorrection"),
+]
+SPECIAL = {
+    "VSGL_SHARPNESS_TOKSVIG": ("SharpnessEstimator", "TOKSVIG"),
+    "VSGL_SHARPNESS_BANERJEE": ("SharpnessEstimator", "BANERJEE"),
+    "VSGL_EXR_FLOAT": ("ExrPixelType", "FLOAT"), "VSGL_EXR_HALF": ("ExrPixelType", "HALF"),
+    "VSGL_EXR_ZIP": ("ExrCompression", "ZIP"), "VSGL_EXR_NONE": ("ExrCompression", "NONE"),
+    "VSGL_EXR_ZIPS": ("ExrCompression", "ZIPS"), "VSGL_EXR_PIZ": ("ExrCompression", "PIZ"),
+    "VSGL_OK": ("Result", "OK"),
+}
+SCALAR_CONSTANTS = {"VSGL_SHARPNESS_MAX": "SHARPNESS_MAX", "VSGL_ALPHA_MIN": "ALPHA_MIN",
+                    "VSGL_MATERIAL_UNSUPPORTED": "MATERIAL_UNSUPPORTED",
+                    "VSGL_EXR_MAX_CHANNELS": "EXR_MAX_CHANNELS"}
+
+
+def _binding_name(define):
+    if define in SPECIAL:
+        return SPECIAL[define]
+    if define.startswith("VSGL_ERROR_"):
+        return "Result", define[len("VSGL_"):]
+    for prefix, cls in ENUM_PREFIXES:
+        if define.startswith(prefix):
+            return cls, define[len(prefix):]
+    return None
+
+
+def test_constants_match_header_defines():
+    problems = []
+    seen = set()
+    for define, value in sorted(header_parse.defines().items()):
+        if define in SCALAR_CONSTANTS:
+            got = getattr(libvsgl, SCALAR_CONSTANTS[define])
+            if abs(got - value) > 1e-6 * abs(value):
+                problems.append("%s = %r, binding %r" % (define, value, got))
+            continue
+        target = _binding_name(define)
+        if target is None:
+            continue
+        cls_name, member = target
+        cls = getattr(libvsgl, cls_name)
+        seen.add((cls_name, member))
+        if member not in cls.__members__:
+            problems.append("%s (= %r) missing from libvsgl.%s" % (define, value, cls_name))
+        elif int(cls[member]) != value:
+            problems.append("%s = %r, binding %s.%s = %d" % (define, value, cls_name, member,
+                                                              int(cls[member])))
+    for _, cls_name in ENUM_PREFIXES + [("", "SharpnessEstimator"), ("", "Result")]:
+        for member in getattr(libvsgl, cls_name).__members__:
+            if (cls_name, member) not in seen:
+                problems.append("libvsgl.%s.%s has no #define in the headers" % (cls_name, member))
+    assert not problems, "\n".join(problems)
