@@ -194,3 +194,13 @@ def test_constants_match_header_defines():
             if (cls_name, member) not in seen:
                 problems.append("libvsgl.%s.%s has no #define in the headers" % (cls_name, member))
     assert not problems, "\n".join(problems)
+
+
+def test_versions_match_header():
+    d = header_parse.defines()
+    assert libvsgl.BINDING_VERSION == (d["VSGL_VERSION_MAJOR"], d["VSGL_VERSION_MINOR"]), \
+        "the headers are %d.%d: update BINDING_VERSION with the binding" % (
+            d["VSGL_VERSION_MAJOR"], d["VSGL_VERSION_MINOR"])
+    assert len(libvsgl.Result) == d["VSGL_RESULT_COUNT"]
+    if "VSGL_BUNDLE_VERSION_MAJOR" in d:
+        assert libvsgl.BUNDLE_VERSION == (d["VSGL_BUNDLE_VERSION_MAJOR"], d["VSGL_BUNDLE_VERSION_MINOR"])
