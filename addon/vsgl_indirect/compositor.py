@@ -25,15 +25,28 @@ def add_node_name(view_layer):
     return ADD_NODE % view_layer
 
 
-def placeholder(path, width, height):
+def placeholder(path, width, height, exclusive=False):
     """Write a black EXR with every pass so the Image node gets its sockets
-    before the real file exists (it is overwritten, or deleted on failure)."""
+    before the real file exists (it is overwritten, or deleted on failure).
+    ``exclusive``: never replace an existing file (another process may have
+    written that frame's real AOV meanwhile); returns False if one existed."""
     import numpy as np
     z = np.zeros((max(height, 1), max(width, 1), 3), np.float32)
     planes = {p: z for p in engine.PASS_NAMES}
     planes["alpha"] = np.zeros(z.shape[:2], np.float32)
     from .config import Options
-    engine.write_exr(path, planes, Options())
+    if not exclusive:
+        engine.write_exr(path, planes, Options())
+        return True
+    tmp = "%s.setup%d.exr" % (path[:-4] if path.endswith(".exr") else path, os.getpid())
+    engine.write_exr(tmp, planes, Options())
+    try:
+        os.link(tmp, path)      # atomic, fails if the file exists
+        return True
+    except FileExistsError:
+        return False
+    finally:
+        os.unlink(tmp)
 
 
 def _combined_socket(node):

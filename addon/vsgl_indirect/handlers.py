@@ -51,10 +51,11 @@ def setup_scene(scene, frame=None):
         path = runner.output_path(scene, layer, frame, options)
         try:
             engine.check_output_path(path)
-            if not os.path.exists(path):
-                # Blender creates the pass sockets from a real file.
-                compositor.placeholder(path, w, h)
+            # Blender creates the pass sockets from a real file; never
+            # replace one (a parallel process may have rendered this frame).
+            if not os.path.exists(path) and compositor.placeholder(path, w, h, exclusive=True):
                 _state["setup_files"].add(path)
+                _placeholder_mtimes[path] = os.path.getmtime(path)
             # One composite output: only the first rendered view layer's AOV is
             # added onto it; the others get their Image node to wire by hand.
             compositor.ensure(scene, layer, path, options.add_to_render and i == 0)
@@ -97,8 +98,9 @@ def on_render_init(scene, *args):
     if props is None or not props.enabled or not engine.can_render():
         return
     setup_scene(scene)
-    for p in _state["setup_files"]:
-        _placeholder_mtimes[p] = os.path.getmtime(p)
+    if scene.vsgl_indirect.add_to_render and not scene.render.use_compositing:
+        runner.report(scene.name, "WARNING", "compositing is off (Output Properties > Post "
+                      "Processing): the AOV files are written but not added to the render")
 
 
 @persistent
