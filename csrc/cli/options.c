@@ -178,6 +178,13 @@ int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
             continue;
         }
         /* Options with a value. */
+        int known = !strcmp(name, "-o") || !strcmp(name, "--output");
+        for (size_t k = 0; k < sizeof enum_opts / sizeof enum_opts[0]; ++k)
+            known |= !strcmp(name, enum_opts[k].name);
+        for (size_t k = 0; k < sizeof num_opts / sizeof num_opts[0]; ++k)
+            known |= !strcmp(name, num_opts[k].name);
+        if (!known)
+            return set_err(err, err_size, "unknown option '%s'%s (see vsgl --help)", name, "");
         if (!value) {
             if (i + 1 >= argc)
                 return set_err(err, err_size, "option %s needs a value%s", name, "");
@@ -213,8 +220,6 @@ int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
                 return 2;
             }
         }
-        if (!done)
-            return set_err(err, err_size, "unknown option '%s'%s (see vsgl --help)", name, "");
     }
     if (!o->scene_path)
         return set_err(err, err_size, "%s: no scene bundle given%s (see vsgl --help)", cmd, "");

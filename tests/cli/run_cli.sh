@@ -1,0 +1,228 @@
+#!/usr/bin/env bash
+# Tests of the command-line program build/vsgl: argument errors, bad bundles,
+# unwritable outputs, info, dry runs, renders read back with OpenImageIO,
+# progress on a terminal and not, cancellation. Scenes come from
+# tests/cli/make_scene.py, an independent writer of docs/bundle-format.md.
+#
+# Usage: tests/cli/run_cli.sh [name-substring]   (from anywhere)
+# Ends with "N passed, N failed"; exit status non-zero on any failure.
+set -uo pipefail
+cd "$(dirname "$0")/../.."
+ROOT=$PWD
+VSGL=${VSGL:-$ROOT/build/vsgl}
+PY=${PYTHON:-/usr/bin/python3}
+[ -x "$PY" ] || PY=python3
+FILTER=${1:-}
+pass=0; fail=0
+T=$(mktemp -d /tmp/vsgl_cli_XXXXXX)
+trap 'rm -rf "$T"' EXIT
+
+if [ ! -x "$VSGL" ]; then
+  make --no-print-directory build/vsgl >/dev/null 2>&1 || true
+fi
+if [ ! -x "$VSGL" ]; then
+  echo "run_cli.sh: $VSGL is missing and 'make build/vsgl' failed"
+  echo "0 passed, 1 failed"; exit 1
+fi
+have() { command -v "$1" >/dev/null 2>&1; }
+
+ok()  { pass=$((pass + 1)); printf 'PASS %s\n' "$1"; }
+bad() { fail=$((fail + 1)); printf 'FAIL %s\n' "$1"; shift; printf '    %s\n' "$@"; }
+want() { [ -z "$FILTER" ] || [[ "$1" == *"$FILTER"* ]]; }
+
+# run: execute the command, keep rc, stdout, stderr.
+run() { "$@" >"$T/out" 2>"$T/err"; rc=$?; }
+
+# expect_fail NAME RC SUBSTRING CMD...: exit status RC and exactly one stderr
+# line "vsgl: ...SUBSTRING...".
+expect_fail() {
+  local name=$1 code=$2 sub=$3; shift 3
+  want "$name" || return 0
+  run "$@"
+  local lines; lines=$(wc -l <"$T/err")
+  local line; line=$(head -1 "$T/err")
+  if [ "$rc" -eq "$code" ] && [ "$lines" -eq 1 ] && [[ "$line" == "vsgl: "* ]] && [[ "$line" == *"$sub"* ]]; then
+    ok "$name"
+  else
+    bad "$name" "command: $*" "want exit $code and one line 'vsgl: ...$sub...'" \
+        "got exit $rc, $lines stderr lines: $(head -3 "$T/err" | tr '\n' '|')"
+  fi
+}
+
+# expect_ok NAME CMD...: exit status 0.
+expect_ok() {
+  local name=$1; shift
+  run "$@"
+  if [ "$rc" -eq 0 ]; then return 0; fi
+  bad "$name" "command: $*" "exit $rc: $(head -3 "$T/err" | tr '\n' '|')"
+  return 1
+}
+
+SCENE=$T/scene.vsglb
+"$PY" tests/cli/make_scene.py "$SCENE" --width 64 --height 48 --output "$T/from_bundle.exr" --frame 7
+"$PY" tests/cli/make_scene.py "$T/nooutput.vsglb" --no-settings
+
+# ---- help and version -------------------------------------------------------
+if want help; then
+  if expect_ok help "$VSGL" --help && grep -q "usage: vsgl render SCENE.vsglb" "$T/out" && grep -q -- "--visibility" "$T/out"; then
+    ok help; else [ "$rc" -ne 0 ] || bad help "usage text missing: $(head -2 "$T/out")"; fi
+fi
+if want version; then
+  v=$("$VSGL" --version); rc=$?
+  if [ $rc -eq 0 ] && [[ "$v" =~ ^vsgl\ [0-9]+\.[0-9]+\.[0-9]+ ]] && [[ "$v" == *"bundle format 1.0"* ]]; then ok version
+  else bad version "got exit $rc: $v"; fi
+fi
+
+# ---- bad command lines: exit 2, one line -------------------------------------
+expect_fail args_none          2 "no command given"              "$VSGL"
+expect_fail args_unknown_cmd   2 "unknown command 'frobnicate'"  "$VSGL" frobnicate
+expect_fail args_unknown_opt   2 "unknown option '--bogus'"      "$VSGL" render "$SCENE" --bogus
+expect_fail args_missing_value 2 "option --aa needs a value"     "$VSGL" render "$SCENE" --aa
+expect_fail args_negative      2 "'-3' is not a whole number"    "$VSGL" render "$SCENE" --aa -3
+expect_fail args_junk_number   2 "'2x' is not a whole number"    "$VSGL" render "$SCENE" --rsm 2x
+expect_fail args_zero_vsgls    2 "'0' is not a whole number >= 1" "$VSGL" render "$SCENE" --vsgls 0
+expect_fail args_huge_number   2 "is not a whole number"         "$VSGL" render "$SCENE" --seed 99999999999
+expect_fail args_bad_enum      2 "'foo' is not one of two|fis|kmeans" "$VSGL" render "$SCENE" --fit=foo
+expect_fail args_bad_preset    2 "is not one of preview|balanced|quality" "$VSGL" render "$SCENE" --preset fast
+expect_fail args_flag_value    2 "option --half takes no value"  "$VSGL" render "$SCENE" --half=1
+expect_fail args_two_scenes    2 "unexpected argument"           "$VSGL" render "$SCENE" other.vsglb
+expect_fail args_no_scene      2 "no scene bundle given"         "$VSGL" render -o "$T/x.exr"
+expect_fail args_info_output   2 "info takes only"               "$VSGL" info "$SCENE" -o "$T/x.exr"
+expect_fail args_empty_output  2 "non-empty path"                "$VSGL" render "$SCENE" -o ""
+expect_fail no_output_path     2 "no output path"                "$VSGL" render "$T/nooutput.vsglb"
+
+# ---- bad bundles: exit 1, one line naming the problem ------------------------
+for kind in truncate magic version2 nan-position nan-power huge-count crc; do
+  "$PY" tests/cli/make_scene.py "$T/bad-$kind.vsglb" --break "$kind"
+done
+expect_fail bundle_missing   1 "No such file or directory"   "$VSGL" render "$T/none.vsglb" -o "$T/x.exr"
+expect_fail bundle_directory 1 "not a regular file"          "$VSGL" info "$T"
+expect_fail bundle_truncated 1 "truncated: header says"      "$VSGL" render "$T/bad-truncate.vsglb" -o "$T/x.exr"
+expect_fail bundle_magic     1 "wrong magic number"          "$VSGL" info "$T/bad-magic.vsglb"
+expect_fail bundle_version   1 "version 2.0, this library reads 1.x" "$VSGL" info "$T/bad-version2.vsglb"
+expect_fail bundle_nan_pos   1 "section POS  (positions): vertex 0 component 1 is NaN" "$VSGL" render "$T/bad-nan-position.vsglb" -o "$T/x.exr"
+expect_fail bundle_nan_power 1 "section LGHT (lights): light 0 field power is NaN" "$VSGL" info "$T/bad-nan-power.vsglb"
+expect_fail bundle_huge      1 "exceed the file"             "$VSGL" info "$T/bad-huge-count.vsglb"
+expect_fail bundle_crc       1 "CRC32 mismatch"              "$VSGL" info "$T/bad-crc.vsglb"
+if want bundle_no_output_file; then
+  if [ -e "$T/x.exr" ]; then bad bundle_no_output_file "a failed run created $T/x.exr"; else ok bundle_no_output_file; fi
+fi
+
+# ---- unwritable outputs: exit 1 before rendering, nothing created -------------
+mkdir -p "$T/adir"; : >"$T/afile"
+expect_fail out_missing_dir 1 "No such file or directory" "$VSGL" render "$SCENE" -o "$T/missing/x.exr"
+expect_fail out_is_dir      1 "is a directory"            "$VSGL" render "$SCENE" -o "$T/adir"
+expect_fail out_under_file  1 "not a directory"           "$VSGL" render "$SCENE" -o "$T/afile/x.exr"
+if want out_unwritable_dir && [ "$(id -u)" = 0 ] && have setpriv; then
+  mkdir -p "$T/ro"; chmod 0555 "$T/ro"; chmod 0755 "$T"
+  run setpriv --reuid=65534 --regid=65534 --clear-groups "$VSGL" render "$SCENE" -o "$T/ro/x.exr"
+  if [ "$rc" -eq 1 ] && [ "$(wc -l <"$T/err")" -eq 1 ] && grep -q "^vsgl: .*Permission denied" "$T/err" && [ -z "$(ls -A "$T/ro")" ]; then
+    ok out_unwritable_dir; else bad out_unwritable_dir "exit $rc: $(cat "$T/err")"; fi
+elif want out_unwritable_dir && [ "$(id -u)" != 0 ]; then
+  mkdir -p "$T/ro"; chmod 0555 "$T/ro"
+  expect_fail out_unwritable_dir 1 "Permission denied" "$VSGL" render "$SCENE" -o "$T/ro/x.exr"
+fi
+
+# ---- info ---------------------------------------------------------------------
+if want info; then
+  if expect_ok info "$VSGL" info "$SCENE"; then
+    miss=""
+    for l in "vertices: 20" "triangles: 10" "materials: 3" "lights: 1" "bounds: (-2, -2, 0) .. (2, 2, 4) m" \
+             "camera: perspective 64x48, lens 35 mm" "light 0: spot, power 500 W" "output: $T/from_bundle.exr" \
+             "frame: 7" "seed=3" "valid: yes (10 triangles kept"; do
+      grep -qF "$l" "$T/out" || miss="$miss [$l]"
+    done
+    if [ -z "$miss" ]; then ok info; else bad info "missing lines:$miss" "$(cat "$T/out")"; fi
+  fi
+fi
+
+# ---- dry run --------------------------------------------------------------------
+if want dry_run; then
+  if expect_ok dry_run "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --preset quality; then
+    if grep -q "dry run: .* would render 64x48 to $T/dry.exr with method=vsgl aa=3" "$T/out" && [ ! -e "$T/dry.exr" ]; then
+      ok dry_run; else bad dry_run "$(cat "$T/out")" "file exists: $([ -e "$T/dry.exr" ] && echo yes || echo no)"; fi
+  fi
+fi
+
+# ---- renders ----------------------------------------------------------------------
+PASSES="DiffInd GlossInd DiffCol GlossCol Diff Gloss Combined"
+if want render_float && expect_ok render_float "$VSGL" render "$SCENE" -o "$T/out.exr" --preset preview; then
+  errs=""
+  [ -s "$T/out.exr" ] || errs="$errs [no file]"
+  grep -q $'\r' "$T/err" && errs="$errs [carriage return on a non-terminal]"
+  grep -Eq '^vsgl: (gbuffer|rsm|fit|shade) \([0-9]+%\)$' "$T/err" || errs="$errs [no plain progress lines: $(head -2 "$T/err" | tr '\n' '|')]"
+  if have oiiotool; then
+    info=$(oiiotool --info -v "$T/out.exr" 2>&1)
+    grep -q "64 x   48, 22 channel, float openexr" <<<"$info" || errs="$errs [header: $(head -2 <<<"$info" | tr '\n' '|')]"
+    for p in $PASSES; do
+      grep -q "VSGL\.$p\.R" <<<"$info" || errs="$errs [no VSGL.$p.R]"
+    done
+    grep -q "VSGL.Combined.A" <<<"$info" || errs="$errs [no VSGL.Combined.A]"
+    grep -q 'vsgl.settings: "method=vsgl aa=1 rsm=128 fit=two' <<<"$info" || errs="$errs [settings metadata]"
+    stats=$(oiiotool --stats "$T/out.exr" 2>&1)
+    nan=$(grep "NanCount" <<<"$stats" | tr -s ' ' '\n' | grep -Ec '^[1-9]')
+    inf=$(grep "InfCount" <<<"$stats" | tr -s ' ' '\n' | grep -Ec '^[1-9]')
+    [ "$nan" -eq 0 ] && [ "$inf" -eq 0 ] || errs="$errs [non-finite: $nan NaN, $inf Inf channels]"
+    # Some indirect light reaches the floor: the maximum of DiffInd is positive.
+    mx=$(grep "Stats Max" <<<"$stats" | awk '{print $8}')   # 4th channel listed = DiffInd.R after Combined RGBA
+    awk -v m="$mx" 'BEGIN { exit !(m > 0) }' || errs="$errs [DiffInd.R max $mx not > 0]"
+  else
+    echo "    SKIP part of render_float: oiiotool not installed"
+  fi
+  if [ -z "$errs" ]; then ok render_float; else bad render_float "$errs"; fi
+fi
+
+if want render_half_verbose && expect_ok render_half_verbose "$VSGL" render "$SCENE" --half -v --preset preview; then
+  errs=""
+  [ -s "$T/from_bundle.exr" ] || errs="$errs [bundle's output path not used]"
+  for l in "vsgl: settings: method=vsgl" "vsgl: render " "gbuffer " "rsm " "fit " "shade " "vsgl: lights used 1, skipped 0" "(64x48, half)"; do
+    grep -qF "$l" "$T/err" || errs="$errs [stderr lacks '$l']"
+  done
+  if have oiiotool; then
+    oiiotool --info "$T/from_bundle.exr" 2>&1 | grep -q "22 channel, half openexr" || errs="$errs [not half: $(oiiotool --info "$T/from_bundle.exr" 2>&1)]"
+  fi
+  if [ -z "$errs" ]; then ok render_half_verbose; else bad render_half_verbose "$errs"; fi
+fi
+
+# A failed render (settings the library refuses) leaves an existing EXR untouched.
+if want render_failure_keeps_file && [ -s "$T/out.exr" ]; then
+  before=$(cksum <"$T/out.exr")
+  expect_fail render_failure_keeps_file 1 "aa_samples" "$VSGL" render "$SCENE" -o "$T/out.exr" --aa 1000
+  [ "$(cksum <"$T/out.exr")" = "$before" ] || bad render_failure_keeps_file_bytes "out.exr changed after a failed render"
+  [ -z "$(ls -A "$T" | grep '\.tmp-')" ] || bad render_failure_keeps_file_temp "temporary file left: $(ls -A "$T")"
+fi
+
+# Same pixels with 1 and 2 threads (the library promises determinism).
+if want render_deterministic && have oiiotool; then
+  if expect_ok render_deterministic "$VSGL" render "$SCENE" -o "$T/t1.exr" --threads 1 --fit fis --vsgls 16 &&
+     expect_ok render_deterministic "$VSGL" render "$SCENE" -o "$T/t2.exr" --threads 2 --fit fis --vsgls 16; then
+    h1=$(oiiotool --hash "$T/t1.exr" 2>&1 | grep -o 'SHA-1: [0-9A-F]*'); h2=$(oiiotool --hash "$T/t2.exr" 2>&1 | grep -o 'SHA-1: [0-9A-F]*')
+    if [ -n "$h1" ] && [ "$h1" = "$h2" ]; then ok render_deterministic; else bad render_deterministic "pixel hashes differ: $h1 vs $h2"; fi
+  fi
+fi
+
+# Progress on a terminal: one line updated with \r (script(1) provides the tty).
+if want render_tty_progress && have script; then
+  script -qfec "$VSGL render '$SCENE' -o '$T/tty.exr' --preset preview" /dev/null >"$T/tty.txt" 2>&1; rc=$?
+  if [ $rc -eq 0 ] && grep -q $'\rvsgl: shade' "$T/tty.txt" && ! grep -Eq '^vsgl: (gbuffer|rsm|fit|shade) \(' "$T/tty.txt"; then
+    ok render_tty_progress; else bad render_tty_progress "exit $rc: $(tr '\r' '~' <"$T/tty.txt" | head -3)"; fi
+fi
+
+# SIGINT cancels: exit 130, one line "vsgl: cancelled", no output file.
+if want render_cancel; then
+  "$PY" tests/cli/make_scene.py "$T/big.vsglb" --width 1920 --height 1080
+  "$VSGL" render "$T/big.vsglb" -o "$T/big.exr" --fit fis --vsgls 1024 --aa 2 2>"$T/err" &
+  pid=$!
+  sleep 1
+  kill -INT $pid
+  for _ in $(seq 1 120); do kill -0 $pid 2>/dev/null || break; sleep 0.25; done
+  if kill -0 $pid 2>/dev/null; then kill -9 $pid; wait $pid 2>/dev/null; bad render_cancel "still running 30 s after SIGINT"
+  else
+    wait $pid; rc=$?
+    if [ $rc -eq 130 ] && [ "$(tail -1 "$T/err")" = "vsgl: cancelled" ] && [ ! -e "$T/big.exr" ]; then ok render_cancel
+    else bad render_cancel "exit $rc, stderr: $(tr '\n' '|' <"$T/err")" "file: $([ -e "$T/big.exr" ] && echo exists || echo none)"; fi
+  fi
+fi
+
+echo "$pass passed, $fail failed"
+[ $fail -eq 0 ]
