@@ -3,13 +3,22 @@
 #include "vsgl/sg.h"
 #include "math/sg_internal.h"
 
-/* Coefficients of t(l) = l sqrt(0.5 (l^2 + A l + B) / (l^3 + C l^2 + D l + E)),
- * least squares over l in [0.05, 5000] (tools/fit_cosine_sharpness.py). */
-#define T_A 2.60394758f
-#define T_B 19.70572125f
-#define T_C 3.99182425f
-#define T_D 15.73260592f
-#define T_E 87.201855f
+/* Fitted functions of the sharpness l (least squares of the integral's
+ * error over A(l), 45 l in [0.05, 5000] x 162 cosines;
+ * tools/fit_cosine_sharpness.py):
+ *   t(l)     = l sqrt(0.5 (l^2 + T_A l + T_B) / (l^3 + T_C l^2 + T_D l + T_E))
+ *   kappa(l) = -((K_A1 + K_A2 l) / (1 + K_B1 l + K_B2 l^2)) / t(l)
+ * and the even correction shape psi(x) = (x^2 - K_PSI) e^{-x^2}. */
+#define T_A 2.8147853f
+#define T_B 3.33731626f
+#define T_C 4.48710224f
+#define T_D 13.6221047f
+#define T_E 15.3642132f
+#define K_A1 0.0124395234f
+#define K_A2 0.00415145935f
+#define K_B1 (-0.184176817f)
+#define K_B2 0.081110396f
+#define K_PSI (-1.2510562f)
 
 /* erf(x) = 1 - P(x) exp(-x^2) for x >= 0 (Abramowitz & Stegun 7.1.26,
  * |error| <= 1.5e-7): returns P so the caller shares the exponential. */
@@ -39,7 +48,9 @@ float vsgl__sg_cosine_accurate(float l, float c)
     float u = (-em * (2.0f + em) / l) * vsgl__sg_mean_length(l);
 
     /* Interpolation weight s(c) in [0, 1], s(1) = 1, s(-1) = 0, odd part c/2
-     * exact; even part from a Gaussian model of w.n with fitted t(l). */
+     * exact; even part from a Gaussian model of w.n with fitted t(l), plus
+     * an even correction kappa (psi(t c) - psi(t)) that keeps all three
+     * constraints (docs/math.md 3.2). */
     float t = l * sqrtf(0.5f * ((l + T_A) * l + T_B) / (((l + T_C) * l + T_D) * l + T_E));
     t = t > 1e-30f ? t : 1e-30f;
     float ac = fabsf(c);
@@ -49,6 +60,8 @@ float vsgl__sg_cosine_accurate(float l, float c)
     float omc2 = (1.0f - ac) * (1.0f + ac);
     float s = (c > 0.0f ? c : 0.0f) - 0.5f * ac * erfc_poly(x) * ex + 0.5f * erfc_poly(t) * et
             + (ex - et) * (0.28209479177387814f / t); /* 1 / (2 sqrt(pi)) */
+    float kappa = -((K_A1 + K_A2 * l) / (1.0f + l * (K_B1 + K_B2 * l))) / t;
+    s += kappa * ((x * x - K_PSI) * ex - (t * t - K_PSI) * et);
     s = s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f;
     float r = VSGL__2PI * (low + u * s);
 
