@@ -126,3 +126,15 @@ def test_other_exception_in_progress_is_logged_and_ignored(lib, caplog):
         images, stats = _render(ctx)
     assert images["combined"].shape == (12, 16, 3)
     assert any("progress callback" in r.getMessage() for r in caplog.records)
+
+
+def test_warnings_reach_the_log_callback(lib):
+    require(lib, "vsgl_scene_create")
+    lines = []
+    s = floor_and_wall()
+    s["indices"] = np.vstack([s["indices"], [[0, 0, 1]]]).astype(np.uint32)  # degenerate
+    with L.Context(log=lambda level, msg: lines.append((level, msg)), log_level="warning") as ctx:
+        L.Scene(ctx, **s).close()
+    assert any(level == L.LogLevel.WARNING and "triangle 4" in msg for level, msg in lines), lines
+    # (log_level 0 is both VSGL_LOG_ERROR and "default = warnings and errors"
+    # in vsgl_context_desc, so errors-only cannot be requested)

@@ -164,3 +164,16 @@ def test_binding_does_not_import_bpy_or_use_star_imports():
     src = open(os.path.join(ADDON, "libvsgl.py")).read()
     assert "import bpy" not in src and "from ctypes import *" not in src
     assert not re.search(r"^\s*from \.", src, re.M), "no relative imports: the tests import the module directly"
+
+
+def test_wrappers_raise_missing_symbol_from_an_incomplete_library(tmp_path, monkeypatch):
+    maj, mnr = libvsgl.BINDING_VERSION
+    fake = libvsgl.load_library(_fake_library(tmp_path, maj * 10000 + mnr * 100))
+    monkeypatch.setattr(libvsgl, "_lib", fake)
+    for call, symbol in [(lambda: libvsgl.sg_integral(1.0), "vsgl_sg_integral"),
+                         (lambda: libvsgl.asg_eval(libvsgl.ASG([1, 0, 0], [0, 1, 0], [0, 0, 1], 1, 1),
+                                                   [0, 0, 1]), "vsgl_asg_eval"),
+                         (lambda: libvsgl.Context(), "vsgl_context_create")]:
+        with pytest.raises(libvsgl.VsglMissingSymbolError) as e:
+            call()
+        assert e.value.symbol == symbol and symbol in str(e.value)
