@@ -46,23 +46,29 @@ int main(int argc, char **argv)
         size_t n = (size_t)W * H * 3;
         printf("### Scene %d: %s\n\nreference %.2f s; mean diffuse %.4g, mean glossy %.4g\n\n", k, name, now() - t0,
                mean(ref.diffuse, n), mean(ref.glossy, n));
-        printf("| fit | VSGLs/light | diffuse mode | estimator | VSGLs | relMSE diffuse | relMSE glossy | mean glossy | shade s |\n");
-        printf("|---|---|---|---|---|---|---|---|---|\n");
+        printf("| fit | VSGLs/light | diffuse mode | estimator | leak corr. | VSGLs | relMSE diffuse | relMSE glossy | mean glossy | shade s |\n");
+        printf("|---|---|---|---|---|---|---|---|---|---|\n");
         s.method = VSGL_METHOD_VSGL;
         for (int f = 0; f < 3; ++f)
             for (int c = 0; c < (f == 0 ? 1 : 6); ++c)
                 for (int d = 0; d < 3; ++d)
-                    for (int e = 0; e < 2; ++e) {
-                        if ((d != VSGL_COSINE_ACCURATE || e != 0) && !(f == 1 && c == 3))
-                            continue; /* mode/estimator sweep only at one point */
+                    for (int e = 0; e < 3; ++e) {
+                        /* e: 0 Toksvig, 1 Banerjee, 2 Toksvig without leak correction */
+                        if ((d != VSGL_COSINE_ACCURATE || e != 0) && !(f == 1 && c == 3) &&
+                            !(e == 2 && d == VSGL_COSINE_ACCURATE && f > 0 && c >= 3))
+                            continue; /* mode/estimator/leak sweep only at a few points */
+                        if (e == 2 && f == 0)
+                            continue;
+                        s.leak_correction = e == 2 ? VSGL_LEAK_OFF : VSGL_LEAK_AUTO;
                         s.fit_mode = f;
                         s.vsgl_count = f == 0 ? 1 : counts[c];
                         s.diffuse_mode = d;
-                        s.sharpness_estimator = e;
+                        s.sharpness_estimator = e == 1 ? VSGL_SHARPNESS_BANERJEE : VSGL_SHARPNESS_TOKSVIG;
                         if (!acc_render(k, W, H, &s, &got, &st))
                             return 1;
-                        printf("| %s | %u | %s | %s | %u | %.4g | %.4g | %.4g | %.3f |\n", fit_names[f],
-                               f == 0 ? 2 : counts[c], diff_names[d], e ? "banerjee" : "toksvig", st.vsgl_count,
+                        printf("| %s | %u | %s | %s | %s | %u | %.4g | %.4g | %.4g | %.3f |\n", fit_names[f],
+                               f == 0 ? 2 : counts[c], diff_names[d], e == 1 ? "banerjee" : "toksvig",
+                               (e == 2 || f == 0) ? "off" : "on", st.vsgl_count,
                                acc_relmse(got.diffuse, ref.diffuse, n), acc_relmse(got.glossy, ref.glossy, n),
                                mean(got.glossy, n), st.seconds_shade);
                         acc_free(&got);
