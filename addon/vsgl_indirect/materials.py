@@ -106,6 +106,11 @@ def map_material(desc):
         spec = "Specular" if desc.version < (4, 0, 0) else "Specular IOR Level"
         note_links(["Base Color", "Metallic", "Roughness", spec, "IOR",
                     "Anisotropic", "Anisotropic Rotation"])
+        ec = "Emission" if desc.version < (4, 0, 0) else "Emission Color"
+        if float(inp.get("Emission Strength", 0.0)) > 0.0 and \
+                max(list(inp.get(ec, (0.0, 0.0, 0.0)))[:3]) > 0.0:
+            warnings.append("%s: emission is not a light source for the indirect AOV "
+                            "(use a light)" % who)
         tw = "Transmission" if desc.version < (4, 0, 0) else "Transmission Weight"
         if float(inp.get(tw, 0.0)) > 0.0:
             warnings.append("%s: transmission is not modelled (treated as opaque)" % who)

@@ -287,3 +287,22 @@ def test_geometry_nodes_and_particle_instances(scene):
     # Hair instances sit on the emitter (x in [9, 11]).
     hx = sd.positions[(sd.positions[:, 0] > 8.5)][:, 0]
     assert hx.min() >= 9 - 0.2 and hx.max() <= 11 + 0.2
+
+
+def test_light_blackbody_and_nodes_warning(scene):
+    camera(scene)
+    link(scene, plane("Floor", 4))
+    lamp = light(scene, "POINT", "Warm", 10.0, color=(1, 1, 1))
+    if "use_temperature" in lamp.data.bl_rna.properties:      # 4.5+
+        lamp.data.use_temperature = True
+        lamp.data.temperature = 3000.0
+        expect = tuple(lamp.data.temperature_color)
+    else:
+        expect = (1.0, 1.0, 1.0)
+    lamp.data.use_nodes = True
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    assert sd.lights[0]["color"] == pytest.approx(expect, rel=1e-5)
+    if expect != (1.0, 1.0, 1.0):
+        assert expect[2] < expect[0]    # 3000 K is reddish: independent sanity
+    assert any("'Warm'" in w and "node" in w for w in sd.warnings)

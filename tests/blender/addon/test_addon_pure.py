@@ -100,3 +100,13 @@ def test_exr_writer_layout(tmp_path):
     assert np.array_equal(ch["VSGL.DiffInd.G"], a[:, :, 1])
     assert np.array_equal(ch["VSGL.Combined.A"], c[:, :, 3])
     assert not [f for f in os.listdir(str(tmp_path)) if "tmp" in f]
+
+
+@pytest.mark.parametrize("version,color", [((3, 4, 1), "Emission"), ((4, 2, 0), "Emission Color")])
+def test_principled_emission_warns(version, color):
+    _, w = materials.map_material(desc(materials.PRINCIPLED, {
+        "Emission Strength": 2.0, color: (1, 1, 1, 1)}, version))
+    assert len(w) == 1 and "emission" in w[0] and "'M'" in w[0]
+    _, w = materials.map_material(desc(materials.PRINCIPLED, {
+        "Emission Strength": 1.0, color: (0, 0, 0, 1)}, version))
+    assert w == []
