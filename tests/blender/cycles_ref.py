@@ -63,15 +63,20 @@ MATS = {
 }
 TOPCAM = dict(type="ORTHO", ortho_scale=4.0, loc=(0, 0, 5), rot=(0, 0, 0), res=(96, 96))
 
+# name, light, analytic DiffDir (= E/pi) at the floor point below the light (None: no closed form used)
+_C25_10 = math.cos(math.radians(25)) * math.cos(math.radians(10))
 LIGHT_CASES = [
-    ("point", dict(type="POINT", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0))),
-    ("spot_90_blend03", dict(type="SPOT", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), spot_size=90, spot_blend=0.3)),
-    ("spot_tilted_60", dict(type="SPOT", energy=100.0, loc=(-0.5, 0, 2), rot=(0, 20, 0), spot_size=60, spot_blend=0.25)),
-    ("sun_3w_tilted", dict(type="SUN", energy=3.0, loc=(0, 0, 3), rot=(25, 10, 0))),
-    ("area_square_05", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="SQUARE", size=0.5)),
-    ("area_rect_tilted", dict(type="AREA", energy=100.0, loc=(0.3, 0, 1.5), rot=(30, 0, 15), shape="RECTANGLE", size=0.6, size_y=0.3)),
-    ("area_disk_spread90", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="DISK", size=0.4, spread=90)),
-    ("area_ellipse_spread150", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(10, 0, 0), shape="ELLIPSE", size=0.5, size_y=0.2, spread=150)),
+    ("point", dict(type="POINT", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0)), 100 / (4 * math.pi ** 2 * 4)),
+    ("spot_90_blend03", dict(type="SPOT", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), spot_size=90, spot_blend=0.3),
+     100 / (4 * math.pi ** 2 * 4)),
+    ("spot_tilted_60", dict(type="SPOT", energy=100.0, loc=(-0.5, 0, 2), rot=(0, 20, 0), spot_size=60, spot_blend=0.25), None),
+    ("sun_3w_tilted", dict(type="SUN", energy=3.0, loc=(0, 0, 3), rot=(25, 10, 0)), 3.0 * _C25_10 / math.pi),
+    ("area_square_5cm", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="SQUARE", size=0.05),
+     100 / (4 * math.pi * 4)),
+    ("area_square_05", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="SQUARE", size=0.5), None),
+    ("area_rect_tilted", dict(type="AREA", energy=100.0, loc=(0.3, 0, 1.5), rot=(30, 0, 15), shape="RECTANGLE", size=0.6, size_y=0.3), None),
+    ("area_disk_spread90", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="DISK", size=0.1, spread=90), None),
+    ("area_ellipse_spread150", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(10, 0, 0), shape="ELLIPSE", size=0.15, size_y=0.06, spread=150), None),
 ]
 
 
@@ -424,16 +429,19 @@ def suite_lights(lib, ctx, out_dir, report):
                   "Tolerance per point: %.0f %% or 3 standard errors, whichever is larger; the error "
                   "combines Cycles' noise (pixel residual against a 3x3 mean) and the RSM's own "
                   "sampling error (batch means over the four texel parity classes; only area lights, "
-                  "whose VPL origins are spread over the light, show one).\n" % (KERNEL_W, RSM_RES_LIGHT, TOL_LIGHT * 100))
-    report.append("| case | Cycles E at centre (W/m^2) | max rel. diff (1-sigma there) | mean rel. diff | points | RSM time (s) | result |")
-    report.append("|---|---|---|---|---|---|---|")
-    for name, ls in LIGHT_CASES:
+                  "whose VPL origins are spread over the light, show one). Where a closed form exists, "
+                  "Cycles' DiffDir at the point below the light (mean of the 2x2 centre pixels) must "
+                  "match it within 0.3 %%.\n" % (KERNEL_W, RSM_RES_LIGHT, TOL_LIGHT * 100))
+    report.append("| case | Cycles DiffDir below the light | analytic | RSM-implied E vs Cycles: max rel. diff (1-sigma there) | mean rel. diff | points | RSM time (s) | result |")
+    report.append("|---|---|---|---|---|---|---|---|")
+    for name, ls, analytic in LIGHT_CASES:
         case = dict(geometry=FLOOR, lights=[ls], camera=TOPCAM)
         ob, lights, co, mats = build_blender(case)
         spp = 256 if ls["type"] == "AREA" else 128  # delta lights: only pixel-filter noise
         cyc, secs = cycles_cached("light_" + name, case, ["DiffDir"], out_dir, spp)
         E_cyc = math.pi * cyc["DiffDir"][:, :, 0]  # white light: channels equal
         h, w = E_cyc.shape
+        dd_centre = float(cyc["DiffDir"][h // 2 - 1:h // 2 + 1, w // 2 - 1:w // 2 + 1, 0].mean())
         xs = (np.arange(w) + 0.5) / w * 4.0 - 2.0
         ys = 2.0 - (np.arange(h) + 0.5) / h * 4.0  # row 0 = top = +y
         X, Y = np.meshgrid(xs, ys)
@@ -481,14 +489,18 @@ def suite_lights(lib, ctx, out_dir, report):
         bad = [e for e in errs if e[0] > max(TOL_LIGHT, 3 * e[5] / e[4])]
         worst = max(errs) if errs else (0, 0, 0, 0, 0, 0)
         ok = not bad and len(errs) > 0
+        if analytic is not None:  # Cycles itself against the closed form (GUIDE section 5)
+            ok = ok and abs(dd_centre / analytic - 1) < 0.003
         passed += ok
         failed += not ok
-        line = "| %s | %.4f | %.3f %% at (%.1f, %.1f) (%.2f %%) | %.3f %% | %d | %.2f | %s |" % (
-            name, centre, 100 * worst[0], worst[1], worst[2], 100 * worst[5] / max(worst[4], 1e-12),
+        line = "| %s | %.4f | %s | %.3f %% at (%.1f, %.1f) (%.2f %%) | %.3f %% | %d | %.2f | %s |" % (
+            name, dd_centre, "-" if analytic is None else "%.4f" % analytic, 100 * worst[0], worst[1], worst[2], 100 * worst[5] / max(worst[4], 1e-12),
             100 * np.mean([e[0] for e in errs]), len(errs), rsecs, "PASS" if ok else "FAIL")
         report.append(line)
-        print(("PASS " if ok else "FAIL ") + "light %s: worst %.3f %% (RSM %.4f vs Cycles %.4f at %.1f,%.1f)%s" % (
-            name, 100 * worst[0], worst[3], worst[4], worst[1], worst[2],
+        print(("PASS " if ok else "FAIL ") + "light %s: worst %.3f %% (RSM %.4f vs Cycles %.4f at %.1f,%.1f); "
+              "Cycles DiffDir below the light %.4f (analytic %s)%s" % (
+            name, 100 * worst[0], worst[3], worst[4], worst[1], worst[2], dd_centre,
+            "-" if analytic is None else "%.4f" % analytic,
             "" if secs is None else " [Cycles rendered in %.1f s]" % secs))
     report.append("")
     return passed, failed

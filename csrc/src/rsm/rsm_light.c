@@ -225,20 +225,36 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
         if (l->type == VSGL_LIGHT_POINT) {
             w = *beam / (4.0 * PI_D);
         } else {
-            for (int j = 0; j < SUB; ++j)
-                for (int i = 0; i < SUB; ++i) {
-                    double a0 = x0 + (x1 - x0) * i / SUB, a1 = x0 + (x1 - x0) * (i + 1) / SUB;
-                    double b0 = y0 + (y1 - y0) * j / SUB, b1 = y0 + (y1 - y0) * (j + 1) / SUB;
-                    double xm = 0.5 * (a0 + a1), ym = 0.5 * (b0 + b1);
-                    double inv = 1.0 / sqrt(1.0 + xm * xm + ym * ym);
-                    /* cosine to the spot axis (-Z): component along local z */
-                    double lz = (axis == 2 ? sign : (ua == 2 ? xm : (va == 2 ? ym : 0.0))) * inv;
-                    double c = -lz;
-                    double mk = spot_mask(l, c);
-                    if (mk > 0.0)
-                        w += mk * vsgl__rsm_rect_solid_angle(a0, a1, b0, b1);
-                }
-            w /= 4.0 * PI_D;
+            /* cosine to the spot axis (-Z) of plane point (x, y) */
+#define SPOT_COS(xx, yy) (-(axis == 2 ? sign : (ua == 2 ? (xx) : (va == 2 ? (yy) : 0.0))) / \
+                          sqrt(1.0 + (xx) * (xx) + (yy) * (yy)))
+            double c00 = SPOT_COS(x0, y0), c01 = SPOT_COS(x0, y1), c10 = SPOT_COS(x1, y0), c11 = SPOT_COS(x1, y1);
+            double cc = SPOT_COS(xc, yc);
+            double cmin = fmin(fmin(fmin(c00, c01), fmin(c10, c11)), cc);
+            double cmax = fmax(fmax(fmax(c00, c01), fmax(c10, c11)), cc);
+            if (cmax <= l->cos_half) {
+                w = 0.0; /* wholly outside the cone */
+            } else if (cmin >= l->cos_half + l->smooth) {
+                w = cc * *beam / (4.0 * PI_D); /* inside the blend: mask = cos, smooth */
+            } else {
+                /* straddles the cone edge or the blend: supersample the mask,
+                 * sub-rectangle solid angles from the (SUB+1)^2 corner values */
+                double F[SUB + 1][SUB + 1];
+                for (int j = 0; j <= SUB; ++j)
+                    for (int i = 0; i <= SUB; ++i) {
+                        double a = x0 + (x1 - x0) * i / SUB, b = y0 + (y1 - y0) * j / SUB;
+                        F[j][i] = atan2(a * b, sqrt(1.0 + a * a + b * b));
+                    }
+                for (int j = 0; j < SUB; ++j)
+                    for (int i = 0; i < SUB; ++i) {
+                        double xm = x0 + (x1 - x0) * (i + 0.5) / SUB, ym = y0 + (y1 - y0) * (j + 0.5) / SUB;
+                        double mk = spot_mask(l, SPOT_COS(xm, ym));
+                        if (mk > 0.0)
+                            w += mk * (F[j + 1][i + 1] - F[j][i + 1] - F[j + 1][i] + F[j][i]);
+                    }
+                w /= 4.0 * PI_D;
+            }
+#undef SPOT_COS
         }
         break;
     }
