@@ -28,7 +28,7 @@ if [ -d tests/python ] && ls tests/python/test_*.py >/dev/null 2>&1; then
   count "Python tests" "$log/py.txt" "${PIPESTATUS[0]}"
 fi
 
-for runner in tests/blender/run_*.sh; do
+for runner in tests/cli/run_*.sh tests/blender/run_*.sh; do
   [ -x "$runner" ] || continue
   echo "== $runner"
   "$runner" 2>&1 | tee "$log/bl.txt"; count "$runner" "$log/bl.txt" "${PIPESTATUS[0]}"
