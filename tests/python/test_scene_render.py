@@ -175,7 +175,8 @@ def test_render_settings_preset(lib):
     require(lib, "vsgl_render_settings_preset")
     for p in L.Preset:
         s = L.render_settings_preset(p)
-        assert s.size == L.ctypes.sizeof(L.vsgl_render_settings)
+        # the library's own sizeof (an older build of the same minor may know fewer fields)
+        assert 0 < s.size <= L.ctypes.sizeof(L.vsgl_render_settings)
     assert L.render_settings_preset(99).as_dict() == L.render_settings_preset("balanced").as_dict()
 
 
