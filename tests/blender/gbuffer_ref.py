@@ -39,6 +39,8 @@ TOL_POS_MEAN = 5e-4     # m: measured ~1.5e-4 (a constant ~0.001 px sample offse
 TOL_NRM_MAX = 0.5       # degrees
 TOL_NRM_MEAN = 0.05     # degrees
 TOL_COVERAGE = 0.985    # fraction of all pixels with the same hit/miss
+TOL_TAN_P995 = 1.0      # degrees, 99.5th percentile (radial tangents turn fast near the axis)
+TOL_TAN_MEAN = 0.1      # degrees
 
 CONFIGS = [
     # name, camera settings, render settings
@@ -75,6 +77,13 @@ def emission_material(name, rgb):
     e.inputs["Color"].default_value = (*rgb, 1.0)
     o = nt.nodes.new("ShaderNodeOutputMaterial")
     nt.links.new(e.outputs["Emission"], o.inputs["Surface"])
+    # the tangent Cycles gives an unlinked Principled "Tangent" socket: radial about local Z
+    t = nt.nodes.new("ShaderNodeTangent")
+    t.direction_type = "RADIAL"
+    t.axis = "Z"
+    a = nt.nodes.new("ShaderNodeOutputAOV")
+    a.name = "T"
+    nt.links.new(t.outputs["Tangent"], a.inputs["Color"])
     return m
 
 
@@ -121,6 +130,9 @@ def build_scene():
     vl = sc.view_layers[0]
     vl.use_pass_position = True
     vl.use_pass_normal = True
+    aov = vl.aovs.add()
+    aov.name = "T"
+    aov.type = "COLOR"
     s = sc.render.image_settings
     s.file_format = "OPEN_EXR_MULTILAYER"
     s.color_depth = "32"
@@ -212,7 +224,8 @@ def cycles_passes(exr):
     P = np.stack([find(".Position.X"), find(".Position.Y"), find(".Position.Z")], -1)
     N = np.stack([find(".Normal.X"), find(".Normal.Y"), find(".Normal.Z")], -1)
     A = find(".Combined.A")
-    return P, N, A
+    T = np.stack([find(".T.R"), find(".T.G"), find(".T.B")], -1)
+    return P, N, A, T
 
 
 # ---- export to flat arrays and the library via ctypes -------------------------
@@ -255,13 +268,17 @@ def load_lib(path):
     lib.vsgl_scene_destroy.restype = None
     lib.vsgl_debug_gbuffer.argtypes = [vp, vp, ctypes.c_uint32, vp, vp, vp]
     lib.vsgl_debug_gbuffer.restype = ctypes.c_int32
+    lib.vsgl_debug_gbuffer_frames.argtypes = [vp, vp, ctypes.c_uint32, vp, vp]
+    lib.vsgl_debug_gbuffer_frames.restype = ctypes.c_int32
     return lib
 
 
 def export_meshes(objects):
-    """World-space triangles, corner (split) normals and a material per object."""
+    """World-space triangles, corner (split) normals, corner tangents (Cycles'
+    default radial-Z tangent from generated coordinates, unnormalised) and a
+    material per object."""
     dg = bpy.context.evaluated_depsgraph_get()
-    pos, idx, nrm, mat = [], [], [], []
+    pos, idx, nrm, mat, tan = [], [], [], [], []
     base = 0
     for oi, ob in enumerate(objects):
         ev = ob.evaluated_get(dg)
@@ -271,7 +288,14 @@ def export_meshes(objects):
         M = np.array(ev.matrix_world, dtype=np.float64)
         co = np.empty(len(me.vertices) * 3, np.float64)
         me.vertices.foreach_get("co", co)
-        co = co.reshape(-1, 3) @ M[:3, :3].T + M[:3, 3]
+        co = co.reshape(-1, 3)
+        # generated coordinates g = (co - texspace_location) / (2 texspace_size) + 0.5
+        loc = np.array(ob.data.texspace_location, np.float64)
+        size = np.array(ob.data.texspace_size, np.float64)
+        g = (co - loc) / (2.0 * size)                     # g - 0.5
+        t_obj = np.stack([-g[:, 1], g[:, 0], np.zeros(len(g))], -1)
+        t_world = t_obj @ np.linalg.inv(M[:3, :3])       # normal transform (inverse transpose)
+        co = co @ M[:3, :3].T + M[:3, 3]
         lt = np.empty(len(me.loop_triangles) * 3, np.int64)
         me.loop_triangles.foreach_get("vertices", lt)
         tl = np.empty(len(me.loop_triangles) * 3, np.int64)
@@ -283,11 +307,14 @@ def export_meshes(objects):
         pos.append(co)
         idx.append(lt.reshape(-1, 3) + base)
         nrm.append(ln[tl].reshape(-1, 9))
+        tc = np.concatenate([t_world[lt], np.ones((len(lt), 1))], -1)   # (3T, 4): xyz + sign
+        tan.append(tc.reshape(-1, 12))
         mat.append(np.full(len(me.loop_triangles), oi, np.uint32))
         base += len(co)
         ev.to_mesh_clear()
     return (np.ascontiguousarray(np.concatenate(pos), np.float32), np.ascontiguousarray(np.concatenate(idx), np.uint32),
-            np.ascontiguousarray(np.concatenate(nrm), np.float32), np.ascontiguousarray(np.concatenate(mat), np.uint32))
+            np.ascontiguousarray(np.concatenate(nrm), np.float32), np.ascontiguousarray(np.concatenate(mat), np.uint32),
+            np.ascontiguousarray(np.concatenate(tan), np.float32))
 
 
 def export_camera(sc, cam):
@@ -309,7 +336,7 @@ def export_camera(sc, cam):
 
 
 def library_gbuffer(lib, arrays, cam, nmat):
-    pos, idx, nrm, mat = arrays
+    pos, idx, nrm, mat, tan = arrays
     mats = (Material * nmat)()
     ctx = ctypes.c_void_p()
     if lib.vsgl_context_create(None, ctypes.byref(ctx)) != 0:
@@ -321,6 +348,7 @@ def library_gbuffer(lib, arrays, cam, nmat):
     d.triangle_count = len(idx)
     d.indices = idx.ctypes.data
     d.corner_normals = nrm.ctypes.data
+    d.corner_tangents = tan.ctypes.data
     d.material_indices = mat.ctypes.data
     d.material_count = nmat
     d.materials = ctypes.addressof(mats)
@@ -333,18 +361,26 @@ def library_gbuffer(lib, arrays, cam, nmat):
     P = np.zeros((h, w, 3), np.float32)
     N = np.zeros((h, w, 3), np.float32)
     Mi = np.zeros((h, w), np.uint32)
+    T = np.zeros((h, w, 3), np.float32)
     r = lib.vsgl_debug_gbuffer(ctx, scene, 1, P.ctypes.data, N.ctypes.data, Mi.ctypes.data)
+    if r == 0:
+        r = lib.vsgl_debug_gbuffer_frames(ctx, scene, 1, T.ctypes.data, None)
     msg = lib.vsgl_context_last_error(ctx).decode()
     lib.vsgl_scene_destroy(scene)
     lib.vsgl_context_destroy(ctx)
     if r != 0:
         raise RuntimeError("vsgl_debug_gbuffer: %d %s" % (r, msg))
-    return P, N, Mi
+    return P, N, Mi, T
 
 
 # ---- comparison ------------------------------------------------------------------
 
-def compare(P, N, Mi, Pc, Nc, Ac):
+def angle_deg(a, b):
+    """Angle between unit vectors via half the chord (stable for small angles)."""
+    return np.degrees(2.0 * np.arcsin(np.clip(np.linalg.norm(a - b, axis=1) / 2.0, 0.0, 1.0)))
+
+
+def compare(P, N, Mi, Pc, Nc, Ac, T, Tc):
     ours = Mi != 0xFFFFFFFF
     theirs = Ac > 0.5
     coverage = float(np.mean(ours == theirs))
@@ -356,15 +392,22 @@ def compare(P, N, Mi, Pc, Nc, Ac):
             interior &= pad[dy:dy + h, dx:dx + w] == Mi
     sel = ours & theirs & interior
     if not np.any(sel):
-        return dict(coverage=coverage, n=0, total=int(ours.size), pmax=float("nan"), pmean=float("nan"), amax=float("nan"), amean=float("nan"))
+        nan = float("nan")
+        return dict(coverage=coverage, n=0, total=int(ours.size), pmax=nan, pmean=nan, amax=nan, amean=nan, tn=0,
+                    tmax=nan, tmean=nan)
     perr = np.linalg.norm(P[sel].astype(np.float64) - Pc[sel], axis=1)
     a = N[sel].astype(np.float64)
     b = Nc[sel].astype(np.float64)
     b /= np.maximum(np.linalg.norm(b, axis=1, keepdims=True), 1e-30)
-    # angle via half the chord (stable for small angles)
-    ang = np.degrees(2.0 * np.arcsin(np.clip(np.linalg.norm(a - b, axis=1) / 2.0, 0.0, 1.0)))
+    ang = angle_deg(a, b)
+    # tangents: skip where Cycles' radial tangent is ill-defined (near the axis: |T| small)
+    tc = Tc[sel].astype(np.float64)
+    tl = np.linalg.norm(tc, axis=1)
+    ok = tl > 0.5
+    tang = angle_deg(T[sel][ok].astype(np.float64), tc[ok] / tl[ok, None]) if np.any(ok) else np.array([np.nan])
     return dict(coverage=coverage, n=int(sel.sum()), total=int(ours.size), pmax=float(perr.max()),
-                pmean=float(perr.mean()), amax=float(ang.max()), amean=float(ang.mean()))
+                pmean=float(perr.mean()), amax=float(ang.max()), amean=float(ang.mean()),
+                tn=int(ok.sum()), tmax=float(np.percentile(tang, 99.5)), tmean=float(tang.mean()))
 
 
 def main():
@@ -377,8 +420,9 @@ def main():
     lib = load_lib(args["--lib"])
     sc, cam, objects = build_scene()
     passed = failed = 0
-    lines = ["| configuration | pixels | coverage match | interior px | pos max (m) | pos mean (m) | normal max (deg) | normal mean (deg) | result |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| configuration | pixels | coverage match | interior px | pos max (m) | pos mean (m) | normal max (deg) | "
+             "normal mean (deg) | tangent p99.5 (deg) | tangent mean (deg) | result |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, cam_opts, res in CONFIGS:
         configure(sc, cam, cam_opts, res)
         exr = os.path.join(cache, name + ".exr")
@@ -387,24 +431,26 @@ def main():
             bpy.ops.render.render(write_still=True)
             if not os.path.exists(exr):
                 raise RuntimeError("render did not write " + exr)
-        Pc, Nc, Ac = cycles_passes(read_exr(exr))
+        Pc, Nc, Ac, Tc = cycles_passes(read_exr(exr))
         camera = export_camera(sc, cam)
         if Pc.shape[:2] != (camera.height, camera.width):
             raise RuntimeError("%s: Cycles image %s, camera %dx%d" % (name, Pc.shape, camera.width, camera.height))
-        P, N, Mi = library_gbuffer(lib, export_meshes(objects), camera, len(objects))
-        s = compare(P, N, Mi, Pc, Nc, Ac)
+        P, N, Mi, T = library_gbuffer(lib, export_meshes(objects), camera, len(objects))
+        s = compare(P, N, Mi, Pc, Nc, Ac, T, Tc)
         ok = (s["n"] > 0.3 * s["total"] and s["coverage"] >= TOL_COVERAGE and s["pmax"] <= TOL_POS_MAX and
-              s["pmean"] <= TOL_POS_MEAN and s["amax"] <= TOL_NRM_MAX and s["amean"] <= TOL_NRM_MEAN)
+              s["pmean"] <= TOL_POS_MEAN and s["amax"] <= TOL_NRM_MAX and s["amean"] <= TOL_NRM_MEAN and
+              s["tn"] > 0.5 * s["n"] and s["tmax"] <= TOL_TAN_P995 and s["tmean"] <= TOL_TAN_MEAN)
         passed += ok
         failed += not ok
-        lines.append("| %s | %dx%d | %.4f | %d | %.2e | %.2e | %.3f | %.4f | %s |" % (
+        lines.append("| %s | %dx%d | %.4f | %d | %.2e | %.2e | %.3f | %.4f | %.3f | %.4f | %s |" % (
             name, camera.width, camera.height, s["coverage"], s["n"], s["pmax"], s["pmean"], s["amax"], s["amean"],
-            "pass" if ok else "FAIL"))
+            s["tmax"], s["tmean"], "pass" if ok else "FAIL"))
         print("gbuffer_ref %s: %s" % (name, lines[-1]), flush=True)
     report = "\n".join(lines) + "\n"
     tol = ("Tolerances: coverage match >= %.3f; interior pixels (3x3 neighbourhood on one object) >= 30%% of the image, "
-           "position max <= %g m, mean <= %g m; normal angle max <= %g deg, mean <= %g deg.\n"
-           % (TOL_COVERAGE, TOL_POS_MAX, TOL_POS_MEAN, TOL_NRM_MAX, TOL_NRM_MEAN))
+           "position max <= %g m, mean <= %g m; normal angle max <= %g deg, mean <= %g deg; tangent angle "
+           "(where Cycles' |T| > 0.5, >= half the interior pixels) 99.5th percentile <= %g deg, mean <= %g deg.\n"
+           % (TOL_COVERAGE, TOL_POS_MAX, TOL_POS_MEAN, TOL_NRM_MAX, TOL_NRM_MEAN, TOL_TAN_P995, TOL_TAN_MEAN))
     with open(os.path.join(out, "report.md"), "w") as f:
         f.write(report + "\n" + tol)
     with open(os.path.join(out, "summary.txt"), "w") as f:

@@ -296,6 +296,15 @@ VT_TEST(gbuffer_progress_cancel_and_debug_copy)
         for (int c = 0; c < 3; ++c)
             same &= pos[e * 3 + c] == g.pos[c][e] && nrm[e * 3 + c] == g.nrm[c][e] && mat[e] == g.material[e];
     VT_CHECK(same, "debug copy differs");
+    float *tg = malloc(n * 12), *vw = malloc(n * 12);
+    VT_CHECK(vsgl_debug_gbuffer_frames(ctx, s, 1, tg, vw) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    same = 1;
+    for (size_t e = 0; e < n; ++e)
+        for (int c = 0; c < 3; ++c)
+            same &= tg[e * 3 + c] == g.tan[c][e] && vw[e * 3 + c] == g.view[c][e];
+    VT_CHECK(same, "debug frames copy differs");
+    VT_CHECK(vsgl_debug_gbuffer_frames(ctx, NULL, 1, tg, vw) == VSGL_ERROR_INVALID_ARGUMENT, "NULL scene");
+    free(tg); free(vw);
     VT_CHECK(vsgl_debug_gbuffer(ctx, s, 1, NULL, NULL, NULL) == VSGL_OK, "all outputs NULL");
     VT_CHECK(vsgl_debug_gbuffer(ctx, NULL, 1, pos, NULL, NULL) == VSGL_ERROR_INVALID_ARGUMENT, "NULL scene");
     vsgl__gbuffer_free(&g);

@@ -34,6 +34,20 @@ extern "C" {
 VSGL_API vsgl_result vsgl_debug_gbuffer(vsgl_context *ctx, const vsgl_scene *scene, uint32_t aa,
                                         float *positions, float *normals, uint32_t *materials);
 
+/**
+ * @brief Like ::vsgl_debug_gbuffer, for the shading frame: same samples,
+ * same element order.
+ *
+ * @param[out] tangents  NULL or count*3 floats: unit tangent orthogonal to the
+ *                       shading normal (corner tangents, else UV dP/du, else
+ *                       an edge; material's anisotropic rotation applied), 0 where missed.
+ * @param[out] views     NULL or count*3 floats: unit direction from the point
+ *                       towards the camera (set for misses too: minus the ray direction).
+ * @return as ::vsgl_debug_gbuffer.
+ */
+VSGL_API vsgl_result vsgl_debug_gbuffer_frames(vsgl_context *ctx, const vsgl_scene *scene, uint32_t aa,
+                                               float *tangents, float *views);
+
 #ifdef __cplusplus
 }
 #endif
