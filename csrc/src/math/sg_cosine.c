@@ -3,22 +3,18 @@
 #include "vsgl/sg.h"
 #include "math/sg_internal.h"
 
-/* Fitted functions of the sharpness l (least squares of the integral's
- * error over A(l), 45 l in [0.05, 5000] x 162 cosines;
- * tools/fit_cosine_sharpness.py):
- *   t(l)     = l sqrt(0.5 (l^2 + T_A l + T_B) / (l^3 + T_C l^2 + T_D l + T_E))
- *   kappa(l) = -((K_A1 + K_A2 l) / (1 + K_B1 l + K_B2 l^2)) / t(l)
- * and the even correction shape psi(x) = (x^2 - K_PSI) e^{-x^2}. */
-#define T_A 2.8147853f
-#define T_B 3.33731626f
-#define T_C 4.48710224f
-#define T_D 13.6221047f
-#define T_E 15.3642132f
-#define K_A1 0.0124395234f
-#define K_A2 0.00415145935f
-#define K_B1 (-0.184176817f)
-#define K_B2 0.081110396f
-#define K_PSI (-1.2510562f)
+/* Shorthands for the fitted constants (sg_internal.h, shared with the
+ * shading kernel). */
+#define T_A VSGL__COS_T_A
+#define T_B VSGL__COS_T_B
+#define T_C VSGL__COS_T_C
+#define T_D VSGL__COS_T_D
+#define T_E VSGL__COS_T_E
+#define K_A1 VSGL__COS_K_A1
+#define K_A2 VSGL__COS_K_A2
+#define K_B1 VSGL__COS_K_B1
+#define K_B2 VSGL__COS_K_B2
+#define K_PSI VSGL__COS_K_PSI
 
 /* erf(x) = 1 - P(x) exp(-x^2) for x >= 0 (Abramowitz & Stegun 7.1.26,
  * |error| <= 1.5e-7): returns P so the caller shares the exponential. */

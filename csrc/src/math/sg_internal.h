@@ -15,6 +15,22 @@
  * argmin over l of the L2 norm on the sphere of max(w.n,0)/pi - G(w;n,l)/A(l). */
 #define VSGL__COSINE_SHARPNESS 2.29250405f
 
+/* Fitted constants of the ACCURATE SG x clamped-cosine form (docs/math.md
+ * 3.2, tools/fit_cosine_sharpness.py), shared with the shading kernel:
+ *   t(l)     = l sqrt(0.5 (l^2 + T_A l + T_B) / (l^3 + T_C l^2 + T_D l + T_E))
+ *   kappa(l) = -((K_A1 + K_A2 l) / (1 + K_B1 l + K_B2 l^2)) / t(l)
+ *   s(c)    += kappa(l) (psi(t c) - psi(t)),  psi(x) = (x^2 - K_PSI) e^{-x^2} */
+#define VSGL__COS_T_A 2.8147853f
+#define VSGL__COS_T_B 3.33731626f
+#define VSGL__COS_T_C 4.48710224f
+#define VSGL__COS_T_D 13.6221047f
+#define VSGL__COS_T_E 15.3642132f
+#define VSGL__COS_K_A1 0.0124395234f
+#define VSGL__COS_K_A2 0.00415145935f
+#define VSGL__COS_K_B1 (-0.184176817f)
+#define VSGL__COS_K_B2 0.081110396f
+#define VSGL__COS_K_PSI (-1.2510562f)
+
 /* NaN/negative -> 0; +inf and > VSGL_SHARPNESS_MAX -> VSGL_SHARPNESS_MAX. */
 float vsgl__sg_clamp_sharpness(float lambda);
 /* A(lambda) / (2 pi) = (1 - e^{-2 lambda}) / lambda (2 at 0); lambda >= 0. */
