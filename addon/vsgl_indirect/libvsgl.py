@@ -595,6 +595,7 @@ PROTOTYPES = (
     ("vsgl_bundle_get_info", _i32, [_VP, _P(vsgl_bundle_info)]),
     # debug.h
     ("vsgl_debug_gbuffer", _i32, [_VP, _VP, _u32, _PF32, _PF32, _PU32]),
+    ("vsgl_debug_gbuffer_frames", _i32, [_VP, _VP, _u32, _PF32, _PF32]),
     # reference.h
     ("vsgl_reference_rsm", _i32, [_VP, _VP, _u32, _u32, _P(ctypes.c_size_t), _PF32, _PF32,
                                   _PF32, _PF32, _PU32]),
@@ -1581,6 +1582,19 @@ def debug_gbuffer(ctx, scene, aa=1):
                                      nrm.ctypes.data_as(_PF32), mat.ctypes.data_as(_PU32))
     ctx.check(rc, "vsgl_debug_gbuffer")
     return {"positions": pos, "normals": nrm, "materials": mat}
+
+
+def debug_gbuffer_frames(ctx, scene, aa=1):
+    """The shading frames of the same samples as :func:`debug_gbuffer`:
+    ``tangents`` and ``views`` float32 (H, W, aa*aa, 3)."""
+    aa = int(aa) or 1
+    H, W, S = scene.height, scene.width, aa * aa
+    tan = np.zeros((H, W, S, 3), np.float32)
+    view = np.zeros((H, W, S, 3), np.float32)
+    rc = ctx._lib.vsgl_debug_gbuffer_frames(ctx.handle, scene.handle, aa,
+                                            tan.ctypes.data_as(_PF32), view.ctypes.data_as(_PF32))
+    ctx.check(rc, "vsgl_debug_gbuffer_frames")
+    return {"tangents": tan, "views": view}
 
 
 # --------------------------------------------------------------------------

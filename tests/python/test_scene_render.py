@@ -223,3 +223,20 @@ def test_debug_gbuffer_hits_the_scene(lib, ctx):
     on_wall = np.abs(p[:, 1] - 2) < 1e-4
     assert np.all(on_floor | on_wall)
     np.testing.assert_allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-5)
+
+
+def test_debug_gbuffer_frames(lib, ctx):
+    require(lib, "vsgl_scene_create", "vsgl_debug_gbuffer", "vsgl_debug_gbuffer_frames")
+    require_complete(lib)
+    scene = L.Scene(ctx, **floor_and_wall())
+    g = L.debug_gbuffer(ctx, scene, aa=1)
+    f = L.debug_gbuffer_frames(ctx, scene, aa=1)
+    hit = g["materials"] != 0xFFFFFFFF
+    t, n, v = f["tangents"][hit], g["normals"][hit], f["views"][hit]
+    np.testing.assert_allclose(np.linalg.norm(t, axis=1), 1.0, atol=1e-5)
+    np.testing.assert_allclose(np.sum(t * n, axis=1), 0.0, atol=1e-5)
+    np.testing.assert_allclose(np.linalg.norm(f["views"], axis=-1), 1.0, atol=1e-5)
+    # the view direction points from the surface point to the camera at (0, -6, 1.5)
+    to_cam = np.array([0, -6, 1.5]) - g["positions"][hit]
+    to_cam /= np.linalg.norm(to_cam, axis=1, keepdims=True)
+    np.testing.assert_allclose(v, to_cam, atol=1e-4)
