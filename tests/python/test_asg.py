@@ -261,3 +261,28 @@ def test_sg_to_asg_eq3(lib, rng):
         assert np.allclose(F[2], R.unit(np.array(g.axis)), atol=2e-7 * 4), a
         assert a.lam == pytest.approx(g.sharpness / 2, rel=1e-6) and a.mu == pytest.approx(a.lam, rel=1e-6)
         assert a.log_amplitude == g.log_amplitude
+
+
+@pytest.mark.parametrize("lam,mu", [(0.0, 0.0), (1e30, 1e30), (1e30, 0.0), (-5.0, 2.0)])
+def test_asg_extreme_bandwidths_are_finite(lib, lam, mu):
+    require(lib, "vsgl_asg_eval", "vsgl_asg_integral", "vsgl_asg_convolve_sg",
+            "vsgl_asg_sg_product_integral")
+    a = L.ASG([1, 0, 0], [0, 1, 0], [0, 0, 1], lam, mu, 0.0)
+    assert L.asg_eval(a, [0, 0, 1]) == pytest.approx(1.0, rel=1e-6)  # the peak is c, always
+    for d in ([0.3, 0.1, 0.9], [1, 0, 0]):
+        v = L.asg_eval(a, d)
+        assert math.isfinite(v) and 0 <= v <= 1.0 + 1e-6
+    v = L.asg_integral(a)
+    assert math.isfinite(v) and v >= 0
+    g = L.SG([0, 0, 1], 10.0, 0.0)
+    c = L.asg_convolve_sg(a, g)
+    assert all(math.isfinite(x) for x in (c.lam, c.mu)) and c.lam >= 0 and c.mu >= 0
+    v = L.asg_sg_product_integral(a, g)
+    assert math.isfinite(v) and v >= 0
+
+
+@pytest.mark.parametrize("a", [-1.0, 1e30])
+def test_bessel_f_extremes(lib, a):
+    require(lib, "vsgl_asg_bessel_f")
+    v = L.asg_bessel_f(a)
+    assert math.isfinite(v) and 0 <= v <= 2 * math.pi * (1 + 1e-6), (a, v)

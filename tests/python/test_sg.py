@@ -338,3 +338,14 @@ def test_mean_length_from_sharpness(lib, lam):
     # Toksvig round trip
     r = L.mean_length_from_sharpness(lam, "toksvig")
     assert L.sharpness_from_mean_length(r, "toksvig") == pytest.approx(l32, rel=1e-5 * (1 + l32))
+
+
+def test_zero_lobes_propagate(lib):
+    """sg.h: a zero axis gives a zero-lobe result; -inf log-amplitude is an exact zero."""
+    require(lib, "vsgl_sg_product", "vsgl_sg_product_integral", "vsgl_sg_lobe_integral")
+    live = L.SG([0, 0, 1], 4.0, 0.3)
+    for dead in (L.SG([0, 0, 0], 4.0, 0.0), L.SG([0, 1, 0], 4.0, -math.inf)):
+        p = L.sg_product(live, dead)
+        assert L.sg_lobe_integral(p) == 0.0, p
+        assert L.sg_product_integral(live, dead) == 0.0
+        assert L.sg_product_integral(dead, live) == 0.0
