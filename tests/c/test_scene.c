@@ -395,6 +395,21 @@ VT_TEST(scene_drops_degenerate_triangles_with_a_warning)
         }
     }
     vsgl_scene_destroy(s);
+    /* every triangle degenerate: a valid scene that hits nothing */
+    for (int i = 0; i < 8 * 3; ++i)
+        f.positions[i] = 1.0f;
+    s = NULL;
+    r = vsgl_scene_create(ctx, &f.desc, &s);
+    VT_CHECK(r == VSGL_OK, "all degenerate: %d '%s'", r, vsgl_context_last_error(ctx));
+    if (s) {
+        vsgl_scene_info info;
+        vsgl_scene_get_info(s, &info);
+        VT_CHECK(info.triangle_count == 0 && info.dropped_triangles == 4 && info.bounds_min[0] == 0 && info.bounds_max[2] == 0,
+                 "kept %u dropped %u", info.triangle_count, info.dropped_triangles);
+        vsgl_hit h;
+        VT_CHECK(!vsgl__scene_intersect(s, v3_make(0, 0, 5), v3_make(0, 0, -1), 0.0f, 100.0f, &h), "hit in an empty scene");
+    }
+    vsgl_scene_destroy(s);
     vsgl_context_destroy(ctx);
 }
 
