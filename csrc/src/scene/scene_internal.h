@@ -51,7 +51,7 @@ void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, v
 const vsgl_material *vsgl__scene_materials(const vsgl_scene *scene, uint32_t *count);
 const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count);
 const vsgl_camera *vsgl__scene_camera(const vsgl_scene *scene);
-/* Bounding box of the valid triangles. */
+/* Bounding box of the valid triangles; lo = hi = (0,0,0) when there are none. */
 void vsgl__scene_bounds(const vsgl_scene *scene, v3 *lo, v3 *hi);
 
 #endif
