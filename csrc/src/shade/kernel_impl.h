@@ -7,6 +7,7 @@
  * with vsgl_specular_factor at the integrand's axis (docs/math.md). */
 #include "shade/kernel.h"
 #include "vsgl/sg.h"
+#include "math/sg_internal.h" /* the accurate cosine form's fitted constants */
 
 #include <math.h>
 #include <string.h>
@@ -66,20 +67,27 @@ static inline __attribute__((always_inline)) float k_cosine_accurate(float l, fl
     float q = small > 0.0f ? q_t : (-em - l * e1) * il2;
     float low = e1 * q;
     /* vMF mean length coth(l) - 1/l */
+    /* vMF mean length coth(l) - 1/l = (1 - 1/l) + 2 e^{-2l} / (1 - e^{-2l}); series below 1
+     * (vsgl__sg_mean_length) */
+    float below1 = l < 1.0f ? 1.0f : 0.0f;
     float e2 = e1 * e1;
-    float ml_c = (1.0f + e2) / (1.0f - e2 + (small > 0.0f ? 1.0f : 0.0f)) - 1.0f / ls;
+    float ml_c = (1.0f - 1.0f / ls) + 2.0f * e2 / (1.0f - e2 + below1);
     float l2 = l * l;
-    float ml_t = l * (1.0f / 3.0f - l2 * (1.0f / 45.0f - l2 * (2.0f / 945.0f - l2 * (1.0f / 4725.0f))));
-    float ml = small > 0.0f ? ml_t : ml_c;
+    float ml_t = l * (1.0f / 3.0f + l2 * (-1.0f / 45.0f + l2 * (2.0f / 945.0f + l2 * (-1.0f / 4725.0f
+               + l2 * (2.0f / 93555.0f + l2 * (-1382.0f / 638512875.0f + l2 * (4.0f / 18243225.0f
+               + l2 * (-3617.0f / 162820783125.0f + l2 * (87734.0f / 38979295480125.0f)))))))));
+    float ml = below1 > 0.0f ? ml_t : ml_c;
     float u = (-em * (2.0f + em) / ls) * ml;
-    float t = l * sqrtf(0.5f * ((l + 2.60394758f) * l + 19.70572125f) /
-                        (((l + 3.99182425f) * l + 15.73260592f) * l + 87.201855f));
+    float t = l * sqrtf(0.5f * ((l + VSGL__COS_T_A) * l + VSGL__COS_T_B) /
+                        (((l + VSGL__COS_T_C) * l + VSGL__COS_T_D) * l + VSGL__COS_T_E));
     t = t > 1e-30f ? t : 1e-30f;
     float ac = fabsf(c);
     float x = t * ac;
     float ex = k_exp(-x * x), et = k_exp(-t * t);
     float s = (c > 0.0f ? c : 0.0f) - 0.5f * ac * k_erfc_poly(x) * ex + 0.5f * k_erfc_poly(t) * et
             + (ex - et) * (0.28209479177387814f / t);
+    float kappa = -((VSGL__COS_K_A1 + VSGL__COS_K_A2 * l) / (1.0f + l * (VSGL__COS_K_B1 + VSGL__COS_K_B2 * l))) / t;
+    s += kappa * ((x * x - VSGL__COS_K_PSI) * ex - (t * t - VSGL__COS_K_PSI) * et);
     s = s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f;
     float r = K_2PI * (low + u * s);
     float omc2 = (1.0f - ac) * (1.0f + ac);
