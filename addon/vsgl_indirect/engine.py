@@ -169,7 +169,7 @@ def exr_passes(planes):
     return out
 
 
-def write_exr(path, planes, options, metadata=None):
+def write_exr(path, planes, options, metadata=None, warnings=None):
     """Write the planes as a multilayer EXR (library writer if built, else exr.py)."""
     passes = exr_passes(planes)
     bad = [n for n, a in passes.items() if not np.all(np.isfinite(a))]
@@ -181,6 +181,7 @@ def write_exr(path, planes, options, metadata=None):
         use_lib = lib.has("vsgl_exr_write") and not getattr(lib, "undefined", ())
     except Exception:
         use_lib = False
+    fallback = ""
     try:
         if use_lib:
             ctx = libvsgl.Context()
@@ -188,6 +189,13 @@ def write_exr(path, planes, options, metadata=None):
                 libvsgl.exr_write(ctx, path, passes, layer=LAYER,
                                   pixel_type="half" if options.half_float else "float",
                                   metadata=metadata)
+            except libvsgl.VsglError as e:
+                if e.code != libvsgl.Result.ERROR_INTERNAL:
+                    raise
+                # OpenEXR itself refused: keep the AOV, say so.
+                fallback = ("libvsgl's EXR writer failed (%s); '%s' written by the add-on's "
+                            "own writer instead" % (e, path))
+                exr.write_multilayer_exr(path, passes, layer=LAYER, half=options.half_float)
             finally:
                 ctx.close()
         else:
@@ -196,6 +204,8 @@ def write_exr(path, planes, options, metadata=None):
         raise AovError("cannot write '%s': %s" % (path, e.strerror or e))
     except Exception as e:
         raise AovError("cannot write '%s': %s" % (path, e))
+    if warnings is not None and fallback:
+        warnings.append(fallback)
     return path
 
 
@@ -222,7 +232,7 @@ def compute(sd, options, path, progress=None, keep_planes=False, metadata=None):
         if p in planes and np.asarray(planes[p]).shape[:2] != (sd.height, sd.width):
             raise AovError("renderer returned %s of size %s, camera is %dx%d"
                            % (p, np.asarray(planes[p]).shape[:2], sd.width, sd.height))
-    write_exr(path, planes, options, metadata)
+    write_exr(path, planes, options, metadata, res.warnings)
     t2 = time.perf_counter()
     res.path = path
     res.stats = dict(stats or {})

@@ -53,12 +53,18 @@ def setup_scene(scene, frame=None):
             engine.check_output_path(path)
             # Blender creates the pass sockets from a real file; never
             # replace one (a parallel process may have rendered this frame).
-            if not os.path.exists(path) and compositor.placeholder(path, w, h, exclusive=True):
-                _state["setup_files"].add(path)
+            made = not os.path.exists(path) and compositor.placeholder(path, w, h, exclusive=True)
+            if made:
                 _placeholder_mtimes[path] = os.path.getmtime(path)
-            # One composite output: only the first rendered view layer's AOV is
-            # added onto it; the others get their Image node to wire by hand.
-            compositor.ensure(scene, layer, path, options.add_to_render and i == 0)
+            try:
+                # One composite output: only the first rendered view layer's AOV is
+                # added onto it; the others get their Image node to wire by hand.
+                compositor.ensure(scene, layer, path, options.add_to_render and i == 0)
+            finally:
+                # The sockets stay; a black file must not look like an AOV.
+                if made and os.path.exists(path) and _is_placeholder(path):
+                    os.unlink(path)
+                    _placeholder_mtimes.pop(path, None)
         except engine.AovError as e:
             errors.append("view layer '%s': %s" % (layer, e))
         except Exception as e:

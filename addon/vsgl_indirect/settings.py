@@ -5,6 +5,21 @@ from bpy.props import BoolProperty, EnumProperty, IntProperty, PointerProperty, 
 from . import config
 
 
+def _update_compositor(self, context):
+    """Keep the compositor in step with the settings (main thread, UI edits)."""
+    from . import compositor, engine, handlers
+    scene = self.id_data
+    if not isinstance(scene, bpy.types.Scene):
+        return
+    try:
+        if not self.enabled:
+            compositor.remove(scene)
+        elif engine.can_render():
+            handlers.setup_scene(scene)
+    except Exception as e:  # never break a property edit
+        print("VSGL WARNING: compositor update failed: %r" % (e,))
+
+
 def _items(names, descriptions=None):
     descriptions = descriptions or {}
     return [(n, n.replace("_", " ").title(), descriptions.get(n, "")) for n in names]
@@ -12,11 +27,11 @@ def _items(names, descriptions=None):
 
 class VSGLIndirectSettings(bpy.types.PropertyGroup):
     enabled: BoolProperty(
-        name="Compute on Render", default=False,
+        name="Compute on Render", default=False, update=_update_compositor,
         description="Compute the indirect-light AOV of every rendered frame before it is "
                     "rendered and composited (F12, -f, -a)")
     add_to_render: BoolProperty(
-        name="Add to Render", default=True,
+        name="Add to Render", default=True, update=_update_compositor,
         description="Add the AOV's Combined pass onto the render in the compositor "
                     "(otherwise only the Image node is set up)")
     preset: EnumProperty(
@@ -47,6 +62,7 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
     seed: IntProperty(name="Seed", default=0, min=0)
     output_path: StringProperty(
         name="Output", subtype="FILE_PATH", default=config.DEFAULT_TEMPLATE,
+        update=_update_compositor,
         description="Per-frame multilayer EXR. {render_dir} = the render output's folder, "
                     "{scene}, {view_layer}; #### = frame number (must be the last digits)")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024,
