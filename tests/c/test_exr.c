@@ -607,3 +607,58 @@ VT_TEST(exr_failed_write_keeps_previous_file_and_deletes_temp)
     vsgl_context_destroy(ctx);
     remove_tree(dir);
 }
+
+VT_TEST(exr_parallel_encoding_is_identical_for_any_thread_count)
+{
+    /* 300 rows = 19 ZIP chunks: more than one batch of parallel encoding. */
+    enum { PW = 29, PH = 300 };
+    static float px[PW * PH * 3];
+    vt_rng rng = {99};
+    for (int i = 0; i < PW * PH * 3; ++i)
+        px[i] = (float)(vt_uniform(&rng) * 4.0);
+    char dir[64];
+    make_temp_dir(dir, sizeof dir);
+    unsigned char *first = NULL;
+    size_t first_n = 0;
+    for (uint32_t threads = 1; threads <= 3; ++threads) {
+        vsgl_context_desc cd;
+        memset(&cd, 0, sizeof cd);
+        cd.thread_count = threads;
+        vsgl_context *ctx = NULL;
+        vsgl_context_create(&cd, &ctx);
+        vsgl_render_output o;
+        memset(&o, 0, sizeof o);
+        o.width = PW;
+        o.height = PH;
+        o.glossy_light = px;
+        char path[128];
+        snprintf(path, sizeof path, "%s/t%u.exr", dir, threads);
+        VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_OK, "threads %u: %s", threads, vsgl_context_last_error(ctx));
+        decoded d;
+        VT_CHECK(decode_exr(path, &d) == 0 && d.count == 3, "decode threads %u", threads);
+        int bad = 0;
+        for (int c = 0; c < d.count; ++c) {
+            int ch = d.names[c][strlen(d.names[c]) - 1] == 'R' ? 0 : d.names[c][strlen(d.names[c]) - 1] == 'G' ? 1 : 2;
+            for (int i = 0; i < PW * PH && bad < 3; ++i)
+                if (d.planes[c][i] != px[i * 3 + ch]) {
+                    ++bad;
+                    VT_CHECK(0, "threads %u %s pixel %d: %g want %g", threads, d.names[c], i, d.planes[c][i], px[i * 3 + ch]);
+                }
+        }
+        free_decoded(&d);
+        unsigned char *bytes = NULL;
+        size_t n = 0;
+        read_file(path, &bytes, &n);
+        if (threads == 1) {
+            first = bytes;
+            first_n = n;
+        } else {
+            VT_CHECK(n == first_n && bytes && first && memcmp(bytes, first, n) == 0, "threads %u: file differs from 1 thread (%zu vs %zu bytes)",
+                     threads, n, first_n);
+            free(bytes);
+        }
+        vsgl_context_destroy(ctx);
+    }
+    free(first);
+    remove_tree(dir);
+}

@@ -2,10 +2,12 @@
 #include "vsgl/io.h"
 #include "core/context.h"
 #include "io/atomic.h"
+#include "core/parallel.h"
 
 #include <openexr.h>
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -59,6 +61,7 @@ typedef struct src_channel {
 
 typedef struct exr_sink {
     vsgl__atomic_file file;
+    pthread_mutex_t lock; /* guards message: encoding threads may report errors */
     char message[256];
 } exr_sink;
 
@@ -78,8 +81,10 @@ static void sink_error(exr_const_context_t c, exr_result_t code, const char *msg
     void *user = NULL;
     if (exr_get_user_data(c, &user) == EXR_ERR_SUCCESS && user) {
         exr_sink *s = user;
+        pthread_mutex_lock(&s->lock);
         if (!s->message[0])
             snprintf(s->message, sizeof s->message, "%s (%s)", msg ? msg : "", exr_get_error_code_as_string(code));
+        pthread_mutex_unlock(&s->lock);
     }
 }
 
@@ -155,6 +160,123 @@ static vsgl_result check_args(vsgl_context *ctx, uint32_t width, uint32_t height
     return VSGL_OK;
 }
 
+/* ---- chunk encoding, in parallel ------------------------------------------
+ * Chunks (16 scanlines for ZIP) are converted and compressed by worker
+ * threads, each with its own pipeline, into per-chunk buffers; the calling
+ * thread then writes them in increasing y, as the line order requires. */
+
+typedef struct chunk_out { unsigned char *data; uint64_t size; exr_result_t rv; } chunk_out;
+
+typedef struct encode_job {
+    exr_context_t e;
+    int part;
+    uint32_t width;
+    size_t bpe;
+    exr_pixel_type_t ptype;
+    const src_channel *chans;
+    uint32_t n;
+    const exr_chunk_info_t *infos; /* every chunk */
+    chunk_out *outs;               /* the current batch */
+    size_t batch_begin;
+} encode_job;
+
+/* The pipeline's last step: keep the compressed bytes instead of writing. */
+static exr_result_t capture_chunk(exr_encode_pipeline_t *enc)
+{
+    chunk_out *out = enc->encoding_user_data;
+    const void *src = enc->compressed_buffer;
+    uint64_t size = enc->compressed_bytes;
+    if (!src || !size) {
+        src = enc->packed_buffer;
+        size = enc->packed_bytes;
+    }
+    out->data = malloc(size ? (size_t)size : 1);
+    if (!out->data)
+        return EXR_ERR_OUT_OF_MEMORY;
+    memcpy(out->data, src, (size_t)size);
+    out->size = size;
+    return EXR_ERR_SUCCESS;
+}
+
+static exr_result_t no_wait(exr_encode_pipeline_t *enc)
+{
+    (void)enc;
+    return EXR_ERR_SUCCESS;
+}
+
+static int32_t encode_chunks(void *user, size_t chunk, size_t begin, size_t end)
+{
+    (void)chunk;
+    encode_job *j = user;
+    for (size_t k = begin; k < end; ++k) {
+        chunk_out *out = &j->outs[k - j->batch_begin];
+        const exr_chunk_info_t *ci = &j->infos[k];
+        exr_encode_pipeline_t enc;
+        memset(&enc, 0, sizeof enc);
+        exr_result_t rv = exr_encoding_initialize(j->e, j->part, ci, &enc);
+        if (rv) {
+            out->rv = rv;
+            return 1;
+        }
+        uint32_t rows = (uint32_t)ci->height, y0 = (uint32_t)ci->start_y;
+        size_t plane = (size_t)j->width * rows * j->bpe;
+        unsigned char *scratch = malloc(plane * j->n);
+        if (!scratch)
+            rv = EXR_ERR_OUT_OF_MEMORY;
+        for (int16_t c = 0; c < enc.channel_count && !rv; ++c) {
+            exr_coding_channel_info_t *ch = &enc.channels[c];
+            uint32_t i = 0;
+            while (i < j->n && strcmp(j->chans[i].name, ch->channel_name) != 0)
+                ++i;
+            if (i == j->n) {
+                rv = EXR_ERR_INVALID_ARGUMENT;
+                break;
+            }
+            unsigned char *dst = scratch + (size_t)i * plane;
+            const src_channel *s = &j->chans[i];
+            for (uint32_t r = 0; r < rows; ++r) {
+                const float *row = s->data + (size_t)(y0 + r) * j->width * s->stride;
+                unsigned char *d = dst + (size_t)r * j->width * j->bpe;
+                if (j->bpe == 2) {
+                    for (uint32_t x = 0; x < j->width; ++x) {
+                        uint16_t h = float_to_half(row[(size_t)x * s->stride]);
+                        memcpy(d + 2 * (size_t)x, &h, 2);
+                    }
+                } else {
+                    for (uint32_t x = 0; x < j->width; ++x)
+                        memcpy(d + 4 * (size_t)x, &row[(size_t)x * s->stride], 4);
+                }
+            }
+            ch->encode_from_ptr = dst;
+            ch->user_pixel_stride = (int32_t)j->bpe;
+            ch->user_line_stride = (int32_t)(j->width * j->bpe);
+            ch->user_bytes_per_element = (int16_t)j->bpe;
+            ch->user_data_type = (uint16_t)j->ptype;
+        }
+        if (!rv)
+            rv = exr_encoding_choose_default_routines(j->e, j->part, &enc);
+        if (!rv) {
+            enc.write_fn = capture_chunk;
+            enc.yield_until_ready_fn = no_wait; /* order is kept by the writing thread */
+            enc.encoding_user_data = out;
+            rv = exr_encoding_run(j->e, j->part, &enc);
+        }
+        exr_encoding_destroy(j->e, &enc);
+        free(scratch);
+        if (rv) {
+            out->rv = rv;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int32_t encode_chunks_batch(void *user, size_t chunk, size_t begin, size_t end)
+{
+    encode_job *j = user;
+    return encode_chunks(user, chunk, j->batch_begin + begin, j->batch_begin + end);
+}
+
 /* Header and pixels into an open sink. */
 static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path, uint32_t width, uint32_t height,
                              const src_channel *chans, uint32_t n, const vsgl_exr_options *o)
@@ -170,22 +292,18 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
 
     static const exr_compression_t comp[] = {EXR_COMPRESSION_ZIP, EXR_COMPRESSION_NONE, EXR_COMPRESSION_ZIPS, EXR_COMPRESSION_PIZ};
     exr_pixel_type_t ptype = o->pixel_type == VSGL_EXR_HALF ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT;
-    size_t bpe = ptype == EXR_PIXEL_HALF ? 2 : 4;
     int part = 0;
     const char *what = "header";
     vsgl_result result = VSGL_OK;
-    unsigned char *scratch = NULL;
-    exr_encode_pipeline_t enc;
-    memset(&enc, 0, sizeof enc);
-    int enc_live = 0;
+    exr_chunk_info_t *infos = NULL;
+    chunk_out *outs = NULL;
+    size_t batch = 0;
 
     rv = exr_add_part(e, NULL, EXR_STORAGE_SCANLINE, &part);
     if (!rv)
         rv = exr_initialize_required_attr_simple(e, part, (int32_t)width, (int32_t)height, comp[o->compression]);
-    for (uint32_t i = 0; i < n && !rv; ++i) {
-        int r = exr_add_channel(e, part, chans[i].name, ptype, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
-        rv = r;
-    }
+    for (uint32_t i = 0; i < n && !rv; ++i)
+        rv = exr_add_channel(e, part, chans[i].name, ptype, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     if (!rv)
         rv = exr_attr_set_string(e, part, "vsgl.version", vsgl_version_string());
     for (uint32_t i = 0; i < o->metadata_count && !rv; ++i) {
@@ -202,67 +320,41 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
     if (rv)
         goto exr_error;
 
-    int32_t lines = 0;
     what = "pixels";
+    int32_t lines = 0;
     rv = exr_get_scanlines_per_chunk(e, part, &lines);
     if (rv)
         goto exr_error;
-    scratch = malloc((size_t)n * width * (size_t)lines * bpe);
-    if (!scratch) {
-        result = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "%s: out of memory for %d scanlines", path, lines);
+    size_t nchunks = (height + (uint32_t)lines - 1) / (uint32_t)lines;
+    uint32_t threads = vsgl_context_thread_count(ctx);
+    batch = 8u * threads;
+    infos = calloc(nchunks, sizeof *infos);
+    outs = calloc(batch, sizeof *outs);
+    if (!infos || !outs) {
+        result = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
         goto done;
     }
-    for (uint32_t y0 = 0; y0 < height; y0 += (uint32_t)lines) {
-        exr_chunk_info_t ci;
-        rv = exr_write_scanline_chunk_info(e, part, (int)y0, &ci);
-        if (rv)
-            goto exr_error;
-        rv = enc_live ? exr_encoding_update(e, part, &ci, &enc) : exr_encoding_initialize(e, part, &ci, &enc);
-        if (rv)
-            goto exr_error;
-        int first = !enc_live;
-        enc_live = 1;
-        uint32_t rows = (uint32_t)ci.height;
-        for (int16_t c = 0; c < enc.channel_count; ++c) {
-            exr_coding_channel_info_t *ch = &enc.channels[c];
-            uint32_t k = 0;
-            while (k < n && strcmp(chans[k].name, ch->channel_name) != 0)
-                ++k;
-            if (k == n) {
-                result = vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "%s: OpenEXR reported unknown channel %s", path, ch->channel_name);
-                goto done;
-            }
-            unsigned char *dst = scratch + (size_t)k * width * (size_t)lines * bpe;
-            const src_channel *s = &chans[k];
-            for (uint32_t r = 0; r < rows; ++r)
-                for (uint32_t x = 0; x < width; ++x) {
-                    float v = s->data[((size_t)(y0 + r) * width + x) * s->stride];
-                    size_t at = ((size_t)r * width + x) * bpe;
-                    if (bpe == 2) {
-                        uint16_t h = float_to_half(v);
-                        memcpy(dst + at, &h, 2);
-                    } else {
-                        memcpy(dst + at, &v, 4);
-                    }
-                }
-            ch->encode_from_ptr = dst;
-            ch->user_pixel_stride = (int32_t)bpe;
-            ch->user_line_stride = (int32_t)(width * bpe);
-            ch->user_bytes_per_element = (int16_t)bpe;
-            ch->user_data_type = (uint16_t)ptype;
-        }
-        if (first) {
-            rv = exr_encoding_choose_default_routines(e, part, &enc);
-            if (rv)
-                goto exr_error;
-        }
-        rv = exr_encoding_run(e, part, &enc);
+    for (size_t k = 0; k < nchunks; ++k) {
+        rv = exr_write_scanline_chunk_info(e, part, (int)(k * (uint32_t)lines), &infos[k]);
         if (rv)
             goto exr_error;
     }
-    if (enc_live) {
-        enc_live = 0;
-        rv = exr_encoding_destroy(e, &enc);
+    encode_job job = {e, part, width, ptype == EXR_PIXEL_HALF ? 2u : 4u, ptype, chans, n, infos, outs, 0};
+    for (size_t b0 = 0; b0 < nchunks; b0 += batch) {
+        size_t b1 = b0 + batch < nchunks ? b0 + batch : nchunks;
+        job.batch_begin = b0;
+        int32_t failed = vsgl__parallel_for(threads, b1 - b0, 1, encode_chunks_batch, &job);
+        for (size_t k = b0; k < b1 && !rv; ++k) {
+            chunk_out *out = &outs[k - b0];
+            if (failed && (out->rv || !out->data))
+                rv = out->rv ? out->rv : EXR_ERR_OUT_OF_MEMORY;
+            else
+                rv = exr_write_scanline_chunk(e, part, infos[k].start_y, out->data, out->size);
+        }
+        for (size_t k = 0; k < batch; ++k) {
+            free(outs[k].data);
+            memset(&outs[k], 0, sizeof outs[k]);
+        }
         if (rv)
             goto exr_error;
     }
@@ -276,11 +368,13 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
 exr_error:
     result = exr_failed(ctx, sink, path, what, rv);
 done:
-    if (enc_live)
-        exr_encoding_destroy(e, &enc);
     if (e)
         exr_finish(&e);
-    free(scratch);
+    if (outs)
+        for (size_t k = 0; k < batch; ++k)
+            free(outs[k].data);
+    free(outs);
+    free(infos);
     return result;
 }
 
@@ -314,7 +408,9 @@ vsgl_result vsgl_exr_write(vsgl_context *ctx, const char *path, uint32_t width, 
         free(chans);
         return r;
     }
+    pthread_mutex_init(&sink.lock, NULL);
     r = write_exr(ctx, &sink, path, width, height, chans, n, &o);
+    pthread_mutex_destroy(&sink.lock);
     free(chans);
     if (r) {
         vsgl__atomic_abort(&sink.file);
