@@ -219,3 +219,28 @@ def test_render_depsgraph_per_view_layer(scene, tmp_path):
     assert "ViewLayer_0001.exr (208 triangles" in r.stdout, r.stdout
     assert "Second_0001.exr (196 triangles" in r.stdout, r.stdout
     assert os.path.exists(str(tmp_path / "aov" / "Second_0001.exr"))
+
+
+def test_extension_zip_install(scene, tmp_path):
+    """The zip from tools/build_addon.sh installs as a 4.2+ extension
+    (blender_manifest.toml) and renders with the library it carries."""
+    if bpy.app.version < (4, 2, 0):
+        pytest.skip("extensions (blender_manifest.toml) need Blender 4.2+")
+    real_render_or_skip()
+    import sys
+    zip_path = str(tmp_path / "vsgl_indirect.zip")
+    r = subprocess.run([os.path.join(REPO, "tools", "build_addon.sh")], cwd=REPO,
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    assert r.returncode == 0, r.stdout
+    shutil.copy(os.path.join(REPO, "build", "vsgl_indirect.zip"), zip_path)
+    path = setup_blend(scene, tmp_path)
+    env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "home"))
+    env.pop("VSGL_LIBRARY", None)
+    r = subprocess.run([sys.executable, os.path.join(os.path.dirname(__file__),
+                                                     "ext_install_render.py"), zip_path, path],
+                       env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                       universal_newlines=True, timeout=240)
+    assert r.returncode == 0, r.stdout
+    assert "install {'FINISHED'}" in r.stdout, r.stdout
+    assert "/lib/libvsgl.so" in r.stdout and "STATUS (True" in r.stdout, r.stdout
+    assert "VSGL INFO: wrote" in r.stdout and os.path.exists(aov(tmp_path, 1)), r.stdout
