@@ -426,10 +426,8 @@ def suite_lights(lib, ctx, out_dir, report):
     report.append("Diffuse floor under one light; irradiance filtered by a cos^2 kernel of half-width "
                   "%.2f m at 25 points in [-1.2, 1.2]^2 (those above 2 %% of the brightest); RSM %d^2 per "
                   "face; Cycles 96x96 px over 4 x 4 m, 128 spp (delta lights) or 256 spp (area). "
-                  "Tolerance per point: %.0f %% or 3 standard errors, whichever is larger; the error "
-                  "combines Cycles' noise (pixel residual against a 3x3 mean) and the RSM's own "
-                  "sampling error (batch means over the four texel parity classes; only area lights, "
-                  "whose VPL origins are spread over the light, show one). Where a closed form exists, "
+                  "Tolerance per point: %.0f %% or 3 standard errors of Cycles' noise (from the pixel "
+                  "residual against a 3x3 mean), whichever is larger; the RSM is deterministic. Where a closed form exists, "
                   "Cycles' DiffDir at the point below the light (mean of the 2x2 centre pixels) must "
                   "match it within 0.3 %%.\n" % (KERNEL_W, RSM_RES_LIGHT, TOL_LIGHT * 100))
     report.append("| case | Cycles DiffDir below the light | analytic | RSM-implied E vs Cycles: max rel. diff (1-sigma there) | mean rel. diff | points | RSM time (s) | result |")
@@ -451,14 +449,8 @@ def suite_lights(lib, ctx, out_dir, report):
             P, F, rsecs = library_rsm(lib, ctx, scene, 0, RSM_RES_LIGHT)
         finally:
             lib.vsgl_scene_destroy(scene)
-        # texel parity classes (row & 1, col & 1): four interleaved RSMs of a
-        # quarter of the texels each, for a batch-means estimate of the RSM's
-        # own sampling error (area lights spread VPL origins over the light)
-        idx = np.arange(len(F))
-        res_ = RSM_RES_LIGHT
-        cls = ((idx // res_) % 2) * 2 + (idx % res_) % 2
         lit = F[:, 0] > 0
-        P, F, cls = P[lit], F[lit, 0], cls[lit]
+        P, F = P[lit], F[lit, 0]
         # per-pixel noise of Cycles from the residual against the 3x3 mean
         # (for a smooth image r = E - mean3x3(E) has variance (8/9) sigma^2)
         pad = np.pad(E_cyc, 1, mode="edge")
@@ -473,8 +465,6 @@ def suite_lights(lib, ctx, out_dir, report):
                 sel = (np.abs(P[:, 0] - gx) < KERNEL_W) & (np.abs(P[:, 1] - gy) < KERNEL_W)
                 contrib = F[sel] * kernel(P[sel, 0] - gx, P[sel, 1] - gy, KERNEL_W)
                 er = float(np.sum(contrib))
-                sub = [4.0 * float(np.sum(contrib[cls[sel] == k])) for k in range(4)]
-                se = math.sqrt(se * se + float(np.var(sub, ddof=1)) / 4.0)
                 if os.environ.get("VSGL_DEBUG_GRID"):
                     print("   %s (%.1f,%.1f) rsm %.5f cycles %.5f +- %.5f ratio %.4f" % (
                         name, gx, gy, er, ec, se, er / max(ec, 1e-12)))
@@ -484,8 +474,8 @@ def suite_lights(lib, ctx, out_dir, report):
         emax = max(p[3] for p in pts)
         centre = [p[3] for p in pts if p[0] == 0 and p[1] == 0][0]
         errs = [(abs(er - ec) / ec, gx, gy, er, ec, se) for gx, gy, er, ec, se in pts if ec > 0.02 * emax]
-        # tolerance: 1 % or 3 standard errors (Cycles' noise and the RSM's
-        # sampling error combined), whichever is larger
+        # tolerance: 1 % or 3 standard errors of Cycles' noise, whichever is
+        # larger (the RSM is deterministic)
         bad = [e for e in errs if e[0] > max(TOL_LIGHT, 3 * e[5] / e[4])]
         worst = max(errs) if errs else (0, 0, 0, 0, 0, 0)
         ok = not bad and len(errs) > 0

@@ -12,8 +12,8 @@
  * - area: one face, concentric (Shirley-Chiu) map of the cosine-weighted
  *   hemisphere below the light: every texel carries the same projected
  *   solid angle pi/res^2, so the flux is (P/4) (pi/res^2) times the spread
- *   mask. Ray origins are stratified over the emitting shape (each 8x8
- *   texel block covers an 8x8 grid on the light) (a large light is
+ *   mask. Ray origins are stratified over the emitting shape (every
+ *   aligned 2^k x 2^k texel block covers a 2^k x 2^k grid on the light) (a large light is
  *   sampled over its area, not as a point).
  *
  * Texel weights are integrated exactly (rectangle solid angles) and the
@@ -159,15 +159,6 @@ void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res
     }
 }
 
-/* splitmix64 finaliser */
-static uint64_t mix64(uint64_t z)
-{
-    z += 0x9E3779B97F4A7C15ull;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 /* Concentric map of [0,1]^2 to the unit disk (Shirley & Chiu 1997). */
 static void concentric(double a, double b, double *x, double *y)
 {
@@ -285,14 +276,17 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
         }
         w = 0.25 * PI_D / (res * res) * mk; /* (P/4) x projected solid angle */
         *beam = PI_D / (res * res) / fmax(z, 0.5 / res); /* solid angle = projected / cos */
-        /* origin on the shape: every 8x8 block of texels (nearly one
-         * direction) covers the 64 strata of an 8x8 grid on the light once,
-         * jittered by a hash of the texel index. (An R2 sequence over the
-         * linear index correlated with the layout and modulated the VPL
-         * density by 2 %; pure hashing left 0.6 % noise at 0.2 m.) */
-        uint64_t hsh = mix64(((uint64_t)face * l->res + row) * l->res + col);
-        double js = (double)(hsh >> 40) * 0x1.0p-24, jt = (double)((hsh >> 16) & 0xFFFFFFu) * 0x1.0p-24;
-        double s = ((double)((col + 3u * row) & 7u) + js) / 8.0, t = ((double)(row & 7u) + jt) / 8.0;
+        /* origin on the shape: the centre of stratum (bitrev(col & 7),
+         * bitrev(row & 7)) of an 8x8 grid on the light. Every aligned
+         * 2x2, 4x4 and 8x8 block of texels (nearly one direction) then
+         * covers a 2x2, 4x4 and 8x8 sub-grid of the light, and neighbours
+         * alternate at the finest scale. Alternatives measured against
+         * Cycles (kernel 0.3 m): origins marching monotonically with the
+         * direction in 8x8 blocks made a comb in the VPL density of period
+         * 8 texels, 1.6 % off near a light's horizon; random jitter or
+         * per-block scrambling left 0.6-2.7 % noise. */
+        static const unsigned char rev3[8] = {0, 4, 2, 6, 1, 5, 3, 7};
+        double s = (rev3[col & 7u] + 0.5) / 8.0, t = (rev3[row & 7u] + 0.5) / 8.0;
         double px, py;
         if (l->shape == VSGL_AREA_DISK || l->shape == VSGL_AREA_ELLIPSE) {
             concentric(s, t, &px, &py);
