@@ -38,6 +38,21 @@ static char *dir_of(const char *path)
     return d;
 }
 
+vsgl__errstr vsgl__strerror(int e)
+{
+    vsgl__errstr r;
+    r.s[0] = '\0';
+#if defined(_GNU_SOURCE)
+    const char *m = strerror_r(e, r.s, sizeof r.s); /* GNU: may return a static string */
+    if (m != r.s)
+        snprintf(r.s, sizeof r.s, "%s", m);
+#else
+    if (strerror_r(e, r.s, sizeof r.s) != 0)
+        snprintf(r.s, sizeof r.s, "error %d", e);
+#endif
+    return r;
+}
+
 static void free_file(vsgl__atomic_file *f)
 {
     free(f->target);
@@ -67,8 +82,11 @@ vsgl_result vsgl__atomic_open(vsgl_context *ctx, const char *path, vsgl__atomic_
     if (!dir)
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "out of memory");
     const char *why = NULL;
-    if (stat(dir, &st) != 0)
-        why = strerror(errno);
+    vsgl__errstr es;
+    if (stat(dir, &st) != 0) {
+        es = vsgl__strerror(errno);
+        why = es.s;
+    }
     else if (!S_ISDIR(st.st_mode))
         why = "is not a directory";
     if (why) {
@@ -103,7 +121,7 @@ vsgl_result vsgl__atomic_open(vsgl_context *ctx, const char *path, vsgl__atomic_
             break;
     }
     vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: cannot create a file in its directory: %s",
-                               path, strerror(e));
+                               path, vsgl__strerror(e).s);
     free_file(f);
     return r;
 }
@@ -144,24 +162,24 @@ void vsgl__atomic_abort(vsgl__atomic_file *f)
 vsgl_result vsgl__atomic_commit(vsgl_context *ctx, vsgl__atomic_file *f)
 {
     if (f->error) {
-        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: write failed: %s", f->target, strerror(f->error));
+        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: write failed: %s", f->target, vsgl__strerror(f->error).s);
         vsgl__atomic_abort(f);
         return r;
     }
     if (fsync(f->fd) != 0) {
-        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: fsync failed: %s", f->target, strerror(errno));
+        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: fsync failed: %s", f->target, vsgl__strerror(errno).s);
         vsgl__atomic_abort(f);
         return r;
     }
     int fd = f->fd;
     f->fd = -1;
     if (close(fd) != 0) {
-        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: close failed: %s", f->target, strerror(errno));
+        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: close failed: %s", f->target, vsgl__strerror(errno).s);
         vsgl__atomic_abort(f);
         return r;
     }
     if (rename(f->temp, f->target) != 0) {
-        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: cannot replace: %s", f->target, strerror(errno));
+        vsgl_result r = vsgl__fail(ctx, VSGL_ERROR_IO, "%s: cannot replace: %s", f->target, vsgl__strerror(errno).s);
         vsgl__atomic_abort(f);
         return r;
     }

@@ -33,6 +33,10 @@ vsgl_result vsgl__atomic_commit(vsgl_context *ctx, vsgl__atomic_file *f);
 /* Close and delete the temporary file, free f. Safe on a closed f. */
 void vsgl__atomic_abort(vsgl__atomic_file *f);
 
+/* Thread-safe strerror: use as vsgl__strerror(e).s within one expression. */
+typedef struct vsgl__errstr { char s[128]; } vsgl__errstr;
+vsgl__errstr vsgl__strerror(int e);
+
 /* Write a whole buffer to path atomically. */
 vsgl_result vsgl__atomic_write_all(vsgl_context *ctx, const char *path, const void *data, size_t n);
 

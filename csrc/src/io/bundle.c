@@ -702,7 +702,7 @@ vsgl_result vsgl_bundle_read(vsgl_context *ctx, const char *path, vsgl_bundle **
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle path is empty");
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0)
-        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: %s", path, strerror(errno));
+        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: %s", path, vsgl__strerror(errno).s);
     struct stat st;
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         close(fd);
@@ -730,7 +730,7 @@ vsgl_result vsgl_bundle_read(vsgl_context *ctx, const char *path, vsgl_bundle **
     close(fd);
     if (got < n) {
         free(buf);
-        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: read failed: %s", path, strerror(e));
+        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: read failed: %s", path, vsgl__strerror(e).s);
     }
     vsgl_result r = vsgl_bundle_read_memory(ctx, buf, n, out);
     free(buf);

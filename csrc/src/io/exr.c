@@ -91,7 +91,7 @@ static void sink_error(exr_const_context_t c, exr_result_t code, const char *msg
 static vsgl_result exr_failed(vsgl_context *ctx, exr_sink *s, const char *path, const char *what, exr_result_t rv)
 {
     if (s->file.error)
-        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: write failed: %s", path, strerror(s->file.error));
+        return vsgl__fail(ctx, VSGL_ERROR_IO, "%s: write failed: %s", path, vsgl__strerror(s->file.error).s);
     return vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "%s: OpenEXR %s failed: %s", path, what,
                       s->message[0] ? s->message : exr_get_default_error_message(rv));
 }
