@@ -67,6 +67,8 @@ static void on_log(void *user, int32_t level, const char *message)
     log_state *l = user;
     if (level == VSGL_LOG_ERROR)
         return; /* failures are reported once, by the caller, from the context */
+    if (strncmp(message, "skipped: ", 9) == 0)
+        return; /* reported once after the render, from vsgl_render_stats.skipped */
     progress_end(l->progress);
     fprintf(stderr, "vsgl: %s%s\n", level == VSGL_LOG_WARNING ? "warning: " : "", message);
 }

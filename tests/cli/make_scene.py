@@ -50,6 +50,12 @@ def build(args):
     m = (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 3.5)
     power = float("nan") if args.break_ == "nan-power" else 500.0
     light = struct.pack("<ii3ff12f7fI", 1, 0, 1, 1, 1, power, *m, 0.05, 1.2, 0.2, 0, 1, 1, 3.14159265, 0)
+    nlights = 1
+    if args.light_up:
+        # a second spot 3.5 m up pointing up (+Z: rotated 180 degrees about X): lights nothing
+        up = (1, 0, 0, 0, 0, -1, 0, 0, 0, 0, -1, 3.5)
+        light += struct.pack("<ii3ff12f7fI", 1, 0, 1, 1, 1, 100.0, *up, 0.05, 0.5, 0.2, 0, 1, 1, 3.14159265, 0)
+        nlights = 2
     # camera at (0, -6, 2) looking along +Y: columns X->(1,0,0), Y->(0,0,1), Z->(0,-1,0)
     cm = (1, 0, 0, 0, 0, 0, -1, -6, 0, 1, 0, 2)
     cam = struct.pack("<ii12f8fII2f", 0, 0, *cm, 35, 36, 24, 6, 0, 0, 0.1, 100,
@@ -60,7 +66,7 @@ def build(args):
         pos = pos[:4] + struct.pack("<f", float("nan")) + pos[8:]
     secs = [section("POS ", 12, len(verts), pos), section("IDX ", 12, len(tris), idx),
             section("MIDX", 4, len(tris), midx), section("MATL", 40, len(mats), matl),
-            section("LGHT", 104, 1, light), section("CAM ", 104, 1, cam)]
+            section("LGHT", 104, nlights, light), section("CAM ", 104, 1, cam)]
     if not args.no_settings:
         secs.append(section("RSET", 44, 1, rset))
     if args.output:
@@ -95,6 +101,7 @@ def main():
     p.add_argument("--output")
     p.add_argument("--frame", type=int)
     p.add_argument("--no-settings", action="store_true")
+    p.add_argument("--light-up", action="store_true", help="add a spot light that lights nothing")
     p.add_argument("--break", dest="break_", default=None)
     args = p.parse_args()
     with open(args.out, "wb") as f:

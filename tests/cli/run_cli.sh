@@ -184,6 +184,17 @@ if want render_half_verbose && expect_ok render_half_verbose "$VSGL" render "$SC
   if [ -z "$errs" ]; then ok render_half_verbose; else bad render_half_verbose "$errs"; fi
 fi
 
+# What the renderer skipped is printed once, with or without -v.
+if want render_skipped; then
+  "$PY" tests/cli/make_scene.py "$T/up.vsglb" --light-up
+  for v in "" -v; do
+    if expect_ok render_skipped "$VSGL" render "$T/up.vsglb" -o "$T/up.exr" $v; then
+      n=$(grep -c '^vsgl: skipped: light 1: ' "$T/err")
+      if [ "$n" -eq 1 ]; then ok "render_skipped${v:+ (-v)}"; else bad "render_skipped${v:+ (-v)}" "$n 'vsgl: skipped: light 1' lines: $(tr '\n' '|' <"$T/err")"; fi
+    fi
+  done
+fi
+
 # A failed render (settings the library refuses) leaves an existing EXR untouched.
 if want render_failure_keeps_file && [ -s "$T/out.exr" ]; then
   before=$(cksum <"$T/out.exr")
