@@ -8,7 +8,11 @@
 #define VSGL_RSM_EMPTY 0xFFFFFFFFu
 
 /* Structure of arrays; texel index = (face * res + row) * res + col.
- * faces = 6 for point lights (cube map), 1 otherwise. Each texel's flux is
+ * faces = 6 for point lights and spots wider than 120 degrees (cube map in
+ * the light's frame), 1 otherwise (spot: perspective image over the cone;
+ * sun: orthographic over the scene bounds; area: concentric map of the
+ * cosine-weighted hemisphere). Per-type details: rsm_light.c, docs/units.md.
+ * Each texel's flux is
  * the RGB power (W) arriving on the surface patch it sees, with the
  * solid-angle/area Jacobian folded in, so that the sum over a closed box
  * equals the light's emitted power as Cycles defines it. */
