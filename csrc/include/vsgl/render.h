@@ -35,7 +35,7 @@ extern "C" {
  * above it, but a VSGL's lobe and its spherical projection leak light to
  * receivers in or below the cluster's plane (a floor lighting itself). The
  * correction fades a VSGL's light out as the emission cosine towards the
- * receiver, softened by the cluster's spread, goes below 0.1, weighted by
+ * receiver, softened by the cluster's spread, goes below 0.05, weighted by
  * how coplanar the cluster's normals are. docs/accuracy.md measures it:
  * it helps with many VSGLs and hurts with two. */
 #define VSGL_LEAK_AUTO 0  /**< on for FIS and k-means, off for two VSGLs per light */

@@ -32,7 +32,7 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
 #define VSGL_SHADE_REFERENCE     2
 
 /* Emission cosine below which the leak correction fades a VSGL out. */
-#define VSGL_LEAK_COSINE 0.1f
+#define VSGL_LEAK_COSINE 0.05f
 
 /* Emitter-hemisphere (leak) correction factor of VSGL v at receiver x, in
  * [0, 1] (the kernel computes the same inline). */
