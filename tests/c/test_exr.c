@@ -662,3 +662,46 @@ VT_TEST(exr_parallel_encoding_is_identical_for_any_thread_count)
     free(first);
     remove_tree(dir);
 }
+
+VT_TEST(exr_render_combined_alpha_cases)
+{
+    enum { CW = 3, CH = 2 };
+    float comb[CW * CH * 3], alpha[CW * CH];
+    for (int i = 0; i < CW * CH * 3; ++i)
+        comb[i] = 0.5f * (float)i;
+    for (int i = 0; i < CW * CH; ++i)
+        alpha[i] = 0.25f * (float)i;
+    char dir[64], path[128];
+    make_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/c.exr", dir);
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = CW;
+    o.height = CH;
+    VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_ERROR_INVALID_ARGUMENT &&
+                 strstr(vsgl_context_last_error(ctx), "no planes"), "no planes: '%s'", vsgl_context_last_error(ctx));
+    /* Combined without alpha: A = 1. */
+    o.combined = comb;
+    VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    decoded d;
+    VT_CHECK(decode_exr(path, &d) == 0 && d.count == 4, "decode: %d channels", d.count);
+    int a = channel_index(&d, "VSGL.Combined.A"), g = channel_index(&d, "VSGL.Combined.G");
+    for (int i = 0; i < CW * CH && a >= 0 && g >= 0; ++i) {
+        VT_CHECK(d.planes[a][i] == 1.0f, "A at %d = %g", i, d.planes[a][i]);
+        VT_CHECK(d.planes[g][i] == comb[3 * i + 1], "G at %d = %g want %g", i, d.planes[g][i], comb[3 * i + 1]);
+    }
+    free_decoded(&d);
+    /* Alpha alone: a single channel VSGL.Combined.A. */
+    o.combined = NULL;
+    o.alpha = alpha;
+    VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(decode_exr(path, &d) == 0 && d.count == 1 && strcmp(d.names[0], "VSGL.Combined.A") == 0, "alpha only: %d channels, %s",
+             d.count, d.count ? d.names[0] : "-");
+    for (int i = 0; i < CW * CH && d.count == 1; ++i)
+        VT_CHECK(d.planes[0][i] == alpha[i], "alpha at %d = %g want %g", i, d.planes[0][i], alpha[i]);
+    free_decoded(&d);
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
