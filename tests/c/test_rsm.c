@@ -292,3 +292,36 @@ VT_TEST(rsm_rect_solid_angle_sums_to_sphere)
     double want = 4 * e * e / pow(1 + x * x + y * y, 1.5);
     VT_CHECK_REL(vsgl__rsm_rect_solid_angle(x - e, x + e, y - e, y + e), want, 1e-5, "at (%g, %g)", x, y);
 }
+
+VT_TEST(rsm_degenerate_lights_and_scenes)
+{
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    for (int k = 0; k < 4; ++k) {
+        fx_scene s;
+        floor_only(&s, 1.0f);
+        vsgl_light *L = &s.lights[0];
+        set_light(L, k == 3 ? VSGL_LIGHT_SUN : VSGL_LIGHT_SPOT, 0, 0, 1);
+        if (k == 0)
+            L->power = 0.0f;                          /* zero power */
+        if (k == 1) {                                 /* a spot looking up sees nothing */
+            const float eye[3] = {0, 0, 1}, at[3] = {0, 0, 2};
+            fx_look_at(L->world_from_light, eye, at);
+        }
+        if (k >= 2)
+            s.triangle_count = s.vertex_count = 0;    /* empty scene (k = 3: sun over empty bounds) */
+        vsgl_scene *sc = make(ctx, &s);
+        if (!sc)
+            continue;
+        vsgl_rsm r;
+        VT_CHECK(vsgl__rsm_build(ctx, sc, 0, 16, &r) == VSGL_OK, "case %d: %s", k, vsgl_context_last_error(ctx));
+        int finite = 1;
+        for (size_t i = 0; i < r.count; ++i)
+            finite &= isfinite(r.flux[0][i]) && isfinite(r.pos[0][i]) && isfinite(r.area[i]);
+        VT_CHECK(finite, "case %d: non-finite texel", k);
+        VT_CHECK(r.total_flux[0] == 0.0 && r.total_flux[1] == 0.0, "case %d: total flux %g", k, r.total_flux[0]);
+        vsgl__rsm_free(&r);
+        vsgl_scene_destroy(sc);
+    }
+    vsgl_context_destroy(ctx);
+}
