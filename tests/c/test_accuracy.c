@@ -42,3 +42,55 @@ VT_TEST(accuracy_fis_error_falls_with_vsgl_count_on_three_scenes)
         acc_free(&ref);
     }
 }
+
+/* A partition between the lit red wall and the green wall: with visibility
+ * rays the VSGL render moves towards the brute-force reference with
+ * visibility (indirect shadows), and the green wall loses red light. */
+VT_TEST(accuracy_visibility_casts_indirect_shadows)
+{
+    const uint32_t W = 40, H = 30;
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.3f, 150.0f);
+    const float wall[4][3] = {{0.2f, -1.0f, 0.0f}, {0.2f, 1.0f, 0.0f}, {0.2f, 1.0f, 1.6f}, {0.2f, -1.0f, 1.6f}};
+    fx_quad(&fx, wall, 3);
+    vsgl_context *ctx;
+    vsgl_scene *scene;
+    vsgl_context_create(NULL, &ctx);
+    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    float *bf = calloc(W * H * 3, sizeof(float)), *on = calloc(W * H * 3, sizeof(float)),
+          *off = calloc(W * H * 3, sizeof(float));
+    float *planes[3] = {bf, on, off};
+    for (int k = 0; k < 3; ++k) {
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.aa_samples = 1;
+        s.rsm_resolution = 32;
+        s.vsgl_count = 128;
+        s.method = k == 0 ? VSGL_METHOD_BRUTE_FORCE : VSGL_METHOD_VSGL;
+        s.visibility = k == 2 ? VSGL_VISIBILITY_NONE : VSGL_VISIBILITY_RAY;
+        vsgl_render_output o;
+        memset(&o, 0, sizeof o);
+        o.width = W;
+        o.height = H;
+        o.diffuse = planes[k];
+        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "render %d: %s", k, vsgl_context_last_error(ctx));
+    }
+    double e_on = acc_relmse(on, bf, W * H * 3), e_off = acc_relmse(off, bf, W * H * 3);
+    VT_CHECK(e_on < 0.5 * e_off, "relMSE with visibility %.4g, without %.4g (reference with visibility)", e_on, e_off);
+    /* red light on the green wall (right edge columns, middle rows) */
+    double red_on = 0, red_off = 0;
+    for (uint32_t y = H / 3; y < 2 * H / 3; ++y)
+        for (uint32_t x = W - 6; x < W - 2; ++x) {
+            red_on += on[(y * W + x) * 3];
+            red_off += off[(y * W + x) * 3];
+        }
+    if (getenv("VSGL_TEST_VERBOSE"))
+        printf("    relMSE vs brute force with visibility: %.4g (VSGL with rays), %.4g (without); red on green wall %.4g vs %.4g\n",
+               e_on, e_off, red_on, red_off);
+    VT_CHECK(red_on < 0.7 * red_off, "red on the green wall: %.4g with visibility, %.4g without", red_on, red_off);
+    free(bf);
+    free(on);
+    free(off);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}

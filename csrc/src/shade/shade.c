@@ -256,6 +256,9 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
     receiver rec[VSGL_KERNEL_BLOCK];
     int hit[VSGL_KERNEL_BLOCK];
     float vis[VSGL_KERNEL_BLOCK];
+    v3 ray_org[VSGL_KERNEL_BLOCK], ray_dir[VSGL_KERNEL_BLOCK];
+    float ray_tmin[VSGL_KERNEL_BLOCK], ray_tmax[VSGL_KERNEL_BLOCK];
+    unsigned char blocked[VSGL_KERNEL_BLOCK];
     uint64_t pairs = 0;
     for (size_t px = j->base + b0; px < j->base + e0; ++px) {
         for (int c = 0; c < 3; ++c)
@@ -278,18 +281,20 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             for (size_t v = 0; v < j->set->count; ++v) {
                 const float *vp = NULL;
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
+                    /* one batched occlusion query per block (Embree ray streams) */
                     const vsgl_vsgl *L = &j->set->items[v];
                     for (size_t k = 0; k < n; ++k) {
-                        vis[k] = 0.0f;
-                        if (!hit[k])
-                            continue;
-                        v3 org = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
-                        v3 d = v3_sub(L->mean, org);
+                        ray_org[k] = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
+                        v3 d = v3_sub(L->mean, ray_org[k]);
                         float dist = v3_length(d);
-                        vis[k] = (dist > j->eps &&
-                                  vsgl__scene_occluded(j->scene, org, v3_scale(d, 1.0f / dist), 0.0f, dist - j->eps))
-                                     ? 0.0f : 1.0f;
+                        ray_dir[k] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
+                        ray_tmin[k] = 0.0f;
+                        /* misses and receivers at the VSGL centre trace an empty interval */
+                        ray_tmax[k] = (hit[k] && dist > j->eps) ? dist - j->eps : 0.0f;
                     }
+                    vsgl__scene_occluded_many(j->scene, (uint32_t)n, ray_org, ray_dir, ray_tmin, ray_tmax, 0, blocked);
+                    for (size_t k = 0; k < n; ++k)
+                        vis[k] = (hit[k] && !blocked[k]) ? 1.0f : 0.0f;
                     vp = vis;
                 }
                 if (j->path == VSGL_SHADE_KERNEL_SCALAR)
