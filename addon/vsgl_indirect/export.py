@@ -261,8 +261,9 @@ def collect(depsgraph, scene=None, require_lights=True):
         holdout = (compat.is_holdout(orig) or orig.name in holdout_names
                    or (parent is not None and (compat.is_holdout(parent.original)
                                                or parent.original.name in holdout_names)))
-        key = ("inst", obj.name, obj.data.as_pointer() if obj.data else 0) if inst.is_instance \
-            else ("obj", obj.name)
+        # Instances of one object share its evaluated mesh; Blender reuses one
+        # temporary object for geometry-nodes instances, hence the data pointer.
+        key = (obj.as_pointer(), obj.data.as_pointer() if obj.data else 0, inst.is_instance)
         arr = mesh_cache.get(key)
         if arr is None:
             try:

@@ -83,6 +83,8 @@ def run_frame(scene, depsgraph, frame, options=None, progress=None, keep_planes=
     """Export the depsgraph's view layer, render, write this frame's EXR.
     Returns the engine Result or None after reporting the error."""
     options = options or options_of(scene)
+    if options.threads == 0 and scene.render.threads_mode == "FIXED":
+        options.threads = scene.render.threads   # honour blender -t N / Fixed threads
     layer = depsgraph.view_layer.name
     path = output_path(scene, layer, frame, options)
     begin(scene.name, frame)
