@@ -31,7 +31,8 @@ PY
 )
 if [ -n "$missing" ]; then
   echo "demo: cannot compute the indirect AOV: $missing" >&2
-  echo "demo: the add-on and export are ready; the missing part is the C renderer (csrc/src/shade, vsgl_render)." >&2
+  echo "demo: the add-on, export and compositor wiring are ready; what is missing is a loadable" >&2
+  echo "demo: libvsgl with a working vsgl_render (build/libvsgl.so from 'make'; csrc/src/shade)." >&2
   exit 1
 fi
 
