@@ -312,6 +312,9 @@ def collect(depsgraph, scene=None, require_lights=True):
 def _add_light(sd, obj, matrix, compat):
     light = obj.data
     name = obj.original.name if obj.original else obj.name
+    if not getattr(light, "normalize", True):
+        sd.warnings.append("light '%s': 'Normalize' off is not modelled; its power is used "
+                           "as if normalized" % name)
     if getattr(light, "use_nodes", False) and light.node_tree is not None:
         sd.warnings.append("light '%s': its node setup is ignored (colour x power only)" % name)
     try:
