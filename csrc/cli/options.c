@@ -29,6 +29,7 @@ const char cli_usage[] =
     "  --threads N           worker threads (0 = all cores)\n"
     "  --seed N              seed of FIS / k-means sampling\n"
     "  --half                16-bit half EXR (default 32-bit float)\n"
+    "  --compression NAME    zip | zips | piz | none   (EXR compression, default zip)\n"
     "  --dry-run             read, validate and check the output path; do not render\n"
     "  -v, --verbose         per-stage timings and statistics on stderr\n"
     "\n"
@@ -83,7 +84,11 @@ static const int vis_values[] = {VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY};
 static const char *const method_names[] = {"vsgl", "brute", NULL};
 static const int method_values[] = {VSGL_METHOD_VSGL, VSGL_METHOD_BRUTE_FORCE};
 
+static const char *const comp_names[] = {"zip", "zips", "piz", "none", NULL};
+static const int comp_values[] = {VSGL_EXR_ZIP, VSGL_EXR_ZIPS, VSGL_EXR_PIZ, VSGL_EXR_NONE};
+
 static const enum_opt enum_opts[] = {
+    {"--compression", comp_names, comp_values, offsetof(cli_options, compression)},
     {"--preset", preset_names, preset_values, offsetof(cli_options, preset)},
     {"--fit", fit_names, fit_values, offsetof(cli_options, fit)},
     {"--sharpness", sharp_names, sharp_values, offsetof(cli_options, sharpness)},

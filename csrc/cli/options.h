@@ -19,6 +19,7 @@ typedef struct cli_options {
     int preset;               /* VSGL_PRESET_*, -1 = not given */
     cli_u32 aa, rsm, vsgls, threads, seed;
     int fit, sharpness, diffuse, glossy, visibility, method; /* -1 = not given */
+    int compression;          /* VSGL_EXR_*, default ZIP */
     int half, verbose, dry_run;
 } cli_options;
 

@@ -250,6 +250,7 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
     memset(&eo, 0, sizeof eo);
     eo.size = sizeof eo;
     eo.pixel_type = o->half ? VSGL_EXR_HALF : VSGL_EXR_FLOAT;
+    eo.compression = o->compression;
     eo.metadata = md;
     eo.metadata_count = sizeof md / sizeof md[0];
     r = vsgl_exr_write_render(ctx, out_path, &out, &eo);
@@ -265,8 +266,9 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
                 stats.seconds_shade);
         fprintf(stderr, "vsgl: lights used %u, skipped %u; VSGLs %u; shading pairs %llu\n", stats.lights_used,
                 stats.lights_skipped, stats.vsgl_count, (unsigned long long)stats.shading_pairs);
-        fprintf(stderr, "vsgl: write %.3f s; wall %.3f s; wrote %s (%ux%u, %s)\n", t_written - t_rendered,
-                t_written - t_start, out_path, cam->width, cam->height, o->half ? "half" : "float");
+        static const char *const comp[] = {"zip", "none", "zips", "piz"};
+        fprintf(stderr, "vsgl: write %.3f s; wall %.3f s; wrote %s (%ux%u, %s, %s)\n", t_written - t_rendered,
+                t_written - t_start, out_path, cam->width, cam->height, o->half ? "half" : "float", comp[o->compression]);
     }
 done:
     for (int i = 0; i < 7; ++i)

@@ -175,7 +175,7 @@ fi
 if want render_half_verbose && expect_ok render_half_verbose "$VSGL" render "$SCENE" --half -v --preset preview; then
   errs=""
   [ -s "$T/from_bundle.exr" ] || errs="$errs [bundle's output path not used]"
-  for l in "vsgl: settings: method=vsgl" "vsgl: render " "gbuffer " "rsm " "fit " "shade " "vsgl: lights used 1, skipped 0" "(64x48, half)"; do
+  for l in "vsgl: settings: method=vsgl" "vsgl: render " "gbuffer " "rsm " "fit " "shade " "vsgl: lights used 1, skipped 0" "(64x48, half, zip)"; do
     grep -qF "$l" "$T/err" || errs="$errs [stderr lacks '$l']"
   done
   if have oiiotool; then
@@ -183,6 +183,17 @@ if want render_half_verbose && expect_ok render_half_verbose "$VSGL" render "$SC
   fi
   if [ -z "$errs" ]; then ok render_half_verbose; else bad render_half_verbose "$errs"; fi
 fi
+
+# Compression choices, read back by oiiotool.
+if want render_compression && have oiiotool; then
+  for c in none zips piz; do
+    if expect_ok render_compression "$VSGL" render "$SCENE" -o "$T/c-$c.exr" --compression "$c" --preset preview; then
+      if oiiotool --info -v "$T/c-$c.exr" 2>&1 | grep -q "compression: \"$c\""; then ok "render_compression $c"
+      else bad "render_compression $c" "$(oiiotool --info -v "$T/c-$c.exr" 2>&1 | grep -i compression)"; fi
+    fi
+  done
+fi
+expect_fail args_bad_compression 2 "'lzma' is not one of zip|zips|piz|none" "$VSGL" render "$SCENE" --compression lzma
 
 # What the renderer skipped is printed once, with or without -v.
 if want render_skipped; then
