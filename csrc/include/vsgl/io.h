@@ -8,7 +8,9 @@
  * the target's directory, fsyncs it, renames it over the target and
  * fsyncs the directory. On any failure the temporary file is deleted and
  * a previous file at the target path is left untouched; a reader never
- * sees a half-written file. New files get mode 0666 minus the umask.
+ * sees a half-written file. New files get mode 0666 minus the umask. (Only
+ * a crash or kill mid-write can leave the hidden temporary file
+ * `.NAME.tmp-PID-...` beside the target.)
  *
  * Readers never trust a file: every count is capped by the bytes actually
  * present before anything is allocated, every section is length- and
@@ -91,7 +93,9 @@ typedef struct vsgl_exr_options {
  * MULTILAYER image whose Image node (with its layer set to the layer name)
  * shows one socket per pass; in Blender 3.4 an RGBA pass "Combined" gives
  * the sockets "Combined" and "Alpha" (checked by tests/c/test_exr.c).
- * The header also gets the string attribute `vsgl.version`.
+ * The header also gets the string attribute `vsgl.version`. Chunks are
+ * compressed on the context's worker threads; the file is identical for
+ * any thread count.
  *
  * Every sample is checked before anything is written: a NaN or infinity
  * fails with ::VSGL_ERROR_INVALID_ARGUMENT and a message naming the pass,
