@@ -277,3 +277,63 @@ def test_compute_in_thread_releases_gil_and_cancels(scene, tmp_path):
     with pytest.raises(engine.AovError, match="cancelled"):
         engine.compute(sd, opts, str(tmp_path / "c.exr"), progress=lambda st, f: True)
     assert not os.path.exists(str(tmp_path / "c.exr"))
+
+
+def _diffuse(name, color):
+    mat = bpy.data.materials.new(name)
+    if mat.node_tree is None:
+        mat.use_nodes = True
+    nt = mat.node_tree
+    for n in list(nt.nodes):
+        if n.bl_idname != "ShaderNodeOutputMaterial":
+            nt.nodes.remove(n)
+    d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = color + (1.0,)
+    nt.links.new(d.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+@pytest.mark.parametrize("fit,shift", [("AUTO", (0.0, 0.0)), ("VERTICAL", (0.15, -0.1))])
+def test_aov_diffcol_aligns_with_cycles_diffcol(scene, tmp_path, fit, shift):
+    """Camera, transforms and materials at once: the AOV's DiffCol plane must
+    match Cycles' own DiffCol pass pixel for pixel (away from edges)."""
+    real_render_or_skip()
+    scene.render.resolution_x, scene.render.resolution_y = 64, 40
+    scene.cycles.samples = 16
+    scene.view_layers[0].use_pass_diffuse_color = True
+    cols = {"Floor": (0.8, 0.2, 0.1), "Wall": (0.1, 0.6, 0.3), "Box": (0.2, 0.3, 0.9)}
+    link(scene, plane("Floor", 8, (0, 0, 0), _diffuse("F", cols["Floor"])))
+    wall = link(scene, plane("Wall", 8, (0, 3, 2), _diffuse("W", cols["Wall"])))
+    wall.rotation_euler = (1.5708, 0, 0)
+    from conftest import cube
+    box = link(scene, cube("Box", 1.0, (0.8, 0.5, 0.5), _diffuse("B", cols["Box"])))
+    box.rotation_euler = (0, 0, 0.6)
+    box.scale = (1.5, 1, 1)
+    cam = camera(scene, (0.5, -5, 1.8), (1.35, 0, 0.1), lens=30)
+    cam.data.sensor_fit = fit
+    cam.data.shift_x, cam.data.shift_y = shift
+    light(scene, "POINT", "Lamp", 300.0, (0, -1, 3))
+    scene.vsgl_indirect.output_path = str(tmp_path / "aov" / "a_####.exr")
+    scene.vsgl_indirect.add_to_render = False
+    scene.vsgl_indirect.enabled = True
+    # The compositor routes Cycles' DiffCol pass to the saved image.
+    tree = compat.compositor_tree(scene, create=True)
+    rl = [n for n in tree.nodes if n.bl_idname == "CompositorNodeRLayers"][0]
+    src = rl.outputs.get("DiffCol") or rl.outputs["Diffuse Color"]   # 5.0 renamed it
+    tree.links.new(src, compat.compositor_output_socket(tree))
+    scene.render.filepath = str(tmp_path / "out" / "ml_")
+    path = save(str(tmp_path / "align.blend"))
+    r = render(path, 1)
+    assert r.returncode == 0 and "VSGL INFO: wrote" in r.stdout, r.stdout
+    ours = read_pass(str(tmp_path / "aov" / "a_0001.exr"), "VSGL.DiffCol")
+    ref = image(str(tmp_path / "out" / "ml_0001.exr"))[..., :3]
+    assert ours.shape == ref.shape
+    # Interior pixels: all 8 neighbours have the same Cycles colour.
+    flat = np.ones(ref.shape[:2], bool)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            flat &= np.all(np.abs(np.roll(np.roll(ref, dy, 0), dx, 1) - ref) < 1e-3, axis=2)
+    flat[[0, -1], :] = flat[:, [0, -1]] = False
+    assert flat.sum() > 0.5 * flat.size
+    diff = np.abs(ours - ref).max(axis=2)[flat]
+    assert np.mean(diff < 0.02) > 0.98, (np.mean(diff < 0.02), np.percentile(diff, 99))
