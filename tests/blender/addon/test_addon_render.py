@@ -293,8 +293,10 @@ def _diffuse(name, color):
     return mat
 
 
-@pytest.mark.parametrize("fit,shift", [("AUTO", (0.0, 0.0)), ("VERTICAL", (0.15, -0.1))])
-def test_aov_diffcol_aligns_with_cycles_diffcol(scene, tmp_path, fit, shift):
+@pytest.mark.parametrize("fit,shift,ctype", [("AUTO", (0.0, 0.0), "PERSP"),
+                                              ("VERTICAL", (0.15, -0.1), "PERSP"),
+                                              ("HORIZONTAL", (0.05, 0.1), "ORTHO")])
+def test_aov_diffcol_aligns_with_cycles_diffcol(scene, tmp_path, fit, shift, ctype):
     """Camera, transforms and materials at once: the AOV's DiffCol plane must
     match Cycles' own DiffCol pass pixel for pixel (away from edges)."""
     real_render_or_skip()
@@ -312,6 +314,8 @@ def test_aov_diffcol_aligns_with_cycles_diffcol(scene, tmp_path, fit, shift):
     cam = camera(scene, (0.5, -5, 1.8), (1.35, 0, 0.1), lens=30)
     cam.data.sensor_fit = fit
     cam.data.shift_x, cam.data.shift_y = shift
+    cam.data.type = ctype
+    cam.data.ortho_scale = 6.0
     light(scene, "POINT", "Lamp", 300.0, (0, -1, 3))
     scene.vsgl_indirect.output_path = str(tmp_path / "aov" / "a_####.exr")
     scene.vsgl_indirect.add_to_render = False
