@@ -13,16 +13,10 @@ import pytest
 import libvsgl
 import vsgl_reference as R
 from conftest import require
+from vsgl_reference import asg_log, dirs_near, rand_frame
 
 L = libvsgl
 LAM_MAX = 2.0 ** 41
-
-
-def rand_frame(rng):
-    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    if np.linalg.det(q) < 0:
-        q[:, 2] = -q[:, 2]
-    return q.T  # rows x, y, z; right-handed
 
 
 def c_asg(frame, lam, mu, la):
@@ -30,23 +24,6 @@ def c_asg(frame, lam, mu, la):
     F = np.float32(frame)
     a = L.ASG(F[0], F[1], F[2], np.float32(lam), np.float32(mu), np.float32(la))
     return a, (np.array(a.x), np.array(a.y), np.array(a.z), a.lam, a.mu, a.log_amplitude)
-
-
-def asg_log(t, d):
-    """log of the ASG t at unit rows d (-inf below the horizon)."""
-    x, y, z, lam, mu, la = t
-    d = R.unit_rows(d)
-    with np.errstate(divide="ignore"):
-        return la + np.log(np.maximum(d @ z, 0.0)) - lam * (d @ x) ** 2 - mu * (d @ y) ** 2
-
-
-def dirs_near(z, width, rng, count):
-    F = R.frame_from_z(z)
-    t = np.abs(rng.normal(size=count)) * width
-    t = np.minimum(t, 1.4)
-    ph = rng.uniform(0, 2 * np.pi, count)
-    return (np.sin(t)[:, None] * (np.cos(ph)[:, None] * F[0] + np.sin(ph)[:, None] * F[1])
-            + np.cos(t)[:, None] * F[2])
 
 
 def test_asg_eval_vs_formula(lib, rng):

@@ -1,6 +1,5 @@
 """Files (vsgl/io.h): multilayer EXR and scene bundles through the binding."""
 
-import os
 import struct
 
 import numpy as np

@@ -11,7 +11,6 @@ import pytest
 
 import header_parse
 import libvsgl
-from conftest import REPO
 
 CC = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc") or shutil.which("clang")
 

@@ -10,7 +10,7 @@ import pytest
 import libvsgl
 import vsgl_reference as R
 from conftest import require
-from test_asg import asg_log, dirs_near, rand_frame
+from vsgl_reference import asg_log, dirs_near, rand_frame
 
 L = libvsgl
 LAM_MAX = 2.0 ** 41

@@ -226,3 +226,27 @@ def bessel_f_quad(a):
     width = 1.0 / math.sqrt(max(a, 1e-12))
     p, wp = graded_rule(0.0, np.pi, [(np.pi / 2, width)], 24)
     return float(2.0 * np.sum(wp * np.exp(-a * np.cos(p) ** 2)))
+
+
+def rand_frame(rng):
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    if np.linalg.det(q) < 0:
+        q[:, 2] = -q[:, 2]
+    return q.T  # rows x, y, z; right-handed
+
+
+def asg_log(t, d):
+    """log of the ASG t at unit rows d (-inf below the horizon)."""
+    x, y, z, lam, mu, la = t
+    d = unit_rows(d)
+    with np.errstate(divide="ignore"):
+        return la + np.log(np.maximum(d @ z, 0.0)) - lam * (d @ x) ** 2 - mu * (d @ y) ** 2
+
+
+def dirs_near(z, width, rng, count):
+    F = frame_from_z(z)
+    t = np.abs(rng.normal(size=count)) * width
+    t = np.minimum(t, 1.4)
+    ph = rng.uniform(0, 2 * np.pi, count)
+    return (np.sin(t)[:, None] * (np.cos(ph)[:, None] * F[0] + np.sin(ph)[:, None] * F[1])
+            + np.cos(t)[:, None] * F[2])
