@@ -77,6 +77,7 @@ typedef struct aq_sph {
     double e1[3], e2[3], pole[3];
     double theta, sin_t, cos_t;
     double abs_phi, rel;
+    int nphi;
 } aq_sph;
 
 static inline double aq_sph_phi(double phi, void *u)
@@ -96,7 +97,7 @@ static inline double aq_sph_theta(double theta, void *u)
     s->cos_t = cos(theta);
     if (s->sin_t == 0.0)
         return 0.0;
-    return s->sin_t * aq_integrate(aq_sph_phi, s, 0.0, 2.0 * AQ_PI, 8, s->abs_phi, s->rel);
+    return s->sin_t * aq_integrate(aq_sph_phi, s, 0.0, 2.0 * AQ_PI, s->nphi, s->abs_phi, s->rel);
 }
 
 /* Integral of f over the unit sphere. pole: unit vector where f peaks;
@@ -116,6 +117,7 @@ static inline double aq_sphere(aq_sph_fn f, void *user, const double pole[3], do
     s.e2[0] = b, s.e2[1] = sg + pole[1] * pole[1] * q, s.e2[2] = -pole[1];
     s.abs_phi = abs_tol / (2.0 * AQ_PI * AQ_PI);
     s.rel = rel;
+    s.nphi = w < 0.1 ? 4 : 8;
     if (!(w > 0.0) || w > 0.5)
         w = 0.5;
     double t0 = 0.0, t1 = w, sum = 0.0;

@@ -170,14 +170,14 @@ double vsgl__asg_integral_exact(double lambda, double mu)
      * e^{-s mu} F(s (lambda - mu)), s = sin^2 theta). With s = u^2 the
      * integrand 2u e^{-u^2 mu} I0e(u^2 d) is smooth; its only feature for
      * large d sits at u ~ 1/sqrt(d), so the panels grow geometrically (x4)
-     * from there, and no panel is wider than 1/4 (e^{-u^2 mu}). */
+     * from there, and no panel is wider than 1/2 (e^{-u^2 mu}, mu < 12). */
     double d = 0.5 * (lambda - mu);
     double u0 = 0.0, sum = 0.0;
-    double u1 = d > 1.0 ? 1.0 / sqrt(d) : 0.25;
+    double u1 = d > 1.0 ? 1.0 / sqrt(d) : 0.5;
     while (u0 < 1.0) {
         double hi = u1 < 1.0 ? u1 : 1.0;
-        if (hi - u0 > 0.25)
-            hi = u0 + 0.25 < 1.0 ? u0 + 0.25 : 1.0;
+        if (hi - u0 > 0.5)
+            hi = u0 + 0.5 < 1.0 ? u0 + 0.5 : 1.0;
         sum += panel(u0, hi, mu, d);
         u0 = hi;
         u1 = 4.0 * hi;
