@@ -83,8 +83,9 @@ def _material_structs(libvsgl, sd):
     return [libvsgl.Material(**m) for m in sd.materials]
 
 
-def render_planes(sd, options, progress=None):
-    """(planes dict, stats dict). ``progress(stage, fraction)`` returns True to cancel."""
+def render_planes(sd, options, progress=None, log=None):
+    """(planes dict, stats dict). ``progress(stage, fraction)`` returns True to
+    cancel; ``log(level, message)`` receives the library's warnings/errors."""
     if RENDER_OVERRIDE is not None:
         return RENDER_OVERRIDE(sd, options)
     missing = render_missing()
@@ -92,7 +93,8 @@ def render_planes(sd, options, progress=None):
         raise AovError(missing)
     libvsgl = _binding()
     try:
-        ctx = libvsgl.Context(thread_count=max(int(options.threads), 0), progress=progress)
+        ctx = libvsgl.Context(thread_count=max(int(options.threads), 0), progress=progress,
+                              log=log, log_level=libvsgl.LogLevel.WARNING)
     except Exception as e:
         raise AovError("cannot create a libvsgl context: %s" % e)
     try:
@@ -226,7 +228,10 @@ def compute(sd, options, path, progress=None, keep_planes=False, metadata=None):
     res.summary = sd.summary()
     check_output_path(path)
     t0 = time.perf_counter()
-    planes, stats = render_planes(sd, options, progress)
+    def log(level, message):
+        if message:
+            res.warnings.append("libvsgl: %s" % _name_elements(message, sd))
+    planes, stats = render_planes(sd, options, progress, log)
     t1 = time.perf_counter()
     for p in ("combined", "diffuse_light"):
         if p in planes and np.asarray(planes[p]).shape[:2] != (sd.height, sd.width):

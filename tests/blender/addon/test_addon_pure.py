@@ -110,3 +110,12 @@ def test_principled_emission_warns(version, color):
     _, w = materials.map_material(desc(materials.PRINCIPLED, {
         "Emission Strength": 1.0, color: (0, 0, 0, 1)}, version))
     assert w == []
+
+
+def test_library_messages_get_blender_names():
+    from vsgl_indirect import engine, export
+    sd = export.SceneData()
+    sd.light_names = ["Key", "Fill"]
+    sd.material_names = ["Floor"]
+    msg = engine._name_elements("light 1: spot size is 0; material 0: NaN; light 7: x", sd)
+    assert msg == "light 1 ('Fill'): spot size is 0; material 0 ('Floor'): NaN; light 7: x"
