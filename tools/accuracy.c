@@ -26,7 +26,7 @@ int main(int argc, char **argv)
     uint32_t W = argc > 1 ? (uint32_t)atoi(argv[1]) : 80, H = argc > 2 ? (uint32_t)atoi(argv[2]) : 60;
     uint32_t rsm = argc > 3 ? (uint32_t)atoi(argv[3]) : 64;
     const char *fit_names[3] = {"two", "fis", "kmeans"};
-    const char *diff_names[3] = {"sg", "pulled", "accurate"};
+    const char *diff_names[3] = {"accurate", "sg", "pulled"}; /* by VSGL_COSINE_* value */
     const uint32_t counts[6] = {2, 8, 32, 128, 512, 2048};
     printf("Image %ux%u, 1 sample/pixel, RSM %u^2, reference: brute-force gathering of every RSM texel.\n\n", W, H, rsm);
     for (int k = 0; k < ACC_SCENES; ++k) {

@@ -110,9 +110,9 @@ class LogLevel(enum.IntEnum):
 
 
 class CosineMode(enum.IntEnum):
-    SG = 0
-    PULLED_OUT = 1
-    ACCURATE = 2
+    ACCURATE = 0
+    SG = 1
+    PULLED_OUT = 2
 
 
 class SharpnessEstimator(enum.IntEnum):

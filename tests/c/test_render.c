@@ -126,7 +126,7 @@ VT_TEST(render_rejects_bad_settings_and_sizes_without_touching_output)
     char err[256];
     struct { const char *field; int value; const char *want; } cases[] = {
         {"fit_mode", 7, "settings: fit_mode is 7"},
-        {"diffuse_mode", -1, "settings: diffuse_mode is -1"},
+        {"diffuse_mode", 3, "settings: diffuse_mode is 3"},
         {"rsm_resolution", 100000, "settings: rsm_resolution is 100000"},
         {"aa_samples", 99, "settings: aa_samples is 99"},
     };

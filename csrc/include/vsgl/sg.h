@@ -60,9 +60,9 @@ VSGL_API float vsgl_sg_product_integral(const vsgl_sg *a, const vsgl_sg *b);
 VSGL_API float vsgl_sg_product_integral_iwasaki(const vsgl_sg *a, const vsgl_sg *b);
 
 /** How ::vsgl_sg_cosine_integral treats the clamped cosine max(w.n, 0). */
-#define VSGL_COSINE_SG          0  /**< poster: cosine ~ pi G(w; n, lambda_d) / A(lambda_d), SG product integral */
-#define VSGL_COSINE_PULLED_OUT  1  /**< FIS supplement: max(xi.n, 0) * integral of the SG */
-#define VSGL_COSINE_ACCURATE    2  /**< accurate fitted form (docs/math.md gives the error) */
+#define VSGL_COSINE_ACCURATE    0  /**< accurate fitted form (docs/math.md gives the error); the default */
+#define VSGL_COSINE_SG          1  /**< poster: cosine ~ pi G(w; n, lambda_d) / A(lambda_d), SG product integral */
+#define VSGL_COSINE_PULLED_OUT  2  /**< FIS supplement: max(xi.n, 0) * integral of the SG */
 
 /** Least-squares sharpness lambda_d of the poster's SG-cosine (docs/math.md). */
 VSGL_API float vsgl_sg_cosine_sharpness(void);
