@@ -10,6 +10,8 @@
  * - vsgl/lobes.h  BRDF lobes as SG/ASG, spherical warping
  * - vsgl/scene.h  scene input (triangles, materials, lights, camera)
  * - vsgl/render.h settings, outputs, ::vsgl_render
+ * - vsgl/io.h     multilayer EXR writer, scene bundle files
+ * - vsgl/debug.h, vsgl/reference.h  test entry points (G-buffer, RSM, brute force)
  */
 #ifndef VSGL_H
 #define VSGL_H

@@ -184,3 +184,45 @@ VT_TEST(render_skips_dark_lights_and_says_why)
     vsgl_scene_destroy(scene);
     vsgl_context_destroy(ctx);
 }
+
+typedef struct progress_log { float last; int backwards, calls; } progress_log;
+static int32_t log_progress(void *user, const char *stage, float f)
+{
+    progress_log *p = user;
+    (void)stage;
+    p->backwards += f < p->last;
+    p->last = f;
+    p->calls++;
+    return 0;
+}
+
+VT_TEST(render_progress_is_overall_and_monotone)
+{
+    static planes p;
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.3f, 100.0f);
+    fx.lights[1] = fx.lights[0];
+    fx.light_count = 2;
+    for (int method = 0; method < 2; ++method) {
+        progress_log log = {-1.0f, 0, 0};
+        vsgl_context_desc d;
+        memset(&d, 0, sizeof d);
+        d.size = sizeof d;
+        d.progress = log_progress;
+        d.progress_user = &log;
+        vsgl_context *ctx;
+        vsgl_scene *scene;
+        vsgl_context_create(&d, &ctx);
+        VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.method = method;
+        s.rsm_resolution = 32;
+        vsgl_render_output o = bind(&p);
+        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_CHECK(log.calls >= 10 && log.backwards == 0 && log.last == 1.0f,
+                 "method %d: %d reports, %d went backwards, last %g", method, log.calls, log.backwards, log.last);
+        vsgl_scene_destroy(scene);
+        vsgl_context_destroy(ctx);
+    }
+}

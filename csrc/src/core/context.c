@@ -37,6 +37,8 @@ vsgl_result vsgl_context_create(const vsgl_context_desc *desc, vsgl_context **ou
     ctx->log_user = d.log_user;
     ctx->progress = d.progress;
     ctx->progress_user = d.progress_user;
+    ctx->progress_base = 0.0f;
+    ctx->progress_span = 1.0f;
     *out = ctx;
     return VSGL_OK;
 }
@@ -91,5 +93,14 @@ int vsgl__progress(const vsgl_context *ctx, const char *stage, float fraction)
 {
     if (!ctx || !ctx->progress)
         return 0;
-    return ctx->progress(ctx->progress_user, stage, fraction) != 0;
+    float f = fraction < 0.0f ? 0.0f : (fraction > 1.0f ? 1.0f : fraction);
+    return ctx->progress(ctx->progress_user, stage, ctx->progress_base + ctx->progress_span * f) != 0;
+}
+
+void vsgl__progress_window(vsgl_context *ctx, float base, float span)
+{
+    if (!ctx)
+        return;
+    ctx->progress_base = base;
+    ctx->progress_span = span;
 }

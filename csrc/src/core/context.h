@@ -14,6 +14,7 @@ struct vsgl_context {
     vsgl_progress_fn progress;
     void *progress_user;
     char last_error[VSGL_MESSAGE_MAX];
+    float progress_base, progress_span; /* stage window of the overall progress */
 };
 
 #if defined(__GNUC__)
@@ -28,8 +29,14 @@ vsgl_result vsgl__fail(vsgl_context *ctx, vsgl_result code, const char *fmt, ...
 /* Log one line at level (no-op below the context's level or without a callback). */
 void vsgl__log(const vsgl_context *ctx, int32_t level, const char *fmt, ...) VSGL_PRINTF(3, 4);
 
-/* Report progress; returns non-zero if the caller asked to cancel. */
+/* Report progress of the current stage (fraction in [0, 1] of the stage,
+ * mapped into the window set by vsgl__progress_window so the caller sees
+ * overall progress); returns non-zero if the caller asked to cancel. */
 int vsgl__progress(const vsgl_context *ctx, const char *stage, float fraction);
+
+/* The part [base, base + span] of the overall progress that the stages
+ * called next fill; (0, 1) by default. */
+void vsgl__progress_window(vsgl_context *ctx, float base, float span);
 
 /* Clear the last error at the start of a fallible public call. */
 void vsgl__clear_error(vsgl_context *ctx);

@@ -50,6 +50,7 @@ static vsgl_result fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const 
         }
         double t0 = now_seconds();
         vsgl_rsm rsm;
+        vsgl__progress_window(ctx, 0.1f + 0.3f * (float)l / (float)light_count, 0.3f / (float)light_count);
         vsgl_result r = vsgl__rsm_build(ctx, scene, l, s->rsm_resolution, &rsm);
         st->seconds_rsm += now_seconds() - t0;
         if (r != VSGL_OK)
@@ -82,7 +83,7 @@ static vsgl_result fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const 
         } else {
             ++st->lights_used;
         }
-        if (vsgl__progress(ctx, "fit", (float)(l + 1) / (float)light_count))
+        if (vsgl__progress(ctx, "fit", 1.0f))
             return vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "fit: cancelled");
     }
     return VSGL_OK;
@@ -112,6 +113,7 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
             continue;
         }
         double t0 = now_seconds();
+        vsgl__progress_window(ctx, 0.1f + 0.2f * (float)l / (float)light_count, 0.2f / (float)light_count);
         r = vsgl__rsm_build(ctx, scene, l, s->rsm_resolution, &rsms[used]);
         st->seconds_rsm += now_seconds() - t0;
         if (r != VSGL_OK)
@@ -128,6 +130,7 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
     }
     if (r == VSGL_OK) {
         double t0 = now_seconds();
+        vsgl__progress_window(ctx, 0.3f, 0.7f);
         float *dl = sample, *gl = sample + 3 * g->count, *dc = sample + 6 * g->count, *gc = sample + 9 * g->count;
         r = vsgl__brute_force_shade(ctx, scene, g, rsms, used, s->visibility == VSGL_VISIBILITY_RAY, dl, gl, dc, gc);
         st->seconds_shade = now_seconds() - t0;
@@ -230,6 +233,8 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
     float *buf = NULL;
 
     double t0 = now_seconds();
+    /* overall progress: G-buffer 0-10 %, RSMs and fits 10-40 % (brute force 10-30 %), shading the rest */
+    vsgl__progress_window(ctx, 0.0f, 0.1f);
     r = vsgl__gbuffer_build(ctx, scene, s.aa_samples, &g);
     st.seconds_gbuffer = now_seconds() - t0;
     if (r != VSGL_OK)
@@ -247,6 +252,7 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
         st.vsgl_count = (uint32_t)set.count;
         if (r == VSGL_OK) {
             t0 = now_seconds();
+            vsgl__progress_window(ctx, 0.4f, 0.6f);
             r = vsgl__shade(ctx, scene, &g, &set, &s, &planes, VSGL_SHADE_KERNEL, &st.shading_pairs);
             st.seconds_shade = now_seconds() - t0;
         }
@@ -254,6 +260,7 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
     if (r == VSGL_OK)
         r = write_outputs(ctx, &planes, pixels, out);
 done:
+    vsgl__progress_window(ctx, 0.0f, 1.0f);
     free(buf);
     vsgl__vsgl_set_free(&set);
     vsgl__gbuffer_free(&g);
