@@ -7,6 +7,8 @@
 
 #include <stdlib.h>
 
+#define PI_D 3.14159265358979323846
+
 typedef struct hand_rsm {
     vsgl_rsm r;
     float *mem;
@@ -21,7 +23,8 @@ static void make_rsm(hand_rsm *h, uint32_t res, uint64_t seed, float offset, flo
     r->faces = 1;
     r->res = res;
     r->count = (size_t)res * res;
-    h->mem = calloc(r->count * 12, sizeof(float));
+    h->mem = calloc(r->count * 13, sizeof(float));
+    r->area = h->mem + r->count * 12;
     for (int c = 0; c < 3; ++c) {
         r->pos[c] = h->mem + r->count * (size_t)c;
         r->nrm[c] = h->mem + r->count * (size_t)(3 + c);
@@ -47,6 +50,7 @@ static void make_rsm(hand_rsm *h, uint32_t res, uint64_t seed, float offset, flo
             r->flux[c][t] = (float)(0.1 + vt_uniform(&rng));
             r->total_flux[c] += r->flux[c][t];
         }
+        r->area[t] = (float)(1e-4 + 1e-2 * vt_uniform(&rng)); /* texel footprint, m^2 */
     }
 }
 
@@ -102,7 +106,8 @@ static void reference_two(const vsgl_scene *scene, const vsgl_rsm *r, int32_t es
                 D[lobe][c] += w * mlen * axis[c];
                 X[lobe][c] += w * x[c];
             }
-            X2[lobe] += w * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+            /* a texel is a patch: its own second moment a / (2 pi) (disk of area a) */
+            X2[lobe] += w * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + r->area[t] / (2.0 * PI_D));
         }
     }
     for (int lobe = 0; lobe < 2; ++lobe) {

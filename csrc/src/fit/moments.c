@@ -55,7 +55,14 @@ static double schlick(double f0, double cos_theta)
     return f0 + (1.0 - f0) * m2 * m2 * m;
 }
 
-static void fill(vsgl_moments *m, const double power[3], v3 axis, float mean_length, v3 rel, v3 n)
+/* `footprint`: the texel's area on the surface (m^2). A VPL stands for a
+ * patch, not a point: its own second moment about its centre, a/(2 pi) for
+ * a disk of area a, is added so that small clusters (down to one texel)
+ * keep the spread of the surface they represent instead of becoming
+ * singular point lights (the brute force clamps the same singularity by
+ * the footprint). */
+static void fill(vsgl_moments *m, const double power[3], v3 axis, float mean_length, v3 rel, v3 n,
+                 float footprint)
 {
     double w = power[0] + power[1] + power[2];
     m->weight = w;
@@ -67,7 +74,8 @@ static void fill(vsgl_moments *m, const double power[3], v3 axis, float mean_len
     m->pos[0] = w * rel.x;
     m->pos[1] = w * rel.y;
     m->pos[2] = w * rel.z;
-    m->pos2 = w * ((double)rel.x * rel.x + (double)rel.y * rel.y + (double)rel.z * rel.z);
+    m->pos2 = w * ((double)rel.x * rel.x + (double)rel.y * rel.y + (double)rel.z * rel.z +
+                   (footprint > 0.0f && footprint < INFINITY ? footprint * 0.15915494309189535 : 0.0));
     m->nrm[0] = w * n.x;
     m->nrm[1] = w * n.y;
     m->nrm[2] = w * n.z;
@@ -94,6 +102,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
     v3 n = v3_make(rsm->nrm[0][t], rsm->nrm[1][t], rsm->nrm[2][t]);
     v3 wi = v3_make(rsm->wi[0][t], rsm->wi[1][t], rsm->wi[2][t]);
     v3 rel = v3_sub(p, origin);
+    float foot = rsm->area ? rsm->area[t] : 0.0f;
     int any = 0;
 
     /* Diffuse lobe: Phi R_d G(w; n, l_d) / A(l_d). */
@@ -102,7 +111,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
         pd[c] = flux[c] * bp.diffuse[c];
     if (pd[0] + pd[1] + pd[2] > 0.0) {
         float ld = vsgl_sg_cosine_sharpness();
-        fill(&out[VSGL_LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel, n);
+        fill(&out[VSGL_LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel, n, foot);
         any = 1;
     }
     /* Specular lobe: Phi R_s G(w; reflect(wi, n), l_h / (4 |wi.n|)) / A(.), with
@@ -118,7 +127,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
             vsgl_ndf_to_sg(&n, alpha, VSGL_NDF_GGX, &ndf);
             vsgl_warp_ndf_sg(&ndf, &wi, &warped);
             fill(&out[VSGL_LOBE_SPECULAR], ps, warped.axis,
-                 vsgl_mean_length_from_sharpness(warped.sharpness, estimator), rel, n);
+                 vsgl_mean_length_from_sharpness(warped.sharpness, estimator), rel, n, foot);
             any = 1;
         }
     }
