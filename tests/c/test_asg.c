@@ -397,9 +397,9 @@ VT_TEST(asg_product_fig4_examples_error_bounded)
             vsgl_asg_product(&a, &b, &c);
             prod_ctx_t p = {to_ref(&a), to_ref(&b), to_ref(&c), 0};
             double w = 0.5 / sqrt(c.lambda + 1.0);
-            double tot = aq_sphere(prod_fn, &p, p.c.z, w, 0.0, 1e-7);
-            p.which = 1;
-            double err = aq_sphere(prod_fn, &p, p.c.z, w, 1e-8 * tot, 1e-6) / tot;
+            double tot = aq_sphere(prod_fn, &p, p.c.z, w, 1e-6 * vsgl_asg_integral(&c), 1e-6);
+            p.which = 1; /* kinks: a loose tolerance (the errors are > 3 %) */
+            double err = aq_sphere(prod_fn, &p, p.c.z, w, 1e-4 * tot, 1e-4) / tot;
             VT_CHECK(err < bound[e][k] && err > 0.5 * bound[e][k], "example %d z1.z2=%.3f: rel L1 error %.4g", e + 1, ca, err);
         }
 }
