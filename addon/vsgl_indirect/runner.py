@@ -34,8 +34,12 @@ def render_dir(scene):
 
 def output_path(scene, view_layer, frame, options=None):
     options = options or options_of(scene)
-    p = convert.frame_path(options.output_path or "{render_dir}/vsgl/{scene}_{view_layer}_####.exr",
-                           frame, scene.name, view_layer, render_dir(scene))
+    template = options.output_path or "{render_dir}/vsgl/{scene}_{view_layer}_####.exr"
+    if "{view_layer}" not in template and sum(vl.use for vl in scene.view_layers) > 1:
+        # Several rendered view layers must not share one file.
+        head, tail = os.path.split(template)
+        template = os.path.join(head, "{view_layer}_" + tail)
+    p = convert.frame_path(template, frame, scene.name, view_layer, render_dir(scene))
     p = bpy.path.abspath(p)
     if p.startswith("//"):
         p = os.path.join(bpy.app.tempdir or "/tmp", p[2:])

@@ -306,3 +306,24 @@ def test_light_blackbody_and_nodes_warning(scene):
     if expect != (1.0, 1.0, 1.0):
         assert expect[2] < expect[0]    # 3000 K is reddish: independent sanity
     assert any("'Warm'" in w and "node" in w for w in sd.warnings)
+
+
+def test_collection_holdout_and_layer_paths_distinct(scene):
+    from vsgl_indirect import runner
+    basic(scene)
+    link(scene, plane("Shown", 1.0))
+    col = bpy.data.collections.new("Matte")
+    scene.collection.children.link(col)
+    link(scene, plane("InMatte", 1.0, (0, 5, 0), principled("Blue", (0, 0, 1, 1))), col)
+    bpy.context.view_layer.layer_collection.children["Matte"].holdout = True
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    tri = np.flatnonzero(sd.positions[sd.indices[:, 0], 1] > 4)
+    assert len(tri) == 2
+    assert sd.materials[sd.material_indices[tri[0]]]["base_color"] == (0.0, 0.0, 0.0)
+    # Two rendered view layers and a template without {view_layer}: distinct files.
+    scene.view_layers.new("Other")
+    scene.vsgl_indirect.output_path = "/tmp/x/aov_####.exr"
+    a = runner.output_path(scene, "ViewLayer", 5)
+    b = runner.output_path(scene, "Other", 5)
+    assert a != b and a.endswith("_0005.exr") and b.endswith("_0005.exr")
