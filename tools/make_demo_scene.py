@@ -105,11 +105,13 @@ c.max_bounces = 0          # direct light only: the AOV brings the first bounce
 c.seed = 0
 scene.world = None
 
+os.makedirs(os.path.dirname(out), exist_ok=True)
+bpy.ops.wm.save_as_mainfile(filepath=out)   # so '//' paths resolve next to it
 props = scene.vsgl_indirect
-props.enabled = True
+props.output_path = "//aov/indirect_####.exr"
 props.add_to_render = True
 props.preset = "BALANCED"
-props.output_path = "//aov/indirect_####.exr"
+props.enabled = True
 
 # Direct-light copy for the side-by-side preview (File Output runs in background).
 from vsgl_indirect import compat  # noqa: E402

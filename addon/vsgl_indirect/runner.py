@@ -24,12 +24,18 @@ def report(scene_name, level, message):
     LAST_RUN.setdefault(scene_name, {}).setdefault("messages", []).append((level, message))
 
 
+def _absolute(p):
+    """Blender path -> absolute; '//' of an unsaved file goes to the temp dir."""
+    if p.startswith("//") and not bpy.data.filepath:
+        return os.path.join(bpy.app.tempdir or "/tmp", p[2:])
+    p = bpy.path.abspath(p)
+    if p.startswith("//"):
+        p = os.path.join(bpy.app.tempdir or "/tmp", p[2:])
+    return os.path.abspath(p)
+
+
 def render_dir(scene):
-    d = os.path.dirname(scene.render.filepath) or "//"
-    d = bpy.path.abspath(d)
-    if d.startswith("//"):   # unsaved file and a relative output path
-        d = os.path.join(bpy.app.tempdir or "/tmp", d[2:])
-    return d
+    return _absolute(os.path.dirname(scene.render.filepath) or "//")
 
 
 def output_path(scene, view_layer, frame, options=None):
@@ -40,10 +46,7 @@ def output_path(scene, view_layer, frame, options=None):
         head, tail = os.path.split(template)
         template = os.path.join(head, "{view_layer}_" + tail)
     p = convert.frame_path(template, frame, scene.name, view_layer, render_dir(scene))
-    p = bpy.path.abspath(p)
-    if p.startswith("//"):
-        p = os.path.join(bpy.app.tempdir or "/tmp", p[2:])
-    return os.path.normpath(p)
+    return os.path.normpath(_absolute(p))
 
 
 def begin(scene_name, frame):

@@ -20,6 +20,11 @@ def _update_compositor(self, context):
         print("VSGL WARNING: compositor update failed: %r" % (e,))
 
 
+# Blender 4.5+ warns about '//' in path properties unless they opt in.
+_PATH_OPTIONS = ({"options": {"PATH_SUPPORTS_BLEND_RELATIVE"}}
+                 if bpy.app.version >= (4, 5, 0) else {})
+
+
 def _items(names, descriptions=None):
     descriptions = descriptions or {}
     return [(n, n.replace("_", " ").title(), descriptions.get(n, "")) for n in names]
@@ -62,7 +67,7 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
     seed: IntProperty(name="Seed", default=0, min=0)
     output_path: StringProperty(
         name="Output", subtype="FILE_PATH", default=config.DEFAULT_TEMPLATE,
-        update=_update_compositor,
+        update=_update_compositor, **_PATH_OPTIONS,
         description="Per-frame multilayer EXR. {render_dir} = the render output's folder, "
                     "{scene}, {view_layer}; #### = frame number (must be the last digits)")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024,
