@@ -119,3 +119,31 @@ def test_library_messages_get_blender_names():
     sd.material_names = ["Floor"]
     msg = engine._name_elements("light 1: spot size is 0; material 0: NaN; light 7: x", sd)
     assert msg == "light 1 ('Fill'): spot size is 0; material 0 ('Floor'): NaN; light 7: x"
+
+
+def test_batched_assemble_matches_per_instance_transform():
+    from vsgl_indirect import export
+    rng = np.random.RandomState(3)
+    pos = rng.rand(5, 3).astype(np.float32)
+    tv = np.array([[0, 1, 2], [2, 3, 4]])
+    tl = np.array([[0, 1, 2], [3, 4, 5]])
+    ln = rng.randn(6, 3).astype(np.float32)
+    ln /= np.linalg.norm(ln, axis=1, keepdims=True)
+    arr = export.MeshArrays(pos, tv, tl, ln, None, np.array([0, 1]))
+    mats = []
+    for i, scale in enumerate([(1, 1, 1), (-1, 2, 1), (0.5, 0.5, 3)]):
+        m = np.eye(4)
+        m[:3, :3] = np.diag(scale) @ np.linalg.qr(rng.randn(3, 3))[0]
+        m[:3, 3] = (i, 2 * i, -i)
+        mats.append(m)
+    chunks = [(arr, mats[0], [4, 7]), (arr, mats[1], [5]), (arr, mats[2], [6, 8])]
+    P, I, N, U, M = export.assemble(chunks)
+    assert P.shape == (15, 3) and I.shape == (6, 3) and U is None
+    for k, m in enumerate(mats):
+        assert np.allclose(P[5 * k:5 * k + 5], convert.transform_points(m, pos), atol=1e-5)
+        flip = np.linalg.det(m[:3, :3]) < 0
+        order = [0, 2, 1] if flip else [0, 1, 2]
+        assert np.array_equal(I[2 * k:2 * k + 2], tv[:, order] + 5 * k)
+        ref = convert.transform_normals(m, ln[tl[:, order].reshape(-1)]).reshape(2, 3, 3)
+        assert np.allclose(N[2 * k:2 * k + 2], ref, atol=1e-5)
+    assert M.tolist() == [4, 7, 5, 5, 6, 8]
