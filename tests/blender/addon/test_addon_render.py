@@ -341,3 +341,29 @@ def test_aov_diffcol_aligns_with_cycles_diffcol(scene, tmp_path, fit, shift, cty
     assert flat.sum() > 0.5 * flat.size
     diff = np.abs(ours - ref).max(axis=2)[flat]
     assert np.mean(diff < 0.02) > 0.98, (np.mean(diff < 0.02), np.percentile(diff, 99))
+
+
+def test_animation_exports_each_frames_state(scene, tmp_path):
+    """-a over animated geometry and lights: each frame's AOV is computed from
+    that frame's render depsgraph (not the frame the file was saved at)."""
+    path = setup_blend(scene, tmp_path)
+    from conftest import cube
+    box = link(scene, cube("Mover", 1.0, (0, 0, 0.5)))
+    for f, x in ((1, 1.0), (3, 9.0)):           # rendered frames are the keyed ones
+        box.location.x = x
+        box.keyframe_insert("location", index=0, frame=f)
+    extra = scene.objects["Spot"].copy()
+    extra.hide_render = True
+    extra.keyframe_insert("hide_render", frame=1)
+    extra.hide_render = False
+    extra.keyframe_insert("hide_render", frame=3)
+    scene.collection.objects.link(extra)
+    scene.frame_set(1)
+    path = save(path)
+    r = render(path, (1, 3), env={"VSGL_TEST_FAKE_RENDER": "bounds"})
+    assert r.returncode == 0 and "VSGL ERROR" not in r.stdout, r.stdout
+    for f in (1, 3):
+        c = read_pass(aov(tmp_path, f), "VSGL.Combined", "RGB")[0, 0]
+        assert c[2] == f
+        assert c[0] == pytest.approx(max(4.0, 4 * f - 3 + 0.5), abs=1e-4), (f, c)
+        assert c[1] == (1 if f == 1 else 2), (f, c)
