@@ -22,7 +22,7 @@ from bpy.app.handlers import persistent
 
 from . import compositor, convert, engine, runner
 
-_state = {"active": {}, "placeholders": {}, "done": set(), "setup_files": set()}
+_state = {"active": {}, "placeholders": {}, "done": set()}
 
 
 def _layers(scene):
@@ -74,15 +74,6 @@ def setup_scene(scene, frame=None):
     for e in errors:
         runner.fail(scene.name, e)
     return errors
-
-
-def _cleanup_setup_files():
-    for path in list(_state["setup_files"]):
-        _state["setup_files"].discard(path)
-        # Only if it is still a placeholder nobody rendered over.
-        if os.path.exists(path) and path not in _state["placeholders"].values():
-            if os.path.getsize(path) and _is_placeholder(path):
-                os.unlink(path)
 
 
 _placeholder_mtimes = {}
@@ -169,7 +160,6 @@ def on_render_post(scene, *args):
 @persistent
 def on_render_end(scene, *args):
     on_render_post(scene)
-    _cleanup_setup_files()
 
 
 @persistent
