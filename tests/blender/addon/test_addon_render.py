@@ -172,15 +172,19 @@ def test_preview_operator_writes_and_loads_image(scene, monkeypatch):
 
 
 def test_addons_route_with_user_scripts(scene, tmp_path):
-    """blender -b file --addons vsgl_indirect -f 1 with the add-on installed
-    in BLENDER_USER_SCRIPTS (as from the zip: library in lib/)."""
+    """blender -b file --addons vsgl_indirect -f 1 with the add-on zip
+    installed in BLENDER_USER_SCRIPTS (library from its lib/)."""
     if not IS_BINARY:
         pytest.skip("--addons is an option of the Blender binary; the pip bpy module has no CLI")
+    import zipfile
+    r = subprocess.run([os.path.join(REPO, "tools", "build_addon.sh")], cwd=REPO,
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    assert r.returncode == 0, r.stdout
+    # What Preferences > Add-ons > Install does with the zip.
+    zipfile.ZipFile(os.path.join(REPO, "build", "vsgl_indirect.zip")).extractall(
+        str(tmp_path / "scripts" / "addons"))
     dst = tmp_path / "scripts" / "addons" / "vsgl_indirect"
-    shutil.copytree(os.path.join(REPO, "addon", "vsgl_indirect"), str(dst),
-                    ignore=shutil.ignore_patterns("__pycache__", "*.so"))
-    os.makedirs(str(dst / "lib"))
-    shutil.copy(os.path.join(REPO, "build", "libvsgl.so"), str(dst / "lib" / "libvsgl.so"))
+    assert (dst / "lib" / "libvsgl.so").exists() and (dst / "blender_manifest.toml").exists()
     path = setup_blend(scene, tmp_path)
     env = dict(os.environ, BLENDER_USER_SCRIPTS=str(tmp_path / "scripts"))
     env.pop("VSGL_LIBRARY", None)
