@@ -5,6 +5,8 @@
  *     tools/asg_error_table.c csrc/src/math/asg.c csrc/src/math/bessel.c \
  *     csrc/src/math/eigen3.c -lm -o build/asg_error_table
  *   build/asg_error_table [integral|conv|product|sg|all] [quick]
+ *   build/asg_error_table conv full FIRST_ROW STEP   (rows of lambda = 1, 2, 3, 5, 10, 30, 100
+ *                                                     in that order; e.g. "6 -1" runs them backwards)
  *
  * References are the double-precision quadratures of tools/asg_error_table.h
  * (tolerances 1e-9 relative or better, three orders below the smallest
@@ -18,6 +20,7 @@
 #include <string.h>
 
 static int quick;
+static int conv_first = 0, conv_step = 1; /* row order of the conv table (to split it over processes) */
 
 /* ------------------------------------------------------------- integral */
 
@@ -202,7 +205,7 @@ static void table_conv(void)
     printf("%6s %6s %8s | %-10s %-10s | %-10s %-10s | %-10s %-10s\n", "lam", "mu", "nu", "relL2 pap", "relL2 ours",
            "absL2n pap", "absL2n ours", "peak pap", "peak ours");
     double worst[3][2] = {{0, 0}, {0, 0}, {0, 0}}; /* class >3, >1 (all nu); >3 with nu >= 1 */
-    for (int i = 0; i < nb; ++i)
+    for (int i = conv_first; i >= 0 && i < nb; i += conv_step)
         for (int j = 0; j <= i; ++j)
             for (int k = 0; k < nn; ++k) {
                 double lam = bw[i], mu = bw[j], nu = quick ? quick_nus[k] : nus[k];
@@ -361,6 +364,10 @@ int main(int argc, char **argv)
 {
     const char *what = argc > 1 ? argv[1] : "all";
     quick = argc > 2 && strcmp(argv[2], "quick") == 0;
+    if (argc > 4 && strcmp(what, "conv") == 0) { /* conv full|quick FIRST_ROW STEP */
+        conv_first = atoi(argv[3]);
+        conv_step = atoi(argv[4]);
+    }
     int all = strcmp(what, "all") == 0;
     if (all || strcmp(what, "integral") == 0)
         table_integral();
