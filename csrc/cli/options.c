@@ -25,6 +25,8 @@ const char cli_usage[] =
     "  --diffuse NAME        sg | pulled | accurate   (receiver cosine)\n"
     "  --glossy NAME         asg | sg\n"
     "  --visibility NAME     none | ray\n"
+    "  --leak NAME           auto | off | on   (emitter-hemisphere light-leak correction)\n"
+    "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
     "  --method NAME         vsgl | brute   (brute: every RSM texel, the reference)\n"
     "  --threads N           worker threads (0 = all cores)\n"
     "  --seed N              seed of FIS / k-means sampling\n"
@@ -81,6 +83,10 @@ static const char *const glossy_names[] = {"asg", "sg", NULL};
 static const int glossy_values[] = {VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG};
 static const char *const vis_names[] = {"none", "ray", NULL};
 static const int vis_values[] = {VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY};
+static const char *const leak_names[] = {"auto", "off", "on", NULL};
+static const int leak_values[] = {VSGL_LEAK_AUTO, VSGL_LEAK_OFF, VSGL_LEAK_ON};
+static const char *const merge_names[] = {"auto", "off", NULL};
+static const int merge_values[] = {VSGL_MERGE_AUTO, VSGL_MERGE_OFF};
 static const char *const method_names[] = {"vsgl", "brute", NULL};
 static const int method_values[] = {VSGL_METHOD_VSGL, VSGL_METHOD_BRUTE_FORCE};
 
@@ -96,6 +102,8 @@ static const enum_opt enum_opts[] = {
     {"--glossy", glossy_names, glossy_values, offsetof(cli_options, glossy)},
     {"--visibility", vis_names, vis_values, offsetof(cli_options, visibility)},
     {"--method", method_names, method_values, offsetof(cli_options, method)},
+    {"--leak", leak_names, leak_values, offsetof(cli_options, leak)},
+    {"--merge", merge_names, merge_values, offsetof(cli_options, merge)},
 };
 
 static const num_opt num_opts[] = {
@@ -117,7 +125,7 @@ int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
 {
     memset(o, 0, sizeof *o);
     o->command = CLI_HELP;
-    o->preset = o->fit = o->sharpness = o->diffuse = o->glossy = o->visibility = o->method = -1;
+    o->preset = o->fit = o->sharpness = o->diffuse = o->glossy = o->visibility = o->method = o->leak = o->merge = -1;
     err[0] = '\0';
     if (argc < 2)
         return set_err(err, err_size, "no command given%s%s (see vsgl --help)", "", "");
@@ -250,6 +258,8 @@ void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_r
     if (o->glossy >= 0) s->glossy_mode = o->glossy;
     if (o->visibility >= 0) s->visibility = o->visibility;
     if (o->method >= 0) s->method = o->method;
+    if (o->leak >= 0) s->leak_correction = o->leak;
+    if (o->merge >= 0) s->sample_merging = o->merge;
 }
 
 static const char *name_of(const char *const *names, const int *values, int v)
@@ -262,9 +272,10 @@ static const char *name_of(const char *const *names, const int *values, int v)
 
 void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size)
 {
-    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u",
+    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s",
              name_of(method_names, method_values, s->method), s->aa_samples, s->rsm_resolution,
              name_of(fit_names, fit_values, s->fit_mode), s->vsgl_count, s->fis_iterations,
              name_of(sharp_names, sharp_values, s->sharpness_estimator), name_of(diffuse_names, diffuse_values, s->diffuse_mode),
-             name_of(glossy_names, glossy_values, s->glossy_mode), name_of(vis_names, vis_values, s->visibility), s->seed);
+             name_of(glossy_names, glossy_values, s->glossy_mode), name_of(vis_names, vis_values, s->visibility), s->seed,
+             name_of(leak_names, leak_values, s->leak_correction), name_of(merge_names, merge_values, s->sample_merging));
 }

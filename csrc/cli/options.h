@@ -18,7 +18,8 @@ typedef struct cli_options {
     const char *output_path;  /* -o; NULL = the bundle's output path */
     int preset;               /* VSGL_PRESET_*, -1 = not given */
     cli_u32 aa, rsm, vsgls, threads, seed;
-    int fit, sharpness, diffuse, glossy, visibility, method; /* -1 = not given */
+    int fit, sharpness, diffuse, glossy, visibility, method;
+    int leak, merge;          /* VSGL_LEAK_*, VSGL_MERGE_*; -1 = not given */
     int compression;          /* VSGL_EXR_*, default ZIP */
     int half, verbose, dry_run;
 } cli_options;

@@ -226,3 +226,37 @@ VT_TEST(render_progress_is_overall_and_monotone)
         vsgl_context_destroy(ctx);
     }
 }
+
+/* Sample merging shades about one sample per pixel away from edges and
+ * changes the image by little (compared with shading every sample). */
+VT_TEST(render_sample_merging_cuts_pairs_at_small_error)
+{
+    static planes on, off;
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.aa_samples = 3;
+    s.rsm_resolution = 32;
+    s.vsgl_count = 32;
+    vsgl_render_stats st_on, st_off;
+    char err[256] = "";
+    VT_CHECK(render_room(0, &s, &on, &st_on, err, sizeof err) == VSGL_OK, "%s", err);
+    s.sample_merging = VSGL_MERGE_OFF;
+    VT_CHECK(render_room(0, &s, &off, &st_off, err, sizeof err) == VSGL_OK, "%s", err);
+    double e = 0, ref = 0;
+    for (int i = 0; i < W * H * 3; ++i) {
+        double d = (double)on.comb[i] - off.comb[i];
+        e += d * d;
+        ref += (double)off.comb[i] * off.comb[i];
+    }
+    double rel_rmse = sqrt(e / (ref > 0 ? ref : 1));
+    if (getenv("VSGL_TEST_VERBOSE"))
+        printf("    merging: %llu pairs vs %llu, relative RMSE %.3g\n", (unsigned long long)st_on.shading_pairs,
+               (unsigned long long)st_off.shading_pairs, rel_rmse);
+    VT_CHECK(st_on.shading_pairs * 3 < st_off.shading_pairs, "pairs %llu merged vs %llu",
+             (unsigned long long)st_on.shading_pairs, (unsigned long long)st_off.shading_pairs);
+    VT_CHECK(rel_rmse < 0.025, "relative RMSE of the combined plane %.3g", rel_rmse);
+    int same_colour = 1;
+    for (int i = 0; i < W * H * 3; ++i)
+        same_colour &= fabsf(on.dc[i] - off.dc[i]) <= 1e-6f * (1.0f + off.dc[i]);
+    VT_CHECK(same_colour, "DiffCol must not change (every sample weights with its own colour)");
+}

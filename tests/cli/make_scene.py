@@ -60,8 +60,10 @@ def build(args):
     cm = (1, 0, 0, 0, 0, 0, -1, -6, 0, 1, 0, 2)
     cam = struct.pack("<ii12f8fII2f", 0, 0, *cm, 35, 36, 24, 6, 0, 0, 0.1, 100,
                       args.width, args.height, 1, 1)
-    # settings: method, aa, rsm, fit, vsgls, fis_iterations, sharpness, diffuse, glossy, visibility, seed
-    rset = struct.pack("<iIIiIIiiiiI", 0, 1, 64, 0, 4, 8, 0, 2, 0, 0, 3)
+    # settings (format 1.0's 44-byte record, which 1.1 readers still accept: the
+    # fields added since read as 0 = default): method, aa, rsm, fit, vsgls,
+    # fis_iterations, sharpness, diffuse (0 = accurate), glossy, visibility, seed
+    rset = struct.pack("<iIIiIIiiiiI", 0, 1, 64, 0, 4, 8, 0, 0, 0, 0, 3)
     if args.break_ == "nan-position":
         pos = pos[:4] + struct.pack("<f", float("nan")) + pos[8:]
     secs = [section("POS ", 12, len(verts), pos), section("IDX ", 12, len(tris), idx),

@@ -69,7 +69,7 @@ if want help; then
 fi
 if want version; then
   v=$("$VSGL" --version); rc=$?
-  if [ $rc -eq 0 ] && [[ "$v" =~ ^vsgl\ [0-9]+\.[0-9]+\.[0-9]+ ]] && [[ "$v" == *"bundle format 1.0"* ]]; then ok version
+  if [ $rc -eq 0 ] && [[ "$v" =~ ^vsgl\ [0-9]+\.[0-9]+\.[0-9]+ ]] && [[ "$v" == *"bundle format 1.1"* ]]; then ok version
   else bad version "got exit $rc: $v"; fi
 fi
 

@@ -34,6 +34,21 @@ VSGL_API vsgl_result vsgl_reference_rsm(vsgl_context *ctx, const vsgl_scene *sce
                                         uint32_t res, size_t *count, float *positions, float *normals,
                                         float *flux, float *areas, uint32_t *materials);
 
+/**
+ * @brief The exact BRDF of the brute-force reference (docs/units.md,
+ * "Materials"): for @p count direction pairs, f(wi, wo) * max(wi.n, 0) of
+ * material @p m, split into the diffuse and the glossy lobe.
+ *
+ * @param[in]  normals, tangents, wi, wo  count*3 floats each: unit shading
+ *             normal, tangent (anisotropy frame), direction towards the
+ *             light, direction towards the viewer (both away from the surface).
+ * @param[out] diffuse, glossy  NULL or count*3 floats (RGB, 1/sr).
+ * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (NULL material or input array).
+ */
+VSGL_API vsgl_result vsgl_reference_brdf(const vsgl_material *m, uint32_t count, const float *normals,
+                                         const float *tangents, const float *wi, const float *wo,
+                                         float *diffuse, float *glossy);
+
 /** Timings and sizes of ::vsgl_reference_render (seconds, bytes). */
 typedef struct vsgl_reference_stats {
     double seconds_gbuffer;

@@ -116,6 +116,8 @@ static const field settings_fields[] = {
     F(vsgl_render_settings, sharpness_estimator, 'i', 1), F(vsgl_render_settings, diffuse_mode, 'i', 1),
     F(vsgl_render_settings, glossy_mode, 'i', 1), F(vsgl_render_settings, visibility, 'i', 1),
     F(vsgl_render_settings, seed, 'u', 1),
+    /* format 1.1 */
+    F(vsgl_render_settings, leak_correction, 'i', 1), F(vsgl_render_settings, sample_merging, 'i', 1),
 };
 #undef F
 
@@ -135,11 +137,15 @@ static void encode_record(layout l, const void *rec, unsigned char *out)
 }
 
 /* Decode; on a non-finite float return the field index and component. */
-static int decode_record(layout l, const unsigned char *in, void *rec, size_t *bad_field, unsigned *bad_comp)
+/* Fields past `size` bytes (a record of an older minor version) keep the
+ * destination's value (zero: the default). */
+static int decode_record(layout l, const unsigned char *in, uint32_t size, void *rec, size_t *bad_field,
+                         unsigned *bad_comp)
 {
     unsigned char *base = rec;
+    const unsigned char *end = in + size;
     for (size_t i = 0; i < l.count; ++i)
-        for (unsigned k = 0; k < l.fields[i].count; ++k) {
+        for (unsigned k = 0; k < l.fields[i].count && in + 4 <= end; ++k) {
             uint32_t v = get_u32(in);
             in += 4;
             memcpy(base + l.fields[i].offset + 4u * k, &v, 4);
@@ -196,24 +202,25 @@ typedef struct section_kind {
     char tag[5];
     const char *what;      /* for messages */
     const char *element;   /* element noun */
-    uint32_t element_size; /* exact (arrays) or minimum (records) */
+    uint32_t element_size; /* exact (arrays) or written size (records) */
     int is_record;
     unsigned floats_per_element; /* arrays of floats: checked finite */
+    uint32_t min_size;     /* records: smallest size read (older minor versions); 0 = element_size */
 } section_kind;
 
 static const section_kind kinds[S_COUNT] = {
-    {"POS ", "positions", "vertex", 12, 0, 3},
-    {"IDX ", "indices", "triangle", 12, 0, 0},
-    {"NRM ", "corner normals", "triangle", 36, 0, 9},
-    {"UV  ", "corner uvs", "triangle", 24, 0, 6},
-    {"TAN ", "corner tangents", "triangle", 48, 0, 12},
-    {"MIDX", "material indices", "triangle", 4, 0, 0},
-    {"MATL", "materials", "material", 40, 1, 0},
-    {"LGHT", "lights", "light", 104, 1, 0},
-    {"CAM ", "camera", "camera", 104, 1, 0},
-    {"RSET", "render settings", "settings", 44, 1, 0},
-    {"OUTP", "output path", "byte", 1, 0, 0},
-    {"FRME", "frame", "frame", 4, 0, 0},
+    {"POS ", "positions", "vertex", 12, 0, 3, 0},
+    {"IDX ", "indices", "triangle", 12, 0, 0, 0},
+    {"NRM ", "corner normals", "triangle", 36, 0, 9, 0},
+    {"UV  ", "corner uvs", "triangle", 24, 0, 6, 0},
+    {"TAN ", "corner tangents", "triangle", 48, 0, 12, 0},
+    {"MIDX", "material indices", "triangle", 4, 0, 0, 0},
+    {"MATL", "materials", "material", 40, 1, 0, 0},
+    {"LGHT", "lights", "light", 104, 1, 0, 0},
+    {"CAM ", "camera", "camera", 104, 1, 0, 0},
+    {"RSET", "render settings", "settings", 52, 1, 0, 44},
+    {"OUTP", "output path", "byte", 1, 0, 0, 0},
+    {"FRME", "frame", "frame", 4, 0, 0, 0},
 };
 
 static uint64_t padded(uint64_t n)
@@ -482,7 +489,7 @@ static vsgl_result read_records(vsgl_context *ctx, int kind, layout l, const uns
     for (uint64_t e = 0; e < count; ++e) {
         size_t f;
         unsigned c;
-        if (decode_record(l, p + e * element_size, (unsigned char *)dst + e * rec_size, &f, &c) != 0) {
+        if (decode_record(l, p + e * element_size, element_size, (unsigned char *)dst + e * rec_size, &f, &c) != 0) {
             float v;
             memcpy(&v, (unsigned char *)dst + e * rec_size + l.fields[f].offset + 4u * c, 4);
             return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section %s (%s): %s %llu field %s%s is %s", k->tag,
@@ -561,9 +568,10 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
         const section_kind *k = &kinds[kind];
         if (where[kind])
             return BAD("bundle section %s (%s) appears twice", k->tag, k->what);
-        if (k->is_record ? esize < k->element_size : esize != k->element_size)
+        uint32_t min_size = k->min_size ? k->min_size : k->element_size;
+        if (k->is_record ? esize < min_size : esize != k->element_size)
             return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section %s (%s): element size %u, want %s%u", k->tag, k->what,
-                              esize, k->is_record ? "at least " : "", k->element_size);
+                              esize, k->is_record ? "at least " : "", k->is_record ? min_size : k->element_size);
         if (count > UINT32_MAX)
             return BAD("bundle section %s: %llu elements (at most %u)", k->tag, ULL(count), UINT32_MAX);
         where[kind] = p;

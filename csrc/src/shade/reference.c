@@ -5,6 +5,7 @@
 #include "core/context.h"
 #include "gbuffer/gbuffer.h"
 #include "rsm/rsm.h"
+#include "scene/material.h"
 #include "shade/brute_force.h"
 
 #include <stdlib.h>
@@ -45,6 +46,30 @@ vsgl_result vsgl_reference_rsm(vsgl_context *ctx, const vsgl_scene *scene, uint3
             materials[i] = r.material[i];
     }
     vsgl__rsm_free(&r);
+    return VSGL_OK;
+}
+
+vsgl_result vsgl_reference_brdf(const vsgl_material *m, uint32_t count, const float *normals,
+                                const float *tangents, const float *wi, const float *wo,
+                                float *diffuse, float *glossy)
+{
+    if (!m || (count && (!normals || !tangents || !wi || !wo)))
+        return VSGL_ERROR_INVALID_ARGUMENT;
+    vsgl_brdf_params p;
+    vsgl__material_params(m, &p);
+    for (uint32_t i = 0; i < count; ++i) {
+        const float *n = normals + 3 * (size_t)i, *t = tangents + 3 * (size_t)i;
+        const float *a = wi + 3 * (size_t)i, *b = wo + 3 * (size_t)i;
+        float d[3], g[3];
+        vsgl__brdf_eval(&p, v3_make(n[0], n[1], n[2]), v3_make(t[0], t[1], t[2]), v3_make(a[0], a[1], a[2]),
+                        v3_make(b[0], b[1], b[2]), d, g);
+        for (int c = 0; c < 3; ++c) {
+            if (diffuse)
+                diffuse[3 * (size_t)i + c] = d[c];
+            if (glossy)
+                glossy[3 * (size_t)i + c] = g[c];
+        }
+    }
     return VSGL_OK;
 }
 

@@ -30,6 +30,7 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
         out->vsgl_count = 256;
         out->diffuse_mode = VSGL_COSINE_ACCURATE;
         out->visibility = VSGL_VISIBILITY_RAY;
+        out->sample_merging = VSGL_MERGE_OFF;
         break;
     default: /* BALANCED */
         out->aa_samples = 2;
@@ -73,6 +74,7 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     CHECK_ENUM(glossy_mode, VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG)
     CHECK_ENUM(visibility, VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY)
     CHECK_ENUM(leak_correction, VSGL_LEAK_AUTO, VSGL_LEAK_ON)
+    CHECK_ENUM(sample_merging, VSGL_MERGE_AUTO, VSGL_MERGE_OFF)
 #undef CHECK_ENUM
     if (s->aa_samples > 16)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: aa_samples is %u (valid 1..16)", s->aa_samples);

@@ -61,6 +61,8 @@ typedef struct shade_job {
     const vsgl_kernel_light *klights; /* the VSGLs, kernel layout */
     int path;             /* VSGL_SHADE_* */
     int leak;             /* apply the emitter-hemisphere correction */
+    int merge;            /* share light between samples of one surface in a pixel */
+    float plane_tol;      /* step along the normal that separates surfaces, metres */
 } shade_job;
 
 /* Receiver lobe of one sample, set up once and used for every VSGL. */
@@ -237,7 +239,35 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     return 1;
 }
 
-/* Rows of pixels through the vectorised kernel, VSGL_KERNEL_BLOCK samples at a time. */
+/* Sample merging: within a pixel, a sample on the same surface as an
+ * earlier one (same material, normals within ~5 degrees, no step along the
+ * normal, not a sharp glossy material) takes the light shaded at the
+ * group's centroid instead of being shaded again; its own colours still
+ * weight it. Indirect light barely changes across a pixel,
+ * so with aa x aa samples this shades about one sample per pixel except at
+ * edges. */
+#define MERGE_COS 0.996f
+
+static int same_surface(const vsgl_gbuffer *g, const vsgl_material *materials, size_t a, size_t b, float plane_tol)
+{
+    if (g->material[a] != g->material[b] || g->material[a] == VSGL_GBUFFER_MISS)
+        return 0;
+    /* glossy reflections change across a pixel with the view: only rough
+     * (alpha >= 0.25, roughness >= 0.5) or non-glossy surfaces merge */
+    vsgl_brdf_params bp;
+    vsgl__material_params(&materials[g->material[a]], &bp);
+    if (bp.glossy && bp.alpha_x * bp.alpha_y < 0.0625f)
+        return 0;
+    v3 na = v3_make(g->nrm[0][a], g->nrm[1][a], g->nrm[2][a]);
+    v3 nb = v3_make(g->nrm[0][b], g->nrm[1][b], g->nrm[2][b]);
+    if (v3_dot(na, nb) < MERGE_COS)
+        return 0;
+    v3 d = v3_make(g->pos[0][b] - g->pos[0][a], g->pos[1][b] - g->pos[1][a], g->pos[2][b] - g->pos[2][a]);
+    return fabsf(v3_dot(d, na)) <= plane_tol;
+}
+
+/* Rows of pixels through the vectorised kernel, VSGL_KERNEL_BLOCK shaded
+ * samples at a time. */
 static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0)
 {
     shade_job *j = user;
@@ -251,33 +281,67 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
     const vsgl_gbuffer *g = j->g;
     const vsgl_pixel_planes *pl = j->planes;
     const size_t spp = g->spp;
-    const size_t first = (j->base + b0) * spp, last = (j->base + e0) * spp;
+    const size_t first = (j->base + b0) * spp, last = (j->base + e0) * spp, ns = last - first;
     vsgl_kernel_block blk;
     receiver rec[VSGL_KERNEL_BLOCK];
-    int hit[VSGL_KERNEL_BLOCK];
     float vis[VSGL_KERNEL_BLOCK];
     v3 ray_org[VSGL_KERNEL_BLOCK], ray_dir[VSGL_KERNEL_BLOCK];
     float ray_tmin[VSGL_KERNEL_BLOCK], ray_tmax[VSGL_KERNEL_BLOCK];
     unsigned char blocked[VSGL_KERNEL_BLOCK];
     uint64_t pairs = 0;
-    for (size_t px = j->base + b0; px < j->base + e0; ++px) {
-        for (int c = 0; c < 3; ++c)
-            pl->diffuse[px * 3 + c] = pl->glossy[px * 3 + c] = pl->diffuse_color[px * 3 + c] =
-                pl->glossy_color[px * 3 + c] = 0.0f;
-        pl->coverage[px] = 0.0f;
+    /* which samples are shaded (shaded[]), and the slot each sample reads its light from */
+    size_t *shaded = malloc((ns + 1) * sizeof *shaded);
+    uint32_t *slot = malloc((ns + 1) * sizeof *slot);
+    float *light = malloc((ns + 1) * 6 * sizeof *light);
+    float *centroid = calloc((ns + 1) * 4, sizeof *centroid); /* per slot: position sum, count */
+    if (!shaded || !slot || !light || !centroid) {
+        free(shaded);
+        free(slot);
+        free(light);
+        free(centroid);
+#if defined(__x86_64__) || defined(__i386__)
+        _mm_setcsr(saved_csr);
+#endif
+        return VSGL_ERROR_OUT_OF_MEMORY;
     }
-    for (size_t s0 = first; s0 < last; s0 += VSGL_KERNEL_BLOCK) {
-        size_t n = last - s0 < VSGL_KERNEL_BLOCK ? last - s0 : VSGL_KERNEL_BLOCK;
-        size_t live = 0;
+    size_t nshaded = 0;
+    for (size_t i = 0; i < ns; ++i) {
+        size_t si = first + i;
+        slot[i] = UINT32_MAX;
+        if (g->material[si] == VSGL_GBUFFER_MISS)
+            continue;
+        if (j->merge)
+            for (size_t k = i - i % spp; k < i && slot[i] == UINT32_MAX; ++k)
+                if (slot[k] != UINT32_MAX && shaded[slot[k]] == first + k && same_surface(g, j->materials, first + k, si, j->plane_tol))
+                    slot[i] = slot[k];
+        if (slot[i] == UINT32_MAX) {
+            slot[i] = (uint32_t)nshaded;
+            shaded[nshaded++] = si;
+        }
+        float *cg = centroid + (size_t)slot[i] * 4;
+        cg[0] += g->pos[0][si];
+        cg[1] += g->pos[1][si];
+        cg[2] += g->pos[2][si];
+        cg[3] += 1.0f;
+    }
+    for (size_t s0 = 0; s0 < nshaded; s0 += VSGL_KERNEL_BLOCK) {
+        size_t n = nshaded - s0 < VSGL_KERNEL_BLOCK ? nshaded - s0 : VSGL_KERNEL_BLOCK;
         int32_t lobes = 0;
         for (size_t k = 0; k < n; ++k) {
-            hit[k] = fill_lane(j, s0 + k, &blk, k, &rec[k]);
-            live += (size_t)hit[k];
+            fill_lane(j, shaded[s0 + k], &blk, k, &rec[k]); /* every shaded sample is a hit */
+            const float *cg = centroid + (s0 + k) * 4;
+            if (cg[3] > 1.0f) { /* a merged group is shaded at its centroid: its mean light to first order */
+                float inv = 1.0f / cg[3];
+                rec[k].x = v3_make(cg[0] * inv, cg[1] * inv, cg[2] * inv);
+                blk.x[k] = rec[k].x.x;
+                blk.y[k] = rec[k].x.y;
+                blk.z[k] = rec[k].x.z;
+            }
             lobes |= (blk.diffuse[k] > 0.0f ? VSGL_KERNEL_DIFFUSE : 0) | (blk.camp[k] > 0.0f ? VSGL_KERNEL_GLOSSY : 0);
         }
         memset(blk.ld, 0, sizeof blk.ld);
         memset(blk.ls, 0, sizeof blk.ls);
-        if (live && lobes) {
+        if (lobes) {
             for (size_t v = 0; v < j->set->count; ++v) {
                 const float *vp = NULL;
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
@@ -289,12 +353,12 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
                         float dist = v3_length(d);
                         ray_dir[k] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
                         ray_tmin[k] = 0.0f;
-                        /* misses and receivers at the VSGL centre trace an empty interval */
-                        ray_tmax[k] = (hit[k] && dist > j->eps) ? dist - j->eps : 0.0f;
+                        /* receivers at the VSGL centre trace an empty interval */
+                        ray_tmax[k] = dist > j->eps ? dist - j->eps : 0.0f;
                     }
                     vsgl__scene_occluded_many(j->scene, (uint32_t)n, ray_org, ray_dir, ray_tmin, ray_tmax, 0, blocked);
                     for (size_t k = 0; k < n; ++k)
-                        vis[k] = (hit[k] && !blocked[k]) ? 1.0f : 0.0f;
+                        vis[k] = blocked[k] ? 0.0f : 1.0f;
                     vp = vis;
                 }
                 if (j->path == VSGL_SHADE_KERNEL_SCALAR)
@@ -302,35 +366,51 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
                 else
                     vsgl__kernel_shade(&blk, n, &j->klights[v], vp, j->s->diffuse_mode, lobes);
             }
-            pairs += (uint64_t)live * j->set->count;
+            pairs += (uint64_t)n * j->set->count;
         }
-        for (size_t k = 0; k < n; ++k) {
-            if (!hit[k])
-                continue;
-            size_t px = (s0 + k) / spp;
-            const receiver *r = &rec[k];
-            float gcol[3] = {0, 0, 0};
-            if (r->glossy)
-                vsgl__glossy_color(&r->bp, r->n, r->o, gcol);
+        for (size_t k = 0; k < n; ++k)
             for (int c = 0; c < 3; ++c) {
-                pl->diffuse[px * 3 + c] += r->bp.diffuse[c] * blk.ld[c][k];
-                pl->glossy[px * 3 + c] += blk.ls[c][k];
-                pl->diffuse_color[px * 3 + c] += r->bp.diffuse[c];
-                pl->glossy_color[px * 3 + c] += gcol[c];
+                light[(s0 + k) * 6 + c] = blk.ld[c][k];
+                light[(s0 + k) * 6 + 3 + c] = blk.ls[c][k];
             }
-            pl->coverage[px] += 1.0f;
-        }
     }
-    const float inv_spp = 1.0f / (float)spp;
+    /* every covered sample: its own colours, the light of its slot */
     for (size_t px = j->base + b0; px < j->base + e0; ++px) {
-        for (int c = 0; c < 3; ++c) {
-            pl->diffuse[px * 3 + c] *= inv_spp;
-            pl->glossy[px * 3 + c] *= inv_spp;
-            pl->diffuse_color[px * 3 + c] *= inv_spp;
-            pl->glossy_color[px * 3 + c] *= inv_spp;
+        float acc[12] = {0};
+        float covered = 0.0f;
+        for (size_t k = 0; k < spp; ++k) {
+            size_t i = (px - j->base - b0) * spp + k, si = first + i;
+            if (slot[i] == UINT32_MAX)
+                continue;
+            vsgl_brdf_params bp;
+            vsgl__material_params(&j->materials[g->material[si]], &bp);
+            v3 n = v3_make(g->nrm[0][si], g->nrm[1][si], g->nrm[2][si]);
+            v3 o = v3_make(g->view[0][si], g->view[1][si], g->view[2][si]);
+            float gcol[3] = {0, 0, 0};
+            if (bp.glossy && v3_dot(n, o) > 0.0f)
+                vsgl__glossy_color(&bp, n, o, gcol);
+            const float *L = light + (size_t)slot[i] * 6;
+            for (int c = 0; c < 3; ++c) {
+                acc[c] += bp.diffuse[c] * L[c];
+                acc[3 + c] += L[3 + c];
+                acc[6 + c] += bp.diffuse[c];
+                acc[9 + c] += gcol[c];
+            }
+            covered += 1.0f;
         }
-        pl->coverage[px] *= inv_spp;
+        const float inv_spp = 1.0f / (float)spp;
+        for (int c = 0; c < 3; ++c) {
+            pl->diffuse[px * 3 + c] = acc[c] * inv_spp;
+            pl->glossy[px * 3 + c] = acc[3 + c] * inv_spp;
+            pl->diffuse_color[px * 3 + c] = acc[6 + c] * inv_spp;
+            pl->glossy_color[px * 3 + c] = acc[9 + c] * inv_spp;
+        }
+        pl->coverage[px] = covered * inv_spp;
     }
+    free(shaded);
+    free(slot);
+    free(light);
+    free(centroid);
     j->pairs[chunk] = pairs;
 #if defined(__x86_64__) || defined(__i386__)
     _mm_setcsr(saved_csr);
@@ -379,7 +459,8 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
         }
     }
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
-                   (extent > 0.0f ? extent : 1.0f) * 1e-5f, 0, per_chunk, kl, path, leak};
+                   (extent > 0.0f ? extent : 1.0f) * 1e-5f, 0, per_chunk, kl, path, leak,
+                   s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f};
     /* Rows in batches so progress can be reported and cancellation honoured. */
     size_t rows_per_batch = g->height / 20 + 1;
     vsgl_result r = VSGL_OK;
