@@ -4,7 +4,7 @@
  *   mkdir -p build && cc -O2 -std=c11 -Icsrc/include -Icsrc/src \
  *     tools/asg_error_table.c csrc/src/math/asg.c csrc/src/math/bessel.c \
  *     csrc/src/math/eigen3.c -lm -o build/asg_error_table
- *   build/asg_error_table [integral|conv|product|sg|all] [quick]
+ *   build/asg_error_table [integral|conv|product|sg|pint|all] [quick]
  *   build/asg_error_table conv full FIRST_ROW STEP   (rows of lambda = 1, 2, 3, 5, 10, 30, 100
  *                                                     in that order; e.g. "6 -1" runs them backwards)
  *
@@ -360,6 +360,57 @@ static void table_sg(void)
     }
 }
 
+/* ---------------------------------------- product integral (VSGL glossy) */
+
+/* vsgl_asg_sg_product_integral vs quadrature as a function of the angle
+ * between the SG axis and the ASG axis (tilted in the x-z plane, the sharp
+ * direction, and in the y-z plane), for glossy-lobe-like ASGs. */
+static void table_pint(void)
+{
+    const double asgs[3][2] = {{10, 3}, {50, 10}, {300, 30}};
+    const double lins[] = {1, 4, 16, 64, 256, 1024};
+    const double angs[] = {0, 10, 20, 30, 45, 60, 80, 100};
+    enum { NA = sizeof angs / sizeof angs[0] };
+    for (int peak_rel = 0; peak_rel < 2; ++peak_rel) {
+        printf("\n== ASG x SG product integral (Eq. 18 at the SG axis) vs quadrature: %s ==\n",
+               peak_rel ? "(approx - exact) / exact value at 0 deg (error relative to the peak)"
+                        : "approx / exact - 1");
+        printf("   SG exp(lam_in (v.xi - 1)); xi tilted from z by the angle in the x-z plane (lambda) / y-z plane (mu)\n");
+        printf("%-10s %-8s", "asg", "lam_in");
+        for (int i = 0; i < NA; ++i)
+            printf(" %14.0f deg", angs[i]);
+        printf("\n");
+        for (int a = 0; a < 3; ++a)
+            for (unsigned l = 0; l < sizeof lins / sizeof lins[0]; ++l) {
+                printf("(%g,%g)%*s %-8g", asgs[a][0], asgs[a][1], (int)(4 - (asgs[a][0] >= 100) - (asgs[a][1] >= 10)), "", lins[l]);
+                double peak = 0.0;
+                for (int i = 0; i < NA; ++i) {
+                    double e[2];
+                    for (int plane = 0; plane < 2; ++plane) {
+                        double t = angs[i] * AQ_PI / 180.0;
+                        double p[3] = {plane ? 0.0 : sin(t), plane ? sin(t) : 0.0, cos(t)};
+                        vsgl_asg g = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, (float)asgs[a][0], (float)asgs[a][1], 0.0f};
+                        vsgl_sg k = {{(float)p[0], (float)p[1], (float)p[2]}, (float)lins[l], 0.0f};
+                        double scale = vsgl__asg_integral_unit(asgs[a][0] + 0.5 * lins[l], asgs[a][1] + 0.5 * lins[l]);
+                        double ex = conv_exact(asgs[a][0], asgs[a][1], 0.5 * lins[l], p, scale * 1e-3);
+                        if (i == 0)
+                            peak = ex;
+                        double ap = vsgl_asg_sg_product_integral(&g, &k);
+                        e[plane] = peak_rel ? (ap - ex) / peak : ap / ex - 1.0;
+                    }
+                    if (peak_rel)
+                        printf(" %+7.2f/%+6.2f%%", 100 * e[0], 100 * e[1]);
+                    else if (fabs(e[0]) < 1e4 && fabs(e[1]) < 1e4)
+                        printf(" %+7.1f/%+6.1f%%", 100 * e[0], 100 * e[1]);
+                    else
+                        printf(" %7.0e/%6.0e ", e[0], e[1]);
+                    fflush(stdout);
+                }
+                printf("\n");
+            }
+    }
+}
+
 int main(int argc, char **argv)
 {
     const char *what = argc > 1 ? argv[1] : "all";
@@ -375,6 +426,8 @@ int main(int argc, char **argv)
         table_sg();
     if (all || strcmp(what, "product") == 0)
         table_product();
+    if (all || strcmp(what, "pint") == 0)
+        table_pint();
     if (all || strcmp(what, "conv") == 0)
         table_conv();
     if (strcmp(what, "conv1") == 0 && argc > 5) {
