@@ -177,6 +177,11 @@ class LeakCorrection(enum.IntEnum):
     ON = 2
 
 
+class SampleMerging(enum.IntEnum):
+    AUTO = 0
+    OFF = 1
+
+
 class Preset(enum.IntEnum):
     PREVIEW = 0
     BALANCED = 1
@@ -199,7 +204,7 @@ MATERIAL_UNSUPPORTED = 1
 SHARPNESS_MAX = 2199023255552.0  # 2^41
 ALPHA_MIN = 4.656612873077393e-10  # 2^-31
 EXR_MAX_CHANNELS = 4
-BUNDLE_VERSION = (1, 0)
+BUNDLE_VERSION = (1, 1)
 
 
 def _enum(value, cls, what):
@@ -400,10 +405,11 @@ class vsgl_render_settings(_Struct):
         ("visibility", _i32),
         ("seed", _u32),
         ("leak_correction", _i32),
+        ("sample_merging", _i32),
     ]
-    _enums = {"leak_correction": LeakCorrection, "method": Method, "fit_mode": FitMode,
-              "sharpness_estimator": SharpnessEstimator, "diffuse_mode": CosineMode,
-              "glossy_mode": GlossyMode, "visibility": Visibility}
+    _enums = {"method": Method, "fit_mode": FitMode, "sharpness_estimator": SharpnessEstimator,
+              "diffuse_mode": CosineMode, "glossy_mode": GlossyMode, "visibility": Visibility,
+              "leak_correction": LeakCorrection, "sample_merging": SampleMerging}
 
 
 #: The planes of vsgl_render_output, in field order (each H x W x 3 except alpha: H x W).
@@ -599,6 +605,8 @@ PROTOTYPES = (
     # reference.h
     ("vsgl_reference_rsm", _i32, [_VP, _VP, _u32, _u32, _P(ctypes.c_size_t), _PF32, _PF32,
                                   _PF32, _PF32, _PU32]),
+    ("vsgl_reference_brdf", _i32, [_P(vsgl_material), _u32, _PF32, _PF32, _PF32, _PF32, _PF32,
+                                   _PF32]),
     ("vsgl_reference_render", _i32, [_VP, _VP, _u32, _u32, _i32, _PF32, _PF32, _PF32, _PF32,
                                      _P(vsgl_reference_stats)]),
 )
@@ -1638,3 +1646,24 @@ def reference_render(ctx, scene, rsm_res=256, aa=1, visibility=Visibility.NONE):
     d = stats.as_dict()
     d["total_flux"] = tuple(d["total_flux"])
     return images, d
+
+
+def reference_brdf(material, normals, tangents, wi, wo):
+    """The reference's exact BRDF times the cosine, f(wi, wo) max(wi.n, 0),
+    of ``material`` for N direction pairs: each argument float32 (N, 3)
+    (unit normal, tangent, towards the light, towards the viewer).
+    Returns (diffuse, glossy), float32 (N, 3) RGB in 1/sr."""
+    if not isinstance(material, vsgl_material):
+        raise TypeError("material must be a libvsgl.Material")
+    n = _check_array(normals, "normals", np.float32, [(len(normals), 3)], True)
+    N = n.shape[0]
+    args = [n] + [_check_array(a, k, np.float32, [(N, 3)], True)
+                  for a, k in ((tangents, "tangents"), (wi, "wi"), (wo, "wo"))]
+    diffuse = np.zeros((N, 3), np.float32)
+    glossy = np.zeros((N, 3), np.float32)
+    rc = library().vsgl_reference_brdf(ctypes.byref(material), _u32_count(N, "count"),
+                                       *[a.ctypes.data_as(_PF32) for a in args],
+                                       diffuse.ctypes.data_as(_PF32), glossy.ctypes.data_as(_PF32))
+    if rc != 0:
+        raise VsglError(rc, "", "vsgl_reference_brdf")
+    return diffuse, glossy

@@ -143,6 +143,7 @@ ENUM_PREFIXES = [
     ("VSGL_SENSOR_FIT_", "SensorFit"), ("VSGL_METHOD_", "Method"), ("VSGL_FIT_", "FitMode"),
     ("VSGL_GLOSSY_", "GlossyMode"), ("VSGL_VISIBILITY_", "Visibility"),
     ("VSGL_PRESET_", "Preset"), ("VSGL_LEAK_", "LeakCorrection"),
+    ("VSGL_MERGE_", "SampleMerging"),
 ]
 SPECIAL = {
     "VSGL_SHARPNESS_TOKSVIG": ("SharpnessEstimator", "TOKSVIG"),
