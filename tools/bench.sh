@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 objs=$(ls build/obj/csrc/src/*/*.o)
-flags="-O2 -Itests/c -Icsrc/include -Icsrc/src"
+flags="-O2 -march=native -Itests/c -Icsrc/include -Icsrc/src"
 libs="-lembree3 -lOpenEXRCore-3_1 -lpthread -lm"
 mkdir -p build/bench
 cc $flags tools/bench/bench_shade.c $objs $libs -o build/bench/bench_shade

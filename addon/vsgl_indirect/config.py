@@ -22,6 +22,8 @@ KNOBS = {
     "glossy_mode": (("ASG", "SG"), "ASG"),
     "visibility": (("NONE", "RAY"), "NONE"),
     "seed": (None, 0),
+    "leak_correction": (("AUTO", "OFF", "ON"), "AUTO"),
+    "sample_merging": (("AUTO", "OFF"), "AUTO"),
 }
 
 
@@ -42,6 +44,8 @@ class Options:
     glossy_mode: str = "ASG"
     visibility: str = "NONE"
     seed: int = 0
+    leak_correction: str = "AUTO"
+    sample_merging: str = "AUTO"
     output_path: str = DEFAULT_TEMPLATE
     threads: int = 0
     half_float: bool = False

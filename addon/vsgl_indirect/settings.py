@@ -65,6 +65,13 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
     visibility: EnumProperty(name="Visibility", items=_items(config.KNOBS["visibility"][0]),
                              default="NONE", description="Indirect shadows: none, or one ray per VSGL")
     seed: IntProperty(name="Seed", default=0, min=0)
+    leak_correction: EnumProperty(name="Leak Correction", items=_items(config.KNOBS["leak_correction"][0]),
+                                  default="AUTO",
+                                  description="Fade light a VSGL sends into its own surface's plane "
+                                              "(auto: on with FIS and k-means)")
+    sample_merging: EnumProperty(name="Sample Merging", items=_items(config.KNOBS["sample_merging"][0]),
+                                 default="AUTO",
+                                 description="Shade a pixel's samples on one surface once (auto: on)")
     output_path: StringProperty(
         name="Output", subtype="FILE_PATH", default=config.DEFAULT_TEMPLATE,
         update=_update_compositor, **_PATH_OPTIONS,
