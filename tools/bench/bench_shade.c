@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
+#include <sys/resource.h>
 
 static double now(void)
 {
@@ -127,6 +128,10 @@ int main(int argc, char **argv)
     }
     printf("render %ux%u balanced preset (aa 1, FIS %u): %.3f s  [gbuffer %.3f rsm %.3f fit %.3f shade %.3f]\n",
            W, H, s.vsgl_count, median(tp, reps), st.seconds_gbuffer, st.seconds_rsm, st.seconds_fit, st.seconds_shade);
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    printf("memory: peak resident %.1f MiB for the whole benchmark (G-buffer of %zu samples, one RSM, planes)\n",
+           (double)ru.ru_maxrss / 1024.0, g.count);
     free(buf);
     vsgl__vsgl_set_free(&set);
     vsgl__rsm_free(&rsm);
