@@ -19,7 +19,8 @@
 extern "C" {
 #endif
 
-/** An anisotropic spherical Gaussian. */
+/** An anisotropic spherical Gaussian. The operators re-orthonormalise the
+ * frame (x projected off z, y = z x x). */
 typedef struct vsgl_asg {
     vsgl_vec3 x;           /**< tangent axis (bandwidth lambda) */
     vsgl_vec3 y;           /**< bitangent axis (bandwidth mu) */
@@ -38,10 +39,14 @@ VSGL_API float vsgl_asg_eval(const vsgl_asg *a, const vsgl_vec3 *dir);
  */
 VSGL_API float vsgl_asg_bessel_f(float a);
 
-/** @brief Integral over the sphere by Xu et al. Eq. 10 (with exact F). */
+/**
+ * @brief Integral over the sphere: Xu et al. Eq. 10 (with exact F) for
+ * min(lambda, mu) >= 12; below, an exact 1-D quadrature (Eq. 10 diverges as
+ * mu -> 0). Max relative error 1.7e-9 (docs/math_asg.md).
+ */
 VSGL_API float vsgl_asg_integral(const vsgl_asg *a);
 
-/** @brief Integral over the sphere by Xu et al. Eq. 11: c pi / sqrt(lambda mu). */
+/** @brief Integral over the sphere by Xu et al. Eq. 11: c pi / sqrt(lambda mu), capped at c pi. */
 VSGL_API float vsgl_asg_integral_approx(const vsgl_asg *a);
 
 /**
@@ -55,14 +60,19 @@ VSGL_API void vsgl_asg_product(const vsgl_asg *a, const vsgl_asg *b, vsgl_asg *o
  * @brief Convolution of an ASG with the SG kernel exp(2 nu (v.p - 1)),
  * nu = sg->sharpness / 2, as an ASG over p (Eq. 18): bandwidths
  * nu lambda / (nu + lambda), nu mu / (nu + mu), amplitude multiplied by
- * pi / sqrt((lambda + nu)(mu + nu)) and by the kernel's own amplitude.
+ * the exact integral of a unit ASG of bandwidths (lambda + nu, mu + nu)
+ * (equal to Eq. 18's pi / sqrt((lambda + nu)(mu + nu)) within 1e-7 when
+ * min(lambda, mu) + nu >= 12, finite at zero bandwidths) and by the
+ * kernel's own amplitude.
  * The kernel's axis is ignored (the result is a function of it).
  */
 VSGL_API void vsgl_asg_convolve_sg(const vsgl_asg *a, const vsgl_sg *kernel, vsgl_asg *out);
 
 /**
  * @brief Integral over the sphere of ASG(w) * SG(w): the convolution of
- * Eq. 18 evaluated at the SG's axis (the poster's glossy shading form).
+ * Eq. 18 evaluated at the SG's axis (the poster's glossy shading form),
+ * both amplitudes included. Broad SGs (sharpness < ~16) off the ASG's axis
+ * lose up to 40 % of the peak value (docs/math_asg.md).
  */
 VSGL_API float vsgl_asg_sg_product_integral(const vsgl_asg *a, const vsgl_sg *g);
 
