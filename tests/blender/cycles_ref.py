@@ -59,6 +59,10 @@ MATS = {
     "red": dict(kind="diffuse", color=(0.8, 0.1, 0.1)),
     "green": dict(kind="diffuse", color=(0.1, 0.7, 0.15)),
     "metal": dict(kind="metal", color=(0.9, 0.7, 0.4), roughness=0.35),
+    # Glossy BSDF node (GGX, constant F = colour): the library's metallic 1,
+    # F0 0 (eta 1). Used in the gather scene: Cycles 3.4's *Principled* metal
+    # disagreed in indirect light (docs/validation.md, "Brute force vs Cycles")
+    "gmetal": dict(kind="glossy", color=(0.9, 0.7, 0.4), roughness=0.35),
     "aniso": dict(kind="metal", color=(0.7, 0.8, 0.9), roughness=0.4, anisotropy=0.6),
     "rough": dict(kind="metal", color=(0.9, 0.7, 0.4), roughness=0.8),
     # Lambert + the Principled specular layer: exactly the library's model
@@ -97,11 +101,11 @@ def room_geometry():
     def P(x, y, z):
         return (0.35 + c * x - s * y, 0.3 + s * x + c * y, z)
     a, b, h = 0.25, 0.25, 0.7
-    q.append(dict(quad=[P(-a, -b, h), P(a, -b, h), P(a, b, h), P(-a, b, h)], mat="metal"))
-    q.append(dict(quad=[P(-a, -b, 0), P(a, -b, 0), P(a, -b, h), P(-a, -b, h)], mat="metal"))
-    q.append(dict(quad=[P(a, -b, 0), P(a, b, 0), P(a, b, h), P(a, -b, h)], mat="metal"))
-    q.append(dict(quad=[P(a, b, 0), P(-a, b, 0), P(-a, b, h), P(a, b, h)], mat="metal"))
-    q.append(dict(quad=[P(-a, b, 0), P(-a, -b, 0), P(-a, -b, h), P(-a, b, h)], mat="metal"))
+    q.append(dict(quad=[P(-a, -b, h), P(a, -b, h), P(a, b, h), P(-a, b, h)], mat="gmetal"))
+    q.append(dict(quad=[P(-a, -b, 0), P(a, -b, 0), P(a, -b, h), P(-a, -b, h)], mat="gmetal"))
+    q.append(dict(quad=[P(a, -b, 0), P(a, b, 0), P(a, b, h), P(a, -b, h)], mat="gmetal"))
+    q.append(dict(quad=[P(a, b, 0), P(-a, b, 0), P(-a, b, h), P(a, b, h)], mat="gmetal"))
+    q.append(dict(quad=[P(-a, b, 0), P(-a, -b, 0), P(-a, -b, h), P(-a, b, h)], mat="gmetal"))
     return q
 
 
@@ -135,6 +139,11 @@ def blender_material(name, spec):
         n = nt.nodes.new("ShaderNodeBsdfDiffuse")
         n.inputs["Color"].default_value = col
         n.inputs["Roughness"].default_value = 0.0
+    elif spec["kind"] == "glossy":
+        n = nt.nodes.new("ShaderNodeBsdfGlossy")
+        n.distribution = "GGX"
+        n.inputs["Color"].default_value = col
+        n.inputs["Roughness"].default_value = spec["roughness"]
     elif spec["kind"] == "lambert_spec":
         d = nt.nodes.new("ShaderNodeBsdfDiffuse")
         d.inputs["Color"].default_value = col
@@ -368,6 +377,8 @@ def library_scene(lib, ctx, ob, lights, co, mats):
             m.metallic, m.roughness, m.specular_f0 = 0.0, 1.0, 0.0
         elif s["kind"] == "lambert_spec":
             m.metallic, m.roughness, m.specular_f0 = 0.0, s["roughness"], 0.08 * 0.5
+        elif s["kind"] == "glossy":
+            m.metallic, m.roughness, m.specular_f0 = 1.0, s["roughness"], 0.0
         else:
             m.metallic = 1.0 if s["kind"] == "metal" else s.get("metallic", 0.0)
             m.roughness, m.specular_f0 = s["roughness"], 0.08 * 0.5
@@ -613,8 +624,8 @@ def suite_gather(lib, ctx, out_dir, report):
     np.save(os.path.join(out_dir, "gather_cycles.npy"), np.stack([cyc[p] for p in passes]))
     report.append("## Brute force vs Cycles\n")
     report.append("Room 2 x 2 x 2 m (open front), red/green side walls, grey floor (Lambert + Principled specular "
-                  "layer, roughness 0.25), "
-                  "GGX metal block (roughness 0.35); spot 300 W + square area 60 W. %dx%d px. Cycles 3.4 one bounce, "
+                  "layer, roughness 0.25), GGX metal block (Glossy BSDF, roughness 0.35); "
+                  "spot 300 W + square area 60 W. %dx%d px. Cycles 3.4 one bounce, "
                   "%d spp%s. Library: brute-force gather, aa %d, visibility rays, RSM per light at the given size.\n"
                   % (W, H, case["samples"], "" if secs is None else " (rendered in %.0f s)" % secs, GATHER_AA))
     report.append("Cycles reference = mean of two %d-spp renders (seeds 1, 2), pixel centres only (box filter "
