@@ -343,6 +343,11 @@ def load_lib(path):
     lib.vsgl_reference_rsm.restype = ctypes.c_int32
     lib.vsgl_reference_render.argtypes = [vp, vp, u32, u32, ctypes.c_int32, P(f), P(f), P(f), P(f), P(ReferenceStats)]
     lib.vsgl_reference_render.restype = ctypes.c_int32
+    lib.vsgl_render_settings_preset.argtypes = [ctypes.c_int32, P(libvsgl.vsgl_render_settings)]
+    lib.vsgl_render_settings_preset.restype = None
+    lib.vsgl_render.argtypes = [vp, vp, P(libvsgl.vsgl_render_settings), P(libvsgl.vsgl_render_output),
+                                P(libvsgl.vsgl_render_stats)]
+    lib.vsgl_render.restype = ctypes.c_int32
     return lib
 
 
@@ -660,6 +665,98 @@ def suite_gather(lib, ctx, out_dir, report):
     return passed, failed
 
 
+# The product curve (GUIDE Sec. 6): error against time for the library's
+# settings next to Cycles at increasing samples per pixel, on the gather
+# room, against the same two-seed reference. A report, not a test.
+CURVE_SPP = [int(v) for v in os.environ.get("VSGL_CURVE_SPP", "1,4,16,64,256").split(",")]
+CURVE_SETTINGS = [
+    # (label, preset, overrides)
+    ("preview preset (2 VSGLs/light, RSM 128)", "PREVIEW", {}),
+    ("balanced preset (k-means 128, RSM 256, aa 2)", "BALANCED", {}),
+    ("quality preset (k-means 256, RSM 512, aa 2, visibility)", "QUALITY", {}),
+    ("FIS 16, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=16, rsm_resolution=128, aa_samples=1)),
+    ("FIS 64, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=64, rsm_resolution=128, aa_samples=1)),
+    ("FIS 256, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1)),
+    ("FIS 256, RSM 128, aa 1, visibility", "BALANCED", dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1,
+                                                             visibility=1)),
+    ("k-means 256, RSM 128, aa 1, visibility", "BALANCED", dict(fit_mode=2, vsgl_count=256, rsm_resolution=128,
+                                                                 aa_samples=1, visibility=1)),
+    ("FIS 1024, RSM 256, aa 1, visibility", "BALANCED", dict(fit_mode=1, vsgl_count=1024, rsm_resolution=256, aa_samples=1,
+                                                              visibility=1)),
+    ("k-means 64, RSM 256, aa 1, visibility", "BALANCED", dict(fit_mode=2, vsgl_count=64, rsm_resolution=256,
+                                                                aa_samples=1, visibility=1)),
+    ("k-means 128, RSM 256, aa 1, visibility", "BALANCED", dict(fit_mode=2, vsgl_count=128, rsm_resolution=256,
+                                                                 aa_samples=1, visibility=1)),
+    ("k-means 128, RSM 256, aa 2, visibility", "BALANCED", dict(fit_mode=2, vsgl_count=128, rsm_resolution=256,
+                                                                 aa_samples=2, visibility=1)),
+    ("brute force, RSM 128, aa 1, visibility", "BALANCED", dict(method=1, rsm_resolution=128, aa_samples=1,
+                                                                 visibility=1)),
+]
+
+
+def suite_curve(lib, ctx, out_dir, report):
+    case = GATHER_CASE
+    ob, lights, co, mats = build_blender(case)
+    passes = ["DiffInd", "DiffCol", "GlossInd", "GlossCol"]
+    half = case["samples"] // 2
+    c1, _ = cycles_cached("gather_room", case, passes, out_dir, half, 1)
+    c2, _ = cycles_cached("gather_room", case, passes, out_dir, half, 2)
+    D_c = 0.5 * (c1["DiffInd"] * c1["DiffCol"] + c2["DiffInd"] * c2["DiffCol"])
+    G_c = 0.5 * (c1["GlossInd"] * c1["GlossCol"] + c2["GlossInd"] * c2["GlossCol"])
+    ref = D_c + G_c
+    floor = relmse(c1["DiffInd"] * c1["DiffCol"] + c1["GlossInd"] * c1["GlossCol"],
+                   c2["DiffInd"] * c2["DiffCol"] + c2["GlossInd"] * c2["GlossCol"]) / 4
+    W, H = case["camera"]["res"]
+    rows = []
+    # Cycles at increasing spp (seed 3: independent of the reference)
+    for spp in CURVE_SPP:
+        key = "curve_cycles"
+        c, _ = cycles_cached(key, case, passes, out_dir, spp, 3)
+        # time it separately (the cached call may not render)
+        t = render_cycles(case, passes, os.path.join(out_dir, "cycles", "curve_timing"), spp, 3)
+        img = c["DiffInd"] * c["DiffCol"] + c["GlossInd"] * c["GlossCol"]
+        rows.append(("Cycles %d spp" % spp, t, relmse(img, ref), None))
+        print("curve: Cycles %4d spp: %.2f s, relMSE %.4f" % (spp, t, rows[-1][2]))
+    scene = library_scene(lib, ctx, ob, lights, co, mats)
+    try:
+        for label, preset, over in CURVE_SETTINGS:
+            s = libvsgl.vsgl_render_settings()
+            lib.vsgl_render_settings_preset(int(libvsgl.Preset[preset]), ctypes.byref(s))
+            for k, v in over.items():
+                setattr(s, k, v)
+            planes = {k: np.zeros((H, W, 3), np.float32) for k in ("diffuse", "glossy")}
+            o = libvsgl.vsgl_render_output()
+            o.width, o.height = W, H
+            o.diffuse = fptr(planes["diffuse"])
+            o.glossy = fptr(planes["glossy"])
+            st = libvsgl.vsgl_render_stats()
+            best = None
+            for _ in range(3):   # median-free: the fastest of 3 runs on a shared machine
+                t0 = time.time()
+                rc = lib.vsgl_render(ctx, scene, ctypes.byref(s), ctypes.byref(o), ctypes.byref(st))
+                t = time.time() - t0
+                if rc != 0:
+                    raise RuntimeError("vsgl_render: %s" % lib.vsgl_context_last_error(ctx).decode())
+                best = t if best is None else min(best, t)
+            img = planes["diffuse"] + planes["glossy"]
+            rows.append(("vsgl " + label, best, relmse(img, ref), st.vsgl_count))
+            print("curve: %-50s %.3f s, relMSE %.4f (%d VSGLs)" % (label, best, rows[-1][2], st.vsgl_count))
+    finally:
+        lib.vsgl_scene_destroy(scene)
+    report.append("## Error against time: VSGL settings next to Cycles\n")
+    report.append("The gather room (spot 300 W + area 60 W, red/green walls, glossy floor, GGX metal block), "
+                  "%dx%d px, one bounce. Reference: mean of two %d-spp Cycles renders (its own noise, "
+                  "relMSE %.4f). relMSE of the coloured indirect light DiffInd*DiffCol + GlossInd*GlossCol "
+                  "(GUIDE Sec. 6). Cycles time: a whole `bpy.ops.render.render` of this scene (scene sync "
+                  "included), seed 3; library time: the fastest of 3 `vsgl_render` calls (scene built once), "
+                  "2 threads on a shared 2-core machine.\n" % (W, H, half, floor))
+    report.append("| method | seconds | relMSE vs reference | VSGLs |")
+    report.append("|---|---|---|---|")
+    for label, t, e, n in rows:
+        report.append("| %s | %.3f | %.4f | %s |" % (label, t, e, "" if n is None else n))
+    return 0, 0
+
+
 BRDF_CASE = dict(
     geometry=[dict(quad=[(-2, -1.5, 0), (-0.7, -1.5, 0), (-0.7, 1.5, 0), (-2, 1.5, 0)], mat="rough"),
               dict(quad=[(-0.6, -1.5, 0), (0.6, -1.5, 0), (0.6, 1.5, 0), (-0.6, 1.5, 0)], mat="floor"),
@@ -820,6 +917,8 @@ def main():
             tilt = dict(BRDF_CASE["camera"], loc=(0.0, -4.33, 2.5), rot=(60, 0, 0), res=(128, 96))
             p3, f3 = suite_brdf(lib, ctx, out_dir, report, camera=tilt, tag="_tilt30")
             p, f = p + p2 + p3, f + f2 + f3
+        elif args["--suite"] == "curve":
+            p, f = suite_curve(lib, ctx, out_dir, report)
         else:
             p, f = suite_gather(lib, ctx, out_dir, report)
     finally:
