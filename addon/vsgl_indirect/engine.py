@@ -83,6 +83,21 @@ def _material_structs(libvsgl, sd):
     return [libvsgl.Material(**m) for m in sd.materials]
 
 
+def scene_arrays(sd, libvsgl):
+    """Keyword arguments of ``libvsgl.Scene`` / ``libvsgl.bundle_write`` for ``sd``."""
+    def opt(a, dtype):
+        return None if a is None else np.ascontiguousarray(a, dtype)
+    return dict(positions=np.ascontiguousarray(sd.positions, np.float32),
+                indices=np.ascontiguousarray(sd.indices, np.uint32),
+                corner_normals=np.ascontiguousarray(sd.corner_normals, np.float32),
+                corner_uvs=opt(sd.corner_uvs, np.float32),
+                corner_tangents=opt(getattr(sd, "corner_tangents", None), np.float32),
+                material_indices=np.ascontiguousarray(sd.material_indices, np.uint32),
+                materials=_material_structs(libvsgl, sd),
+                lights=[libvsgl.Light(**l) for l in sd.lights],
+                camera=libvsgl.Camera(**sd.camera))
+
+
 def render_planes(sd, options, progress=None, log=None):
     """(planes dict, stats dict). ``progress(stage, fraction)`` returns True to
     cancel; ``log(level, message)`` receives the library's warnings/errors."""
@@ -99,16 +114,7 @@ def render_planes(sd, options, progress=None, log=None):
         raise AovError("cannot create a libvsgl context: %s" % e)
     try:
         try:
-            scene = libvsgl.Scene(
-                ctx, positions=np.ascontiguousarray(sd.positions, np.float32),
-                indices=np.ascontiguousarray(sd.indices, np.uint32),
-                corner_normals=np.ascontiguousarray(sd.corner_normals, np.float32),
-                corner_uvs=(None if sd.corner_uvs is None
-                            else np.ascontiguousarray(sd.corner_uvs, np.float32)),
-                material_indices=np.ascontiguousarray(sd.material_indices, np.uint32),
-                materials=_material_structs(libvsgl, sd),
-                lights=[libvsgl.Light(**l) for l in sd.lights],
-                camera=libvsgl.Camera(**sd.camera))
+            scene = libvsgl.Scene(ctx, **scene_arrays(sd, libvsgl))
         except libvsgl.VsglError as e:
             raise AovError("the scene was refused: %s" % _name_elements(e.message or str(e), sd))
         try:

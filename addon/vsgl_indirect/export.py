@@ -23,6 +23,7 @@ class SceneData:
         self.indices = np.zeros((0, 3), np.uint32)
         self.corner_normals = np.zeros((0, 3, 3), np.float32)
         self.corner_uvs = None
+        self.corner_tangents = None  # (T,3,4) float32 when a material is anisotropic
         self.material_indices = np.zeros(0, np.uint32)
         self.materials = []        # vsgl_material field dicts
         self.material_names = []
@@ -60,15 +61,45 @@ class MeshArrays:
         self.loop_uvs = loop_uvs          # (L,2) float32 or None
         self.tri_material = tri_material  # (T,) int: slot index
         self.slots = []                   # material per slot (bpy materials)
+        self.texspace = None              # (location, size) of the texture space; None = bounds
 
 
-def assemble(chunks, want_uvs=False):
+def _texspace(arr):
+    """(location, size) float64 of ``arr``'s texture space: the mesh's own,
+    else Blender's automatic one (bounding box centre and half extent, a zero
+    extent counting as 1)."""
+    if arr.texspace is not None:
+        loc, size = arr.texspace
+        return np.asarray(loc, np.float64), np.asarray(size, np.float64)
+    p = arr.positions.astype(np.float64)
+    lo, hi = (p.min(0), p.max(0)) if len(p) else (np.zeros(3), np.zeros(3))
+    size = (hi - lo) / 2.0
+    return (lo + hi) / 2.0, np.where(size == 0, 1.0, size)
+
+
+def default_tangents_local(arr):
+    """Cycles' tangent for an unlinked Tangent socket (graph.cpp connects a
+    Tangent node, radial, axis Z), per vertex, object space, unnormalised:
+    ``(-g.y, g.x, 0)`` with ``g`` = generated coordinates - 0.5 =
+    ``(co - texspace_location) / (2 texspace_size)`` (a zero size gives 0, as
+    Cycles' mesh_texture_space)."""
+    loc, size = _texspace(arr)
+    f = np.divide(0.5, size, out=np.zeros(3), where=size != 0)
+    g = (arr.positions.astype(np.float64) - loc) * f
+    return np.stack([-g[:, 1], g[:, 0], np.zeros(len(g))], -1)
+
+
+def assemble(chunks, want_uvs=False, want_tangents=False):
     """Concatenate ``chunks`` = [(MeshArrays, matrix 4x4, slot_to_global list)]
     into world-space (positions, indices, corner_normals, corner_uvs,
-    material_indices). Instances of one MeshArrays are transformed together
+    material_indices) and, with ``want_tangents``, a sixth item
+    corner_tangents (T,3,4): Cycles' default tangent
+    (:func:`default_tangents_local`) through the normal matrix, unnormalised,
+    bitangent sign 1. Instances of one MeshArrays are transformed together
     (one batched numpy op per mesh, not per instance). Mirrored instances
     (det < 0) get their winding flipped so geometric normals keep facing
-    the same way as in Blender; normals use the inverse transpose.
+    the same way as in Blender; normals and tangents use the inverse
+    transpose and follow the flipped corner order.
     """
     groups, order = {}, []
     for arr, matrix, slot_map in chunks:
@@ -80,7 +111,7 @@ def assemble(chunks, want_uvs=False):
             order.append(id(arr))
         g[1].append(np.asarray(matrix, np.float64).reshape(4, 4))
         g[2].append(list(slot_map) if len(slot_map) else [0])
-    pos, idx, nrm, uvs, mats = [], [], [], [], []
+    pos, idx, nrm, uvs, mats, tan = [], [], [], [], [], []
     base = 0
     for key in order:
         arr, ms, smaps = groups[key]
@@ -106,6 +137,12 @@ def assemble(chunks, want_uvs=False):
         idx.append((tv + base + (np.arange(k) * V)[:, None, None]).reshape(-1, 3)
                    .astype(np.uint32))
         nrm.append((n / ln).reshape(-1, 3, 3).astype(np.float32))
+        if want_tangents:
+            tw = np.einsum("kij,vj->kvi", nm, default_tangents_local(arr))     # (k, V, 3)
+            tc = tw[np.arange(k)[:, None, None], tv]                            # (k, T, 3, 3)
+            t4 = np.ones((k, T, 3, 4), np.float32)
+            t4[..., :3] = tc
+            tan.append(t4.reshape(-1, 3, 4))
         if want_uvs:
             if arr.loop_uvs is not None:
                 uvs.append(arr.loop_uvs[tl].reshape(-1, 3, 2).astype(np.float32))
@@ -118,10 +155,12 @@ def assemble(chunks, want_uvs=False):
         mats.append(table[np.arange(k)[:, None], np.minimum(slot, last)].reshape(-1))
         base += k * V
     if not idx:
-        return (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.uint32),
-                np.zeros((0, 3, 3), np.float32), None, np.zeros(0, np.uint32))
-    return (np.concatenate(pos), np.concatenate(idx), np.concatenate(nrm),
-            np.concatenate(uvs) if want_uvs else None, np.concatenate(mats).astype(np.uint32))
+        out = (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.uint32),
+               np.zeros((0, 3, 3), np.float32), None, np.zeros(0, np.uint32))
+        return out + (np.zeros((0, 3, 4), np.float32),) if want_tangents else out
+    out = (np.concatenate(pos), np.concatenate(idx), np.concatenate(nrm),
+           np.concatenate(uvs) if want_uvs else None, np.concatenate(mats).astype(np.uint32))
+    return out + (np.concatenate(tan),) if want_tangents else out
 
 
 # --------------------------------------------------------------------------
@@ -147,8 +186,11 @@ def _mesh_arrays(mesh, compat):
         uv = np.empty(len(mesh.loops) * 2, np.float32)
         layer.data.foreach_get("uv", uv)
         uv = uv.reshape(-1, 2)
-    return MeshArrays(pos.reshape(nv, 3), tv.reshape(nt, 3), tl.reshape(nt, 3), ln, uv,
-                      mi)
+    arr = MeshArrays(pos.reshape(nv, 3), tv.reshape(nt, 3), tl.reshape(nt, 3), ln, uv, mi)
+    # Cycles' generated coordinates use the evaluated mesh's texture space
+    # (automatic: its own bounding box, computed on access).
+    arr.texspace = (tuple(mesh.texspace_location), tuple(mesh.texspace_size))
+    return arr
 
 
 def _socket_value(s):
@@ -317,8 +359,12 @@ def collect(depsgraph, scene=None, require_lights=True):
         sd.instance_count += int(inst.is_instance)
 
     want_uvs = any(a.loop_uvs is not None for a, _, _ in chunks)
+    # Tangents only matter to anisotropic lobes: skip them (NULL) otherwise.
+    want_tangents = any(m.get("anisotropy", 0.0) > 0.0 for m in sd.materials)
+    out = assemble(chunks, want_uvs, want_tangents)
     (sd.positions, sd.indices, sd.corner_normals, sd.corner_uvs,
-     sd.material_indices) = assemble(chunks, want_uvs)
+     sd.material_indices) = out[:5]
+    sd.corner_tangents = out[5] if want_tangents else None
     if not sd.materials:
         material_global(None, False)
 
