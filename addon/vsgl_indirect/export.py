@@ -62,6 +62,7 @@ class MeshArrays:
         self.tri_material = tri_material  # (T,) int: slot index
         self.slots = []                   # material per slot (bpy materials)
         self.texspace = None              # (location, size) of the texture space; None = bounds
+        self.undeformed = None            # (V,3) undeformed coordinates (generated); None = positions
 
 
 def _texspace(arr):
@@ -82,10 +83,13 @@ def default_tangents_local(arr):
     Tangent node, radial, axis Z), per vertex, object space, unnormalised:
     ``(-g.y, g.x, 0)`` with ``g`` = generated coordinates - 0.5 =
     ``(co - texspace_location) / (2 texspace_size)`` (a zero size gives 0, as
-    Cycles' mesh_texture_space)."""
+    Cycles' mesh_texture_space). ``co`` is the undeformed coordinate (the
+    mesh without deform modifiers, as Cycles' generated attribute) when the
+    evaluated mesh has it, else the position."""
     loc, size = _texspace(arr)
     f = np.divide(0.5, size, out=np.zeros(3), where=size != 0)
-    g = (arr.positions.astype(np.float64) - loc) * f
+    co = arr.undeformed if arr.undeformed is not None else arr.positions
+    g = (co.astype(np.float64) - loc) * f
     return np.stack([-g[:, 1], g[:, 0], np.zeros(len(g))], -1)
 
 
@@ -167,7 +171,7 @@ def assemble(chunks, want_uvs=False, want_tangents=False):
 # bpy glue
 # --------------------------------------------------------------------------
 
-def _mesh_arrays(mesh, compat):
+def _mesh_arrays(mesh, compat, want_undeformed=False):
     mesh.calc_loop_triangles()
     lt = mesh.loop_triangles
     nt, nv = len(lt), len(mesh.vertices)
@@ -187,9 +191,21 @@ def _mesh_arrays(mesh, compat):
         layer.data.foreach_get("uv", uv)
         uv = uv.reshape(-1, 2)
     arr = MeshArrays(pos.reshape(nv, 3), tv.reshape(nt, 3), tl.reshape(nt, 3), ln, uv, mi)
-    # Cycles' generated coordinates use the evaluated mesh's texture space
-    # (automatic: its own bounding box, computed on access).
+    # Cycles' generated coordinates: the evaluated mesh's texture space (Blender
+    # gives it the original mesh's, also under modifiers) and undeformed
+    # coordinates (the ORCO layer a render depsgraph carries through to_mesh;
+    # without it undeformed_co is the position).
     arr.texspace = (tuple(mesh.texspace_location), tuple(mesh.texspace_size))
+    if want_undeformed and nv:
+        und = np.empty(nv * 3, np.float32)
+        try:
+            mesh.vertices.foreach_get("undeformed_co", und)
+        except (AttributeError, TypeError, RuntimeError):
+            und = None
+        if und is not None:
+            und = und.reshape(nv, 3)
+            if not np.array_equal(und, arr.positions):
+                arr.undeformed = und
     return arr
 
 
@@ -305,6 +321,20 @@ def collect(depsgraph, scene=None, require_lights=True):
         sd.material_names.append(key)
         return mat_index[key]
 
+    aniso_cache = {}
+
+    def anisotropic(mat):
+        """Does ``mat`` map to an anisotropic lobe (needs tangents)?"""
+        if mat is None:
+            return False
+        key = mat.original.name_full if mat.original else mat.name_full
+        if key not in aniso_cache:
+            fields = mat_cache.get(key)
+            if fields is None:
+                fields, _ = materials.map_material(describe_material(mat, compat))
+            aniso_cache[key] = fields.get("anisotropy", 0.0) > 0.0
+        return aniso_cache[key]
+
     mesh_cache = {}
     chunks = []
     for inst in depsgraph.object_instances:
@@ -344,8 +374,8 @@ def collect(depsgraph, scene=None, require_lights=True):
                                                    np.zeros(0, np.int32))
             else:
                 try:
-                    arr = _mesh_arrays(mesh, compat)
                     slots = [s.material for s in obj.material_slots] or list(mesh.materials)
+                    arr = _mesh_arrays(mesh, compat, any(anisotropic(m) for m in slots))
                 finally:
                     obj.to_mesh_clear()
                 arr.slots = slots

@@ -102,7 +102,10 @@ def test_tangents_match_formula_rotated_scaled_mirrored(scene):
     assert np.median(cos) < 0.99
 
 
-def test_modifier_texspace_follows_evaluated_mesh(scene):
+def test_modifier_uses_the_evaluated_meshs_texspace(scene):
+    """Under a generative modifier the evaluated mesh keeps the original
+    mesh's automatic texture space (not its own, larger bounds) -- and Cycles
+    uses that one (test_gbuffer_tangent_matches_cycles, object 'Arrayed')."""
     camera(scene)
     light(scene)
     ob = link(scene, blob("Arrayed", (0, 0, 0), aniso()))
@@ -115,6 +118,10 @@ def test_modifier_texspace_follows_evaluated_mesh(scene):
     exp = expected_tangents(sd, [ob])
     assert not np.isnan(exp).any()
     assert np.allclose(sd.corner_tangents[..., :3], exp, atol=1e-5)
+    ev = ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    co = np.array([v.co for v in ob.data.vertices])
+    assert np.allclose(ev.texspace_location, (co.min(0) + co.max(0)) / 2, atol=1e-6)
+    assert np.allclose(ev.texspace_size, (co.max(0) - co.min(0)) / 2, atol=1e-6)
 
 
 def test_isotropic_scene_has_no_tangents(scene):
@@ -252,6 +259,20 @@ def test_gbuffer_tangent_matches_cycles(scene):
     arr.modifiers.new("Array", "ARRAY").count = 2
     arr.rotation_euler = (0.0, 0.0, 0.9)
     arr.scale = (0.6, 0.6, 0.6)
+    # deform modifier: Cycles' generated coordinates are the undeformed ones
+    # (triangulated last so flat normals agree: Blender's polygon normal of a
+    # non-planar quad is not Cycles' triangle normal)
+    mats.append(aniso("A4", 0.9))
+    _add_tangent_aov(mats[4])
+    tw = link(s, blob("Twisted", (1.8, -1.2, 0.1), mats[4]))
+    sub = tw.modifiers.new("Sub", "SUBSURF")
+    sub.levels = sub.render_levels = 2
+    sub.subdivision_type = "SIMPLE"
+    twist = tw.modifiers.new("Twist", "SIMPLE_DEFORM")
+    twist.deform_method = "TWIST"
+    twist.angle = 1.2
+    twist.deform_axis = "Z"
+    tw.modifiers.new("Tri", "TRIANGULATE")
     cam = camera(s, (5.5, -5.0, 3.8))
     from mathutils import Vector
     cam.rotation_euler = (Vector((0.0, 0.0, 0.5)) - cam.location).to_track_quat("-Z", "Y").to_euler()
@@ -279,7 +300,24 @@ def test_gbuffer_tangent_matches_cycles(scene):
     im.exr_codec = "NONE"
     bpy.context.view_layer.update()
 
-    sd = collect(s)
+    # Export the render depsgraph, as the add-on does during a render (only it
+    # carries the undeformed coordinates), from the Cycles render itself.
+    got = {}
+
+    def grab(scene, depsgraph=None):
+        if depsgraph is not None and depsgraph.mode == "RENDER" and "sd" not in got:
+            got["sd"] = export.collect(depsgraph, scene)
+
+    with tempfile.TemporaryDirectory() as d:
+        s.render.filepath = os.path.join(d, "cycles")
+        bpy.app.handlers.frame_change_post.append(grab)
+        try:
+            bpy.ops.render.render(write_still=True)
+        finally:
+            bpy.app.handlers.frame_change_post.remove(grab)
+        path = [os.path.join(d, f) for f in os.listdir(d) if f.endswith(".exr")][0]
+        ch = _read_cycles_exr(path)
+    sd = got["sd"]
     assert sd.corner_tangents is not None
     ctx = libvsgl.Context()
     try:
@@ -293,12 +331,6 @@ def test_gbuffer_tangent_matches_cycles(scene):
         ctx.close()
     Mi = gb["materials"][:, :, 0]
     T = fr["tangents"][:, :, 0].astype(np.float64)
-
-    with tempfile.TemporaryDirectory() as d:
-        s.render.filepath = os.path.join(d, "cycles")
-        bpy.ops.render.render(write_still=True)
-        path = [os.path.join(d, f) for f in os.listdir(d) if f.endswith(".exr")][0]
-        ch = _read_cycles_exr(path)
 
     def find(suffix):
         for k in ch:
