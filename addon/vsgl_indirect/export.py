@@ -313,7 +313,12 @@ def collect(depsgraph, scene=None, require_lights=True):
         elif key == DEFAULT_KEY:
             fields, warns = materials.default_material(), []
         else:
-            fields, warns = materials.map_material(describe_material(mat, compat))
+            desc = describe_material(mat, compat)
+            fields, warns = materials.map_material(desc)
+            if fields.get("anisotropy", 0.0) > 0.0 and "Tangent" in desc.linked:
+                warns = list(warns) + [
+                    "material '%s': its Tangent input is linked; Cycles' default tangent "
+                    "(radial about the object's Z) is used instead" % key]
         mat_cache[key] = fields
         sd.warnings.extend(warns)
         mat_index[key] = len(sd.materials)

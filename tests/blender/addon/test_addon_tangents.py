@@ -365,3 +365,18 @@ def test_gbuffer_tangent_matches_cycles(scene):
             "material %s: tangent p99.5 %.3f deg" % (sd.material_names[mi],
                                                       np.percentile(ang[m], 99.5))
     assert p995 < TOL_P995_DEG, "tangent angle p99.5 %.3f deg (mean %.3f)" % (p995, ang.mean())
+
+
+def test_linked_tangent_is_reported(scene):
+    camera(scene)
+    light(scene)
+    mat = aniso("UVTangent")
+    nt = mat.node_tree
+    t = nt.nodes.new("ShaderNodeTangent")
+    t.direction_type = "UV_MAP"
+    nt.links.new(t.outputs["Tangent"], nt.nodes["Principled BSDF"].inputs["Tangent"])
+    link(scene, blob("Blob", (0, 0, 0), mat))
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    assert sd.corner_tangents is not None
+    assert any("UVTangent" in w and "Tangent input is linked" in w for w in sd.warnings), sd.warnings
