@@ -295,7 +295,26 @@ def collect(depsgraph, scene=None, require_lights=True):
     viewport = depsgraph.mode != "RENDER"
 
     mat_index = {}
-    mat_cache = {}
+    mapped_cache = {}   # key -> (fields, warnings) of a bpy material, mapped once
+
+    def material_key(mat):
+        return mat.original.name_full if mat.original else mat.name_full
+
+    def mapped(mat):
+        key = material_key(mat)
+        if key not in mapped_cache:
+            desc = describe_material(mat, compat)
+            fields, warns = materials.map_material(desc)
+            if fields.get("anisotropy", 0.0) > 0.0 and "Tangent" in desc.linked:
+                warns = list(warns) + [
+                    "material '%s': its Tangent input is linked; Cycles' default tangent "
+                    "(radial about the object's Z) is used instead" % key]
+            mapped_cache[key] = (fields, warns)
+        return mapped_cache[key]
+
+    def anisotropic(mat):
+        """Does ``mat`` map to an anisotropic lobe (needs tangents)?"""
+        return mat is not None and mapped(mat)[0].get("anisotropy", 0.0) > 0.0
 
     def material_global(mat, holdout):
         if holdout:
@@ -303,7 +322,7 @@ def collect(depsgraph, scene=None, require_lights=True):
         elif mat is None:
             key = DEFAULT_KEY
         else:
-            key = mat.original.name_full if mat.original else mat.name_full
+            key = material_key(mat)
         if key in mat_index:
             return mat_index[key]
         if key == HOLDOUT_KEY:
@@ -313,32 +332,12 @@ def collect(depsgraph, scene=None, require_lights=True):
         elif key == DEFAULT_KEY:
             fields, warns = materials.default_material(), []
         else:
-            desc = describe_material(mat, compat)
-            fields, warns = materials.map_material(desc)
-            if fields.get("anisotropy", 0.0) > 0.0 and "Tangent" in desc.linked:
-                warns = list(warns) + [
-                    "material '%s': its Tangent input is linked; Cycles' default tangent "
-                    "(radial about the object's Z) is used instead" % key]
-        mat_cache[key] = fields
+            fields, warns = mapped(mat)
         sd.warnings.extend(warns)
         mat_index[key] = len(sd.materials)
         sd.materials.append(fields)
         sd.material_names.append(key)
         return mat_index[key]
-
-    aniso_cache = {}
-
-    def anisotropic(mat):
-        """Does ``mat`` map to an anisotropic lobe (needs tangents)?"""
-        if mat is None:
-            return False
-        key = mat.original.name_full if mat.original else mat.name_full
-        if key not in aniso_cache:
-            fields = mat_cache.get(key)
-            if fields is None:
-                fields, _ = materials.map_material(describe_material(mat, compat))
-            aniso_cache[key] = fields.get("anisotropy", 0.0) > 0.0
-        return aniso_cache[key]
 
     mesh_cache = {}
     chunks = []
