@@ -162,12 +162,7 @@ class VSGL_OT_export_bundle(bpy.types.Operator):
         try:
             sd, _ = runner.export_scene(scene, context.evaluated_depsgraph_get())
             engine.check_output_path(path)
-            arrays = dict(positions=sd.positions, indices=sd.indices,
-                          corner_normals=sd.corner_normals, corner_uvs=sd.corner_uvs,
-                          material_indices=sd.material_indices,
-                          materials=[libvsgl.Material(**m) for m in sd.materials],
-                          lights=[libvsgl.Light(**l) for l in sd.lights],
-                          camera=libvsgl.Camera(**sd.camera))
+            arrays = engine.scene_arrays(sd, libvsgl)  # the same arrays a render passes (tangents included)
             ctx = libvsgl.Context()
             try:
                 libvsgl.bundle_write(ctx, path, arrays, engine.settings_for(options, libvsgl),

@@ -674,6 +674,8 @@ CURVE_SETTINGS = [
     ("preview preset (2 VSGLs/light, RSM 128)", "PREVIEW", {}),
     ("balanced preset (k-means 128, RSM 256, aa 2)", "BALANCED", {}),
     ("quality preset (k-means 256, RSM 512, aa 2, visibility)", "QUALITY", {}),
+    ("balanced preset, pulled-out cosine", "BALANCED", dict(diffuse_mode=2)),
+    ("quality preset, pulled-out cosine", "QUALITY", dict(diffuse_mode=2)),
     ("FIS 16, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=16, rsm_resolution=128, aa_samples=1)),
     ("FIS 64, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=64, rsm_resolution=128, aa_samples=1)),
     ("FIS 256, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1)),

@@ -126,8 +126,10 @@ int main(int argc, char **argv)
         }
         tp[r] = now() - t0;
     }
-    printf("render %ux%u balanced preset (aa 1, FIS %u): %.3f s  [gbuffer %.3f rsm %.3f fit %.3f shade %.3f]\n",
-           W, H, s.vsgl_count, median(tp, reps), st.seconds_gbuffer, st.seconds_rsm, st.seconds_fit, st.seconds_shade);
+    static const char *const fits[] = {"two", "fis", "kmeans"};
+    printf("render %ux%u balanced preset with aa 1 (%s %u, %u VSGLs): %.3f s  [gbuffer %.3f rsm %.3f fit %.3f shade %.3f]\n",
+           W, H, fits[s.fit_mode], s.vsgl_count, st.vsgl_count, median(tp, reps), st.seconds_gbuffer, st.seconds_rsm,
+           st.seconds_fit, st.seconds_shade);
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     printf("memory: peak resident %.1f MiB for the whole benchmark (G-buffer of %zu samples, one RSM, planes)\n",
