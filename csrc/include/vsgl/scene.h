@@ -63,8 +63,12 @@ typedef struct vsgl_material {
  * - @p power: watts for point, spot and area; irradiance in W/m^2 for sun.
  *   The caller folds in Blender 4's exposure (2^exposure) and blackbody.
  * - @p color: linear RGB multiplier of @p power.
- * - @p world_from_light: the object's matrix; scale is allowed (a spot's
- *   cone follows its scaled axes, an area's size is scaled by it).
+ * - @p world_from_light: the object's matrix; scale is allowed (an area's
+ *   size is scaled by it). Spot lights follow Blender 3.4's Cycles, as
+ *   measured (docs/units.md): the cone ignores the object's scale, and the
+ *   intensity inside the cone carries an extra cos(theta). Blender 4.x
+ *   scales the cone with the object and differs there; a flag for the 4.x
+ *   semantics is not modelled yet.
  */
 typedef struct vsgl_light {
     int32_t type;            /**< VSGL_LIGHT_* */
