@@ -63,6 +63,10 @@ class MeshArrays:
         self.slots = []                   # material per slot (bpy materials)
         self.texspace = None              # (location, size) of the texture space; None = bounds
         self.undeformed = None            # (V,3) undeformed coordinates (generated); None = positions
+        # Flat-shaded triangles: Cycles shades them with the triangle's own
+        # normal, not the polygon's (they differ on non-planar quads)
+        self.tri_flat = None              # (T,) bool or None (all smooth)
+        self.flat_normals = None          # (T,3) float64 unit local geometric normals
 
 
 def _texspace(arr):
@@ -135,6 +139,9 @@ def assemble(chunks, want_uvs=False, want_tangents=False):
         if ok.any():
             nm[ok] = np.linalg.inv(A[ok]).transpose(0, 2, 1)
         n = np.einsum("kij,ktcj->ktci", nm, arr.loop_normals.astype(np.float64)[tl])
+        if arr.tri_flat is not None:
+            g = np.einsum("kij,tj->kti", nm, arr.flat_normals)           # (k,T,3)
+            n[:, arr.tri_flat] = g[:, arr.tri_flat][:, :, None, :]
         ln = np.linalg.norm(n, axis=3, keepdims=True)
         ln[ln == 0] = 1.0
         pos.append(p.reshape(-1, 3).astype(np.float32))
@@ -191,6 +198,18 @@ def _mesh_arrays(mesh, compat, want_undeformed=False):
         layer.data.foreach_get("uv", uv)
         uv = uv.reshape(-1, 2)
     arr = MeshArrays(pos.reshape(nv, 3), tv.reshape(nt, 3), tl.reshape(nt, 3), ln, uv, mi)
+    if nt:
+        smooth = np.empty(nt, bool)
+        lt.foreach_get("use_smooth", smooth)
+        if not smooth.all():
+            p = arr.positions.astype(np.float64)[arr.tri_verts]             # (T,3,3)
+            gn = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+            length = np.linalg.norm(gn, axis=1, keepdims=True)
+            flat = ~smooth & (length[:, 0] > 0)
+            if flat.any():
+                length[length == 0] = 1.0
+                arr.tri_flat = flat
+                arr.flat_normals = gn / length
     # Cycles' generated coordinates: the evaluated mesh's texture space (Blender
     # gives it the original mesh's, also under modifiers) and undeformed
     # coordinates (the ORCO layer a render depsgraph carries through to_mesh;

@@ -44,6 +44,30 @@ def test_counts_transforms_and_flat_normals(scene):
     assert np.allclose(sd.corner_normals, fn[:, None, :].repeat(3, 1), atol=1e-5)
 
 
+def test_flat_non_planar_quad_uses_triangle_normals(scene):
+    """Cycles shades a flat (not smooth) face with each triangle's own normal;
+    on a non-planar quad that differs from the polygon normal (by ~14 deg
+    here), so the export must not pass the polygon's. Smooth faces keep their
+    split normals."""
+    basic(scene)
+    ob = link(scene, mesh_object("Warped", [(-1, -1, 0), (1, -1, 0.6), (1, 1, 0), (-1, 1, 0.6)], [(0, 1, 2, 3)]))
+    ob.rotation_euler = (0.2, -0.4, 0.7)
+    ob.scale = (1.5, -1.0, 1.0)           # mirrored too
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    fn = face_normals(sd)
+    assert sd.triangle_count == 2
+    assert float(np.dot(fn[0], fn[1])) < 0.99          # the two triangles really differ
+    assert np.allclose(sd.corner_normals, fn[:, None, :].repeat(3, 1), atol=1e-5)
+    for poly in ob.data.polygons:
+        poly.use_smooth = True
+    ob.data.update()
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    # smooth: corner normals are Blender's split normals (not per-triangle constants)
+    assert not np.allclose(sd.corner_normals[0], sd.corner_normals[0][:1].repeat(3, 0), atol=1e-3)
+
+
 def test_negative_scale_keeps_winding(scene):
     basic(scene)
     ob = link(scene, cube("Mirror", 2.0))
