@@ -64,8 +64,11 @@ def test_flat_non_planar_quad_uses_triangle_normals(scene):
     ob.data.update()
     bpy.context.view_layer.update()
     sd = collect(scene)
-    # smooth: corner normals are Blender's split normals (not per-triangle constants)
-    assert not np.allclose(sd.corner_normals[0], sd.corner_normals[0][:1].repeat(3, 0), atol=1e-3)
+    # smooth: Blender's split normals, here the one polygon's normal at every
+    # corner of both triangles, which is neither triangle's own normal
+    cn = sd.corner_normals.reshape(-1, 3)
+    assert np.allclose(cn, cn[:1].repeat(6, 0), atol=1e-5)
+    assert float(np.dot(cn[0], fn[0])) < 0.9999 and float(np.dot(cn[0], fn[1])) < 0.9999
 
 
 def test_negative_scale_keeps_winding(scene):
