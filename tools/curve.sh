@@ -14,3 +14,4 @@ blender -b --factory-startup --python-exit-code 1 --python tests/blender/cycles_
   tail -30 "$OUT/blender_curve.log"; exit 1; }
 grep "^curve:" "$OUT/blender_curve.log"
 echo "(report: $OUT/report_curve.md)"
+if python3 -c "import matplotlib" >/dev/null 2>&1; then python3 tools/plot_curve.py; fi
