@@ -260,3 +260,53 @@ VT_TEST(render_sample_merging_cuts_pairs_at_small_error)
         same_colour &= fabsf(on.dc[i] - off.dc[i]) <= 1e-6f * (1.0f + off.dc[i]);
     VT_CHECK(same_colour, "DiffCol must not change (every sample weights with its own colour)");
 }
+
+/* The same room at very different scales and far from the origin: every
+ * plane finite and non-negative, and the light (a scale-free quantity once
+ * the power is scaled with the area) about the same. */
+VT_TEST(render_survives_extreme_scales_and_offsets)
+{
+    static planes ref, p;
+    const float scales[4] = {1.0f, 1e-3f, 1e3f, 1.0f};
+    const float offsets[4] = {0.0f, 0.0f, 0.0f, 1e5f};
+    double ref_mean = 0;
+    for (int k = 0; k < 4; ++k) {
+        fx_scene fx;
+        fx_room(&fx, W, H, 0.3f, 150.0f * scales[k] * scales[k]); /* same irradiance */
+        for (uint32_t v = 0; v < fx.vertex_count * 3; ++v)
+            fx.positions[v] = fx.positions[v] * scales[k] + offsets[k];
+        for (int r = 0; r < 3; ++r) {
+            fx.lights[0].world_from_light[r * 4 + 3] = fx.lights[0].world_from_light[r * 4 + 3] * scales[k] + offsets[k];
+            fx.camera.world_from_camera[r * 4 + 3] = fx.camera.world_from_camera[r * 4 + 3] * scales[k] + offsets[k];
+        }
+        fx.camera.clip_start *= scales[k];
+        fx.camera.clip_end *= scales[k];
+        vsgl_context *ctx;
+        vsgl_scene *scene;
+        vsgl_context_create(NULL, &ctx);
+        VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scale %g: %s", scales[k], vsgl_context_last_error(ctx));
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_QUALITY, &s);
+        s.rsm_resolution = 32;
+        s.vsgl_count = 32;
+        planes *out = k == 0 ? &ref : &p;
+        vsgl_render_output o = bind(out);
+        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "scale %g offset %g: %s", scales[k], offsets[k],
+                 vsgl_context_last_error(ctx));
+        int bad = 0;
+        double mean = 0;
+        for (int i = 0; i < W * H * 3; ++i) {
+            bad += !(isfinite(out->comb[i]) && out->comb[i] >= 0.0f);
+            mean += out->comb[i];
+        }
+        mean /= W * H * 3;
+        VT_CHECK(bad == 0, "scale %g offset %g: %d bad values", scales[k], offsets[k], bad);
+        if (k == 0)
+            ref_mean = mean;
+        else
+            VT_CHECK(fabs(mean - ref_mean) <= (offsets[k] > 0 ? 0.05 : 0.02) * ref_mean,
+                     "scale %g offset %g: mean %.5g vs %.5g at scale 1", scales[k], offsets[k], mean, ref_mean);
+        vsgl_scene_destroy(scene);
+        vsgl_context_destroy(ctx);
+    }
+}

@@ -431,6 +431,11 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
     v3 lo, hi;
     vsgl__scene_bounds(scene, &lo, &hi);
     float extent = v3_length(v3_sub(hi, lo));
+    /* Ray offset: a fraction of the scene's size, but never below a few ulps
+     * of its coordinates (a scene 100 km from the origin has 1 cm floats). */
+    float max_abs = fmaxf(fmaxf(fmaxf(fabsf(lo.x), fabsf(hi.x)), fmaxf(fabsf(lo.y), fabsf(hi.y))),
+                          fmaxf(fabsf(lo.z), fabsf(hi.z)));
+    float eps = fmaxf((extent > 0.0f ? extent : 1.0f) * 1e-5f, max_abs * 1e-6f);
     uint32_t material_count;
     /* The kernel models the ASG glossy lobe; the SG lobe uses the reference path. */
     if (s->glossy_mode == VSGL_GLOSSY_SG)
@@ -459,7 +464,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
         }
     }
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
-                   (extent > 0.0f ? extent : 1.0f) * 1e-5f, 0, per_chunk, kl, path, leak,
+                   eps, 0, per_chunk, kl, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f};
     /* Rows in batches so progress can be reported and cancellation honoured. */
     size_t rows_per_batch = g->height / 20 + 1;
