@@ -112,7 +112,8 @@ typedef int32_t (*vsgl_progress_fn)(void *user, const char *stage, float fractio
 typedef struct vsgl_context_desc {
     uint32_t size;            /**< sizeof(vsgl_context_desc); 0 is accepted as "current" */
     uint32_t thread_count;    /**< worker threads; 0 = all online cores */
-    int32_t log_level;        /**< most verbose level passed to @p log; 0 = warnings and errors */
+    int32_t log_level;        /**< most verbose level passed to @p log; 0 = the default,
+                                   VSGL_LOG_WARNING (errors only cannot be selected: filter in the callback) */
     vsgl_log_fn log;          /**< NULL = no logging */
     void *log_user;
     vsgl_progress_fn progress;/**< NULL = no progress reports */

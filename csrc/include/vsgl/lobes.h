@@ -67,7 +67,8 @@ VSGL_API void vsgl_warp_ndf_asg(const vsgl_asg *ndf, const vsgl_vec3 *view, vsgl
 
 /**
  * @brief The smooth factor M of a microfacet lobe, rho_s(i,o) cos(i) =
- * M(i) D(h): F_schlick(i.h; f0) G2_smith_ggx(i, o; alpha) / (4 |o.n|).
+ * M(i) D(h): F_schlick(i.h; f0) G2(i, o; alpha) / (4 |o.n|), G2 the
+ * height-correlated Smith GGX masking-shadowing.
  * Evaluate it at the lobe axis. Returns 0 if i or o is below the surface.
  */
 VSGL_API float vsgl_specular_factor(const vsgl_vec3 *n, const vsgl_vec3 *view,

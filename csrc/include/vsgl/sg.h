@@ -44,7 +44,9 @@ VSGL_API float vsgl_sg_lobe_integral(const vsgl_sg *g);
 /**
  * @brief Product of two SGs, itself an SG: axis along l1 xi1 + l2 xi2,
  * sharpness its length, log-amplitude la1 + la2 - l1 l2 |xi1 - xi2|^2 /
- * (lm + l1 + l2) (the cancellation-free form).
+ * (lm + l1 + l2) (the cancellation-free form). The product's sharpness is
+ * clamped to ::VSGL_SHARPNESS_MAX like any other (two lobes at the cap give
+ * twice the exact product integral).
  * @param[out] out may alias @p a or @p b.
  */
 VSGL_API void vsgl_sg_product(const vsgl_sg *a, const vsgl_sg *b, vsgl_sg *out);
@@ -55,7 +57,8 @@ VSGL_API float vsgl_sg_product_integral(const vsgl_sg *a, const vsgl_sg *b);
 /**
  * @brief Iwasaki et al. 2012 approximation of the product integral:
  * 2 pi a1 a2 G(xi1; xi2, l1 l2 / (l1 + l2)) / (l1 + l2). Accurate for sharp
- * lobes, over-estimates broad ones (docs/math.md).
+ * lobes, over-estimates broad ones (docs/math.md); capped at the exact bound
+ * a1 a2 min(A(l1), A(l2)) so it stays finite as the sharpness goes to 0.
  */
 VSGL_API float vsgl_sg_product_integral_iwasaki(const vsgl_sg *a, const vsgl_sg *b);
 
