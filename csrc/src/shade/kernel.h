@@ -24,8 +24,7 @@ typedef struct vsgl_kernel_block {
     float Yx[VSGL_KERNEL_BLOCK], Yy[VSGL_KERNEL_BLOCK], Yz[VSGL_KERNEL_BLOCK];
     float Zx[VSGL_KERNEL_BLOCK], Zy[VSGL_KERNEL_BLOCK], Zz[VSGL_KERNEL_BLOCK];
     float lam[VSGL_KERNEL_BLOCK], mu[VSGL_KERNEL_BLOCK], camp[VSGL_KERNEL_BLOCK];
-    /* smooth factor inputs: alpha^2, n.o, sqrt(a2 + (1 - a2)(n.o)^2), F0 */
-    float a2[VSGL_KERNEL_BLOCK], co[VSGL_KERNEL_BLOCK], so[VSGL_KERNEL_BLOCK];
+    /* the smooth Fresnel/shadowing factor M(z, o) per channel at the lobe axis */
     float f0r[VSGL_KERNEL_BLOCK], f0g[VSGL_KERNEL_BLOCK], f0b[VSGL_KERNEL_BLOCK];
     /* accumulators */
     float ld[3][VSGL_KERNEL_BLOCK];     /* diffuse light: sum power * cosine integral / pi */

@@ -172,28 +172,11 @@ k_body(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restric
     float norm_den = (lam + nu) * (mu + nu);
     float norm = norm_den > 0.0f ? K_PI / sqrtf(norm_den) : K_PI;
     float gint = b->camp[i] * (gz > 0.0f ? gz : 0.0f) * k_exp(-hx * gx * gx - hy * gy * gy) * norm * amp;
-    /* smooth factor at the integrand's axis: normalize(l_in p + (lam + mu) Z) */
-    float sw = lam + mu;
-    float ix = lin * px + sw * b->Zx[i], iy = lin * py + sw * b->Zy[i], iz = lin * pz + sw * b->Zz[i];
-    float il = sqrtf(ix * ix + iy * iy + iz * iz);
-    float iil = il > 1e-30f ? 1.0f / il : 0.0f;
-    ix *= iil; iy *= iil; iz *= iil;
-    float ci = ix * b->nx[i] + iy * b->ny[i] + iz * b->nz[i];
-    ci = ci < 1.0f ? ci : 1.0f;
-    float hhx = ix + b->ox[i], hhy = iy + b->oy[i], hhz = iz + b->oz[i];
-    float hl = sqrtf(hhx * hhx + hhy * hhy + hhz * hhz);
-    float ih = hl > 1e-30f ? (ix * hhx + iy * hhy + iz * hhz) / hl : 0.0f;
-    ih = ih > 0.0f ? (ih < 1.0f ? ih : 1.0f) : 0.0f;
-    float w = 1.0f - ih, w2 = w * w, w5 = w2 * w2 * w;
-    float a2 = b->a2[i], co = b->co[i];
-    float si = sqrtf(a2 + (1.0f - a2) * ci * ci);
-    float gden = 2.0f * (ci * b->so[i] + co * si);
-    float geo = ci / (gden > 1e-30f ? gden : 1e-30f);
-    geo = ci > 0.0f ? geo : 0.0f;
-    float gm = gint * geo;
-    b->ls[0][i] += L->pr * gm * (b->f0r[i] + (1.0f - b->f0r[i]) * w5);
-    b->ls[1][i] += L->pg * gm * (b->f0g[i] + (1.0f - b->f0g[i]) * w5);
-    b->ls[2][i] += L->pb * gm * (b->f0b[i] + (1.0f - b->f0b[i]) * w5);
+    /* the smooth Fresnel/shadowing factor, per receiver at its lobe axis
+     * (Xu et al. Eq. 30: M(z, o)), precomputed per lane and channel */
+    b->ls[0][i] += L->pr * gint * b->f0r[i];
+    b->ls[1][i] += L->pg * gint * b->f0g[i];
+    b->ls[2][i] += L->pb * gint * b->f0b[i];
 }
 
 /* One loop per (lobes, mode) so each is branch-free and vectorised. */

@@ -99,20 +99,15 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
 }
 
 /* Glossy integral of the receiver's lobe with the incident SG, and the
- * axis of the integrand (where the smooth factor is evaluated). */
+ * axis where the smooth factor is evaluated: the receiver's lobe axis
+ * (Xu et al. Eq. 30), the same for every VSGL, as in the kernel. */
 static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_sg *in, v3 *axis)
 {
     if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
-        vsgl_sg prod;
-        vsgl_sg_product(&r->sg, in, &prod);
-        *axis = prod.axis;
+        *axis = r->sg.axis;
         return vsgl_sg_product_integral(&r->sg, in);
     }
-    v3 m = v3_add(v3_scale(in->axis, in->sharpness),
-                  v3_scale(r->asg.z, r->asg.lambda + r->asg.mu));
-    *axis = v3_normalize(m);
-    if (v3_dot(*axis, *axis) == 0.0f)
-        *axis = r->asg.z;
+    *axis = r->asg.z;
     return vsgl_asg_sg_product_integral(&r->asg, in);
 }
 
@@ -206,7 +201,6 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
         b->Yy[k] = 1.0f; b->Yx[k] = b->Yz[k] = 0.0f;
         b->Zz[k] = 1.0f; b->Zx[k] = b->Zy[k] = 0.0f;
         b->lam[k] = b->mu[k] = b->camp[k] = 0.0f;
-        b->a2[k] = 1.0f; b->co[k] = 1.0f; b->so[k] = 1.0f;
         b->f0r[k] = b->f0g[k] = b->f0b[k] = 0.0f;
         return 0;
     }
@@ -228,14 +222,13 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
         b->Zz[k] = 1.0f; b->Zx[k] = b->Zy[k] = 0.0f;
         b->lam[k] = b->mu[k] = b->camp[k] = 0.0f;
     }
-    float a = r->alpha < VSGL_ALPHA_MIN ? VSGL_ALPHA_MIN : (r->alpha > 1.0f ? 1.0f : r->alpha);
-    float a2 = a * a, co = clampf(v3_dot(r->n, r->o), 0.0f, 1.0f);
-    b->a2[k] = a2;
-    b->co[k] = co;
-    b->so[k] = sqrtf(a2 + (1.0f - a2) * co * co);
-    b->f0r[k] = clampf(r->bp.f0[0], 0.0f, 1.0f);
-    b->f0g[k] = clampf(r->bp.f0[1], 0.0f, 1.0f);
-    b->f0b[k] = clampf(r->bp.f0[2], 0.0f, 1.0f);
+    float m[3] = {0.0f, 0.0f, 0.0f};
+    if (r->glossy)
+        for (int c = 0; c < 3; ++c)
+            m[c] = vsgl_specular_factor(&r->n, &r->o, &r->asg.z, r->alpha, r->bp.f0[c]);
+    b->f0r[k] = m[0];
+    b->f0g[k] = m[1];
+    b->f0b[k] = m[2];
     return 1;
 }
 
