@@ -85,7 +85,7 @@ test-python: $(BUILD)/libvsgl.so
 ASAN_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
 $(BUILD)/asan/%.o: %.c $(HEADERS)
 	@mkdir -p $(dir $@)
-	clang $(CFLAGS_COMMON) $(ASAN_FLAGS) -c $< -o $@
+	clang $(CFLAGS_COMMON) $(ASAN_FLAGS) -MMD -c $< -o $@
 
 $(BUILD)/asan/vsgl_tests: $(ASAN_TEST_OBJ) $(ASAN_LIB_OBJ)
 	clang $(ASAN_FLAGS) -o $@ $^ $(LDLIBS)
@@ -109,7 +109,7 @@ bench:
 clean:
 	rm -rf $(BUILD)
 
--include $(LIB_OBJ:.o=.d) $(TEST_OBJ:.o=.d)
+-include $(LIB_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(ASAN_LIB_OBJ:.o=.d) $(ASAN_TEST_OBJ:.o=.d)
 
 # The shading kernel: vectorised with ISA clones (kernel.c) and a scalar
 # build of the same source (kernel_scalar.c) for the benchmark baseline.
