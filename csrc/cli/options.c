@@ -31,7 +31,7 @@ const char cli_usage[] =
     "  --threads N           worker threads (0 = all cores)\n"
     "  --seed N              seed of FIS / k-means sampling\n"
     "  --half                16-bit half EXR (default 32-bit float)\n"
-    "  --compression NAME    zip | zips | piz | none   (EXR compression, default zip)\n"
+    "  --compression NAME    zip | zips | piz | none   (EXR compression, default piz)\n"
     "  --dry-run             read, validate and check the output path; do not render\n"
     "  -v, --verbose         per-stage timings and statistics on stderr\n"
     "\n"
@@ -124,6 +124,7 @@ static void join_names(const char *const *names, char *buf, size_t n)
 int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
 {
     memset(o, 0, sizeof *o);
+    o->compression = VSGL_EXR_PIZ; /* 1080p, 22 float channels: PIZ 1.06 s / 60 MB, ZIP 1.73 s / 63 MB */
     o->command = CLI_HELP;
     o->preset = o->fit = o->sharpness = o->diffuse = o->glossy = o->visibility = o->method = o->leak = o->merge = -1;
     err[0] = '\0';
