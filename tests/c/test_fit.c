@@ -131,24 +131,38 @@ static void reference_two(const vsgl_scene *scene, const vsgl_rsm *r, int32_t es
     }
 }
 
-static vsgl_scene *room_scene(vsgl_context **ctx, fx_scene *fx)
+/* The room fixture's materials, behind a context and a scene (the fits read
+ * materials and bounds from the scene). Returns 0 (and fails the test) if
+ * the scene cannot be built. */
+typedef struct room { fx_scene fx; vsgl_context *ctx; vsgl_scene *scene; } room;
+
+static int room_open(room *r)
 {
-    fx_room(fx, 32, 24, 0.3f, 100.0f);
-    vsgl_scene *scene = NULL;
-    if (vsgl_context_create(NULL, ctx) != VSGL_OK)
-        return NULL;
-    if (vsgl_scene_create(*ctx, fx_desc(fx), &scene) != VSGL_OK)
-        fprintf(stderr, "scene: %s\n", vsgl_context_last_error(*ctx));
-    return scene;
+    fx_room(&r->fx, 32, 24, 0.3f, 100.0f);
+    r->ctx = NULL;
+    r->scene = NULL;
+    if (vsgl_context_create(NULL, &r->ctx) == VSGL_OK &&
+        vsgl_scene_create(r->ctx, fx_desc(&r->fx), &r->scene) != VSGL_OK)
+        fprintf(stderr, "scene: %s\n", vsgl_context_last_error(r->ctx));
+    VT_CHECK(r->scene != NULL, "scene creation failed");
+    if (!r->scene)
+        vsgl_context_destroy(r->ctx);
+    return r->scene != NULL;
+}
+
+static void room_close(room *r)
+{
+    vsgl_scene_destroy(r->scene);
+    vsgl_context_destroy(r->ctx);
 }
 
 VT_TEST(fit_two_matches_poster_equations_on_hand_built_rsm)
 {
-    fx_scene fx;
-    vsgl_context *ctx = NULL;
-    vsgl_scene *scene = room_scene(&ctx, &fx);
-    VT_CHECK(scene != NULL, "scene creation failed");
-    if (!scene) { vsgl_context_destroy(ctx); return; }
+    static room rm;
+    if (!room_open(&rm))
+        return;
+    vsgl_context *ctx = rm.ctx;
+    vsgl_scene *scene = rm.scene;
     const float offsets[3] = {0.0f, 40.0f, 1000.0f};
     for (int est = 0; est < 2; ++est)
         for (int oi = 0; oi < 3; ++oi) {
@@ -178,17 +192,16 @@ VT_TEST(fit_two_matches_poster_equations_on_hand_built_rsm)
             vsgl__vsgl_set_free(&set);
             free_rsm(&h);
         }
-    vsgl_scene_destroy(scene);
-    vsgl_context_destroy(ctx);
+    room_close(&rm);
 }
 
 VT_TEST(fit_fis_single_cluster_equals_two_and_top_mip_equals_total)
 {
-    fx_scene fx;
-    vsgl_context *ctx = NULL;
-    vsgl_scene *scene = room_scene(&ctx, &fx);
-    VT_CHECK(scene != NULL, "scene creation failed");
-    if (!scene) { vsgl_context_destroy(ctx); return; }
+    static room rm;
+    if (!room_open(&rm))
+        return;
+    vsgl_context *ctx = rm.ctx;
+    vsgl_scene *scene = rm.scene;
     hand_rsm h;
     make_rsm(&h, 32, 3, 5.0f, 1.0f);
     vsgl_render_settings s;
@@ -220,8 +233,7 @@ VT_TEST(fit_fis_single_cluster_equals_two_and_top_mip_equals_total)
     vsgl__vsgl_set_free(&two);
     vsgl__vsgl_set_free(&fis);
     free_rsm(&h);
-    vsgl_scene_destroy(scene);
-    vsgl_context_destroy(ctx);
+    room_close(&rm);
 }
 
 static double total_weight(const vsgl_vsgl_set *s)
@@ -234,11 +246,11 @@ static double total_weight(const vsgl_vsgl_set *s)
 
 VT_TEST(fit_fis_and_kmeans_conserve_total_power)
 {
-    fx_scene fx;
-    vsgl_context *ctx = NULL;
-    vsgl_scene *scene = room_scene(&ctx, &fx);
-    VT_CHECK(scene != NULL, "scene creation failed");
-    if (!scene) { vsgl_context_destroy(ctx); return; }
+    static room rm;
+    if (!room_open(&rm))
+        return;
+    vsgl_context *ctx = rm.ctx;
+    vsgl_scene *scene = rm.scene;
     hand_rsm h;
     make_rsm(&h, 64, 11, 0.0f, 1.5f);
     vsgl_render_settings s;
@@ -264,6 +276,5 @@ VT_TEST(fit_fis_and_kmeans_conserve_total_power)
     }
     vsgl__vsgl_set_free(&two);
     free_rsm(&h);
-    vsgl_scene_destroy(scene);
-    vsgl_context_destroy(ctx);
+    room_close(&rm);
 }

@@ -196,8 +196,9 @@ KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, size_t n, const vsgl
 {
     const vsgl_kernel_light local = *light; /* no aliasing with the block */
     const vsgl_kernel_light *L = &local;
-    float ld_sharp = vsgl_sg_cosine_sharpness();
-    float ld_norm = K_PI / k_sg_integral(ld_sharp);
+    /* the poster's SG-cosine lobe: constants (no call on the hot path) */
+    const float ld_sharp = VSGL__COSINE_SHARPNESS;
+    const float ld_norm = K_PI / k_sg_integral(VSGL__COSINE_SHARPNESS);
     if (n > VSGL_KERNEL_BLOCK)
         n = VSGL_KERNEL_BLOCK;
     if (visibility) {

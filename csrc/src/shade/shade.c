@@ -98,6 +98,28 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     }
 }
 
+/* Visibility of `target` (a VSGL's mean) from receivers rec[0..n), n <=
+ * VSGL_KERNEL_BLOCK: one batched occlusion query (Embree ray streams) from
+ * each receiver offset along its normal; vis[k] = 0 if blocked, else 1. A
+ * receiver at the target traces an empty segment (visible). */
+static void visibility_rays(const shade_job *j, v3 target, const receiver *rec, size_t n, float *vis)
+{
+    v3 org[VSGL_KERNEL_BLOCK], dir[VSGL_KERNEL_BLOCK];
+    float tmin[VSGL_KERNEL_BLOCK], tmax[VSGL_KERNEL_BLOCK];
+    unsigned char blocked[VSGL_KERNEL_BLOCK];
+    for (size_t k = 0; k < n; ++k) {
+        org[k] = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
+        v3 d = v3_sub(target, org[k]);
+        float dist = v3_length(d);
+        dir[k] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
+        tmin[k] = 0.0f;
+        tmax[k] = dist > j->eps ? dist - j->eps : 0.0f;
+    }
+    vsgl__scene_occluded_many(j->scene, (uint32_t)n, org, dir, tmin, tmax, 0, blocked);
+    for (size_t k = 0; k < n; ++k)
+        vis[k] = blocked[k] ? 0.0f : 1.0f;
+}
+
 /* Glossy integral of the receiver's lobe with the incident SG, and the
  * axis where the smooth factor is evaluated: the receiver's lobe axis
  * (Xu et al. Eq. 30), the same for every VSGL, as in the kernel. */
@@ -147,11 +169,9 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 if (j->leak)
                     in.log_amplitude += logf(fmaxf(vsgl__leak_factor(v, r.x), 1e-30f));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
-                    v3 org = v3_add(r.x, v3_scale(r.n, j->eps));
-                    v3 d = v3_sub(v->mean, org);
-                    float dist = v3_length(d);
-                    if (dist > j->eps &&
-                        vsgl__scene_occluded(j->scene, org, v3_scale(d, 1.0f / dist), 0.0f, dist - j->eps))
+                    float vis;
+                    visibility_rays(j, v->mean, &r, 1, &vis);
+                    if (vis == 0.0f)
                         continue;
                 }
                 if (has_diffuse) {
@@ -278,9 +298,6 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
     vsgl_kernel_block blk;
     receiver rec[VSGL_KERNEL_BLOCK];
     float vis[VSGL_KERNEL_BLOCK];
-    v3 ray_org[VSGL_KERNEL_BLOCK], ray_dir[VSGL_KERNEL_BLOCK];
-    float ray_tmin[VSGL_KERNEL_BLOCK], ray_tmax[VSGL_KERNEL_BLOCK];
-    unsigned char blocked[VSGL_KERNEL_BLOCK];
     uint64_t pairs = 0;
     /* which samples are shaded (shaded[]), and the slot each sample reads its light from */
     size_t *shaded = malloc((ns + 1) * sizeof *shaded);
@@ -338,20 +355,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             for (size_t v = 0; v < j->set->count; ++v) {
                 const float *vp = NULL;
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
-                    /* one batched occlusion query per block (Embree ray streams) */
-                    const vsgl_vsgl *L = &j->set->items[v];
-                    for (size_t k = 0; k < n; ++k) {
-                        ray_org[k] = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
-                        v3 d = v3_sub(L->mean, ray_org[k]);
-                        float dist = v3_length(d);
-                        ray_dir[k] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
-                        ray_tmin[k] = 0.0f;
-                        /* receivers at the VSGL centre trace an empty interval */
-                        ray_tmax[k] = dist > j->eps ? dist - j->eps : 0.0f;
-                    }
-                    vsgl__scene_occluded_many(j->scene, (uint32_t)n, ray_org, ray_dir, ray_tmin, ray_tmax, 0, blocked);
-                    for (size_t k = 0; k < n; ++k)
-                        vis[k] = blocked[k] ? 0.0f : 1.0f;
+                    visibility_rays(j, j->set->items[v].mean, rec, n, vis);
                     vp = vis;
                 }
                 if (j->path == VSGL_SHADE_KERNEL_SCALAR)
