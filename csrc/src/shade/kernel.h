@@ -35,8 +35,12 @@ typedef struct vsgl_kernel_block {
 typedef struct vsgl_kernel_light {
     float mx, my, mz;        /* mean position */
     float var;               /* positional variance per axis */
+    float var2;              /* 2 var */
+    float ivar;              /* 1 / var (FLT_MAX when var is 0) */
+    float valid;             /* 1 if var > 0 (a receiver at the mean of a point-like VSGL gets nothing) */
     float ax, ay, az;        /* -axis of the radiant intensity (incident direction) */
     float lv;                /* sharpness of the radiant intensity */
+    float lax, lay, laz;     /* lv times the -axis */
     float c0;                /* 1 / (2 pi A(lv)) */
     float pr, pg, pb;        /* power */
     float nx, ny, nz;        /* mean surface normal of the cluster */
@@ -48,12 +52,14 @@ typedef struct vsgl_kernel_light {
 #define VSGL_KERNEL_DIFFUSE 1
 #define VSGL_KERNEL_GLOSSY  2
 
-/* Accumulate VSGL L into receivers [0, n) of b. Diffuse modes as in
- * vsgl/sg.h (VSGL_COSINE_*); the glossy lobe is the block's ASG.
- * visibility: NULL or n factors in [0, 1]. */
-void vsgl__kernel_shade(vsgl_kernel_block *b, size_t n, const vsgl_kernel_light *L,
+/* Accumulate VSGL L into all VSGL_KERNEL_BLOCK receivers of b (a fixed
+ * trip count: the caller fills unused lanes with any finite receiver and
+ * ignores their sums). Diffuse modes as in vsgl/sg.h (VSGL_COSINE_*); the
+ * glossy lobe is the block's ASG. visibility: NULL or VSGL_KERNEL_BLOCK
+ * factors in [0, 1]. */
+void vsgl__kernel_shade(vsgl_kernel_block *b, const vsgl_kernel_light *L,
                         const float *visibility, int32_t diffuse_mode, int32_t lobes);
-void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, size_t n, const vsgl_kernel_light *L,
+void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *L,
                                const float *visibility, int32_t diffuse_mode, int32_t lobes);
 
 #endif

@@ -9,6 +9,7 @@
 #include "scene/material.h"
 #include "vsgl/lobes.h"
 
+#include <float.h>
 #include <stdlib.h>
 #include <string.h>
 #if defined(__x86_64__) || defined(__i386__)
@@ -349,6 +350,17 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             }
             lobes |= (blk.diffuse[k] > 0.0f ? VSGL_KERNEL_DIFFUSE : 0) | (blk.camp[k] > 0.0f ? VSGL_KERNEL_GLOSSY : 0);
         }
+        for (size_t k = n; k < VSGL_KERNEL_BLOCK; ++k) { /* padding lanes: shaded, never read */
+            blk.x[k] = blk.x[0]; blk.y[k] = blk.y[0]; blk.z[k] = blk.z[0];
+            blk.nx[k] = blk.nx[0]; blk.ny[k] = blk.ny[0]; blk.nz[k] = blk.nz[0];
+            blk.diffuse[k] = 0.0f;
+            blk.Xx[k] = 1.0f; blk.Xy[k] = blk.Xz[k] = 0.0f;
+            blk.Yy[k] = 1.0f; blk.Yx[k] = blk.Yz[k] = 0.0f;
+            blk.Zz[k] = 1.0f; blk.Zx[k] = blk.Zy[k] = 0.0f;
+            blk.lam[k] = blk.mu[k] = blk.camp[k] = 0.0f;
+            blk.f0r[k] = blk.f0g[k] = blk.f0b[k] = 0.0f;
+            vis[k] = 0.0f;
+        }
         memset(blk.ld, 0, sizeof blk.ld);
         memset(blk.ls, 0, sizeof blk.ls);
         if (lobes) {
@@ -359,9 +371,9 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
                     vp = vis;
                 }
                 if (j->path == VSGL_SHADE_KERNEL_SCALAR)
-                    vsgl__kernel_shade_scalar(&blk, n, &j->klights[v], vp, j->s->diffuse_mode, lobes);
+                    vsgl__kernel_shade_scalar(&blk, &j->klights[v], vp, j->s->diffuse_mode, lobes);
                 else
-                    vsgl__kernel_shade(&blk, n, &j->klights[v], vp, j->s->diffuse_mode, lobes);
+                    vsgl__kernel_shade(&blk, &j->klights[v], vp, j->s->diffuse_mode, lobes);
             }
             pairs += (uint64_t)n * j->set->count;
         }
@@ -451,8 +463,12 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
             vsgl_kernel_light *o = &kl[k];
             o->mx = v->mean.x; o->my = v->mean.y; o->mz = v->mean.z;
             o->var = v->variance;
+            o->var2 = 2.0f * v->variance;
+            o->ivar = v->variance > 0.0f ? 1.0f / v->variance : FLT_MAX;
+            o->valid = v->variance > 0.0f ? 1.0f : 0.0f;
             o->ax = -v->axis.x; o->ay = -v->axis.y; o->az = -v->axis.z;
             o->lv = v->sharpness;
+            o->lax = o->lv * o->ax; o->lay = o->lv * o->ay; o->laz = o->lv * o->az;
             o->c0 = 1.0f / (TWO_PI * vsgl_sg_integral(v->sharpness));
             o->pr = v->power[0]; o->pg = v->power[1]; o->pb = v->power[2];
             o->nx = v->normal.x; o->ny = v->normal.y; o->nz = v->normal.z;
