@@ -39,6 +39,29 @@ VT_TEST(kernel_cosine_matches_library_accurate_form)
     }
 }
 
+/* The short form for sharp lobes (no exp, no series) against the full one. */
+VT_TEST(kernel_sharp_cosine_matches_full_form)
+{
+    vt_rng r = {11};
+    double worst = 0.0;
+    for (int i = 0; i < 200000; ++i) {
+        float l = (float)(K_SHARP_COSINE * pow(10.0, 11.0 * vt_uniform(&r)));
+        float c = (float)(2.0 * vt_uniform(&r) - 1.0);
+        if (i % 7 == 0)
+            c = (float)(1e-3 * (2.0 * vt_uniform(&r) - 1.0)); /* the horizon, where the terms dropped live */
+        float full = k_cosine_cpart(l, c, k_cosine_lpart(l));
+        float sharp = k_cosine_cpart(l, c, k_cosine_lpart_sharp(l));
+        float a = (float)(2.0 * 3.14159265358979 / l); /* A(l) for large l */
+        double e = fabs((double)sharp - full) / a;
+        worst = e > worst ? e : worst;
+    }
+    VT_CHECK(worst < 2e-6, "worst |sharp - full| / A(lambda) = %.3g", worst);
+    /* and a lambda below the switch would be wrong: the test can fail */
+    float l = 4.0f, c = 0.0f;
+    float full = k_cosine_cpart(l, c, k_cosine_lpart(l)), sharp = k_cosine_cpart(l, c, k_cosine_lpart_sharp(l));
+    VT_CHECK(fabsf(sharp - full) > 1e-3f * full, "lambda 4: the short form differs (%g vs %g)", sharp, full);
+}
+
 typedef struct bundle {
     vsgl_context *ctx;
     vsgl_scene *scene;

@@ -49,64 +49,10 @@ static inline __attribute__((always_inline)) float k_erfc_poly(float x)
     return k * (0.254829592f + k * (-0.284496736f + k * (1.421413741f + k * (-1.453152027f + k * 1.061405429f))));
 }
 
-/* The ACCURATE SG x clamped-cosine integral of a unit-amplitude SG
- * (lambda l, cosine c between its axis and the normal); see sg_cosine.c. */
-static inline __attribute__((always_inline)) float k_cosine_accurate(float l, float c)
-{
-    l = l < K_SHARP_MAX ? l : K_SHARP_MAX;
-    float small = l < 0.5f ? 1.0f : 0.0f;
-    float ls = l > 1e-30f ? l : 1e-30f;
-    float e1 = k_exp(-l);
-    /* expm1(-l): Taylor below 0.5 */
-    float em_t = -l * (1.0f - l * 0.5f * (1.0f - l * (1.0f / 3.0f) * (1.0f - l * 0.25f * (1.0f - l * 0.2f * (1.0f - l * (1.0f / 6.0f))))));
-    float em = small > 0.0f ? em_t : e1 - 1.0f;
-    e1 = 1.0f + em;
-    float q_t = 0.5f + l * (-1.0f / 3.0f + l * (1.0f / 8.0f + l * (-1.0f / 30.0f + l * (1.0f / 144.0f + l * (-1.0f / 840.0f + l * (1.0f / 5760.0f))))));
-    float il2 = 1.0f / (ls * ls);
-    float q = small > 0.0f ? q_t : (-em - l * e1) * il2;
-    float low = e1 * q;
-    /* vMF mean length coth(l) - 1/l */
-    /* vMF mean length coth(l) - 1/l = (1 - 1/l) + 2 e^{-2l} / (1 - e^{-2l}); series below 1
-     * (vsgl__sg_mean_length) */
-    float below1 = l < 1.0f ? 1.0f : 0.0f;
-    float e2 = e1 * e1;
-    float ml_c = (1.0f - 1.0f / ls) + 2.0f * e2 / (1.0f - e2 + below1);
-    float l2 = l * l;
-    float ml_t = l * (1.0f / 3.0f + l2 * (-1.0f / 45.0f + l2 * (2.0f / 945.0f + l2 * (-1.0f / 4725.0f
-               + l2 * (2.0f / 93555.0f + l2 * (-1382.0f / 638512875.0f + l2 * (4.0f / 18243225.0f
-               + l2 * (-3617.0f / 162820783125.0f + l2 * (87734.0f / 38979295480125.0f)))))))));
-    float ml = below1 > 0.0f ? ml_t : ml_c;
-    float u = (-em * (2.0f + em) / ls) * ml;
-    float t = l * sqrtf(0.5f * ((l + VSGL__COS_T_A) * l + VSGL__COS_T_B) /
-                        (((l + VSGL__COS_T_C) * l + VSGL__COS_T_D) * l + VSGL__COS_T_E));
-    t = t > 1e-30f ? t : 1e-30f;
-    float ac = fabsf(c);
-    float x = t * ac;
-    float ex = k_exp(-x * x), et = k_exp(-t * t);
-    float s = (c > 0.0f ? c : 0.0f) - 0.5f * ac * k_erfc_poly(x) * ex + 0.5f * k_erfc_poly(t) * et
-            + (ex - et) * (0.28209479177387814f / t);
-    float kappa = -((VSGL__COS_K_A1 + VSGL__COS_K_A2 * l) / (1.0f + l * (VSGL__COS_K_B1 + VSGL__COS_K_B2 * l))) / t;
-    s += kappa * ((x * x - VSGL__COS_K_PSI) * ex - (t * t - VSGL__COS_K_PSI) * et);
-    s = s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f;
-    float r = K_2PI * (low + u * s);
-    float omc2 = (1.0f - ac) * (1.0f + ac);
-    float bound = K_PI * k_exp(-l * c * c / (1.0f + sqrtf(omc2)));
-    float rb = bound < r ? bound : r;
-    r = c < 0.0f ? rb : r; /* no && : a combined mask does not vectorise (GCC 12) */
-    return l > 0.0f ? r : K_PI;
-}
-
-/* A(l) = 2 pi (1 - e^{-2l}) / l, 4 pi at 0. */
-static inline __attribute__((always_inline)) float k_sg_integral(float l)
-{
-    float e = k_exp(-2.0f * l);
-    float taylor = 4.0f * K_PI * (1.0f - l * (1.0f - l * (2.0f / 3.0f)));
-    return l < 1e-3f ? taylor : K_2PI * (1.0f - e) / l;
-}
-
-/* Reciprocal square root of a positive, non-tiny value. Plain 1/sqrt so
- * that GCC emits the estimate + Newton step (-mrecip in kernel.c); the
- * argument is never masked, which would force a full-precision division. */
+/* Reciprocal square root of a positive normal float: a bit-level first
+ * guess and three Newton steps (relative error ~2e-7). GCC has no 16-lane
+ * reciprocal-square-root pattern for 1/sqrtf (it emits a square root and
+ * then a reciprocal, both refined: twice the work and latency). */
 static inline __attribute__((always_inline)) float k_rsqrt(float x)
 {
     int32_t i;
@@ -121,6 +67,112 @@ static inline __attribute__((always_inline)) float k_rsqrt(float x)
     return y;
 }
 
+/* The ACCURATE SG x clamped-cosine integral of a unit-amplitude SG
+ * (lambda l, cosine c between its axis and the normal); see sg_cosine.c.
+ * Split in two so the kernel can run them as separate stages: what depends
+ * on l alone, then the cosine's part. */
+typedef struct k_cos_l {
+    float low, u;   /* 2 pi times the integral below the horizon-free part, and the blend weight */
+    float t, it;    /* the erf scale and 1/sqrt(pi)/t */
+    float kappa;    /* the constrained correction's weight */
+    float ct;       /* every c-independent term of s */
+} k_cos_l;
+
+static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart(float l)
+{
+    k_cos_l o;
+    l = l < K_SHARP_MAX ? l : K_SHARP_MAX;
+    float small = l < 0.5f ? 1.0f : 0.0f;
+    float ls = l > 1e-30f ? l : 1e-30f;
+    float inv = 1.0f / ls;
+    float e1 = k_exp(-l);
+    /* expm1(-l): Taylor below 0.5 */
+    float em_t = -l * (1.0f - l * 0.5f * (1.0f - l * (1.0f / 3.0f) * (1.0f - l * 0.25f * (1.0f - l * 0.2f * (1.0f - l * (1.0f / 6.0f))))));
+    float em = small > 0.0f ? em_t : e1 - 1.0f;
+    e1 = 1.0f + em;
+    float q_t = 0.5f + l * (-1.0f / 3.0f + l * (1.0f / 8.0f + l * (-1.0f / 30.0f + l * (1.0f / 144.0f + l * (-1.0f / 840.0f + l * (1.0f / 5760.0f))))));
+    float q = small > 0.0f ? q_t : (-em - l * e1) * (inv * inv);
+    /* vMF mean length coth(l) - 1/l = (1 - 1/l) + 2 e^{-2l} / (1 - e^{-2l}); series below 1
+     * (vsgl__sg_mean_length) */
+    float below1 = l < 1.0f ? 1.0f : 0.0f;
+    float e2 = e1 * e1;
+    float ml_c = (1.0f - inv) + 2.0f * e2 / (1.0f - e2 + below1);
+    float l2 = l * l;
+    float ml_t = l * (1.0f / 3.0f + l2 * (-1.0f / 45.0f + l2 * (2.0f / 945.0f + l2 * (-1.0f / 4725.0f
+               + l2 * (2.0f / 93555.0f + l2 * (-1382.0f / 638512875.0f + l2 * (4.0f / 18243225.0f
+               + l2 * (-3617.0f / 162820783125.0f + l2 * (87734.0f / 38979295480125.0f)))))))));
+    float ml = below1 > 0.0f ? ml_t : ml_c;
+    o.low = K_2PI * e1 * q;
+    o.u = K_2PI * (-em * (2.0f + em) * inv) * ml;
+    /* t = l sqrt(h), h = 0.5 N(l) / D(l): one reciprocal square root gives t and 1/t */
+    float h = 0.5f * ((l + VSGL__COS_T_A) * l + VSGL__COS_T_B) /
+              (((l + VSGL__COS_T_C) * l + VSGL__COS_T_D) * l + VSGL__COS_T_E);
+    float rh = k_rsqrt(h);
+    float t = l * h * rh;
+    t = t > 1e-30f ? t : 1e-30f;
+    float it = rh * inv;
+    it = t > 1e-30f ? it : 1e30f;
+    float et = k_exp(-t * t);
+    o.kappa = -((VSGL__COS_K_A1 + VSGL__COS_K_A2 * l) / (1.0f + l * (VSGL__COS_K_B1 + VSGL__COS_K_B2 * l))) * it;
+    o.it = 0.28209479177387814f * it;
+    o.t = t;
+    o.ct = 0.5f * k_erfc_poly(t) * et - et * o.it - o.kappa * (t * t - VSGL__COS_K_PSI) * et;
+    return o;
+}
+
+/* The same for sharp lobes, l >= K_SHARP_COSINE: e^{-l} < 1.3e-14 and
+ * e^{-t^2} < 2.7e-7 drop out, which leaves no exp and no series (the
+ * c-independent terms are below 1e-7 of A(l); tests/c/test_kernel.c). */
+#define K_SHARP_COSINE 32.0f
+static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart_sharp(float l)
+{
+    k_cos_l o;
+    l = l < K_SHARP_MAX ? l : K_SHARP_MAX;
+    float inv = 1.0f / l;
+    o.low = 0.0f;
+    o.u = K_2PI * inv * (1.0f - inv);
+    float h = 0.5f * ((l + VSGL__COS_T_A) * l + VSGL__COS_T_B) /
+              (((l + VSGL__COS_T_C) * l + VSGL__COS_T_D) * l + VSGL__COS_T_E);
+    float rh = k_rsqrt(h);
+    o.t = l * h * rh;
+    float it = rh * inv;
+    o.kappa = -((VSGL__COS_K_A1 + VSGL__COS_K_A2 * l) / (1.0f + l * (VSGL__COS_K_B1 + VSGL__COS_K_B2 * l))) * it;
+    o.it = 0.28209479177387814f * it;
+    o.ct = 0.0f;
+    return o;
+}
+
+static inline __attribute__((always_inline)) float k_cosine_cpart(float l, float c, k_cos_l o)
+{
+    l = l < K_SHARP_MAX ? l : K_SHARP_MAX;
+    float ac = fabsf(c);
+    float x = o.t * ac;
+    float ex = k_exp(-x * x);
+    float s = (c > 0.0f ? c : 0.0f) - 0.5f * ac * k_erfc_poly(x) * ex + ex * o.it
+            + o.kappa * (x * x - VSGL__COS_K_PSI) * ex + o.ct;
+    s = s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f;
+    float r = o.low + o.u * s;
+    float omc2 = (1.0f - ac) * (1.0f + ac);
+    float bound = K_PI * k_exp(-l * c * c / (1.0f + sqrtf(omc2)));
+    float rb = bound < r ? bound : r;
+    r = c < 0.0f ? rb : r; /* no && : a combined mask does not vectorise (GCC 12) */
+    return l > 0.0f ? r : K_PI;
+}
+
+static inline __attribute__((always_inline)) float k_cosine_accurate(float l, float c)
+{
+    return k_cosine_cpart(l, c, k_cosine_lpart(l));
+}
+
+/* A(l) = 2 pi (1 - e^{-2l}) / l, 4 pi at 0. */
+static inline __attribute__((always_inline)) float k_sg_integral(float l)
+{
+    float e = k_exp(-2.0f * l);
+    float taylor = 4.0f * K_PI * (1.0f - l * (1.0f - l * (2.0f / 3.0f)));
+    return l < 1e-3f ? taylor : K_2PI * (1.0f - e) / l;
+}
+
+
 /* The kernel runs in stages, each a loop over the block's receivers that
  * leaves its results in a small scratch block (L1-resident). One fused loop
  * is one long chain of dependent operations per vector of receivers, more
@@ -132,6 +184,9 @@ typedef struct k_scratch {
     float amp[VSGL_KERNEL_BLOCK];                                             /* its amplitude */
     float expo[VSGL_KERNEL_BLOCK];
     float r[VSGL_KERNEL_BLOCK], d2[VSGL_KERNEL_BLOCK], ls[VSGL_KERNEL_BLOCK];
+    /* the accurate cosine's part that depends on lin alone (k_cos_l) */
+    float low[VSGL_KERNEL_BLOCK], u[VSGL_KERNEL_BLOCK], t[VSGL_KERNEL_BLOCK], it[VSGL_KERNEL_BLOCK];
+    float kappa[VSGL_KERNEL_BLOCK], ct[VSGL_KERNEL_BLOCK];
 } k_scratch;
 
 /* Stage 1: the incident radiance as one SG (Eq. 7), all but the exp.
@@ -194,6 +249,20 @@ static inline __attribute__((always_inline)) void k_amplitude(size_t i, k_scratc
     t->amp[i] *= k_exp(t->expo[i]);
 }
 
+/* Stage 3a (accurate cosine only): the part of the cosine integral that
+ * depends on the incident sharpness alone. */
+static inline __attribute__((always_inline)) void k_cosine_stage(size_t i, k_scratch *restrict t)
+{
+    k_cos_l o = k_cosine_lpart(t->lin[i]);
+    t->low[i] = o.low; t->u[i] = o.u; t->t[i] = o.t; t->it[i] = o.it; t->kappa[i] = o.kappa; t->ct[i] = o.ct;
+}
+
+static inline __attribute__((always_inline)) void k_cosine_stage_sharp(size_t i, k_scratch *restrict t)
+{
+    k_cos_l o = k_cosine_lpart_sharp(t->lin[i]);
+    t->low[i] = o.low; t->u[i] = o.u; t->t[i] = o.t; t->it[i] = o.it; t->kappa[i] = o.kappa; t->ct[i] = o.ct;
+}
+
 /* Stage 3: diffuse, the integral of the incident SG times max(w.n, 0), / pi. */
 static inline __attribute__((always_inline)) void
 k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, int32_t mode,
@@ -217,7 +286,8 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
     } else {
         float c = mn * ilin;
         c = c > 1.0f ? 1.0f : (c < -1.0f ? -1.0f : c);
-        cosint = k_cosine_accurate(lin, c);
+        k_cos_l o = {t->low[i], t->u[i], t->t[i], t->it[i], t->kappa[i], t->ct[i]};
+        cosint = k_cosine_cpart(lin, c, o);
     }
     float ed = t->amp[i] * cosint * (1.0f / K_PI) * b->diffuse[i];
     b->ld[0][i] += L->pr * ed;
@@ -274,7 +344,17 @@ KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_li
         switch (mode) {
         case VSGL_COSINE_SG: K_FOR(k_diffuse(b, i, L, VSGL_COSINE_SG, &t, ld_sharp, ld_norm)); break;
         case VSGL_COSINE_PULLED_OUT: K_FOR(k_diffuse(b, i, L, VSGL_COSINE_PULLED_OUT, &t, ld_sharp, ld_norm)); break;
-        default: K_FOR(k_diffuse(b, i, L, VSGL_COSINE_ACCURATE, &t, ld_sharp, ld_norm)); break;
+        default: {
+            /* blocks where every incident lobe is sharp take the short form */
+            float lmin = K_SHARP_MAX;
+            K_FOR(lmin = t.lin[i] < lmin ? t.lin[i] : lmin);
+            if (lmin >= K_SHARP_COSINE)
+                K_FOR(k_cosine_stage_sharp(i, &t));
+            else
+                K_FOR(k_cosine_stage(i, &t));
+            K_FOR(k_diffuse(b, i, L, VSGL_COSINE_ACCURATE, &t, ld_sharp, ld_norm));
+            break;
+        }
         }
     }
     if (lobes & VSGL_KERNEL_GLOSSY)
