@@ -50,9 +50,10 @@ static inline __attribute__((always_inline)) float k_erfc_poly(float x)
 }
 
 /* Reciprocal square root of a positive normal float: a bit-level first
- * guess and three Newton steps (relative error ~2e-7). GCC has no 16-lane
- * reciprocal-square-root pattern for 1/sqrtf (it emits a square root and
- * then a reciprocal, both refined: twice the work and latency). */
+ * guess and two Newton steps (relative error below 4.7e-6; each step
+ * squares it). GCC has no 16-lane reciprocal-square-root pattern for
+ * 1/sqrtf: it emits a square root and then a reciprocal, both refined,
+ * twice the work and the latency. */
 static inline __attribute__((always_inline)) float k_rsqrt(float x)
 {
     int32_t i;
@@ -63,8 +64,15 @@ static inline __attribute__((always_inline)) float k_rsqrt(float x)
     float hx = 0.5f * x;
     y = y * (1.5f - hx * y * y);
     y = y * (1.5f - hx * y * y);
-    y = y * (1.5f - hx * y * y);
     return y;
+}
+
+/* The same with a third Newton step (~2e-7), where the erfc terms of the
+ * accurate cosine amplify the error of t. */
+static inline __attribute__((always_inline)) float k_rsqrt_fine(float x)
+{
+    float y = k_rsqrt(x);
+    return y * (1.5f - 0.5f * x * y * y);
 }
 
 /* The ACCURATE SG x clamped-cosine integral of a unit-amplitude SG
@@ -107,7 +115,7 @@ static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart(float l)
     /* t = l sqrt(h), h = 0.5 N(l) / D(l): one reciprocal square root gives t and 1/t */
     float h = 0.5f * ((l + VSGL__COS_T_A) * l + VSGL__COS_T_B) /
               (((l + VSGL__COS_T_C) * l + VSGL__COS_T_D) * l + VSGL__COS_T_E);
-    float rh = k_rsqrt(h);
+    float rh = k_rsqrt_fine(h);
     float t = l * h * rh;
     t = t > 1e-30f ? t : 1e-30f;
     float it = rh * inv;
@@ -124,6 +132,7 @@ static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart(float l)
  * e^{-t^2} < 2.7e-7 drop out, which leaves no exp and no series (the
  * c-independent terms are below 1e-7 of A(l); tests/c/test_kernel.c). */
 #define K_SHARP_COSINE 32.0f
+#define VSGL_COSINE_PULLED_OUT_SHARP 100 /* the pulled-out form where e^{-2 lin} drops out */
 static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart_sharp(float l)
 {
     k_cos_l o;
@@ -133,7 +142,7 @@ static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart_sharp(float 
     o.u = K_2PI * inv * (1.0f - inv);
     float h = 0.5f * ((l + VSGL__COS_T_A) * l + VSGL__COS_T_B) /
               (((l + VSGL__COS_T_C) * l + VSGL__COS_T_D) * l + VSGL__COS_T_E);
-    float rh = k_rsqrt(h);
+    float rh = k_rsqrt_fine(h);
     o.t = l * h * rh;
     float it = rh * inv;
     o.kappa = -((VSGL__COS_K_A1 + VSGL__COS_K_A2 * l) / (1.0f + l * (VSGL__COS_K_B1 + VSGL__COS_K_B2 * l))) * it;
@@ -271,7 +280,10 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
     float mx = t->mx[i], my = t->my[i], mz = t->mz[i], lin = t->lin[i], ilin = t->ilin[i];
     float mn = mx * b->nx[i] + my * b->ny[i] + mz * b->nz[i];
     float cosint;
-    if (mode == VSGL_COSINE_PULLED_OUT) {
+    if (mode == VSGL_COSINE_PULLED_OUT_SHARP) {
+        /* every lobe of the block has lin >= K_SHARP_COSINE: e^{-2 lin} < 2e-28 */
+        cosint = (mn > 0.0f ? mn : 0.0f) * (K_2PI * ilin * ilin);
+    } else if (mode == VSGL_COSINE_PULLED_OUT) {
         /* max(c, 0) A(lin) with c = m.n / lin, A(l) = 2 pi (1 - e^{-2l}) / l */
         float e = k_exp(-2.0f * lin);
         float big = K_2PI * (1.0f - e) * ilin * ilin;
@@ -304,15 +316,16 @@ k_glossy(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restr
     float mx = t->mx[i], my = t->my[i], mz = t->mz[i], ilin = t->ilin[i];
     float nu = 0.5f * t->lin[i];
     float lam = b->lam[i], mu = b->mu[i];
-    float gx = (mx * b->Xx[i] + my * b->Xy[i] + mz * b->Xz[i]) * ilin;
-    float gy = (mx * b->Yx[i] + my * b->Yy[i] + mz * b->Yz[i]) * ilin;
-    float gz = (mx * b->Zx[i] + my * b->Zy[i] + mz * b->Zz[i]) * ilin;
+    /* the incident axis in the lobe's frame, unnormalised (m = lin p) */
+    float gx = mx * b->Xx[i] + my * b->Xy[i] + mz * b->Xz[i];
+    float gy = mx * b->Yx[i] + my * b->Yy[i] + mz * b->Yz[i];
+    float gz = mx * b->Zx[i] + my * b->Zy[i] + mz * b->Zz[i];
     float lamn = lam + nu, mun = mu + nu;
     float rp = k_rsqrt(lamn * mun + 1e-30f);
-    float rp2 = rp * rp;
-    float hx = nu * lam * mun * rp2;
-    float hy = nu * mu * lamn * rp2;
-    float gint = b->camp[i] * (gz > 0.0f ? gz : 0.0f) * k_exp(-hx * gx * gx - hy * gy * gy) * (K_PI * rp) * t->amp[i];
+    float w2 = rp * rp * nu * ilin * ilin;
+    float hx = lam * mun * w2;
+    float hy = mu * lamn * w2;
+    float gint = b->camp[i] * (gz > 0.0f ? gz : 0.0f) * k_exp(-hx * gx * gx - hy * gy * gy) * (K_PI * rp * ilin) * t->amp[i];
     /* the smooth Fresnel/shadowing factor, per receiver at its lobe axis
      * (Xu et al. Eq. 30: M(z, o)), precomputed per lane and channel */
     b->ls[0][i] += L->pr * gint * b->f0r[i];
@@ -341,20 +354,25 @@ KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_li
     K_FOR(k_exponent(b, i, L, &t));
     K_FOR(k_amplitude(i, &t));
     if (lobes & VSGL_KERNEL_DIFFUSE) {
+        /* blocks where every incident lobe is sharp take short forms */
+        float lmin = K_SHARP_MAX;
+        K_FOR(lmin = t.lin[i] < lmin ? t.lin[i] : lmin);
+        int sharp = lmin >= K_SHARP_COSINE;
         switch (mode) {
         case VSGL_COSINE_SG: K_FOR(k_diffuse(b, i, L, VSGL_COSINE_SG, &t, ld_sharp, ld_norm)); break;
-        case VSGL_COSINE_PULLED_OUT: K_FOR(k_diffuse(b, i, L, VSGL_COSINE_PULLED_OUT, &t, ld_sharp, ld_norm)); break;
-        default: {
-            /* blocks where every incident lobe is sharp take the short form */
-            float lmin = K_SHARP_MAX;
-            K_FOR(lmin = t.lin[i] < lmin ? t.lin[i] : lmin);
-            if (lmin >= K_SHARP_COSINE)
+        case VSGL_COSINE_PULLED_OUT:
+            if (sharp)
+                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_PULLED_OUT_SHARP, &t, ld_sharp, ld_norm));
+            else
+                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_PULLED_OUT, &t, ld_sharp, ld_norm));
+            break;
+        default:
+            if (sharp)
                 K_FOR(k_cosine_stage_sharp(i, &t));
             else
                 K_FOR(k_cosine_stage(i, &t));
             K_FOR(k_diffuse(b, i, L, VSGL_COSINE_ACCURATE, &t, ld_sharp, ld_norm));
             break;
-        }
         }
     }
     if (lobes & VSGL_KERNEL_GLOSSY)
