@@ -120,6 +120,9 @@ clean:
 KERNEL_MATH := -fno-math-errno -fno-trapping-math -funsafe-math-optimizations -ffinite-math-only -mrecip
 $(BUILD)/obj/csrc/src/shade/kernel.o: OPT += -O3 $(KERNEL_MATH)
 $(BUILD)/obj/csrc/src/shade/kernel_scalar.o: OPT += -fno-math-errno -fno-trapping-math
+# The tests' per-ISA copies of the kernel (tests/c/kernel_isa*.c) take the
+# library kernel's flags, so that they check the arithmetic that ships.
+$(BUILD)/obj/tests/c/kernel_isa%.o: OPT += -O3 $(KERNEL_MATH)
 
 # libFuzzer + ASan + UBSan on the scene-bundle reader (tests/fuzz/), for
 # FUZZ_SECONDS seconds from a seed corpus the library writes (CRC checks

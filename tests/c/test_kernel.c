@@ -10,6 +10,8 @@
 #define KERNEL_NAME test_kernel_copy
 #include "shade/kernel_impl.h"
 
+#include "kernel_isa.h"
+
 #include <stdlib.h>
 
 VT_TEST(kernel_exp_matches_libm)
@@ -145,4 +147,115 @@ VT_TEST(kernel_shading_matches_reference_path)
         }
         teardown(&b);
     }
+}
+
+/* A random block of receivers (mixed diffuse / glossy lanes, random
+ * orthonormal lobe frames) and a random VSGL, from broad and near to sharp
+ * and far, in the kernel's layout. */
+static void random_block(vt_rng *r, vsgl_kernel_block *b)
+{
+    memset(b, 0, sizeof *b);
+    for (int k = 0; k < VSGL_KERNEL_BLOCK; ++k) {
+        b->x[k] = (float)(4.0 * vt_uniform(r) - 2.0);
+        b->y[k] = (float)(4.0 * vt_uniform(r) - 2.0);
+        b->z[k] = (float)(4.0 * vt_uniform(r) - 2.0);
+        double th = acos(2.0 * vt_uniform(r) - 1.0), ph = 6.283185307 * vt_uniform(r);
+        vsgl_vec3 z = {(float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)), (float)cos(th)};
+        vsgl_vec3 t = fabsf(z.x) < 0.9f ? (vsgl_vec3){1, 0, 0} : (vsgl_vec3){0, 1, 0};
+        float d = t.x * z.x + t.y * z.y + t.z * z.z;
+        vsgl_vec3 x = {t.x - d * z.x, t.y - d * z.y, t.z - d * z.z};
+        float n = sqrtf(x.x * x.x + x.y * x.y + x.z * x.z);
+        x.x /= n; x.y /= n; x.z /= n;
+        vsgl_vec3 y = {z.y * x.z - z.z * x.y, z.z * x.x - z.x * x.z, z.x * x.y - z.y * x.x};
+        b->nx[k] = z.x; b->ny[k] = z.y; b->nz[k] = z.z;
+        b->diffuse[k] = vt_uniform(r) < 0.8 ? 1.0f : 0.0f;
+        b->Xx[k] = x.x; b->Xy[k] = x.y; b->Xz[k] = x.z;
+        b->Yx[k] = y.x; b->Yy[k] = y.y; b->Yz[k] = y.z;
+        b->Zx[k] = z.x; b->Zy[k] = z.y; b->Zz[k] = z.z;
+        if (vt_uniform(r) < 0.7) {
+            b->lam[k] = (float)pow(10.0, 4.0 * vt_uniform(r) - 0.5);
+            b->mu[k] = (float)pow(10.0, 4.0 * vt_uniform(r) - 0.5);
+            b->camp[k] = (float)(1.0 + 100.0 * vt_uniform(r));
+            b->f0r[k] = b->f0g[k] = b->f0b[k] = (float)vt_uniform(r);
+        }
+    }
+}
+
+static void random_light(vt_rng *r, vsgl_kernel_light *o, int sharp)
+{
+    memset(o, 0, sizeof *o);
+    o->mx = (float)(4.0 * vt_uniform(r) - 2.0);
+    o->my = (float)(4.0 * vt_uniform(r) - 2.0);
+    o->mz = (float)(4.0 * vt_uniform(r) - 2.0);
+    o->var = (float)pow(10.0, sharp ? -7.0 + 2.0 * vt_uniform(r) : -3.0 + 3.0 * vt_uniform(r));
+    o->var2 = 2.0f * o->var;
+    o->ivar = 1.0f / o->var;
+    o->valid = 1.0f;
+    o->az = 1.0f;
+    o->lv = (float)(3.0 * vt_uniform(r));
+    o->lax = o->lv * o->ax; o->lay = o->lv * o->ay; o->laz = o->lv * o->az;
+    o->c0 = 1.0f / (6.2831853f * vsgl_sg_integral(o->lv));
+    o->pr = 1.0f; o->pg = 0.5f; o->pb = 0.25f;
+    o->nz = -1.0f;
+    o->hemi_weight = (float)vt_uniform(r);
+    o->hemi_scale = 20.0f;
+}
+
+/* Every ISA copy (AVX-512, AVX2, baseline) and the library's scalar build
+ * accumulate the same light, for every diffuse form, with and without
+ * visibility, in blocks of broad and of sharp lobes (the short forms). */
+VT_TEST(kernel_isa_clones_agree_with_scalar_build)
+{
+#if KERNEL_ISA_CLONES
+    typedef void (*kfn)(vsgl_kernel_block *, const vsgl_kernel_light *, const float *, int32_t, int32_t);
+    kfn fns[3] = {test_kernel_isa_base, test_kernel_isa_v3, test_kernel_isa_v4};
+    const char *names[3] = {"x86-64", "x86-64-v3", "x86-64-v4"};
+    int have[3] = {1, __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"),
+                   __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                       __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl")};
+    vt_rng r = {2024};
+    static vsgl_kernel_block base, ref, got;
+    float vis[VSGL_KERNEL_BLOCK];
+    double worst[3] = {0, 0, 0};
+    for (int trial = 0; trial < 60; ++trial) {
+        random_block(&r, &base);
+        vsgl_kernel_light L[8];
+        for (int k = 0; k < 8; ++k)
+            random_light(&r, &L[k], trial % 2);
+        for (int k = 0; k < VSGL_KERNEL_BLOCK; ++k)
+            vis[k] = (float)vt_uniform(&r);
+        for (int mode = 0; mode < 3; ++mode)
+            for (int withvis = 0; withvis < 2; ++withvis) {
+                ref = base;
+                for (int k = 0; k < 8; ++k)
+                    vsgl__kernel_shade_scalar(&ref, &L[k], withvis ? vis : NULL, mode, 3);
+                double scale = 0.0;
+                for (int c = 0; c < 3; ++c)
+                    for (int k = 0; k < VSGL_KERNEL_BLOCK; ++k)
+                        scale = fmax(scale, fmax(ref.ld[c][k], ref.ls[c][k]));
+                for (int f = 0; f < 3; ++f) {
+                    if (!have[f])
+                        continue;
+                    got = base;
+                    for (int k = 0; k < 8; ++k)
+                        fns[f](&got, &L[k], withvis ? vis : NULL, mode, 3);
+                    for (int c = 0; c < 3; ++c)
+                        for (int k = 0; k < VSGL_KERNEL_BLOCK; ++k) {
+                            double ed = fabs((double)got.ld[c][k] - ref.ld[c][k]) / (fabs(ref.ld[c][k]) + 1e-6 * scale);
+                            double es = fabs((double)got.ls[c][k] - ref.ls[c][k]) / (fabs(ref.ls[c][k]) + 1e-6 * scale);
+                            VT_CHECK(isfinite(got.ld[c][k]) && isfinite(got.ls[c][k]), "%s: non-finite", names[f]);
+                            worst[f] = fmax(worst[f], fmax(ed, es));
+                        }
+                }
+            }
+    }
+    for (int f = 0; f < 3; ++f) {
+        if (getenv("VSGL_TEST_VERBOSE"))
+            printf("    %s: %s, worst relative difference to the scalar build %.3g\n", names[f],
+                   have[f] ? "run" : "not supported here", worst[f]);
+        VT_CHECK(worst[f] < 2e-4, "%s: worst relative difference %.3g", names[f], worst[f]);
+    }
+#else
+    printf("    (skipped: the ISA clones are built by GCC on x86-64 only)\n");
+#endif
 }
