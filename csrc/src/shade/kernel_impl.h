@@ -132,7 +132,10 @@ static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart(float l)
  * e^{-t^2} < 2.7e-7 drop out, which leaves no exp and no series (the
  * c-independent terms are below 1e-7 of A(l); tests/c/test_kernel.c). */
 #define K_SHARP_COSINE 32.0f
-#define VSGL_COSINE_PULLED_OUT_SHARP 100 /* the pulled-out form where e^{-2 lin} drops out */
+/* the diffuse forms' short versions for blocks of sharp lobes */
+#define VSGL_COSINE_PULLED_OUT_SHARP 100 /* e^{-2 lin} drops out */
+#define VSGL_COSINE_ACCURATE_SHARP 101   /* no bound below the horizon */
+#define VSGL_COSINE_SG_SHARP 102         /* e^{-2 lm} drops out of A(lm), lm >= lin - 2.3 */
 static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart_sharp(float l)
 {
     k_cos_l o;
@@ -151,7 +154,10 @@ static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart_sharp(float 
     return o;
 }
 
-static inline __attribute__((always_inline)) float k_cosine_cpart(float l, float c, k_cos_l o)
+/* The part that depends on the cosine c. The bound below the horizon
+ * (c < 0) is never active for sharp lobes (l >= K_SHARP_COSINE: it changes
+ * the result by < 2e-8 of A(l)), so the short form leaves it out. */
+static inline __attribute__((always_inline)) float k_cosine_cpart_s(float l, float c, k_cos_l o, int sharp)
 {
     l = l < K_SHARP_MAX ? l : K_SHARP_MAX;
     float ac = fabsf(c);
@@ -161,11 +167,18 @@ static inline __attribute__((always_inline)) float k_cosine_cpart(float l, float
             + o.kappa * (x * x - VSGL__COS_K_PSI) * ex + o.ct;
     s = s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f;
     float r = o.low + o.u * s;
+    if (sharp)
+        return r;
     float omc2 = (1.0f - ac) * (1.0f + ac);
     float bound = K_PI * k_exp(-l * c * c / (1.0f + sqrtf(omc2)));
     float rb = bound < r ? bound : r;
     r = c < 0.0f ? rb : r; /* no && : a combined mask does not vectorise (GCC 12) */
     return l > 0.0f ? r : K_PI;
+}
+
+static inline __attribute__((always_inline)) float k_cosine_cpart(float l, float c, k_cos_l o)
+{
+    return k_cosine_cpart_s(l, c, o, 0);
 }
 
 static inline __attribute__((always_inline)) float k_cosine_accurate(float l, float c)
@@ -289,17 +302,20 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
         float big = K_2PI * (1.0f - e) * ilin * ilin;
         float taylor = 4.0f * K_PI * (1.0f - lin * (1.0f - lin * (2.0f / 3.0f))) * ilin;
         cosint = (mn > 0.0f ? mn : 0.0f) * (lin < 1e-3f ? taylor : big);
-    } else if (mode == VSGL_COSINE_SG) {
+    } else if (mode == VSGL_COSINE_SG || mode == VSGL_COSINE_SG_SHARP) {
         float qx = mx + ld_sharp * b->nx[i], qy = my + ld_sharp * b->ny[i], qz = mz + ld_sharp * b->nz[i];
-        float lm = sqrtf(qx * qx + qy * qy + qz * qz);
+        float lm2 = qx * qx + qy * qy + qz * qz;
+        float ilm = k_rsqrt(lm2 > 1e-30f ? lm2 : 1e-30f);
+        float lm = lm2 * ilm;
         float ex = mx * ilin - b->nx[i], ey = my * ilin - b->ny[i], ez = mz * ilin - b->nz[i];
         float dd = ex * ex + ey * ey + ez * ez;
-        cosint = k_exp(-lin * ld_sharp * dd / (lm + lin + ld_sharp)) * k_sg_integral(lm) * ld_norm;
+        float alm = mode == VSGL_COSINE_SG_SHARP ? K_2PI * ilm : k_sg_integral(lm);
+        cosint = k_exp(-lin * ld_sharp * dd / (lm + lin + ld_sharp)) * alm * ld_norm;
     } else {
         float c = mn * ilin;
         c = c > 1.0f ? 1.0f : (c < -1.0f ? -1.0f : c);
         k_cos_l o = {t->low[i], t->u[i], t->t[i], t->it[i], t->kappa[i], t->ct[i]};
-        cosint = k_cosine_cpart(lin, c, o);
+        cosint = k_cosine_cpart_s(lin, c, o, mode == VSGL_COSINE_ACCURATE_SHARP);
     }
     float ed = t->amp[i] * cosint * (1.0f / K_PI) * b->diffuse[i];
     b->ld[0][i] += L->pr * ed;
@@ -359,7 +375,12 @@ KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_li
         K_FOR(lmin = t.lin[i] < lmin ? t.lin[i] : lmin);
         int sharp = lmin >= K_SHARP_COSINE;
         switch (mode) {
-        case VSGL_COSINE_SG: K_FOR(k_diffuse(b, i, L, VSGL_COSINE_SG, &t, ld_sharp, ld_norm)); break;
+        case VSGL_COSINE_SG:
+            if (sharp)
+                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_SG_SHARP, &t, ld_sharp, ld_norm));
+            else
+                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_SG, &t, ld_sharp, ld_norm));
+            break;
         case VSGL_COSINE_PULLED_OUT:
             if (sharp)
                 K_FOR(k_diffuse(b, i, L, VSGL_COSINE_PULLED_OUT_SHARP, &t, ld_sharp, ld_norm));
@@ -367,11 +388,13 @@ KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_li
                 K_FOR(k_diffuse(b, i, L, VSGL_COSINE_PULLED_OUT, &t, ld_sharp, ld_norm));
             break;
         default:
-            if (sharp)
+            if (sharp) {
                 K_FOR(k_cosine_stage_sharp(i, &t));
-            else
+                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_ACCURATE_SHARP, &t, ld_sharp, ld_norm));
+            } else {
                 K_FOR(k_cosine_stage(i, &t));
-            K_FOR(k_diffuse(b, i, L, VSGL_COSINE_ACCURATE, &t, ld_sharp, ld_norm));
+                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_ACCURATE, &t, ld_sharp, ld_norm));
+            }
             break;
         }
     }
