@@ -52,14 +52,15 @@ typedef struct vsgl_kernel_light {
 #define VSGL_KERNEL_DIFFUSE 1
 #define VSGL_KERNEL_GLOSSY  2
 
-/* Accumulate VSGL L into all VSGL_KERNEL_BLOCK receivers of b (a fixed
- * trip count: the caller fills unused lanes with any finite receiver and
- * ignores their sums). Diffuse modes as in vsgl/sg.h (VSGL_COSINE_*); the
- * glossy lobe is the block's ASG. visibility: NULL or VSGL_KERNEL_BLOCK
- * factors in [0, 1]. */
-void vsgl__kernel_shade(vsgl_kernel_block *b, const vsgl_kernel_light *L,
+/* Accumulate VSGLs lights[0, count) into all VSGL_KERNEL_BLOCK receivers
+ * of b (a fixed trip count: the caller fills unused lanes with any finite
+ * receiver and ignores their sums), in that order. Diffuse modes as in
+ * vsgl/sg.h (VSGL_COSINE_*); the glossy lobe is the block's ASG.
+ * visibility: NULL or count x VSGL_KERNEL_BLOCK factors in [0, 1]
+ * (VSGL-major). */
+void vsgl__kernel_shade(vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count,
                         const float *visibility, int32_t diffuse_mode, int32_t lobes);
-void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *L,
+void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count,
                                const float *visibility, int32_t diffuse_mode, int32_t lobes);
 
 #endif

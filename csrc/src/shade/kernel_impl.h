@@ -204,7 +204,8 @@ typedef struct k_scratch {
     float mx[VSGL_KERNEL_BLOCK], my[VSGL_KERNEL_BLOCK], mz[VSGL_KERNEL_BLOCK]; /* lin times the incident axis */
     float lin[VSGL_KERNEL_BLOCK], ilin[VSGL_KERNEL_BLOCK];                    /* its sharpness and 1/it */
     float amp[VSGL_KERNEL_BLOCK];                                             /* its amplitude */
-    float expo[VSGL_KERNEL_BLOCK];
+    float expo[VSGL_KERNEL_BLOCK];                                            /* an exp's argument */
+    float gpre[VSGL_KERNEL_BLOCK];                                            /* the glossy integral's factor */
     float r[VSGL_KERNEL_BLOCK], d2[VSGL_KERNEL_BLOCK], ls[VSGL_KERNEL_BLOCK];
     /* the accurate cosine's part that depends on lin alone (k_cos_l) */
     float low[VSGL_KERNEL_BLOCK], u[VSGL_KERNEL_BLOCK], t[VSGL_KERNEL_BLOCK], it[VSGL_KERNEL_BLOCK];
@@ -327,7 +328,7 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
  * h_x = nu lam / (nu + lam), h_y = nu mu / (nu + mu), norm = pi / sqrt((lam + nu)(mu + nu)),
  * all from one reciprocal square root of the product. */
 static inline __attribute__((always_inline)) void
-k_glossy(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, const k_scratch *restrict t)
+k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t)
 {
     float mx = t->mx[i], my = t->my[i], mz = t->mz[i], ilin = t->ilin[i];
     float nu = 0.5f * t->lin[i];
@@ -341,63 +342,96 @@ k_glossy(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restr
     float w2 = rp * rp * nu * ilin * ilin;
     float hx = lam * mun * w2;
     float hy = mu * lamn * w2;
-    float gint = b->camp[i] * (gz > 0.0f ? gz : 0.0f) * k_exp(-hx * gx * gx - hy * gy * gy) * (K_PI * rp * ilin) * t->amp[i];
-    /* the smooth Fresnel/shadowing factor, per receiver at its lobe axis
-     * (Xu et al. Eq. 30: M(z, o)), precomputed per lane and channel */
+    t->expo[i] = -hx * gx * gx - hy * gy * gy;
+    t->gpre[i] = b->camp[i] * (gz > 0.0f ? gz : 0.0f) * (K_PI * rp * ilin) * t->amp[i];
+}
+
+/* Stage 5: the glossy lobe's exp and the accumulation, with the smooth
+ * Fresnel/shadowing factor per receiver at its lobe axis (Xu et al. Eq. 30:
+ * M(z, o)), precomputed per lane and channel. */
+static inline __attribute__((always_inline)) void
+k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, const k_scratch *restrict t)
+{
+    float gint = t->gpre[i] * k_exp(t->expo[i]);
     b->ls[0][i] += L->pr * gint * b->f0r[i];
     b->ls[1][i] += L->pg * gint * b->f0g[i];
     b->ls[2][i] += L->pb * gint * b->f0b[i];
 }
 
+/* Each stage is one loop over the block's receivers; with NL = 2 VSGLs per
+ * pass (the j loop is unrolled before vectorisation), every loop body holds
+ * two independent chains, which the core overlaps. Sums are added in VSGL
+ * order, as one VSGL at a time would. */
 #define K_FOR(STMT)                                    \
     for (size_t i = 0; i < VSGL_KERNEL_BLOCK; ++i) \
         STMT
+#define K_FORN(STMT)                                   \
+    for (size_t i = 0; i < VSGL_KERNEL_BLOCK; ++i) \
+        for (int j = 0; j < NL; ++j)                   \
+            STMT
 
-KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_light *light,
-                             const float *restrict visibility, int32_t mode, int32_t lobes)
+static inline __attribute__((always_inline)) void
+k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, const int NL,
+        const float *restrict visibility, int32_t mode, int32_t lobes, k_scratch *restrict t)
 {
-    const vsgl_kernel_light local = *light; /* no aliasing with the block */
-    const vsgl_kernel_light *L = &local;
-    k_scratch t;
     /* the poster's SG-cosine lobe: constants (no call on the hot path) */
     const float ld_sharp = VSGL__COSINE_SHARPNESS;
     const float ld_norm = K_PI / k_sg_integral(VSGL__COSINE_SHARPNESS);
     if (visibility)
-        K_FOR(k_geometry(b, i, L, visibility[i], &t));
+        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL_KERNEL_BLOCK + i], t + j));
     else
-        K_FOR(k_geometry(b, i, L, 1.0f, &t));
-    K_FOR(k_axis(b, i, L, &t));
-    K_FOR(k_exponent(b, i, L, &t));
-    K_FOR(k_amplitude(i, &t));
+        K_FORN(k_geometry(b, i, L + j, 1.0f, t + j));
+    K_FORN(k_axis(b, i, L + j, t + j));
+    K_FORN(k_exponent(b, i, L + j, t + j));
+    K_FORN(k_amplitude(i, t + j));
     if (lobes & VSGL_KERNEL_DIFFUSE) {
         /* blocks where every incident lobe is sharp take short forms */
         float lmin = K_SHARP_MAX;
-        K_FOR(lmin = t.lin[i] < lmin ? t.lin[i] : lmin);
+        K_FORN(lmin = t[j].lin[i] < lmin ? t[j].lin[i] : lmin);
         int sharp = lmin >= K_SHARP_COSINE;
         switch (mode) {
         case VSGL_COSINE_SG:
             if (sharp)
-                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_SG_SHARP, &t, ld_sharp, ld_norm));
+                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_SG_SHARP, t + j, ld_sharp, ld_norm));
             else
-                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_SG, &t, ld_sharp, ld_norm));
+                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_SG, t + j, ld_sharp, ld_norm));
             break;
         case VSGL_COSINE_PULLED_OUT:
             if (sharp)
-                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_PULLED_OUT_SHARP, &t, ld_sharp, ld_norm));
+                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_PULLED_OUT_SHARP, t + j, ld_sharp, ld_norm));
             else
-                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_PULLED_OUT, &t, ld_sharp, ld_norm));
+                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_PULLED_OUT, t + j, ld_sharp, ld_norm));
             break;
         default:
             if (sharp) {
-                K_FOR(k_cosine_stage_sharp(i, &t));
-                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_ACCURATE_SHARP, &t, ld_sharp, ld_norm));
+                K_FORN(k_cosine_stage_sharp(i, t + j));
+                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_ACCURATE_SHARP, t + j, ld_sharp, ld_norm));
             } else {
-                K_FOR(k_cosine_stage(i, &t));
-                K_FOR(k_diffuse(b, i, L, VSGL_COSINE_ACCURATE, &t, ld_sharp, ld_norm));
+                K_FORN(k_cosine_stage(i, t + j));
+                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_ACCURATE, t + j, ld_sharp, ld_norm));
             }
             break;
         }
     }
-    if (lobes & VSGL_KERNEL_GLOSSY)
-        K_FOR(k_glossy(b, i, L, &t));
+    if (lobes & VSGL_KERNEL_GLOSSY) {
+        K_FORN(k_glossy(b, i, t + j));
+        K_FORN(k_glossy_sum(b, i, L + j, t + j));
+    }
+}
+
+KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_light *lights, size_t count,
+                             const float *restrict visibility, int32_t mode, int32_t lobes)
+{
+    k_scratch t[2];
+    vsgl_kernel_light local[2]; /* copies: no aliasing with the block */
+    size_t v = 0;
+    for (; v + 2 <= count; v += 2) {
+        local[0] = lights[v];
+        local[1] = lights[v + 1];
+        k_shade(b, local, 2, visibility ? visibility + v * VSGL_KERNEL_BLOCK : NULL, mode, lobes, t);
+    }
+    if (v < count) {
+        local[0] = lights[v];
+        k_shade(b, local, 1, visibility ? visibility + v * VSGL_KERNEL_BLOCK : NULL, mode, lobes, t);
+    }
 }

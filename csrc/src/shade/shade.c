@@ -298,7 +298,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
     const size_t first = (j->base + b0) * spp, last = (j->base + e0) * spp, ns = last - first;
     vsgl_kernel_block blk;
     receiver rec[VSGL_KERNEL_BLOCK];
-    float vis[VSGL_KERNEL_BLOCK];
+    float vis[2 * VSGL_KERNEL_BLOCK]; /* visibility of two VSGLs */
     uint64_t pairs = 0;
     /* which samples are shaded (shaded[]), and the slot each sample reads its light from */
     size_t *shaded = malloc((ns + 1) * sizeof *shaded);
@@ -359,21 +359,24 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             blk.Zz[k] = 1.0f; blk.Zx[k] = blk.Zy[k] = 0.0f;
             blk.lam[k] = blk.mu[k] = blk.camp[k] = 0.0f;
             blk.f0r[k] = blk.f0g[k] = blk.f0b[k] = 0.0f;
-            vis[k] = 0.0f;
+            vis[k] = vis[VSGL_KERNEL_BLOCK + k] = 0.0f;
         }
         memset(blk.ld, 0, sizeof blk.ld);
         memset(blk.ls, 0, sizeof blk.ls);
         if (lobes) {
-            for (size_t v = 0; v < j->set->count; ++v) {
-                const float *vp = NULL;
-                if (j->s->visibility == VSGL_VISIBILITY_RAY) {
-                    visibility_rays(j, j->set->items[v].mean, rec, n, vis);
-                    vp = vis;
+            void (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t) =
+                j->path == VSGL_SHADE_KERNEL_SCALAR ? vsgl__kernel_shade_scalar : vsgl__kernel_shade;
+            const size_t count = j->set->count;
+            if (j->s->visibility == VSGL_VISIBILITY_RAY) {
+                /* two VSGLs per kernel call, the pairs it interleaves */
+                for (size_t v = 0; v < count; v += 2) {
+                    size_t m = count - v < 2 ? count - v : 2;
+                    for (size_t q = 0; q < m; ++q)
+                        visibility_rays(j, j->set->items[v + q].mean, rec, n, vis + q * VSGL_KERNEL_BLOCK);
+                    kernel(&blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
                 }
-                if (j->path == VSGL_SHADE_KERNEL_SCALAR)
-                    vsgl__kernel_shade_scalar(&blk, &j->klights[v], vp, j->s->diffuse_mode, lobes);
-                else
-                    vsgl__kernel_shade(&blk, &j->klights[v], vp, j->s->diffuse_mode, lobes);
+            } else {
+                kernel(&blk, j->klights, count, NULL, j->s->diffuse_mode, lobes);
             }
             pairs += (uint64_t)n * j->set->count;
         }
