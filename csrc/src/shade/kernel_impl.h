@@ -133,9 +133,9 @@ static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart(float l)
  * c-independent terms are below 1e-7 of A(l); tests/c/test_kernel.c). */
 #define K_SHARP_COSINE 32.0f
 /* the diffuse forms' short versions for blocks of sharp lobes */
-#define VSGL_COSINE_PULLED_OUT_SHARP 100 /* e^{-2 lin} drops out */
-#define VSGL_COSINE_ACCURATE_SHARP 101   /* no bound below the horizon */
-#define VSGL_COSINE_SG_SHARP 102         /* e^{-2 lm} drops out of A(lm), lm >= lin - 2.3 */
+#define K_COSINE_PULLED_OUT_SHARP 100 /* e^{-2 lin} drops out */
+#define K_COSINE_ACCURATE_SHARP 101   /* no bound below the horizon */
+#define K_COSINE_SG_SHARP 102         /* e^{-2 lm} drops out of A(lm), lm >= lin - 2.3 */
 static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart_sharp(float l)
 {
     k_cos_l o;
@@ -294,7 +294,7 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
     float mx = t->mx[i], my = t->my[i], mz = t->mz[i], lin = t->lin[i], ilin = t->ilin[i];
     float mn = mx * b->nx[i] + my * b->ny[i] + mz * b->nz[i];
     float cosint;
-    if (mode == VSGL_COSINE_PULLED_OUT_SHARP) {
+    if (mode == K_COSINE_PULLED_OUT_SHARP) {
         /* every lobe of the block has lin >= K_SHARP_COSINE: e^{-2 lin} < 2e-28 */
         cosint = (mn > 0.0f ? mn : 0.0f) * (K_2PI * ilin * ilin);
     } else if (mode == VSGL_COSINE_PULLED_OUT) {
@@ -303,20 +303,20 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
         float big = K_2PI * (1.0f - e) * ilin * ilin;
         float taylor = 4.0f * K_PI * (1.0f - lin * (1.0f - lin * (2.0f / 3.0f))) * ilin;
         cosint = (mn > 0.0f ? mn : 0.0f) * (lin < 1e-3f ? taylor : big);
-    } else if (mode == VSGL_COSINE_SG || mode == VSGL_COSINE_SG_SHARP) {
+    } else if (mode == VSGL_COSINE_SG || mode == K_COSINE_SG_SHARP) {
         float qx = mx + ld_sharp * b->nx[i], qy = my + ld_sharp * b->ny[i], qz = mz + ld_sharp * b->nz[i];
         float lm2 = qx * qx + qy * qy + qz * qz;
         float ilm = k_rsqrt(lm2 > 1e-30f ? lm2 : 1e-30f);
         float lm = lm2 * ilm;
         float ex = mx * ilin - b->nx[i], ey = my * ilin - b->ny[i], ez = mz * ilin - b->nz[i];
         float dd = ex * ex + ey * ey + ez * ez;
-        float alm = mode == VSGL_COSINE_SG_SHARP ? K_2PI * ilm : k_sg_integral(lm);
+        float alm = mode == K_COSINE_SG_SHARP ? K_2PI * ilm : k_sg_integral(lm);
         cosint = k_exp(-lin * ld_sharp * dd / (lm + lin + ld_sharp)) * alm * ld_norm;
     } else {
         float c = mn * ilin;
         c = c > 1.0f ? 1.0f : (c < -1.0f ? -1.0f : c);
         k_cos_l o = {t->low[i], t->u[i], t->t[i], t->it[i], t->kappa[i], t->ct[i]};
-        cosint = k_cosine_cpart_s(lin, c, o, mode == VSGL_COSINE_ACCURATE_SHARP);
+        cosint = k_cosine_cpart_s(lin, c, o, mode == K_COSINE_ACCURATE_SHARP);
     }
     float ed = t->amp[i] * cosint * (1.0f / K_PI) * b->diffuse[i];
     b->ld[0][i] += L->pr * ed;
@@ -392,20 +392,20 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         switch (mode) {
         case VSGL_COSINE_SG:
             if (sharp)
-                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_SG_SHARP, t + j, ld_sharp, ld_norm));
+                K_FORN(k_diffuse(b, i, L + j, K_COSINE_SG_SHARP, t + j, ld_sharp, ld_norm));
             else
                 K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_SG, t + j, ld_sharp, ld_norm));
             break;
         case VSGL_COSINE_PULLED_OUT:
             if (sharp)
-                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_PULLED_OUT_SHARP, t + j, ld_sharp, ld_norm));
+                K_FORN(k_diffuse(b, i, L + j, K_COSINE_PULLED_OUT_SHARP, t + j, ld_sharp, ld_norm));
             else
                 K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_PULLED_OUT, t + j, ld_sharp, ld_norm));
             break;
         default:
             if (sharp) {
                 K_FORN(k_cosine_stage_sharp(i, t + j));
-                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_ACCURATE_SHARP, t + j, ld_sharp, ld_norm));
+                K_FORN(k_diffuse(b, i, L + j, K_COSINE_ACCURATE_SHARP, t + j, ld_sharp, ld_norm));
             } else {
                 K_FORN(k_cosine_stage(i, t + j));
                 K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_ACCURATE, t + j, ld_sharp, ld_norm));
