@@ -389,29 +389,26 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         float lmin = K_SHARP_MAX;
         K_FORN(lmin = t[j].lin[i] < lmin ? t[j].lin[i] : lmin);
         int sharp = lmin >= K_SHARP_COSINE;
+        /* one loop per form, the form a constant in each */
+#define K_DIFFUSE(FORM) K_FORN(k_diffuse(b, i, L + j, (FORM), t + j, ld_sharp, ld_norm))
         switch (mode) {
         case VSGL_COSINE_SG:
-            if (sharp)
-                K_FORN(k_diffuse(b, i, L + j, K_COSINE_SG_SHARP, t + j, ld_sharp, ld_norm));
-            else
-                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_SG, t + j, ld_sharp, ld_norm));
+            if (sharp) K_DIFFUSE(K_COSINE_SG_SHARP); else K_DIFFUSE(VSGL_COSINE_SG);
             break;
         case VSGL_COSINE_PULLED_OUT:
-            if (sharp)
-                K_FORN(k_diffuse(b, i, L + j, K_COSINE_PULLED_OUT_SHARP, t + j, ld_sharp, ld_norm));
-            else
-                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_PULLED_OUT, t + j, ld_sharp, ld_norm));
+            if (sharp) K_DIFFUSE(K_COSINE_PULLED_OUT_SHARP); else K_DIFFUSE(VSGL_COSINE_PULLED_OUT);
             break;
         default:
             if (sharp) {
                 K_FORN(k_cosine_stage_sharp(i, t + j));
-                K_FORN(k_diffuse(b, i, L + j, K_COSINE_ACCURATE_SHARP, t + j, ld_sharp, ld_norm));
+                K_DIFFUSE(K_COSINE_ACCURATE_SHARP);
             } else {
                 K_FORN(k_cosine_stage(i, t + j));
-                K_FORN(k_diffuse(b, i, L + j, VSGL_COSINE_ACCURATE, t + j, ld_sharp, ld_norm));
+                K_DIFFUSE(VSGL_COSINE_ACCURATE);
             }
             break;
         }
+#undef K_DIFFUSE
     }
     if (lobes & VSGL_KERNEL_GLOSSY) {
         K_FORN(k_glossy(b, i, t + j));
