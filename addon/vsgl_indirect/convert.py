@@ -55,6 +55,9 @@ def transform_normals(m, n):
     return (out / ln).astype(np.float32)
 
 
+LIGHT_FLAG_SPOT_V4 = 1  # vsgl_light.flags (vsgl/scene.h)
+
+
 def light_power(energy, color, exposure=0.0, blackbody=(1.0, 1.0, 1.0)):
     """(rgb, power): Cycles strength = colour x energy x 2^exposure (x blackbody)."""
     rgb = tuple(float(c) * float(b) for c, b in zip(color[:3], blackbody[:3]))
@@ -64,8 +67,11 @@ def light_power(energy, color, exposure=0.0, blackbody=(1.0, 1.0, 1.0)):
 def light_fields(name, ltype, matrix_world, energy, color, exposure=0.0,
                  blackbody=(1.0, 1.0, 1.0), radius=0.0, spot_size=math.pi / 4,
                  spot_blend=0.15, sun_angle=0.0, shape="SQUARE", size=1.0, size_y=1.0,
-                 spread=math.pi):
-    """``vsgl_light`` fields for a Blender light. Raises ExportError naming it."""
+                 spread=math.pi, blender_version=(3, 4, 0)):
+    """``vsgl_light`` fields for a Blender light. Raises ExportError naming it.
+
+    Spots follow the semantics of ``blender_version``'s Cycles: 4.0 and later
+    drop 3.x's extra cos(theta) and scale the cone with the object."""
     if ltype not in LIGHT_TYPES:
         raise ExportError("light '%s': unsupported light type %s" % (name, ltype))
     rgb, power = light_power(energy, color, exposure, blackbody)
@@ -75,10 +81,12 @@ def light_fields(name, ltype, matrix_world, energy, color, exposure=0.0,
     f = dict(type=LIGHT_TYPES[ltype], area_shape=0, color=rgb, power=power,
              world_from_light=matrix_3x4(matrix_world), radius=max(float(radius), 0.0),
              spot_size=0.0, spot_blend=0.0, sun_angle=0.0, size_x=0.0, size_y=0.0,
-             spread=0.0, reserved=0)
+             spread=0.0, flags=0)
     if ltype == "SPOT":
         f["spot_size"] = float(spot_size)
         f["spot_blend"] = min(max(float(spot_blend), 0.0), 1.0)
+        if tuple(blender_version) >= (4, 0, 0):
+            f["flags"] = LIGHT_FLAG_SPOT_V4
     elif ltype == "SUN":
         f["sun_angle"] = float(sun_angle)
         f["radius"] = 0.0

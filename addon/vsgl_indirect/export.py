@@ -448,7 +448,7 @@ def _add_light(sd, obj, matrix, compat):
             spot_size=getattr(light, "spot_size", 0.0), spot_blend=getattr(light, "spot_blend", 0.0),
             sun_angle=getattr(light, "angle", 0.0), shape=getattr(light, "shape", "SQUARE"),
             size=getattr(light, "size", 0.0), size_y=getattr(light, "size_y", 0.0),
-            spread=getattr(light, "spread", np.pi))
+            spread=getattr(light, "spread", np.pi), blender_version=compat.VERSION)
     except ExportError as e:
         sd.warnings.append("%s; skipped" % e)
         return

@@ -201,6 +201,8 @@ class ExrCompression(enum.IntEnum):
 
 
 MATERIAL_UNSUPPORTED = 1
+LIGHT_FLAG_SPOT_V4 = 1   # vsgl_light.flags: Blender 4.0+ spot semantics
+LIGHT_FLAGS_KNOWN = 1
 SHARPNESS_MAX = 2199023255552.0  # 2^41
 ALPHA_MIN = 4.656612873077393e-10  # 2^-31
 EXR_MAX_CHANNELS = 4
@@ -334,7 +336,7 @@ class vsgl_light(_Struct):
         ("size_x", _f32),
         ("size_y", _f32),
         ("spread", _f32),
-        ("reserved", _u32),
+        ("flags", _u32),
     ]
     _enums = {"type": LightType, "area_shape": AreaShape}
 

@@ -400,6 +400,8 @@ def library_scene(lib, ctx, ob, lights, co, mats):
         L.radius = getattr(d, "shadow_soft_size", 0.0)
         L.spot_size = getattr(d, "spot_size", 1.0)
         L.spot_blend = getattr(d, "spot_blend", 0.0)
+        if d.type == "SPOT" and bpy.app.version >= (4, 0, 0):
+            L.flags = libvsgl.LIGHT_FLAG_SPOT_V4  # no cos(theta), the cone follows the object's scale
         L.sun_angle = getattr(d, "angle", 0.0)
         if d.type == "AREA":
             L.area_shape = shapes[d.shape]

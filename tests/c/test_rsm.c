@@ -230,6 +230,94 @@ VT_TEST(rsm_irradiance_on_plane_matches_analytic)
     vsgl_context_destroy(ctx);
 }
 
+/* Blender 4.0+ spot (VSGL_LIGHT_FLAG_SPOT_V4, measured in Blender 5.0):
+ * intensity P/(4 pi) times the blend alone, the cone in the light frame
+ * divided by the object's scale. Relative intensity towards local
+ * direction (x, y, z) (the spot points along -z) for scales (sx, sy, sz). */
+static double spot_v4_rel(double x, double y, double z, const double sc[3], double size, double blend)
+{
+    x /= sc[0];
+    y /= sc[1];
+    z /= sc[2];
+    return spot_rel(-z / sqrt(x * x + y * y + z * z), size, blend) / (-z / sqrt(x * x + y * y + z * z));
+}
+
+VT_TEST(rsm_spot_v4_irradiance_and_power)
+{
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    const double h = 2.0;
+    const double scales[2][3] = {{1.0, 1.0, 1.0}, {1.0, 0.5, 1.0}};
+    for (int k = 0; k < 2; ++k) {
+        const double *sc3 = scales[k];
+        /* irradiance on a floor 2 m below */
+        fx_scene s;
+        floor_only(&s, 6.0f);
+        vsgl_light *L = &s.lights[0];
+        set_light(L, VSGL_LIGHT_SPOT, 0, 0, (float)h);
+        L->flags = VSGL_LIGHT_FLAG_SPOT_V4;
+        for (int c = 0; c < 3; ++c)
+            L->world_from_light[4 * c + 1] *= (float)sc3[1];
+        vsgl_scene *sc = make(ctx, &s);
+        vsgl_rsm r;
+        if (!sc || vsgl__rsm_build(ctx, sc, 0, 512, &r) != VSGL_OK) {
+            VT_CHECK(0, "build: %s", vsgl_context_last_error(ctx));
+            vsgl_scene_destroy(sc);
+            continue;
+        }
+        const double pts[5][2] = {{0, 0}, {0.5, 0}, {1.0, 0}, {0, 0.3}, {0, 0.55}};
+        for (int q = 0; q < 5; ++q) {
+            const double w = 0.1;
+            double want = 0, want34 = 0;
+            int n = 64;
+            for (int a = 0; a < n; ++a)
+                for (int b = 0; b < n; ++b) {
+                    double x = pts[q][0] + w * (2.0 * (a + 0.5) / n - 1), y = pts[q][1] + w * (2.0 * (b + 0.5) / n - 1);
+                    double d2 = x * x + y * y + h * h, c = h / sqrt(d2);
+                    double kk = kern(x - pts[q][0], y - pts[q][1], w);
+                    want += L->power / (4 * PI) * spot_v4_rel(x, y, -h, sc3, L->spot_size, L->spot_blend) * c / d2 * kk;
+                    want34 += L->power / (4 * PI) * spot_rel(c, L->spot_size, L->spot_blend) * c / d2 * kk;
+                }
+            want *= 4 * w * w / ((double)n * n);
+            want34 *= 4 * w * w / ((double)n * n);
+            double got = rsm_irradiance(&r, 0, pts[q][0], pts[q][1], w);
+            VT_CHECK(fabs(got - want * L->color[0]) <= 3e-3 * fmax(want * L->color[0], 0.01),
+                     "scale (%g %g %g) at (%g, %g): RSM %g, 4.0+ model %g (3.4 model %g)", sc3[0], sc3[1], sc3[2],
+                     pts[q][0], pts[q][1], got, want * L->color[0], want34 * L->color[0]);
+        }
+        vsgl__rsm_free(&r);
+        vsgl_scene_destroy(sc);
+
+        /* total flux in a closed box = (P / 4 pi) int mask dw, integrated
+         * here over the plane z = -1 (dw = dx dy / (1 + x^2 + y^2)^1.5) */
+        closed_box(&s);
+        L = &s.lights[0];
+        set_light(L, VSGL_LIGHT_SPOT, 0.1f, 0.2f, 1.5f);
+        L->flags = VSGL_LIGHT_FLAG_SPOT_V4;
+        for (int c = 0; c < 3; ++c)
+            L->world_from_light[4 * c + 1] *= (float)sc3[1];
+        sc = make(ctx, &s);
+        if (!sc || vsgl__rsm_build(ctx, sc, 0, 256, &r) != VSGL_OK) {
+            VT_CHECK(0, "build: %s", vsgl_context_last_error(ctx));
+            vsgl_scene_destroy(sc);
+            continue;
+        }
+        double e = 0, lim = 1.0; /* the cone (half 0.6 rad, tan 0.68) fits in [-1, 1]^2 */
+        int n = 1000;
+        for (int a = 0; a < n; ++a)
+            for (int b = 0; b < n; ++b) {
+                double x = lim * (2.0 * (a + 0.5) / n - 1), y = lim * (2.0 * (b + 0.5) / n - 1);
+                double m = spot_v4_rel(x, y, -1.0, sc3, L->spot_size, L->spot_blend);
+                e += m / pow(1 + x * x + y * y, 1.5);
+            }
+        e *= 4 * lim * lim / ((double)n * n) / (4 * PI);
+        VT_CHECK_REL(r.total_flux[0], e * L->power * L->color[0], 1e-3, "scale (%g %g %g): total flux", sc3[0], sc3[1], sc3[2]);
+        vsgl__rsm_free(&r);
+        vsgl_scene_destroy(sc);
+    }
+    vsgl_context_destroy(ctx);
+}
+
 VT_TEST(rsm_is_deterministic_across_thread_counts)
 {
     fx_scene s;

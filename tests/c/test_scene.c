@@ -205,7 +205,7 @@ MUT(m_area_size, f->lights[0].type = VSGL_LIGHT_AREA; f->lights[0].area_shape = 
     f->lights[0].size_x = 1.0f; f->lights[0].size_y = 0.0f; f->lights[0].spread = 3.14159f)
 MUT(m_area_spread, f->lights[0].type = VSGL_LIGHT_AREA; f->lights[0].size_x = 1.0f; f->lights[0].spread = 0.0f)
 MUT(m_sun_angle, f->lights[0].type = VSGL_LIGHT_SUN; f->lights[0].sun_angle = 4.0f)
-MUT(m_light_reserved, f->lights[1].reserved = 3)
+MUT(m_light_flags, f->lights[1].flags = 6)
 MUT(m_light_unused_nan, f->lights[0].size_x = NAN)
 MUT(m_light_matrix_inf, f->lights[1].world_from_light[7] = INFINITY)
 MUT(m_cam_matrix_huge, f->camera.world_from_camera[11] = 1e19f)
@@ -263,7 +263,7 @@ static const bad_case bad_cases[] = {
     {"area size", m_area_size, "light 0: size_y is 0 (must be > 0)"},
     {"area spread", m_area_spread, "light 0: spread is 0 (must be in (0, pi])"},
     {"sun angle", m_sun_angle, "light 0: sun_angle is 4 (must be in [0, 3.14159])"},
-    {"light reserved", m_light_reserved, "light 1: reserved is 3 (must be 0)"},
+    {"light unknown flags", m_light_flags, "light 1: flags 0x6 has unknown bits (known: 0x1)"},
     {"light unused NaN", m_light_unused_nan, "light 0: size_x is nan (must be finite, |x| <= 1e18)"},
     {"light matrix Inf", m_light_matrix_inf, "light 1: world_from_light is not finite"},
     {"camera matrix huge", m_cam_matrix_huge, "camera: world_from_camera has an element above 1e18"},

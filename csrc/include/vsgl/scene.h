@@ -64,11 +64,13 @@ typedef struct vsgl_material {
  *   The caller folds in Blender 4's exposure (2^exposure) and blackbody.
  * - @p color: linear RGB multiplier of @p power.
  * - @p world_from_light: the object's matrix; scale is allowed (an area's
- *   size is scaled by it). Spot lights follow Blender 3.4's Cycles, as
- *   measured (docs/units.md): the cone ignores the object's scale, and the
- *   intensity inside the cone carries an extra cos(theta). Blender 4.x
- *   scales the cone with the object and differs there; a flag for the 4.x
- *   semantics is not modelled yet.
+ *   size is scaled by it).
+ * - Spot lights follow Cycles as measured (docs/units.md). By default
+ *   (@p flags 0) Blender 3.x: the intensity inside the cone carries an
+ *   extra cos(theta) and the cone ignores the object's scale. With
+ *   ::VSGL_LIGHT_FLAG_SPOT_V4, Blender 4.0 and later: no cos(theta), and the
+ *   cone follows the object's scaled axes (a spot scaled (1, 0.5, 1) has an
+ *   elliptical cone, half as wide in tangent along its local Y).
  */
 typedef struct vsgl_light {
     int32_t type;            /**< VSGL_LIGHT_* */
@@ -82,8 +84,13 @@ typedef struct vsgl_light {
     float sun_angle;         /**< angular diameter in radians, [0, pi] */
     float size_x, size_y;    /**< area size in metres (size_y ignored for square/disk) */
     float spread;            /**< area spread in radians, (0, pi] */
-    uint32_t reserved;       /**< must be 0 */
+    uint32_t flags;          /**< VSGL_LIGHT_FLAG_* bits; 0 = Blender 3.x semantics */
 } vsgl_light;
+
+/** Spot light with Blender 4.0+ semantics (see ::vsgl_light). */
+#define VSGL_LIGHT_FLAG_SPOT_V4 1u
+/** Every flag this version knows; other bits are rejected. */
+#define VSGL_LIGHT_FLAGS_KNOWN VSGL_LIGHT_FLAG_SPOT_V4
 
 /* ------------------------------------------------------------------------ */
 /* Camera                                                                     */

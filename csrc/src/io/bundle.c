@@ -100,7 +100,7 @@ static const field light_fields[] = {
     F(vsgl_light, power, 'f', 1), F(vsgl_light, world_from_light, 'f', 12), F(vsgl_light, radius, 'f', 1),
     F(vsgl_light, spot_size, 'f', 1), F(vsgl_light, spot_blend, 'f', 1), F(vsgl_light, sun_angle, 'f', 1),
     F(vsgl_light, size_x, 'f', 1), F(vsgl_light, size_y, 'f', 1), F(vsgl_light, spread, 'f', 1),
-    F(vsgl_light, reserved, 'u', 1),
+    F(vsgl_light, flags, 'u', 1),
 };
 static const field camera_fields[] = {
     F(vsgl_camera, type, 'i', 1), F(vsgl_camera, sensor_fit, 'i', 1), F(vsgl_camera, world_from_camera, 'f', 12),

@@ -5,8 +5,11 @@
  *   soft radius ignored (VPLs are seen from the centre).
  * - spot: intensity P/(4 pi) cos(theta) smoothstep((cos(theta) - cos(size/2))
  *   / ((1 - cos(size/2)) blend)); the extra cos(theta) and the cone ignoring
- *   the object's scale are Blender 3.4's behaviour (measured). One
- *   perspective face over the cone when size/2 <= 60 degrees, else a cube.
+ *   the object's scale are Blender 3.4's behaviour (measured). Blender 4.0+
+ *   (VSGL_LIGHT_FLAG_SPOT_V4, measured in 5.0): no cos(theta), and theta is
+ *   taken in the light's frame divided by the object's scale per axis (an
+ *   elliptical cone for a non-uniform scale). One perspective face over the
+ *   cone when its widest half-angle is <= 60 degrees, else a cube.
  * - sun: orthographic map over the scene bounds, W/m^2 times the texel's
  *   area across the beam; sun angle ignored (parallel rays).
  * - area: one face, concentric (Shirley-Chiu) map of the cosine-weighted
@@ -41,15 +44,29 @@ static double smoothstep01(double f)
     return f * f * (3.0 - 2.0 * f);
 }
 
-/* Blender 3.4 spot: relative intensity at cosine c to the axis. */
+/* Relative spot intensity at cosine c to the axis (Blender 3.4: the
+ * smoothstep blend times c; 4.0+: the blend alone). */
 static double spot_mask(const vsgl_rsm_light *l, double c)
 {
     if (c <= l->cos_half)
         return 0.0;
-    double t = c - l->cos_half, a = c;
+    double t = c - l->cos_half, a = l->spot_v4 ? 1.0 : c;
     if (t < l->smooth && l->smooth != 0.0)
         a *= smoothstep01(t / l->smooth);
     return a;
+}
+
+/* The cosine the mask sees for a local direction (x, y, z) of the light
+ * frame (the spot points along -z): 3.4 the plain one, 4.0+ the one in the
+ * frame divided by the object's scale. */
+static double spot_cos(const vsgl_rsm_light *l, double x, double y, double z)
+{
+    if (l->spot_v4) {
+        x *= l->inv_scale[0];
+        y *= l->inv_scale[1];
+        z *= l->inv_scale[2];
+    }
+    return -z / sqrt(x * x + y * y + z * z);
 }
 
 /* Area spread: fraction of a soft box's slat grid left open at angle theta
@@ -106,8 +123,22 @@ void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res
         double half = 0.5 * (double)L->spot_size;
         out->cos_half = cos(half);
         out->smooth = (1.0 - out->cos_half) * (double)L->spot_blend;
-        if (half <= PI_D / 3.0)
-            out->tan_half = tan(half) * (1.0 + 1e-6);
+        out->inv_scale[0] = out->inv_scale[1] = out->inv_scale[2] = 1.0;
+        double widest = half; /* the cone's widest half-angle in the light frame */
+        if (L->flags & VSGL_LIGHT_FLAG_SPOT_V4) {
+            out->spot_v4 = 1;
+            double s3[3] = {v3_dot(sx, out->ax), v3_dot(sy, out->ay), v3_length(sz)};
+            for (int k = 0; k < 3; ++k)
+                out->inv_scale[k] = s3[k] > 0.0 ? 1.0 / fabs(s3[k]) : 1.0;
+            if (half < 0.5 * PI_D) {
+                double t = tan(half) * fmax(s3[0], s3[1]) / s3[2];
+                widest = atan(t);
+            } else {
+                widest = PI_D; /* a cone past the horizon stays past it */
+            }
+        }
+        if (widest <= PI_D / 3.0)
+            out->tan_half = tan(widest) * (1.0 + 1e-6);
         else
             out->faces = 6;
         break;
@@ -216,9 +247,10 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
         if (l->type == VSGL_LIGHT_POINT) {
             w = *beam / (4.0 * PI_D);
         } else {
-            /* cosine to the spot axis (-Z) of plane point (x, y) */
-#define SPOT_COS(xx, yy) (-(axis == 2 ? sign : (ua == 2 ? (xx) : (va == 2 ? (yy) : 0.0))) / \
-                          sqrt(1.0 + (xx) * (xx) + (yy) * (yy)))
+            /* the mask's cosine for plane point (x, y) of this face */
+#define SPOT_COS(xx, yy) spot_cos(l, axis == 0 ? sign : (ua == 0 ? (xx) : (yy)), \
+                                  axis == 1 ? sign : (ua == 1 ? (xx) : (yy)), \
+                                  axis == 2 ? sign : (ua == 2 ? (xx) : (yy)))
             double c00 = SPOT_COS(x0, y0), c01 = SPOT_COS(x0, y1), c10 = SPOT_COS(x1, y0), c11 = SPOT_COS(x1, y1);
             double cc = SPOT_COS(xc, yc);
             double cmin = fmin(fmin(fmin(c00, c01), fmin(c10, c11)), cc);
@@ -226,7 +258,8 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
             if (cmax <= l->cos_half) {
                 w = 0.0; /* wholly outside the cone */
             } else if (cmin >= l->cos_half + l->smooth) {
-                w = cc * *beam / (4.0 * PI_D); /* inside the blend: mask = cos, smooth */
+                /* inside the blend: the mask is 1 (4.0+) or the cosine to the axis (3.4), smooth */
+                w = (l->spot_v4 ? 1.0 : cc) * *beam / (4.0 * PI_D);
             } else {
                 /* straddles the cone edge or the blend: supersample the mask,
                  * sub-rectangle solid angles from the (SUB+1)^2 corner values */
@@ -316,15 +349,29 @@ void vsgl__rsm_light_emitted(const vsgl_rsm_light *l, double out[3])
     case VSGL_LIGHT_POINT:
         w = 1.0;
         break;
-    case VSGL_LIGHT_SPOT: {
-        /* (1/4pi) * 2pi * int_{cos_half}^1 mask(c) dc, midpoint rule */
-        enum { N = 200000 };
-        double s = 0.0, a = l->cos_half, h = (1.0 - a) / N;
-        for (int i = 0; i < N; ++i)
-            s += spot_mask(l, a + (i + 0.5) * h);
-        w = 0.5 * s * h;
+    case VSGL_LIGHT_SPOT:
+        if (!l->spot_v4 || (l->inv_scale[0] == l->inv_scale[1] && l->inv_scale[1] == l->inv_scale[2])) {
+            /* (1/4pi) * 2pi * int_{cos_half}^1 mask(c) dc, midpoint rule */
+            enum { N = 200000 };
+            double s = 0.0, a = l->cos_half, h = (1.0 - a) / N;
+            for (int i = 0; i < N; ++i)
+                s += spot_mask(l, a + (i + 0.5) * h);
+            w = 0.5 * s * h;
+        } else {
+            /* elliptical cone: (1/4pi) int mask dw over the sphere in the
+             * light frame, midpoint rule in (cos theta, phi) about the axis */
+            enum { NT = 2000, NP = 720 };
+            double s = 0.0, ht = 2.0 / NT, hp = 2.0 * PI_D / NP;
+            for (int i = 0; i < NT; ++i) {
+                double c = 1.0 - (i + 0.5) * ht, r = sqrt(fmax(0.0, 1.0 - c * c));
+                for (int j = 0; j < NP; ++j) {
+                    double ph = (j + 0.5) * hp;
+                    s += spot_mask(l, spot_cos(l, r * cos(ph), r * sin(ph), -c));
+                }
+            }
+            w = s * ht * hp / (4.0 * PI_D);
+        }
         break;
-    }
     case VSGL_LIGHT_SUN:
         w = l->sun_texel_area * (double)l->res * l->res;
         break;

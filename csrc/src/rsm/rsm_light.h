@@ -1,5 +1,6 @@
 /* Internal to csrc/src/rsm: how each light type maps RSM texels to rays and
- * to emitted power (Cycles units, Blender 3.4 semantics; docs/units.md). */
+ * to emitted power (Cycles units, Blender 3.4 semantics and Blender 4.0+
+ * spots; docs/units.md). */
 #ifndef VSGL_RSM_LIGHT_H
 #define VSGL_RSM_LIGHT_H
 
@@ -15,6 +16,8 @@ typedef struct vsgl_rsm_light {
     /* spot */
     double cos_half, smooth;/* cos(size/2), (1 - cos_half) * blend */
     double tan_half;        /* single-face spot: image half-width on the plane at distance 1 */
+    int spot_v4;            /* Blender 4.0+ spot: no cos(theta), the cone in the scaled frame */
+    double inv_scale[3];    /* 1 / the object's scale along the light frame's axes (spot_v4) */
     /* sun: orthographic map over the scene bounds */
     v3 sun_dir;             /* direction the light travels */
     v3 sun_origin;          /* ray origin of texel (0,0) corner */

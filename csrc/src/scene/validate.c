@@ -160,8 +160,9 @@ vsgl_result vsgl__validate_light(vsgl_context *ctx, uint32_t index, const vsgl_l
         if (!(l->spread > 0.0f) || l->spread > VSGL_PI_F)
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: spread is %g (must be in (0, pi])", who, (double)l->spread);
     }
-    if (l->reserved != 0)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: reserved is %u (must be 0)", who, (unsigned)l->reserved);
+    if (l->flags & ~VSGL_LIGHT_FLAGS_KNOWN)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: flags 0x%x has unknown bits (known: 0x%x)", who,
+                          (unsigned)l->flags, (unsigned)VSGL_LIGHT_FLAGS_KNOWN);
     return VSGL_OK;
 }
 
