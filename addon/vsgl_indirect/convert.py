@@ -55,7 +55,7 @@ def transform_normals(m, n):
     return (out / ln).astype(np.float32)
 
 
-LIGHT_FLAG_SPOT_V4 = 1  # vsgl_light.flags (vsgl/scene.h)
+LIGHT_FLAG_BLENDER_4 = 1  # vsgl_light.flags (vsgl/scene.h)
 
 
 def light_power(energy, color, exposure=0.0, blackbody=(1.0, 1.0, 1.0)):
@@ -70,8 +70,9 @@ def light_fields(name, ltype, matrix_world, energy, color, exposure=0.0,
                  spread=math.pi, blender_version=(3, 4, 0)):
     """``vsgl_light`` fields for a Blender light. Raises ExportError naming it.
 
-    Spots follow the semantics of ``blender_version``'s Cycles: 4.0 and later
-    drop 3.x's extra cos(theta) and scale the cone with the object."""
+    Spot and area lights follow ``blender_version``'s Cycles (4.x and later:
+    a spot has no extra cos(theta) and its cone scales with the object, an
+    area light of P watts emits P watts; docs/units.md)."""
     if ltype not in LIGHT_TYPES:
         raise ExportError("light '%s': unsupported light type %s" % (name, ltype))
     rgb, power = light_power(energy, color, exposure, blackbody)
@@ -81,12 +82,10 @@ def light_fields(name, ltype, matrix_world, energy, color, exposure=0.0,
     f = dict(type=LIGHT_TYPES[ltype], area_shape=0, color=rgb, power=power,
              world_from_light=matrix_3x4(matrix_world), radius=max(float(radius), 0.0),
              spot_size=0.0, spot_blend=0.0, sun_angle=0.0, size_x=0.0, size_y=0.0,
-             spread=0.0, flags=0)
+             spread=0.0, flags=LIGHT_FLAG_BLENDER_4 if tuple(blender_version) >= (4, 0, 0) else 0)
     if ltype == "SPOT":
         f["spot_size"] = float(spot_size)
         f["spot_blend"] = min(max(float(spot_blend), 0.0), 1.0)
-        if tuple(blender_version) >= (4, 0, 0):
-            f["flags"] = LIGHT_FLAG_SPOT_V4
     elif ltype == "SUN":
         f["sun_angle"] = float(sun_angle)
         f["radius"] = 0.0

@@ -201,7 +201,7 @@ class ExrCompression(enum.IntEnum):
 
 
 MATERIAL_UNSUPPORTED = 1
-LIGHT_FLAG_SPOT_V4 = 1   # vsgl_light.flags: Blender 4.0+ spot semantics
+LIGHT_FLAG_BLENDER_4 = 1   # vsgl_light.flags: Blender 4.0+ spot semantics
 LIGHT_FLAGS_KNOWN = 1
 SHARPNESS_MAX = 2199023255552.0  # 2^41
 ALPHA_MIN = 4.656612873077393e-10  # 2^-31

@@ -79,6 +79,9 @@ LIGHT_CASES = [
     ("spot_90_blend03", dict(type="SPOT", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), spot_size=90, spot_blend=0.3),
      100 / (4 * math.pi ** 2 * 4)),
     ("spot_tilted_60", dict(type="SPOT", energy=100.0, loc=(-0.5, 0, 2), rot=(0, 20, 0), spot_size=60, spot_blend=0.25), None),
+    # a non-uniform scale: 3.x ignores it, 4.x+ makes the cone elliptical
+    ("spot_scaled_y05", dict(type="SPOT", energy=100.0, loc=(0.2, 0, 2), rot=(0, 0, 30), spot_size=80, spot_blend=0.2,
+                             scale=(1.0, 0.5, 1.0)), None),
     ("sun_3w_tilted", dict(type="SUN", energy=3.0, loc=(0, 0, 3), rot=(25, 10, 0)), 3.0 * _C25_10 / math.pi),
     ("area_square_5cm", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="SQUARE", size=0.05),
      100 / (4 * math.pi * 4)),
@@ -219,6 +222,8 @@ def build_blender(case):
         sc.collection.objects.link(lo)
         lo.location = ls["loc"]
         lo.rotation_euler = tuple(math.radians(a) for a in ls["rot"])
+        if "scale" in ls:
+            lo.scale = ls["scale"]
         lights.append(lo)
     cs = case["camera"]
     cam = bpy.data.cameras.new("cam")
@@ -279,6 +284,25 @@ def render_cycles(case, passes, path_prefix, samples, seed=1):
              "GlossCol": "use_pass_glossy_color", "GlossDir": "use_pass_glossy_direct"}
     for p in passes:
         setattr(vl, flags[p], True)
+    if not hasattr(sc, "node_tree"):
+        # Blender 5: no scene compositor tree; write the render result (every
+        # pass) as one uncompressed multilayer EXR, read by read_passes_exr
+        for flag in ("use_compositing", "use_sequencer"):
+            if hasattr(sc.render, flag):
+                setattr(sc.render, flag, False)
+        s = sc.render.image_settings
+        if hasattr(s, "media_type"):
+            s.media_type = "MULTI_LAYER_IMAGE"
+        s.file_format = "OPEN_EXR_MULTILAYER"
+        s.color_depth = "32"
+        s.exr_codec = "NONE"
+        sc.render.filepath = path_prefix + "_all.part.exr"
+        sc.frame_set(1)
+        t0 = time.time()
+        bpy.ops.render.render(write_still=True)
+        secs = time.time() - t0
+        os.replace(path_prefix + "_all.part.exr", path_prefix + "_all.exr")  # a cache entry is never partial
+        return secs
     sc.use_nodes = True
     nt = sc.node_tree
     for n in list(nt.nodes):
@@ -298,6 +322,27 @@ def render_cycles(case, passes, path_prefix, samples, seed=1):
     return time.time() - t0
 
 
+# Blender 5's multilayer EXR names the passes in full
+PASS_LONG_NAMES = {"DiffDir": "Diffuse Direct", "DiffInd": "Diffuse Indirect", "DiffCol": "Diffuse Color",
+                   "GlossDir": "Glossy Direct", "GlossInd": "Glossy Indirect", "GlossCol": "Glossy Color"}
+
+
+def read_passes_exr(path, passes):
+    """Passes (rows top first, HxWx3) from an uncompressed multilayer EXR,
+    with the independent reader of gbuffer_ref.py."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("gbuffer_ref_reader", os.path.join(HERE, "gbuffer_ref.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    ch = mod.read_exr(path)
+    out = {}
+    for p in passes:
+        names = [k for k in ch if k.split(".")[-2] in (p, PASS_LONG_NAMES[p])]
+        rgb = [next(k for k in names if k.endswith("." + c)) for c in "RGB"]
+        out[p] = np.stack([ch[k] for k in rgb], axis=-1).astype(np.float32)
+    return out
+
+
 def load_exr_rgb(path):
     im = bpy.data.images.load(path, check_existing=False)
     w, h = im.size
@@ -310,8 +355,14 @@ def cycles_cached(name, case, passes, out_dir, samples, seed=1):
     key = hashlib.sha1((open(__file__).read() + json.dumps(case, sort_keys=True) + repr(passes)
                         + bpy.app.version_string + str(samples) + str(seed)).encode()).hexdigest()[:12]
     prefix = os.path.join(out_dir, "cycles", "%s_%s" % (name, key))
-    files = {p: prefix + "_" + p + "_0001.exr" for p in passes}
     secs = None
+    if not hasattr(bpy.context.scene, "node_tree"):   # Blender 5: one multilayer file
+        f = prefix + "_all.exr"
+        if not os.path.exists(f):
+            os.makedirs(os.path.dirname(prefix), exist_ok=True)
+            secs = render_cycles(case, passes, prefix, samples, seed)
+        return read_passes_exr(f, passes), secs
+    files = {p: prefix + "_" + p + "_0001.exr" for p in passes}
     if not all(os.path.exists(f) for f in files.values()):
         os.makedirs(os.path.dirname(prefix), exist_ok=True)
         secs = render_cycles(case, passes, prefix, samples, seed)
@@ -400,8 +451,8 @@ def library_scene(lib, ctx, ob, lights, co, mats):
         L.radius = getattr(d, "shadow_soft_size", 0.0)
         L.spot_size = getattr(d, "spot_size", 1.0)
         L.spot_blend = getattr(d, "spot_blend", 0.0)
-        if d.type == "SPOT" and bpy.app.version >= (4, 0, 0):
-            L.flags = libvsgl.LIGHT_FLAG_SPOT_V4  # no cos(theta), the cone follows the object's scale
+        if bpy.app.version >= (4, 0, 0):
+            L.flags = libvsgl.LIGHT_FLAG_BLENDER_4  # spots and area lights as Cycles 4.x+
         L.sun_angle = getattr(d, "angle", 0.0)
         if d.type == "AREA":
             L.area_shape = shapes[d.shape]
@@ -482,6 +533,14 @@ def suite_lights(lib, ctx, out_dir, report):
         cyc, secs = cycles_cached("light_" + name, case, ["DiffDir"], out_dir, spp)
         E_cyc = math.pi * cyc["DiffDir"][:, :, 0]  # white light: channels equal
         h, w = E_cyc.shape
+        if ls["type"] == "AREA" and analytic is not None and bpy.app.version >= (4, 0, 0):
+            analytic *= 4.0 / math.pi  # Blender 4.x+: an area light of P watts emits P W (3.x: pi P / 4)
+        bad_px = int(np.count_nonzero(~np.isfinite(E_cyc)))
+        if bad_px:  # Cycles 4.2 writes NaN pixels for a disk light with spread 90 degrees
+            print("SKIP light %s: Cycles %s wrote %d non-finite pixels" % (name, bpy.app.version_string, bad_px))
+            report.append("| %s | - | - | - | - | - | - | skipped: Cycles %s wrote %d non-finite pixels |"
+                          % (name, bpy.app.version_string, bad_px))
+            continue
         dd_centre = float(cyc["DiffDir"][h // 2 - 1:h // 2 + 1, w // 2 - 1:w // 2 + 1, 0].mean())
         xs = (np.arange(w) + 0.5) / w * 4.0 - 2.0
         ys = 2.0 - (np.arange(h) + 0.5) / h * 4.0  # row 0 = top = +y
@@ -913,7 +972,9 @@ def main():
         raise RuntimeError("vsgl_context_create failed")
     report = []
     try:
-        if args["--suite"] == "lights":
+        if args["--suite"] == "units":  # light units alone (Blender 4.x/5.x: the BRDF suites are 3.4's)
+            p, f = suite_lights(lib, ctx, out_dir, report)
+        elif args["--suite"] == "lights":
             p, f = suite_lights(lib, ctx, out_dir, report)
             p2, f2 = suite_brdf(lib, ctx, out_dir, report)
             # oblique view (elevation 30 deg): shadowing of the view direction

@@ -230,7 +230,7 @@ VT_TEST(rsm_irradiance_on_plane_matches_analytic)
     vsgl_context_destroy(ctx);
 }
 
-/* Blender 4.0+ spot (VSGL_LIGHT_FLAG_SPOT_V4, measured in Blender 5.0):
+/* Blender 4.0+ spot (VSGL_LIGHT_FLAG_BLENDER_4, measured in Blender 5.0):
  * intensity P/(4 pi) times the blend alone, the cone in the light frame
  * divided by the object's scale. Relative intensity towards local
  * direction (x, y, z) (the spot points along -z) for scales (sx, sy, sz). */
@@ -255,7 +255,7 @@ VT_TEST(rsm_spot_v4_irradiance_and_power)
         floor_only(&s, 6.0f);
         vsgl_light *L = &s.lights[0];
         set_light(L, VSGL_LIGHT_SPOT, 0, 0, (float)h);
-        L->flags = VSGL_LIGHT_FLAG_SPOT_V4;
+        L->flags = VSGL_LIGHT_FLAG_BLENDER_4;
         for (int c = 0; c < 3; ++c)
             L->world_from_light[4 * c + 1] *= (float)sc3[1];
         vsgl_scene *sc = make(ctx, &s);
@@ -293,7 +293,7 @@ VT_TEST(rsm_spot_v4_irradiance_and_power)
         closed_box(&s);
         L = &s.lights[0];
         set_light(L, VSGL_LIGHT_SPOT, 0.1f, 0.2f, 1.5f);
-        L->flags = VSGL_LIGHT_FLAG_SPOT_V4;
+        L->flags = VSGL_LIGHT_FLAG_BLENDER_4;
         for (int c = 0; c < 3; ++c)
             L->world_from_light[4 * c + 1] *= (float)sc3[1];
         sc = make(ctx, &s);

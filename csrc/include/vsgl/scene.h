@@ -65,12 +65,15 @@ typedef struct vsgl_material {
  * - @p color: linear RGB multiplier of @p power.
  * - @p world_from_light: the object's matrix; scale is allowed (an area's
  *   size is scaled by it).
- * - Spot lights follow Cycles as measured (docs/units.md). By default
- *   (@p flags 0) Blender 3.x: the intensity inside the cone carries an
- *   extra cos(theta) and the cone ignores the object's scale. With
- *   ::VSGL_LIGHT_FLAG_SPOT_V4, Blender 4.0 and later: no cos(theta), and the
- *   cone follows the object's scaled axes (a spot scaled (1, 0.5, 1) has an
- *   elliptical cone, half as wide in tangent along its local Y).
+ * - Lights follow Cycles as measured (docs/units.md). By default
+ *   (@p flags 0) Blender 3.x: a spot's intensity inside the cone carries an
+ *   extra cos(theta) and its cone ignores the object's scale; an area light
+ *   of P watts emits pi P / 4 W (radiance P / (4 A)). With
+ *   ::VSGL_LIGHT_FLAG_BLENDER_4, Blender 4.x and later (measured in 4.2 and
+ *   5.0): a spot has no cos(theta) and its cone follows the object's scaled
+ *   axes (a spot scaled (1, 0.5, 1) has an elliptical cone, half as wide in
+ *   tangent along its local Y); an area light of P watts emits P W
+ *   (radiance P / (pi A)). Point and sun lights are the same in both.
  */
 typedef struct vsgl_light {
     int32_t type;            /**< VSGL_LIGHT_* */
@@ -87,10 +90,10 @@ typedef struct vsgl_light {
     uint32_t flags;          /**< VSGL_LIGHT_FLAG_* bits; 0 = Blender 3.x semantics */
 } vsgl_light;
 
-/** Spot light with Blender 4.0+ semantics (see ::vsgl_light). */
-#define VSGL_LIGHT_FLAG_SPOT_V4 1u
+/** Spot and area lights as Cycles in Blender 4.x and later (see ::vsgl_light). */
+#define VSGL_LIGHT_FLAG_BLENDER_4 1u
 /** Every flag this version knows; other bits are rejected. */
-#define VSGL_LIGHT_FLAGS_KNOWN VSGL_LIGHT_FLAG_SPOT_V4
+#define VSGL_LIGHT_FLAGS_KNOWN VSGL_LIGHT_FLAG_BLENDER_4
 
 /* ------------------------------------------------------------------------ */
 /* Camera                                                                     */

@@ -6,7 +6,7 @@
  * - spot: intensity P/(4 pi) cos(theta) smoothstep((cos(theta) - cos(size/2))
  *   / ((1 - cos(size/2)) blend)); the extra cos(theta) and the cone ignoring
  *   the object's scale are Blender 3.4's behaviour (measured). Blender 4.0+
- *   (VSGL_LIGHT_FLAG_SPOT_V4, measured in 5.0): no cos(theta), and theta is
+ *   (VSGL_LIGHT_FLAG_BLENDER_4, measured in 5.0): no cos(theta), and theta is
  *   taken in the light's frame divided by the object's scale per axis (an
  *   elliptical cone for a non-uniform scale). One perspective face over the
  *   cone when its widest half-angle is <= 60 degrees, else a cube.
@@ -14,8 +14,8 @@
  *   area across the beam; sun angle ignored (parallel rays).
  * - area: one face, concentric (Shirley-Chiu) map of the cosine-weighted
  *   hemisphere below the light: every texel carries the same projected
- *   solid angle pi/res^2, so the flux is (P/4) (pi/res^2) times the spread
- *   mask. Ray origins are stratified over the emitting shape (every
+ *   solid angle pi/res^2, so the flux is L A (pi/res^2) times the spread
+ *   mask, L A = P/4 (Blender 3.x) or P/pi (4.x+). Ray origins are stratified over the emitting shape (every
  *   aligned 2^k x 2^k texel block covers a 2^k x 2^k grid on the light) (a large light is
  *   sampled over its area, not as a point).
  *
@@ -125,7 +125,7 @@ void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res
         out->smooth = (1.0 - out->cos_half) * (double)L->spot_blend;
         out->inv_scale[0] = out->inv_scale[1] = out->inv_scale[2] = 1.0;
         double widest = half; /* the cone's widest half-angle in the light frame */
-        if (L->flags & VSGL_LIGHT_FLAG_SPOT_V4) {
+        if (L->flags & VSGL_LIGHT_FLAG_BLENDER_4) {
             out->spot_v4 = 1;
             double s3[3] = {v3_dot(sx, out->ax), v3_dot(sy, out->ay), v3_length(sz)};
             for (int k = 0; k < 3; ++k)
@@ -174,6 +174,7 @@ void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res
     }
     case VSGL_LIGHT_AREA: {
         out->shape = L->area_shape;
+        out->area_power = (L->flags & VSGL_LIGHT_FLAG_BLENDER_4) ? 1.0 : 0.25 * PI_D;
         int square = L->area_shape == VSGL_AREA_SQUARE || L->area_shape == VSGL_AREA_DISK;
         out->size_x = (double)L->size_x * v3_length(sx);
         out->size_y = (double)(square ? L->size_x : L->size_y) * v3_length(sy);
@@ -307,7 +308,7 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
         } else {
             mk = 1.0;
         }
-        w = 0.25 * PI_D / (res * res) * mk; /* (P/4) x projected solid angle */
+        w = l->area_power / (res * res) * mk; /* radiance x area x projected solid angle pi/res^2 */
         *beam = PI_D / (res * res) / fmax(z, 0.5 / res); /* solid angle = projected / cos */
         /* origin on the shape: the centre of stratum (bitrev(col & 7),
          * bitrev(row & 7)) of an 8x8 grid on the light. Every aligned
@@ -377,16 +378,16 @@ void vsgl__rsm_light_emitted(const vsgl_rsm_light *l, double out[3])
         break;
     case VSGL_LIGHT_AREA: {
         if (l->tan_half_spread <= 0.0) {
-            w = 0.25 * PI_D;
+            w = l->area_power;
         } else {
-            /* (P/4) * 2 * int_0^{pi/2} mask cos sin dtheta */
+            /* (L A / P) * 2 pi * int_0^{pi/2} mask cos sin dtheta, L A / P = area_power / pi */
             enum { N = 200000 };
             double s = 0.0, h = 0.5 * PI_D / N;
             for (int i = 0; i < N; ++i) {
                 double th = (i + 0.5) * h;
                 s += spread_mask(l, cos(th)) * cos(th) * sin(th);
             }
-            w = 0.25 * PI_D * 2.0 * s * h;
+            w = l->area_power * 2.0 * s * h;
         }
         break;
     }

@@ -29,6 +29,7 @@ typedef struct vsgl_rsm_light {
     double size_x, size_y;  /* world-space extents of the emitting shape (scale applied) */
     double tan_half_spread; /* tan(spread/2); 0 = no spread limit (spread = pi) */
     double spread_norm;     /* normalisation of the spread mask (Cycles) */
+    double area_power;      /* emitted power / P: pi/4 (Blender 3.x), 1 (4.x+) */
 } vsgl_rsm_light;
 
 /* Prepare light `index` of the scene for an RSM of `res` texels per side. */

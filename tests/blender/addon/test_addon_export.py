@@ -219,6 +219,9 @@ def test_lights_units_per_type(scene):
     assert (L["A"]["area_shape"], L["A"]["size_x"], L["A"]["size_y"], L["A"]["spread"]) == \
         (1, pytest.approx(0.5), pytest.approx(2.0), pytest.approx(1.0))
     assert (L["Disk"]["area_shape"], L["Disk"]["size_y"]) == (2, pytest.approx(0.7))
+    # the running Blender's light semantics (spots, area power; docs/units.md)
+    want = 1 if VERSION >= (4, 0, 0) else 0
+    assert all(f["flags"] == want for f in sd.lights), [f["flags"] for f in sd.lights]
 
 
 def test_camera_fields(scene):

@@ -68,6 +68,10 @@ def test_light_units_and_exposure():
     assert (e["size_x"], e["size_y"], e["area_shape"], e["spread"]) == (2, 5, 3, 1.0)
     with pytest.raises(convert.ExportError, match="'X'"):
         convert.light_fields("X", "HEMI", m, 1.0, (1, 1, 1))
+    # Blender 4.x+ semantics travel as a flag
+    assert s["flags"] == 0
+    s4 = convert.light_fields("S", "SPOT", m, 10.0, (1, 1, 1), spot_size=1.0, blender_version=(4, 2, 0))
+    assert s4["flags"] == convert.LIGHT_FLAG_BLENDER_4 == 1
 
 
 def test_camera_scale_removed_and_render_size():
