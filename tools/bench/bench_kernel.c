@@ -3,7 +3,8 @@
  * random VSGLs above it, for each diffuse form, diffuse only, glossy only
  * and both; pixel-VSGL pairs per second, the best of 5 runs. The VSGLs
  * are the sharp kind a room's k-means clusters give (|m| >= 32 on most
- * lanes), so the short forms are exercised; docs/performance.md.
+ * lanes), so the short forms are exercised; docs/performance.md. Denormals
+ * are flushed as in the library's shading workers.
  *
  * Usage: bench_kernel [repeats] */
 #include "shade/kernel.h"
@@ -14,6 +15,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#if defined(__x86_64__) || defined(__i386__)
+#  include <xmmintrin.h>
+#endif
 
 static double now(void)
 {
@@ -31,6 +35,9 @@ static float uniform(unsigned long long *s)
 int main(int argc, char **argv)
 {
     int reps = argc > 1 ? atoi(argv[1]) : 3000;
+#if defined(__x86_64__) || defined(__i386__)
+    _mm_setcsr(_mm_getcsr() | 0x8040u); /* FTZ | DAZ, as the library's shading workers */
+#endif
     enum { NL = 256 };
     static vsgl_kernel_light L[NL];
     static vsgl_kernel_block b;
