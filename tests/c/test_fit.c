@@ -60,12 +60,6 @@ static void free_rsm(hand_rsm *h)
     free(h->r.material);
 }
 
-static double schlick_d(double f0, double c)
-{
-    double m = 1.0 - (c < 0 ? 0 : (c > 1 ? 1 : c));
-    return f0 + (1.0 - f0) * m * m * m * m * m;
-}
-
 /* The poster's sums (Sec. 2.1-2.2, errata GUIDE Sec. 3) in double. */
 typedef struct ref_vsgl { double power[3], axis[3], sharpness, mean[3], variance; int present; } ref_vsgl;
 
@@ -92,7 +86,8 @@ static void reference_two(const vsgl_scene *scene, const vsgl_rsm *r, int32_t es
                 if (!bp.glossy || cosi <= 0)
                     continue;
                 for (int c = 0; c < 3; ++c) {
-                    pw[c] = r->flux[c][t] * schlick_d(bp.f0[c], cosi);
+                    /* R_s: the lobe's directional albedo (its table is tested in test_material.c) */
+                    pw[c] = r->flux[c][t] * vsgl__glossy_albedo(vsgl__scene_glossy_albedo(scene, r->material[t]), c, (float)cosi);
                     axis[c] = 2.0 * cosi * n[c] - wi[c];
                 }
                 double a = sqrt((double)bp.alpha_x * bp.alpha_y);

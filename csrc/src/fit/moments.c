@@ -48,13 +48,6 @@ void vsgl__moments_add(vsgl_moments *acc, const vsgl_moments *m, double scale)
     acc->pos2 += scale * m->pos2;
 }
 
-static double schlick(double f0, double cos_theta)
-{
-    double m = 1.0 - (cos_theta < 0.0 ? 0.0 : (cos_theta > 1.0 ? 1.0 : cos_theta));
-    double m2 = m * m;
-    return f0 + (1.0 - f0) * m2 * m2 * m;
-}
-
 /* `footprint`: the texel's area on the surface (m^2). A VPL stands for a
  * patch, not a point: its own second moment about its centre, a/(2 pi) for
  * a disk of area a, is added so that small clusters (down to one texel)
@@ -115,12 +108,17 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
         any = 1;
     }
     /* Specular lobe: Phi R_s G(w; reflect(wi, n), l_h / (4 |wi.n|)) / A(.), with
-     * R_s the Fresnel reflectance at the incident angle. */
+     * R_s the lobe's directional albedo at the incident angle (Fresnel,
+     * shadowing and the lobe's spread; the poster's R_s is the Fresnel term
+     * alone, which overstates rough lobes: 0.8 against 0.44 for a metal of
+     * roughness 0.8 at normal incidence, 0.61 against 0.07 for a rough
+     * dielectric at grazing incidence). */
     if (bp.glossy) {
         float cos_i = v3_dot(wi, n);
+        const vsgl_albedo_table *alb = vsgl__scene_glossy_albedo(scene, mat);
         double ps[3];
         for (int c = 0; c < 3; ++c)
-            ps[c] = flux[c] * schlick(bp.f0[c], cos_i);
+            ps[c] = flux[c] * vsgl__glossy_albedo(alb, c, cos_i);
         if (cos_i > 0.0f && ps[0] + ps[1] + ps[2] > 0.0) {
             float alpha = sqrtf(bp.alpha_x * bp.alpha_y);
             vsgl_sg ndf, warped;

@@ -24,6 +24,9 @@
 
 #include "vsgl/lobes.h"
 
+#include <math.h>
+#include <string.h>
+
 #define VSGL_PI_F 3.14159265358979323846f
 
 static float saturate(float x) { return x != x ? 0.0f : clampf(x, 0.0f, 1.0f); }
@@ -122,4 +125,58 @@ void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3])
     (void)wo;
     float g = p->glossy ? 1.0f : 0.0f;
     out[0] = out[1] = out[2] = g;
+}
+
+void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out)
+{
+    enum { S = 32 };
+    memset(out, 0, sizeof *out);
+    if (!p->glossy)
+        return;
+    const v3 n = v3_make(0.0f, 0.0f, 1.0f), t = v3_make(1.0f, 0.0f, 0.0f);
+    const float ax = p->alpha_x, ay = p->alpha_y;
+    for (int k = 0; k < VSGL_ALBEDO_N; ++k) {
+        double ci = k == 0 ? 0.01 : (double)k / (VSGL_ALBEDO_N - 1);
+        double si = sqrt(fmax(0.0, 1.0 - ci * ci));
+        double acc[3] = {0.0, 0.0, 0.0};
+        for (int a = 0; a < S; ++a)
+            for (int b = 0; b < S; ++b) {
+                /* wi's azimuth (anisotropic lobes only): a golden-ratio sequence
+                 * over the samples, independent of the normal's strata */
+                double gi = (a * S + b) * 0.6180339887498949;
+                double phi_i = p->alpha_x == p->alpha_y ? 0.0 : 2.0 * 3.14159265358979323846 * (gi - floor(gi));
+                v3 wi = v3_make((float)(si * cos(phi_i)), (float)(si * sin(phi_i)), (float)ci);
+                /* GGX normal with pdf D(h) (h.n): a stretched slope */
+                double u = (a + 0.5) / S, v = (b + 0.5) / S;
+                double r = sqrt(u / (1.0 - u)), ph = 2.0 * 3.14159265358979323846 * v;
+                double mx = -r * cos(ph) * ax, my = -r * sin(ph) * ay;
+                double len = sqrt(mx * mx + my * my + 1.0);
+                v3 h = v3_make((float)(mx / len), (float)(my / len), (float)(1.0 / len));
+                double ih = v3_dot(wi, h);
+                if (!(ih > 0.0))
+                    continue;
+                v3 wo = v3_sub(v3_scale(h, (float)(2.0 * ih)), wi);
+                if (!(wo.z > 0.0f))
+                    continue;
+                float dif[3], gl[3];
+                vsgl__brdf_eval(p, n, t, wo, wi, dif, gl); /* f cos(wo) (reciprocal) */
+                double hx = h.x / ax, hy = h.y / ay, q = hx * hx + hy * hy + (double)h.z * h.z;
+                double D = 1.0 / (3.14159265358979323846 * ax * ay * q * q);
+                double pdf = D * h.z / (4.0 * ih); /* of wo */
+                for (int c = 0; c < 3; ++c)
+                    acc[c] += gl[c] / pdf;
+            }
+        for (int c = 0; c < 3; ++c)
+            out->a[k][c] = (float)(acc[c] / (S * S));
+    }
+}
+
+float vsgl__glossy_albedo(const vsgl_albedo_table *t, int channel, float cos_i)
+{
+    float x = clampf(cos_i, 0.0f, 1.0f) * (VSGL_ALBEDO_N - 1);
+    int k = (int)x;
+    if (k >= VSGL_ALBEDO_N - 1)
+        return t->a[VSGL_ALBEDO_N - 1][channel];
+    float f = x - (float)k;
+    return t->a[k][channel] * (1.0f - f) + t->a[k + 1][channel] * f;
 }

@@ -6,6 +6,7 @@
 #include <embree3/rtcore.h>
 
 #include "scene/scene_internal.h"
+#include "scene/material.h"
 #include "core/context.h"
 
 #define VSGL_SCENE_EMBREE_MESSAGE 256
@@ -26,6 +27,7 @@ struct vsgl_scene {
     uint32_t *source_triangle;   /* triangle_count: index in the caller's array */
     uint32_t material_count;
     vsgl_material *materials;
+    vsgl_albedo_table *glossy_albedo; /* material_count: the glossy lobe's directional albedo */
     uint32_t light_count;
     vsgl_light *lights;
     vsgl_camera camera;

@@ -49,6 +49,10 @@ void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, v
 
 /* Validated copies (never NULL when the count is > 0). */
 const vsgl_material *vsgl__scene_materials(const vsgl_scene *scene, uint32_t *count);
+/* The glossy lobe's directional albedo table of a material (scene/material.h),
+ * computed when the scene is created; NULL for an index out of range. */
+struct vsgl_albedo_table;
+const struct vsgl_albedo_table *vsgl__scene_glossy_albedo(const vsgl_scene *scene, uint32_t material);
 const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count);
 const vsgl_camera *vsgl__scene_camera(const vsgl_scene *scene);
 /* Bounding box of the valid triangles; lo = hi = (0,0,0) when there are none. */
