@@ -38,6 +38,18 @@ static vsgl_scene *make(vsgl_context *ctx, fx_scene *s)
     return sc;
 }
 
+/* The scene and the RSM of its light 0 at `res`; NULL (after a failed
+ * check, nothing left allocated) if either fails. */
+static vsgl_scene *make_rsm(vsgl_context *ctx, fx_scene *s, uint32_t res, vsgl_rsm *r)
+{
+    vsgl_scene *sc = make(ctx, s);
+    if (sc && vsgl__rsm_build(ctx, sc, 0, res, r) == VSGL_OK)
+        return sc;
+    VT_CHECK(0, "build: %s", vsgl_context_last_error(ctx));
+    vsgl_scene_destroy(sc);
+    return NULL;
+}
+
 static void set_light(vsgl_light *L, int type, float x, float y, float z)
 {
     float keep_c[3] = {1.0f, 0.5f, 0.25f};
@@ -192,13 +204,10 @@ VT_TEST(rsm_irradiance_on_plane_matches_analytic)
             const float eye[3] = {1, 0, 3}, at[3] = {0, 0, 0};
             fx_look_at(L->world_from_light, eye, at);
         }
-        vsgl_scene *sc = make(ctx, &s);
         vsgl_rsm r;
-        if (!sc || vsgl__rsm_build(ctx, sc, 0, 512, &r) != VSGL_OK) {
-            VT_CHECK(0, "build: %s", vsgl_context_last_error(ctx));
-            vsgl_scene_destroy(sc);
+        vsgl_scene *sc = make_rsm(ctx, &s, 512, &r);
+        if (!sc)
             continue;
-        }
         const double xs[] = {0.0, 0.5, 1.0};
         for (int q = 0; q < 3; ++q) {
             const double w = 0.2;
@@ -258,13 +267,10 @@ VT_TEST(rsm_spot_v4_irradiance_and_power)
         L->flags = VSGL_LIGHT_FLAG_BLENDER_4;
         for (int c = 0; c < 3; ++c)
             L->world_from_light[4 * c + 1] *= (float)sc3[1];
-        vsgl_scene *sc = make(ctx, &s);
         vsgl_rsm r;
-        if (!sc || vsgl__rsm_build(ctx, sc, 0, 512, &r) != VSGL_OK) {
-            VT_CHECK(0, "build: %s", vsgl_context_last_error(ctx));
-            vsgl_scene_destroy(sc);
+        vsgl_scene *sc = make_rsm(ctx, &s, 512, &r);
+        if (!sc)
             continue;
-        }
         const double pts[5][2] = {{0, 0}, {0.5, 0}, {1.0, 0}, {0, 0.3}, {0, 0.55}};
         for (int q = 0; q < 5; ++q) {
             const double w = 0.1;
@@ -296,12 +302,9 @@ VT_TEST(rsm_spot_v4_irradiance_and_power)
         L->flags = VSGL_LIGHT_FLAG_BLENDER_4;
         for (int c = 0; c < 3; ++c)
             L->world_from_light[4 * c + 1] *= (float)sc3[1];
-        sc = make(ctx, &s);
-        if (!sc || vsgl__rsm_build(ctx, sc, 0, 256, &r) != VSGL_OK) {
-            VT_CHECK(0, "build: %s", vsgl_context_last_error(ctx));
-            vsgl_scene_destroy(sc);
+        sc = make_rsm(ctx, &s, 256, &r);
+        if (!sc)
             continue;
-        }
         double e = 0, lim = 1.0; /* the cone (half 0.6 rad, tan 0.68) fits in [-1, 1]^2 */
         int n = 1000;
         for (int a = 0; a < n; ++a)
