@@ -352,6 +352,8 @@ def collect(depsgraph, scene=None, require_lights=True):
             fields, warns = materials.default_material(), []
         else:
             fields, warns = mapped(mat)
+        if compat.VERSION >= (4, 0, 0):  # Cycles 4.x+ GGX shadowing (vsgl/scene.h)
+            fields = dict(fields, flags=int(fields.get("flags", 0)) | materials.MATERIAL_FLAG_BLENDER_4)
         sd.warnings.extend(warns)
         mat_index[key] = len(sd.materials)
         sd.materials.append(fields)

@@ -8,6 +8,7 @@ warnings naming the material. Unit-testable with plain Python.
 import math
 
 MATERIAL_UNSUPPORTED = 1  # VSGL_MATERIAL_UNSUPPORTED
+MATERIAL_FLAG_BLENDER_4 = 2  # VSGL_MATERIAL_FLAG_BLENDER_4: Cycles 4.x+ GGX shadowing
 
 # Node kinds the bpy glue reports.
 PRINCIPLED = "PRINCIPLED"

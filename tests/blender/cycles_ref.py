@@ -129,6 +129,22 @@ GATHER_RES = [int(r) for r in os.environ.get("VSGL_GATHER_RES", "32,64,128").spl
 # ---------------------------------------------------------------------------
 
 
+def _principled_defaults(n):
+    """A Principled BSDF reduced to what the library models: no tint, sheen
+    or coat, F0 0.04 (3.x Specular 0.5; 4.x IOR 1.5 at Specular IOR Level 0.5)."""
+    if "Specular" in n.inputs:                        # 3.x
+        n.inputs["Specular"].default_value = 0.5
+        n.inputs["Specular Tint"].default_value = 0.0
+        n.inputs["Sheen"].default_value = 0.0
+        n.inputs["Clearcoat"].default_value = 0.0
+    else:                                             # 4.x+
+        n.inputs["IOR"].default_value = 1.5
+        n.inputs["Specular IOR Level"].default_value = 0.5
+        n.inputs["Specular Tint"].default_value = (1.0, 1.0, 1.0, 1.0)
+        n.inputs["Sheen Weight"].default_value = 0.0
+        n.inputs["Coat Weight"].default_value = 0.0
+
+
 def blender_material(name, spec):
     m = bpy.data.materials.new(name)
     m.use_nodes = True
@@ -156,10 +172,7 @@ def blender_material(name, spec):
         p.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
         p.inputs["Metallic"].default_value = 0.0
         p.inputs["Roughness"].default_value = spec["roughness"]
-        p.inputs["Specular"].default_value = 0.5
-        p.inputs["Specular Tint"].default_value = 0.0
-        p.inputs["Sheen"].default_value = 0.0
-        p.inputs["Clearcoat"].default_value = 0.0
+        _principled_defaults(p)
         n = nt.nodes.new("ShaderNodeAddShader")
         nt.links.new(d.outputs[0], n.inputs[0])
         nt.links.new(p.outputs[0], n.inputs[1])
@@ -169,12 +182,10 @@ def blender_material(name, spec):
         n.inputs["Base Color"].default_value = col
         n.inputs["Metallic"].default_value = 1.0 if spec["kind"] == "metal" else spec.get("metallic", 0.0)
         n.inputs["Roughness"].default_value = spec["roughness"]
-        n.inputs["Specular"].default_value = 0.5
-        n.inputs["Specular Tint"].default_value = 0.0
-        n.inputs["Sheen"].default_value = 0.0
-        n.inputs["Clearcoat"].default_value = 0.0
-        n.inputs["Anisotropic"].default_value = spec.get("anisotropy", 0.0)
-        n.inputs["Anisotropic Rotation"].default_value = 0.0
+        _principled_defaults(n)
+        aniso = "Anisotropic" if "Anisotropic" in n.inputs else "Anisotropy"   # renamed in 4.0
+        n.inputs[aniso].default_value = spec.get("anisotropy", 0.0)
+        n.inputs[aniso + " Rotation"].default_value = 0.0
     nt.links.new(n.outputs[0], out.inputs["Surface"])
     return m
 
@@ -439,6 +450,8 @@ def library_scene(lib, ctx, ob, lights, co, mats):
             m.metallic = 1.0 if s["kind"] == "metal" else s.get("metallic", 0.0)
             m.roughness, m.specular_f0 = s["roughness"], 0.08 * 0.5
             m.anisotropy = s.get("anisotropy", 0.0)
+        if bpy.app.version >= (4, 0, 0):
+            m.flags = libvsgl.MATERIAL_FLAG_BLENDER_4  # height-correlated Smith, as Cycles 4.x+
     clights = (libvsgl.vsgl_light * len(lights))()
     types = {"POINT": 0, "SPOT": 1, "SUN": 2, "AREA": 3}
     shapes = {"SQUARE": 0, "RECTANGLE": 1, "DISK": 2, "ELLIPSE": 3}
@@ -838,7 +851,8 @@ TOL_BRDF_MAX = 0.04     # worst pixel (on the flanks of sharp highlights)
 # safe_sqrtf turns into 0, so G1 = 2. A view exactly along the normal does
 # not occur in practice; the straight-down anisotropic row compares with
 # Cycles / 2 (still checking the alpha_x/alpha_y mapping and the frame).
-CYCLES34_ANISO_FACTOR = 2.0
+# Blender 4.2 and 5.0 do not have the quirk (measured: the row is then 0.5x).
+CYCLES34_ANISO_FACTOR = 2.0 if bpy.app.version < (4, 0, 0) else 1.0
 
 
 def suite_brdf(lib, ctx, out_dir, report, camera=None, tag=""):
@@ -911,6 +925,8 @@ def suite_brdf(lib, ctx, out_dir, report, camera=None, tag=""):
         else:
             m.metallic, m.roughness, m.specular_f0 = 1.0, sp["roughness"], 0.04
             m.anisotropy = sp.get("anisotropy", 0.0)
+        if bpy.app.version >= (4, 0, 0):
+            m.flags = libvsgl.MATERIAL_FLAG_BLENDER_4
         dsum = np.zeros((n, 3), np.float32)
         gsum = np.zeros((n, 3), np.float32)
         for lpos, lpower in lights:
@@ -972,7 +988,7 @@ def main():
         raise RuntimeError("vsgl_context_create failed")
     report = []
     try:
-        if args["--suite"] == "units":  # light units alone (Blender 4.x/5.x: the BRDF suites are 3.4's)
+        if args["--suite"] == "units":  # light units alone
             p, f = suite_lights(lib, ctx, out_dir, report)
         elif args["--suite"] == "lights":
             p, f = suite_lights(lib, ctx, out_dir, report)

@@ -25,6 +25,11 @@ extern "C" {
 
 /** Material flags. */
 #define VSGL_MATERIAL_UNSUPPORTED 1u /**< caller could not map the material; shaded as given, reported */
+/** GGX shadowing as Cycles in Blender 4.x and later: height-correlated Smith
+ *  1 / (1 + L(i) + L(o)); without it Blender 3.x's separable G1(i) G1(o). */
+#define VSGL_MATERIAL_FLAG_BLENDER_4 2u
+/** Every material flag this version knows; other bits are rejected. */
+#define VSGL_MATERIAL_FLAGS_KNOWN (VSGL_MATERIAL_UNSUPPORTED | VSGL_MATERIAL_FLAG_BLENDER_4)
 
 /**
  * The Principled BSDF subset the method models. Zero-initialised is black.

@@ -9,10 +9,11 @@
  *   FH = (F_dielectric(h.i, eta) - F0) / (1 - F0), eta = (1 + sqrt(F0)) /
  *   (1 - sqrt(F0)) from the dielectric F0, cspec0 = lerp(F0, base_color,
  *   metallic). Specular tint is not modelled (taken as 0).
- * - Shadowing: separable Smith G1(i) G1(o) for GGX (Cycles 3.x). Cycles 4.x
- *   uses the height-correlated form 1/(1 + L(i) + L(o)); the two agree at
- *   normal view and differ in directional albedo by < 0.1 % at alpha 0.09,
- *   1 % at alpha 0.25, 16 % at alpha 1 (view cosine 0.3).
+ * - Shadowing: separable Smith G1(i) G1(o) for GGX (Cycles 3.x), or with
+ *   VSGL_MATERIAL_FLAG_BLENDER_4 the height-correlated form 1/(1 + L(i) +
+ *   L(o)) of Cycles 4.x; the two agree at normal view and differ in
+ *   directional albedo by < 0.1 % at alpha 0.09, 1 % at alpha 0.25, 16 % at
+ *   alpha 1 (view cosine 0.3).
  * - Diffuse: Lambert, base_color (1 - metallic), not attenuated by the
  *   specular layer (3.x). Blender 3.x's Principled diffuse is Burley's
  *   (retro-reflection, grazing darkening), 4.x's is Lambert attenuated by
@@ -49,6 +50,7 @@ void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out)
     /* Cycles 3.x allocates the specular closure when Specular or Metallic
      * is above its cutoff (1e-5). */
     out->glossy = (f0 > 0.08f * 1e-5f || metallic > 1e-5f) ? 1 : 0;
+    out->height_correlated = (m->flags & VSGL_MATERIAL_FLAG_BLENDER_4) ? 1 : 0;
     float s0 = sqrtf(fminf(f0, 0.99f));
     out->eta = (1.0f + s0) / (1.0f - s0);
 }
@@ -67,11 +69,12 @@ static float fresnel_dielectric(float cosi, float eta)
     return 0.5f * A * A * (1.0f + B * B);
 }
 
-/* GGX Smith G1 for direction (x, y, z) in the tangent frame, z > 0. */
-static float ggx_g1(float ax, float ay, float x, float y, float z)
+/* GGX Smith Lambda for direction (x, y, z) in the tangent frame, z > 0;
+ * G1 = 1 / (1 + Lambda). */
+static float ggx_lambda(float ax, float ay, float x, float y, float z)
 {
     float a2t2 = (ax * ax * x * x + ay * ay * y * y) / (z * z);
-    return 2.0f / (1.0f + sqrtf(1.0f + a2t2));
+    return 0.5f * (sqrtf(1.0f + a2t2) - 1.0f);
 }
 
 void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
@@ -103,8 +106,9 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
     float sx = hx / ax, sy = hy / ay;
     float q = sx * sx + sy * sy + hz * hz;
     float D = 1.0f / (VSGL_PI_F * ax * ay * q * q);
-    float G = ggx_g1(ax, ay, v3_dot(wi, tx), v3_dot(wi, ty), ci) *
-              ggx_g1(ax, ay, v3_dot(wo, tx), v3_dot(wo, ty), co);
+    float li = ggx_lambda(ax, ay, v3_dot(wi, tx), v3_dot(wi, ty), ci);
+    float lo = ggx_lambda(ax, ay, v3_dot(wo, tx), v3_dot(wo, ty), co);
+    float G = p->height_correlated ? 1.0f / (1.0f + li + lo) : 1.0f / ((1.0f + li) * (1.0f + lo));
     /* f cos(i) = F D G / (4 cos(o)) */
     float common = D * G / (4.0f * co);
     if (!(common < INFINITY))

@@ -14,6 +14,7 @@ typedef struct vsgl_brdf_params {
     int glossy;         /* 0 if the specular lobe contributes nothing */
     float eta;          /* IOR shaping the Fresnel curve between f0 and 1 (Cycles 3.x: from the
                          * dielectric F0, also for metals); 1 = constant f0 */
+    int height_correlated; /* Smith shadowing 1/(1 + L(i) + L(o)) (Blender 4.x+), else G1(i) G1(o) */
 } vsgl_brdf_params;
 
 void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out);
@@ -21,7 +22,8 @@ void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out);
 /* Exact reflectance times cosine, split into diffuse and glossy RGB parts:
  * f(wi, wo) * max(wi.n, 0), with tangent t for anisotropy. wi, wo unit,
  * pointing away from the surface; both parts are 0 unless wi.n > 0 and
- * wo.n > 0. Glossy is GGX with separable Smith G1(i) G1(o) and Blender 3.x's
+ * wo.n > 0. Glossy is GGX with separable Smith G1(i) G1(o) (height-correlated
+ * with VSGL_MATERIAL_FLAG_BLENDER_4) and Blender 3.x's
  * Principled Fresnel (cspec0 blended to white by the normalised dielectric
  * Fresnel); choices and differences to Cycles in docs/units.md. */
 void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,

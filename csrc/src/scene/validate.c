@@ -117,7 +117,7 @@ vsgl_result vsgl__validate_material(vsgl_context *ctx, uint32_t index, const vsg
     CHECK_RANGE(ctx, who, "specular_f0", m->specular_f0, 0.0f, 1.0f);
     CHECK_RANGE(ctx, who, "anisotropy", m->anisotropy, 0.0f, 1.0f);
     CHECK_RANGE(ctx, who, "anisotropic_rotation", m->anisotropic_rotation, 0.0f, 1.0f);
-    if (m->flags & ~(uint32_t)VSGL_MATERIAL_UNSUPPORTED)
+    if (m->flags & ~(uint32_t)VSGL_MATERIAL_FLAGS_KNOWN)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: flags 0x%x has unknown bits", who, (unsigned)m->flags);
     if (m->reserved != 0)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: reserved is %u (must be 0)", who, (unsigned)m->reserved);

@@ -188,6 +188,9 @@ def test_materials_from_nodes_both_versions(scene):
     assert any("'Emit'" in w for w in sd.warnings)
     assert by["Diff"]["base_color"] == pytest.approx((0.7, 0.6, 0.5))
     assert by["Diff"]["specular_f0"] == 0
+    # the running Blender's GGX shadowing (height-correlated from 4.0 on)
+    want = materials.MATERIAL_FLAG_BLENDER_4 if VERSION >= (4, 0, 0) else 0
+    assert all(m["flags"] & materials.MATERIAL_FLAG_BLENDER_4 == want for m in sd.materials)
     # Per-triangle material: polygon i -> material i % 3 (two triangles each).
     names = [sd.material_names[i] for i in sd.material_indices]
     assert names.count("P") == names.count("Emit") == names.count("Diff") == 4
