@@ -284,3 +284,56 @@ VT_TEST(material_glossy_albedo_table_matches_quadrature)
     vsgl__glossy_albedo_table(&p, &t);
     VT_CHECK(vsgl__glossy_albedo(&t, 0, 1.0f) < 0.5f, "rough metal albedo %g (F = 0.8)", vsgl__glossy_albedo(&t, 0, 1.0f));
 }
+
+/* Blender 4.x+ diffuse base weight: 1 - the albedo of the dielectric
+ * specular layer alone (F0 = specular_f0, white) divided by the same lobe's
+ * albedo with F = 1 (single scattering's shadowing loss compensated, as
+ * Cycles' albedo scaling; matched against Cycles 5.0.1's DiffCol in
+ * tests/blender/cycles_ref.py), against the quadrature of the exact BRDF;
+ * 3.x materials and metals keep weight 1. */
+VT_TEST(material_blender4_diffuse_weight_is_one_minus_dielectric_albedo)
+{
+    int n = getenv("VSGL_TEST_QUICK") ? 200 : 400;
+    const float roughs[] = {0.3f, 0.6f};
+    for (unsigned a = 0; a < 2; ++a) {
+        vsgl_material m;
+        memset(&m, 0, sizeof m);
+        m.base_color[0] = 0.8f; m.base_color[1] = 0.4f; m.base_color[2] = 0.2f;
+        m.roughness = roughs[a];
+        m.specular_f0 = 0.04f;
+        m.metallic = 0.25f;
+        m.flags = VSGL_MATERIAL_FLAG_BLENDER_4;
+        vsgl_albedo_table t;
+        vsgl_brdf_params p;
+        vsgl__material_params(&m, &p);
+        vsgl__glossy_albedo_table(&p, &t);
+        vsgl__dielectric_albedo_table(&m, &t);
+        /* the layer alone, by quadrature */
+        vsgl_material d = m;
+        d.metallic = 0.0f;
+        d.base_color[0] = d.base_color[1] = d.base_color[2] = 0.0f;
+        vsgl_brdf_params pd, pw;
+        vsgl__material_params(&d, &pd);
+        vsgl_material wm = d;
+        wm.metallic = 1.0f;
+        wm.base_color[0] = wm.base_color[1] = wm.base_color[2] = 1.0f;
+        vsgl__material_params(&wm, &pw);
+        const float cs[] = {1.0f, 0.75f, 0.5f, 0.25f};
+        for (int q = 0; q < 4; ++q) {
+            double ad[3], ag[3], aw[3];
+            v3 wo = v3_make(sqrtf(1 - cs[q] * cs[q]), 0, cs[q]);
+            albedo(&pd, wo, n, ad, ag);
+            albedo(&pw, wo, n, ad, aw);
+            double want = 1.0 - ag[0] / aw[0], got = vsgl__diffuse_view_weight(&t, cs[q]);
+            VT_CHECK(fabs(got - want) < 3e-3, "rough %g cos %g: weight %.4f, 1 - quadrature %.4f", roughs[a], cs[q], got, want);
+        }
+        /* without the flag (Blender 3.x), and for a metal: nothing taken off */
+        m.flags = 0;
+        vsgl__dielectric_albedo_table(&m, &t);
+        VT_CHECK(vsgl__diffuse_view_weight(&t, 0.5f) == 1.0f, "3.x material: weight %g", vsgl__diffuse_view_weight(&t, 0.5f));
+        m.flags = VSGL_MATERIAL_FLAG_BLENDER_4;
+        m.metallic = 1.0f;
+        vsgl__dielectric_albedo_table(&m, &t);
+        VT_CHECK(vsgl__diffuse_view_weight(&t, 0.5f) == 1.0f, "metal: weight %g", vsgl__diffuse_view_weight(&t, 0.5f));
+    }
+}

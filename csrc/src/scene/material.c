@@ -175,6 +175,43 @@ void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out
     }
 }
 
+void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t)
+{
+    memset(t->diel, 0, sizeof t->diel);
+    if (!(m->flags & VSGL_MATERIAL_FLAG_BLENDER_4) || !(saturate(m->metallic) < 1.0f))
+        return;
+    vsgl_material d = *m;
+    d.metallic = 0.0f;
+    d.base_color[0] = d.base_color[1] = d.base_color[2] = 0.0f;
+    vsgl_brdf_params bp;
+    vsgl__material_params(&d, &bp);
+    if (!bp.glossy)
+        return;
+    vsgl_albedo_table tmp, white;
+    vsgl__glossy_albedo_table(&bp, &tmp);
+    /* the same lobe with F = 1: what single scattering loses to shadowing */
+    vsgl_material w = d;
+    w.metallic = 1.0f;
+    w.base_color[0] = w.base_color[1] = w.base_color[2] = 1.0f;
+    vsgl_brdf_params bw;
+    vsgl__material_params(&w, &bw);
+    vsgl__glossy_albedo_table(&bw, &white);
+    for (int k = 0; k < VSGL_ALBEDO_N; ++k)
+        t->diel[k] = clampf(tmp.a[k][0] / fmaxf(white.a[k][0], 1e-6f), 0.0f, 1.0f);
+}
+
+float vsgl__diffuse_view_weight(const vsgl_albedo_table *t, float cos_o)
+{
+    if (!t)
+        return 1.0f;
+    float x = clampf(cos_o, 0.0f, 1.0f) * (VSGL_ALBEDO_N - 1);
+    int k = (int)x;
+    if (k >= VSGL_ALBEDO_N - 1)
+        return 1.0f - t->diel[VSGL_ALBEDO_N - 1];
+    float f = x - (float)k;
+    return 1.0f - (t->diel[k] * (1.0f - f) + t->diel[k + 1] * f);
+}
+
 float vsgl__glossy_albedo(const vsgl_albedo_table *t, int channel, float cos_i)
 {
     float x = clampf(cos_i, 0.0f, 1.0f) * (VSGL_ALBEDO_N - 1);

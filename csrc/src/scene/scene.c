@@ -209,6 +209,7 @@ static int32_t albedo_range(void *user, size_t chunk, size_t begin, size_t end)
         vsgl_brdf_params bp;
         vsgl__material_params(&s->materials[k], &bp);
         vsgl__glossy_albedo_table(&bp, &s->glossy_albedo[k]);
+        vsgl__dielectric_albedo_table(&s->materials[k], &s->glossy_albedo[k]);
     }
     return 0;
 }

@@ -82,9 +82,12 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                     sg[c] += (double)e[c] * rg[c] * inv;
                 }
             }
+            /* Blender 4.x+: the colour of the diffuse base seen from v (the light stays) */
+            float wd = vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(j->scene, m), v3_dot(n, v));
             for (int c = 0; c < 3; ++c) {
                 dl[c] = dcol[c] > 0.0f ? (float)(sd[c] / dcol[c]) : 0.0f;
                 gl[c] = gcol[c] > 0.0f ? (float)(sg[c] / gcol[c]) : 0.0f;
+                dcol[c] *= wd;
             }
         }
         put3(j->dl, s, dl);

@@ -155,8 +155,10 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
             float gcol[3] = {0, 0, 0};
             if (r.glossy)
                 vsgl__glossy_color(&r.bp, r.n, r.o, gcol);
+            /* Blender 4.x+: the dielectric layer dims the diffuse base seen from o */
+            float wd = vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(j->scene, g->material[i]), v3_dot(r.n, r.o));
             for (int c = 0; c < 3; ++c) {
-                col_d[c] += r.bp.diffuse[c];
+                col_d[c] += r.bp.diffuse[c] * wd;
                 col_g[c] += gcol[c];
             }
             int has_diffuse = r.bp.diffuse[0] + r.bp.diffuse[1] + r.bp.diffuse[2] > 0.0f;
@@ -190,7 +192,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 }
             }
             for (int c = 0; c < 3; ++c) {
-                acc_d[c] += r.bp.diffuse[c] * ld[c];
+                acc_d[c] += r.bp.diffuse[c] * wd * ld[c];
                 acc_g[c] += ls[c];
             }
         }
@@ -402,10 +404,11 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             if (bp.glossy && v3_dot(n, o) > 0.0f)
                 vsgl__glossy_color(&bp, n, o, gcol);
             const float *L = light + (size_t)slot[i] * 6;
+            float wd = vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(j->scene, g->material[si]), v3_dot(n, o));
             for (int c = 0; c < 3; ++c) {
-                acc[c] += bp.diffuse[c] * L[c];
+                acc[c] += bp.diffuse[c] * wd * L[c];
                 acc[3 + c] += L[3 + c];
-                acc[6 + c] += bp.diffuse[c];
+                acc[6 + c] += bp.diffuse[c] * wd;
                 acc[9 + c] += gcol[c];
             }
             covered += 1.0f;
