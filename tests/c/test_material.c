@@ -327,10 +327,24 @@ VT_TEST(material_blender4_diffuse_weight_is_one_minus_dielectric_albedo)
             double want = 1.0 - ag[0] / aw[0], got = vsgl__diffuse_view_weight(&t, cs[q]);
             VT_CHECK(fabs(got - want) < 3e-3, "rough %g cos %g: weight %.4f, 1 - quadrature %.4f", roughs[a], cs[q], got, want);
         }
+        /* the diffuse base's emitted power: 2 int (1 - E/E1) mu dmu, trapezoid over 33 quadrature points */
+        double pw_sum = 0.0;
+        for (int q = 0; q <= 32; ++q) {
+            float mu = q == 0 ? 1e-3f : q / 32.0f;
+            double ad[3], ag[3], aw[3];
+            v3 wo = v3_make(sqrtf(1 - mu * mu), 0, mu);
+            albedo(&pd, wo, n / 2, ad, ag);
+            albedo(&pw, wo, n / 2, ad, aw);
+            pw_sum += (q == 0 || q == 32 ? 0.5 : 1.0) * (1.0 - ag[0] / aw[0]) * mu;
+        }
+        VT_CHECK(fabs(t.diffuse_power - 2.0 * pw_sum / 32.0) < 3e-3, "rough %g: diffuse power %.4f, quadrature %.4f",
+                 roughs[a], t.diffuse_power, 2.0 * pw_sum / 32.0);
+        VT_CHECK(t.diffuse_power < 0.97f && t.diffuse_power > 0.85f, "rough %g: diffuse power %g", roughs[a], t.diffuse_power);
         /* without the flag (Blender 3.x), and for a metal: nothing taken off */
         m.flags = 0;
         vsgl__dielectric_albedo_table(&m, &t);
-        VT_CHECK(vsgl__diffuse_view_weight(&t, 0.5f) == 1.0f, "3.x material: weight %g", vsgl__diffuse_view_weight(&t, 0.5f));
+        VT_CHECK(vsgl__diffuse_view_weight(&t, 0.5f) == 1.0f && t.diffuse_power == 1.0f, "3.x material: weight %g",
+                 vsgl__diffuse_view_weight(&t, 0.5f));
         m.flags = VSGL_MATERIAL_FLAG_BLENDER_4;
         m.metallic = 1.0f;
         vsgl__dielectric_albedo_table(&m, &t);

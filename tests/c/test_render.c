@@ -330,6 +330,7 @@ VT_TEST(render_blender4_diffuse_colour_dimmed_by_specular_layer)
 {
     static planes p3, p4;
     static double first[W * H];
+    double light_ratio[3] = {0, 0, 0};
     char err[256] = "";
     const int methods[3] = {0, 1, 2}; /* kernel, reference shading path, brute force */
     for (int mi = 0; mi < 3; ++mi) {
@@ -343,7 +344,7 @@ VT_TEST(render_blender4_diffuse_colour_dimmed_by_specular_layer)
         VT_CHECK(render_room_flags(1, &s, &p3, NULL, err, sizeof err, 0) == VSGL_OK, "%s", err);
         VT_CHECK(render_room_flags(1, &s, &p4, NULL, err, sizeof err, VSGL_MATERIAL_FLAG_BLENDER_4) == VSGL_OK, "%s", err);
         int floor_px = 0, wall_px = 0;
-        double lo = 1.0, hi = 0.0;
+        double lo = 1.0, hi = 0.0, l3 = 0.0, l4 = 0.0;
         for (int i = 0; i < W * H; ++i) {
             double a = p3.dc[3 * i], b = p4.dc[3 * i];
             if (!(a > 0.0) || p3.alpha[i] < 1.0f)
@@ -359,9 +360,21 @@ VT_TEST(render_blender4_diffuse_colour_dimmed_by_specular_layer)
             } else {
                 ++wall_px;
                 VT_CHECK(ratio == 1.0, "method %d pixel %d: a wall's colour changed (%g)", mi, i, ratio);
+                l3 += p3.dl[3 * i];
+                l4 += p4.dl[3 * i];
             }
         }
         VT_CHECK(floor_px > 50 && wall_px > 50, "method %d: %d floor and %d wall pixels", mi, floor_px, wall_px);
         VT_CHECK(lo > 0.70 && hi < 0.95 && hi - lo > 0.03, "method %d: floor DiffCol ratio in [%g, %g]", mi, lo, hi);
+        light_ratio[mi] = l4 / l3;
     }
+    /* the floor's VPLs reflect less diffuse light onto the walls: the VSGL
+     * fit (power times the dimming's mean) and the brute force (dimmed per
+     * direction) agree on how much */
+    VT_CHECK(light_ratio[2] < 0.99 && light_ratio[2] > 0.8, "brute force: wall light ratio %g", light_ratio[2]);
+    if (getenv("VSGL_TEST_VERBOSE"))
+        printf("    wall light ratio (4.x / 3.x materials): VSGL %.4f, SG-glossy path %.4f, brute force %.4f\n", light_ratio[0],
+               light_ratio[1], light_ratio[2]);
+    VT_CHECK(fabs(light_ratio[0] - light_ratio[2]) < 0.01, "wall light ratio: VSGL %g, brute force %g",
+             light_ratio[0], light_ratio[2]);
 }

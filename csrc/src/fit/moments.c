@@ -99,9 +99,13 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
     int any = 0;
 
     /* Diffuse lobe: Phi R_d G(w; n, l_d) / A(l_d). */
+    /* (Blender 4.x+ materials: the dielectric layer dims the diffuse
+     * reflection in each direction; the lobe keeps its shape, its power
+     * takes the cosine-weighted mean of the dimming) */
+    const vsgl_albedo_table *alb = vsgl__scene_glossy_albedo(scene, mat);
     double pd[3];
     for (int c = 0; c < 3; ++c)
-        pd[c] = flux[c] * bp.diffuse[c];
+        pd[c] = flux[c] * bp.diffuse[c] * alb->diffuse_power;
     if (pd[0] + pd[1] + pd[2] > 0.0) {
         float ld = vsgl_sg_cosine_sharpness();
         fill(&out[VSGL_LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel, n, foot);
@@ -115,7 +119,6 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
      * dielectric at grazing incidence). */
     if (bp.glossy) {
         float cos_i = v3_dot(wi, n);
-        const vsgl_albedo_table *alb = vsgl__scene_glossy_albedo(scene, mat);
         double ps[3];
         for (int c = 0; c < 3; ++c)
             ps[c] = flux[c] * vsgl__glossy_albedo(alb, c, cos_i);

@@ -178,6 +178,7 @@ void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out
 void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t)
 {
     memset(t->diel, 0, sizeof t->diel);
+    t->diffuse_power = 1.0f;
     if (!(m->flags & VSGL_MATERIAL_FLAG_BLENDER_4) || !(saturate(m->metallic) < 1.0f))
         return;
     vsgl_material d = *m;
@@ -198,6 +199,13 @@ void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t)
     vsgl__glossy_albedo_table(&bw, &white);
     for (int k = 0; k < VSGL_ALBEDO_N; ++k)
         t->diel[k] = clampf(tmp.a[k][0] / fmaxf(white.a[k][0], 1e-6f), 0.0f, 1.0f);
+    /* 2 int (1 - diel) mu dmu over the piecewise-linear table, 64 midpoints */
+    double acc = 0.0;
+    for (int i = 0; i < 64; ++i) {
+        float mu = (i + 0.5f) / 64.0f;
+        acc += vsgl__diffuse_view_weight(t, mu) * mu;
+    }
+    t->diffuse_power = (float)(2.0 * acc / 64.0);
 }
 
 float vsgl__diffuse_view_weight(const vsgl_albedo_table *t, float cos_o)

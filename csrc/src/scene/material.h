@@ -45,6 +45,9 @@ typedef struct vsgl_albedo_table {
      * scaling), which Cycles takes off the diffuse base seen from a
      * direction; 0 otherwise */
     float diel[VSGL_ALBEDO_N];
+    /* the diffuse base's emitted power with that weight, relative to
+     * Lambert's: 2 int_0^1 (1 - diel(mu)) mu dmu (1 without the flag) */
+    float diffuse_power;
 } vsgl_albedo_table;
 void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out);
 /* Linear interpolation of the table at cos_i in [0, 1]. */

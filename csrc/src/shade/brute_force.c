@@ -65,9 +65,11 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                     continue;
                 float vd[3], vg[3], rd[3], rg[3];
                 vsgl__brdf_eval(&j->params[q->material], q->n, q->t, v3_neg(w), q->wi, vd, vg);
+                /* Blender 4.x+: the VPL's diffuse base dimmed towards x */
+                float wq = vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(j->scene, q->material), -v3_dot(q->n, w));
                 float e[3];
                 for (int c = 0; c < 3; ++c)
-                    e[c] = q->flux[c] * (vd[c] + vg[c]);
+                    e[c] = q->flux[c] * (vd[c] * wq + vg[c]);
                 if (!(e[0] + e[1] + e[2] > 0.0f))
                     continue;
                 vsgl__brdf_eval(P, n, t, w, v, rd, rg);
