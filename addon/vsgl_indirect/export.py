@@ -283,7 +283,8 @@ def describe_material(mat, compat):
         if s.is_linked:
             linked.add(s.name)
     return materials.ShaderDesc(name, kind, inputs, linked, node=node.name, viewport=vp,
-                                version=ver)
+                                version=ver,
+                                multiscatter=getattr(node, "distribution", "") == "MULTI_GGX")
 
 
 def _holdout_objects(view_layer):

@@ -202,7 +202,8 @@ class ExrCompression(enum.IntEnum):
 
 MATERIAL_UNSUPPORTED = 1
 MATERIAL_FLAG_BLENDER_4 = 2   # vsgl_material.flags: Cycles 4.x+ GGX shadowing
-MATERIAL_FLAGS_KNOWN = 3
+MATERIAL_FLAG_MULTISCATTER = 4  # vsgl_material.flags: Cycles 4.x+ "Multiscatter GGX"
+MATERIAL_FLAGS_KNOWN = 7
 LIGHT_FLAG_BLENDER_4 = 1   # vsgl_light.flags: Blender 4.0+ spot semantics
 LIGHT_FLAGS_KNOWN = 1
 SHARPNESS_MAX = 2199023255552.0  # 2^41

@@ -9,6 +9,7 @@ import math
 
 MATERIAL_UNSUPPORTED = 1  # VSGL_MATERIAL_UNSUPPORTED
 MATERIAL_FLAG_BLENDER_4 = 2  # VSGL_MATERIAL_FLAG_BLENDER_4: Cycles 4.x+ GGX shadowing
+MATERIAL_FLAG_MULTISCATTER = 4  # VSGL_MATERIAL_FLAG_MULTISCATTER: "Multiscatter GGX"
 
 # Node kinds the bpy glue reports.
 PRINCIPLED = "PRINCIPLED"
@@ -30,7 +31,8 @@ class ShaderDesc:
     """
 
     def __init__(self, name, kind, inputs=None, linked=(), node="",
-                 viewport=((0.8, 0.8, 0.8, 1.0), 0.0, 0.5), version=(4, 0, 0), reason=""):
+                 viewport=((0.8, 0.8, 0.8, 1.0), 0.0, 0.5), version=(4, 0, 0), reason="",
+                 multiscatter=False):
         self.name = name
         self.kind = kind
         self.inputs = dict(inputs or {})
@@ -39,6 +41,7 @@ class ShaderDesc:
         self.viewport = viewport
         self.version = tuple(version)
         self.reason = reason
+        self.multiscatter = bool(multiscatter)  # the node's distribution is "Multiscatter GGX"
 
 
 def default_material():
@@ -134,4 +137,8 @@ def map_material(desc):
         why = (": " + desc.reason) if desc.reason else ""
         warnings.append("%s: unsupported shader%s; using its viewport display colour, "
                         "metallic and roughness" % (who, why))
+    # Cycles 4.x+'s "Multiscatter GGX" (measured in 5.0.1; 3.x's random-walk
+    # version was not measured and stays single-scatter)
+    if desc.multiscatter and desc.kind in (PRINCIPLED, GLOSSY, ANISOTROPIC) and desc.version >= (4, 0, 0):
+        m["flags"] = int(m.get("flags", 0)) | MATERIAL_FLAG_MULTISCATTER
     return m, warnings

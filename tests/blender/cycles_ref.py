@@ -148,7 +148,7 @@ def _principled_defaults(n):
         n.inputs["Coat Weight"].default_value = 0.0
 
 
-def blender_material(name, spec):
+def blender_material(name, spec, dist="GGX"):
     m = bpy.data.materials.new(name)
     m.use_nodes = True
     nt = m.node_tree
@@ -171,7 +171,7 @@ def blender_material(name, spec):
         d.inputs["Color"].default_value = col
         d.inputs["Roughness"].default_value = 0.0
         p = nt.nodes.new("ShaderNodeBsdfPrincipled")  # black base: its specular layer only
-        p.distribution = "GGX"
+        p.distribution = dist
         p.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
         p.inputs["Metallic"].default_value = 0.0
         p.inputs["Roughness"].default_value = spec["roughness"]
@@ -181,7 +181,7 @@ def blender_material(name, spec):
         nt.links.new(p.outputs[0], n.inputs[1])
     else:
         n = nt.nodes.new("ShaderNodeBsdfPrincipled")
-        n.distribution = "GGX"  # single-scatter: what the library models
+        n.distribution = dist  # single-scatter "GGX" unless the case asks for "MULTI_GGX"
         n.inputs["Base Color"].default_value = col
         n.inputs["Metallic"].default_value = 1.0 if spec["kind"] == "metal" else spec.get("metallic", 0.0)
         n.inputs["Roughness"].default_value = spec["roughness"]
@@ -209,7 +209,7 @@ def build_blender(case):
     me = bpy.data.meshes.new("geo")
     me.from_pydata(verts, [], faces)
     for name in mats:
-        me.materials.append(blender_material(name, MATS[name]))
+        me.materials.append(blender_material(name, MATS[name], case.get("dist", "GGX")))
     for p, mi in zip(me.polygons, fmat):
         p.material_index = mi
         p.use_smooth = False
@@ -901,7 +901,7 @@ def suite_diffcol(lib, ctx, out_dir, report):
     return passed, failed
 
 
-def suite_brdf(lib, ctx, out_dir, report, camera=None, tag=""):
+def suite_brdf(lib, ctx, out_dir, report, camera=None, tag="", multiscatter=False):
     """Cycles' direct passes on a flat floor of three materials under three
     point lights, seen straight down (wo = +z), against the library's exact
     BRDF (vsgl_reference_brdf) times the lights' irradiance. Per pixel:
@@ -911,6 +911,8 @@ def suite_brdf(lib, ctx, out_dir, report, camera=None, tag=""):
     # with several lights its per-pixel noise would dwarf 1 %), summed
     cyc, lights = None, []
     base = dict(BRDF_CASE, camera=camera or BRDF_CASE["camera"])
+    if multiscatter:  # Blender 4.x+: the Principled BSDF's default distribution
+        base["dist"] = "MULTI_GGX"
     for li, ls in enumerate(base["lights"]):
         case = dict(base, lights=[ls])
         ob, lo, co, mats = build_blender(case)
@@ -972,7 +974,7 @@ def suite_brdf(lib, ctx, out_dir, report, camera=None, tag=""):
             m.metallic, m.roughness, m.specular_f0 = 1.0, sp["roughness"], 0.04
             m.anisotropy = sp.get("anisotropy", 0.0)
         if bpy.app.version >= (4, 0, 0):
-            m.flags = libvsgl.MATERIAL_FLAG_BLENDER_4
+            m.flags = libvsgl.MATERIAL_FLAG_BLENDER_4 | (libvsgl.MATERIAL_FLAG_MULTISCATTER if multiscatter else 0)
         dsum = np.zeros((n, 3), np.float32)
         gsum = np.zeros((n, 3), np.float32)
         for lpos, lpower in lights:
@@ -1045,6 +1047,10 @@ def main():
             p3, f3 = suite_brdf(lib, ctx, out_dir, report, camera=tilt, tag="_tilt30")
             p4, f4 = suite_diffcol(lib, ctx, out_dir, report)
             p, f = p + p2 + p3 + p4, f + f2 + f3 + f4
+            if bpy.app.version >= (4, 0, 0):  # "Multiscatter GGX", top view and 30 degrees
+                p5, f5 = suite_brdf(lib, ctx, out_dir, report, tag="_ms", multiscatter=True)
+                p6, f6 = suite_brdf(lib, ctx, out_dir, report, camera=tilt, tag="_ms_tilt30", multiscatter=True)
+                p, f = p + p5 + p6, f + f5 + f6
         elif args["--suite"] == "curve":
             p, f = suite_curve(lib, ctx, out_dir, report)
         else:

@@ -41,7 +41,9 @@ VSGL_API vsgl_result vsgl_reference_rsm(vsgl_context *ctx, const vsgl_scene *sce
  *
  * @param[in]  normals, tangents, wi, wo  count*3 floats each: unit shading
  *             normal, tangent (anisotropy frame), direction towards the
- *             light, direction towards the viewer (both away from the surface).
+ *             light, direction towards the viewer (both away from the surface);
+ *             the glossy lobe's multiple-scattering compensation
+ *             (VSGL_MATERIAL_FLAG_MULTISCATTER) is taken for this viewer.
  * @param[out] diffuse, glossy  NULL or count*3 floats (RGB, 1/sr).
  * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (NULL material or input array).
  */

@@ -28,8 +28,14 @@ extern "C" {
 /** GGX shadowing as Cycles in Blender 4.x and later: height-correlated Smith
  *  1 / (1 + L(i) + L(o)); without it Blender 3.x's separable G1(i) G1(o). */
 #define VSGL_MATERIAL_FLAG_BLENDER_4 2u
+/** GGX with the multiple-scattering energy compensation of Cycles 4.x+
+ *  ("Multiscatter GGX", the Principled BSDF's default there): the glossy
+ *  lobe seen from a view of cosine mu is scaled by 1 + F_ms (1 - E1(mu)) /
+ *  E1(mu), E1 the lobe's single-scatter albedo with F = 1, F_ms =
+ *  F_avg E_avg / (1 - F_avg (1 - E_avg)) (E_avg the mean of E1, F_avg of F). */
+#define VSGL_MATERIAL_FLAG_MULTISCATTER 4u
 /** Every material flag this version knows; other bits are rejected. */
-#define VSGL_MATERIAL_FLAGS_KNOWN (VSGL_MATERIAL_UNSUPPORTED | VSGL_MATERIAL_FLAG_BLENDER_4)
+#define VSGL_MATERIAL_FLAGS_KNOWN (VSGL_MATERIAL_UNSUPPORTED | VSGL_MATERIAL_FLAG_BLENDER_4 | VSGL_MATERIAL_FLAG_MULTISCATTER)
 
 /**
  * The Principled BSDF subset the method models. Zero-initialised is black.

@@ -51,6 +51,13 @@ void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out)
      * is above its cutoff (1e-5). */
     out->glossy = (f0 > 0.08f * 1e-5f || metallic > 1e-5f) ? 1 : 0;
     out->height_correlated = (m->flags & VSGL_MATERIAL_FLAG_BLENDER_4) ? 1 : 0;
+    out->multiscatter = (m->flags & VSGL_MATERIAL_FLAG_MULTISCATTER) && out->glossy ? 1 : 0;
+    float eavg = out->multiscatter ? vsgl__ggx_white_albedo_avg(sqrtf(sqrtf(out->alpha_x * out->alpha_y))) : 1.0f;
+    for (int c = 0; c < 3; ++c) {
+        out->favg[c] = out->f0[c] + (1.0f - out->f0[c]) * (1.0f / 21.0f);
+        /* multi-bounce Fresnel: light leaving after k bounces carries F^k */
+        out->fms[c] = out->favg[c] * eavg / (1.0f - out->favg[c] * (1.0f - eavg));
+    }
     float s0 = sqrtf(fminf(f0, 0.99f));
     out->eta = (1.0f + s0) / (1.0f - s0);
 }
@@ -167,8 +174,8 @@ void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out
                 double hx = h.x / ax, hy = h.y / ay, q = hx * hx + hy * hy + (double)h.z * h.z;
                 double D = 1.0 / (3.14159265358979323846 * ax * ay * q * q);
                 double pdf = D * h.z / (4.0 * ih); /* of wo */
-                for (int c = 0; c < 3; ++c)
-                    acc[c] += gl[c] / pdf;
+                for (int c = 0; c < 3; ++c) /* seen from wo (multiple scattering, 4.x+) */
+                    acc[c] += gl[c] * vsgl__ms_scale(p, c, wo.z) / pdf;
             }
         for (int c = 0; c < 3; ++c)
             out->a[k][c] = (float)(acc[c] / (S * S));
@@ -206,6 +213,15 @@ void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t)
         acc += vsgl__diffuse_view_weight(t, mu) * mu;
     }
     t->diffuse_power = (float)(2.0 * acc / 64.0);
+}
+
+float vsgl__ms_scale(const vsgl_brdf_params *p, int channel, float cos_view)
+{
+    if (!p->multiscatter)
+        return 1.0f;
+    float e1 = vsgl__ggx_white_albedo(sqrtf(sqrtf(p->alpha_x * p->alpha_y)), cos_view);
+    e1 = e1 > 0.05f ? e1 : 0.05f;
+    return 1.0f + p->fms[channel] * (1.0f - e1) / e1;
 }
 
 float vsgl__diffuse_view_weight(const vsgl_albedo_table *t, float cos_o)

@@ -15,6 +15,9 @@ typedef struct vsgl_brdf_params {
     float eta;          /* IOR shaping the Fresnel curve between f0 and 1 (Cycles 3.x: from the
                          * dielectric F0, also for metals); 1 = constant f0 */
     int height_correlated; /* Smith shadowing 1/(1 + L(i) + L(o)) (Blender 4.x+), else G1(i) G1(o) */
+    int multiscatter;   /* VSGL_MATERIAL_FLAG_MULTISCATTER: see vsgl__ms_scale */
+    float favg[3];      /* cosine-weighted mean Fresnel per channel (Schlick: f0 + (1 - f0) / 21) */
+    float fms[3];       /* the compensation's Fresnel: F_avg E_avg / (1 - F_avg (1 - E_avg)) (Kulla & Conty) */
 } vsgl_brdf_params;
 
 void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out);
@@ -60,6 +63,18 @@ void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t)
  * Principled: within 0.5 % of 5.0.1's DiffCol at 90, 45 and 20 degree
  * views); 1 for Blender 3.x materials. */
 float vsgl__diffuse_view_weight(const vsgl_albedo_table *t, float cos_o);
+
+/* The white single-scatter GGX albedo E1(mu, roughness) (ggx_albedo.c). */
+float vsgl__ggx_white_albedo(float roughness, float mu);
+/* Its cosine-weighted mean 2 int E1(mu) mu dmu. */
+float vsgl__ggx_white_albedo_avg(float roughness);
+/* Multiple-scattering energy compensation of the glossy lobe seen from a
+ * view direction of cosine cos_view (the direction towards the camera or
+ * the previous bounce): 1 + F_avg (1 - E1) / E1 for
+ * VSGL_MATERIAL_FLAG_MULTISCATTER materials, else 1. vsgl__brdf_eval does
+ * not apply it (its two directions are symmetric); callers that know the
+ * view direction do. */
+float vsgl__ms_scale(const vsgl_brdf_params *p, int channel, float cos_view);
 
 /* GlossCol of Cycles for this material seen from wo: what the GlossInd pass
  * is divided by. Blender 3.x writes the specular closure's weight, i.e.

@@ -68,8 +68,8 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 /* Blender 4.x+: the VPL's diffuse base dimmed towards x */
                 float wq = vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(j->scene, q->material), -v3_dot(q->n, w));
                 float e[3];
-                for (int c = 0; c < 3; ++c)
-                    e[c] = q->flux[c] * (vd[c] * wq + vg[c]);
+                for (int c = 0; c < 3; ++c) /* the VPL's view is towards x */
+                    e[c] = q->flux[c] * (vd[c] * wq + vg[c] * vsgl__ms_scale(&j->params[q->material], c, -v3_dot(q->n, w)));
                 if (!(e[0] + e[1] + e[2] > 0.0f))
                     continue;
                 vsgl__brdf_eval(P, n, t, w, v, rd, rg);
@@ -81,7 +81,7 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 double inv = 1.0 / ((double)d2 + (double)q->area * (1.0 / 3.14159265358979323846));
                 for (int c = 0; c < 3; ++c) {
                     sd[c] += (double)e[c] * rd[c] * inv;
-                    sg[c] += (double)e[c] * rg[c] * inv;
+                    sg[c] += (double)e[c] * rg[c] * vsgl__ms_scale(P, c, v3_dot(n, v)) * inv;
                 }
             }
             /* Blender 4.x+: the colour of the diffuse base seen from v (the light stays) */

@@ -66,8 +66,8 @@ vsgl_result vsgl_reference_brdf(const vsgl_material *m, uint32_t count, const fl
         for (int c = 0; c < 3; ++c) {
             if (diffuse)
                 diffuse[3 * (size_t)i + c] = d[c];
-            if (glossy)
-                glossy[3 * (size_t)i + c] = g[c];
+            if (glossy) /* with multiple scattering (4.x+) seen from wo */
+                glossy[3 * (size_t)i + c] = g[c] * vsgl__ms_scale(&p, c, n[0] * b[0] + n[1] * b[1] + n[2] * b[2]);
         }
     }
     return VSGL_OK;

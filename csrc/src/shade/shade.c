@@ -188,7 +188,8 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                     if (gi > 0.0f)
                         for (int c = 0; c < 3; ++c)
                             ls[c] += v->power[c] * gi *
-                                     vsgl_specular_factor(&r.n, &r.o, &axis, r.alpha, r.bp.f0[c]);
+                                     vsgl_specular_factor(&r.n, &r.o, &axis, r.alpha, r.bp.f0[c]) *
+                                     vsgl__ms_scale(&r.bp, c, v3_dot(r.n, r.o));
                 }
             }
             for (int c = 0; c < 3; ++c) {
@@ -248,7 +249,8 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     float m[3] = {0.0f, 0.0f, 0.0f};
     if (r->glossy)
         for (int c = 0; c < 3; ++c)
-            m[c] = vsgl_specular_factor(&r->n, &r->o, &r->asg.z, r->alpha, r->bp.f0[c]);
+            m[c] = vsgl_specular_factor(&r->n, &r->o, &r->asg.z, r->alpha, r->bp.f0[c]) *
+                   vsgl__ms_scale(&r->bp, c, v3_dot(r->n, r->o));
     b->f0r[k] = m[0];
     b->f0g[k] = m[1];
     b->f0b[k] = m[2];

@@ -191,6 +191,9 @@ def test_materials_from_nodes_both_versions(scene):
     # the running Blender's GGX shadowing (height-correlated from 4.0 on)
     want = materials.MATERIAL_FLAG_BLENDER_4 if VERSION >= (4, 0, 0) else 0
     assert all(m["flags"] & materials.MATERIAL_FLAG_BLENDER_4 == want for m in sd.materials)
+    # a Principled BSDF's distribution: Multiscatter GGX is 4.x's default
+    ms = by["P"]["flags"] & materials.MATERIAL_FLAG_MULTISCATTER
+    assert bool(ms) == (VERSION >= (4, 0, 0) and m1.node_tree.nodes["Principled BSDF"].distribution == "MULTI_GGX")
     # Per-triangle material: polygon i -> material i % 3 (two triangles each).
     names = [sd.material_names[i] for i in sd.material_indices]
     assert names.count("P") == names.count("Emit") == names.count("Diff") == 4

@@ -151,3 +151,14 @@ def test_batched_assemble_matches_per_instance_transform():
         ref = convert.transform_normals(m, ln[tl[:, order].reshape(-1)]).reshape(2, 3, 3)
         assert np.allclose(N[2 * k:2 * k + 2], ref, atol=1e-5)
     assert M.tolist() == [4, 7, 5, 5, 6, 8]
+
+
+def test_multiscatter_ggx_flag_from_4_0():
+    for version, want in (((3, 4, 1), 0), ((5, 0, 1), materials.MATERIAL_FLAG_MULTISCATTER)):
+        d = materials.ShaderDesc("M", materials.PRINCIPLED, {"Roughness": 0.7}, node="BSDF", version=version,
+                                 multiscatter=True)
+        m, _ = materials.map_material(d)
+        assert m["flags"] & materials.MATERIAL_FLAG_MULTISCATTER == want
+    d = materials.ShaderDesc("M", materials.DIFFUSE, {"Color": (1, 1, 1, 1)}, node="BSDF", version=(5, 0, 1),
+                             multiscatter=True)
+    assert materials.map_material(d)[0]["flags"] == 0
