@@ -453,8 +453,10 @@ def library_scene(lib, ctx, ob, lights, co, mats):
             m.metallic = 1.0 if s["kind"] == "metal" else s.get("metallic", 0.0)
             m.roughness, m.specular_f0 = s["roughness"], 0.08 * 0.5
             m.anisotropy = s.get("anisotropy", 0.0)
-        if bpy.app.version >= (4, 0, 0):
-            m.flags = libvsgl.MATERIAL_FLAG_BLENDER_4  # height-correlated Smith, as Cycles 4.x+
+        if bpy.app.version >= (4, 0, 0) and s["kind"] != "lambert_spec":
+            # height-correlated Smith and the Principled's dimmed DiffCol, as Cycles 4.x+ (the
+            # lambert_spec floor is a Diffuse BSDF *added* to a Principled one: nothing dims it)
+            m.flags = libvsgl.MATERIAL_FLAG_BLENDER_4
     clights = (libvsgl.vsgl_light * len(lights))()
     types = {"POINT": 0, "SPOT": 1, "SUN": 2, "AREA": 3}
     shapes = {"SQUARE": 0, "RECTANGLE": 1, "DISK": 2, "ELLIPSE": 3}
