@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # RSM light units (SUITE=lights, default) or the brute-force gather (SUITE=gather) vs Cycles' DiffDir (tests/blender/cycles_ref.py --suite lights) in Blender 3.4;
-# with SUITE=lights, also the same suite (light units, exact BRDF vs Cycles' direct passes) in the pip `bpy` module (newest Blender) if $PIP_PYTHON imports it.
+# then the same suite in the pip `bpy` module (newest Blender) if $PIP_PYTHON imports it.
 # Cycles renders are cached in build/blender/cycles/cycles/ (keyed by a hash of the script, case, version).
 # Prints one line per light and ends with "N passed, N failed"; exits non-zero on failure.
 set -uo pipefail
@@ -30,27 +30,27 @@ else
 fi
 [ $rc -ne 0 ] && echo "(Blender log: $OUT/blender_$SUITE.log)"
 PIP_PYTHON=${PIP_PYTHON:-python3}
-if [ "$SUITE" = lights ] && "$PIP_PYTHON" -c "import bpy, numpy" >/dev/null 2>&1; then
-  # Blender 4.x+ semantics (spots, area power, GGX shadowing) against that Blender's Cycles
+if "$PIP_PYTHON" -c "import bpy, numpy" >/dev/null 2>&1; then
+  # Blender 4.x+ semantics (lights, GGX shadowing and multiple scattering, DiffCol) against that Blender's Cycles
   OUT5=build/blender/cycles_bpy
   mkdir -p "$OUT5"
-  rm -f "$OUT5/summary_lights.txt"
-  "$PIP_PYTHON" tests/blender/cycles_ref.py -- --suite lights --lib build/libvsgl.so --out "$OUT5" >"$OUT5/bpy_lights.log" 2>&1
+  rm -f "$OUT5/summary_$SUITE.txt"
+  "$PIP_PYTHON" tests/blender/cycles_ref.py -- --suite "$SUITE" --lib build/libvsgl.so --out "$OUT5" >"$OUT5/bpy_$SUITE.log" 2>&1
   rc5=$?
   ver=$("$PIP_PYTHON" -c 'import bpy; print(bpy.app.version_string)' 2>/dev/null | tail -1)
-  echo "== light units and BRDF in pip bpy $ver"
-  grep -E "^(PASS|FAIL|SKIP)" "$OUT5/bpy_lights.log"
+  echo "== $SUITE in pip bpy $ver"
+  grep -E "^(PASS|FAIL|SKIP|gather res)" "$OUT5/bpy_$SUITE.log"
   p1=$(grep -Eo '^[0-9]+ passed' "$OUT/summary_$SUITE.txt" 2>/dev/null | grep -Eo '[0-9]+' || echo 0)
   f1=$(grep -Eo '[0-9]+ failed' "$OUT/summary_$SUITE.txt" 2>/dev/null | grep -Eo '[0-9]+' || echo 1)
-  if [ -f "$OUT5/summary_lights.txt" ]; then
-    p5=$(grep -Eo '^[0-9]+ passed' "$OUT5/summary_lights.txt" | grep -Eo '[0-9]+'); f5=$(grep -Eo '[0-9]+ failed' "$OUT5/summary_lights.txt" | grep -Eo '[0-9]+')
+  if [ -f "$OUT5/summary_$SUITE.txt" ]; then
+    p5=$(grep -Eo '^[0-9]+ passed' "$OUT5/summary_$SUITE.txt" | grep -Eo '[0-9]+'); f5=$(grep -Eo '[0-9]+ failed' "$OUT5/summary_$SUITE.txt" | grep -Eo '[0-9]+')
     echo "(bpy $ver: ${p5} passed, ${f5} failed)"
   else
-    tail -20 "$OUT5/bpy_lights.log"; p5=0; f5=1; [ $rc5 -eq 0 ] && rc5=1
+    tail -20 "$OUT5/bpy_$SUITE.log"; p5=0; f5=1; [ $rc5 -eq 0 ] && rc5=1
   fi
-  [ $rc5 -ne 0 ] && { echo "(log: $OUT5/bpy_lights.log)"; rc=1; }
+  [ $rc5 -ne 0 ] && { echo "(log: $OUT5/bpy_$SUITE.log)"; rc=1; }
   echo "$((p1 + p5)) passed, $((f1 + f5)) failed"
 else
-  [ "$SUITE" = lights ] && echo "run_lights.sh: bpy not importable in $PIP_PYTHON; newest-Blender light units and BRDF skipped"
+  echo "run_$SUITE.sh: bpy not importable in $PIP_PYTHON; the newest Blender's check skipped"
 fi
 exit $rc

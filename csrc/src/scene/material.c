@@ -52,6 +52,10 @@ void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out)
     out->glossy = (f0 > 0.08f * 1e-5f || metallic > 1e-5f) ? 1 : 0;
     out->height_correlated = (m->flags & VSGL_MATERIAL_FLAG_BLENDER_4) ? 1 : 0;
     out->multiscatter = (m->flags & VSGL_MATERIAL_FLAG_MULTISCATTER) && out->glossy ? 1 : 0;
+    out->metallic = metallic;
+    out->f0_dielectric = f0;
+    for (int c = 0; c < 3; ++c)
+        out->base[c] = saturate(m->base_color[c]);
     float eavg = out->multiscatter ? vsgl__ggx_white_albedo_avg(sqrtf(sqrtf(out->alpha_x * out->alpha_y))) : 1.0f;
     for (int c = 0; c < 3; ++c) {
         out->favg[c] = out->f0[c] + (1.0f - out->f0[c]) * (1.0f / 21.0f);
@@ -132,10 +136,17 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
 
 void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3])
 {
-    (void)n;
-    (void)wo;
     float g = p->glossy ? 1.0f : 0.0f;
     out[0] = out[1] = out[2] = g;
+    if (!p->glossy || !p->height_correlated)
+        return;
+    /* Blender 4.x+: the Fresnel reflectance towards the viewer, the
+     * dielectric's exact one and the metal's Schlick one, mixed by metallic */
+    float c = clampf(v3_dot(n, wo), 0.0f, 1.0f);
+    float fd = p->f0_dielectric > 0.0f && p->eta > 1.0f ? fresnel_dielectric(c, p->eta) : p->f0_dielectric;
+    float m = 1.0f - c, m5 = m * m * m * m * m;
+    for (int k = 0; k < 3; ++k)
+        out[k] = (1.0f - p->metallic) * fd + p->metallic * (p->base[k] + (1.0f - p->base[k]) * m5);
 }
 
 void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out)

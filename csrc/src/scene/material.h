@@ -17,6 +17,7 @@ typedef struct vsgl_brdf_params {
     int height_correlated; /* Smith shadowing 1/(1 + L(i) + L(o)) (Blender 4.x+), else G1(i) G1(o) */
     int multiscatter;   /* VSGL_MATERIAL_FLAG_MULTISCATTER: see vsgl__ms_scale */
     float favg[3];      /* cosine-weighted mean Fresnel per channel (Schlick: f0 + (1 - f0) / 21) */
+    float metallic, base[3], f0_dielectric; /* the Principled inputs (GlossCol of Blender 4.x+) */
     float fms[3];       /* the compensation's Fresnel: F_avg E_avg / (1 - F_avg (1 - E_avg)) (Kulla & Conty) */
 } vsgl_brdf_params;
 
@@ -80,7 +81,10 @@ float vsgl__ms_scale(const vsgl_brdf_params *p, int channel, float cos_view);
  * is divided by. Blender 3.x writes the specular closure's weight, i.e.
  * white (1,1,1) whenever the Principled BSDF has a specular lobe (measured:
  * metallic 0.3 or 1, any base colour -> GlossCol = 1) and 0 otherwise; the
- * Fresnel colour stays inside GlossInd. (4.x writes an albedo estimate.) */
+ * Fresnel colour stays inside GlossInd. Blender 4.x+ (VSGL_MATERIAL_FLAG_
+ * BLENDER_4) writes the Fresnel reflectance towards the viewer (measured in
+ * 5.0.1: 0.0899 for a dielectric of IOR 1.5 at 60 degrees, F = 0.0892; a
+ * metal within ~1 % of Schlick's F of its base colour): that is written. */
 void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3]);
 
 #endif
