@@ -652,19 +652,28 @@ def interior_mask(col):
     return same
 
 
+GATHER_PASSES = ["DiffInd", "DiffCol", "GlossInd", "GlossCol"]
+
+
+def gather_reference(out_dir):
+    """The gather room built in Blender and its Cycles reference: two
+    independent renders (seeds 1, 2) whose mean is the reference and whose
+    difference measures its noise. Returns the Blender objects, the two
+    renders' passes, their coloured (diffuse, glossy) planes and the render
+    time (None when cached)."""
+    blend = build_blender(GATHER_CASE)
+    half = GATHER_CASE["samples"] // 2
+    c1, s1 = cycles_cached("gather_room", GATHER_CASE, GATHER_PASSES, out_dir, half, 1)
+    c2, s2 = cycles_cached("gather_room", GATHER_CASE, GATHER_PASSES, out_dir, half, 2)
+    coloured = [(c["DiffInd"] * c["DiffCol"], c["GlossInd"] * c["GlossCol"]) for c in (c1, c2)]
+    return blend, (c1, c2), coloured, None if s1 is None or s2 is None else s1 + s2
+
+
 def suite_gather(lib, ctx, out_dir, report):
-    case = GATHER_CASE
-    ob, lights, co, mats = build_blender(case)
-    passes = ["DiffInd", "DiffCol", "GlossInd", "GlossCol"]
-    # two independent Cycles renders (seeds 1, 2): their mean is the
-    # reference, their difference measures its noise
+    case, passes = GATHER_CASE, GATHER_PASSES
+    (ob, lights, co, mats), (c1, c2), ((D1, G1), (D2, G2)), secs = gather_reference(out_dir)
     half = case["samples"] // 2
-    c1, s1 = cycles_cached("gather_room", case, passes, out_dir, half, 1)
-    c2, s2 = cycles_cached("gather_room", case, passes, out_dir, half, 2)
-    secs = None if s1 is None or s2 is None else s1 + s2
     W, H = case["camera"]["res"]
-    D1, D2 = c1["DiffInd"] * c1["DiffCol"], c2["DiffInd"] * c2["DiffCol"]
-    G1, G2 = c1["GlossInd"] * c1["GlossCol"], c2["GlossInd"] * c2["GlossCol"]
     D_c, G_c = 0.5 * (D1 + D2), 0.5 * (G1 + G2)
     cyc = {p: 0.5 * (c1[p] + c2[p]) for p in passes}
     # noise of the mean of two renders: relMSE(c1, c2) / 4 (each has variance
@@ -782,17 +791,11 @@ CURVE_SETTINGS = [
 
 
 def suite_curve(lib, ctx, out_dir, report):
-    case = GATHER_CASE
-    ob, lights, co, mats = build_blender(case)
-    passes = ["DiffInd", "DiffCol", "GlossInd", "GlossCol"]
-    half = case["samples"] // 2
-    c1, _ = cycles_cached("gather_room", case, passes, out_dir, half, 1)
-    c2, _ = cycles_cached("gather_room", case, passes, out_dir, half, 2)
-    D_c = 0.5 * (c1["DiffInd"] * c1["DiffCol"] + c2["DiffInd"] * c2["DiffCol"])
-    G_c = 0.5 * (c1["GlossInd"] * c1["GlossCol"] + c2["GlossInd"] * c2["GlossCol"])
+    case, passes = GATHER_CASE, GATHER_PASSES
+    (ob, lights, co, mats), _, ((D1, G1), (D2, G2)), _ = gather_reference(out_dir)
+    D_c, G_c = 0.5 * (D1 + D2), 0.5 * (G1 + G2)
     ref = D_c + G_c
-    floor = relmse(c1["DiffInd"] * c1["DiffCol"] + c1["GlossInd"] * c1["GlossCol"],
-                   c2["DiffInd"] * c2["DiffCol"] + c2["GlossInd"] * c2["GlossCol"]) / 4
+    floor = relmse(D1 + G1, D2 + G2) / 4
     W, H = case["camera"]["res"]
     rows = []
     # Cycles at increasing spp (seed 3: independent of the reference)

@@ -383,3 +383,21 @@ VT_TEST(material_multiscatter_white_furnace)
         }
     }
 }
+
+/* The tabulated row means of the white GGX albedo (ggx_albedo.c) are the
+ * trapezoid rule over the albedo table itself. */
+VT_TEST(material_ggx_white_albedo_mean_matches_its_table)
+{
+    for (int j = 0; j < 32; ++j) {
+        float r = (float)j / 31.0f;
+        double acc = 0.0;
+        for (int k = 0; k < 32; ++k) {
+            float mu = (float)k / 31.0f;
+            float e = vsgl__ggx_white_albedo(r, k == 0 ? 0.0f : mu); /* node k (its first cosine is 0.02) */
+            acc += (k == 0 || k == 31 ? 0.5 : 1.0) * e * mu;
+        }
+        double want = 2.0 * acc / 31.0, got = vsgl__ggx_white_albedo_avg(r);
+        VT_CHECK(fabs(got - want) < 2e-5, "roughness %g: mean %.7f, trapezoid %.7f", r, got, want);
+        VT_CHECK(j == 0 || got < vsgl__ggx_white_albedo_avg((float)(j - 1) / 31.0f) + 1e-6, "roughness %g: not decreasing", r);
+    }
+}

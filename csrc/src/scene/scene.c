@@ -292,6 +292,11 @@ const vsgl_albedo_table *vsgl__scene_glossy_albedo(const vsgl_scene *scene, uint
     return material < scene->material_count ? &scene->glossy_albedo[material] : NULL;
 }
 
+float vsgl__scene_diffuse_weight(const vsgl_scene *scene, uint32_t material, float cos_view)
+{
+    return vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(scene, material), cos_view);
+}
+
 const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count)
 {
     if (count)

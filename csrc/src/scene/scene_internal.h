@@ -53,6 +53,9 @@ const vsgl_material *vsgl__scene_materials(const vsgl_scene *scene, uint32_t *co
  * computed when the scene is created; NULL for an index out of range. */
 struct vsgl_albedo_table;
 const struct vsgl_albedo_table *vsgl__scene_glossy_albedo(const vsgl_scene *scene, uint32_t material);
+/* The DiffCol weight of a material seen from a direction of cosine cos_view
+ * (vsgl__diffuse_view_weight: 1 unless it is a Blender 4.x+ material). */
+float vsgl__scene_diffuse_weight(const vsgl_scene *scene, uint32_t material, float cos_view);
 const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count);
 const vsgl_camera *vsgl__scene_camera(const vsgl_scene *scene);
 /* Bounding box of the valid triangles; lo = hi = (0,0,0) when there are none. */

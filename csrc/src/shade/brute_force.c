@@ -51,6 +51,9 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
             const vsgl_brdf_params *P = &j->params[m];
             v3 x = load(g->pos, s), n = load(g->nrm, s), v = load(g->view, s), t = load(g->tan, s);
             memcpy(dcol, P->diffuse, sizeof dcol);
+            float ms[3]; /* the receiver's glossy compensation towards the viewer */
+            for (int c = 0; c < 3; ++c)
+                ms[c] = vsgl__ms_scale(P, c, v3_dot(n, v));
             vsgl__glossy_color(P, n, v, gcol);
             double sd[3] = {0, 0, 0}, sg[3] = {0, 0, 0};
             for (size_t k = 0; k < j->vpl_count; ++k) {
@@ -65,11 +68,13 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                     continue;
                 float vd[3], vg[3], rd[3], rg[3];
                 vsgl__brdf_eval(&j->params[q->material], q->n, q->t, v3_neg(w), q->wi, vd, vg);
-                /* Blender 4.x+: the VPL's diffuse base dimmed towards x */
-                float wq = vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(j->scene, q->material), -v3_dot(q->n, w));
+                /* Blender 4.x+: the VPL's diffuse base dimmed and its glossy lobe
+                 * compensated as seen from x (its view) */
+                float cq = -v3_dot(q->n, w);
+                float wq = vsgl__scene_diffuse_weight(j->scene, q->material, cq);
                 float e[3];
-                for (int c = 0; c < 3; ++c) /* the VPL's view is towards x */
-                    e[c] = q->flux[c] * (vd[c] * wq + vg[c] * vsgl__ms_scale(&j->params[q->material], c, -v3_dot(q->n, w)));
+                for (int c = 0; c < 3; ++c)
+                    e[c] = q->flux[c] * (vd[c] * wq + vg[c] * vsgl__ms_scale(&j->params[q->material], c, cq));
                 if (!(e[0] + e[1] + e[2] > 0.0f))
                     continue;
                 vsgl__brdf_eval(P, n, t, w, v, rd, rg);
@@ -81,11 +86,11 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 double inv = 1.0 / ((double)d2 + (double)q->area * (1.0 / 3.14159265358979323846));
                 for (int c = 0; c < 3; ++c) {
                     sd[c] += (double)e[c] * rd[c] * inv;
-                    sg[c] += (double)e[c] * rg[c] * vsgl__ms_scale(P, c, v3_dot(n, v)) * inv;
+                    sg[c] += (double)e[c] * rg[c] * ms[c] * inv;
                 }
             }
             /* Blender 4.x+: the colour of the diffuse base seen from v (the light stays) */
-            float wd = vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(j->scene, m), v3_dot(n, v));
+            float wd = vsgl__scene_diffuse_weight(j->scene, m, v3_dot(n, v));
             for (int c = 0; c < 3; ++c) {
                 dl[c] = dcol[c] > 0.0f ? (float)(sd[c] / dcol[c]) : 0.0f;
                 gl[c] = gcol[c] > 0.0f ? (float)(sg[c] / gcol[c]) : 0.0f;

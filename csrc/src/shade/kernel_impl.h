@@ -369,9 +369,6 @@ k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
  * pass (the j loop is unrolled before vectorisation), every loop body holds
  * two independent chains, which the core overlaps. Sums are added in VSGL
  * order, as one VSGL at a time would. */
-#define K_FOR(STMT)                                    \
-    for (size_t i = 0; i < VSGL_KERNEL_BLOCK; ++i) \
-        STMT
 #define K_FORN(STMT)                                   \
     for (size_t i = 0; i < VSGL_KERNEL_BLOCK; ++i) \
         for (int j = 0; j < NL; ++j)                   \

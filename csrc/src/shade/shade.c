@@ -72,6 +72,7 @@ typedef struct receiver {
     vsgl_brdf_params bp;
     float alpha;
     int glossy;
+    float ms[3];         /* multiple-scattering compensation towards o (1 unless 4.x+ Multiscatter GGX) */
     vsgl_asg asg;        /* warped NDF (ASG mode) */
     vsgl_sg sg;          /* warped NDF (SG mode) */
 } receiver;
@@ -87,6 +88,8 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->glossy = r->bp.glossy && v3_dot(r->n, r->o) > 0.0f;
     if (!r->glossy)
         return;
+    for (int c = 0; c < 3; ++c)
+        r->ms[c] = vsgl__ms_scale(&r->bp, c, v3_dot(r->n, r->o));
     if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
         vsgl_sg ndf;
         vsgl_ndf_to_sg(&r->n, r->alpha, VSGL_NDF_GGX, &ndf);
@@ -156,7 +159,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
             if (r.glossy)
                 vsgl__glossy_color(&r.bp, r.n, r.o, gcol);
             /* Blender 4.x+: the dielectric layer dims the diffuse base seen from o */
-            float wd = vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(j->scene, g->material[i]), v3_dot(r.n, r.o));
+            float wd = vsgl__scene_diffuse_weight(j->scene, g->material[i], v3_dot(r.n, r.o));
             for (int c = 0; c < 3; ++c) {
                 col_d[c] += r.bp.diffuse[c] * wd;
                 col_g[c] += gcol[c];
@@ -188,8 +191,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                     if (gi > 0.0f)
                         for (int c = 0; c < 3; ++c)
                             ls[c] += v->power[c] * gi *
-                                     vsgl_specular_factor(&r.n, &r.o, &axis, r.alpha, r.bp.f0[c]) *
-                                     vsgl__ms_scale(&r.bp, c, v3_dot(r.n, r.o));
+                                     vsgl_specular_factor(&r.n, &r.o, &axis, r.alpha, r.bp.f0[c]) * r.ms[c];
                 }
             }
             for (int c = 0; c < 3; ++c) {
@@ -210,22 +212,29 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
 }
 
 
+/* Lane `k` of a kernel block as a receiver at (x, y, z) with no lobe: finite
+ * everywhere, contributes nothing (misses, and the padding of a last block). */
+static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z)
+{
+    b->x[k] = x; b->y[k] = y; b->z[k] = z;
+    b->nx[k] = b->ny[k] = 0.0f;
+    b->nz[k] = 1.0f;
+    b->ox[k] = b->oy[k] = 0.0f;
+    b->oz[k] = 1.0f;
+    b->diffuse[k] = 0.0f;
+    b->Xx[k] = 1.0f; b->Xy[k] = b->Xz[k] = 0.0f;
+    b->Yy[k] = 1.0f; b->Yx[k] = b->Yz[k] = 0.0f;
+    b->Zz[k] = 1.0f; b->Zx[k] = b->Zy[k] = 0.0f;
+    b->lam[k] = b->mu[k] = b->camp[k] = 0.0f;
+    b->f0r[k] = b->f0g[k] = b->f0b[k] = 0.0f;
+}
+
 /* Fill lane `k` of a kernel block from G-buffer sample i; returns 0 for a miss. */
 static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t k, receiver *r)
 {
     if (j->g->material[i] == VSGL_GBUFFER_MISS) {
         memset(r, 0, sizeof *r);
-        b->x[k] = b->y[k] = b->z[k] = 0.0f;
-        b->nx[k] = b->ny[k] = 0.0f;
-        b->nz[k] = 1.0f;
-        b->ox[k] = b->oy[k] = 0.0f;
-        b->oz[k] = 1.0f;
-        b->diffuse[k] = 0.0f;
-        b->Xx[k] = 1.0f; b->Xy[k] = b->Xz[k] = 0.0f;
-        b->Yy[k] = 1.0f; b->Yx[k] = b->Yz[k] = 0.0f;
-        b->Zz[k] = 1.0f; b->Zx[k] = b->Zy[k] = 0.0f;
-        b->lam[k] = b->mu[k] = b->camp[k] = 0.0f;
-        b->f0r[k] = b->f0g[k] = b->f0b[k] = 0.0f;
+        clear_lane(b, k, 0.0f, 0.0f, 0.0f);
         return 0;
     }
     setup_receiver(j, i, r);
@@ -249,8 +258,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     float m[3] = {0.0f, 0.0f, 0.0f};
     if (r->glossy)
         for (int c = 0; c < 3; ++c)
-            m[c] = vsgl_specular_factor(&r->n, &r->o, &r->asg.z, r->alpha, r->bp.f0[c]) *
-                   vsgl__ms_scale(&r->bp, c, v3_dot(r->n, r->o));
+            m[c] = vsgl_specular_factor(&r->n, &r->o, &r->asg.z, r->alpha, r->bp.f0[c]) * r->ms[c];
     b->f0r[k] = m[0];
     b->f0g[k] = m[1];
     b->f0b[k] = m[2];
@@ -354,15 +362,10 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             }
             lobes |= (blk.diffuse[k] > 0.0f ? VSGL_KERNEL_DIFFUSE : 0) | (blk.camp[k] > 0.0f ? VSGL_KERNEL_GLOSSY : 0);
         }
-        for (size_t k = n; k < VSGL_KERNEL_BLOCK; ++k) { /* padding lanes: shaded, never read */
-            blk.x[k] = blk.x[0]; blk.y[k] = blk.y[0]; blk.z[k] = blk.z[0];
-            blk.nx[k] = blk.nx[0]; blk.ny[k] = blk.ny[0]; blk.nz[k] = blk.nz[0];
-            blk.diffuse[k] = 0.0f;
-            blk.Xx[k] = 1.0f; blk.Xy[k] = blk.Xz[k] = 0.0f;
-            blk.Yy[k] = 1.0f; blk.Yx[k] = blk.Yz[k] = 0.0f;
-            blk.Zz[k] = 1.0f; blk.Zx[k] = blk.Zy[k] = 0.0f;
-            blk.lam[k] = blk.mu[k] = blk.camp[k] = 0.0f;
-            blk.f0r[k] = blk.f0g[k] = blk.f0b[k] = 0.0f;
+        for (size_t k = n; k < VSGL_KERNEL_BLOCK; ++k) {
+            /* padding lanes: shaded, never read; at lane 0's position so that
+             * they do not change the block's choice of short forms */
+            clear_lane(&blk, k, blk.x[0], blk.y[0], blk.z[0]);
             vis[k] = vis[VSGL_KERNEL_BLOCK + k] = 0.0f;
         }
         memset(blk.ld, 0, sizeof blk.ld);
@@ -406,7 +409,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             if (bp.glossy && v3_dot(n, o) > 0.0f)
                 vsgl__glossy_color(&bp, n, o, gcol);
             const float *L = light + (size_t)slot[i] * 6;
-            float wd = vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(j->scene, g->material[si]), v3_dot(n, o));
+            float wd = vsgl__scene_diffuse_weight(j->scene, g->material[si], v3_dot(n, o));
             for (int c = 0; c < 3; ++c) {
                 acc[c] += bp.diffuse[c] * wd * L[c];
                 acc[3 + c] += L[3 + c];

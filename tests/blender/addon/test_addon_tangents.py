@@ -177,14 +177,20 @@ def test_instances_batched_like_normals(scene):
     assert matched.all()
 
 
-def test_tangents_reach_scene_and_bundle(scene):
+def _library_with(symbol):
+    """(libvsgl module, loaded library) or a skip naming what is missing."""
     from vsgl_indirect import libvsgl
     try:
         lib = libvsgl.library()
     except Exception as e:
         pytest.skip("libvsgl not loadable: %s" % e)
-    if not lib.has("vsgl_bundle_write_memory") or getattr(lib, "undefined", ()):
-        pytest.skip("libvsgl has no bundle writer in this build")
+    if not lib.has(symbol) or getattr(lib, "undefined", ()):
+        pytest.skip("libvsgl has no %s in this build" % symbol)
+    return libvsgl, lib
+
+
+def test_tangents_reach_scene_and_bundle(scene):
+    libvsgl, lib = _library_with("vsgl_bundle_write_memory")
     camera(scene)
     light(scene)
     link(scene, blob("Blob", (0, 0, 0), aniso()))
@@ -235,13 +241,7 @@ def _angle_deg(a, b):
 
 
 def test_gbuffer_tangent_matches_cycles(scene):
-    from vsgl_indirect import libvsgl
-    try:
-        lib = libvsgl.library()
-    except Exception as e:
-        pytest.skip("libvsgl not loadable: %s" % e)
-    if not lib.has("vsgl_debug_gbuffer_frames") or getattr(lib, "undefined", ()):
-        pytest.skip("libvsgl has no vsgl_debug_gbuffer_frames in this build")
+    libvsgl, lib = _library_with("vsgl_debug_gbuffer_frames")
     s = scene
     s.render.resolution_x, s.render.resolution_y = 96, 72
     mats = [aniso("A%d" % i, 0.5 + 0.1 * i) for i in range(4)]
