@@ -90,6 +90,21 @@ def principled(name, color=(0.8, 0.8, 0.8, 1), metallic=0.0, roughness=0.5, **ex
     return mat
 
 
+def shader_material(name, bl_idname):
+    """A material whose surface is one new node of type ``bl_idname`` (the
+    default nodes removed); returns (material, node)."""
+    mat = bpy.data.materials.new(name)
+    if mat.node_tree is None:
+        mat.use_nodes = True
+    nt = mat.node_tree
+    for n in list(nt.nodes):
+        if n.bl_idname != "ShaderNodeOutputMaterial":
+            nt.nodes.remove(n)
+    node = nt.nodes.new(bl_idname)
+    nt.links.new(node.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    return mat, node
+
+
 def camera(scene, location=(0, -6, 1), rotation=(1.4, 0, 0), lens=35.0):
     cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
     cam.location = location

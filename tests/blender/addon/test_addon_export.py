@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from mathutils import Matrix, Vector
 
-from conftest import VERSION, camera, cube, light, link, mesh_object, plane, principled
+from conftest import VERSION, camera, cube, light, link, mesh_object, plane, principled, shader_material
 from vsgl_indirect import export, materials
 from vsgl_indirect.convert import ExportError
 
@@ -152,26 +152,10 @@ def test_materials_from_nodes_both_versions(scene):
     else:
         m1 = principled("P", (0.1, 0.2, 0.3, 1), 0.5, 0.25, Specular=0.25)
         f0 = 0.02
-    m2 = bpy.data.materials.new("Emit")
-    if m2.node_tree is None:
-        m2.use_nodes = True
-    nt = m2.node_tree
-    for n in list(nt.nodes):
-        if n.bl_idname != "ShaderNodeOutputMaterial":
-            nt.nodes.remove(n)
-    em = nt.nodes.new("ShaderNodeEmission")
-    nt.links.new(em.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    m2, _ = shader_material("Emit", "ShaderNodeEmission")
     m2.diffuse_color = (0.3, 0.6, 0.9, 1)
-    m3 = bpy.data.materials.new("Diff")
-    if m3.node_tree is None:
-        m3.use_nodes = True
-    nt = m3.node_tree
-    for n in list(nt.nodes):
-        if n.bl_idname != "ShaderNodeOutputMaterial":
-            nt.nodes.remove(n)
-    d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    m3, d = shader_material("Diff", "ShaderNodeBsdfDiffuse")
     d.inputs["Color"].default_value = (0.7, 0.6, 0.5, 1)
-    nt.links.new(d.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
     ob = link(scene, cube("Multi", 2.0))
     for m in (m1, m2, m3):
         ob.data.materials.append(m)

@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 import pytest
 
-from conftest import (IS_BINARY, REPO, camera, light, link, plane, real_render_or_skip, render,
+from conftest import (IS_BINARY, REPO, camera, light, link, plane, real_render_or_skip, render, shader_material,
                       room, save)
 from exr_read import read_exr, read_pass
 from vsgl_indirect import compat, compositor, engine, handlers, runner
@@ -284,16 +284,8 @@ def test_compute_in_thread_releases_gil_and_cancels(scene, tmp_path):
 
 
 def _diffuse(name, color):
-    mat = bpy.data.materials.new(name)
-    if mat.node_tree is None:
-        mat.use_nodes = True
-    nt = mat.node_tree
-    for n in list(nt.nodes):
-        if n.bl_idname != "ShaderNodeOutputMaterial":
-            nt.nodes.remove(n)
-    d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    mat, d = shader_material(name, "ShaderNodeBsdfDiffuse")
     d.inputs["Color"].default_value = color + (1.0,)
-    nt.links.new(d.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
     return mat
 
 
