@@ -207,7 +207,10 @@ void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t)
     if (!bp.glossy)
         return;
     vsgl_albedo_table tmp, white;
-    vsgl__glossy_albedo_table(&bp, &tmp);
+    if (saturate(m->metallic) > 0.0f)
+        vsgl__glossy_albedo_table(&bp, &tmp);
+    else
+        tmp = *t; /* a dielectric's own glossy lobe is that layer: already in t */
     /* the same lobe with F = 1: what single scattering loses to shadowing */
     vsgl_material w = d;
     w.metallic = 1.0f;

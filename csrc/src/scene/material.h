@@ -57,7 +57,8 @@ void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out
 /* Linear interpolation of the table at cos_i in [0, 1]. */
 float vsgl__glossy_albedo(const vsgl_albedo_table *t, int channel, float cos_i);
 /* The table's dielectric-layer albedo for material m (zero unless m has
- * VSGL_MATERIAL_FLAG_BLENDER_4, a dielectric part and a specular layer). */
+ * VSGL_MATERIAL_FLAG_BLENDER_4, a dielectric part and a specular layer);
+ * t's glossy part must already be m's (vsgl__glossy_albedo_table). */
 void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t);
 /* Weight of the diffuse base seen from a direction of cosine cos_o (DiffCol
  * factor): 1 - the dielectric layer's compensated albedo there (Cycles 4.x+
