@@ -793,6 +793,7 @@ CURVE_SETTINGS = [
 def suite_curve(lib, ctx, out_dir, report):
     case, passes = GATHER_CASE, GATHER_PASSES
     (ob, lights, co, mats), _, ((D1, G1), (D2, G2)), _ = gather_reference(out_dir)
+    half = case["samples"] // 2
     D_c, G_c = 0.5 * (D1 + D2), 0.5 * (G1 + G2)
     ref = D_c + G_c
     floor = relmse(D1 + G1, D2 + G2) / 4
