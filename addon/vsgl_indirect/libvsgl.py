@@ -159,6 +159,7 @@ class FitMode(enum.IntEnum):
     TWO = 0
     FIS = 1
     KMEANS = 2
+    LATTICE = 3
 
 
 class GlossyMode(enum.IntEnum):

@@ -197,8 +197,9 @@ static void random_light(vt_rng *r, vsgl_kernel_light *o, int sharp)
     o->c0 = 1.0f / (6.2831853f * vsgl_sg_integral(o->lv));
     o->pr = 1.0f; o->pg = 0.5f; o->pb = 0.25f;
     o->nz = -1.0f;
-    o->hemi_weight = (float)vt_uniform(r);
-    o->hemi_scale = 20.0f;
+    o->clip = (float)vt_uniform(r);
+    o->conv = vt_uniform(r) < 0.5 ? 1.0f : 0.0f;
+    o->ibehind = 1.0f / (0.02f * sqrtf(o->var));
 }
 
 /* Every ISA copy (AVX-512, AVX2, baseline) and the library's scalar build

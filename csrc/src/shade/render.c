@@ -66,6 +66,7 @@ static vsgl_result fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const 
         switch (s->fit_mode) {
         case VSGL_FIT_FIS: r = vsgl__fit_fis(ctx, scene, &rsm, s, set); break;
         case VSGL_FIT_KMEANS: r = vsgl__fit_kmeans(ctx, scene, &rsm, s, set); break;
+        case VSGL_FIT_LATTICE: r = vsgl__fit_lattice(ctx, scene, &rsm, s, set); break;
         default: r = vsgl__fit_two(ctx, scene, &rsm, s, set); break;
         }
         st->seconds_fit += now_seconds() - t0;
