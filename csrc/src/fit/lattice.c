@@ -11,8 +11,8 @@
  *    is what lets the shading clip its emission to its own hemisphere;
  *  - position: within bin b (axis a), lattice points h apart in the two
  *    axes across a, with tent (bilinear) weights, which sum to 1 and are
- *    continuous in the VPL's position; along a, slabs h thick (surfaces of
- *    one bin at different heights, a floor and a table top, stay apart);
+ *    continuous in the VPL's position; along a, slabs h/4 thick (surfaces
+ *    of one bin at different heights, a floor and a table top, stay apart);
  *  - the lattice is anchored at the scene's bounds, not at the light, and
  *    h follows the light's effective lit area A (the power-weighted
  *    participation area (sum w)^2 / sum(w^2 / a)), h = sqrt(A / N): both
@@ -31,6 +31,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Slab thickness along a bin's axis, in units of h. */
+#define VSGL_LATTICE_SLAB 0.25
 /* Extra positional variance per VSGL, in units of h^2. */
 #define VSGL_LATTICE_OVERLAP (1.0 / 12.0)
 
@@ -186,7 +188,7 @@ vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const 
                 continue;
             double wb = na * na;
             int u = (a + 1) % 3, v = (a + 2) % 3;
-            int32_t k = (int32_t)floor(q[a]);
+            int32_t k = (int32_t)floor(q[a] * (1.0 / VSGL_LATTICE_SLAB));
             double fu = floor(q[u]), fv = floor(q[v]);
             double tu = q[u] - fu, tv = q[v] - fv;
             for (int du = 0; du < 2; ++du)
