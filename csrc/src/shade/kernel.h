@@ -52,6 +52,8 @@ typedef struct vsgl_kernel_light {
     float clip;              /* emitter-hemisphere clip: coherence^2 of the normals, 0 = off (shade.h) */
     float conv;              /* 1 for a diffuse lobe: clamped-cosine emission in the far field */
     float ibehind;           /* 1 / (VSGL_CLIP_BEHIND sigma) */
+    float planar;            /* weight of the planar glossy model (coherence^2 of a diffuse lobe, clip on), else 0 */
+    float u1x, u1y, u1z, u2x, u2y, u2z; /* an orthonormal basis of the cluster's plane */
 } vsgl_kernel_light;
 
 /* Lobes a block needs (skip the work for lobes no lane has). */

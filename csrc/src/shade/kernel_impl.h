@@ -218,6 +218,8 @@ typedef struct k_scratch {
     float r[VSGL_KERNEL_BLOCK], d2[VSGL_KERNEL_BLOCK], ls[VSGL_KERNEL_BLOCK];
     /* the accurate cosine's part that depends on lin alone (k_cos_l) */
     float low[VSGL_KERNEL_BLOCK], u[VSGL_KERNEL_BLOCK], t[VSGL_KERNEL_BLOCK], it[VSGL_KERNEL_BLOCK];
+    float h[VSGL_KERNEL_BLOCK];                                               /* height above the cluster's plane */
+    float pexpo[VSGL_KERNEL_BLOCK], ppre[VSGL_KERNEL_BLOCK];                  /* the planar glossy's exp argument, factor */
     float kappa[VSGL_KERNEL_BLOCK], ct[VSGL_KERNEL_BLOCK];
 } k_scratch;
 
@@ -241,6 +243,7 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
      * or in the cluster's plane, nothing for a receiver facing the same way,
      * the clamped cosine's far-field falloff for diffuse lobes. */
     float h = -(dx * L->nx + dy * L->ny + dz * L->nz);
+    t->h[i] = h;
     float sb = h * L->ibehind;
     sb = sb < 0.0f ? 0.0f : (sb > 1.0f ? 1.0f : sb);
     float sp = (1.0f - (b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz)) * (1.0f / VSGL_CLIP_PARALLEL);
@@ -363,13 +366,62 @@ k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t)
     t->gpre[i] = b->camp[i] * (gz > 0.0f ? gz : 0.0f) * (K_PI * rp * ilin) * t->amp[i];
 }
 
+/* Stage 4b: glossy light from a planar cluster (shade.h, vsgl__planar_glossy):
+ * the radiance of the cluster's plane where the lobe's axis meets it,
+ * blurred by the lobe's footprint there: all but the exp. */
+static inline __attribute__((always_inline)) void
+k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
+{
+    float zx = b->Zx[i], zy = b->Zy[i], zz = b->Zz[i];
+    float h = t->h[i];
+    float nz = zx * L->nx + zy * L->ny + zz * L->nz;
+    float ok = (h > 0.0f ? 1.0f : 0.0f) * (nz < -1e-6f ? 1.0f : 0.0f);
+    float inz = 1.0f / (nz < -1e-6f ? nz : -1.0f);
+    float tt = -h * inz;
+    float nxd = b->Xx[i] * L->nx + b->Xy[i] * L->ny + b->Xz[i] * L->nz;
+    float nyd = b->Yx[i] * L->nx + b->Yy[i] * L->ny + b->Yz[i] * L->nz;
+    float zu1 = zx * L->u1x + zy * L->u1y + zz * L->u1z, zu2 = zx * L->u2x + zy * L->u2y + zz * L->u2z;
+    float xu1 = b->Xx[i] * L->u1x + b->Xy[i] * L->u1y + b->Xz[i] * L->u1z;
+    float xu2 = b->Xx[i] * L->u2x + b->Xy[i] * L->u2y + b->Xz[i] * L->u2z;
+    float yu1 = b->Yx[i] * L->u1x + b->Yy[i] * L->u1y + b->Yz[i] * L->u1z;
+    float yu2 = b->Yx[i] * L->u2x + b->Yy[i] * L->u2y + b->Yz[i] * L->u2z;
+    float fx = nxd * inz, fy = nyd * inz;
+    float a1 = tt * (xu1 - zu1 * fx), a2 = tt * (xu2 - zu2 * fx);
+    float b1 = tt * (yu1 - zu1 * fy), b2 = tt * (yu2 - zu2 * fy);
+    /* the offset from the cluster's mean to where the axis meets its plane: t z - (mean - x) */
+    float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
+    float ox = tt * zx - dx, oy = tt * zy - dy, oz = tt * zz - dz;
+    float d1 = ox * L->u1x + oy * L->u1y + oz * L->u1z, d2 = ox * L->u2x + oy * L->u2y + oz * L->u2z;
+    float lam = b->lam[i] > 1e-6f ? b->lam[i] : 1e-6f, mu = b->mu[i] > 1e-6f ? b->mu[i] : 1e-6f;
+    float il = 0.5f / lam, im = 0.5f / mu;
+    float s11 = L->var + a1 * a1 * il + b1 * b1 * im;
+    float s22 = L->var + a2 * a2 * il + b2 * b2 * im;
+    float s12 = a1 * a2 * il + b1 * b2 * im;
+    /* det = var^2 + var tr(A) + det(A), A the footprint: no cancellation */
+    float cr = a1 * b2 - a2 * b1;
+    float det = L->var * (L->var + (a1 * a1 + a2 * a2) * il + (b1 * b1 + b2 * b2) * im) + cr * cr * il * im;
+    det = det > 1e-30f ? det : 1e-30f;
+    float idet = 1.0f / det;
+    float qf = (s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) * idet;
+    t->pexpo[i] = qf > 0.0f ? -0.5f * qf : 0.0f;
+    float dlm = det * lam * mu;
+    t->ppre[i] = ok * b->camp[i] * (1.0f / K_2PI) * k_rsqrt(dlm > 1e-30f ? dlm : 1e-30f);
+}
+
 /* Stage 5: the glossy lobe's exp and the accumulation, with the smooth
  * Fresnel/shadowing factor per receiver at its lobe axis (Xu et al. Eq. 30:
  * M(z, o)), precomputed per lane and channel. */
 static inline __attribute__((always_inline)) void
-k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, const k_scratch *restrict t)
+k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, const k_scratch *restrict t,
+             int form)
 {
-    float gint = t->gpre[i] * k_exp(t->expo[i]);
+    float gint;
+    if (form == 0)       /* the SG model alone */
+        gint = t->gpre[i] * k_exp(t->expo[i]);
+    else if (form == 1)  /* the planar model alone */
+        gint = t->ppre[i] * k_exp(t->pexpo[i]);
+    else
+        gint = (1.0f - L->planar) * t->gpre[i] * k_exp(t->expo[i]) + L->planar * t->ppre[i] * k_exp(t->pexpo[i]);
     b->ls[0][i] += L->pr * gint * b->f0r[i];
     b->ls[1][i] += L->pg * gint * b->f0g[i];
     b->ls[2][i] += L->pb * gint * b->f0b[i];
@@ -425,8 +477,22 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
 #undef K_DIFFUSE
     }
     if (lobes & VSGL_KERNEL_GLOSSY) {
-        K_FORN(k_glossy(b, i, t + j));
-        K_FORN(k_glossy_sum(b, i, L + j, t + j));
+        /* the SG model, the planar one (coherent diffuse clusters) or a blend */
+        int all_planar = 1, none_planar = 1;
+        for (int j = 0; j < NL; ++j) {
+            all_planar &= L[j].planar == 1.0f;
+            none_planar &= L[j].planar == 0.0f;
+        }
+        if (!all_planar)
+            K_FORN(k_glossy(b, i, t + j));
+        if (!none_planar)
+            K_FORN(k_planar(b, i, L + j, t + j));
+        if (none_planar)
+            K_FORN(k_glossy_sum(b, i, L + j, t + j, 0));
+        else if (all_planar)
+            K_FORN(k_glossy_sum(b, i, L + j, t + j, 1));
+        else
+            K_FORN(k_glossy_sum(b, i, L + j, t + j, 2));
     }
 }
 

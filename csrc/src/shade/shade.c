@@ -68,6 +68,34 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
     return 1.0f - v->coherence * v->coherence * (1.0f - e);
 }
 
+float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
+{
+    v3 n = v->normal;
+    float h = v3_dot(n, v3_sub(x, v->mean)), nz = v3_dot(n, lobe->z);
+    if (!(h > 0.0f) || !(nz < -1e-6f) || !(lobe->log_amplitude > -INFINITY))
+        return 0.0f;
+    float t = h / -nz;
+    v3 dlt = v3_sub(v3_add(x, v3_scale(lobe->z, t)), v->mean);
+    v3 ex = v3_scale(v3_sub(lobe->x, v3_scale(lobe->z, v3_dot(n, lobe->x) / nz)), t);
+    v3 ey = v3_scale(v3_sub(lobe->y, v3_scale(lobe->z, v3_dot(n, lobe->y) / nz)), t);
+    v3 u1, u2;
+    v3_basis(n, &u1, &u2);
+    float lam = fmaxf(lobe->lambda, 1e-6f), mu = fmaxf(lobe->mu, 1e-6f);
+    float a1 = v3_dot(ex, u1), a2 = v3_dot(ex, u2), b1 = v3_dot(ey, u1), b2 = v3_dot(ey, u2);
+    float d1 = v3_dot(dlt, u1), d2 = v3_dot(dlt, u2);
+    float il = 0.5f / lam, im = 0.5f / mu, var = v->variance;
+    float s11 = var + a1 * a1 * il + b1 * b1 * im;
+    float s22 = var + a2 * a2 * il + b2 * b2 * im;
+    float s12 = a1 * a2 * il + b1 * b2 * im;
+    float cr = a1 * b2 - a2 * b1; /* det = var^2 + var tr(A) + det(A): no cancellation */
+    float det = var * (var + (a1 * a1 + a2 * a2) * il + (b1 * b1 + b2 * b2) * im) + cr * cr * il * im;
+    if (!(det > 0.0f))
+        return 0.0f;
+    float q = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
+    /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
+    return expf(lobe->log_amplitude - 0.5f * q) / (TWO_PI * sqrtf(fmaxf(det * lam * mu, 1e-30f)));
+}
+
 typedef struct shade_job {
     const vsgl_scene *scene;
     const vsgl_gbuffer *g;
@@ -207,6 +235,13 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 if (r.glossy) {
                     v3 axis;
                     float gi = glossy_integral(j, &r, &in, &axis);
+                    if (j->leak && v->lobe == VSGL_LOBE_DIFFUSE) {
+                        vsgl_asg lobe = r.asg;
+                        if (j->s->glossy_mode == VSGL_GLOSSY_SG)
+                            vsgl_sg_to_asg(&r.sg, &lobe);
+                        float k2 = v->coherence * v->coherence;
+                        gi = (1.0f - k2) * gi + k2 * vsgl__planar_glossy(v, r.x, &lobe);
+                    }
                     if (gi > 0.0f)
                         for (int c = 0; c < 3; ++c)
                             ls[c] += v->power[c] * gi *
@@ -505,6 +540,11 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
             o->clip = leak ? v->coherence * v->coherence : 0.0f;
             o->conv = v->lobe == VSGL_LOBE_DIFFUSE ? 1.0f : 0.0f;
             o->ibehind = 1.0f / (VSGL_CLIP_BEHIND * sqrtf(v->variance) + 1e-30f);
+            o->planar = leak && v->lobe == VSGL_LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
+            v3 u1, u2;
+            v3_basis(v->normal, &u1, &u2);
+            o->u1x = u1.x; o->u1y = u1.y; o->u1z = u1.z;
+            o->u2x = u2.x; o->u2y = u2.y; o->u2z = u2.z;
         }
     }
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),

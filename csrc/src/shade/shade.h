@@ -6,6 +6,7 @@
 #include "fit/vsgl_set.h"
 #include "gbuffer/gbuffer.h"
 #include "vsgl/sg.h"
+#include "vsgl/asg.h"
 #include "shade/kernel.h"
 
 /* Per-pixel accumulation planes (width*height*3 floats each, caller-owned,
@@ -55,6 +56,20 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
 /* The clip factor of VSGL v for a receiver at x with unit normal n, in [0, 1]
  * (the kernel computes the same inline); `on` selects the clip. */
 float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
+
+/* Glossy light of a planar, Lambertian cluster (the lattice's diffuse
+ * VSGLs) through a receiver lobe (ASG, amplitude included), per watt: the
+ * cluster's plane has radiance N(y)/pi, N its 2-D Gaussian of variance
+ * `variance` per axis about the mean; the lobe's axis meets the plane at
+ * y0 = x + t z (t = h / -(n.z), nothing unless the receiver is in front,
+ * h > 0, and the axis points at the plane's front); the lobe's angular
+ * spread maps to a footprint of covariance J diag(1/2lambda, 1/2mu) J^T
+ * there; the result is the lobe's integral pi / sqrt(lambda mu) times the
+ * radiance blurred by the footprint, N(y0 - mean; variance I + footprint) / pi.
+ * Unlike the round spread SG it sees a plane foreshortened (a cabinet's
+ * face reflecting the floor beside it: 0.65 -> 1.08 of the brute force's
+ * glossy light in the sun room) and never anything behind the plane. */
+float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe);
 
 /* Shade every G-buffer sample with every VSGL; writes `planes`.
  * `pairs` receives the number of sample x VSGL evaluations. */
