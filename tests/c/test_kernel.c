@@ -204,6 +204,9 @@ static void random_light(vt_rng *r, vsgl_kernel_light *o, int sharp)
     o->clip = (float)vt_uniform(r);
     o->conv = vt_uniform(r) < 0.5 ? 1.0f : 0.0f;
     o->ibehind = 1.0f / (0.02f * sqrtf(o->var));
+    /* a planar cluster (its normal -z) for half the lights: the planar glossy stage */
+    o->planar = vt_uniform(r) < 0.5 ? (vt_uniform(r) < 0.5 ? 1.0f : (float)vt_uniform(r)) : 0.0f;
+    o->u1x = 1.0f; o->u2y = 1.0f;
 }
 
 /* Every ISA copy (AVX-512, AVX2, baseline) and the library's scalar build
@@ -221,12 +224,20 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
     vt_rng r = {2024};
     static vsgl_kernel_block base, ref, got;
     static float vis[8 * VSGL_KERNEL_BLOCK];
-    double worst[3] = {0, 0, 0};
+    double worst[3] = {0, 0, 0}, worst_c[3] = {0, 0, 0};
     for (int trial = 0; trial < 60; ++trial) {
         random_block(&r, &base);
         vsgl_kernel_light L[8];
-        for (int k = 0; k < 8; ++k)
+        /* half the trials without the emitter clip and the planar model: the
+         * strict tolerance; the clip's fades scale with the height above a
+         * cluster's plane, a difference of coordinates that any order of
+         * operations rounds differently near the plane */
+        int plain = trial % 4 < 2;
+        for (int k = 0; k < 8; ++k) {
             random_light(&r, &L[k], trial % 2);
+            if (plain)
+                L[k].clip = L[k].planar = 0.0f;
+        }
         for (int k = 0; k < 8 * VSGL_KERNEL_BLOCK; ++k)
             vis[k] = (float)vt_uniform(&r);
         for (int mode = 0; mode < 3; ++mode)
@@ -249,16 +260,24 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
                             double ed = fabs((double)got.ld[c][k] - ref.ld[c][k]) / (fabs(ref.ld[c][k]) + 1e-6 * scale);
                             double es = fabs((double)got.ls[c][k] - ref.ls[c][k]) / (fabs(ref.ls[c][k]) + 1e-6 * scale);
                             VT_CHECK(isfinite(got.ld[c][k]) && isfinite(got.ls[c][k]), "%s: non-finite", names[f]);
-                            worst[f] = fmax(worst[f], fmax(ed, es));
+                            if (plain)
+                                worst[f] = fmax(worst[f], fmax(ed, es));
+                            else
+                                worst_c[f] = fmax(worst_c[f], fmax(ed, es));
                         }
                 }
             }
     }
     for (int f = 0; f < 3; ++f) {
         if (getenv("VSGL_TEST_VERBOSE"))
-            printf("    %s: %s, worst relative difference to the scalar build %.3g\n", names[f],
-                   have[f] ? "run" : "not supported here", worst[f]);
+            printf("    %s: %s, worst relative difference to the scalar build %.3g (with the clip and planar model %.3g)\n",
+                   names[f], have[f] ? "run" : "not supported here", worst[f], worst_c[f]);
         VT_CHECK(worst[f] < 2e-4, "%s: worst relative difference %.3g", names[f], worst[f]);
+        /* the clip's fades near a cluster's plane and the planar model's
+         * quadratic form for the most anisotropic lobes (lambda / mu up to
+         * 10^4) are ill-conditioned: rounding of ~5e-4 of values far below
+         * what a pixel shows */
+        VT_CHECK(worst_c[f] < 2e-3, "%s: with the clip: worst relative difference %.3g", names[f], worst_c[f]);
     }
 #else
     printf("    (skipped: the ISA clones are built by GCC on x86-64 only)\n");

@@ -372,12 +372,21 @@ k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t)
 static inline __attribute__((always_inline)) void
 k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
 {
+    /* lengths in units of the cluster's sigma, so that nothing overflows:
+     * the axis must meet the plane at t <= 1e4 sigma and >= 0.6 degrees
+     * off it (beyond, the footprint's density is ~0 anyway) */
     float zx = b->Zx[i], zy = b->Zy[i], zz = b->Zz[i];
-    float h = t->h[i];
+    float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
+    float d2 = t->d2[i];
+    float var = L->var > d2 * 4.547473508864641e-13f ? L->var : d2 * 4.547473508864641e-13f;
+    var = var > 1e-30f ? var : 1e-30f;
+    float is = k_rsqrt_fine(var); /* the offsets scale with it and q amplifies their error */
+    float h = t->h[i] * is;
     float nz = zx * L->nx + zy * L->ny + zz * L->nz;
-    float ok = (h > 0.0f ? 1.0f : 0.0f) * (nz < -1e-6f ? 1.0f : 0.0f);
-    float inz = 1.0f / (nz < -1e-6f ? nz : -1.0f);
+    float ok = (h > 0.0f ? 1.0f : 0.0f) * (nz < -0.01f ? 1.0f : 0.0f);
+    float inz = 1.0f / (nz < -0.01f ? nz : -0.01f);
     float tt = -h * inz;
+    tt = tt < 1e4f ? (tt > 0.0f ? tt : 0.0f) : 1e4f;
     float nxd = b->Xx[i] * L->nx + b->Xy[i] * L->ny + b->Xz[i] * L->nz;
     float nyd = b->Yx[i] * L->nx + b->Yy[i] * L->ny + b->Yz[i] * L->nz;
     float zu1 = zx * L->u1x + zy * L->u1y + zz * L->u1z, zu2 = zx * L->u2x + zy * L->u2y + zz * L->u2z;
@@ -389,23 +398,20 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     float a1 = tt * (xu1 - zu1 * fx), a2 = tt * (xu2 - zu2 * fx);
     float b1 = tt * (yu1 - zu1 * fy), b2 = tt * (yu2 - zu2 * fy);
     /* the offset from the cluster's mean to where the axis meets its plane: t z - (mean - x) */
-    float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
-    float ox = tt * zx - dx, oy = tt * zy - dy, oz = tt * zz - dz;
-    float d1 = ox * L->u1x + oy * L->u1y + oz * L->u1z, d2 = ox * L->u2x + oy * L->u2y + oz * L->u2z;
-    float lam = b->lam[i] > 1e-6f ? b->lam[i] : 1e-6f, mu = b->mu[i] > 1e-6f ? b->mu[i] : 1e-6f;
+    float ox = tt * zx - dx * is, oy = tt * zy - dy * is, oz = tt * zz - dz * is;
+    float d1 = ox * L->u1x + oy * L->u1y + oz * L->u1z, e2 = ox * L->u2x + oy * L->u2y + oz * L->u2z;
+    float lam = b->lam[i] > 0.01f ? b->lam[i] : 0.01f, mu = b->mu[i] > 0.01f ? b->mu[i] : 0.01f;
     float il = 0.5f / lam, im = 0.5f / mu;
-    float s11 = L->var + a1 * a1 * il + b1 * b1 * im;
-    float s22 = L->var + a2 * a2 * il + b2 * b2 * im;
+    float s11 = 1.0f + a1 * a1 * il + b1 * b1 * im;
+    float s22 = 1.0f + a2 * a2 * il + b2 * b2 * im;
     float s12 = a1 * a2 * il + b1 * b2 * im;
-    /* det = var^2 + var tr(A) + det(A), A the footprint: no cancellation */
+    /* det = 1 + tr(A) + det(A), A the footprint: no cancellation */
     float cr = a1 * b2 - a2 * b1;
-    float det = L->var * (L->var + (a1 * a1 + a2 * a2) * il + (b1 * b1 + b2 * b2) * im) + cr * cr * il * im;
-    det = det > 1e-30f ? det : 1e-30f;
+    float det = s11 + s22 - 1.0f + cr * cr * il * im;
     float idet = 1.0f / det;
-    float qf = (s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) * idet;
+    float qf = (s22 * d1 * d1 - 2.0f * s12 * d1 * e2 + s11 * e2 * e2) * idet;
     t->pexpo[i] = qf > 0.0f ? -0.5f * qf : 0.0f;
-    float dlm = det * lam * mu;
-    t->ppre[i] = ok * b->camp[i] * (1.0f / K_2PI) * k_rsqrt(dlm > 1e-30f ? dlm : 1e-30f);
+    t->ppre[i] = ok * b->camp[i] * (1.0f / K_2PI) * k_rsqrt(det * lam * mu) * (is * is);
 }
 
 /* Stage 5: the glossy lobe's exp and the accumulation, with the smooth

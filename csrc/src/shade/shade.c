@@ -74,13 +74,15 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
     float h = v3_dot(n, v3_sub(x, v->mean)), nz = v3_dot(n, lobe->z);
     if (!(h > 0.0f) || !(nz < -1e-6f) || !(lobe->log_amplitude > -INFINITY))
         return 0.0f;
+    if (!(nz < -0.01f))
+        return 0.0f; /* within 0.6 degrees of the plane: the footprint's density is ~0 (the kernel's bound) */
     float t = h / -nz;
     v3 dlt = v3_sub(v3_add(x, v3_scale(lobe->z, t)), v->mean);
     v3 ex = v3_scale(v3_sub(lobe->x, v3_scale(lobe->z, v3_dot(n, lobe->x) / nz)), t);
     v3 ey = v3_scale(v3_sub(lobe->y, v3_scale(lobe->z, v3_dot(n, lobe->y) / nz)), t);
     v3 u1, u2;
     v3_basis(n, &u1, &u2);
-    float lam = fmaxf(lobe->lambda, 1e-6f), mu = fmaxf(lobe->mu, 1e-6f);
+    float lam = fmaxf(lobe->lambda, 0.01f), mu = fmaxf(lobe->mu, 0.01f);
     float a1 = v3_dot(ex, u1), a2 = v3_dot(ex, u2), b1 = v3_dot(ey, u1), b2 = v3_dot(ey, u2);
     float d1 = v3_dot(dlt, u1), d2 = v3_dot(dlt, u2);
     float il = 0.5f / lam, im = 0.5f / mu, var = v->variance;
