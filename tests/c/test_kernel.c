@@ -192,6 +192,7 @@ static void random_light(vt_rng *r, vsgl_kernel_light *o, int sharp)
     o->my = (float)(4.0 * vt_uniform(r) - 2.0);
     o->mz = (float)(4.0 * vt_uniform(r) - 2.0);
     o->var = (float)pow(10.0, sharp ? -7.0 + 2.0 * vt_uniform(r) : -3.0 + 3.0 * vt_uniform(r));
+    o->pvar = o->var * (vt_uniform(r) < 0.5 ? 1.0f : 2.0f);
     o->var2 = 2.0f * o->var;
     o->ivar = 1.0f / o->var;
     o->valid = 1.0f;

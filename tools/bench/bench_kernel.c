@@ -49,6 +49,9 @@ int main(int argc, char **argv)
         l->my = 2.0f * uniform(&s) - 1.0f;
         l->mz = 2.0f * uniform(&s);
         l->var = 0.001f + 0.05f * uniform(&s);
+        l->pvar = 2.0f * l->var;
+        l->planar = 1.0f; /* the lattice's coherent diffuse clusters: the planar glossy model */
+        l->u1x = 1.0f; l->u2y = 1.0f;
         l->var2 = 2.0f * l->var;
         l->ivar = 1.0f / l->var;
         l->valid = 1.0f;

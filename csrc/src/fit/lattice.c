@@ -20,10 +20,13 @@
  *
  * So every VSGL's sums are continuous functions of the RSM; a light that
  * moves a little changes them a little. The tents of neighbouring lattice
- * points overlap, so their Gaussians sum to a smooth field; each VSGL's
- * positional variance is widened by VSGL_LATTICE_OVERLAP h^2 on top of its
- * own (h^2 / 6 per axis for a uniformly lit tent), which takes the ripple
- * of the sum from ~7 % to ~1 % (docs/accuracy.md). */
+ * points overlap, so their Gaussians sum to a smooth field. Seen through
+ * a sharp glossy lobe, the sum of Gaussians of the tents' own variance
+ * (h^2 / 6 per axis) still ripples by ~7 % (stripes in a metal floor's
+ * reflection of a lit wall); the planar glossy model widens each by
+ * VSGL_LATTICE_OVERLAP h^2 (ripple ~0.3 %). The diffuse light is not
+ * widened: wider Gaussians spill light past a junction, where the wall
+ * beside the floor cannot see it (-4 % of the diffuse light in a box). */
 #include "fit/grid.h"
 #include "core/context.h"
 
@@ -33,8 +36,9 @@
 
 /* Slab thickness along a bin's axis, in units of h. */
 #define VSGL_LATTICE_SLAB 0.25
-/* Extra positional variance per VSGL, in units of h^2. */
-#define VSGL_LATTICE_OVERLAP (1.0 / 12.0)
+/* Extra positional variance of a VSGL seen through a glossy lobe, in
+ * units of h^2 (vsgl_vsgl.widen). */
+#define VSGL_LATTICE_OVERLAP (1.0 / 6.0)
 
 /* Open-addressing map from a packed lattice key to a cluster's sums. */
 typedef struct cell_map {
@@ -217,7 +221,7 @@ vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const 
             vsgl_vsgl v;
             vsgl__grid_moments(f, &mo);
             if (vsgl__moments_to_vsgl(&mo, g.origin, s->sharpness_estimator, rsm->light, lobe, &v)) {
-                v.variance += (float)widen;
+                v.widen = (float)widen;
                 r = vsgl__vsgl_set_push(out, &v);
                 if (r != VSGL_OK)
                     r = vsgl__fail(ctx, r, "fit: out of memory");

@@ -22,6 +22,8 @@ typedef struct vsgl_vsgl {
     float power[3];     /* sum of Phi R over the cluster (RGB, W), after FIS weighting */
     v3 normal;          /* unit mean surface normal of the cluster's VPLs */
     float coherence;    /* |weighted mean normal| in [0, 1]: 1 = all VPLs coplanar-facing */
+    float widen;        /* extra positional variance (m^2) for the planar glossy model only: the
+                         * lattice's overlap of neighbouring clusters (0 for the other fits) */
     uint32_t light;     /* scene light index */
     uint32_t lobe;      /* VSGL_LOBE_* */
 } vsgl_vsgl;

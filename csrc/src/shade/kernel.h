@@ -53,6 +53,7 @@ typedef struct vsgl_kernel_light {
     float conv;              /* 1 for a diffuse lobe: clamped-cosine emission in the far field */
     float ibehind;           /* 1 / (VSGL_CLIP_BEHIND sigma) */
     float planar;            /* weight of the planar glossy model (coherence^2 of a diffuse lobe, clip on), else 0 */
+    float pvar;              /* its positional variance (var + the fit's overlap widening) */
     float u1x, u1y, u1z, u2x, u2y, u2z; /* an orthonormal basis of the cluster's plane */
 } vsgl_kernel_light;
 

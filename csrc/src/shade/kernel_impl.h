@@ -378,7 +378,7 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     float zx = b->Zx[i], zy = b->Zy[i], zz = b->Zz[i];
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
     float d2 = t->d2[i];
-    float var = L->var > d2 * 4.547473508864641e-13f ? L->var : d2 * 4.547473508864641e-13f;
+    float var = L->pvar > d2 * 4.547473508864641e-13f ? L->pvar : d2 * 4.547473508864641e-13f;
     var = var > 1e-30f ? var : 1e-30f;
     float is = k_rsqrt_fine(var); /* the offsets scale with it and q amplifies their error */
     float h = t->h[i] * is;

@@ -85,7 +85,7 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
     float lam = fmaxf(lobe->lambda, 0.01f), mu = fmaxf(lobe->mu, 0.01f);
     float a1 = v3_dot(ex, u1), a2 = v3_dot(ex, u2), b1 = v3_dot(ey, u1), b2 = v3_dot(ey, u2);
     float d1 = v3_dot(dlt, u1), d2 = v3_dot(dlt, u2);
-    float il = 0.5f / lam, im = 0.5f / mu, var = v->variance;
+    float il = 0.5f / lam, im = 0.5f / mu, var = v->variance + v->widen;
     float s11 = var + a1 * a1 * il + b1 * b1 * im;
     float s22 = var + a2 * a2 * il + b2 * b2 * im;
     float s12 = a1 * a2 * il + b1 * b2 * im;
@@ -543,6 +543,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
             o->conv = v->lobe == VSGL_LOBE_DIFFUSE ? 1.0f : 0.0f;
             o->ibehind = 1.0f / (VSGL_CLIP_BEHIND * sqrtf(v->variance) + 1e-30f);
             o->planar = leak && v->lobe == VSGL_LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
+            o->pvar = v->variance + v->widen;
             v3 u1, u2;
             v3_basis(v->normal, &u1, &u2);
             o->u1x = u1.x; o->u1y = u1.y; o->u1z = u1.z;
