@@ -12,13 +12,13 @@ DEFAULT_TEMPLATE = "{render_dir}/vsgl/{scene}_{view_layer}_####.exr"
 # name -> (enum items or None, default)
 KNOBS = {
     "method": (("VSGL", "BRUTE_FORCE"), "VSGL"),
-    "aa_samples": (None, 1),
+    "aa_samples": (None, 2),
     "rsm_resolution": (None, 256),
-    "fit_mode": (("TWO", "FIS", "KMEANS"), "TWO"),
-    "vsgl_count": (None, 64),
+    "fit_mode": (("TWO", "FIS", "KMEANS", "LATTICE"), "LATTICE"),
+    "vsgl_count": (None, 128),
     "fis_iterations": (None, 8),
     "sharpness_estimator": (("TOKSVIG", "BANERJEE"), "TOKSVIG"),
-    "diffuse_mode": (("SG", "PULLED_OUT", "ACCURATE"), "ACCURATE"),
+    "diffuse_mode": (("SG", "PULLED_OUT", "ACCURATE"), "PULLED_OUT"),
     "glossy_mode": (("ASG", "SG"), "ASG"),
     "visibility": (("NONE", "RAY"), "NONE"),
     "seed": (None, 0),
@@ -34,13 +34,13 @@ class Options:
     preset: str = "BALANCED"
     use_advanced: bool = False
     method: str = "VSGL"
-    aa_samples: int = 1
+    aa_samples: int = 2
     rsm_resolution: int = 256
-    fit_mode: str = "TWO"
-    vsgl_count: int = 64
+    fit_mode: str = "LATTICE"
+    vsgl_count: int = 128
     fis_iterations: int = 8
     sharpness_estimator: str = "TOKSVIG"
-    diffuse_mode: str = "ACCURATE"
+    diffuse_mode: str = "PULLED_OUT"
     glossy_mode: str = "ASG"
     visibility: str = "NONE"
     seed: int = 0

@@ -47,19 +47,21 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
     use_advanced: BoolProperty(name="Advanced", default=False,
                                description="Use the knobs below instead of the preset's values")
     method: EnumProperty(name="Method", items=_items(config.KNOBS["method"][0]), default="VSGL")
-    aa_samples: IntProperty(name="AA Samples", default=1, min=1, max=8,
+    aa_samples: IntProperty(name="AA Samples", default=config.KNOBS["aa_samples"][1], min=1, max=8,
                             description="Camera samples per pixel per axis (N x N)")
     rsm_resolution: IntProperty(name="RSM Resolution", default=256, min=8, max=4096,
                                 description="Reflective shadow map side per light (texels)")
-    fit_mode: EnumProperty(name="Fit", items=_items(config.KNOBS["fit_mode"][0]), default="TWO",
-                           description="Two VSGLs per light, filtered importance sampling or k-means")
-    vsgl_count: IntProperty(name="VSGLs per Light", default=64, min=1, max=65536)
+    fit_mode: EnumProperty(name="Fit", items=_items(config.KNOBS["fit_mode"][0]),
+                           default=config.KNOBS["fit_mode"][1],
+                           description="Two VSGLs per light, filtered importance sampling, k-means, or a "
+                                       "world-space lattice (steady in animation, no blotches)")
+    vsgl_count: IntProperty(name="VSGLs per Light", default=config.KNOBS["vsgl_count"][1], min=1, max=65536)
     fis_iterations: IntProperty(name="FIS Iterations", default=8, min=1, max=32)
     sharpness_estimator: EnumProperty(name="Sharpness",
                                       items=_items(config.KNOBS["sharpness_estimator"][0]),
                                       default="TOKSVIG")
     diffuse_mode: EnumProperty(name="Diffuse Cosine", items=_items(config.KNOBS["diffuse_mode"][0]),
-                               default="ACCURATE")
+                               default=config.KNOBS["diffuse_mode"][1])
     glossy_mode: EnumProperty(name="Glossy Lobe", items=_items(config.KNOBS["glossy_mode"][0]),
                               default="ASG")
     visibility: EnumProperty(name="Visibility", items=_items(config.KNOBS["visibility"][0]),
@@ -67,8 +69,8 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
     seed: IntProperty(name="Seed", default=0, min=0)
     leak_correction: EnumProperty(name="Leak Correction", items=_items(config.KNOBS["leak_correction"][0]),
                                   default="AUTO",
-                                  description="Fade light a VSGL sends into its own surface's plane "
-                                              "(auto: on with FIS and k-means)")
+                                  description="Clip a VSGL's light to the front of its surface "
+                                              "(auto: on)")
     sample_merging: EnumProperty(name="Sample Merging", items=_items(config.KNOBS["sample_merging"][0]),
                                  default="AUTO",
                                  description="Shade a pixel's samples on one surface once (auto: on)")

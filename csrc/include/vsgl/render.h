@@ -33,14 +33,16 @@ extern "C" {
 #define VSGL_VISIBILITY_NONE 0
 #define VSGL_VISIBILITY_RAY  1  /**< one ray from the shading point to each VSGL centre / VPL */
 
-/* Emitter-hemisphere (light-leak) correction: VPLs on a surface emit only
- * above it, but a VSGL's lobe and its spherical projection leak light to
- * receivers in or below the cluster's plane (a floor lighting itself). The
- * correction fades a VSGL's light out as the emission cosine towards the
- * receiver, softened by the cluster's spread, goes below 0.05, weighted by
- * how coplanar the cluster's normals are. docs/accuracy.md measures it:
- * it helps with many VSGLs and hurts with two. */
-#define VSGL_LEAK_AUTO 0  /**< on for FIS and k-means, off for two VSGLs per light */
+/* Emitter-hemisphere clip (the light-leak correction): VPLs on a surface
+ * emit only in front of it, with a clamped cosine; the papers' SG lobe
+ * leaks ~9 % of a cluster's light behind its surface (a sunlit roof lights
+ * the ceiling under it, a floor lights itself) and is 15-25 % off in the
+ * far field. With the clip, a cluster gives nothing behind or in its own
+ * plane, nothing to receivers facing its way, the clamped cosine's falloff
+ * far away, and a lattice cluster's glossy light comes from its plane seen
+ * foreshortened. Weighted by how coherent the cluster's normals are (the
+ * lattice's clusters: fully). docs/accuracy.md measures it. */
+#define VSGL_LEAK_AUTO 0  /**< on */
 #define VSGL_LEAK_OFF  1  /**< the papers' model */
 #define VSGL_LEAK_ON   2
 
@@ -66,8 +68,9 @@ typedef struct vsgl_render_settings {
     int32_t method;              /**< VSGL_METHOD_*, default VSGL */
     uint32_t aa_samples;         /**< samples per pixel per axis (N x N), default 1 */
     uint32_t rsm_resolution;     /**< RSM side in texels (cube faces: per face), default 256 */
-    int32_t fit_mode;            /**< VSGL_FIT_*, default TWO */
-    uint32_t vsgl_count;         /**< VSGLs per light for FIS/k-means, default 64 */
+    int32_t fit_mode;            /**< VSGL_FIT_*, default TWO (the presets: LATTICE) */
+    uint32_t vsgl_count;         /**< VSGLs per light for FIS/k-means; lattice: about this many per light
+                                      (more where surfaces of several orientations share the lit area), default 64 */
     uint32_t fis_iterations;     /**< bisection steps of the mip level, default 8 */
     int32_t sharpness_estimator; /**< VSGL_SHARPNESS_*, default TOKSVIG */
     int32_t diffuse_mode;        /**< VSGL_COSINE_*, default ACCURATE */

@@ -219,6 +219,7 @@ typedef struct k_scratch {
     /* the accurate cosine's part that depends on lin alone (k_cos_l) */
     float low[VSGL_KERNEL_BLOCK], u[VSGL_KERNEL_BLOCK], t[VSGL_KERNEL_BLOCK], it[VSGL_KERNEL_BLOCK];
     float h[VSGL_KERNEL_BLOCK];                                               /* height above the cluster's plane */
+    float vis[VSGL_KERNEL_BLOCK];                                             /* visibility x validity */
     float pexpo[VSGL_KERNEL_BLOCK], ppre[VSGL_KERNEL_BLOCK];                  /* the planar glossy's exp argument, factor */
     float kappa[VSGL_KERNEL_BLOCK], ct[VSGL_KERNEL_BLOCK];
 } k_scratch;
@@ -255,6 +256,7 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
     float w = s / (s + VSGL_CLIP_NEAR) * L->conv;
     float e = sb * sb * (3.0f - 2.0f * sb) * sp * sp * (3.0f - 2.0f * sp) * ((1.0f - w) + w * rho);
     float valid = (d2 > 0.0f ? 1.0f : L->valid) * vis;
+    t->vis[i] = valid;
     t->amp[i] = valid * L->c0 * (1.0f - L->clip * (1.0f - e));
 }
 
@@ -411,7 +413,7 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     float idet = 1.0f / det;
     float qf = (s22 * d1 * d1 - 2.0f * s12 * d1 * e2 + s11 * e2 * e2) * idet;
     t->pexpo[i] = qf > 0.0f ? -0.5f * qf : 0.0f;
-    t->ppre[i] = ok * b->camp[i] * (1.0f / K_2PI) * k_rsqrt(det * lam * mu) * (is * is);
+    t->ppre[i] = ok * t->vis[i] * b->camp[i] * (1.0f / K_2PI) * k_rsqrt(det * lam * mu) * (is * is);
 }
 
 /* Stage 5: the glossy lobe's exp and the accumulation, with the smooth

@@ -151,7 +151,17 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     }
 }
 
-/* Visibility of `target` (a VSGL's mean) from receivers rec[0..n), n <=
+/* Where visibility rays aim for VSGL v: its mean, pushed off its surface
+ * along its mean normal by one sigma. A curved surface's cluster has its
+ * mean inside the object (a sphere's cap: the mean of points on it lies
+ * below them), and rays from the surface around it would be blocked by
+ * that very surface. */
+static v3 ray_target(const vsgl_vsgl *v)
+{
+    return v3_add(v->mean, v3_scale(v->normal, v->coherence * sqrtf(v->variance)));
+}
+
+/* Visibility of `target` (a VSGL's ray target) from receivers rec[0..n), n <=
  * VSGL_KERNEL_BLOCK: one batched occlusion query (Embree ray streams) from
  * each receiver offset along its normal; vis[k] = 0 if blocked, else 1. A
  * receiver at the target traces an empty segment (visible). */
@@ -225,7 +235,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                     in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), 1e-30f));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
                     float vis;
-                    visibility_rays(j, v->mean, &r, 1, &vis);
+                    visibility_rays(j, ray_target(v), &r, 1, &vis);
                     if (vis == 0.0f)
                         continue;
                 }
@@ -435,7 +445,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
                 for (size_t v = 0; v < count; v += 2) {
                     size_t m = count - v < 2 ? count - v : 2;
                     for (size_t q = 0; q < m; ++q)
-                        visibility_rays(j, j->set->items[v + q].mean, rec, n, vis + q * VSGL_KERNEL_BLOCK);
+                        visibility_rays(j, ray_target(&j->set->items[v + q]), rec, n, vis + q * VSGL_KERNEL_BLOCK);
                     kernel(&blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
                 }
             } else {
