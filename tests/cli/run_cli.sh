@@ -139,7 +139,7 @@ fi
 # ---- dry run --------------------------------------------------------------------
 if want dry_run; then
   if expect_ok dry_run "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --preset quality; then
-    if grep -q "dry run: .* would render 64x48 to $T/dry.exr with method=vsgl aa=2 rsm=512 fit=kmeans" "$T/out" && [ ! -e "$T/dry.exr" ]; then
+    if grep -q "dry run: .* would render 64x48 to $T/dry.exr with method=vsgl aa=2 rsm=512 fit=lattice" "$T/out" && [ ! -e "$T/dry.exr" ]; then
       ok dry_run; else bad dry_run "$(cat "$T/out")" "file exists: $([ -e "$T/dry.exr" ] && echo yes || echo no)"; fi
   fi
 fi
