@@ -11,8 +11,9 @@
  *    is what lets the shading clip its emission to its own hemisphere;
  *  - position: within bin b (axis a), lattice points h apart in the two
  *    axes across a, with tent (bilinear) weights, which sum to 1 and are
- *    continuous in the VPL's position; along a, slabs h/4 thick (surfaces
- *    of one bin at different heights, a floor and a table top, stay apart);
+ *    continuous in the VPL's position; along a, slabs h thick (surfaces of
+ *    one bin at different heights, a floor and a table top, stay apart;
+ *    thinner slabs cut a sphere into more clusters for no gain);
  *  - the lattice is anchored at the scene's bounds, not at the light, and
  *    h follows the light's effective lit area A (the power-weighted
  *    participation area (sum w)^2 / sum(w^2 / a)), h = sqrt(A / N): both
@@ -35,7 +36,7 @@
 #include <string.h>
 
 /* Slab thickness along a bin's axis, in units of h. */
-#define VSGL_LATTICE_SLAB 0.25
+#define VSGL_LATTICE_SLAB 1.0
 /* Extra positional variance of a VSGL seen through a glossy lobe, in
  * units of h^2 (vsgl_vsgl.widen). */
 #define VSGL_LATTICE_OVERLAP (1.0 / 6.0)
