@@ -2,14 +2,14 @@
 #
 # Python: the C library is tested from Debian's /usr/bin/python3 (the one
 # Debian's Blender 3.4 embeds, with python3-numpy/python3-pytest). The
-# newest Blender-as-a-module (`bpy` from PyPI) is tested from $(PIP_PYTHON),
+# newest Blender-as-a-module (`bpy` from PyPI) is tested from $(BPY_PYTHON),
 # the pyenv python3 on PATH, into which tools/ installs bpy with pip.
 SHELL := /bin/bash
 .DEFAULT_GOAL := all
 
 CC      ?= cc
 PYTHON  ?= /usr/bin/python3
-PIP_PYTHON ?= python3
+BPY_PYTHON ?= python3
 BUILD   := build
 INCLUDES := -Icsrc/include -Icsrc/src $(shell pkg-config --cflags-only-I OpenEXR 2>/dev/null)
 WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes -Wmissing-prototypes
@@ -73,7 +73,7 @@ $(BUILD)/tests/vsgl_tests: $(TEST_OBJ) $(LIB_OBJ)
 test:
 	@tools/deps.sh test
 	@$(MAKE) --no-print-directory all $(BUILD)/tests/vsgl_tests >/dev/null
-	@PYTHON=$(PYTHON) PIP_PYTHON=$(PIP_PYTHON) tools/run_tests.sh
+	@PYTHON=$(PYTHON) BPY_PYTHON=$(BPY_PYTHON) tools/run_tests.sh
 
 test-c: $(BUILD)/tests/vsgl_tests
 	$(BUILD)/tests/vsgl_tests $(T)

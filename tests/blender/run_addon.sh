@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Add-on tests (tests/blender/addon) on Debian's Blender 3.4 binary and on the
-# pip `bpy` module (Blender 5.x) in $PIP_PYTHON. Ends with "N passed, N failed".
+# pip `bpy` module (Blender 5.x) in $BPY_PYTHON. Ends with "N passed, N failed".
 set -uo pipefail
 cd "$(dirname "$0")/../.."
-PIP_PYTHON=${PIP_PYTHON:-python3}
+BPY_PYTHON=${BPY_PYTHON:-python3}
 BLENDER=${BLENDER:-blender}
 export PYTHONDONTWRITEBYTECODE=1
 pass=0; fail=0; status=0
@@ -30,12 +30,12 @@ else
   echo "run_addon.sh: no '$BLENDER' binary; install Debian's blender (tools/deps.sh test)"; fail=$((fail + 1)); status=1
 fi
 
-if "$PIP_PYTHON" -c 'import bpy, numpy, pytest' >/dev/null 2>&1 || tools/install_bpy.sh; then
-  echo "== add-on tests in bpy $("$PIP_PYTHON" -c 'import bpy; print(bpy.app.version_string)' 2>/dev/null | tail -1)"
-  "$PIP_PYTHON" -m pytest -q -rs -p no:cacheprovider tests/blender/addon "$@" 2>&1 | tee "$log"
+if "$BPY_PYTHON" -c 'import bpy, numpy, pytest' >/dev/null 2>&1 || tools/install_bpy.sh; then
+  echo "== add-on tests in bpy $("$BPY_PYTHON" -c 'import bpy; print(bpy.app.version_string)' 2>/dev/null | tail -1)"
+  "$BPY_PYTHON" -m pytest -q -rs -p no:cacheprovider tests/blender/addon "$@" 2>&1 | tee "$log"
   tally "pip bpy" "${PIPESTATUS[0]}"
 else
-  echo "run_addon.sh: cannot import bpy in $PIP_PYTHON (tools/install_bpy.sh failed)"; fail=$((fail + 1)); status=1
+  echo "run_addon.sh: cannot import bpy in $BPY_PYTHON (tools/install_bpy.sh failed)"; fail=$((fail + 1)); status=1
 fi
 rm -f "$log"
 echo "$pass passed, $fail failed"
