@@ -1,6 +1,7 @@
 """Export of the evaluated depsgraph against the scene built in each test and
 Blender's own values (matrix_world, loop counts, light settings)."""
 import math
+import os
 
 import bpy
 import numpy as np
@@ -347,3 +348,36 @@ def test_collection_holdout_and_layer_paths_distinct(scene):
     a = runner.output_path(scene, "ViewLayer", 5)
     b = runner.output_path(scene, "Other", 5)
     assert a != b and a.endswith("_0005.exr") and b.endswith("_0005.exr")
+
+
+def test_degenerate_objects_dropped_with_named_warning(scene, tmp_path):
+    """Issue 10: an object scaled (1, 1, 0) or (0, 0, 0) gave zero-length
+    normals and the library refused the whole frame without naming it. Its
+    degenerate triangles are dropped with a warning naming the object; the
+    rest of the scene (and the object's faces that keep an area) is exported."""
+    basic(scene)
+    link(scene, plane("Floor", 6.0))
+    flat = link(scene, cube("Flat", 1.0, location=(0, 0, 1)))
+    flat.scale = (1, 1, 0)
+    gone = link(scene, cube("Gone", 1.0, location=(1, 1, 1)))
+    gone.scale = (0, 0, 0)
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    lengths = np.linalg.norm(sd.corner_normals.astype(np.float64), axis=2)
+    assert lengths.min() > 0.5, "zero-length normals exported"
+    p = sd.positions.astype(np.float64)[sd.indices.astype(np.int64)]
+    area = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    assert area.min() > 0, "zero-area triangles exported"
+    # Floor (2) and Flat's top and bottom (2 + 2) stay; Flat's sides and all of Gone go.
+    assert sd.triangle_count == 6, sd.triangle_count
+    text = "\n".join(sd.warnings)
+    assert "object 'Flat': 8 of 12 triangles are degenerate" in text, text
+    assert "object 'Gone': all 12 triangles are degenerate" in text, text
+    assert "Floor" not in text
+    # ... and the frame renders: the library accepts what is left and lights it.
+    from conftest import real_render_or_skip
+    real_render_or_skip()
+    from vsgl_indirect import engine
+    from vsgl_indirect.config import Options
+    res = engine.compute(sd, Options(preset="PREVIEW"), os.path.join(str(tmp_path), "flat.exr"))
+    assert os.path.exists(res.path) and res.stats["lights_used"] == 1
