@@ -154,6 +154,62 @@ if want dry_run; then
   fi
 fi
 
+# Issue 10: the dry run validates the settings as the render does (it used
+# to call all of these valid), and a huge image is refused up front with a
+# message naming the size, the estimate and the limit (a 16384^2 render grew
+# to 23 GB and was killed after 8.5 minutes without a message).
+expect_fail dry_run_aa17      1 "settings: aa_samples is 17 (valid 1..16)"          "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --aa 17
+expect_fail dry_run_rsm1      1 "settings: rsm_resolution is 1 (valid 2..8192)"     "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --rsm 1
+expect_fail dry_run_rsm16384  1 "settings: rsm_resolution is 16384 (valid 2..8192)" "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --rsm 16384
+expect_fail dry_run_vsgls     1 "settings: vsgl_count is 65537 (valid 1..65536)"    "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --vsgls 65537
+if want huge || want dry_run || want memory; then
+  "$PY" tests/cli/make_scene.py "$T/huge.vsglb" --width 16384 --height 16384
+fi
+expect_fail dry_run_huge 1 "render: 16384x16384 with aa 2 and RSM 256 needs about" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --dry-run --preset balanced --max-memory 20G
+if want render_huge_refused; then
+  start=$(date +%s)
+  expect_fail render_huge_refused 1 "more than the memory limit of 20.0 GiB (max_memory)" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --preset balanced --max-memory 20G
+  [ $(( $(date +%s) - start )) -le 10 ] || bad render_huge_refused_fast "took $(( $(date +%s) - start )) s to refuse"
+  [ ! -e "$T/huge.exr" ] || bad render_huge_refused_file "a refused render wrote $T/huge.exr"
+fi
+expect_fail render_huge_machine 1 "(memory available on this machine)" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --preset quality --aa 16
+expect_fail args_max_memory 2 "option --max-memory: '12Q' is not a size" "$VSGL" render "$SCENE" --max-memory 12Q
+if want dry_run_memory; then
+  if expect_ok dry_run_memory "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run -v; then
+    if grep -Eq "; memory about [0-9.]+ MiB \(limit [0-9.]+ [GM]iB\)$" "$T/out" && grep -q "^vsgl: memory: about .*(output planes .*G-buffer .*RSMs .*); limit " "$T/err"; then
+      ok dry_run_memory; else bad dry_run_memory "stdout: $(cat "$T/out")" "stderr: $(tr '\n' '|' <"$T/err")"; fi
+  fi
+fi
+
+# The estimate against the peak RSS of real renders (1024^2, 2048^2).
+if want memory_estimate; then
+  for n in 1024 2048; do
+    "$PY" tests/cli/make_scene.py "$T/m$n.vsglb" --width $n --height $n
+    for preset in preview balanced; do
+      est=$("$VSGL" render "$T/m$n.vsglb" -o "$T/m.exr" --preset $preset --dry-run -v 2>&1 | grep '^vsgl: memory: about' |
+            sed -E 's/^vsgl: memory: about ([0-9.]+) (GiB|MiB).*/\1 \2/' | awk '{print ($2 == "GiB" ? $1 * 1024 : $1)}')
+      rss=$("$PY" -c 'import resource, subprocess, sys
+subprocess.run(sys.argv[1:], check=True, stderr=subprocess.DEVNULL)
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0)' "$VSGL" render "$T/m$n.vsglb" -o "$T/m.exr" --preset $preset)
+      # within -10 % .. +10 % of the peak, allowing 64 MiB for the program, its libraries and the scene
+      if [ -n "$est" ] && [ -n "$rss" ] && awk -v e="$est" -v r="$rss" 'BEGIN { exit !(e >= 0.9 * (r - 64) && e <= 1.1 * r + 8) }'; then
+        ok "memory_estimate ${n}^2 $preset (estimate $est MiB, peak RSS $rss MiB)"
+      else
+        bad "memory_estimate ${n}^2 $preset" "estimate '$est' MiB, peak RSS '$rss' MiB"
+      fi
+    done
+  done
+fi
+
+# A scene without lights renders black and says so (it used to exit 0 silently).
+if want render_no_lights; then
+  "$PY" tests/cli/make_scene.py "$T/dark.vsglb" --no-lights
+  if expect_ok render_no_lights "$VSGL" render "$T/dark.vsglb" -o "$T/dark.exr"; then
+    if grep -q "^vsgl: warning: .*no lights.*black" "$T/err"; then ok render_no_lights
+    else bad render_no_lights "stderr: $(tr '\n' '|' <"$T/err")"; fi
+  fi
+fi
+
 # ---- renders ----------------------------------------------------------------------
 PASSES="DiffInd GlossInd DiffCol GlossCol Diff Gloss Combined"
 if want render_float && expect_ok render_float "$VSGL" render "$SCENE" -o "$T/out.exr" --preset preview; then
