@@ -1,8 +1,11 @@
 """Scene settings of the add-on (``scene.vsgl_indirect``)."""
 import bpy
-from bpy.props import BoolProperty, EnumProperty, IntProperty, PointerProperty, StringProperty
+from bpy.props import (BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty,
+                       StringProperty)
 
 from . import config
+from .libvsgl import (AA_SAMPLES_MAX, FIS_ITERATIONS_MAX, RSM_RESOLUTION_MAX, RSM_RESOLUTION_MIN,
+                      VSGL_COUNT_MAX)
 
 
 def _update_compositor(self, context):
@@ -47,14 +50,15 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
     use_advanced: BoolProperty(name="Advanced", default=False,
                                description="Use the knobs below instead of the preset's values")
     method: EnumProperty(name="Method", items=_items(config.KNOBS["method"][0]), default="VSGL")
-    aa_samples: IntProperty(name="AA Samples", default=1, min=1, max=8,
+    aa_samples: IntProperty(name="AA Samples", default=1, min=1, max=AA_SAMPLES_MAX,
                             description="Camera samples per pixel per axis (N x N)")
-    rsm_resolution: IntProperty(name="RSM Resolution", default=256, min=8, max=4096,
+    rsm_resolution: IntProperty(name="RSM Resolution", default=256, min=RSM_RESOLUTION_MIN,
+                                max=RSM_RESOLUTION_MAX,
                                 description="Reflective shadow map side per light (texels)")
     fit_mode: EnumProperty(name="Fit", items=_items(config.KNOBS["fit_mode"][0]), default="TWO",
                            description="Two VSGLs per light, filtered importance sampling or k-means")
-    vsgl_count: IntProperty(name="VSGLs per Light", default=64, min=1, max=65536)
-    fis_iterations: IntProperty(name="FIS Iterations", default=8, min=1, max=32)
+    vsgl_count: IntProperty(name="VSGLs per Light", default=64, min=1, max=VSGL_COUNT_MAX)
+    fis_iterations: IntProperty(name="FIS Iterations", default=8, min=1, max=FIS_ITERATIONS_MAX)
     sharpness_estimator: EnumProperty(name="Sharpness",
                                       items=_items(config.KNOBS["sharpness_estimator"][0]),
                                       default="TOKSVIG")
@@ -79,6 +83,10 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "{scene}, {view_layer}; #### = frame number (must be the last digits)")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024,
                          description="Worker threads of the library (0 = all cores)")
+    max_memory_gb: FloatProperty(
+        name="Max Memory (GiB)", default=0.0, min=0.0, soft_max=256.0, precision=1,
+        description="Refuse a frame whose estimated memory is above this, with a message "
+                    "naming its size (0 = the memory this machine has available)")
     half_float: BoolProperty(name="Half Float", default=False,
                              description="Write 16-bit half floats instead of 32-bit")
 

@@ -381,3 +381,21 @@ def test_degenerate_objects_dropped_with_named_warning(scene, tmp_path):
     from vsgl_indirect.config import Options
     res = engine.compute(sd, Options(preset="PREVIEW"), os.path.join(str(tmp_path), "flat.exr"))
     assert os.path.exists(res.path) and res.stats["lights_used"] == 1
+
+
+def test_frame_above_max_memory_is_refused_with_its_size(scene, tmp_path):
+    """Issue 10: the add-on's 'Max Memory' reaches the library, which refuses
+    the frame up front, naming the image size, the estimate and the limit."""
+    from conftest import real_render_or_skip
+    real_render_or_skip()
+    from vsgl_indirect import engine
+    from vsgl_indirect.config import Options
+    basic(scene)
+    link(scene, plane("Floor", 6.0))
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    with pytest.raises(engine.AovError) as e:
+        engine.compute(sd, Options(preset="PREVIEW", max_memory_gb=0.0001), os.path.join(str(tmp_path), "m.exr"))
+    assert "needs about" in str(e.value) and "memory limit of 0.1 MiB (max_memory)" in str(e.value), str(e.value)
+    res = engine.compute(sd, Options(preset="PREVIEW"), os.path.join(str(tmp_path), "m.exr"))
+    assert engine.memory_summary(res.stats).startswith("about ")
