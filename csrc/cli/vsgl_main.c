@@ -285,7 +285,8 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
     eo.compression = o->compression;
     eo.metadata = md;
     eo.metadata_count = sizeof md / sizeof md[0];
-    r = vsgl_exr_write_render(ctx, out_path, &out, &eo);
+    r = vsgl_exr_write_render(ctx, out_path, &out, &eo); /* SIGINT/SIGTERM cancel it too */
+    progress_end(progress);
     if (r) {
         status = fail(ctx, r, out_path);
         goto done;
