@@ -8,21 +8,31 @@ with the RENDER depsgraph -> engine render -> compositor -> render_post.
 - render_init / load_post / settings changes: set up the compositor nodes
   (never in render_pre: editing the node tree there stops Blender 3.4 from
   calling frame_change_post for the next frames of ``-a``).
-- render_pre: replace this frame's file by a black placeholder (so a failed
-  computation can never leave an older AOV to be composited).
+- render_pre: note the frame (nothing is written: several farm workers may
+  share the AOV files, and a file another worker finished is a valid AOV of
+  this frame that it may be compositing right now).
 - frame_change_post with a RENDER depsgraph: export that depsgraph (render
-  visibility, render modifier levels), compute, write this frame's EXR.
-- render_post/render_cancel/render_complete: placeholders never replaced are
-  deleted and reported.
+  visibility, render modifier levels), compute, write this frame's EXR
+  atomically (a reader sees the old complete file or the new one). If the
+  computation fails, a file older than this render job (a previous run's)
+  is retired (renamed away, then deleted) so it is not composited; one
+  written meanwhile by another worker stays.
+- render_post/render_cancel/render_complete: frames never computed are
+  reported.
+
+Farm safety (issue 10): no handler ever replaces or deletes a complete AOV
+another process wrote; the compositor-setup placeholder is only ever put
+where no file exists and only ever removed if it is still the same inode.
 """
 import os
+import time
 
 import bpy
 from bpy.app.handlers import persistent
 
 from . import compositor, convert, engine, runner
 
-_state = {"active": {}, "placeholders": {}, "done": set()}
+_state = {"active": {}, "pending": {}, "done": set(), "job_start": {}}
 
 
 def _layers(scene):
@@ -53,18 +63,15 @@ def setup_scene(scene, frame=None):
             engine.check_output_path(path)
             # Blender creates the pass sockets from a real file; never
             # replace one (a parallel process may have rendered this frame).
-            made = not os.path.exists(path) and compositor.placeholder(path, w, h, exclusive=True)
-            if made:
-                _placeholder_mtimes[path] = os.path.getmtime(path)
+            inode = None if os.path.exists(path) else compositor.placeholder(path, w, h, exclusive=True)
             try:
                 # One composite output: only the first rendered view layer's AOV is
                 # added onto it; the others get their Image node to wire by hand.
                 compositor.ensure(scene, layer, path, options.add_to_render and i == 0)
             finally:
                 # The sockets stay; a black file must not look like an AOV.
-                if made and os.path.exists(path) and _is_placeholder(path):
-                    os.unlink(path)
-                    _placeholder_mtimes.pop(path, None)
+                if inode:
+                    remove_if_inode(path, inode)
         except engine.AovError as e:
             errors.append("view layer '%s': %s" % (layer, e))
         except Exception as e:
@@ -76,17 +83,53 @@ def setup_scene(scene, frame=None):
     return errors
 
 
-_placeholder_mtimes = {}
+def _aside(path):
+    d, name = os.path.split(path)
+    return os.path.join(d, ".%s.retired-%d-%d" % (name, os.getpid(), time.monotonic_ns()))
 
 
-def _is_placeholder(path):
-    return _placeholder_mtimes.get(path) == os.path.getmtime(path)
+def _retire(path, keep):
+    """Rename ``path`` aside and delete it, unless ``keep(stat)`` holds for the
+    file actually moved (another process renamed a new file over ``path``
+    between our check and the rename): that one is linked back. Readers see
+    the old file, the new one or none; never half a file."""
+    aside = _aside(path)
+    try:
+        os.rename(path, aside)
+    except FileNotFoundError:
+        return False
+    try:
+        if keep(os.stat(aside)):
+            try:
+                os.link(aside, path)      # put it back unless yet another file is there
+            except FileExistsError:
+                pass
+            return False
+        return True
+    finally:
+        os.unlink(aside)
 
 
-def _write_placeholder(scene, path):
-    w, h = _render_size(scene)
-    compositor.placeholder(path, w, h)
-    _placeholder_mtimes[path] = os.path.getmtime(path)
+def remove_if_inode(path, inode):
+    """Remove our placeholder at ``path`` only while it is the same file."""
+    try:
+        if os.stat(path).st_ino != inode:
+            return False
+    except FileNotFoundError:
+        return False
+    return _retire(path, lambda st: st.st_ino != inode)
+
+
+def retire_stale(path, since):
+    """After a failed computation: retire the file at ``path`` if it is older
+    than ``since`` (a previous run's AOV must not be composited); a file
+    written since (by another worker of this job) is a valid AOV and stays."""
+    try:
+        if os.stat(path).st_mtime >= since:
+            return False
+    except FileNotFoundError:
+        return False
+    return _retire(path, lambda st: st.st_mtime >= since)
 
 
 @persistent
@@ -94,6 +137,7 @@ def on_render_init(scene, *args):
     props = getattr(scene, "vsgl_indirect", None)
     if props is None or not props.enabled or not engine.can_render():
         return
+    _state["job_start"][scene.name] = time.time()
     setup_scene(scene)
     if scene.vsgl_indirect.add_to_render and not scene.render.use_compositing:
         runner.report(scene.name, "WARNING", "compositing is off (Output Properties > Post "
@@ -112,12 +156,12 @@ def on_render_pre(scene, *args):
         runner.fail(scene.name, "frame %d: no indirect AOV: %s" % (frame, engine.render_missing()))
         return
     _state["active"][scene.name] = frame
+    _state["job_start"].setdefault(scene.name, time.time())
     for layer in _layers(scene):
         path = runner.output_path(scene, layer, frame, options)
         try:
             engine.check_output_path(path)
-            _write_placeholder(scene, path)
-            _state["placeholders"][(scene.name, layer, frame)] = path
+            _state["pending"][(scene.name, layer, frame)] = path
         except engine.AovError as e:
             runner.fail(scene.name, "frame %d, view layer '%s': %s" % (frame, layer, e))
 
@@ -131,15 +175,17 @@ def on_frame_change_post(scene, depsgraph=None, *args):
         return
     layer = depsgraph.view_layer.name
     key = (scene.name, layer, frame)
-    if key in _state["done"] or key not in _state["placeholders"]:
+    if key in _state["done"] or key not in _state["pending"]:
         return
     _state["done"].add(key)
     result = runner.run_frame(scene, depsgraph, frame)
-    path = _state["placeholders"].pop(key, None)
-    if result is None and path is not None and os.path.exists(path):
-        os.unlink(path)   # no file rather than a black AOV that looks valid
-    else:
-        _placeholder_mtimes.pop(path, None)
+    path = _state["pending"].pop(key, None)
+    if result is None and path is not None:
+        # No AOV from us: a previous run's file must not be composited.
+        since = _state["job_start"].get(scene.name, time.time())
+        if retire_stale(path, since):
+            runner.report(scene.name, "WARNING", "frame %d, view layer '%s': removed the previous "
+                          "run's AOV %s (this frame's could not be computed)" % (frame, layer, path))
     img = bpy.data.images.get(compositor.IMAGE_NAME % (scene.name, layer))
     if img is not None:
         img.reload()
@@ -149,10 +195,8 @@ def on_frame_change_post(scene, depsgraph=None, *args):
 def on_render_post(scene, *args):
     frame = _state["active"].pop(scene.name, None)
     _state["done"] = {k for k in _state["done"] if k[0] != scene.name}
-    for key in [k for k in _state["placeholders"] if k[0] == scene.name]:
-        path = _state["placeholders"].pop(key)
-        if os.path.exists(path):
-            os.unlink(path)
+    for key in [k for k in _state["pending"] if k[0] == scene.name]:
+        _state["pending"].pop(key)
         runner.fail(scene.name, "frame %s, view layer '%s': the AOV was not computed "
                     "(Blender gave no render depsgraph for it)" % (frame, key[1]))
 
@@ -160,6 +204,7 @@ def on_render_post(scene, *args):
 @persistent
 def on_render_end(scene, *args):
     on_render_post(scene)
+    _state["job_start"].pop(scene.name, None)
 
 
 @persistent
