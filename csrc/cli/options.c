@@ -149,7 +149,21 @@ static void join_names(const char *const *names, char *buf, size_t n)
         snprintf(buf + strlen(buf), n - strlen(buf), "%s%s", i ? "|" : "", names[i]);
 }
 
+static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t err_size);
+
+/* The reason is printed as one line "vsgl: ...": an argument quoted in it
+ * must not break it (found by tests/fuzz/fuzz_cli.c: a newline in an option
+ * name gave a two-line message). Control characters become '?'. */
 int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
+{
+    int rc = parse_args(argc, argv, o, err, err_size);
+    for (char *p = err; rc && *p; ++p)
+        if ((unsigned char)*p < 0x20 || *p == 0x7f)
+            *p = '?';
+    return rc;
+}
+
+static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t err_size)
 {
     memset(o, 0, sizeof *o);
     o->compression = VSGL_EXR_PIZ; /* 1080p, 22 float channels: PIZ 1.06 s / 60 MB, ZIP 1.73 s / 63 MB */

@@ -173,6 +173,8 @@ if want render_huge_refused; then
   [ ! -e "$T/huge.exr" ] || bad render_huge_refused_file "a refused render wrote $T/huge.exr"
 fi
 expect_fail render_huge_machine 1 "(memory available on this machine)" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --preset quality --aa 16
+# Found by tests/fuzz/fuzz_cli.c: a newline inside a quoted argument split the one error line.
+expect_fail args_newline       2 "unknown option '--bo?gus'"   "$VSGL" render "$SCENE" $'--bo\ngus'
 expect_fail args_max_memory 2 "option --max-memory: '12Q' is not a size" "$VSGL" render "$SCENE" --max-memory 12Q
 if want dry_run_memory; then
   if expect_ok dry_run_memory "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run -v; then
