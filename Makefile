@@ -45,8 +45,12 @@ $(BUILD)/obj/%.o: %.c $(HEADERS) | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_COMMON) $(OPT) -MMD -c $< -o $@
 
+# RPATH (not RUNPATH: it also applies to the dependencies' own dependencies,
+# e.g. embree -> tbb) $ORIGIN: the add-on zip ships libembree3, libOpenEXRCore
+# and libtbb beside libvsgl.so (tools/build_addon.sh); a build/ without them
+# falls back to the system's.
 $(BUILD)/libvsgl.so: $(LIB_OBJ)
-	$(CC) -shared -o $@ $^ $(LDLIBS)
+	$(CC) -shared -o $@ $^ $(LDLIBS) -Wl,-rpath,'$$ORIGIN' -Wl,--disable-new-dtags
 
 $(BUILD)/vsgl: $(CLI_SRC) $(BUILD)/libvsgl.so
 	$(CC) $(CFLAGS_COMMON) $(OPT) -o $@ $(CLI_SRC) -L$(BUILD) -lvsgl -Wl,-rpath,'$$ORIGIN' -lm

@@ -692,6 +692,43 @@ def _undefined_vsgl_symbols(path):
         return []
 
 
+#: sonames libvsgl links against -> (what it is, Debian/Ubuntu package).
+DEPENDENCIES = {
+    "libembree3.so.3": ("Intel Embree 3", "libembree3-3"),
+    "libOpenEXRCore-3_1.so.30": ("OpenEXR Core 3.1", "libopenexr-3-1-30"),
+    "libtbb.so.12": ("oneTBB", "libtbb12"),
+    "libstdc++.so.6": ("the GNU C++ runtime", "libstdc++6"),
+    "libz.so.1": ("zlib", "zlib1g"),
+}
+
+
+def load_error_message(path, error):
+    """What to tell a user whose ``ctypes.CDLL(path)`` failed with ``error``:
+    the missing library and the package that provides it; a zip user is not
+    told to run `make`."""
+    import re
+    in_addon = os.path.dirname(os.path.abspath(path)) == os.path.join(_HERE, "lib")
+    fix = ("reinstall the add-on from a zip built by tools/build_addon.sh, which ships it in "
+           "vsgl_indirect/lib/" if in_addon else
+           "or rebuild libvsgl with `make` on this machine")
+    m = re.search(r"([\w.+-]+\.so[\w.]*): cannot open shared object file", error)
+    if m:
+        soname = m.group(1)
+        what, pkg = DEPENDENCIES.get(soname, (None, None))
+        if pkg:
+            return ("cannot load %s: it needs %s (%s), which is not installed: install the "
+                    "package %s (Debian/Ubuntu: apt-get install %s), %s"
+                    % (path, soname, what, pkg, pkg, fix))
+        return ("cannot load %s: it needs %s, which is not installed (install the package "
+                "that provides it), %s" % (path, soname, fix))
+    m = re.search(r"version `([^']+)' not found", error)
+    if m:
+        return ("cannot load %s: this system's libraries are too old (%s not found; the add-on "
+                "zip needs x86-64 Linux with glibc >= 2.34 and libstdc++ of GCC >= 12): %s"
+                % (path, m.group(1), error))
+    return "cannot load %s: %s (%s)" % (path, error, fix)
+
+
 class _Library:
     """A loaded libvsgl: one attribute per exported prototype, argtypes and
     restype set once here. Immutable after construction."""
@@ -705,8 +742,7 @@ class _Library:
             self.cdll = ctypes.CDLL(self.path)
         except OSError as e:
             if "undefined symbol" not in str(e):
-                raise VsglLibraryError("cannot load %s: %s (rebuild it with `make`)"
-                                       % (self.path, e)) from None
+                raise VsglLibraryError(load_error_message(self.path, str(e))) from None
             # Incomplete build: load lazily so the defined functions work; a
             # call that reaches an undefined one would abort the process, so
             # they are listed (callers such as the tests check `undefined`).

@@ -76,5 +76,31 @@ if want no_pip_python; then
   if [ -z "$hits" ]; then ok no_pip_python; else bad no_pip_python "$hits"; fi
 fi
 
+# Issue 10: the add-on zip carried libvsgl.so but not libembree3,
+# libOpenEXRCore or libtbb. Now they are inside, and the loader takes them
+# from there (not from the system) through libvsgl's $ORIGIN rpath.
+if want addon_zip; then
+  if tools/build_addon.sh >"$T/zip.log" 2>&1 && mkdir -p "$T/zip" && (cd "$T/zip" && python3 -c 'import sys, zipfile; zipfile.ZipFile(sys.argv[1]).extractall()' "$ROOT/build/vsgl_indirect.zip"); then
+    lib="$T/zip/vsgl_indirect/lib"
+    errs=""
+    deps=$(ldd "$lib/libvsgl.so")
+    for so in libembree3.so.3 libOpenEXRCore-3_1.so.30 libtbb.so.12; do
+      grep -q "^\s*$so => $lib/$so " <<<"$deps" || errs="$errs [$so not taken from the zip: $(grep "$so" <<<"$deps" | xargs)]"
+    done
+    nf=$(grep -c "not found" <<<"$deps")
+    [ "$nf" -eq 0 ] || errs="$errs [$nf libraries not found]"
+    out=$(env -u VSGL_LIBRARY -u LD_LIBRARY_PATH /usr/bin/python3 -c '
+import sys; sys.path.insert(0, sys.argv[1])
+import libvsgl
+print(libvsgl.version_string())
+print("".join(l for l in open("/proc/self/maps") if "libembree3" in l or "libtbb" in l))' "$T/zip/vsgl_indirect" 2>&1)
+    grep -q "^[0-9]*\.[0-9]*\.[0-9]*$" <<<"$out" || errs="$errs [binding cannot load the zip's library: $(head -3 <<<"$out" | tr '\n' '|')]"
+    grep -E "libembree3|libtbb" <<<"$out" | grep -vq "$lib/" && errs="$errs [a system copy was mapped: $(grep -E 'libembree3|libtbb' <<<"$out" | grep -v "$lib/" | head -1)]"
+    if [ -z "$errs" ]; then ok addon_zip_self_contained; else bad addon_zip_self_contained "$errs"; fi
+  else
+    bad addon_zip_self_contained "tools/build_addon.sh failed: $(tail -3 "$T/zip.log")"
+  fi
+fi
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
