@@ -1,4 +1,6 @@
 """Scene settings of the add-on (``scene.vsgl_indirect``)."""
+import os
+
 import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty,
                        StringProperty)
@@ -23,6 +25,15 @@ def _update_compositor(self, context):
         print("VSGL WARNING: compositor update failed: %r" % (e,))
 
 
+# Only inside the Blender application: the pip bpy module has no UI to keep
+# in step (render_init sets the compositor up), and its 4.2 LTS build
+# segfaults at exit (status 139, after every render) while an update=
+# callback is registered, even after unregistering it (issue 10; 5.0 does
+# not). The handlers are removed at exit by __init__._unregister_at_exit.
+IN_APPLICATION = "blender" in os.path.basename(bpy.app.binary_path or "").lower()
+_UPDATE = {"update": _update_compositor} if IN_APPLICATION else {}
+
+
 # Blender 4.5+ warns about '//' in path properties unless they opt in.
 _PATH_OPTIONS = ({"options": {"PATH_SUPPORTS_BLEND_RELATIVE"}}
                  if bpy.app.version >= (4, 5, 0) else {})
@@ -35,11 +46,11 @@ def _items(names, descriptions=None):
 
 class VSGLIndirectSettings(bpy.types.PropertyGroup):
     enabled: BoolProperty(
-        name="Compute on Render", default=False, update=_update_compositor,
+        name="Compute on Render", default=False, **_UPDATE,
         description="Compute the indirect-light AOV of every rendered frame before it is "
                     "rendered and composited (F12, -f, -a)")
     add_to_render: BoolProperty(
-        name="Add to Render", default=True, update=_update_compositor,
+        name="Add to Render", default=True, **_UPDATE,
         description="Add the AOV's Combined pass onto the render in the compositor "
                     "(otherwise only the Image node is set up)")
     preset: EnumProperty(
@@ -78,7 +89,7 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                                  description="Shade a pixel's samples on one surface once (auto: on)")
     output_path: StringProperty(
         name="Output", subtype="FILE_PATH", default=config.DEFAULT_TEMPLATE,
-        update=_update_compositor, **_PATH_OPTIONS,
+        **_PATH_OPTIONS, **_UPDATE,
         description="Per-frame multilayer EXR. {render_dir} = the render output's folder, "
                     "{scene}, {view_layer}; #### = frame number (must be the last digits)")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024,

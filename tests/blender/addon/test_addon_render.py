@@ -240,6 +240,30 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     assert not _nodes(tree, "VSGL")
 
 
+def test_settings_update_callbacks_only_in_the_application():
+    """Edits rewire the compositor through update= callbacks inside Blender;
+    the pip bpy module gets none (its 4.2 LTS build segfaults at exit with
+    them; render_init sets the compositor up there)."""
+    from vsgl_indirect import settings as st
+    assert st.IN_APPLICATION == IS_BINARY
+    assert bool(st._UPDATE) == IS_BINARY
+
+
+def test_process_with_the_addon_exits_cleanly(tmp_path):
+    """Issue 10: the pip bpy 4.2.23 module exited with a segfault (139) after
+    every render while the add-on was registered (any Python callable left
+    in Blender at exit: update= callbacks, app handlers)."""
+    import sys
+    code = ("import sys; sys.path.insert(0, %r); import bpy, vsgl_indirect; vsgl_indirect.register(); "
+            "s = bpy.context.scene; s.vsgl_indirect.enabled = True; print('ok')" % os.path.join(REPO, "addon"))
+    if IS_BINARY:
+        cmd = [bpy.app.binary_path, "-b", "--factory-startup", "--python-expr", code]
+    else:
+        cmd = [sys.executable, "-c", code]
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=120)
+    assert r.returncode == 0 and "ok" in r.stdout, (r.returncode, r.stdout[-2000:])
+
+
 def test_preview_operator_writes_and_loads_image(scene, monkeypatch):
     room(scene)
     calls = []
