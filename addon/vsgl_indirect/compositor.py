@@ -70,6 +70,19 @@ def _render_layers_node(tree, scene, view_layer):
     return n
 
 
+def has_passes(node, add_to_render=True):
+    """The Image node shows the AOV's passes (and, with ``add_to_render``,
+    its Combined output feeds our Add node)."""
+    if node is None or "DiffInd" not in node.outputs or not node.outputs["DiffInd"].enabled:
+        return False
+    src = _combined_socket(node)
+    if src is None or src.name != "Combined":
+        return False
+    if not add_to_render:
+        return True
+    return any(l.to_node.name.startswith("VSGL Add [") for l in src.links)
+
+
 def ensure(scene, view_layer, path, add_to_render=True):
     """Set up (or update) the nodes for ``view_layer`` to read the sequence
     ``path`` belongs to (any frame's file) and return the Image node.
@@ -107,6 +120,7 @@ def ensure(scene, view_layer, path, add_to_render=True):
     if not node.use_auto_refresh:
         node.use_auto_refresh = True
     if node.image != img or _combined_socket(node) is None or "DiffInd" not in node.outputs:
+        img.reload()        # a failed read (a file that vanished meanwhile) is cached
         node.image = None
         node.image = img
     if hasattr(node, "layer") and node.has_layers:

@@ -61,17 +61,7 @@ def setup_scene(scene, frame=None):
         path = runner.output_path(scene, layer, frame, options)
         try:
             engine.check_output_path(path)
-            # Blender creates the pass sockets from a real file; never
-            # replace one (a parallel process may have rendered this frame).
-            inode = None if os.path.exists(path) else compositor.placeholder(path, w, h, exclusive=True)
-            try:
-                # One composite output: only the first rendered view layer's AOV is
-                # added onto it; the others get their Image node to wire by hand.
-                compositor.ensure(scene, layer, path, options.add_to_render and i == 0)
-            finally:
-                # The sockets stay; a black file must not look like an AOV.
-                if inode:
-                    remove_if_inode(path, inode)
+            _setup_layer(scene, layer, path, w, h, options.add_to_render and i == 0)
         except engine.AovError as e:
             errors.append("view layer '%s': %s" % (layer, e))
         except Exception as e:
@@ -81,6 +71,35 @@ def setup_scene(scene, frame=None):
     for e in errors:
         runner.fail(scene.name, e)
     return errors
+
+
+def _setup_layer(scene, layer, path, w, h, add, attempts=6):
+    """compositor.ensure with a file at ``path`` for the pass sockets. Another
+    worker's placeholder may vanish while Blender reads it (the sockets then
+    come out empty): check and retry with our own placeholder."""
+    err = None
+    for attempt in range(attempts):
+        # Blender creates the pass sockets from a real file; never replace
+        # one (a parallel process may have rendered this frame).
+        inode = None if os.path.exists(path) else compositor.placeholder(path, w, h, exclusive=True)
+        try:
+            # One composite output: only the first rendered view layer's AOV is
+            # added onto it; the others get their Image node to wire by hand.
+            node = compositor.ensure(scene, layer, path, add)
+            if compositor.has_passes(node, add):
+                return node
+            err = None
+        except (engine.AovError, RuntimeError) as e:   # RuntimeError: "Cannot read" (it vanished)
+            err = e
+        finally:
+            # The sockets stay; a black file must not look like an AOV.
+            if inode:
+                remove_if_inode(path, inode)
+        time.sleep(0.02 * (attempt + 1))
+    if isinstance(err, engine.AovError):
+        raise err
+    raise engine.AovError("compositor: the Image node for '%s' shows no AOV passes (%s)"
+                          % (path, err or "the file could not be read"))
 
 
 def _aside(path):

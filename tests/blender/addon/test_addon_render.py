@@ -143,6 +143,9 @@ def test_farm_race_overlapping_frames_never_composite_a_placeholder(scene, tmp_p
         if bad:
             wrong.append("worker %d: %s" % (w, bad[:3]))
     n = workers * (frames[1] - frames[0] + 1)
+    if wrong and os.environ.get("VSGL_TEST_FARM_LOGS"):
+        for w in range(workers):
+            print("---- worker %d\n%s" % (w, logs[w]))
     assert not wrong, "%d of %d composites wrong or errors:\n%s" % (len(wrong), n, "\n".join(wrong))
 
 
