@@ -159,6 +159,7 @@ class FitMode(enum.IntEnum):
     TWO = 0
     FIS = 1
     KMEANS = 2
+    LATTICE = 3
 
 
 class GlossyMode(enum.IntEnum):
@@ -506,6 +507,21 @@ class vsgl_bundle_info(_Struct):
     ]
 
 
+# debug.h
+class vsgl_debug_vsgl(_Struct):
+    _fields_ = [
+        ("mean", ctypes.c_float * 3),
+        ("variance", ctypes.c_float),
+        ("axis", ctypes.c_float * 3),
+        ("sharpness", ctypes.c_float),
+        ("power", ctypes.c_float * 3),
+        ("normal", ctypes.c_float * 3),
+        ("coherence", ctypes.c_float),
+        ("light", ctypes.c_uint32),
+        ("lobe", ctypes.c_uint32),
+    ]
+
+
 # reference.h
 class vsgl_reference_stats(_Struct):
     _fields_ = [
@@ -529,7 +545,7 @@ STRUCTS = {cls.__name__: cls for cls in (
     vsgl_vec3, vsgl_context_desc, vsgl_sg, vsgl_asg, vsgl_material, vsgl_light,
     vsgl_camera, vsgl_scene_desc, vsgl_scene_info, vsgl_render_settings,
     vsgl_render_output, vsgl_memory_estimate, vsgl_render_stats, vsgl_exr_pass, vsgl_exr_metadata,
-    vsgl_exr_options, vsgl_bundle_options, vsgl_bundle_info, vsgl_reference_stats)}
+    vsgl_exr_options, vsgl_bundle_options, vsgl_bundle_info, vsgl_debug_vsgl, vsgl_reference_stats)}
 #: Python field names that differ from the C ones.
 FIELD_C_NAMES = {"lambda_": "lambda"}
 
@@ -622,6 +638,7 @@ PROTOTYPES = (
     # debug.h
     ("vsgl_debug_gbuffer", _i32, [_VP, _VP, _u32, _PF32, _PF32, _PU32]),
     ("vsgl_debug_gbuffer_frames", _i32, [_VP, _VP, _u32, _PF32, _PF32]),
+    ("vsgl_debug_vsgls", _i32, [_VP, _VP, _P(vsgl_render_settings), _P(ctypes.c_size_t), _P(vsgl_debug_vsgl)]),
     # reference.h
     ("vsgl_reference_rsm", _i32, [_VP, _VP, _u32, _u32, _P(ctypes.c_size_t), _PF32, _PF32,
                                   _PF32, _PF32, _PU32]),
@@ -1684,6 +1701,26 @@ def debug_gbuffer_frames(ctx, scene, aa=1):
                                             tan.ctypes.data_as(_PF32), view.ctypes.data_as(_PF32))
     ctx.check(rc, "vsgl_debug_gbuffer_frames")
     return {"tangents": tan, "views": view}
+
+
+def debug_vsgls(ctx, scene, settings=None):
+    """The VSGLs :func:`render` would shade with ``settings``, as a dict of
+    arrays over them: mean, axis, normal, power (N, 3) float32, variance,
+    sharpness, coherence (N,) float32, light, lobe (N,) uint32 (0 diffuse,
+    1 specular)."""
+    s = _settings(settings)
+    fn = ctx._lib.vsgl_debug_vsgls
+    count = ctypes.c_size_t(0)
+    ctx.check(fn(ctx.handle, scene.handle, ctypes.byref(s), ctypes.byref(count), None), "vsgl_debug_vsgls")
+    items = (vsgl_debug_vsgl * max(count.value, 1))()
+    ctx.check(fn(ctx.handle, scene.handle, ctypes.byref(s), ctypes.byref(count),
+                 ctypes.cast(items, _P(vsgl_debug_vsgl))), "vsgl_debug_vsgls")
+    n = count.value
+    a = np.ctypeslib.as_array(ctypes.cast(items, _P(ctypes.c_float)), (max(n, 1) * 17,))[:n * 17].reshape(n, 17)
+    u = a.view(np.uint32)
+    return {"mean": a[:, 0:3].copy(), "variance": a[:, 3].copy(), "axis": a[:, 4:7].copy(),
+            "sharpness": a[:, 7].copy(), "power": a[:, 8:11].copy(), "normal": a[:, 11:14].copy(),
+            "coherence": a[:, 14].copy(), "light": u[:, 15].copy(), "lobe": u[:, 16].copy()}
 
 
 # --------------------------------------------------------------------------

@@ -19,7 +19,7 @@ const char cli_usage[] =
     "  --preset NAME         preview | balanced | quality\n"
     "  --aa N                N x N camera samples per pixel (1..16)\n"
     "  --rsm N               reflective shadow map side in texels (2..8192)\n"
-    "  --fit NAME            two | fis | kmeans   (VSGL fit)\n"
+    "  --fit NAME            two | fis | kmeans | lattice   (VSGL fit)\n"
     "  --vsgls N             VSGLs per light (fis, kmeans; 1..65536)\n"
     "  --sharpness NAME      toksvig | banerjee\n"
     "  --diffuse NAME        sg | pulled | accurate   (receiver cosine)\n"
@@ -101,8 +101,8 @@ typedef struct num_opt { const char *name; uint32_t min; size_t offset; } num_op
 
 static const char *const preset_names[] = {"preview", "balanced", "quality", NULL};
 static const int preset_values[] = {VSGL_PRESET_PREVIEW, VSGL_PRESET_BALANCED, VSGL_PRESET_QUALITY};
-static const char *const fit_names[] = {"two", "fis", "kmeans", NULL};
-static const int fit_values[] = {VSGL_FIT_TWO, VSGL_FIT_FIS, VSGL_FIT_KMEANS};
+static const char *const fit_names[] = {"two", "fis", "kmeans", "lattice", NULL};
+static const int fit_values[] = {VSGL_FIT_TWO, VSGL_FIT_FIS, VSGL_FIT_KMEANS, VSGL_FIT_LATTICE};
 static const char *const sharp_names[] = {"toksvig", "banerjee", NULL};
 static const int sharp_values[] = {VSGL_SHARPNESS_TOKSVIG, VSGL_SHARPNESS_BANERJEE};
 static const char *const diffuse_names[] = {"sg", "pulled", "accurate", NULL};

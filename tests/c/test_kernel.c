@@ -73,7 +73,7 @@ typedef struct bundle {
     fx_scene fx;
 } bundle;
 
-static int setup(bundle *b, float roughness, uint32_t vsgls)
+static int setup(bundle *b, float roughness, uint32_t vsgls, int32_t fit, int32_t leak)
 {
     memset(b, 0, sizeof *b);
     fx_room(&b->fx, 40, 30, roughness, 100.0f);
@@ -81,13 +81,14 @@ static int setup(bundle *b, float roughness, uint32_t vsgls)
     vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &in);
     in.vsgl_count = vsgls;
     in.rsm_resolution = 32;
-    in.leak_correction = VSGL_LEAK_OFF;
+    in.leak_correction = leak;
+    in.fit_mode = fit;
     vsgl_rsm rsm;
     if (vsgl_context_create(NULL, &b->ctx) || vsgl_scene_create(b->ctx, fx_desc(&b->fx), &b->scene) ||
         vsgl__settings_resolve(b->ctx, &in, &b->s) || vsgl__gbuffer_build(b->ctx, b->scene, 1, &b->g) ||
         vsgl__rsm_build(b->ctx, b->scene, 0, 32, &rsm))
         return 0;
-    int ok = vsgl__fit_fis(b->ctx, b->scene, &rsm, &b->s, &b->set) == VSGL_OK;
+    int ok = (fit == VSGL_FIT_LATTICE ? vsgl__fit_lattice : vsgl__fit_fis)(b->ctx, b->scene, &rsm, &b->s, &b->set) == VSGL_OK;
     vsgl__rsm_free(&rsm);
     return ok;
 }
@@ -120,10 +121,13 @@ static double relmse(const float *a, const float *ref, size_t n)
 
 VT_TEST(kernel_shading_matches_reference_path)
 {
+    /* FIS without the emitter clip; the lattice with it (shade.h) */
     const float rough[3] = {0.15f, 0.4f, 0.8f};
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < 6; ++k) {
         bundle b;
-        VT_CHECK(setup(&b, rough[k], 32), "setup: %s", b.ctx ? vsgl_context_last_error(b.ctx) : "");
+        int clip = k >= 3;
+        VT_CHECK(setup(&b, rough[k % 3], 32, clip ? VSGL_FIT_LATTICE : VSGL_FIT_FIS, clip ? VSGL_LEAK_ON : VSGL_LEAK_OFF),
+                 "setup: %s", b.ctx ? vsgl_context_last_error(b.ctx) : "");
         size_t px = (size_t)b.g.width * b.g.height;
         for (int mode = 0; mode < 3; ++mode) {
             b.s.diffuse_mode = mode;
@@ -132,15 +136,15 @@ VT_TEST(kernel_shading_matches_reference_path)
             float *sca = shade(&b, VSGL_SHADE_KERNEL_SCALAR);
             double ed = relmse(vec, ref, 3 * px), eg = relmse(vec + 3 * px, ref + 3 * px, 3 * px);
             double sd = relmse(sca, ref, 3 * px), sg = relmse(sca + 3 * px, ref + 3 * px, 3 * px);
-            VT_CHECK(ed < 1e-10 && sd < 1e-10, "roughness %g mode %d: diffuse relMSE vec %.3g scalar %.3g", rough[k], mode, ed, sd);
+            VT_CHECK(ed < 1e-10 && sd < 1e-10, "roughness %g mode %d: diffuse relMSE vec %.3g scalar %.3g", rough[k % 3], mode, ed, sd);
             /* glossy: the kernel normalises the ASG x SG integral as Eq. 18
              * (pi / sqrt(...)), the reference path by the exact Eq. 10 form;
              * they differ for broad lobes */
-            double tol = rough[k] < 0.5f ? 1e-10 : 1e-4;
+            double tol = rough[k % 3] < 0.5f ? 1e-10 : 1e-4;
             if (getenv("VSGL_TEST_VERBOSE"))
-                printf("    roughness %g mode %d: relMSE diffuse %.3g glossy %.3g (scalar build %.3g %.3g)\n", rough[k], mode, ed, eg, sd, sg);
+                printf("    roughness %g mode %d: relMSE diffuse %.3g glossy %.3g (scalar build %.3g %.3g)\n", rough[k % 3], mode, ed, eg, sd, sg);
             VT_CHECK(eg < tol && sg < tol, "roughness %g mode %d: glossy relMSE vec %.3g scalar %.3g (tol %g)",
-                     rough[k], mode, eg, sg, tol);
+                     rough[k % 3], mode, eg, sg, tol);
             free(ref);
             free(vec);
             free(sca);
@@ -197,8 +201,9 @@ static void random_light(vt_rng *r, vsgl_kernel_light *o, int sharp)
     o->c0 = 1.0f / (6.2831853f * vsgl_sg_integral(o->lv));
     o->pr = 1.0f; o->pg = 0.5f; o->pb = 0.25f;
     o->nz = -1.0f;
-    o->hemi_weight = (float)vt_uniform(r);
-    o->hemi_scale = 20.0f;
+    o->clip = (float)vt_uniform(r);
+    o->conv = vt_uniform(r) < 0.5 ? 1.0f : 0.0f;
+    o->ibehind = 1.0f / (0.02f * sqrtf(o->var));
 }
 
 /* Every ISA copy (AVX-512, AVX2, baseline) and the library's scalar build

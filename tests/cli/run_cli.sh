@@ -317,10 +317,11 @@ fi
 # Issue 10: SIGINT or SIGTERM during the EXR write (12-15 s at 4K) was
 # ignored: the process wrote on, exited 0 and replaced the file. Now: exit
 # 130, "vsgl: cancelled", the previous file kept, no temporary file left.
-# The signal is sent once the write's temporary file exists.
-wait_for_temp() {  # wait_for_temp DIR PID: 0 once a .*.tmp-* file exists in DIR
-  for _ in $(seq 1 1200); do
-    ls -A "$1" 2>/dev/null | grep -q '\.tmp-' && return 0
+# The signal is sent once the write has started (its progress line is out:
+# not the output-path check's short-lived probe) and its temporary file exists.
+wait_for_temp() {  # wait_for_temp DIR PID STDERR: 0 once writing into a .*.tmp-* file in DIR
+  for _ in $(seq 1 1500); do
+    grep -q '^vsgl: write' "$3" 2>/dev/null && ls -A "$1" 2>/dev/null | grep -q '\.tmp-' && return 0
     kill -0 "$2" 2>/dev/null || return 1
     sleep 0.02
   done
@@ -335,7 +336,7 @@ for sig in INT TERM; do
   mkdir -p "$T/wc"; rm -f "$T/wc/"*; echo "previous" >"$T/wc/f.exr"
   "$VSGL" render "$T/w4k.vsglb" -o "$T/wc/f.exr" --preset preview --compression zip 2>"$T/err" &
   pid=$!
-  if ! wait_for_temp "$T/wc" $pid; then
+  if ! wait_for_temp "$T/wc" $pid "$T/err"; then
     wait $pid; bad "$name" "the write ended (exit $?) before its temporary file was seen"; continue
   fi
   kill -$sig $pid
@@ -350,9 +351,9 @@ done
 # process is gone and says so.
 if want write_kill; then
   mkdir -p "$T/wk"
-  "$VSGL" render "$T/w4k.vsglb" -o "$T/wk/f.exr" --preset preview --compression zip 2>/dev/null &
+  "$VSGL" render "$T/w4k.vsglb" -o "$T/wk/f.exr" --preset preview --compression zip 2>"$T/err_kill" &
   pid=$!
-  if wait_for_temp "$T/wk" $pid; then
+  if wait_for_temp "$T/wk" $pid "$T/err_kill"; then
     kill -9 $pid; wait $pid 2>/dev/null
     left=$(ls -A "$T/wk" | grep '\.tmp-')
     if [ -z "$left" ]; then bad write_kill "no temporary file after kill -9"

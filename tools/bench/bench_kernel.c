@@ -59,8 +59,9 @@ int main(int argc, char **argv)
         l->c0 = 1.0f / (6.2831853f * vsgl_sg_integral(l->lv));
         l->pr = l->pg = l->pb = 1.0f;
         l->nz = 1.0f;
-        l->hemi_weight = 0.5f;
-        l->hemi_scale = 20.0f;
+        l->clip = 0.5f;
+        l->conv = 1.0f;
+        l->ibehind = 1.0f / (0.02f * sqrtf(l->var));
     }
     for (int i = 0; i < VSGL_KERNEL_BLOCK; ++i) {
         b.x[i] = uniform(&s); b.y[i] = uniform(&s); b.z[i] = -1.0f;

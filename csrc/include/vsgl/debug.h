@@ -9,6 +9,7 @@
 #define VSGL_DEBUG_H
 
 #include "scene.h"
+#include "render.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -47,6 +48,32 @@ VSGL_API vsgl_result vsgl_debug_gbuffer(vsgl_context *ctx, const vsgl_scene *sce
  */
 VSGL_API vsgl_result vsgl_debug_gbuffer_frames(vsgl_context *ctx, const vsgl_scene *scene, uint32_t aa,
                                                float *tangents, float *views);
+
+/** One fitted VSGL (vsgl_render's VSGL method), world frame, metres. */
+typedef struct vsgl_debug_vsgl {
+    float mean[3];      /**< mean VPL position */
+    float variance;     /**< positional variance per axis (m^2), widening included */
+    float axis[3];      /**< unit axis of the radiant intensity */
+    float sharpness;    /**< its SG sharpness */
+    float power[3];     /**< RGB power (W) */
+    float normal[3];    /**< unit mean surface normal of the cluster */
+    float coherence;    /**< length of the mean normal, 0..1 (1: every VPL faces the same way) */
+    uint32_t light;     /**< scene light index */
+    uint32_t lobe;      /**< 0 diffuse, 1 specular */
+} vsgl_debug_vsgl;
+
+/**
+ * @brief Fit the VSGLs that ::vsgl_render would shade with @p settings
+ * (RSM resolution, fit mode, count, estimator) and copy them out.
+ * @param[in,out] count in: capacity of @p out (0 with @p out NULL asks for
+ *        the count); out: the number of VSGLs.
+ * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (bad settings; a
+ *         capacity below the count: *count then holds the count),
+ *         ::VSGL_ERROR_OUT_OF_MEMORY.
+ */
+VSGL_API vsgl_result vsgl_debug_vsgls(vsgl_context *ctx, const vsgl_scene *scene,
+                                      const vsgl_render_settings *settings, size_t *count,
+                                      vsgl_debug_vsgl *out);
 
 #ifdef __cplusplus
 }

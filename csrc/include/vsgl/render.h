@@ -24,6 +24,8 @@ extern "C" {
 #define VSGL_FIT_TWO    0  /**< poster: one diffuse + one specular VSGL per light */
 #define VSGL_FIT_FIS    1  /**< filtered importance sampling over RSM mips */
 #define VSGL_FIT_KMEANS 2  /**< k-means in image + world space */
+#define VSGL_FIT_LATTICE 3 /**< world-space lattice with tent weights, one cluster per surface orientation:
+                                continuous in the light's motion (no flicker), overlapping (no blotches) */
 
 #define VSGL_GLOSSY_ASG 0  /**< receiver lobe as a warped ASG (default) */
 #define VSGL_GLOSSY_SG  1  /**< receiver lobe as a warped SG (cheaper) */

@@ -62,6 +62,8 @@ vsgl_result vsgl__fit_two(vsgl_context *ctx, const vsgl_scene *scene, const vsgl
                           const vsgl_render_settings *s, vsgl_vsgl_set *out);
 vsgl_result vsgl__fit_fis(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
                           const vsgl_render_settings *s, vsgl_vsgl_set *out);
+vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
+                              const vsgl_render_settings *s, vsgl_vsgl_set *out);
 vsgl_result vsgl__fit_kmeans(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
                              const vsgl_render_settings *s, vsgl_vsgl_set *out);
 

@@ -14,6 +14,7 @@
 /* Least-squares sharpness of the poster's SG cosine lobe (docs/math.md):
  * argmin over l of the L2 norm on the sphere of max(w.n,0)/pi - G(w;n,l)/A(l). */
 #define VSGL__COSINE_SHARPNESS 2.29250405f
+#define VSGL__COSINE_A_LD 2.7127863856 /* A(VSGL__COSINE_SHARPNESS) */
 
 /* Fitted constants of the ACCURATE SG x clamped-cosine form (docs/math.md
  * 3.2, tools/fit_cosine_sharpness.py), shared with the shading kernel:

@@ -12,6 +12,11 @@
 
 #define VSGL_KERNEL_BLOCK 64
 
+/* The emitter-hemisphere clip's constants (shade.h explains the clip). */
+#define VSGL_CLIP_BEHIND 0.02f   /* the behind fade, in units of sigma */
+#define VSGL_CLIP_PARALLEL 0.3f  /* the parallel fade, in 1 - n.n_v */
+#define VSGL_CLIP_NEAR 4.0f      /* the spread sharpness where conv is half-way */
+
 /* Receivers of one block. Non-glossy receivers have camp = 0 (and any
  * frame); receivers without a diffuse lobe have diffuse = 0. */
 typedef struct vsgl_kernel_block {
@@ -44,8 +49,9 @@ typedef struct vsgl_kernel_light {
     float c0;                /* 1 / (2 pi A(lv)) */
     float pr, pg, pb;        /* power */
     float nx, ny, nz;        /* mean surface normal of the cluster */
-    float hemi_weight;       /* coherence^2 of the normals times the correction switch (0 = off) */
-    float hemi_scale;        /* 1 / the emission cosine below which the correction fades light out */
+    float clip;              /* emitter-hemisphere clip: coherence^2 of the normals, 0 = off (shade.h) */
+    float conv;              /* 1 for a diffuse lobe: clamped-cosine emission in the far field */
+    float ibehind;           /* 1 / (VSGL_CLIP_BEHIND sigma) */
 } vsgl_kernel_light;
 
 /* Lobes a block needs (skip the work for lobes no lane has). */

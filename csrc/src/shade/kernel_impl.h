@@ -15,6 +15,8 @@
 #define K_PI 3.14159265358979323846f
 #define K_2PI 6.28318530717958647692f
 #define K_SHARP_MAX 2199023255552.0f       /* 2^41 */
+/* A(2.29) / pi: the clamped cosine over the diffuse lobe's SG at the axis */
+#define K_CLIP_RHO ((float)(VSGL__COSINE_A_LD / 3.14159265358979323846))
 
 /* e^x, 0 below -87 and e^88 above 88: Cephes-style degree-5 polynomial
  * after rintf range reduction (not the 1.5*2^23 trick, which the
@@ -232,17 +234,25 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
 {
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
     float d2 = dx * dx + dy * dy + dz * dz;
-    t->r[i] = k_rsqrt(d2 > 1e-24f ? d2 : 1e-24f);
+    float r = k_rsqrt(d2 > 1e-24f ? d2 : 1e-24f);
+    t->r[i] = r;
     t->d2[i] = d2;
-    /* Emitter-hemisphere correction: VPLs on a surface emit only above it.
-     * h / sqrt(d^2 + 2 var) is the emission cosine towards x softened over
-     * the cluster's spread; light fades out as it goes to 0 (below the
-     * cluster's plane or grazing it), weighted by how coplanar the cluster is. */
-    float ce = -(dx * L->nx + dy * L->ny + dz * L->nz) * k_rsqrt_coarse(d2 + L->var2 + 1e-30f);
-    float st = ce * L->hemi_scale;
-    st = st < 0.0f ? 0.0f : (st > 1.0f ? 1.0f : st);
+    /* Emitter-hemisphere clip (shade.h, vsgl__emitter_clip): nothing behind
+     * or in the cluster's plane, nothing for a receiver facing the same way,
+     * the clamped cosine's far-field falloff for diffuse lobes. */
+    float h = -(dx * L->nx + dy * L->ny + dz * L->nz);
+    float sb = h * L->ibehind;
+    sb = sb < 0.0f ? 0.0f : (sb > 1.0f ? 1.0f : sb);
+    float sp = (1.0f - (b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz)) * (1.0f / VSGL_CLIP_PARALLEL);
+    sp = sp > 1.0f ? 1.0f : sp;
+    float c = h * r;
+    c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
+    float rho = K_CLIP_RHO * c * k_exp(VSGL__COSINE_SHARPNESS * (1.0f - c));
+    float s = d2 * L->ivar;
+    float w = s / (s + VSGL_CLIP_NEAR) * L->conv;
+    float e = sb * sb * (3.0f - 2.0f * sb) * sp * sp * (3.0f - 2.0f * sp) * ((1.0f - w) + w * rho);
     float valid = (d2 > 0.0f ? 1.0f : L->valid) * vis;
-    t->amp[i] = valid * L->c0 * (1.0f - L->hemi_weight * (1.0f - st * st * (3.0f - 2.0f * st)));
+    t->amp[i] = valid * L->c0 * (1.0f - L->clip * (1.0f - e));
 }
 
 static inline __attribute__((always_inline)) void

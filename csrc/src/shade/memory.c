@@ -139,11 +139,19 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
         if (s->fit_mode != VSGL_FIT_TWO) {
             uint64_t cells = (uint64_t)rl.faces * side * side;
             uint64_t grid = mul(cells, VSGL_GRID_STRIDE * sizeof(float));
-            if (s->fit_mode == VSGL_FIT_FIS)
+            if (s->fit_mode == VSGL_FIT_FIS) {
                 fit = add(grid + grid / 3u, mul(cells + 1u, sizeof(double))); /* mips; importance CDF */
-            else
+            } else if (s->fit_mode == VSGL_FIT_LATTICE) {
+                /* fit/lattice.c: a hash map of lattice cells, each with its sums; a texel's
+                 * tent weights reach 4 cells, and there are a few cells per cluster */
+                uint64_t lattice_cells = mul(s->vsgl_count, 16u);
+                if (lattice_cells > mul(texels, 4u))
+                    lattice_cells = mul(texels, 4u);
+                fit = add(grid, mul(lattice_cells, VSGL_GRID_STRIDE * sizeof(double) + 2u * 12u));
+            } else {
                 fit = add(grid, add(mul(texels, sizeof(uint32_t)), /* labels, centres, sums */
                                     mul(s->vsgl_count, 64u + VSGL_GRID_STRIDE * sizeof(double))));
+            }
         }
         fit_max = fit > fit_max ? fit : fit_max;
     }

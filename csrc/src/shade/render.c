@@ -34,9 +34,8 @@ static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt,
         snprintf(st->skipped + used, sizeof st->skipped - used, "%s\n", line);
 }
 
-/* Fit the VSGLs of every light, one RSM alive at a time. */
-static vsgl_result fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
-                              vsgl_vsgl_set *set, vsgl_render_stats *st)
+vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
+                             vsgl_vsgl_set *set, vsgl_render_stats *st)
 {
     uint32_t light_count = 0;
     const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
@@ -66,6 +65,7 @@ static vsgl_result fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const 
         switch (s->fit_mode) {
         case VSGL_FIT_FIS: r = vsgl__fit_fis(ctx, scene, &rsm, s, set); break;
         case VSGL_FIT_KMEANS: r = vsgl__fit_kmeans(ctx, scene, &rsm, s, set); break;
+        case VSGL_FIT_LATTICE: r = vsgl__fit_lattice(ctx, scene, &rsm, s, set); break;
         default: r = vsgl__fit_two(ctx, scene, &rsm, s, set); break;
         }
         st->seconds_fit += now_seconds() - t0;
@@ -257,7 +257,7 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
     if (s.method == VSGL_METHOD_BRUTE_FORCE) {
         r = brute_force(ctx, scene, &s, &g, &planes, &st);
     } else {
-        r = fit_lights(ctx, scene, &s, &set, &st);
+        r = vsgl__fit_lights(ctx, scene, &s, &set, &st);
         st.vsgl_count = (uint32_t)set.count;
         if (r == VSGL_OK) {
             t0 = now_seconds();

@@ -70,7 +70,7 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: " #field " is %d (valid %d..%d)", \
                           (int)s->field, (int)(lo), (int)(hi));
     CHECK_ENUM(method, VSGL_METHOD_VSGL, VSGL_METHOD_BRUTE_FORCE)
-    CHECK_ENUM(fit_mode, VSGL_FIT_TWO, VSGL_FIT_KMEANS)
+    CHECK_ENUM(fit_mode, VSGL_FIT_TWO, VSGL_FIT_LATTICE)
     CHECK_ENUM(sharpness_estimator, VSGL_SHARPNESS_TOKSVIG, VSGL_SHARPNESS_BANERJEE)
     CHECK_ENUM(diffuse_mode, VSGL_COSINE_ACCURATE, VSGL_COSINE_PULLED_OUT)
     CHECK_ENUM(glossy_mode, VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG)

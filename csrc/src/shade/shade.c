@@ -41,12 +41,31 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
     return 1;
 }
 
-float vsgl__leak_factor(const vsgl_vsgl *v, v3 x)
+static float smoothstep01(float t)
 {
+    t = clampf(t, 0.0f, 1.0f);
+    return t * t * (3.0f - 2.0f * t);
+}
+
+float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
+{
+    if (!on)
+        return 1.0f;
     v3 d = v3_sub(x, v->mean);
-    float ce = v3_dot(d, v->normal) / sqrtf(v3_dot(d, d) + 2.0f * v->variance + 1e-30f);
-    float t = clampf(ce / VSGL_LEAK_COSINE, 0.0f, 1.0f);
-    return 1.0f - v->coherence * v->coherence * (1.0f - t * t * (3.0f - 2.0f * t));
+    float d2 = v3_dot(d, d);
+    float var = fmaxf(v->variance, d2 * VARIANCE_FLOOR);
+    float h = v3_dot(d, v->normal);
+    float e = smoothstep01(h / (VSGL_CLIP_BEHIND * sqrtf(var) + 1e-30f)) *
+              smoothstep01((1.0f - v3_dot(n, v->normal)) * (1.0f / VSGL_CLIP_PARALLEL));
+    if (v->lobe == VSGL_LOBE_DIFFUSE) {
+        float c = d2 > 0.0f ? clampf(h / sqrtf(d2), 0.0f, 1.0f) : 0.0f;
+        float ld = vsgl_sg_cosine_sharpness();
+        float rho = vsgl_sg_integral(ld) * INV_PI * c * expf(ld * (1.0f - c));
+        float s = var > 0.0f ? d2 / var : 0.0f;
+        float w = s / (s + VSGL_CLIP_NEAR);
+        e *= (1.0f - w) + w * rho;
+    }
+    return 1.0f - v->coherence * v->coherence * (1.0f - e);
 }
 
 typedef struct shade_job {
@@ -173,7 +192,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 if (!vsgl__vsgl_incident_sg(v, r.x, &in))
                     continue;
                 if (j->leak)
-                    in.log_amplitude += logf(fmaxf(vsgl__leak_factor(v, r.x), 1e-30f));
+                    in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), 1e-30f));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
                     float vis;
                     visibility_rays(j, v->mean, &r, 1, &vis);
@@ -461,7 +480,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
     if (s->glossy_mode == VSGL_GLOSSY_SG)
         path = VSGL_SHADE_REFERENCE;
     int leak = s->leak_correction == VSGL_LEAK_ON ||
-               (s->leak_correction == VSGL_LEAK_AUTO && s->fit_mode != VSGL_FIT_TWO);
+               s->leak_correction == VSGL_LEAK_AUTO;
     vsgl_kernel_light *kl = NULL;
     if (path != VSGL_SHADE_REFERENCE) {
         kl = malloc((set->count + 1) * sizeof *kl);
@@ -483,8 +502,9 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
             o->c0 = 1.0f / (TWO_PI * vsgl_sg_integral(v->sharpness));
             o->pr = v->power[0]; o->pg = v->power[1]; o->pb = v->power[2];
             o->nx = v->normal.x; o->ny = v->normal.y; o->nz = v->normal.z;
-            o->hemi_weight = leak ? v->coherence * v->coherence : 0.0f;
-            o->hemi_scale = 1.0f / VSGL_LEAK_COSINE;
+            o->clip = leak ? v->coherence * v->coherence : 0.0f;
+            o->conv = v->lobe == VSGL_LOBE_DIFFUSE ? 1.0f : 0.0f;
+            o->ibehind = 1.0f / (VSGL_CLIP_BEHIND * sqrtf(v->variance) + 1e-30f);
         }
     }
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),

@@ -6,6 +6,7 @@
 #include "fit/vsgl_set.h"
 #include "gbuffer/gbuffer.h"
 #include "vsgl/sg.h"
+#include "shade/kernel.h"
 
 /* Per-pixel accumulation planes (width*height*3 floats each, caller-owned,
  * zeroed by the callee): coloured contributions and the colours (DiffCol,
@@ -31,12 +32,29 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
 #define VSGL_SHADE_KERNEL_SCALAR 1
 #define VSGL_SHADE_REFERENCE     2
 
-/* Emission cosine below which the leak correction fades a VSGL out. */
-#define VSGL_LEAK_COSINE 0.05f
+/* Emitter-hemisphere clip (the leak correction). A cluster's VPLs lie on
+ * a surface and emit only in front of it, with a clamped cosine; the
+ * papers' model emits an SG (lambda 2.29 for a diffuse lobe) with ~9 % of
+ * its power behind the surface and a 15-25 % wrong falloff, and lets a
+ * cluster light its own plane. For a cluster whose normals agree
+ * (coherence k), the light reaching a receiver at x with normal n is
+ * scaled by 1 - k^2 (1 - e), e = conv * behind * parallel:
+ *  - behind: 0 behind or in the cluster's plane (height h = n_v.(x - mean)
+ *    <= 0), 1 from h >= 0.02 sigma on (smoothstep);
+ *  - parallel: 0 for a receiver facing the same way as the cluster (it
+ *    cannot see that plane: a floor never lights the floor), 1 from
+ *    1 - n.n_v >= 0.3 (smoothstep);
+ *  - conv (diffuse lobes): the far-field ratio of the clamped cosine to
+ *    the SG at the emission cosine c = h / |x - mean|,
+ *    rho(c) = A(2.29)/pi c e^{2.29 (1 - c)}, blended towards 1 in the
+ *    near field by w = s / (s + 4), s = |x - mean|^2 / var (the spread's
+ *    sharpness), where the SG product is the better model.
+ * docs/accuracy.md measures it against a planar emitter's exact irradiance. */
+/* (VSGL_CLIP_* in shade/kernel.h) */
 
-/* Emitter-hemisphere (leak) correction factor of VSGL v at receiver x, in
- * [0, 1] (the kernel computes the same inline). */
-float vsgl__leak_factor(const vsgl_vsgl *v, v3 x);
+/* The clip factor of VSGL v for a receiver at x with unit normal n, in [0, 1]
+ * (the kernel computes the same inline); `on` selects the clip. */
+float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
 
 /* Shade every G-buffer sample with every VSGL; writes `planes`.
  * `pairs` receives the number of sample x VSGL evaluations. */

@@ -1,0 +1,230 @@
+/* About N VSGLs per light on a world-space lattice (the "stable" fit).
+ *
+ * The importance-sampled fits (FIS, k-means) draw their cluster centres
+ * from the RSM's power distribution, so a light that moves by a millimetre
+ * reshuffles every cluster (flicker), and clusters of random size and
+ * shape sum to blotches. Here the clusters are fixed in the world:
+ *
+ *  - orientation: a VPL of normal n belongs to the six signed-axis bins
+ *    with weights max(+-n_a, 0)^2 (they sum to 1, smooth in n), so a
+ *    cluster never mixes a floor with a wall: its VPLs face one way, which
+ *    is what lets the shading clip its emission to its own hemisphere;
+ *  - position: within bin b (axis a), lattice points h apart in the two
+ *    axes across a, with tent (bilinear) weights, which sum to 1 and are
+ *    continuous in the VPL's position; along a, slabs h/4 thick (surfaces
+ *    of one bin at different heights, a floor and a table top, stay apart);
+ *  - the lattice is anchored at the scene's bounds, not at the light, and
+ *    h follows the light's effective lit area A (the power-weighted
+ *    participation area (sum w)^2 / sum(w^2 / a)), h = sqrt(A / N): both
+ *    change smoothly as the light moves.
+ *
+ * So every VSGL's sums are continuous functions of the RSM; a light that
+ * moves a little changes them a little. The tents of neighbouring lattice
+ * points overlap, so their Gaussians sum to a smooth field; each VSGL's
+ * positional variance is widened by VSGL_LATTICE_OVERLAP h^2 on top of its
+ * own (h^2 / 6 per axis for a uniformly lit tent), which takes the ripple
+ * of the sum from ~7 % to ~1 % (docs/accuracy.md). */
+#include "fit/grid.h"
+#include "core/context.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Slab thickness along a bin's axis, in units of h. */
+#define VSGL_LATTICE_SLAB 0.25
+/* Extra positional variance per VSGL, in units of h^2. */
+#define VSGL_LATTICE_OVERLAP (1.0 / 12.0)
+
+/* Open-addressing map from a packed lattice key to a cluster's sums. */
+typedef struct cell_map {
+    uint64_t *keys;      /* 0 = empty (packed keys are never 0) */
+    uint32_t *slot;      /* index into sums, in first-touch order */
+    size_t cap, count;
+    double *sums;        /* count * VSGL_GRID_STRIDE */
+    size_t sums_cap;
+} cell_map;
+
+static uint64_t pack_key(uint32_t bin, int32_t k, int32_t i, int32_t j)
+{
+    /* 3 bits of bin + 1, three 20-bit biased coordinates */
+    const int32_t bias = 1 << 19;
+    return ((uint64_t)(bin + 1) << 60) | ((uint64_t)(uint32_t)(k + bias) << 40) |
+           ((uint64_t)(uint32_t)(i + bias) << 20) | (uint64_t)(uint32_t)(j + bias);
+}
+
+static uint64_t hash64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+static int map_grow(cell_map *m)
+{
+    size_t cap = m->cap ? m->cap * 2 : 1024;
+    uint64_t *keys = calloc(cap, sizeof *keys);
+    uint32_t *slot = malloc(cap * sizeof *slot);
+    if (!keys || !slot) {
+        free(keys);
+        free(slot);
+        return 0;
+    }
+    for (size_t e = 0; e < m->cap; ++e) {
+        if (!m->keys[e])
+            continue;
+        size_t p = hash64(m->keys[e]) & (cap - 1);
+        while (keys[p])
+            p = (p + 1) & (cap - 1);
+        keys[p] = m->keys[e];
+        slot[p] = m->slot[e];
+    }
+    free(m->keys);
+    free(m->slot);
+    m->keys = keys;
+    m->slot = slot;
+    m->cap = cap;
+    return 1;
+}
+
+/* The sums of `key`, created (zeroed) on first use; NULL if out of memory. */
+static double *map_get(cell_map *m, uint64_t key)
+{
+    if ((m->count + 1) * 2 > m->cap && !map_grow(m))
+        return NULL;
+    size_t p = hash64(key) & (m->cap - 1);
+    while (m->keys[p] && m->keys[p] != key)
+        p = (p + 1) & (m->cap - 1);
+    if (m->keys[p])
+        return m->sums + (size_t)m->slot[p] * VSGL_GRID_STRIDE;
+    if (m->count == m->sums_cap) {
+        size_t cap = m->sums_cap ? m->sums_cap * 2 : 256;
+        double *s = realloc(m->sums, cap * VSGL_GRID_STRIDE * sizeof *s);
+        if (!s)
+            return NULL;
+        m->sums = s;
+        m->sums_cap = cap;
+    }
+    m->keys[p] = key;
+    m->slot[p] = (uint32_t)m->count;
+    double *s = m->sums + m->count * VSGL_GRID_STRIDE;
+    memset(s, 0, VSGL_GRID_STRIDE * sizeof *s);
+    ++m->count;
+    return s;
+}
+
+static void map_free(cell_map *m)
+{
+    free(m->keys);
+    free(m->slot);
+    free(m->sums);
+    memset(m, 0, sizeof *m);
+}
+
+/* The lattice spacing for about n clusters over the light's lit area. */
+static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, uint32_t n, double extent)
+{
+    double sw = 0.0, sw2a = 0.0, swa = 0.0;
+    size_t per_face = (size_t)rsm->res * rsm->res;
+    for (size_t t = 0; t < rsm->count; ++t) {
+        size_t rem = t % per_face;
+        size_t gi = ((t / per_face) * g->res + rem / rsm->res) * g->res + rem % rsm->res;
+        const float *m = g->level[0].data + gi * VSGL_GRID_STRIDE;
+        double w = (double)m[0] + m[VSGL_GRID_FIELDS];
+        double a = rsm->area[t];
+        if (!(w > 0.0) || !(a > 0.0) || !(a < INFINITY))
+            continue;
+        sw += w;
+        sw2a += w * w / a;
+        swa += w * a;
+    }
+    if (!(sw > 0.0) || !(sw2a > 0.0))
+        return extent > 0.0 ? extent : 1.0;
+    double area = sw * sw / sw2a;
+    double h = sqrt(area / (double)(n ? n : 1));
+    /* a cluster should hold a few texels: h >= 1.5 x the typical texel size */
+    double texel = sqrt(swa / sw);
+    if (h < 1.5 * texel)
+        h = 1.5 * texel;
+    /* keys hold 20-bit coordinates */
+    double hmin = (extent > 0.0 ? extent : 1.0) / 200000.0;
+    return h > hmin ? h : hmin;
+}
+
+vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
+                              const vsgl_render_settings *s, vsgl_vsgl_set *out)
+{
+    uint32_t n_clusters = s->vsgl_count ? s->vsgl_count : 64;
+    vsgl_grid g;
+    vsgl_result r = vsgl__grid_build(ctx, scene, rsm, s->sharpness_estimator, 0, &g);
+    if (r != VSGL_OK)
+        return r;
+    v3 lo, hi;
+    vsgl__scene_bounds(scene, &lo, &hi);
+    double extent = v3_length(v3_sub(hi, lo));
+    double h = lattice_spacing(rsm, &g, n_clusters, extent);
+    double inv_h = 1.0 / h;
+    const double anchor[3] = {lo.x, lo.y, lo.z};
+    cell_map map;
+    memset(&map, 0, sizeof map);
+    size_t per_face = (size_t)rsm->res * rsm->res;
+    /* Sequential in texel order: the sums and the VSGLs' order are the same
+     * for any thread count. */
+    for (size_t t = 0; t < rsm->count && r == VSGL_OK; ++t) {
+        size_t rem = t % per_face;
+        size_t gi = ((t / per_face) * g.res + rem / rsm->res) * g.res + rem % rsm->res;
+        const float *m = g.level[0].data + gi * VSGL_GRID_STRIDE;
+        if (!(m[0] + m[VSGL_GRID_FIELDS] > 0.0f))
+            continue;
+        const double p[3] = {rsm->pos[0][t], rsm->pos[1][t], rsm->pos[2][t]};
+        const double nrm[3] = {rsm->nrm[0][t], rsm->nrm[1][t], rsm->nrm[2][t]};
+        double q[3];
+        for (int a = 0; a < 3; ++a)
+            q[a] = (p[a] - anchor[a]) * inv_h;
+        for (uint32_t bin = 0; bin < 6 && r == VSGL_OK; ++bin) {
+            int a = (int)(bin >> 1);
+            double na = (bin & 1) ? -nrm[a] : nrm[a];
+            if (!(na > 0.0))
+                continue;
+            double wb = na * na;
+            int u = (a + 1) % 3, v = (a + 2) % 3;
+            int32_t k = (int32_t)floor(q[a] * (1.0 / VSGL_LATTICE_SLAB));
+            double fu = floor(q[u]), fv = floor(q[v]);
+            double tu = q[u] - fu, tv = q[v] - fv;
+            for (int du = 0; du < 2; ++du)
+                for (int dv = 0; dv < 2; ++dv) {
+                    double w = wb * (du ? tu : 1.0 - tu) * (dv ? tv : 1.0 - tv);
+                    if (!(w > 0.0))
+                        continue;
+                    double *dst = map_get(&map, pack_key(bin, k, (int32_t)fu + du, (int32_t)fv + dv));
+                    if (!dst) {
+                        r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "fit: out of memory for the lattice clusters");
+                        break;
+                    }
+                    for (int f = 0; f < VSGL_GRID_STRIDE; ++f)
+                        dst[f] += w * m[f];
+                }
+        }
+    }
+    double total = g.total[0] + g.total[VSGL_GRID_FIELDS];
+    double widen = VSGL_LATTICE_OVERLAP * h * h;
+    for (size_t c = 0; c < map.count && r == VSGL_OK; ++c)
+        for (uint32_t lobe = 0; lobe < 2 && r == VSGL_OK; ++lobe) {
+            const double *f = map.sums + c * VSGL_GRID_STRIDE + lobe * VSGL_GRID_FIELDS;
+            if (!(f[0] > 1e-9 * total)) /* a sliver of a tent: nothing a pixel could show */
+                continue;
+            vsgl_moments mo;
+            vsgl_vsgl v;
+            vsgl__grid_moments(f, &mo);
+            if (vsgl__moments_to_vsgl(&mo, g.origin, s->sharpness_estimator, rsm->light, lobe, &v)) {
+                v.variance += (float)widen;
+                r = vsgl__vsgl_set_push(out, &v);
+                if (r != VSGL_OK)
+                    r = vsgl__fail(ctx, r, "fit: out of memory");
+            }
+        }
+    vsgl__log(ctx, VSGL_LOG_DEBUG, "fit: light %u: lattice spacing %.4g m, %zu clusters", rsm->light, h, map.count);
+    map_free(&map);
+    vsgl__grid_free(&g);
+    return r;
+}
