@@ -24,6 +24,7 @@ Farm safety (issue 10): no handler ever replaces or deletes a complete AOV
 another process wrote; the compositor-setup placeholder is only ever put
 where no file exists and only ever removed if it is still the same inode.
 """
+import contextlib
 import os
 import time
 
@@ -61,7 +62,8 @@ def setup_scene(scene, frame=None):
         path = runner.output_path(scene, layer, frame, options)
         try:
             engine.check_output_path(path)
-            _setup_layer(scene, layer, path, w, h, options.add_to_render and i == 0)
+            with _setup_lock(os.path.dirname(path)):
+                _setup_layer(scene, layer, path, w, h, options.add_to_render and i == 0)
         except engine.AovError as e:
             errors.append("view layer '%s': %s" % (layer, e))
         except Exception as e:
@@ -71,6 +73,28 @@ def setup_scene(scene, frame=None):
     for e in errors:
         runner.fail(scene.name, e)
     return errors
+
+
+SETUP_LOCK = ".vsgl-setup.lock"
+
+
+@contextlib.contextmanager
+def _setup_lock(directory):
+    """One compositor setup at a time per AOV folder, across processes (and
+    hosts sharing it): otherwise a worker may read another's placeholder just
+    as that one removes it ("Cannot read ..."). An empty hidden file
+    ``.vsgl-setup.lock`` stays in the folder."""
+    try:
+        import fcntl
+        fd = os.open(os.path.join(directory, SETUP_LOCK), os.O_RDWR | os.O_CREAT, 0o666)
+    except (ImportError, OSError):   # no fcntl (Windows) or a read-only folder: no lock
+        yield
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)                 # releases the lock
 
 
 def _setup_layer(scene, layer, path, w, h, add, attempts=6):

@@ -163,7 +163,7 @@ def test_failed_frame_retires_only_a_previous_runs_aov(scene, tmp_path):
     assert r.returncode == 0 and "no light with non-zero power" in r.stdout, r.stdout
     assert "removed the previous run's AOV" in r.stdout, r.stdout
     assert not os.path.exists(aov(tmp_path, 1))
-    assert not [n for n in os.listdir(str(tmp_path / "aov")) if "retired" in n or "setup" in n]
+    assert not [n for n in os.listdir(str(tmp_path / "aov")) if "retired" in n or ".setup-" in n]
 
 
 def test_placeholder_and_stale_removal_keep_other_writers_files(tmp_path):
@@ -227,7 +227,7 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     for _ in range(3):
         assert handlers.setup_scene(scene) == []
         # the sockets' placeholder is gone again, and nothing beside it
-        assert os.listdir(str(tmp_path / "aov")) == [], os.listdir(str(tmp_path / "aov"))
+        assert os.listdir(str(tmp_path / "aov")) == [handlers.SETUP_LOCK], os.listdir(str(tmp_path / "aov"))
     tree = compat.compositor_tree(scene, create=False)
     assert len(_nodes(tree, "VSGL Indirect [")) == 1 and len(_nodes(tree, "VSGL Add [")) == 1
     out = compat.compositor_output_socket(tree)
