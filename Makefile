@@ -2,14 +2,14 @@
 #
 # Python: the C library is tested from Debian's /usr/bin/python3 (the one
 # Debian's Blender 3.4 embeds, with python3-numpy/python3-pytest). The
-# newest Blender-as-a-module (`bpy` from PyPI) is tested from $(PIP_PYTHON),
+# newest Blender-as-a-module (`bpy` from PyPI) is tested from $(BPY_PYTHON),
 # the pyenv python3 on PATH, into which tools/ installs bpy with pip.
 SHELL := /bin/bash
 .DEFAULT_GOAL := all
 
 CC      ?= cc
 PYTHON  ?= /usr/bin/python3
-PIP_PYTHON ?= python3
+BPY_PYTHON ?= python3
 BUILD   := build
 INCLUDES := -Icsrc/include -Icsrc/src $(shell pkg-config --cflags-only-I OpenEXR 2>/dev/null)
 WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes -Wmissing-prototypes
@@ -45,8 +45,12 @@ $(BUILD)/obj/%.o: %.c $(HEADERS) | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_COMMON) $(OPT) -MMD -c $< -o $@
 
+# RPATH (not RUNPATH: it also applies to the dependencies' own dependencies,
+# e.g. embree -> tbb) $ORIGIN: the add-on zip ships libembree3, libOpenEXRCore
+# and libtbb beside libvsgl.so (tools/build_addon.sh); a build/ without them
+# falls back to the system's.
 $(BUILD)/libvsgl.so: $(LIB_OBJ)
-	$(CC) -shared -o $@ $^ $(LDLIBS)
+	$(CC) -shared -o $@ $^ $(LDLIBS) -Wl,-rpath,'$$ORIGIN' -Wl,--disable-new-dtags
 
 $(BUILD)/vsgl: $(CLI_SRC) $(BUILD)/libvsgl.so
 	$(CC) $(CFLAGS_COMMON) $(OPT) -o $@ $(CLI_SRC) -L$(BUILD) -lvsgl -Wl,-rpath,'$$ORIGIN' -lm
@@ -73,7 +77,7 @@ $(BUILD)/tests/vsgl_tests: $(TEST_OBJ) $(LIB_OBJ)
 test:
 	@tools/deps.sh test
 	@$(MAKE) --no-print-directory all $(BUILD)/tests/vsgl_tests >/dev/null
-	@PYTHON=$(PYTHON) PIP_PYTHON=$(PIP_PYTHON) tools/run_tests.sh
+	@PYTHON=$(PYTHON) BPY_PYTHON=$(BPY_PYTHON) tools/run_tests.sh
 
 test-c: $(BUILD)/tests/vsgl_tests
 	$(BUILD)/tests/vsgl_tests $(T)
@@ -125,7 +129,7 @@ $(BUILD)/obj/csrc/src/shade/kernel_scalar.o: OPT += -fno-math-errno -fno-trappin
 $(BUILD)/obj/tests/c/kernel_isa%.o: OPT += -O3 $(KERNEL_MATH)
 
 # libFuzzer + ASan + UBSan on the scene-bundle reader (tests/fuzz/), for
-# FUZZ_SECONDS seconds from a seed corpus the library writes (CRC checks
+# FUZZ_SECONDS seconds each target from a seed corpus the library writes (CRC checks
 # are skipped in this build so mutations reach the structural checks). Findings are
 # saved as $(BUILD)/fuzz/crash-* and make the target fail.
 .PHONY: fuzz
@@ -138,14 +142,32 @@ $(BUILD)/fuzz/fuzz_bundle: tests/fuzz/fuzz_bundle.c $(FUZZ_LIB_SRC) $(HEADERS)
 $(BUILD)/fuzz/make_corpus: tests/fuzz/make_corpus.c $(FUZZ_LIB_SRC) $(HEADERS)
 	@mkdir -p $(dir $@)
 	clang $(CFLAGS_COMMON) $(FUZZ_FLAGS) -o $@ tests/fuzz/make_corpus.c $(FUZZ_LIB_SRC) -lm
+# Issue 10: also scene validation + the render on whatever the reader accepts
+# (fuzz_scene: the whole library) and the CLI's option parser (fuzz_cli).
+$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c $(LIB_SRC) $(HEADERS)
+	@mkdir -p $(dir $@)
+	clang $(CFLAGS_COMMON) $(FUZZ_FLAGS) -fsanitize=fuzzer -DFUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION -o $@ tests/fuzz/fuzz_scene.c $(LIB_SRC) $(LDLIBS)
+FUZZ_CLI_SRC := csrc/cli/options.c csrc/src/shade/settings.c csrc/src/core/context.c csrc/src/core/result.c
+$(BUILD)/fuzz/fuzz_cli: tests/fuzz/fuzz_cli.c $(FUZZ_CLI_SRC) $(HEADERS) csrc/cli/options.h
+	@mkdir -p $(dir $@)
+	clang $(CFLAGS_COMMON) -Icsrc/cli $(FUZZ_FLAGS) -fsanitize=fuzzer -o $@ tests/fuzz/fuzz_cli.c $(FUZZ_CLI_SRC) -lm
+FUZZ_RUN := UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ASAN_OPTIONS=detect_leaks=1
 fuzz:
 	@tools/deps.sh asan
-	@$(MAKE) --no-print-directory $(BUILD)/fuzz/fuzz_bundle $(BUILD)/fuzz/make_corpus
-	@mkdir -p $(BUILD)/fuzz/corpus
+	@$(MAKE) --no-print-directory $(BUILD)/fuzz/fuzz_bundle $(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/fuzz_scene $(BUILD)/fuzz/fuzz_cli
+	@mkdir -p $(BUILD)/fuzz/corpus $(BUILD)/fuzz/corpus_scene $(BUILD)/fuzz/corpus_cli
 	$(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/corpus
+	cp -n $(BUILD)/fuzz/corpus/* $(BUILD)/fuzz/corpus_scene/
+	tools/fuzz_cli_seeds.sh $(BUILD)/fuzz/corpus_cli
 	$(BUILD)/fuzz/fuzz_bundle tests/fuzz/regressions/*
-	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 $(BUILD)/fuzz/fuzz_bundle -max_total_time=$(FUZZ_SECONDS) \
+	$(BUILD)/fuzz/fuzz_scene tests/fuzz/regressions_scene/*
+	$(BUILD)/fuzz/fuzz_cli tests/fuzz/regressions_cli/*
+	$(FUZZ_RUN) $(BUILD)/fuzz/fuzz_bundle -max_total_time=$(FUZZ_SECONDS) \
 	  -dict=tests/fuzz/bundle.dict -artifact_prefix=$(BUILD)/fuzz/ -print_final_stats=1 $(BUILD)/fuzz/corpus
+	$(FUZZ_RUN) $(BUILD)/fuzz/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -timeout=30 -rss_limit_mb=4096 \
+	  -dict=tests/fuzz/bundle.dict -artifact_prefix=$(BUILD)/fuzz/scene- -print_final_stats=1 $(BUILD)/fuzz/corpus_scene
+	$(FUZZ_RUN) $(BUILD)/fuzz/fuzz_cli -max_total_time=$(FUZZ_SECONDS) \
+	  -dict=tests/fuzz/cli.dict -artifact_prefix=$(BUILD)/fuzz/cli- -print_final_stats=1 $(BUILD)/fuzz/corpus_cli
 
 # Blender add-on zip (issue 5): build/vsgl_indirect.zip with lib/libvsgl.so inside.
 .PHONY: addon

@@ -4,6 +4,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 PYTHON=${PYTHON:-/usr/bin/python3}
+export BPY_PYTHON=${BPY_PYTHON:-python3}
 total_pass=0; total_fail=0; status=0
 log=$(mktemp -d)
 
@@ -19,6 +20,14 @@ count() {  # count <name> <logfile> <exit code>: add the suite's counts
   return 0
 }
 
+# The newest bpy (Blender as a module) for the add-on, G-buffer and light
+# suites: installed once, here, so that every suite after it runs on it.
+echo "== bpy in $BPY_PYTHON"
+if ! tools/install_bpy.sh; then
+  echo "run_tests.sh: tools/install_bpy.sh could not install bpy into $BPY_PYTHON"
+  total_fail=$((total_fail + 1)); status=1
+fi
+
 echo "== C unit tests"
 build/tests/vsgl_tests 2>&1 | tee "$log/c.txt"; count "C unit tests" "$log/c.txt" "${PIPESTATUS[0]}"
 
@@ -28,7 +37,7 @@ if [ -d tests/python ] && ls tests/python/test_*.py >/dev/null 2>&1; then
   count "Python tests" "$log/py.txt" "${PIPESTATUS[0]}"
 fi
 
-for runner in tests/cli/run_*.sh tests/blender/run_*.sh; do
+for runner in tests/tools/run_*.sh tests/cli/run_*.sh tests/blender/run_*.sh; do
   [ -x "$runner" ] || continue
   echo "== $runner"
   "$runner" 2>&1 | tee "$log/bl.txt"; count "$runner" "$log/bl.txt" "${PIPESTATUS[0]}"

@@ -29,6 +29,12 @@ _modules = (settings, operators, ui, handlers)
 def register():
     for m in _modules:
         m.register()
+    # The pip bpy 4.2 LTS module segfaults at exit (status 139, after every
+    # render) while any of our functions is still stored in Blender (a
+    # handler, a registered class's callbacks): unregister before it exits.
+    import atexit
+    atexit.unregister(_unregister_at_exit)
+    atexit.register(_unregister_at_exit)
     from . import engine
     ok, msg = engine.library_status()
     if not ok:
@@ -37,5 +43,15 @@ def register():
 
 
 def unregister():
+    import atexit
+    atexit.unregister(_unregister_at_exit)
     for m in reversed(_modules):
         m.unregister()
+
+
+def _unregister_at_exit():
+    try:
+        if "vsgl_indirect" in bpy.types.Scene.bl_rna.properties:
+            unregister()
+    except Exception:  # never turn a clean exit into a failure
+        pass

@@ -18,7 +18,7 @@ def corner_normals(mesh):
 
 
 def light_exposure(light):
-    """Blender 4.x exposure in stops (0 on 3.x)."""
+    """Light exposure in stops (Blender 4.3+; 0 before)."""
     return float(getattr(light, "exposure", 0.0))
 
 

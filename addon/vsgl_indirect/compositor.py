@@ -27,9 +27,10 @@ def add_node_name(view_layer):
 
 def placeholder(path, width, height, exclusive=False):
     """Write a black EXR with every pass so the Image node gets its sockets
-    before the real file exists (it is overwritten, or deleted on failure).
-    ``exclusive``: never replace an existing file (another process may have
-    written that frame's real AOV meanwhile); returns False if one existed."""
+    before the real file exists. ``exclusive``: never replace an existing
+    file (another process may have written that frame's real AOV
+    meanwhile): returns the placeholder's inode (for
+    ``handlers.remove_if_inode``), or None if a file was there."""
     import numpy as np
     z = np.zeros((max(height, 1), max(width, 1), 3), np.float32)
     planes = {p: z for p in engine.PASS_NAMES}
@@ -38,13 +39,14 @@ def placeholder(path, width, height, exclusive=False):
     if not exclusive:
         engine.write_exr(path, planes, Options())
         return True
-    tmp = "%s.setup%d.exr" % (path[:-4] if path.endswith(".exr") else path, os.getpid())
+    d, name = os.path.split(path)
+    tmp = os.path.join(d, ".%s.setup-%d" % (name, os.getpid()))
     engine.write_exr(tmp, planes, Options())
     try:
         os.link(tmp, path)      # atomic, fails if the file exists
-        return True
+        return os.stat(tmp).st_ino
     except FileExistsError:
-        return False
+        return None
     finally:
         os.unlink(tmp)
 
@@ -66,6 +68,19 @@ def _render_layers_node(tree, scene, view_layer):
     n.scene = scene
     n.layer = view_layer
     return n
+
+
+def has_passes(node, add_to_render=True):
+    """The Image node shows the AOV's passes (and, with ``add_to_render``,
+    its Combined output feeds our Add node)."""
+    if node is None or "DiffInd" not in node.outputs or not node.outputs["DiffInd"].enabled:
+        return False
+    src = _combined_socket(node)
+    if src is None or src.name != "Combined":
+        return False
+    if not add_to_render:
+        return True
+    return any(l.to_node.name.startswith("VSGL Add [") for l in src.links)
 
 
 def ensure(scene, view_layer, path, add_to_render=True):
@@ -105,6 +120,7 @@ def ensure(scene, view_layer, path, add_to_render=True):
     if not node.use_auto_refresh:
         node.use_auto_refresh = True
     if node.image != img or _combined_socket(node) is None or "DiffInd" not in node.outputs:
+        img.reload()        # a failed read (a file that vanished meanwhile) is cached
         node.image = None
         node.image = img
     if hasattr(node, "layer") and node.has_layers:

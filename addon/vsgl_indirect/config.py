@@ -48,7 +48,11 @@ class Options:
     sample_merging: str = "AUTO"
     output_path: str = DEFAULT_TEMPLATE
     threads: int = 0
+    max_memory_gb: float = 0.0      # 0 = the memory the machine has available
     half_float: bool = False
+
+    def max_memory_bytes(self):
+        return max(int(float(self.max_memory_gb) * (1 << 30)), 0)
 
     @classmethod
     def from_props(cls, props):

@@ -109,7 +109,8 @@ def render_planes(sd, options, progress=None, log=None):
     libvsgl = _binding()
     try:
         ctx = libvsgl.Context(thread_count=max(int(options.threads), 0), progress=progress,
-                              log=log, log_level=libvsgl.LogLevel.WARNING)
+                              log=log, log_level=libvsgl.LogLevel.WARNING,
+                              max_memory=options.max_memory_bytes())
     except Exception as e:
         raise AovError("cannot create a libvsgl context: %s" % e)
     try:
@@ -141,6 +142,18 @@ def _name_elements(message, sd):
     message = re.sub(r"\blight (\d+)", sub("light", sd.light_names), message)
     message = re.sub(r"\bmaterial (\d+)", sub("material", sd.material_names), message)
     return message
+
+
+def format_bytes(n):
+    return "%.1f GiB" % (n / float(1 << 30)) if n >= (1 << 30) else "%.1f MiB" % (n / float(1 << 20))
+
+
+def memory_summary(stats):
+    """'about 1.4 GiB of 22.8 GiB' from a render's stats, '' without an estimate."""
+    est = (stats or {}).get("memory_estimate")
+    if not est:
+        return ""
+    return "about %s of %s" % (format_bytes(est["total"]), format_bytes(est["limit"]))
 
 
 def check_output_path(path):

@@ -97,7 +97,25 @@ def default_tangents_local(arr):
     return np.stack([-g[:, 1], g[:, 0], np.zeros(len(g))], -1)
 
 
-def assemble(chunks, want_uvs=False, want_tangents=False):
+def _cofactor(A):
+    """Cofactor matrices of (k,3,3) ``A``: det(A) inv(A)^T where A is invertible,
+    and still the normal transform where it is not (a scale of 0 along an axis
+    maps the faces across that axis to faces with normals along it)."""
+    c0, c1, c2 = A[:, :, 0], A[:, :, 1], A[:, :, 2]
+    return np.stack([np.cross(c1, c2), np.cross(c2, c0), np.cross(c0, c1)], axis=2)
+
+
+def degenerate_mask(positions, indices, corner_normals):
+    """Triangles libvsgl would drop: zero area (in the float32 positions it is
+    given) or a corner normal of (near) zero length (as vsgl_scene_create)."""
+    p = np.asarray(positions, np.float32).astype(np.float64)[np.asarray(indices, np.int64)]
+    area2 = np.square(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])).sum(axis=1)
+    n = np.asarray(corner_normals, np.float32).astype(np.float64)
+    n2 = np.square(n).sum(axis=2)
+    return ~(area2 > 0) | ~np.isfinite(area2) | ~np.all(n2 > 1e-20, axis=1)
+
+
+def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None):
     """Concatenate ``chunks`` = [(MeshArrays, matrix 4x4, slot_to_global list)]
     into world-space (positions, indices, corner_normals, corner_uvs,
     material_indices) and, with ``want_tangents``, a sixth item
@@ -107,22 +125,29 @@ def assemble(chunks, want_uvs=False, want_tangents=False):
     (one batched numpy op per mesh, not per instance). Mirrored instances
     (det < 0) get their winding flipped so geometric normals keep facing
     the same way as in Blender; normals and tangents use the inverse
-    transpose and follow the flipped corner order.
+    transpose (the cofactor matrix where the matrix is singular) and follow
+    the flipped corner order.
+
+    Degenerate triangles (:func:`degenerate_mask`: zero area or zero-length
+    normal, e.g. an object scaled (1, 1, 0) or (0, 0, 0)) are left out; with
+    a dict ``dropped``, ``dropped[i] = (n_dropped, n_triangles)`` for every
+    chunk ``i`` that lost some.
     """
     groups, order = {}, []
-    for arr, matrix, slot_map in chunks:
+    for ci, (arr, matrix, slot_map) in enumerate(chunks):
         if arr.tri_verts.shape[0] == 0:
             continue
         g = groups.get(id(arr))
         if g is None:
-            g = groups[id(arr)] = (arr, [], [])
+            g = groups[id(arr)] = (arr, [], [], [])
             order.append(id(arr))
         g[1].append(np.asarray(matrix, np.float64).reshape(4, 4))
         g[2].append(list(slot_map) if len(slot_map) else [0])
+        g[3].append(ci)
     pos, idx, nrm, uvs, mats, tan = [], [], [], [], [], []
     base = 0
     for key in order:
-        arr, ms, smaps = groups[key]
+        arr, ms, smaps, chunk_ids = groups[key]
         M = np.stack(ms)                       # (k, 4, 4)
         k, V, T = len(ms), arr.positions.shape[0], arr.tri_verts.shape[0]
         A, t = M[:, :3, :3], M[:, :3, 3]
@@ -134,7 +159,7 @@ def assemble(chunks, want_uvs=False, want_tangents=False):
         if flip.any():
             tv[flip] = tv[flip][:, :, [0, 2, 1]]
             tl[flip] = tl[flip][:, :, [0, 2, 1]]
-        nm = A.copy()
+        nm = _cofactor(A)
         ok = np.abs(det) > 1e-30
         if ok.any():
             nm[ok] = np.linalg.inv(A[ok]).transpose(0, 2, 1)
@@ -143,27 +168,36 @@ def assemble(chunks, want_uvs=False, want_tangents=False):
             g = np.einsum("kij,tj->kti", nm, arr.flat_normals)           # (k,T,3)
             n[:, arr.tri_flat] = g[:, arr.tri_flat][:, :, None, :]
         ln = np.linalg.norm(n, axis=3, keepdims=True)
+        zero = ~(ln[..., 0] > 0)
         ln[ln == 0] = 1.0
-        pos.append(p.reshape(-1, 3).astype(np.float32))
-        idx.append((tv + base + (np.arange(k) * V)[:, None, None]).reshape(-1, 3)
-                   .astype(np.uint32))
-        nrm.append((n / ln).reshape(-1, 3, 3).astype(np.float32))
+        p32 = p.reshape(-1, 3).astype(np.float32)
+        tri = (tv + (np.arange(k) * V)[:, None, None]).reshape(-1, 3)
+        n32 = (n / ln).reshape(-1, 3, 3).astype(np.float32)
+        bad = degenerate_mask(p32, tri, n32) | zero.reshape(-1, 3).any(axis=1)
+        keep = ~bad
+        if dropped is not None:
+            per = bad.reshape(k, T).sum(axis=1)
+            for j in np.nonzero(per)[0]:
+                dropped[chunk_ids[j]] = (int(per[j]), T)
+        pos.append(p32)
+        idx.append((tri[keep] + base).astype(np.uint32))
+        nrm.append(n32[keep])
         if want_tangents:
             tw = np.einsum("kij,vj->kvi", nm, default_tangents_local(arr))     # (k, V, 3)
             tc = tw[np.arange(k)[:, None, None], tv]                            # (k, T, 3, 3)
             t4 = np.ones((k, T, 3, 4), np.float32)
             t4[..., :3] = tc
-            tan.append(t4.reshape(-1, 3, 4))
+            tan.append(t4.reshape(-1, 3, 4)[keep])
         if want_uvs:
             if arr.loop_uvs is not None:
-                uvs.append(arr.loop_uvs[tl].reshape(-1, 3, 2).astype(np.float32))
+                uvs.append(arr.loop_uvs[tl].reshape(-1, 3, 2).astype(np.float32)[keep])
             else:
-                uvs.append(np.zeros((k * T, 3, 2), np.float32))
+                uvs.append(np.zeros((int(keep.sum()), 3, 2), np.float32))
         width = max(len(sm) for sm in smaps)
         table = np.array([sm + [sm[-1]] * (width - len(sm)) for sm in smaps], np.uint32)
         slot = np.clip(arr.tri_material, 0, None)[None, :]
         last = np.array([len(sm) - 1 for sm in smaps])[:, None]
-        mats.append(table[np.arange(k)[:, None], np.minimum(slot, last)].reshape(-1))
+        mats.append(table[np.arange(k)[:, None], np.minimum(slot, last)].reshape(-1)[keep])
         base += k * V
     if not idx:
         out = (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.uint32),
@@ -417,7 +451,12 @@ def collect(depsgraph, scene=None, require_lights=True):
     want_uvs = any(a.loop_uvs is not None for a, _, _ in chunks)
     # Tangents only matter to anisotropic lobes: skip them (NULL) otherwise.
     want_tangents = any(m.get("anisotropy", 0.0) > 0.0 for m in sd.materials)
-    out = assemble(chunks, want_uvs, want_tangents)
+    dropped = {}
+    out = assemble(chunks, want_uvs, want_tangents, dropped)
+    for ci, (n, total) in sorted(dropped.items()):
+        what = ("all %d triangles are" % total) if n == total else ("%d of %d triangles are" % (n, total))
+        sd.warnings.append("object '%s': %s degenerate (zero area or zero-length normal, e.g. a "
+                           "scale of 0 along an axis) and not lit or shaded" % (sd.object_names[ci], what))
     (sd.positions, sd.indices, sd.corner_normals, sd.corner_uvs,
      sd.material_indices) = out[:5]
     sd.corner_tangents = out[5] if want_tangents else None

@@ -8,21 +8,32 @@ with the RENDER depsgraph -> engine render -> compositor -> render_post.
 - render_init / load_post / settings changes: set up the compositor nodes
   (never in render_pre: editing the node tree there stops Blender 3.4 from
   calling frame_change_post for the next frames of ``-a``).
-- render_pre: replace this frame's file by a black placeholder (so a failed
-  computation can never leave an older AOV to be composited).
+- render_pre: note the frame (nothing is written: several farm workers may
+  share the AOV files, and a file another worker finished is a valid AOV of
+  this frame that it may be compositing right now).
 - frame_change_post with a RENDER depsgraph: export that depsgraph (render
-  visibility, render modifier levels), compute, write this frame's EXR.
-- render_post/render_cancel/render_complete: placeholders never replaced are
-  deleted and reported.
+  visibility, render modifier levels), compute, write this frame's EXR
+  atomically (a reader sees the old complete file or the new one). If the
+  computation fails, a file older than this render job (a previous run's)
+  is retired (renamed away, then deleted) so it is not composited; one
+  written meanwhile by another worker stays.
+- render_post/render_cancel/render_complete: frames never computed are
+  reported.
+
+Farm safety (issue 10): no handler ever replaces or deletes a complete AOV
+another process wrote; the compositor-setup placeholder is only ever put
+where no file exists and only ever removed if it is still the same inode.
 """
+import contextlib
 import os
+import time
 
 import bpy
 from bpy.app.handlers import persistent
 
 from . import compositor, convert, engine, runner
 
-_state = {"active": {}, "placeholders": {}, "done": set()}
+_state = {"active": {}, "pending": {}, "done": set(), "job_start": {}}
 
 
 def _layers(scene):
@@ -51,20 +62,8 @@ def setup_scene(scene, frame=None):
         path = runner.output_path(scene, layer, frame, options)
         try:
             engine.check_output_path(path)
-            # Blender creates the pass sockets from a real file; never
-            # replace one (a parallel process may have rendered this frame).
-            made = not os.path.exists(path) and compositor.placeholder(path, w, h, exclusive=True)
-            if made:
-                _placeholder_mtimes[path] = os.path.getmtime(path)
-            try:
-                # One composite output: only the first rendered view layer's AOV is
-                # added onto it; the others get their Image node to wire by hand.
-                compositor.ensure(scene, layer, path, options.add_to_render and i == 0)
-            finally:
-                # The sockets stay; a black file must not look like an AOV.
-                if made and os.path.exists(path) and _is_placeholder(path):
-                    os.unlink(path)
-                    _placeholder_mtimes.pop(path, None)
+            with _setup_lock(os.path.dirname(path)):
+                _setup_layer(scene, layer, path, w, h, options.add_to_render and i == 0)
         except engine.AovError as e:
             errors.append("view layer '%s': %s" % (layer, e))
         except Exception as e:
@@ -76,17 +75,104 @@ def setup_scene(scene, frame=None):
     return errors
 
 
-_placeholder_mtimes = {}
+SETUP_LOCK = ".vsgl-setup.lock"
 
 
-def _is_placeholder(path):
-    return _placeholder_mtimes.get(path) == os.path.getmtime(path)
+@contextlib.contextmanager
+def _setup_lock(directory):
+    """One compositor setup at a time per AOV folder, across processes (and
+    hosts sharing it): otherwise a worker may read another's placeholder just
+    as that one removes it ("Cannot read ..."). An empty hidden file
+    ``.vsgl-setup.lock`` stays in the folder."""
+    try:
+        import fcntl
+        fd = os.open(os.path.join(directory, SETUP_LOCK), os.O_RDWR | os.O_CREAT, 0o666)
+    except (ImportError, OSError):   # no fcntl (Windows) or a read-only folder: no lock
+        yield
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)                 # releases the lock
 
 
-def _write_placeholder(scene, path):
-    w, h = _render_size(scene)
-    compositor.placeholder(path, w, h)
-    _placeholder_mtimes[path] = os.path.getmtime(path)
+def _setup_layer(scene, layer, path, w, h, add, attempts=6):
+    """compositor.ensure with a file at ``path`` for the pass sockets. Another
+    worker's placeholder may vanish while Blender reads it (the sockets then
+    come out empty): check and retry with our own placeholder."""
+    err = None
+    for attempt in range(attempts):
+        # Blender creates the pass sockets from a real file; never replace
+        # one (a parallel process may have rendered this frame).
+        inode = None if os.path.exists(path) else compositor.placeholder(path, w, h, exclusive=True)
+        try:
+            # One composite output: only the first rendered view layer's AOV is
+            # added onto it; the others get their Image node to wire by hand.
+            node = compositor.ensure(scene, layer, path, add)
+            if compositor.has_passes(node, add):
+                return node
+            err = None
+        except (engine.AovError, RuntimeError) as e:   # RuntimeError: "Cannot read" (it vanished)
+            err = e
+        finally:
+            # The sockets stay; a black file must not look like an AOV.
+            if inode:
+                remove_if_inode(path, inode)
+        time.sleep(0.02 * (attempt + 1))
+    if isinstance(err, engine.AovError):
+        raise err
+    raise engine.AovError("compositor: the Image node for '%s' shows no AOV passes (%s)"
+                          % (path, err or "the file could not be read"))
+
+
+def _aside(path):
+    d, name = os.path.split(path)
+    return os.path.join(d, ".%s.retired-%d-%d" % (name, os.getpid(), time.monotonic_ns()))
+
+
+def _retire(path, keep):
+    """Rename ``path`` aside and delete it, unless ``keep(stat)`` holds for the
+    file actually moved (another process renamed a new file over ``path``
+    between our check and the rename): that one is linked back. Readers see
+    the old file, the new one or none; never half a file."""
+    aside = _aside(path)
+    try:
+        os.rename(path, aside)
+    except FileNotFoundError:
+        return False
+    try:
+        if keep(os.stat(aside)):
+            try:
+                os.link(aside, path)      # put it back unless yet another file is there
+            except FileExistsError:
+                pass
+            return False
+        return True
+    finally:
+        os.unlink(aside)
+
+
+def remove_if_inode(path, inode):
+    """Remove our placeholder at ``path`` only while it is the same file."""
+    try:
+        if os.stat(path).st_ino != inode:
+            return False
+    except FileNotFoundError:
+        return False
+    return _retire(path, lambda st: st.st_ino != inode)
+
+
+def retire_stale(path, since):
+    """After a failed computation: retire the file at ``path`` if it is older
+    than ``since`` (a previous run's AOV must not be composited); a file
+    written since (by another worker of this job) is a valid AOV and stays."""
+    try:
+        if os.stat(path).st_mtime >= since:
+            return False
+    except FileNotFoundError:
+        return False
+    return _retire(path, lambda st: st.st_mtime >= since)
 
 
 @persistent
@@ -94,6 +180,7 @@ def on_render_init(scene, *args):
     props = getattr(scene, "vsgl_indirect", None)
     if props is None or not props.enabled or not engine.can_render():
         return
+    _state["job_start"][scene.name] = time.time()
     setup_scene(scene)
     if scene.vsgl_indirect.add_to_render and not scene.render.use_compositing:
         runner.report(scene.name, "WARNING", "compositing is off (Output Properties > Post "
@@ -112,12 +199,12 @@ def on_render_pre(scene, *args):
         runner.fail(scene.name, "frame %d: no indirect AOV: %s" % (frame, engine.render_missing()))
         return
     _state["active"][scene.name] = frame
+    _state["job_start"].setdefault(scene.name, time.time())
     for layer in _layers(scene):
         path = runner.output_path(scene, layer, frame, options)
         try:
             engine.check_output_path(path)
-            _write_placeholder(scene, path)
-            _state["placeholders"][(scene.name, layer, frame)] = path
+            _state["pending"][(scene.name, layer, frame)] = path
         except engine.AovError as e:
             runner.fail(scene.name, "frame %d, view layer '%s': %s" % (frame, layer, e))
 
@@ -131,15 +218,17 @@ def on_frame_change_post(scene, depsgraph=None, *args):
         return
     layer = depsgraph.view_layer.name
     key = (scene.name, layer, frame)
-    if key in _state["done"] or key not in _state["placeholders"]:
+    if key in _state["done"] or key not in _state["pending"]:
         return
     _state["done"].add(key)
     result = runner.run_frame(scene, depsgraph, frame)
-    path = _state["placeholders"].pop(key, None)
-    if result is None and path is not None and os.path.exists(path):
-        os.unlink(path)   # no file rather than a black AOV that looks valid
-    else:
-        _placeholder_mtimes.pop(path, None)
+    path = _state["pending"].pop(key, None)
+    if result is None and path is not None:
+        # No AOV from us: a previous run's file must not be composited.
+        since = _state["job_start"].get(scene.name, time.time())
+        if retire_stale(path, since):
+            runner.report(scene.name, "WARNING", "frame %d, view layer '%s': removed the previous "
+                          "run's AOV %s (this frame's could not be computed)" % (frame, layer, path))
     img = bpy.data.images.get(compositor.IMAGE_NAME % (scene.name, layer))
     if img is not None:
         img.reload()
@@ -149,10 +238,8 @@ def on_frame_change_post(scene, depsgraph=None, *args):
 def on_render_post(scene, *args):
     frame = _state["active"].pop(scene.name, None)
     _state["done"] = {k for k in _state["done"] if k[0] != scene.name}
-    for key in [k for k in _state["placeholders"] if k[0] == scene.name]:
-        path = _state["placeholders"].pop(key)
-        if os.path.exists(path):
-            os.unlink(path)
+    for key in [k for k in _state["pending"] if k[0] == scene.name]:
+        _state["pending"].pop(key)
         runner.fail(scene.name, "frame %s, view layer '%s': the AOV was not computed "
                     "(Blender gave no render depsgraph for it)" % (frame, key[1]))
 
@@ -160,6 +247,7 @@ def on_render_post(scene, *args):
 @persistent
 def on_render_end(scene, *args):
     on_render_post(scene)
+    _state["job_start"].pop(scene.name, None)
 
 
 @persistent

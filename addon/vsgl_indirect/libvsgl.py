@@ -35,7 +35,7 @@ __all__ = [
     "BINDING_VERSION", "VsglLibraryError", "VsglMissingSymbolError", "VsglError",
     "VsglCancelledError", "library", "load_library", "find_library", "version",
     "version_string", "result_string", "missing_symbols",
-    "SG", "ASG", "Context", "Scene", "render", "render_settings_preset",
+    "SG", "ASG", "Context", "Scene", "render", "render_estimate", "render_settings_preset",
     "Material", "Light", "Camera", "RenderSettings",
 ]
 
@@ -210,6 +210,13 @@ LIGHT_FLAGS_KNOWN = 1
 SHARPNESS_MAX = 2199023255552.0  # 2^41
 ALPHA_MIN = 4.656612873077393e-10  # 2^-31
 EXR_MAX_CHANNELS = 4
+# Valid ranges of the numeric render settings (render.h; the add-on's
+# property limits and the CLI use the same).
+AA_SAMPLES_MAX = 16
+RSM_RESOLUTION_MIN = 2
+RSM_RESOLUTION_MAX = 8192
+VSGL_COUNT_MAX = 65536
+FIS_ITERATIONS_MAX = 32
 BUNDLE_VERSION = (1, 1)
 
 
@@ -299,6 +306,7 @@ class vsgl_context_desc(_Struct):
         ("log_user", ctypes.c_void_p),
         ("progress", PROGRESS_FN),
         ("progress_user", ctypes.c_void_p),
+        ("max_memory", ctypes.c_uint64),
     ]
 
 
@@ -432,6 +440,11 @@ class vsgl_render_output(_Struct):
     _fields_ = [("width", _u32), ("height", _u32)] + [(p, _PF32) for p in PLANES]
 
 
+class vsgl_memory_estimate(_Struct):
+    _fields_ = [(n, ctypes.c_uint64) for n in
+                ("output", "gbuffer", "planes", "rsm", "fit", "shade", "total", "limit")]
+
+
 class vsgl_render_stats(_Struct):
     _fields_ = [
         ("seconds_total", ctypes.c_double),
@@ -531,7 +544,7 @@ RenderSettings = vsgl_render_settings
 STRUCTS = {cls.__name__: cls for cls in (
     vsgl_vec3, vsgl_context_desc, vsgl_sg, vsgl_asg, vsgl_material, vsgl_light,
     vsgl_camera, vsgl_scene_desc, vsgl_scene_info, vsgl_render_settings,
-    vsgl_render_output, vsgl_render_stats, vsgl_exr_pass, vsgl_exr_metadata,
+    vsgl_render_output, vsgl_memory_estimate, vsgl_render_stats, vsgl_exr_pass, vsgl_exr_metadata,
     vsgl_exr_options, vsgl_bundle_options, vsgl_bundle_info, vsgl_debug_vsgl, vsgl_reference_stats)}
 #: Python field names that differ from the C ones.
 FIELD_C_NAMES = {"lambda_": "lambda"}
@@ -601,6 +614,8 @@ PROTOTYPES = (
     ("vsgl_scene_get_info", _i32, [_VP, _P(vsgl_scene_info)]),
     # render.h
     ("vsgl_render_settings_preset", None, [_i32, _P(vsgl_render_settings)]),
+    ("vsgl_render_estimate", _i32, [_VP, _VP, _P(vsgl_render_settings), _u32,
+                                    _P(vsgl_memory_estimate)]),
     ("vsgl_render", _i32, [_VP, _VP, _P(vsgl_render_settings), _P(vsgl_render_output),
                            _P(vsgl_render_stats)]),
     # io.h
@@ -694,6 +709,43 @@ def _undefined_vsgl_symbols(path):
         return []
 
 
+#: sonames libvsgl links against -> (what it is, Debian/Ubuntu package).
+DEPENDENCIES = {
+    "libembree3.so.3": ("Intel Embree 3", "libembree3-3"),
+    "libOpenEXRCore-3_1.so.30": ("OpenEXR Core 3.1", "libopenexr-3-1-30"),
+    "libtbb.so.12": ("oneTBB", "libtbb12"),
+    "libstdc++.so.6": ("the GNU C++ runtime", "libstdc++6"),
+    "libz.so.1": ("zlib", "zlib1g"),
+}
+
+
+def load_error_message(path, error):
+    """What to tell a user whose ``ctypes.CDLL(path)`` failed with ``error``:
+    the missing library and the package that provides it; a zip user is not
+    told to run `make`."""
+    import re
+    in_addon = os.path.dirname(os.path.abspath(path)) == os.path.join(_HERE, "lib")
+    fix = ("reinstall the add-on from a zip built by tools/build_addon.sh, which ships it in "
+           "vsgl_indirect/lib/" if in_addon else
+           "or rebuild libvsgl with `make` on this machine")
+    m = re.search(r"([\w.+-]+\.so[\w.]*): cannot open shared object file", error)
+    if m:
+        soname = m.group(1)
+        what, pkg = DEPENDENCIES.get(soname, (None, None))
+        if pkg:
+            return ("cannot load %s: it needs %s (%s), which is not installed: install the "
+                    "package %s (Debian/Ubuntu: apt-get install %s), %s"
+                    % (path, soname, what, pkg, pkg, fix))
+        return ("cannot load %s: it needs %s, which is not installed (install the package "
+                "that provides it), %s" % (path, soname, fix))
+    m = re.search(r"version `([^']+)' not found", error)
+    if m:
+        return ("cannot load %s: this system's libraries are too old (%s not found; the add-on "
+                "zip needs x86-64 Linux with glibc >= 2.34 and libstdc++ of GCC >= 12): %s"
+                % (path, m.group(1), error))
+    return "cannot load %s: %s (%s)" % (path, error, fix)
+
+
 class _Library:
     """A loaded libvsgl: one attribute per exported prototype, argtypes and
     restype set once here. Immutable after construction."""
@@ -707,8 +759,7 @@ class _Library:
             self.cdll = ctypes.CDLL(self.path)
         except OSError as e:
             if "undefined symbol" not in str(e):
-                raise VsglLibraryError("cannot load %s: %s (rebuild it with `make`)"
-                                       % (self.path, e)) from None
+                raise VsglLibraryError(load_error_message(self.path, str(e))) from None
             # Incomplete build: load lazily so the defined functions work; a
             # call that reaches an undefined one would abort the process, so
             # they are listed (callers such as the tests check `undefined`).
@@ -1116,7 +1167,7 @@ class Context:
     _handle = None
 
     def __init__(self, thread_count=0, log=None, log_level=None, progress=None,
-                 desc_size=None):
+                 desc_size=None, max_memory=0):
         lib = library()
         self._lib = lib
         self._log, self._progress = log, progress
@@ -1125,6 +1176,10 @@ class Context:
         if int(thread_count) < 0:
             raise ValueError("thread_count must be >= 0 (0 = all cores), got %r" % thread_count)
         desc.thread_count = int(thread_count)
+        if int(max_memory) < 0:
+            raise ValueError("max_memory must be >= 0 bytes (0 = what the machine has), got %r"
+                             % max_memory)
+        desc.max_memory = int(max_memory)
         if log_level is not None:
             desc.log_level = _enum(log_level, LogLevel, "log_level")
         if desc_size is not None:  # for tests of the size check
@@ -1369,6 +1424,23 @@ def _stats_dict(stats):
     return d
 
 
+def _output_floats(planes):
+    return sum(1 if p == "alpha" else 3 for p in planes)
+
+
+def render_estimate(ctx, scene, settings=None, planes=PLANES):
+    """Validate ``settings`` as :func:`render` would and estimate the bytes a
+    render of ``scene`` with the output ``planes`` needs. Returns the
+    vsgl_memory_estimate as a dict (output, gbuffer, planes, rsm, fit,
+    shade, total, limit); raises VsglError (ERROR_OUT_OF_MEMORY: the message
+    names the size, the estimate and the limit) if it cannot fit."""
+    est = vsgl_memory_estimate()
+    rc = ctx._lib.vsgl_render_estimate(ctx.handle, scene.handle, ctypes.byref(_settings(settings)),
+                                       _output_floats(planes), ctypes.byref(est))
+    ctx.check(rc, "vsgl_render_estimate")
+    return est.as_dict()
+
+
 def render(ctx, scene, settings=None, planes=PLANES):
     """Render the indirect planes of ``scene``.
 
@@ -1383,6 +1455,8 @@ def render(ctx, scene, settings=None, planes=PLANES):
             raise ValueError("unknown plane %r (one of %s)" % (p, ", ".join(PLANES)))
     s = _settings(settings)
     fn = ctx._lib.vsgl_render
+    # Refused before the output arrays exist if it cannot fit.
+    estimate = render_estimate(ctx, scene, s, planes) if ctx._lib.has("vsgl_render_estimate") else None
     H, W = scene.height, scene.width
     images = {p: np.zeros((H, W) if p == "alpha" else (H, W, 3), np.float32) for p in planes}
     out = vsgl_render_output(width=W, height=H)
@@ -1391,7 +1465,9 @@ def render(ctx, scene, settings=None, planes=PLANES):
     stats = vsgl_render_stats()
     rc = fn(ctx.handle, scene.handle, ctypes.byref(s), ctypes.byref(out), ctypes.byref(stats))
     ctx.check(rc, "vsgl_render")
-    return images, _stats_dict(stats)
+    stats = _stats_dict(stats)
+    stats["memory_estimate"] = estimate
+    return images, stats
 
 
 # --------------------------------------------------------------------------

@@ -51,7 +51,8 @@ def output_path(scene, view_layer, frame, options=None):
 
 def begin(scene_name, frame):
     LAST_RUN[scene_name] = {"status": "running", "frame": frame, "messages": [],
-                            "timings": {}, "skipped": "", "summary": "", "path": "", "error": ""}
+                            "timings": {}, "skipped": "", "summary": "", "path": "", "error": "",
+                            "memory": ""}
 
 
 def export_scene(scene, depsgraph):
@@ -69,15 +70,16 @@ def finish(scene_name, result, t_export):
         if "seconds_" + k in st:
             timings["lib " + k] = st["seconds_" + k]
     info.update(status="done", timings=timings, skipped=st.get("skipped", ""),
-                summary=result.summary, path=result.path)
+                summary=result.summary, path=result.path, memory=engine.memory_summary(st))
     for w in result.warnings:
         report(scene_name, "WARNING", w)
     for line in (st.get("skipped") or "").splitlines():
         if line.strip():
             report(scene_name, "INFO", "skipped: " + line.strip())
-    report(scene_name, "INFO", "wrote %s (%s; export %.3fs, render %.3fs, write %.3fs)"
+    mem = info.get("memory")
+    report(scene_name, "INFO", "wrote %s (%s; export %.3fs, render %.3fs, write %.3fs%s)"
            % (result.path, result.summary, t_export, result.timings.get("render", 0),
-              result.timings.get("write", 0)))
+              result.timings.get("write", 0), "; memory %s" % mem if mem else ""))
 
 
 def fail(scene_name, message):

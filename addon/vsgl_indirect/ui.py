@@ -31,6 +31,7 @@ class VSGL_PT_indirect(bpy.types.Panel):
             for k in config.KNOBS:
                 col.prop(props, k)
         layout.prop(props, "threads")
+        layout.prop(props, "max_memory_gb")
         layout.prop(props, "half_float")
         row = layout.row()
         row.enabled = ok
@@ -46,6 +47,8 @@ class VSGL_PT_indirect(bpy.types.Panel):
             box.label(text=info["error"], icon="ERROR")
         if info.get("summary"):
             box.label(text=info["summary"])
+        if info.get("memory"):
+            box.label(text="Memory: " + info["memory"])
         t = info.get("timings") or {}
         if t:
             col = box.column(align=True)

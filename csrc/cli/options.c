@@ -17,10 +17,10 @@ const char cli_usage[] =
     "\n"
     "  -o, --output PATH     EXR to write (default: the bundle's output path)\n"
     "  --preset NAME         preview | balanced | quality\n"
-    "  --aa N                N x N camera samples per pixel\n"
-    "  --rsm N               reflective shadow map side in texels\n"
+    "  --aa N                N x N camera samples per pixel (1..16)\n"
+    "  --rsm N               reflective shadow map side in texels (2..8192)\n"
     "  --fit NAME            two | fis | kmeans | lattice   (VSGL fit)\n"
-    "  --vsgls N             VSGLs per light (fis, kmeans)\n"
+    "  --vsgls N             VSGLs per light (fis, kmeans; 1..65536)\n"
     "  --sharpness NAME      toksvig | banerjee\n"
     "  --diffuse NAME        sg | pulled | accurate   (receiver cosine)\n"
     "  --glossy NAME         asg | sg\n"
@@ -29,10 +29,13 @@ const char cli_usage[] =
     "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
     "  --method NAME         vsgl | brute   (brute: every RSM texel, the reference)\n"
     "  --threads N           worker threads (0 = all cores)\n"
+    "  --max-memory SIZE     refuse a render estimated to need more (e.g. 8G, 512M;\n"
+    "                        default: the memory available on this machine)\n"
     "  --seed N              seed of FIS / k-means sampling\n"
     "  --half                16-bit half EXR (default 32-bit float)\n"
     "  --compression NAME    zip | zips | piz | none   (EXR compression, default piz)\n"
-    "  --dry-run             read, validate and check the output path; do not render\n"
+    "  --dry-run             read and validate the scene and settings, estimate the\n"
+    "                        memory, check the output path; do not render\n"
     "  -v, --verbose         per-stage timings and statistics on stderr\n"
     "\n"
     "Exit status: 0 success, 1 failure (one line 'vsgl: reason' on stderr),\n"
@@ -55,6 +58,31 @@ static int parse_u32(const char *s, uint32_t lo, cli_u32 *out)
         return -1;
     out->set = 1;
     out->value = (uint32_t)v;
+    return 0;
+}
+
+int cli_parse_bytes(const char *s, uint64_t *out)
+{
+    if (!s || *s < '0' || *s > '9')
+        return -1;
+    errno = 0;
+    char *end = NULL;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno)
+        return -1;
+    unsigned shift = 0;
+    switch (*end) {
+    case 'K': case 'k': shift = 10; ++end; break;
+    case 'M': case 'm': shift = 20; ++end; break;
+    case 'G': case 'g': shift = 30; ++end; break;
+    case 'T': case 't': shift = 40; ++end; break;
+    default: break;
+    }
+    if (*end == 'B' || *end == 'b')
+        ++end;
+    if (*end || (shift && v > (UINT64_MAX >> shift)))
+        return -1;
+    *out = (uint64_t)v << shift;
     return 0;
 }
 
@@ -121,7 +149,21 @@ static void join_names(const char *const *names, char *buf, size_t n)
         snprintf(buf + strlen(buf), n - strlen(buf), "%s%s", i ? "|" : "", names[i]);
 }
 
+static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t err_size);
+
+/* The reason is printed as one line "vsgl: ...": an argument quoted in it
+ * must not break it (found by tests/fuzz/fuzz_cli.c: a newline in an option
+ * name gave a two-line message). Control characters become '?'. */
 int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
+{
+    int rc = parse_args(argc, argv, o, err, err_size);
+    for (char *p = err; rc && *p; ++p)
+        if ((unsigned char)*p < 0x20 || *p == 0x7f)
+            *p = '?';
+    return rc;
+}
+
+static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t err_size)
 {
     memset(o, 0, sizeof *o);
     o->compression = VSGL_EXR_PIZ; /* 1080p, 22 float channels: PIZ 1.06 s / 60 MB, ZIP 1.73 s / 63 MB */
@@ -192,7 +234,7 @@ int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
             continue;
         }
         /* Options with a value. */
-        int known = !strcmp(name, "-o") || !strcmp(name, "--output");
+        int known = !strcmp(name, "-o") || !strcmp(name, "--output") || !strcmp(name, "--max-memory");
         for (size_t k = 0; k < sizeof enum_opts / sizeof enum_opts[0]; ++k)
             known |= !strcmp(name, enum_opts[k].name);
         for (size_t k = 0; k < sizeof num_opts / sizeof num_opts[0]; ++k)
@@ -208,6 +250,12 @@ int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
             if (!*value)
                 return set_err(err, err_size, "option %s needs a non-empty path%s", name, "");
             o->output_path = value;
+            continue;
+        }
+        if (!strcmp(name, "--max-memory")) {
+            if (cli_parse_bytes(value, &o->max_memory) != 0 || o->max_memory == 0)
+                return set_err(err, err_size, "option --max-memory: '%s' is not a size such as 8G, 512M or a byte count > 0%s",
+                               value, "");
             continue;
         }
         int done = 0;

@@ -22,7 +22,12 @@ typedef struct cli_options {
     int leak, merge;          /* VSGL_LEAK_*, VSGL_MERGE_*; -1 = not given */
     int compression;          /* VSGL_EXR_*, default ZIP */
     int half, verbose, dry_run;
+    uint64_t max_memory;      /* --max-memory in bytes; 0 = what the machine has available */
 } cli_options;
+
+/* Parse a byte size: digits with an optional K, M, G or T (powers of 1024)
+ * and an optional trailing B ("512M", "8G", "1073741824"). 0 or -1 (junk). */
+int cli_parse_bytes(const char *s, uint64_t *out);
 
 /* Parse argv. Returns 0, or 2 with a one-line reason in err (no "vsgl: " prefix). */
 int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size);

@@ -166,6 +166,17 @@ static int cmd_info(vsgl_context *ctx, const cli_options *o)
 
 typedef struct planes { float *p[7]; float *alpha; } planes;
 
+/* Floats per pixel of the planes cmd_render passes: 7 RGB planes + alpha. */
+#define CLI_OUTPUT_FLOATS (7 * 3 + 1)
+
+static void format_bytes(uint64_t b, char *buf, size_t n)
+{
+    if (b >= (1ull << 30))
+        snprintf(buf, n, "%.1f GiB", (double)b / (double)(1ull << 30));
+    else
+        snprintf(buf, n, "%.1f MiB", (double)b / (double)(1ull << 20));
+}
+
 static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *progress)
 {
     double t_start = now_seconds();
@@ -199,9 +210,30 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
     }
     double t_loaded = now_seconds();
     const vsgl_camera *cam = vsgl_bundle_scene(b)->camera;
+    /* The render's own validation of the settings and its memory estimate,
+     * before the output planes are allocated (also for --dry-run). */
+    vsgl_memory_estimate est;
+    r = vsgl_render_estimate(ctx, scene, &s, CLI_OUTPUT_FLOATS, &est);
+    if (r) {
+        status = fail(ctx, r, "settings");
+        goto done;
+    }
+    char need[32], limit[32];
+    format_bytes(est.total, need, sizeof need);
+    format_bytes(est.limit, limit, sizeof limit);
+    if (o->verbose) {
+        char parts[6][32];
+        const uint64_t v[6] = {est.output, est.gbuffer, est.planes, est.rsm, est.fit, est.shade};
+        for (int i = 0; i < 6; ++i)
+            format_bytes(v[i], parts[i], sizeof parts[i]);
+        fprintf(stderr, "vsgl: memory: about %s (output planes %s, G-buffer %s, planes %s, RSMs %s, fit %s, shading %s); "
+                "limit %s\n", need, parts[0], parts[1], parts[2], parts[3], parts[4], parts[5], limit);
+    }
+    if (o->dry_run && vsgl_bundle_scene(b)->light_count == 0) /* a render says so itself */
+        fprintf(stderr, "vsgl: warning: the scene has no lights: the indirect light will be black\n");
     if (o->dry_run) {
-        printf("dry run: %s is valid; would render %ux%u to %s with %s\n", o->scene_path, cam->width, cam->height,
-               out_path, desc);
+        printf("dry run: %s is valid; would render %ux%u to %s with %s; memory about %s (limit %s)\n", o->scene_path,
+               cam->width, cam->height, out_path, desc, need, limit);
         goto done;
     }
 
@@ -253,7 +285,8 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
     eo.compression = o->compression;
     eo.metadata = md;
     eo.metadata_count = sizeof md / sizeof md[0];
-    r = vsgl_exr_write_render(ctx, out_path, &out, &eo);
+    r = vsgl_exr_write_render(ctx, out_path, &out, &eo); /* SIGINT/SIGTERM cancel it too */
+    progress_end(progress);
     if (r) {
         status = fail(ctx, r, out_path);
         goto done;
@@ -315,6 +348,7 @@ int main(int argc, char **argv)
     cd.log_user = &log;
     cd.progress = on_progress;
     cd.progress_user = &progress;
+    cd.max_memory = o.max_memory;
     vsgl_context *ctx = NULL;
     vsgl_result r = vsgl_context_create(&cd, &ctx);
     if (r)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # RSM light units (SUITE=lights, default) or the brute-force gather (SUITE=gather) vs Cycles' DiffDir (tests/blender/cycles_ref.py --suite lights) in Blender 3.4;
-# then the same suite in the pip `bpy` module (newest Blender) if $PIP_PYTHON imports it.
+# then the same suite in the pip `bpy` module (newest Blender) if $BPY_PYTHON imports it.
 # Cycles renders are cached in build/blender/cycles/cycles/ (keyed by a hash of the script, case, version).
 # Prints one line per light and ends with "N passed, N failed"; exits non-zero on failure.
 set -uo pipefail
@@ -29,15 +29,15 @@ else
   [ $rc -eq 0 ] && rc=1
 fi
 [ $rc -ne 0 ] && echo "(Blender log: $OUT/blender_$SUITE.log)"
-PIP_PYTHON=${PIP_PYTHON:-python3}
-if "$PIP_PYTHON" -c "import bpy, numpy" >/dev/null 2>&1; then
+BPY_PYTHON=${BPY_PYTHON:-python3}
+if "$BPY_PYTHON" -c "import bpy, numpy" >/dev/null 2>&1; then
   # Blender 4.x+ semantics (lights, GGX shadowing and multiple scattering, DiffCol) against that Blender's Cycles
   OUT5=build/blender/cycles_bpy
   mkdir -p "$OUT5"
   rm -f "$OUT5/summary_$SUITE.txt"
-  "$PIP_PYTHON" tests/blender/cycles_ref.py -- --suite "$SUITE" --lib build/libvsgl.so --out "$OUT5" >"$OUT5/bpy_$SUITE.log" 2>&1
+  "$BPY_PYTHON" tests/blender/cycles_ref.py -- --suite "$SUITE" --lib build/libvsgl.so --out "$OUT5" >"$OUT5/bpy_$SUITE.log" 2>&1
   rc5=$?
-  ver=$("$PIP_PYTHON" -c 'import bpy; print(bpy.app.version_string)' 2>/dev/null | tail -1)
+  ver=$("$BPY_PYTHON" -c 'import bpy; print(bpy.app.version_string)' 2>/dev/null | tail -1)
   echo "== $SUITE in pip bpy $ver"
   grep -E "^(PASS|FAIL|SKIP|gather res)" "$OUT5/bpy_$SUITE.log"
   p1=$(grep -Eo '^[0-9]+ passed' "$OUT/summary_$SUITE.txt" 2>/dev/null | grep -Eo '[0-9]+' || echo 0)
@@ -51,6 +51,6 @@ if "$PIP_PYTHON" -c "import bpy, numpy" >/dev/null 2>&1; then
   [ $rc5 -ne 0 ] && { echo "(log: $OUT5/bpy_$SUITE.log)"; rc=1; }
   echo "$((p1 + p5)) passed, $((f1 + f5)) failed"
 else
-  echo "run_$SUITE.sh: bpy not importable in $PIP_PYTHON; the newest Blender's check skipped"
+  echo "run_$SUITE.sh: bpy not importable in $BPY_PYTHON; the newest Blender's check skipped"
 fi
 exit $rc

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # G-buffer vs Cycles (tests/blender/gbuffer_ref.py): in Debian's Blender 3.4
-# (the reference) and, if the pip `bpy` module imports in $PIP_PYTHON, in
+# (the reference) and, if the pip `bpy` module imports in $BPY_PYTHON, in
 # that newest Blender too. Cycles renders are cached under
 # build/blender/gbuffer*/cycles_<hash of script + Blender version>/.
 # Prints the comparison tables and ends with "N passed, N failed" (both
@@ -8,7 +8,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 BLENDER=${BLENDER:-blender}
-PIP_PYTHON=${PIP_PYTHON:-python3}
+BPY_PYTHON=${BPY_PYTHON:-python3}
 passed=0; failed=0; rc=0
 
 run() {  # run <name> <out dir> <command...>
@@ -41,11 +41,11 @@ if command -v "$BLENDER" >/dev/null 2>&1; then
 else
   echo "run_scene.sh: $BLENDER not found; Blender 3.4 G-buffer check skipped"
 fi
-if "$PIP_PYTHON" -c "import bpy" >/dev/null 2>&1; then
-  run "pip bpy in $PIP_PYTHON" build/blender/gbuffer_bpy \
-    "$PIP_PYTHON" tests/blender/gbuffer_ref.py -- --lib build/libvsgl.so --out build/blender/gbuffer_bpy
+if "$BPY_PYTHON" -c "import bpy" >/dev/null 2>&1; then
+  run "pip bpy in $BPY_PYTHON" build/blender/gbuffer_bpy \
+    "$BPY_PYTHON" tests/blender/gbuffer_ref.py -- --lib build/libvsgl.so --out build/blender/gbuffer_bpy
 else
-  echo "run_scene.sh: bpy not importable in $PIP_PYTHON; newest-Blender G-buffer check skipped"
+  echo "run_scene.sh: bpy not importable in $BPY_PYTHON; newest-Blender G-buffer check skipped"
 fi
 echo "$passed passed, $failed failed"
 exit $rc

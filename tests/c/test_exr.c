@@ -3,6 +3,7 @@
  * Blender 3.4; atomicity and failure cases. */
 #include "harness.h"
 #include "vsgl.h"
+#include "io/atomic.h"
 
 #include <openexr.h>
 
@@ -604,6 +605,154 @@ VT_TEST(exr_failed_write_keeps_previous_file_and_deletes_temp)
     VT_CHECK(k >= 0 && d.planes[k][5] == (float)(5 * 3 + 1) * 1.37f, "new value at pixel 5: %g", k >= 0 ? d.planes[k][5] : -1.0);
     free_decoded(&d);
     free(before);
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
+
+/* Issue 10: `kill -9` during a write left `.NAME.tmp-*` files that no later
+ * run removed. The next write into the folder deletes this host's temporary
+ * files whose process is gone, and logs each; live writers', other hosts'
+ * and unrelated files stay. */
+typedef struct warn_capture { int n; char text[1024]; } warn_capture;
+static void capture_warnings(void *user, int32_t level, const char *message)
+{
+    warn_capture *w = user;
+    if (level != VSGL_LOG_WARNING)
+        return;
+    ++w->n;
+    size_t used = strlen(w->text);
+    snprintf(w->text + used, sizeof w->text - used, "%s\n", message);
+}
+
+static void this_host(char *buf, size_t n)
+{
+    char h[256] = {0};
+    gethostname(h, sizeof h - 1);
+    size_t k = 0;
+    for (const char *p = h; *p && k + 1 < n && k < 63; ++p)
+        buf[k++] = ((*p >= 'A' && *p <= 'Z') || (*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') || *p == '.') ? *p : '_';
+    buf[k] = '\0';
+}
+
+static void touch(const char *dir, const char *name, size_t bytes)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "wb");
+    for (size_t i = 0; f && i < bytes; ++i)
+        fputc('x', f);
+    if (f)
+        fclose(f);
+}
+
+static int exists_in(const char *dir, const char *name)
+{
+    char path[512];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    return stat(path, &st) == 0;
+}
+
+VT_TEST(exr_write_removes_stale_temp_files_of_dead_writers)
+{
+    char dir[64], path[128], host[64];
+    make_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/frame.exr", dir);
+    this_host(host, sizeof host);
+    pid_t child = fork();
+    if (child == 0)
+        _exit(0);
+    waitpid(child, NULL, 0); /* its pid is now gone */
+    char dead[160], dead_old[160], alive[160], other[160], unrelated[] = ".frame.exr.tmp-notapid";
+    snprintf(dead, sizeof dead, ".frame.exr.tmp-%ld-000000123-0-%s", (long)child, host);
+    snprintf(dead_old, sizeof dead_old, ".other.exr.tmp-%ld-000000456-1", (long)child); /* before host tags */
+    snprintf(alive, sizeof alive, ".frame.exr.tmp-%ld-000000789-0-%s", (long)getppid(), host);
+    snprintf(other, sizeof other, ".frame.exr.tmp-%ld-000000001-0-%s", (long)child, "some-other-host");
+    touch(dir, dead, 5000);
+    touch(dir, dead_old, 10);
+    touch(dir, alive, 10);
+    touch(dir, other, 10);
+    touch(dir, unrelated, 10);
+    warn_capture w;
+    memset(&w, 0, sizeof w);
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.log = capture_warnings;
+    cd.log_user = &w;
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(&cd, &ctx);
+    static image im;
+    fill(&im);
+    vsgl_render_output o = output_of(&im);
+    VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_OK, "write: %s", vsgl_context_last_error(ctx));
+    VT_CHECK(!exists_in(dir, dead) && !exists_in(dir, dead_old), "stale temp files kept");
+    VT_CHECK(exists_in(dir, alive) && exists_in(dir, other) && exists_in(dir, unrelated),
+             "a live writer's, another host's or an unrelated file was removed");
+    VT_CHECK(w.n == 2 && strstr(w.text, dead) && strstr(w.text, "(5000 bytes) left by an interrupted write of process") &&
+                 strstr(w.text, "which is gone"), "%d warnings: %s", w.n, w.text);
+    long pid = 0;
+    int ours = 0;
+    VT_CHECK(vsgl__atomic_temp_owner(other, host, &pid, &ours) == 1 && pid == (long)child && !ours, "parse other");
+    VT_CHECK(vsgl__atomic_temp_owner("frame.exr", host, &pid, &ours) == 0 &&
+                 vsgl__atomic_temp_owner(".a.tmp-12-x-0", host, &pid, &ours) == 0, "parse junk");
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
+
+/* Issue 10: SIGINT during a long EXR write was ignored (the CLI wrote on,
+ * exited 0 and replaced the file). The writer asks the progress callback
+ * between batches of chunks; a cancel keeps the previous file. */
+typedef struct cancel_state { int calls, write_calls; } cancel_state;
+static int32_t cancel_in_write(void *user, const char *stage, float fraction)
+{
+    cancel_state *c = user;
+    (void)fraction;
+    ++c->calls;
+    if (stage && strcmp(stage, "write") == 0)
+        return ++c->write_calls >= 2; /* let the first batch through */
+    return 0;
+}
+
+VT_TEST(exr_write_is_cancelled_by_the_progress_callback)
+{
+    char dir[64], path[128];
+    make_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/big.exr", dir);
+    enum { BW = 256, BH = 512 };
+    float *plane = calloc((size_t)BW * BH * 3, sizeof(float));
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = BW;
+    o.height = BH;
+    o.diffuse_light = o.glossy_light = o.combined = plane;
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    VT_CHECK(plane && vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_OK, "first write");
+    vsgl_context_destroy(ctx);
+    unsigned char *before = NULL, *after = NULL;
+    size_t nb = 0, na = 0;
+    read_file(path, &before, &nb);
+    cancel_state c = {0, 0};
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.thread_count = 1;
+    cd.progress = cancel_in_write;
+    cd.progress_user = &c;
+    vsgl_context_create(&cd, &ctx);
+    for (size_t i = 0; plane && i < (size_t)BW * BH * 3; ++i)
+        plane[i] = (float)i;
+    vsgl_exr_options eo;
+    memset(&eo, 0, sizeof eo);
+    eo.compression = VSGL_EXR_ZIPS; /* one scanline per chunk: many batches */
+    vsgl_result r = vsgl_exr_write_render(ctx, path, &o, &eo);
+    VT_CHECK(r == VSGL_ERROR_CANCELLED, "result %d '%s' after %d write progress calls", r, vsgl_context_last_error(ctx),
+             c.write_calls);
+    read_file(path, &after, &na);
+    VT_CHECK(nb > 0 && na == nb && before && after && memcmp(before, after, nb) == 0, "previous file changed");
+    VT_CHECK(count_entries(dir) == 1, "temporary file left: %d entries", count_entries(dir));
+    free(before);
+    free(after);
+    free(plane);
     vsgl_context_destroy(ctx);
     remove_tree(dir);
 }

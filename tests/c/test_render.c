@@ -193,6 +193,120 @@ VT_TEST(render_skips_dark_lights_and_says_why)
     vsgl_context_destroy(ctx);
 }
 
+/* Issue 10: a render that cannot fit is refused before anything is
+ * allocated, with a message naming the size, the estimate and the limit;
+ * the estimate validates settings exactly as the render does. */
+typedef struct warn_log { int warnings; char first[512]; } warn_log;
+static void log_warnings(void *user, int32_t level, const char *message)
+{
+    warn_log *w = user;
+    if (level == VSGL_LOG_WARNING && w->warnings++ == 0)
+        snprintf(w->first, sizeof w->first, "%s", message);
+}
+
+VT_TEST(render_refuses_what_exceeds_the_memory_limit_up_front)
+{
+    static planes p;
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.3f, 100.0f);
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.size = sizeof cd;
+    cd.max_memory = 1u << 20; /* 1 MiB: the 48x36 room at aa 2 needs more */
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    VT_CHECK(vsgl_context_create(&cd, &ctx) == VSGL_OK, "context");
+    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene: %s", vsgl_context_last_error(ctx));
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    vsgl_memory_estimate e;
+    vsgl_result r = vsgl_render_estimate(ctx, scene, &s, 22, &e);
+    const char *msg = vsgl_context_last_error(ctx);
+    VT_CHECK(r == VSGL_ERROR_OUT_OF_MEMORY, "estimate result %d '%s'", r, msg);
+    VT_CHECK(strstr(msg, "render: 48x36 with aa 2 and RSM 256 needs about ") == msg, "'%s'", msg);
+    VT_CHECK(strstr(msg, "more than the memory limit of 1.0 MiB (max_memory)") != NULL, "'%s'", msg);
+    /* the parts: 48x36 pixels x 22 output floats; 4 samples x 52 bytes; 52 bytes of planes */
+    VT_CHECK(e.output == (uint64_t)W * H * 22 * 4 && e.gbuffer == (uint64_t)W * H * 4 * 52 &&
+                 e.planes == (uint64_t)W * H * 52 && e.limit == (1u << 20),
+             "output %llu gbuffer %llu planes %llu limit %llu", (unsigned long long)e.output,
+             (unsigned long long)e.gbuffer, (unsigned long long)e.planes, (unsigned long long)e.limit);
+    VT_CHECK(e.rsm >= 256u * 256u * 68u && e.fit > 0 && e.shade > 0, "rsm %llu fit %llu shade %llu",
+             (unsigned long long)e.rsm, (unsigned long long)e.fit, (unsigned long long)e.shade);
+    VT_CHECK(e.total == e.output + e.gbuffer + e.planes + e.rsm + e.fit + e.shade && e.total > e.limit, "total %llu",
+             (unsigned long long)e.total);
+    /* the render refuses at once and leaves the planes alone */
+    memset(&p, 0x7f, sizeof p);
+    vsgl_render_output o = bind(&p);
+    r = vsgl_render(ctx, scene, &s, &o, NULL);
+    msg = vsgl_context_last_error(ctx);
+    VT_CHECK(r == VSGL_ERROR_OUT_OF_MEMORY && strstr(msg, "more than the memory limit of 1.0 MiB") != NULL,
+             "render result %d '%s'", r, msg);
+    VT_CHECK(p.dl[0] == p.dl[W * H * 3 - 1] && p.alpha[0] == p.alpha[W * H - 1], "output touched");
+    /* the same settings errors as vsgl_render, before any estimate */
+    struct { uint32_t aa, rsm, vsgls; const char *want; } bad[] = {
+        {17, 256, 64, "settings: aa_samples is 17 (valid 1..16)"},
+        {1, 1, 64, "settings: rsm_resolution is 1 (valid 2..8192)"},
+        {1, 16384, 64, "settings: rsm_resolution is 16384 (valid 2..8192)"},
+        {1, 256, 65537, "settings: vsgl_count is 65537 (valid 1..65536)"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        vsgl_render_settings b = s;
+        b.aa_samples = bad[i].aa;
+        b.rsm_resolution = bad[i].rsm;
+        b.vsgl_count = bad[i].vsgls;
+        r = vsgl_render_estimate(ctx, scene, &b, 22, &e);
+        VT_CHECK(r == VSGL_ERROR_INVALID_ARGUMENT && strcmp(vsgl_context_last_error(ctx), bad[i].want) == 0,
+                 "case %zu: %d '%s'", i, r, vsgl_context_last_error(ctx));
+    }
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+    /* a generous limit: the same render runs, and its estimate says OK */
+    cd.max_memory = 0;
+    VT_CHECK(vsgl_context_create(&cd, &ctx) == VSGL_OK, "context");
+    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+    VT_CHECK(vsgl_render_estimate(ctx, scene, &s, 22, &e) == VSGL_OK && e.limit > e.total, "limit %llu '%s'",
+             (unsigned long long)e.limit, vsgl_context_last_error(ctx));
+    VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
+/* Issue 10: a scene without lights renders black and says why. */
+VT_TEST(render_without_lights_warns_that_it_is_black)
+{
+    static planes p;
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.3f, 100.0f);
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 0)
+            fx.light_count = 0;
+        else {
+            fx.light_count = 1;
+            fx.lights[0].power = 0.0f;
+        }
+        warn_log w;
+        memset(&w, 0, sizeof w);
+        vsgl_context_desc cd;
+        memset(&cd, 0, sizeof cd);
+        cd.log = log_warnings;
+        cd.log_user = &w;
+        vsgl_context *ctx = NULL;
+        vsgl_scene *scene = NULL;
+        vsgl_context_create(&cd, &ctx);
+        VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene: %s", vsgl_context_last_error(ctx));
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+        vsgl_render_output o = bind(&p);
+        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        const char *want = pass == 0 ? "render: the scene has no lights: the indirect light is black"
+                                     : "render: none of the 1 lights lights anything (all skipped): the indirect light is black";
+        VT_CHECK(w.warnings == 1 && strcmp(w.first, want) == 0, "pass %d: %d warnings, first '%s'", pass, w.warnings,
+                 w.first);
+        vsgl_scene_destroy(scene);
+        vsgl_context_destroy(ctx);
+    }
+}
+
 typedef struct progress_log { float last; int backwards, calls; } progress_log;
 static int32_t log_progress(void *user, const char *stage, float f)
 {

@@ -172,7 +172,6 @@ MUT(m_vertex_inf, f->positions[5 * 3 + 2] = -INFINITY)
 MUT(m_vertex_huge, f->positions[0] = 2e18f)
 MUT(m_index_range, f->indices[1 * 3 + 2] = 99)
 MUT(m_material_index, f->mat_idx[3] = 2)
-MUT(m_normal_zero, f->normals[2 * 9 + 3 + 2] = 0.0f)
 MUT(m_normal_nan, f->normals[0] = NAN)
 MUT(m_uv_nan, f->uvs[1 * 6 + 3] = NAN)
 MUT(m_tangent_inf, f->tangents[3 * 12 + 7] = INFINITY)
@@ -231,7 +230,6 @@ static const bad_case bad_cases[] = {
     {"vertex huge", m_vertex_huge, "vertex 0: x is 2e+18 (must be finite, |x| <= 1e18)"},
     {"index range", m_index_range, "triangle 1: vertex index 99 out of range (vertex_count 8)"},
     {"material index", m_material_index, "triangle 3: material index 2 out of range (material_count 2)"},
-    {"normal zero", m_normal_zero, "triangle 2: corner 1 normal (0, 0, 0) has zero length"},
     {"normal NaN", m_normal_nan, "triangle 0: corner 0 normal (nan, 0, 1) is not finite"},
     {"uv NaN", m_uv_nan, "triangle 1: corner 1 uv v is nan (must be finite)"},
     {"tangent Inf", m_tangent_inf, "triangle 3: corner 1 tangent component 3 is inf (must be finite)"},
@@ -408,6 +406,53 @@ VT_TEST(scene_drops_degenerate_triangles_with_a_warning)
                  "kept %u dropped %u", info.triangle_count, info.dropped_triangles);
         vsgl_hit h;
         VT_CHECK(!vsgl__scene_intersect(s, v3_make(0, 0, 5), v3_make(0, 0, -1), 0.0f, 100.0f, &h), "hit in an empty scene");
+    }
+    vsgl_scene_destroy(s);
+    vsgl_context_destroy(ctx);
+}
+
+/* Issue 10: an object scaled (1, 1, 0) or (0, 0, 0) gives zero-length
+ * corner normals; such a triangle is dropped with a warning like a
+ * zero-area one (it used to refuse the whole frame). */
+VT_TEST(scene_drops_triangles_with_zero_normals)
+{
+    log_capture cap;
+    memset(&cap, 0, sizeof cap);
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.thread_count = 1;
+    cd.log = capture_log;
+    cd.log_user = &cap;
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(&cd, &ctx);
+    fixture f;
+    fixture_init(&f);
+    for (int k = 0; k < 3; ++k)
+        f.normals[2 * 9 + 3 + k] = 0.0f;  /* triangle 2, corner 1: (0, 0, 0) */
+    vsgl_scene *s = NULL;
+    vsgl_result r = vsgl_scene_create(ctx, &f.desc, &s);
+    VT_CHECK(r == VSGL_OK, "result %d '%s'", r, vsgl_context_last_error(ctx));
+    if (s) {
+        vsgl_scene_info info;
+        vsgl_scene_get_info(s, &info);
+        VT_CHECK(info.triangle_count == 3 && info.dropped_triangles == 1, "kept %u dropped %u", info.triangle_count,
+                 info.dropped_triangles);
+        VT_CHECK(cap.warnings == 1, "warnings %d", cap.warnings);
+        VT_CHECK(strcmp(cap.first, "triangle 2: corner 1 normal (0, 0, 0) has zero length, dropped") == 0,
+                 "first warning '%s'", cap.first);
+        VT_CHECK(vsgl__scene_source_triangle(s, 2) == 3, "source %u", vsgl__scene_source_triangle(s, 2));
+    }
+    vsgl_scene_destroy(s);
+    /* every normal zero (scale 0, 0, 0 collapses the normal matrix): valid, empty */
+    memset(f.normals, 0, sizeof f.normals);
+    s = NULL;
+    r = vsgl_scene_create(ctx, &f.desc, &s);
+    VT_CHECK(r == VSGL_OK, "all zero: %d '%s'", r, vsgl_context_last_error(ctx));
+    if (s) {
+        vsgl_scene_info info;
+        vsgl_scene_get_info(s, &info);
+        VT_CHECK(info.triangle_count == 0 && info.dropped_triangles == 4, "kept %u dropped %u", info.triangle_count,
+                 info.dropped_triangles);
     }
     vsgl_scene_destroy(s);
     vsgl_context_destroy(ctx);

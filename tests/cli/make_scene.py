@@ -56,6 +56,8 @@ def build(args):
         up = (1, 0, 0, 0, 0, -1, 0, 0, 0, 0, -1, 3.5)
         light += struct.pack("<ii3ff12f7fI", 1, 0, 1, 1, 1, 100.0, *up, 0.05, 0.5, 0.2, 0, 1, 1, 3.14159265, 0)
         nlights = 2
+    if args.no_lights:
+        light, nlights = b"", 0
     # camera at (0, -6, 2) looking along +Y: columns X->(1,0,0), Y->(0,0,1), Z->(0,-1,0)
     cm = (1, 0, 0, 0, 0, 0, -1, -6, 0, 1, 0, 2)
     cam = struct.pack("<ii12f8fII2f", 0, 0, *cm, 35, 36, 24, 6, 0, 0, 0.1, 100,
@@ -104,6 +106,7 @@ def main():
     p.add_argument("--frame", type=int)
     p.add_argument("--no-settings", action="store_true")
     p.add_argument("--light-up", action="store_true", help="add a spot light that lights nothing")
+    p.add_argument("--no-lights", action="store_true", help="a scene without lights")
     p.add_argument("--break", dest="break_", default=None)
     args = p.parse_args()
     with open(args.out, "wb") as f:

@@ -114,10 +114,20 @@ expect_fail out_missing_dir 1 "No such file or directory" "$VSGL" render "$SCENE
 expect_fail out_is_dir      1 "is a directory"            "$VSGL" render "$SCENE" -o "$T/adir"
 expect_fail out_under_file  1 "not a directory"           "$VSGL" render "$SCENE" -o "$T/afile/x.exr"
 if want out_unwritable_dir && [ "$(id -u)" = 0 ] && have setpriv; then
-  mkdir -p "$T/ro"; chmod 0555 "$T/ro"; chmod 0755 "$T"
-  run setpriv --reuid=65534 --regid=65534 --clear-groups "$VSGL" render "$SCENE" -o "$T/ro/x.exr"
-  if [ "$rc" -eq 1 ] && [ "$(wc -l <"$T/err")" -eq 1 ] && grep -q "^vsgl: .*Permission denied" "$T/err" && [ -z "$(ls -A "$T/ro")" ]; then
-    ok out_unwritable_dir; else bad out_unwritable_dir "exit $rc: $(cat "$T/err")"; fi
+  # As root the check needs an unprivileged user (65534). It may not be able
+  # to reach the checkout (a clone inside a 0700 directory such as mktemp -d
+  # makes): it runs copies of vsgl and libvsgl.so ($ORIGIN rpath) from $T.
+  mkdir -p "$T/ro" "$T/bin"; chmod 0555 "$T/ro"; chmod 0755 "$T" "$T/bin"
+  cp "$VSGL" "$(dirname "$VSGL")/libvsgl.so" "$T/bin/" 2>/dev/null
+  chmod a+rX "$T/bin"/* "$SCENE" 2>/dev/null
+  as_nobody() { setpriv --reuid=65534 --regid=65534 --clear-groups "$@"; }
+  if ! why=$(as_nobody "$T/bin/vsgl" info "$SCENE" 2>&1 >/dev/null); then
+    printf 'SKIP out_unwritable_dir: uid 65534 cannot run vsgl from %s: %s\n' "$T/bin" "$(head -1 <<<"$why")"
+  else
+    run as_nobody "$T/bin/vsgl" render "$SCENE" -o "$T/ro/x.exr"
+    if [ "$rc" -eq 1 ] && [ "$(wc -l <"$T/err")" -eq 1 ] && grep -q "^vsgl: .*Permission denied" "$T/err" && [ -z "$(ls -A "$T/ro")" ]; then
+      ok out_unwritable_dir; else bad out_unwritable_dir "exit $rc: $(cat "$T/err")"; fi
+  fi
 elif want out_unwritable_dir && [ "$(id -u)" != 0 ]; then
   mkdir -p "$T/ro"; chmod 0555 "$T/ro"
   expect_fail out_unwritable_dir 1 "Permission denied" "$VSGL" render "$SCENE" -o "$T/ro/x.exr"
@@ -141,6 +151,64 @@ if want dry_run; then
   if expect_ok dry_run "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --preset quality; then
     if grep -q "dry run: .* would render 64x48 to $T/dry.exr with method=vsgl aa=2 rsm=512 fit=lattice" "$T/out" && [ ! -e "$T/dry.exr" ]; then
       ok dry_run; else bad dry_run "$(cat "$T/out")" "file exists: $([ -e "$T/dry.exr" ] && echo yes || echo no)"; fi
+  fi
+fi
+
+# Issue 10: the dry run validates the settings as the render does (it used
+# to call all of these valid), and a huge image is refused up front with a
+# message naming the size, the estimate and the limit (a 16384^2 render grew
+# to 23 GB and was killed after 8.5 minutes without a message).
+expect_fail dry_run_aa17      1 "settings: aa_samples is 17 (valid 1..16)"          "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --aa 17
+expect_fail dry_run_rsm1      1 "settings: rsm_resolution is 1 (valid 2..8192)"     "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --rsm 1
+expect_fail dry_run_rsm16384  1 "settings: rsm_resolution is 16384 (valid 2..8192)" "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --rsm 16384
+expect_fail dry_run_vsgls     1 "settings: vsgl_count is 65537 (valid 1..65536)"    "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --vsgls 65537
+if want huge || want dry_run || want memory; then
+  "$PY" tests/cli/make_scene.py "$T/huge.vsglb" --width 16384 --height 16384
+fi
+expect_fail dry_run_huge 1 "render: 16384x16384 with aa 2 and RSM 256 needs about" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --dry-run --preset balanced --max-memory 20G
+if want render_huge_refused; then
+  start=$(date +%s)
+  expect_fail render_huge_refused 1 "more than the memory limit of 20.0 GiB (max_memory)" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --preset balanced --max-memory 20G
+  [ $(( $(date +%s) - start )) -le 10 ] || bad render_huge_refused_fast "took $(( $(date +%s) - start )) s to refuse"
+  [ ! -e "$T/huge.exr" ] || bad render_huge_refused_file "a refused render wrote $T/huge.exr"
+fi
+expect_fail render_huge_machine 1 "(memory available on this machine)" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --preset quality --aa 16
+# Found by tests/fuzz/fuzz_cli.c: a newline inside a quoted argument split the one error line.
+expect_fail args_newline       2 "unknown option '--bo?gus'"   "$VSGL" render "$SCENE" $'--bo\ngus'
+expect_fail args_max_memory 2 "option --max-memory: '12Q' is not a size" "$VSGL" render "$SCENE" --max-memory 12Q
+if want dry_run_memory; then
+  if expect_ok dry_run_memory "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run -v; then
+    if grep -Eq "; memory about [0-9.]+ MiB \(limit [0-9.]+ [GM]iB\)$" "$T/out" && grep -q "^vsgl: memory: about .*(output planes .*G-buffer .*RSMs .*); limit " "$T/err"; then
+      ok dry_run_memory; else bad dry_run_memory "stdout: $(cat "$T/out")" "stderr: $(tr '\n' '|' <"$T/err")"; fi
+  fi
+fi
+
+# The estimate against the peak RSS of real renders (1024^2, 2048^2).
+if want memory_estimate; then
+  for n in 1024 2048; do
+    "$PY" tests/cli/make_scene.py "$T/m$n.vsglb" --width $n --height $n
+    for preset in preview balanced; do
+      est=$("$VSGL" render "$T/m$n.vsglb" -o "$T/m.exr" --preset $preset --dry-run -v 2>&1 | grep '^vsgl: memory: about' |
+            sed -E 's/^vsgl: memory: about ([0-9.]+) (GiB|MiB).*/\1 \2/' | awk '{print ($2 == "GiB" ? $1 * 1024 : $1)}')
+      rss=$("$PY" -c 'import resource, subprocess, sys
+subprocess.run(sys.argv[1:], check=True, stderr=subprocess.DEVNULL)
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0)' "$VSGL" render "$T/m$n.vsglb" -o "$T/m.exr" --preset $preset)
+      # within -10 % .. +10 % of the peak, allowing 64 MiB for the program, its libraries and the scene
+      if [ -n "$est" ] && [ -n "$rss" ] && awk -v e="$est" -v r="$rss" 'BEGIN { exit !(e >= 0.9 * (r - 64) && e <= 1.1 * r + 8) }'; then
+        ok "memory_estimate ${n}^2 $preset (estimate $est MiB, peak RSS $rss MiB)"
+      else
+        bad "memory_estimate ${n}^2 $preset" "estimate '$est' MiB, peak RSS '$rss' MiB"
+      fi
+    done
+  done
+fi
+
+# A scene without lights renders black and says so (it used to exit 0 silently).
+if want render_no_lights; then
+  "$PY" tests/cli/make_scene.py "$T/dark.vsglb" --no-lights
+  if expect_ok render_no_lights "$VSGL" render "$T/dark.vsglb" -o "$T/dark.exr"; then
+    if grep -q "^vsgl: warning: .*no lights.*black" "$T/err"; then ok render_no_lights
+    else bad render_no_lights "stderr: $(tr '\n' '|' <"$T/err")"; fi
   fi
 fi
 
@@ -243,6 +311,59 @@ if want render_cancel; then
     wait $pid; rc=$?
     if [ $rc -eq 130 ] && [ "$(tail -1 "$T/err")" = "vsgl: cancelled" ] && [ ! -e "$T/big.exr" ]; then ok render_cancel
     else bad render_cancel "exit $rc, stderr: $(tr '\n' '|' <"$T/err")" "file: $([ -e "$T/big.exr" ] && echo exists || echo none)"; fi
+  fi
+fi
+
+# Issue 10: SIGINT or SIGTERM during the EXR write (12-15 s at 4K) was
+# ignored: the process wrote on, exited 0 and replaced the file. Now: exit
+# 130, "vsgl: cancelled", the previous file kept, no temporary file left.
+# The signal is sent once the write has started (its progress line is out:
+# not the output-path check's short-lived probe) and its temporary file exists.
+wait_for_temp() {  # wait_for_temp DIR PID STDERR: 0 once writing into a .*.tmp-* file in DIR
+  for _ in $(seq 1 1500); do
+    grep -q '^vsgl: write' "$3" 2>/dev/null && ls -A "$1" 2>/dev/null | grep -q '\.tmp-' && return 0
+    kill -0 "$2" 2>/dev/null || return 1
+    sleep 0.02
+  done
+  return 1
+}
+if want write_cancel || want write_kill; then
+  "$PY" tests/cli/make_scene.py "$T/w4k.vsglb" --width 3840 --height 2160
+fi
+for sig in INT TERM; do
+  name=write_cancel_$sig
+  want "$name" || continue
+  mkdir -p "$T/wc"; rm -f "$T/wc/"*; echo "previous" >"$T/wc/f.exr"
+  "$VSGL" render "$T/w4k.vsglb" -o "$T/wc/f.exr" --preset preview --compression zip 2>"$T/err" &
+  pid=$!
+  if ! wait_for_temp "$T/wc" $pid "$T/err"; then
+    wait $pid; bad "$name" "the write ended (exit $?) before its temporary file was seen"; continue
+  fi
+  kill -$sig $pid
+  wait $pid; rc=$?
+  if [ $rc -eq 130 ] && [ "$(tail -1 "$T/err")" = "vsgl: cancelled" ] && [ "$(cat "$T/wc/f.exr")" = "previous" ] &&
+     [ -z "$(ls -A "$T/wc" | grep '\.tmp-')" ]; then ok "$name"
+  else bad "$name" "exit $rc, stderr: $(tail -2 "$T/err" | tr '\n' '|')" "file: $(head -c 20 "$T/wc/f.exr" | tr -c '[:print:]' '?'), dir: $(ls -A "$T/wc" | tr '\n' ' ')"; fi
+done
+
+# Issue 10: kill -9 during a write left .NAME.tmp-* files (up to 57 MB) that
+# no later run removed. The next write into the folder removes those whose
+# process is gone and says so.
+if want write_kill; then
+  mkdir -p "$T/wk"
+  "$VSGL" render "$T/w4k.vsglb" -o "$T/wk/f.exr" --preset preview --compression zip 2>"$T/err_kill" &
+  pid=$!
+  if wait_for_temp "$T/wk" $pid "$T/err_kill"; then
+    kill -9 $pid; wait $pid 2>/dev/null
+    left=$(ls -A "$T/wk" | grep '\.tmp-')
+    if [ -z "$left" ]; then bad write_kill "no temporary file after kill -9"
+    elif expect_ok write_kill "$VSGL" render "$SCENE" -o "$T/wk/small.exr" --preset preview; then
+      if [ -z "$(ls -A "$T/wk" | grep '\.tmp-')" ] && grep -q "^vsgl: warning: removed $T/wk/$left: a temporary file .* of process $pid, which is gone" "$T/err"; then
+        ok write_kill
+      else bad write_kill "left: $(ls -A "$T/wk" | tr '\n' ' ')" "stderr: $(tr '\n' '|' <"$T/err")"; fi
+    fi
+  else
+    wait $pid; bad write_kill "the write ended before its temporary file was seen"
   fi
 fi
 

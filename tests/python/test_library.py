@@ -149,6 +149,37 @@ def test_not_a_library_gives_clear_error(tmp_path):
     assert str(junk) in str(e.value)
 
 
+def test_missing_dependency_names_it_and_its_package(tmp_path):
+    """Issue 10: a libvsgl whose dependency is absent gave 'cannot load ...
+    (rebuild it with `make`)', which a zip user cannot do. The message names
+    the missing library and the package that provides it."""
+    if CC is None:
+        pytest.skip("no C compiler")
+    dep, user = tmp_path / "dep.c", tmp_path / "user.c"
+    dep.write_text("int vsgl_test_dep(void) { return 1; }\n")
+    user.write_text("int vsgl_test_dep(void);\nint vsgl_version(void) { return vsgl_test_dep(); }\n")
+    so_dep = tmp_path / "libvsgl_test_dep.so.1"
+    subprocess.run([CC, "-shared", "-fPIC", str(dep), "-o", str(so_dep), "-Wl,-soname,libvsgl_test_dep.so.1"],
+                   check=True)
+    so = tmp_path / "libvsgl.so"
+    subprocess.run([CC, "-shared", "-fPIC", str(user), "-o", str(so), str(so_dep)], check=True)
+    os.unlink(str(so_dep))
+    with pytest.raises(libvsgl.VsglLibraryError) as e:
+        libvsgl.load_library(str(so))
+    msg = str(e.value)
+    assert "it needs libvsgl_test_dep.so.1, which is not installed" in msg, msg
+    # the sonames libvsgl really needs map to their Debian packages
+    for soname, pkg in (("libembree3.so.3", "libembree3-3"), ("libtbb.so.12", "libtbb12"),
+                        ("libOpenEXRCore-3_1.so.30", "libopenexr-3-1-30")):
+        m = libvsgl.load_error_message("/x/libvsgl.so", "%s: cannot open shared object file: "
+                                       "No such file or directory" % soname)
+        assert ("it needs %s" % soname) in m and ("apt-get install %s" % pkg) in m, m
+    # inside the add-on (lib/ beside libvsgl.py) the fix is the zip, not `make`
+    inside = os.path.join(os.path.dirname(os.path.abspath(libvsgl.__file__)), "lib", "libvsgl.so")
+    m = libvsgl.load_error_message(inside, "libtbb.so.12: cannot open shared object file: x")
+    assert "make" not in m and "vsgl_indirect/lib/" in m, m
+
+
 def test_argtypes_are_set_once_on_load(lib):
     # every exported prototype carries its types; ctypes rejects wrong arguments
     for name, restype, argtypes in libvsgl.PROTOTYPES:

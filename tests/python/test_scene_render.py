@@ -240,3 +240,40 @@ def test_debug_gbuffer_frames(lib, ctx):
     to_cam = np.array([0, -6, 1.5]) - g["positions"][hit]
     to_cam /= np.linalg.norm(to_cam, axis=1, keepdims=True)
     np.testing.assert_allclose(v, to_cam, atol=1e-4)
+
+
+# ---- memory limit (issue 10) -----------------------------------------------
+
+def test_render_estimate_and_memory_limit(lib):
+    """A render above the context's max_memory is refused before the output
+    arrays are allocated, naming the size, the estimate and the limit; the
+    estimate is the documented sum of its parts and is returned in stats."""
+    require(lib, "vsgl_render_estimate")
+    s = floor_and_wall(width=640, height=480)
+    with L.Context(max_memory=1 << 20) as small:
+        scene = L.Scene(small, **s)
+        try:
+            with pytest.raises(L.VsglError) as e:
+                L.render(small, scene, L.render_settings_preset("balanced"))
+            assert e.value.code == L.Result.ERROR_OUT_OF_MEMORY
+            assert "render: 640x480 with aa 2 and RSM 256 needs about" in e.value.message
+            assert "more than the memory limit of 1.0 MiB (max_memory)" in e.value.message
+        finally:
+            scene.close()
+    with L.Context() as ctx:
+        scene = L.Scene(ctx, **s)
+        try:
+            est = L.render_estimate(ctx, scene, L.render_settings_preset("balanced"), planes=("combined", "alpha"))
+            assert est["output"] == 640 * 480 * 4 * 4
+            assert est["gbuffer"] == 640 * 480 * 4 * 52
+            assert est["total"] == sum(est[k] for k in ("output", "gbuffer", "planes", "rsm", "fit", "shade"))
+            assert est["limit"] > est["total"]
+            with pytest.raises(L.VsglError) as e:
+                L.render_estimate(ctx, scene, dict(rsm_resolution=16384))
+            assert e.value.message == "settings: rsm_resolution is 16384 (valid 2..8192)"
+            _, stats = L.render(ctx, scene, L.render_settings_preset("preview"), planes=("combined",))
+            assert stats["memory_estimate"]["total"] > 0
+        finally:
+            scene.close()
+    with pytest.raises(ValueError):
+        L.Context(max_memory=-1)

@@ -118,6 +118,9 @@ typedef struct vsgl_context_desc {
     void *log_user;
     vsgl_progress_fn progress;/**< NULL = no progress reports */
     void *progress_user;
+    uint64_t max_memory;      /**< bytes a render may allocate (::vsgl_render_estimate);
+                                   0 = the memory this machine has available when the render
+                                   starts (MemAvailable, capped by the cgroup and RLIMIT_AS limits) */
 } vsgl_context_desc;
 
 /**

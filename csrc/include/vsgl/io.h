@@ -10,7 +10,9 @@
  * a previous file at the target path is left untouched; a reader never
  * sees a half-written file. New files get mode 0666 minus the umask. (Only
  * a crash or kill mid-write can leave the hidden temporary file
- * `.NAME.tmp-PID-...` beside the target.)
+ * `.NAME.tmp-PID-NS-TRY-HOST` beside the target; the next write into that
+ * directory deletes such files of this host whose process is gone and logs
+ * a warning naming each.)
  *
  * Readers never trust a file: every count is capped by the bytes actually
  * present before anything is allocated, every section is length- and
@@ -97,6 +99,11 @@ typedef struct vsgl_exr_options {
  * compressed on the context's worker threads; the file is identical for
  * any thread count.
  *
+ * The context's progress callback is called with the stage "write" between
+ * batches of chunks and before the file replaces the target; when it asks
+ * to cancel, the temporary file is deleted, a previous file at @p path is
+ * kept and ::VSGL_ERROR_CANCELLED is returned.
+ *
  * Every sample is checked before anything is written: a NaN or infinity
  * fails with ::VSGL_ERROR_INVALID_ARGUMENT and a message naming the pass,
  * channel and pixel ("pass DiffInd channel G pixel (3, 7): NaN"); no file
@@ -108,7 +115,8 @@ typedef struct vsgl_exr_options {
  * @param[in] opt    NULL for defaults.
  * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT, ::VSGL_ERROR_IO (message
  *         names the path and the system error), ::VSGL_ERROR_OUT_OF_MEMORY,
- *         ::VSGL_ERROR_INTERNAL (OpenEXR refused; its message is included).
+ *         ::VSGL_ERROR_CANCELLED, ::VSGL_ERROR_INTERNAL (OpenEXR refused; its
+ *         message is included).
  */
 VSGL_API vsgl_result vsgl_exr_write(vsgl_context *ctx, const char *path,
                                     uint32_t width, uint32_t height,

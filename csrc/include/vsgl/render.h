@@ -59,6 +59,15 @@ extern "C" {
 #define VSGL_PRESET_BALANCED 1
 #define VSGL_PRESET_QUALITY  2
 
+/* Valid ranges of the numeric settings (zero selects the default). One
+ * source for the library, the CLI (--help, docs/cli.md) and the add-on's
+ * property limits (libvsgl.py mirrors them; tests check the mirror). */
+#define VSGL_AA_SAMPLES_MAX        16
+#define VSGL_RSM_RESOLUTION_MIN    2
+#define VSGL_RSM_RESOLUTION_MAX    8192
+#define VSGL_VSGL_COUNT_MAX        65536
+#define VSGL_FIS_ITERATIONS_MAX    32
+
 /**
  * Render settings. Zero-initialised means "default" for every field, so
  * the default of each is stated. @p size: sizeof(vsgl_render_settings) or 0.
@@ -118,13 +127,51 @@ typedef struct vsgl_render_stats {
 } vsgl_render_stats;
 
 /**
+ * What a render will allocate, in bytes, before it allocates anything
+ * (see ::vsgl_render_estimate). Upper estimates of the peak: the G-buffer,
+ * the planes and the scratch of every stage are alive at once while the
+ * largest of rsm and fit is.
+ */
+typedef struct vsgl_memory_estimate {
+    uint64_t output;         /**< the caller's output planes (width x height x output floats per pixel) */
+    uint64_t gbuffer;        /**< camera samples: width x height x aa^2 x 52 */
+    uint64_t planes;         /**< the library's own accumulation planes: 52 per pixel */
+    uint64_t rsm;            /**< reflective shadow maps alive at once (one; every light's with brute force), 68 per texel */
+    uint64_t fit;            /**< moment grids and cluster labels of the largest light's fit */
+    uint64_t shade;          /**< shading scratch of every worker thread and the VSGL table */
+    uint64_t total;          /**< the sum of the fields above */
+    uint64_t limit;          /**< the context's max_memory, or what the machine has available if that is 0 */
+} vsgl_memory_estimate;
+
+/**
+ * @brief Validate @p settings exactly as ::vsgl_render does and estimate
+ * the memory a render of @p scene with them needs; refuse what exceeds
+ * the context's memory limit. ::vsgl_render makes the same check before
+ * allocating, so a render that cannot fit fails at once with a message
+ * naming the image size, the estimate and the limit.
+ * @param[in] output_floats_per_pixel floats per pixel of the output planes the
+ *        caller will pass (7 RGB planes + alpha = 22); counted in @p out->output.
+ * @param[out] out filled whenever the settings are valid (also on
+ *        ::VSGL_ERROR_OUT_OF_MEMORY). May be NULL.
+ * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (settings; message names
+ *         the field), ::VSGL_ERROR_OUT_OF_MEMORY (the estimate is above the limit).
+ */
+VSGL_API vsgl_result vsgl_render_estimate(vsgl_context *ctx, const vsgl_scene *scene,
+                                          const vsgl_render_settings *settings,
+                                          uint32_t output_floats_per_pixel,
+                                          vsgl_memory_estimate *out);
+
+/**
  * @brief Render the indirect AOV planes.
  * @param[in,out] out planes to fill; every non-NULL plane is written
  *        completely on success and left untouched on failure.
  * @param[out] stats may be NULL.
+ * A scene without lights, or whose every light is skipped, renders black
+ * planes and logs a warning saying why.
  * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (settings or output
- *         sizes; message names the field), ::VSGL_ERROR_OUT_OF_MEMORY,
- *         ::VSGL_ERROR_CANCELLED.
+ *         sizes; message names the field), ::VSGL_ERROR_OUT_OF_MEMORY (also
+ *         up front, before anything is allocated, when ::vsgl_render_estimate
+ *         exceeds the context's memory limit), ::VSGL_ERROR_CANCELLED.
  */
 VSGL_API vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene,
                                  const vsgl_render_settings *settings,

@@ -168,8 +168,9 @@ typedef struct vsgl_scene vsgl_scene;
  * @brief Validate @p desc and build a scene.
  *
  * Every array, count and index is checked: NaN/Inf, out-of-range indices,
- * degenerate triangles (reported as warnings and dropped), zero-length
- * normals, non-finite or singular matrices, non-positive sizes, unknown
+ * degenerate triangles (zero area or a zero-length corner normal:
+ * reported as warnings, counted in vsgl_scene_info.dropped_triangles and
+ * dropped), non-finite or singular matrices, non-positive sizes, unknown
  * enums. The first error is returned with a message naming the element,
  * e.g. "light 3: spot size is 0" (see ::vsgl_context_last_error).
  *

@@ -37,6 +37,7 @@ vsgl_result vsgl_context_create(const vsgl_context_desc *desc, vsgl_context **ou
     ctx->log_user = d.log_user;
     ctx->progress = d.progress;
     ctx->progress_user = d.progress_user;
+    ctx->max_memory = d.max_memory;
     ctx->progress_base = 0.0f;
     ctx->progress_span = 1.0f;
     *out = ctx;

@@ -3,8 +3,10 @@
 #include "vsgl/io.h"
 #include "core/context.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,6 +55,96 @@ vsgl__errstr vsgl__strerror(int e)
     return r;
 }
 
+/* This host's name, reduced to [A-Za-z0-9._] (a temp name's last field). */
+static void host_tag(char *buf, size_t n)
+{
+    char h[256] = {0};
+    if (gethostname(h, sizeof h - 1) != 0 || !h[0])
+        snprintf(h, sizeof h, "localhost");
+    size_t k = 0;
+    for (const char *p = h; *p && k + 1 < n && k < 63; ++p) {
+        char c = *p;
+        buf[k++] = ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.') ? c : '_';
+    }
+    buf[k] = '\0';
+}
+
+/* Parse "<digits>-" at *p, advancing past it; -1 if absent. */
+static long long take_number(const char **p, char end)
+{
+    const char *s = *p;
+    long long v = 0;
+    if (*s < '0' || *s > '9')
+        return -1;
+    while (*s >= '0' && *s <= '9') {
+        if (v > 100000000000000LL)
+            return -1;
+        v = v * 10 + (*s++ - '0');
+    }
+    if (*s != end)
+        return -1;
+    *p = s + (end ? 1 : 0);
+    return v;
+}
+
+/* Is `name` a temporary file of these writers, ".<x>.tmp-<pid>-<ns>-<try>"
+ * with an optional "-<host>"? Gives the pid and whether the host is ours. */
+int vsgl__atomic_temp_owner(const char *name, const char *host, long *pid, int *this_host)
+{
+    if (name[0] != '.')
+        return 0;
+    const char *t = NULL;
+    for (const char *q = strstr(name, ".tmp-"); q; q = strstr(q + 1, ".tmp-"))
+        t = q; /* the last one: a target may itself contain ".tmp-" */
+    if (!t || t == name)
+        return 0;
+    const char *p = t + 5;
+    long long v = take_number(&p, '-');
+    if (v <= 0 || take_number(&p, '-') < 0)
+        return 0;
+    const char *try_start = p;
+    if (take_number(&p, '\0') >= 0) { /* no host field: an older writer, same machine */
+        *this_host = 1;
+    } else {
+        p = try_start;
+        if (take_number(&p, '-') < 0 || !*p)
+            return 0;
+        *this_host = strcmp(p, host) == 0;
+    }
+    *pid = (long)v;
+    return 1;
+}
+
+/* Delete the temporary files a crashed or killed writer left in `dir`
+ * (issue 10): only this host's, only if their process is gone, and say so. */
+static void remove_stale_temps(vsgl_context *ctx, const char *dir, const char *host)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return;
+    long self = (long)getpid();
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        long pid = 0;
+        int ours = 0;
+        if (!vsgl__atomic_temp_owner(e->d_name, host, &pid, &ours) || !ours || pid == self)
+            continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+            continue; /* alive (or not ours to signal: EPERM means it exists) */
+        size_t n = strlen(dir) + strlen(e->d_name) + 2;
+        char *path = malloc(n);
+        if (!path)
+            break;
+        snprintf(path, n, "%s/%s", dir, e->d_name);
+        struct stat st;
+        if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) && unlink(path) == 0)
+            vsgl__log(ctx, VSGL_LOG_WARNING, "removed %s: a temporary file (%lld bytes) left by an interrupted "
+                      "write of process %ld, which is gone", path, (long long)st.st_size, pid);
+        free(path);
+    }
+    closedir(d);
+}
+
 static void free_file(vsgl__atomic_file *f)
 {
     free(f->target);
@@ -94,25 +186,29 @@ vsgl_result vsgl__atomic_open(vsgl_context *ctx, const char *path, vsgl__atomic_
         free(dir);
         return r;
     }
+    char host[64];
+    host_tag(host, sizeof host);
+    remove_stale_temps(ctx, dir, host);
     free(dir);
 
     const char *base = strrchr(path, '/');
     size_t dir_len = base ? (size_t)(base - path) + 1 : 0;
     base = base ? base + 1 : path;
-    size_t cap = len + 64;
+    size_t cap = len + 64 + sizeof host;
     f->target = dup_string(path);
     f->temp = malloc(cap);
     if (!f->target || !f->temp) {
         free_file(f);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "out of memory");
     }
-    /* ".<name>.tmp-<pid>-<ns>-<try>": unique per process and attempt; O_EXCL guarantees it. */
+    /* ".<name>.tmp-<pid>-<ns>-<try>-<host>": unique per process and attempt (O_EXCL
+     * guarantees it); the pid and host let a later write tell a stale one. */
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     int e = 0;
     for (unsigned attempt = 0; attempt < 100; ++attempt) {
-        snprintf(f->temp, cap, "%.*s.%s.tmp-%ld-%09ld-%u", (int)dir_len, path, base,
-                 (long)getpid(), (long)ts.tv_nsec, attempt);
+        snprintf(f->temp, cap, "%.*s.%s.tmp-%ld-%09ld-%u-%s", (int)dir_len, path, base,
+                 (long)getpid(), (long)ts.tv_nsec, attempt, host);
         f->fd = open(f->temp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
         if (f->fd >= 0)
             return VSGL_OK;

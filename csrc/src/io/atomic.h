@@ -37,6 +37,11 @@ void vsgl__atomic_abort(vsgl__atomic_file *f);
 typedef struct vsgl__errstr { char s[128]; } vsgl__errstr;
 vsgl__errstr vsgl__strerror(int e);
 
+/* Is directory entry `name` a temporary file of these writers
+ * (".<target>.tmp-<pid>-<ns>-<try>[-<host>]")? Then *pid is its writer and
+ * *this_host whether `host` (see atomic.c) wrote it. Returns 0 or 1. */
+int vsgl__atomic_temp_owner(const char *name, const char *host, long *pid, int *this_host);
+
 /* Write a whole buffer to path atomically. */
 vsgl_result vsgl__atomic_write_all(vsgl_context *ctx, const char *path, const void *data, size_t n);
 

@@ -342,6 +342,12 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
     encode_job job = {e, part, width, ptype == EXR_PIXEL_HALF ? 2u : 4u, ptype, chans, n, infos, outs, 0};
     for (size_t b0 = 0; b0 < nchunks; b0 += batch) {
         size_t b1 = b0 + batch < nchunks ? b0 + batch : nchunks;
+        /* SIGINT in the CLI, Esc in the add-on: stop between batches (a 4K
+         * write takes 12-15 s); the caller deletes the temporary file. */
+        if (vsgl__progress(ctx, "write", (float)b0 / (float)nchunks)) {
+            result = vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "%s: write cancelled; a previous file there is kept", path);
+            goto done;
+        }
         job.batch_begin = b0;
         int32_t failed = vsgl__parallel_for(threads, b1 - b0, 1, encode_chunks_batch, &job);
         for (size_t k = b0; k < b1 && !rv; ++k) {
@@ -412,6 +418,8 @@ vsgl_result vsgl_exr_write(vsgl_context *ctx, const char *path, uint32_t width, 
     r = write_exr(ctx, &sink, path, width, height, chans, n, &o);
     pthread_mutex_destroy(&sink.lock);
     free(chans);
+    if (!r && vsgl__progress(ctx, "write", 1.0f))
+        r = vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "%s: write cancelled; a previous file there is kept", path);
     if (r) {
         vsgl__atomic_abort(&sink.file);
         return r;

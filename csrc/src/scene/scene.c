@@ -72,6 +72,18 @@ static int face_normal(const float *p0, const float *p1, const float *p2, float 
     return (n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f);
 }
 
+/* First corner (0-2) of a triangle whose normal has (near) zero length, or -1. */
+static int zero_normal_corner(const float *n9)
+{
+    for (int c = 0; c < 3; ++c) {
+        const float *n = n9 + c * 3;
+        double l2 = (double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2];
+        if (!(l2 > 1e-20))
+            return c;
+    }
+    return -1;
+}
+
 static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene *s)
 {
     uint32_t tc = d->triangle_count;
@@ -85,17 +97,30 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
         float n[3];
         keep[t] = (unsigned char)face_normal(d->positions + (size_t)ix[0] * 3, d->positions + (size_t)ix[1] * 3,
                                              d->positions + (size_t)ix[2] * 3, n);
+        int zero_corner = -1;
+        if (keep[t] && d->corner_normals)
+            zero_corner = zero_normal_corner(d->corner_normals + (size_t)t * 9);
+        if (zero_corner >= 0)
+            keep[t] = 0;
         if (keep[t]) {
             ++kept;
         } else {
-            if (dropped < VSGL_MAX_DROP_WARNINGS)
-                vsgl__log(ctx, VSGL_LOG_WARNING, "triangle %u: zero area (vertices %u, %u, %u), dropped",
-                          (unsigned)t, (unsigned)ix[0], (unsigned)ix[1], (unsigned)ix[2]);
+            if (dropped < VSGL_MAX_DROP_WARNINGS) {
+                if (zero_corner >= 0) {
+                    const float *cn = d->corner_normals + (size_t)t * 9 + zero_corner * 3;
+                    vsgl__log(ctx, VSGL_LOG_WARNING, "triangle %u: corner %d normal (%g, %g, %g) has zero length, dropped",
+                              (unsigned)t, zero_corner, (double)cn[0], (double)cn[1], (double)cn[2]);
+                } else {
+                    vsgl__log(ctx, VSGL_LOG_WARNING, "triangle %u: zero area (vertices %u, %u, %u), dropped",
+                              (unsigned)t, (unsigned)ix[0], (unsigned)ix[1], (unsigned)ix[2]);
+                }
+            }
             ++dropped;
         }
     }
     if (dropped > VSGL_MAX_DROP_WARNINGS)
-        vsgl__log(ctx, VSGL_LOG_WARNING, "scene: %u zero-area triangles dropped in all", (unsigned)dropped);
+        vsgl__log(ctx, VSGL_LOG_WARNING, "scene: %u degenerate triangles (zero area or zero-length normal) dropped in all",
+                  (unsigned)dropped);
     s->triangle_count = kept;
     s->dropped_triangles = dropped;
 

@@ -224,10 +224,8 @@ vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *
                 if (!finite_f(n[0]) || !finite_f(n[1]) || !finite_f(n[2]))
                     return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "triangle %u: corner %d normal (%g, %g, %g) is not finite",
                                       (unsigned)t, c, (double)n[0], (double)n[1], (double)n[2]);
-                double l2 = (double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2];
-                if (!(l2 > 1e-20))
-                    return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "triangle %u: corner %d normal (%g, %g, %g) has zero length",
-                                      (unsigned)t, c, (double)n[0], (double)n[1], (double)n[2]);
+                /* a zero-length normal (an object scaled to zero along an axis)
+                 * makes the triangle degenerate: scene.c drops it with a warning */
             }
         if (d->corner_uvs)
             for (int k = 0; k < 6; ++k) {

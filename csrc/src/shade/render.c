@@ -219,6 +219,15 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
     vsgl_result r = vsgl__settings_resolve(ctx, settings, &s);
     if (r == VSGL_OK)
         r = check_output(ctx, scene, out);
+    if (r == VSGL_OK) { /* refuse what cannot fit before allocating (shade/memory.c) */
+        const float *const rgb[7] = {out->diffuse_light, out->glossy_light, out->diffuse_color, out->glossy_color,
+                                     out->diffuse, out->glossy, out->combined};
+        uint64_t floats = out->alpha ? 1u : 0u;
+        for (int i = 0; i < 7; ++i)
+            floats += rgb[i] ? 3u : 0u;
+        vsgl_memory_estimate est;
+        r = vsgl__memory_estimate(ctx, scene, &s, (uint64_t)out->width * out->height * floats * sizeof(float), &est);
+    }
     if (r != VSGL_OK)
         return r;
 
@@ -259,6 +268,15 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
     }
     if (r == VSGL_OK)
         r = write_outputs(ctx, &planes, pixels, out);
+    if (r == VSGL_OK && st.lights_used == 0) {
+        uint32_t light_count = 0;
+        (void)vsgl__scene_lights(scene, &light_count);
+        if (light_count == 0)
+            vsgl__log(ctx, VSGL_LOG_WARNING, "render: the scene has no lights: the indirect light is black");
+        else
+            vsgl__log(ctx, VSGL_LOG_WARNING, "render: none of the %u lights lights anything (all skipped): "
+                      "the indirect light is black", light_count);
+    }
 done:
     vsgl__progress_window(ctx, 0.0f, 1.0f);
     free(buf);

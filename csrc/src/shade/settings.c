@@ -78,16 +78,17 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     CHECK_ENUM(leak_correction, VSGL_LEAK_AUTO, VSGL_LEAK_ON)
     CHECK_ENUM(sample_merging, VSGL_MERGE_AUTO, VSGL_MERGE_OFF)
 #undef CHECK_ENUM
-    if (s->aa_samples > 16)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: aa_samples is %u (valid 1..16)", s->aa_samples);
-    if (s->rsm_resolution < 2 || s->rsm_resolution > 8192)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: rsm_resolution is %u (valid 2..8192)",
-                          s->rsm_resolution);
-    if (s->vsgl_count > 65536)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: vsgl_count is %u (valid 1..65536)",
-                          s->vsgl_count);
-    if (s->fis_iterations > 32)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: fis_iterations is %u (valid 1..32)",
-                          s->fis_iterations);
+    if (s->aa_samples > VSGL_AA_SAMPLES_MAX)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: aa_samples is %u (valid 1..%d)", s->aa_samples,
+                          VSGL_AA_SAMPLES_MAX);
+    if (s->rsm_resolution < VSGL_RSM_RESOLUTION_MIN || s->rsm_resolution > VSGL_RSM_RESOLUTION_MAX)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: rsm_resolution is %u (valid %d..%d)",
+                          s->rsm_resolution, VSGL_RSM_RESOLUTION_MIN, VSGL_RSM_RESOLUTION_MAX);
+    if (s->vsgl_count > VSGL_VSGL_COUNT_MAX)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: vsgl_count is %u (valid 1..%d)",
+                          s->vsgl_count, VSGL_VSGL_COUNT_MAX);
+    if (s->fis_iterations > VSGL_FIS_ITERATIONS_MAX)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: fis_iterations is %u (valid 1..%d)",
+                          s->fis_iterations, VSGL_FIS_ITERATIONS_MAX);
     return VSGL_OK;
 }

@@ -1,6 +1,7 @@
 """Export of the evaluated depsgraph against the scene built in each test and
 Blender's own values (matrix_world, loop counts, light settings)."""
 import math
+import os
 
 import bpy
 import numpy as np
@@ -192,12 +193,13 @@ def test_lights_units_per_type(scene):
     light(scene, "SUN", "Sun", 3.0, (0, 0, 5), angle=0.1)
     light(scene, "AREA", "A", 20.0, (0, 0, 3), shape="RECTANGLE", size=0.5, size_y=2.0, spread=1.0)
     light(scene, "AREA", "Disk", 20.0, (0, 0, 3), shape="DISK", size=0.7)
-    if VERSION >= (4, 0, 0):
+    has_exposure = hasattr(p.data, "exposure")      # light exposure: 4.3+ (not in 4.2 LTS)
+    if has_exposure:
         p.data.exposure = 1.5
     bpy.context.view_layer.update()
     sd = collect(scene)
     L = dict(zip(sd.light_names, sd.lights))
-    expo = 2 ** 1.5 if VERSION >= (4, 0, 0) else 1.0
+    expo = 2 ** 1.5 if has_exposure else 1.0
     assert L["P"]["power"] == pytest.approx(100 * expo, rel=1e-5)
     assert L["P"]["color"] == pytest.approx((1, 0.5, 0.25)) and L["P"]["radius"] == pytest.approx(0.25)
     assert (L["S"]["type"], L["S"]["spot_size"], L["S"]["spot_blend"]) == \
@@ -347,3 +349,54 @@ def test_collection_holdout_and_layer_paths_distinct(scene):
     a = runner.output_path(scene, "ViewLayer", 5)
     b = runner.output_path(scene, "Other", 5)
     assert a != b and a.endswith("_0005.exr") and b.endswith("_0005.exr")
+
+
+def test_degenerate_objects_dropped_with_named_warning(scene, tmp_path):
+    """Issue 10: an object scaled (1, 1, 0) or (0, 0, 0) gave zero-length
+    normals and the library refused the whole frame without naming it. Its
+    degenerate triangles are dropped with a warning naming the object; the
+    rest of the scene (and the object's faces that keep an area) is exported."""
+    basic(scene)
+    link(scene, plane("Floor", 6.0))
+    flat = link(scene, cube("Flat", 1.0, location=(0, 0, 1)))
+    flat.scale = (1, 1, 0)
+    gone = link(scene, cube("Gone", 1.0, location=(1, 1, 1)))
+    gone.scale = (0, 0, 0)
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    lengths = np.linalg.norm(sd.corner_normals.astype(np.float64), axis=2)
+    assert lengths.min() > 0.5, "zero-length normals exported"
+    p = sd.positions.astype(np.float64)[sd.indices.astype(np.int64)]
+    area = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    assert area.min() > 0, "zero-area triangles exported"
+    # Floor (2) and Flat's top and bottom (2 + 2) stay; Flat's sides and all of Gone go.
+    assert sd.triangle_count == 6, sd.triangle_count
+    text = "\n".join(sd.warnings)
+    assert "object 'Flat': 8 of 12 triangles are degenerate" in text, text
+    assert "object 'Gone': all 12 triangles are degenerate" in text, text
+    assert "Floor" not in text
+    # ... and the frame renders: the library accepts what is left and lights it.
+    from conftest import real_render_or_skip
+    real_render_or_skip()
+    from vsgl_indirect import engine
+    from vsgl_indirect.config import Options
+    res = engine.compute(sd, Options(preset="PREVIEW"), os.path.join(str(tmp_path), "flat.exr"))
+    assert os.path.exists(res.path) and res.stats["lights_used"] == 1
+
+
+def test_frame_above_max_memory_is_refused_with_its_size(scene, tmp_path):
+    """Issue 10: the add-on's 'Max Memory' reaches the library, which refuses
+    the frame up front, naming the image size, the estimate and the limit."""
+    from conftest import real_render_or_skip
+    real_render_or_skip()
+    from vsgl_indirect import engine
+    from vsgl_indirect.config import Options
+    basic(scene)
+    link(scene, plane("Floor", 6.0))
+    bpy.context.view_layer.update()
+    sd = collect(scene)
+    with pytest.raises(engine.AovError) as e:
+        engine.compute(sd, Options(preset="PREVIEW", max_memory_gb=0.0001), os.path.join(str(tmp_path), "m.exr"))
+    assert "needs about" in str(e.value) and "memory limit of 0.1 MiB (max_memory)" in str(e.value), str(e.value)
+    res = engine.compute(sd, Options(preset="PREVIEW"), os.path.join(str(tmp_path), "m.exr"))
+    assert engine.memory_summary(res.stats).startswith("about ")

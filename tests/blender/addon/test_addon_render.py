@@ -99,6 +99,93 @@ def test_parallel_processes_write_distinct_identical_files(scene, tmp_path):
     assert c3["VSGL.Combined.R"].max() > 0
 
 
+def test_farm_race_overlapping_frames_never_composite_a_placeholder(scene, tmp_path):
+    """Issue 10: 4 workers share one AOV template and render overlapping
+    frames (a requeued task while its first worker still runs). render_pre
+    used to overwrite another worker's finished AOV with a black placeholder:
+    4 to 12 of 32 composites came out black or failed with 'Cannot read'.
+    Every composite must be its frame's AOV (fake renderer: 0.1 f, 0.2, 0.3
+    on a black beauty), and no worker may log an error."""
+    path = setup_blend(scene, tmp_path)
+    scene.objects["Spot"].data.energy = 1e-9   # beauty ~ black (world is None)
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    save(path)
+    frames = (1, 6)
+    workers = 4
+    farm = os.path.join(os.path.dirname(__file__), "farm_output.py")
+    procs = []
+    for w in range(workers):
+        e = dict(os.environ, VSGL_TEST_FAKE_RENDER="1", VSGL_TEST_OUT=str(tmp_path / ("w%d" % w) / "beauty_"))
+        if IS_BINARY:
+            cmd = [bpy.app.binary_path, "-b", "--factory-startup", path, "--python",
+                   os.path.join(REPO, "tests", "blender", "bootstrap_addon.py"), "--python", farm,
+                   "-s", str(frames[0]), "-e", str(frames[1]), "-t", "1", "-a"]
+        else:
+            import sys
+            cmd = [sys.executable, os.path.join(os.path.dirname(__file__), "bpy_render.py"), path,
+                   "%d:%d" % frames, farm]
+        procs.append(subprocess.Popen(cmd, env=e, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                      universal_newlines=True))
+    logs = [p.communicate(timeout=600)[0] for p in procs]
+    wrong = []
+    for w in range(workers):
+        assert procs[w].returncode == 0, logs[w]
+        for f in range(frames[0], frames[1] + 1):
+            out = str(tmp_path / ("w%d" % w) / ("beauty_%04d.exr" % f))
+            if not os.path.exists(out):
+                wrong.append("worker %d frame %d: no composite" % (w, f))
+                continue
+            px = image(out)
+            if not np.allclose(px[..., :3], (0.1 * f, 0.2, 0.3), atol=1e-3):
+                wrong.append("worker %d frame %d: composite %s" % (w, f, px[0, 0, :3]))
+        bad = [line for line in logs[w].splitlines() if "VSGL ERROR" in line or "Cannot read" in line
+               or "Traceback" in line]
+        if bad:
+            wrong.append("worker %d: %s" % (w, bad[:3]))
+    n = workers * (frames[1] - frames[0] + 1)
+    if wrong and os.environ.get("VSGL_TEST_FARM_LOGS"):
+        for w in range(workers):
+            print("---- worker %d\n%s" % (w, logs[w]))
+    assert not wrong, "%d of %d composites wrong or errors:\n%s" % (len(wrong), n, "\n".join(wrong))
+
+
+def test_failed_frame_retires_only_a_previous_runs_aov(scene, tmp_path):
+    """Without placeholders, a frame whose AOV cannot be computed must still
+    not composite a previous run's file: it is retired (and reported); a
+    file written during this job by another worker would stay."""
+    path = setup_blend(scene, tmp_path)
+    r = render(path, 1, env={"VSGL_TEST_FAKE_RENDER": "1"})
+    assert r.returncode == 0 and os.path.exists(aov(tmp_path, 1)), r.stdout
+    os.utime(aov(tmp_path, 1), (1, 1))          # a previous run's file
+    bpy.data.objects.remove(scene.objects["Spot"])
+    save(path)
+    r = render(path, 1, env={"VSGL_TEST_FAKE_RENDER": "1"})
+    assert r.returncode == 0 and "no light with non-zero power" in r.stdout, r.stdout
+    assert "removed the previous run's AOV" in r.stdout, r.stdout
+    assert not os.path.exists(aov(tmp_path, 1))
+    assert not [n for n in os.listdir(str(tmp_path / "aov")) if "retired" in n or ".setup-" in n]
+
+
+def test_placeholder_and_stale_removal_keep_other_writers_files(tmp_path):
+    """The two removals of handlers.py never delete a file another process
+    renamed over the path (the farm race of issue 10)."""
+    p = str(tmp_path / "f_0001.exr")
+    with open(p, "w") as f:
+        f.write("placeholder")
+    ino = os.stat(p).st_ino
+    other = str(tmp_path / "other")
+    with open(other, "w") as f:
+        f.write("real AOV")
+    os.replace(other, p)                        # another worker's atomic write
+    assert not handlers.remove_if_inode(p, ino) and open(p).read() == "real AOV"
+    assert handlers.remove_if_inode(p, os.stat(p).st_ino) and not os.path.exists(p)
+    with open(p, "w") as f:
+        f.write("fresh")
+    assert not handlers.retire_stale(p, os.stat(p).st_mtime - 10) and os.path.exists(p)
+    assert handlers.retire_stale(p, os.stat(p).st_mtime + 10) and not os.path.exists(p)
+    assert os.listdir(str(tmp_path)) == []
+
+
 def test_bad_scene_reported_render_continues(scene, tmp_path):
     link(scene, plane("Floor", 4))
     camera(scene)
@@ -139,6 +226,8 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     scene.render.filepath = str(tmp_path / "out" / "b_")
     for _ in range(3):
         assert handlers.setup_scene(scene) == []
+        # the sockets' placeholder is gone again, and nothing beside it
+        assert os.listdir(str(tmp_path / "aov")) == [handlers.SETUP_LOCK], os.listdir(str(tmp_path / "aov"))
     tree = compat.compositor_tree(scene, create=False)
     assert len(_nodes(tree, "VSGL Indirect [")) == 1 and len(_nodes(tree, "VSGL Add [")) == 1
     out = compat.compositor_output_socket(tree)
@@ -152,6 +241,30 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     assert out.links[0].from_node.bl_idname == "CompositorNodeRLayers"
     compositor.remove(scene)
     assert not _nodes(tree, "VSGL")
+
+
+def test_settings_update_callbacks_only_in_the_application():
+    """Edits rewire the compositor through update= callbacks inside Blender;
+    the pip bpy module gets none (its 4.2 LTS build segfaults at exit with
+    them; render_init sets the compositor up there)."""
+    from vsgl_indirect import settings as st
+    assert st.IN_APPLICATION == IS_BINARY
+    assert bool(st._UPDATE) == IS_BINARY
+
+
+def test_process_with_the_addon_exits_cleanly(tmp_path):
+    """Issue 10: the pip bpy 4.2.23 module exited with a segfault (139) after
+    every render while the add-on was registered (any Python callable left
+    in Blender at exit: update= callbacks, app handlers)."""
+    import sys
+    code = ("import sys; sys.path.insert(0, %r); import bpy, vsgl_indirect; vsgl_indirect.register(); "
+            "s = bpy.context.scene; s.vsgl_indirect.enabled = True; print('ok')" % os.path.join(REPO, "addon"))
+    if IS_BINARY:
+        cmd = [bpy.app.binary_path, "-b", "--factory-startup", "--python-expr", code]
+    else:
+        cmd = [sys.executable, "-c", code]
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=120)
+    assert r.returncode == 0 and "ok" in r.stdout, (r.returncode, r.stdout[-2000:])
 
 
 def test_preview_operator_writes_and_loads_image(scene, monkeypatch):

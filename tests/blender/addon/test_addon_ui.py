@@ -73,3 +73,30 @@ def test_classes_and_properties_registered():
             assert cls.is_registered, cls
     assert "vsgl_indirect" in bpy.types.Scene.bl_rna.properties
     assert vsgl_indirect.bl_info["blender"] == (3, 4, 0)
+
+
+def test_property_limits_are_the_library_ranges():
+    """Issue 10: the RSM range was 8..4096 here, 2..8192 in the library and
+    1+ in the CLI docs. The properties take the library's (render.h via
+    libvsgl.py, which tests/python/test_layout.py checks against the header)."""
+    from vsgl_indirect import libvsgl
+    props = bpy.types.Scene.bl_rna.properties["vsgl_indirect"].fixed_type.bl_rna.properties
+    want = {"rsm_resolution": (libvsgl.RSM_RESOLUTION_MIN, libvsgl.RSM_RESOLUTION_MAX),
+            "aa_samples": (1, libvsgl.AA_SAMPLES_MAX),
+            "vsgl_count": (1, libvsgl.VSGL_COUNT_MAX),
+            "fis_iterations": (1, libvsgl.FIS_ITERATIONS_MAX)}
+    for name, (lo, hi) in want.items():
+        assert (props[name].hard_min, props[name].hard_max) == (lo, hi), name
+    assert (libvsgl.RSM_RESOLUTION_MIN, libvsgl.RSM_RESOLUTION_MAX) == (2, 8192)
+
+
+def test_last_run_box_shows_the_memory_estimate(scene):
+    runner.begin(scene.name, 4)
+    res = engine.Result()
+    res.path, res.summary = "/tmp/x.exr", "2 triangles"
+    res.stats = {"memory_estimate": {"total": 3 << 29, "limit": 22 << 30}}
+    res.timings = {"render": 0.1, "write": 0.01}
+    runner.finish(scene.name, res, 0.01)
+    texts = [t for t, _ in draw(scene).labels]
+    assert "Memory: about 1.5 GiB of 22.0 GiB" in texts, texts
+    assert "max_memory_gb" in draw(scene).props
