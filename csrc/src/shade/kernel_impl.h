@@ -253,8 +253,10 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
     c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
     float rho = K_CLIP_RHO * c * k_exp(VSGL__COSINE_SHARPNESS * (1.0f - c));
     float s = d2 * L->ivar;
-    float w = s / (s + VSGL_CLIP_NEAR) * L->conv;
-    float e = sb * sb * (3.0f - 2.0f * sb) * sp * sp * (3.0f - 2.0f * sp) * ((1.0f - w) + w * rho);
+    float wn = s / (s + VSGL_CLIP_NEAR), w = wn * L->conv;
+    /* the parallel clip in the near field only: far away the receiver's own cosine does it */
+    float par = 1.0f - (1.0f - sp * sp * (3.0f - 2.0f * sp)) * (1.0f - wn);
+    float e = sb * sb * (3.0f - 2.0f * sb) * par * ((1.0f - w) + w * rho);
     float valid = (d2 > 0.0f ? 1.0f : L->valid) * vis;
     t->vis[i] = valid;
     t->amp[i] = valid * L->c0 * (1.0f - L->clip * (1.0f - e));

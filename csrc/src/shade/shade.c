@@ -55,14 +55,15 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
     float d2 = v3_dot(d, d);
     float var = fmaxf(v->variance, d2 * VARIANCE_FLOOR);
     float h = v3_dot(d, v->normal);
-    float e = smoothstep01(h / (VSGL_CLIP_BEHIND * sqrtf(var) + 1e-30f)) *
-              smoothstep01((1.0f - v3_dot(n, v->normal)) * (1.0f / VSGL_CLIP_PARALLEL));
+    float s = var > 0.0f ? d2 / var : 0.0f;
+    float w = s / (s + VSGL_CLIP_NEAR);
+    /* the parallel clip in the near field only: far away the receiver's own cosine does it */
+    float par = 1.0f - (1.0f - smoothstep01((1.0f - v3_dot(n, v->normal)) * (1.0f / VSGL_CLIP_PARALLEL))) * (1.0f - w);
+    float e = smoothstep01(h / (VSGL_CLIP_BEHIND * sqrtf(var) + 1e-30f)) * par;
     if (v->lobe == VSGL_LOBE_DIFFUSE) {
         float c = d2 > 0.0f ? clampf(h / sqrtf(d2), 0.0f, 1.0f) : 0.0f;
         float ld = vsgl_sg_cosine_sharpness();
         float rho = vsgl_sg_integral(ld) * INV_PI * c * expf(ld * (1.0f - c));
-        float s = var > 0.0f ? d2 / var : 0.0f;
-        float w = s / (s + VSGL_CLIP_NEAR);
         e *= (1.0f - w) + w * rho;
     }
     return 1.0f - v->coherence * v->coherence * (1.0f - e);
