@@ -25,7 +25,7 @@ int main(int argc, char **argv)
 {
     uint32_t W = argc > 1 ? (uint32_t)atoi(argv[1]) : 80, H = argc > 2 ? (uint32_t)atoi(argv[2]) : 60;
     uint32_t rsm = argc > 3 ? (uint32_t)atoi(argv[3]) : 64;
-    const char *fit_names[3] = {"two", "fis", "kmeans"};
+    const char *fit_names[4] = {"two", "fis", "kmeans", "lattice"};
     const char *diff_names[3] = {"accurate", "sg", "pulled"}; /* by VSGL_COSINE_* value */
     const uint32_t counts[6] = {2, 8, 32, 128, 512, 2048};
     printf("Image %ux%u, 1 sample/pixel, RSM %u^2, reference: brute-force gathering of every RSM texel.\n\n", W, H, rsm);
@@ -49,7 +49,7 @@ int main(int argc, char **argv)
         printf("| fit | VSGLs/light | diffuse mode | estimator | leak corr. | VSGLs | relMSE diffuse | relMSE glossy | mean glossy | shade s |\n");
         printf("|---|---|---|---|---|---|---|---|---|---|\n");
         s.method = VSGL_METHOD_VSGL;
-        for (int f = 0; f < 3; ++f)
+        for (int f = 0; f < 4; ++f)
             for (int c = 0; c < (f == 0 ? 1 : 6); ++c)
                 for (int d = 0; d < 3; ++d)
                     for (int e = 0; e < 3; ++e) {
@@ -57,8 +57,7 @@ int main(int argc, char **argv)
                         if ((d != VSGL_COSINE_ACCURATE || e != 0) && !(f == 1 && c == 3) &&
                             !(e == 2 && d == VSGL_COSINE_ACCURATE && f > 0 && c >= 3))
                             continue; /* mode/estimator/leak sweep only at a few points */
-                        if (e == 2 && f == 0)
-                            continue;
+
                         s.leak_correction = e == 2 ? VSGL_LEAK_OFF : VSGL_LEAK_AUTO;
                         s.fit_mode = f;
                         s.vsgl_count = f == 0 ? 1 : counts[c];
@@ -68,7 +67,7 @@ int main(int argc, char **argv)
                             return 1;
                         printf("| %s | %u | %s | %s | %s | %u | %.4g | %.4g | %.4g | %.3f |\n", fit_names[f],
                                f == 0 ? 2 : counts[c], diff_names[d], e == 1 ? "banerjee" : "toksvig",
-                               (e == 2 || f == 0) ? "off" : "on", st.vsgl_count,
+                               e == 2 ? "off" : "on", st.vsgl_count,
                                acc_relmse(got.diffuse, ref.diffuse, n), acc_relmse(got.glossy, ref.glossy, n),
                                mean(got.glossy, n), st.seconds_shade);
                         acc_free(&got);

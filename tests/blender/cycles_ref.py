@@ -765,11 +765,14 @@ def suite_gather(lib, ctx, out_dir, report):
 CURVE_SPP = [int(v) for v in os.environ.get("VSGL_CURVE_SPP", "1,4,16,64,256").split(",")]
 CURVE_SETTINGS = [
     # (label, preset, overrides)
-    ("preview preset (2 VSGLs/light, RSM 128)", "PREVIEW", {}),
-    ("balanced preset (k-means 128, RSM 256, aa 2)", "BALANCED", {}),
-    ("quality preset (k-means 256, RSM 512, aa 2, visibility)", "QUALITY", {}),
-    ("balanced preset, pulled-out cosine", "BALANCED", dict(diffuse_mode=2)),
-    ("quality preset, pulled-out cosine", "QUALITY", dict(diffuse_mode=2)),
+    ("preview preset (lattice 32, RSM 128)", "PREVIEW", {}),
+    ("balanced preset (lattice 128, RSM 256, aa 2)", "BALANCED", {}),
+    ("quality preset (lattice 256, RSM 512, aa 2, visibility)", "QUALITY", {}),
+    ("lattice 512, RSM 512, aa 2, visibility", "BALANCED", dict(vsgl_count=512, rsm_resolution=512, visibility=1)),
+    ("lattice 32, RSM 256, aa 1, visibility", "BALANCED", dict(vsgl_count=32, aa_samples=1, visibility=1)),
+    ("lattice 64, RSM 256, aa 1, visibility", "BALANCED", dict(vsgl_count=64, aa_samples=1, visibility=1)),
+    ("lattice 128, RSM 256, aa 1, visibility", "BALANCED", dict(vsgl_count=128, aa_samples=1, visibility=1)),
+    ("lattice 128, RSM 256, aa 2, visibility", "BALANCED", dict(vsgl_count=128, visibility=1)),
     ("FIS 16, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=16, rsm_resolution=128, aa_samples=1)),
     ("FIS 64, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=64, rsm_resolution=128, aa_samples=1)),
     ("FIS 256, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1)),

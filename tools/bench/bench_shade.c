@@ -152,7 +152,7 @@ int main(int argc, char **argv)
         }
         tp[r] = now() - t0;
     }
-    static const char *const fits[] = {"two", "fis", "kmeans"};
+    static const char *const fits[] = {"two", "fis", "kmeans", "lattice"};
     printf("render %ux%u balanced preset with aa 1 (%s %u, %u VSGLs): %.3f s  [gbuffer %.3f rsm %.3f fit %.3f shade %.3f]\n",
            W, H, fits[s.fit_mode], s.vsgl_count, st.vsgl_count, median(tp, reps), st.seconds_gbuffer, st.seconds_rsm,
            st.seconds_fit, st.seconds_shade);
