@@ -36,6 +36,17 @@ def false_colour(err, vmax):
     return np.stack([np.clip(2 * t - 1, 0, 1), 1 - np.abs(2 * t - 1), np.clip(1 - 2 * t, 0, 1)], -1)
 
 
+def signed_error(diff, scale):
+    """A signed error image: diff * scale (diff: luminance differences), red
+    where positive (too bright), blue where negative (too dark), through the
+    same Reinhard + gamma curve as the images (so 1 on the scale looks like a
+    mid-bright pixel)."""
+    v = np.asarray(diff, np.float64) * scale
+    pos, neg = np.clip(v, 0, None), np.clip(-v, 0, None)
+    t = lambda x: (x / (1.0 + x)) ** (1 / 2.2)
+    return np.stack([t(pos), np.zeros_like(v), t(neg)], -1)
+
+
 def tonemap(x, exposure=1.0):
     """Linear RGB -> display: exposure, Reinhard x/(1+x), gamma 2.2."""
     x = np.clip(np.asarray(x, np.float64) * exposure, 0, None)

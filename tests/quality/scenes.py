@@ -11,6 +11,8 @@ builds in Blender (`build_blender`):
     camera:    dict(type=PERSP|ORTHO, lens | ortho_scale, loc, rot, res=(W, H))
 
 plus what only the harness reads: `extent` (m, the largest side of the room),
+`convex` (True for an empty closed box: every point sees every other, so the
+brute force needs no shadow rays),
 `light_motion` (which light moves and how: `loc` a unit direction, or `rot` a
 unit Euler-axis direction and `lever` (m), the distance at which the turn moves
 the light's footprint by the step), `camera_motion` (a unit direction),
@@ -144,6 +146,7 @@ def _spot_metal_floor():
         lights=[dict(type="SPOT", energy=2500.0, loc=spot_loc, rot=look_rot(spot_loc, spot_target),
                      spot_size=40.0, spot_blend=0.3)],
         camera=dict(type="PERSP", lens=18.0, loc=cam_loc, rot=look_rot(cam_loc, cam_target)),
+        convex=True,  # an empty closed box: every surface sees every other
         extent=6.0,
         light_motion=dict(light=0, loc=(1.0, 0.0, 0.0)),
         camera_motion=dict(loc=(1.0, 0.0, 0.0)),
@@ -168,6 +171,7 @@ def _metal_floor_red_wall():
         lights=[dict(type="SPOT", energy=2500.0, loc=spot_loc, rot=look_rot(spot_loc, spot_target),
                      spot_size=55.0, spot_blend=0.25)],
         camera=dict(type="PERSP", lens=18.0, loc=cam_loc, rot=look_rot(cam_loc, cam_target)),
+        convex=True,  # an empty closed box: every surface sees every other
         extent=5.0,
         light_motion=dict(light=0, loc=(0.0, 1.0, 0.0)),
         camera_motion=dict(loc=(1.0, 0.0, 0.0)),
@@ -191,6 +195,7 @@ def _box_point_area_glossy_green():
                 dict(type="AREA", energy=40.0, loc=(0.55, 0.6, 2.45), rot=(0.0, 0.0, 0.0), shape="SQUARE",
                      size=0.3)],
         camera=dict(type="PERSP", lens=16.0, loc=cam_loc, rot=look_rot(cam_loc, cam_target)),
+        convex=True,  # an empty closed box: every surface sees every other
         extent=3.0,
         light_motion=dict(light=0, loc=(1.0, 0.0, 0.0)),
         camera_motion=dict(loc=(1.0, 0.0, 0.0)),
@@ -263,8 +268,32 @@ def _sun_opening():
     )
 
 
+def _sun_opening_thick():
+    # the same room inside a closed outer shell 0.3 m away (walls and roof,
+    # the window a tunnel through both): the sunlit exterior is no longer the
+    # other side of the interior surfaces. Separates what zero-thickness
+    # walls do (VSGLs of the sunlit roof and outer wall, 0 m from the ceiling
+    # and the wall inside: white-hot junction lines) from the sun fit itself.
+    s = _sun_opening()
+    s["name"] = "sun_opening_thick"
+    s["feature"] = ("the sun room inside a closed outer shell 0.3 m away, the window a tunnel: the sunlit exterior "
+                    "is 0.3 m from the interior instead of 0 m (separates the zero-thickness-wall leak of "
+                    "sun_opening from the fit of the sun's light)")
+    s["materials"]["outer"] = WHITE
+    g = box_room(-2.3, 2.3, -2.3, 2.3, 0, 3.0, dict(floor=None, ceiling="outer", left=None, right="outer",
+                                                    back="outer", front="outer"))
+    s["geometry"] += [q for q in g if q["mat"] is not None]
+    s["geometry"] += wall_x_with_hole(-2.3, -2.3, 2.3, 0.0, 3.0, -0.6, 0.6, 0.9, 2.0, "outer")
+    x0, x1, y0, y1, z0, z1 = -2.3, -2.0, -0.6, 0.6, 0.9, 2.0
+    s["geometry"] += [quad((x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0), "outer"),   # sill
+                      quad((x0, y0, z1), (x0, y1, z1), (x1, y1, z1), (x1, y0, z1), "outer"),   # lintel
+                      quad((x0, y0, z0), (x0, y0, z1), (x1, y0, z1), (x1, y0, z0), "outer"),   # jambs
+                      quad((x0, y1, z0), (x1, y1, z0), (x1, y1, z1), (x0, y1, z1), "outer")]
+    return s
+
+
 _BUILDERS = [_spot_metal_floor, _metal_floor_red_wall, _box_point_area_glossy_green, _glossy_sphere_floor,
-             _sun_opening]
+             _sun_opening, _sun_opening_thick]
 NAMES = [b.__name__[1:] for b in _BUILDERS]
 
 
@@ -273,7 +302,7 @@ def scene(name):
     for b in _BUILDERS:
         if b.__name__[1:] == name:
             s = b()
-            assert s["name"] == name
+            assert s["name"] == name, (s["name"], name)
             return s
     raise KeyError("unknown scene %r (one of %s)" % (name, ", ".join(NAMES)))
 
