@@ -423,9 +423,10 @@ def markdown(results, args, img_rel):
             if any("light" in e["flicker"] for e in r["configs"].values()):
                 anim_labels = [l for l, e in r["configs"].items() if "light" in e["flicker"]]
                 body += ["![%s light animation](%s/%s_flicker.png)" % (name, img_rel, name), "",
-                         "Light animation, columns %s. Rows: frame 0; mean |frame t+1 - frame t|; mean |second "
-                         "difference|; false colour, red >= 2 %% of the 99th-percentile luminance per frame "
-                         "(a smooth 1/1000 step changes a pixel by well under that)." % ", ".join(anim_labels), ""]
+                         "Light animation, columns %s (labels: median flicker, Diff and Gloss). Rows: frame 0; mean "
+                         "|frame t+1 - frame t|; mean |second difference|; false colour (blue 0, green 1 %%, red >= "
+                         "2 %% of the reference's 99th-percentile luminance per frame; a smooth 1/1000 step changes "
+                         "a pixel by well under that)." % ", ".join(anim_labels), ""]
     return "\n".join(lines + summary + [""] + body) + "\n"
 
 
@@ -436,32 +437,46 @@ def still_image(name, r, images, up):
     lum = imgutil.luminance
     noise = (lum(images["seeds"][0]["Combined"]) - lum(images["seeds"][1]["Combined"])) / 2
     bot = [imgutil.signed_error(noise, 4 * e)]
+    heads = [["reference", "cycles 2x%d spp" % r["reference"]["spp"]]]
     for label in r["configs"]:
+        c = r["configs"][label]
         img = images["still"][label]["Combined"]
         top.append(imgutil.tonemap(img, e))
         bot.append(imgutil.signed_error(lum(img) - lum(ref), 4 * e))
-    sep = np.ones((ref.shape[0], 1, 3))
-    row = lambda tiles: np.concatenate(sum([[t, sep] for t in tiles], [])[:-1], axis=1)
-    grid = np.concatenate([row(top), np.ones((1, row(top).shape[1], 3)), row(bot)], axis=0)
-    return imgutil.upscale(grid, up)
+        heads.append([label, "bias d %.2f g %.2f" % (c["still"]["Diff"]["bias"], c["still"]["Gloss"]["bias"])])
+    return _grid([top, bot], heads, up)
 
 
-def flicker_image(images, up, ref):
+def _grid(rows, heads, up):
+    """Tiles (rows of equal-size images) upscaled, 1-px white gaps, a label strip above each column."""
+    rows = [[imgutil.upscale(t, up) for t in row] for row in rows]
+    h, w = rows[0][0].shape[:2]
+    cols = []
+    for j in range(len(rows[0])):
+        parts = [imgutil.text_strip(heads[j], w)]
+        for row in rows:
+            parts += [np.ones((1, w, 3)), row[j]]
+        cols.append(np.concatenate(parts, axis=0))
+    sep = np.ones((cols[0].shape[0], 1, 3))
+    return np.concatenate(sum([[c, sep] for c in cols], [])[:-1], axis=1)
+
+
+def flicker_image(images, up, ref, r):
     e = imgutil.exposure_for(ref)
     p99 = 1.5 / e
-    cols = []
+    rows, heads = [[], [], []], []
     for label, seq in images["anim"].items():
         lum = [imgutil.luminance(f) for f in seq]
         d1 = np.mean([np.abs(lum[t + 1] - lum[t]) for t in range(len(lum) - 1)], axis=0)
         d2 = np.mean([np.abs(lum[t + 2] - 2 * lum[t + 1] + lum[t]) for t in range(len(lum) - 2)], axis=0)
-        col = np.concatenate([imgutil.tonemap(seq[0], e), imgutil.false_colour(d1 / p99, 0.02),
-                              imgutil.false_colour(d2 / p99, 0.02)], axis=0)
-        cols.append(col)
-    if not cols:
+        rows[0].append(imgutil.tonemap(seq[0], e))
+        rows[1].append(imgutil.false_colour(d1 / p99, 0.02))
+        rows[2].append(imgutil.false_colour(d2 / p99, 0.02))
+        f = r["configs"][label]["flicker"]["light"]
+        heads.append([label, "d %.3f g %.3f" % (f["Diff"]["median"], f["Gloss"]["median"])])
+    if not heads:
         return None
-    sep = np.ones((cols[0].shape[0], 1, 3))
-    grid = np.concatenate(sum([[c, sep] for c in cols], [])[:-1], axis=1)
-    return imgutil.upscale(grid, up)
+    return _grid(rows, heads, up)
 
 
 def git_commit():
@@ -550,7 +565,7 @@ def main(argv=None):
             up = max(1, 240 // h)
             imgutil.save_png(os.path.join(img_dir, "%s_still.png" % name), still_image(name, r, images, up))
             # one exposure per scene: the still reference's (a percentile does not depend on the size)
-            fimg = flicker_image(images, max(1, 180 // anim_size[1]), images["ref"]["Combined"])
+            fimg = flicker_image(images, max(1, 180 // anim_size[1]), images["ref"]["Combined"], r)
             if fimg is not None:
                 imgutil.save_png(os.path.join(img_dir, "%s_flicker.png" % name), fimg)
         if args.acceptance:

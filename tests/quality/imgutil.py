@@ -72,3 +72,40 @@ def upscale(img, k):
         return img
     return np.repeat(np.repeat(img, k, axis=0), k, axis=1)
 
+
+
+# A 3x5 pixel font (upper case, digits, a little punctuation) for the labels
+# of the comparison images, so that a PNG says what each tile is.
+_GLYPHS = {
+    "A": "010101111101101", "B": "110101110101110", "C": "011100100100011", "D": "110101101101110",
+    "E": "111100110100111", "F": "111100110100100", "G": "011100101101011", "H": "101101111101101",
+    "I": "111010010010111", "J": "001001001101010", "K": "101101110101101", "L": "100100100100111",
+    "M": "101111111101101", "N": "110101101101101", "O": "010101101101010", "P": "110101110100100",
+    "Q": "010101101110011", "R": "110101110101101", "S": "011100010001110", "T": "111010010010010",
+    "U": "101101101101111", "V": "101101101101010", "W": "101101111111101", "X": "101101010101101",
+    "Y": "101101010010010", "Z": "111001010100111", "0": "111101101101111", "1": "010110010010111",
+    "2": "110001010100111", "3": "110001010001110", "4": "101101111001001", "5": "111100110001110",
+    "6": "011100111101111", "7": "111001010010010", "8": "111101111101111", "9": "111101111001110",
+    " ": "000000000000000", "-": "000000111000000", ".": "000000000000010", "=": "000111000111000",
+    ",": "000000000010100", ":": "000010000010000", "_": "000000000000111", "(": "010100100100010",
+    ")": "010001001001010", "/": "001001010100100", "%": "101001010100101", "+": "000010111010000",
+}
+
+
+def text_strip(lines, width, scale=2, pad=2):
+    """White text on black, one row per line, `width` pixels wide (cut at the
+    right edge): an (H, width, 3) array to stack above a tile."""
+    lh = 5 * scale + pad
+    out = np.zeros((lh * len(lines) + pad, width, 3))
+    for li, text in enumerate(lines):
+        x = pad
+        for ch in str(text).upper():
+            g = _GLYPHS.get(ch, _GLYPHS[" "])
+            bits = np.array([int(b) for b in g], float).reshape(5, 3)
+            glyph = np.repeat(np.repeat(bits, scale, 0), scale, 1)
+            y0 = pad + li * lh
+            if x + glyph.shape[1] > width:
+                break
+            out[y0:y0 + glyph.shape[0], x:x + glyph.shape[1]] = glyph[..., None]
+            x += 4 * scale
+    return out
