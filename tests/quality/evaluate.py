@@ -20,9 +20,11 @@ Configurations (--configs, comma-separated; --set adds one more):
   brute                        vsgl_reference_render: every RSM texel a VPL, exact BRDF,
                                RSM 128, aa 1, one shadow ray per pair
   km1024, fis128               balanced with fit_mode kmeans / fis and vsgl_count 1024 / 128
-  LABEL:k=v,k=v                a preset (preset=NAME, default balanced) with fields of
-                               vsgl_render_settings changed (enum names or numbers), or
-                               brute:rsm_resolution=64,visibility=0,aa_samples=1
+  LABEL:k=v,k=v                a preset (preset=NAME, default balanced; preset=brute for the
+                               brute force) with fields of vsgl_render_settings changed (enum
+                               names or numbers); NAME:k=v,... changes a named configuration,
+                               e.g. brute:rsm_resolution=64,visibility=ray,aa_samples=1 (brute:
+                               visibility auto = no rays in the rooms marked convex)
   --set k=v k=v ...            the same as one configuration labelled by its changes
                                (--name LABEL to name it); repeat --set for more
 
@@ -169,6 +171,8 @@ def parse_config(spec, label=None):
             changes[k] = _value(v)
         base = changes.pop("preset", None)
         if head in NAMED and base is None:
+            # a named configuration changed: labelled by the whole spec ("brute:rsm_resolution=64")
+            label = label or (spec if changes else head)
             base, extra = NAMED[head]
             changes = dict(extra, **changes)
         base = base or "balanced"
