@@ -257,7 +257,7 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
             for p in PASSES:
                 fl = M.flicker([x[p] for x in seq])
                 entry["flicker"][kind][p] = dict(median=fl["median"], ratio=fl["ratio"],
-                                                 median_second=fl["median_second"])
+                                                 median_second=fl["median_second"], l1=fl["l1"])
             if want_images and kind == "light":
                 images["anim"][cfg.label] = [x["Combined"] for x in seq]
         if anim_t:
@@ -323,8 +323,10 @@ def quick_line(name, label, e, ref):
     def flk(kind):
         if kind not in fl:
             return "-"
-        return "%s/%s (x%s/%s)" % (_f(fl[kind]["Diff"]["median"], "%.4f"), _f(fl[kind]["Gloss"]["median"], "%.4f"),
-                                   _f(fl[kind]["Diff"]["ratio"], "%.1f"), _f(fl[kind]["Gloss"]["ratio"], "%.1f"))
+        return "%s/%s (x%s/%s, L1 %s/%s)" % (
+            _f(fl[kind]["Diff"]["median"], "%.4f"), _f(fl[kind]["Gloss"]["median"], "%.4f"),
+            _f(fl[kind]["Diff"]["ratio"], "%.1f"), _f(fl[kind]["Gloss"]["ratio"], "%.1f"),
+            _f(fl[kind]["Diff"]["l1"], "%.4f"), _f(fl[kind]["Gloss"]["l1"], "%.4f"))
     return ("%-28s %-16s %6.3fs  bias D %s G %s C %s  relMSE C %s  struct D %s (%sx) G %s (%sx)  FLIP %s  "
             "flicker light %s camera %s%s" % (
                 name, label, e["seconds"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]), _f(s["Combined"]["bias"]),
@@ -356,7 +358,9 @@ def markdown(results, args, img_rel):
              "measured the same way (relMSE(seed 1, seed 2)/4 = what a perfect image scores against the two-seed "
              "mean; a blotch-free image is ~1x); **FLIP** = mean HDR-FLIP of the combined pass; **flicker** = "
              "median relative RMS of consecutive frames, Diff/Gloss, light moving and camera moving, with "
-             "the second-to-first difference ratio in brackets (> 1: jitter, the fit reshuffling).", ""]
+             "the second-to-first difference ratio in brackets (> 1: jitter, the fit reshuffling) and the "
+             "L1 form (median sum|f[t+1]-f[t]|/sum|f[t]|; the RMS form is dominated by hot pixels where there "
+             "are any, e.g. the brute force's at junctions).", ""]
     if results.get("flip_error"):
         lines += ["FLIP skipped: flip-evaluator does not import (%s)." % results["flip_error"], ""]
     summary = ["## Summary (presets)", "",
@@ -384,8 +388,10 @@ def markdown(results, args, img_rel):
                 if kind not in e["flicker"]:
                     return "-"
                 f = e["flicker"][kind]
-                return "%s / %s (%s / %s)" % (_f(f["Diff"]["median"], "%.4f"), _f(f["Gloss"]["median"], "%.4f"),
-                                              _f(f["Diff"]["ratio"], "%.1f"), _f(f["Gloss"]["ratio"], "%.1f"))
+                return "%s / %s (%s / %s; L1 %s / %s)" % (
+                    _f(f["Diff"]["median"], "%.4f"), _f(f["Gloss"]["median"], "%.4f"),
+                    _f(f["Diff"]["ratio"], "%.1f"), _f(f["Gloss"]["ratio"], "%.1f"),
+                    _f(f["Diff"].get("l1"), "%.4f"), _f(f["Gloss"].get("l1"), "%.4f"))
             row = "| %s | %.3f | %d | %s | %s | %s | %s | %s | %s | %s (%sx) | %s (%sx) | %s (%sx) | %s | %s | %s |" % (
                 label, e["seconds"], e["vsgls"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]), _f(s["Combined"]["bias"]),
                 _f(s["Diff"]["relmse"], "%.4f"), _f(s["Gloss"]["relmse"], "%.4f"), _f(s["Combined"]["relmse"], "%.4f"),

@@ -24,7 +24,8 @@ GlossInd*GlossCol, Combined = Diff + Gloss (`coloured`).
   sqrt(sum((f[t+2] - 2 f[t+1] + f[t])^2) / sum(f[t+1]^2)) to it. For a smooth
   change the second difference is much smaller than the first (ratio << 1);
   for frame-to-frame noise of equal variance it is sqrt(3) = 1.73x: a ratio
-  > 1 means jitter.
+  > 1 means jitter. Also the L1 form, median of sum|f[t+1] - f[t]| / sum|f[t]|,
+  which a few hot pixels cannot dominate.
 """
 import numpy as np
 
@@ -113,17 +114,26 @@ def _rel(d, f):
     return float(np.sqrt(np.sum(np.asarray(d, np.float64) ** 2) / s)) if s > 0 else float("nan")
 
 
+def _rel_l1(d, f):
+    s = float(np.sum(np.abs(np.asarray(f, np.float64))))
+    return float(np.sum(np.abs(np.asarray(d, np.float64)))) / s if s > 0 else float("nan")
+
+
 def flicker(frames):
     """dict(first=[per pair], second=[per triple], median, median_second,
-    ratio = median_second / median) of a frame sequence (>= 3 frames for the
-    ratio)."""
+    ratio = median_second / median, l1 = median over pairs of
+    sum|f[t+1] - f[t]| / sum|f[t]|) of a frame sequence (>= 3 frames for the
+    ratio). The RMS form (the issue's) is dominated by a few hot pixels when
+    there are any (a junction pixel jumping from 1.5 to 0.4 can carry 99 % of
+    the squared difference); the L1 form shows how much of the image moves."""
     f = [np.asarray(x, np.float64) for x in frames]
     first = [_rel(f[t + 1] - f[t], f[t]) for t in range(len(f) - 1)]
     second = [_rel(f[t + 2] - 2 * f[t + 1] + f[t], f[t + 1]) for t in range(len(f) - 2)]
+    l1 = [_rel_l1(f[t + 1] - f[t], f[t]) for t in range(len(f) - 1)]
     med = float(np.median(first)) if first else float("nan")
     med2 = float(np.median(second)) if second else float("nan")
     return dict(first=first, second=second, median=med, median_second=med2,
-                ratio=med2 / med if med > 0 else float("nan"))
+                ratio=med2 / med if med > 0 else float("nan"), l1=float(np.median(l1)) if l1 else float("nan"))
 
 
 def all_metrics(img, ref_seeds, k=4):

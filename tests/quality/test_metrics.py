@@ -81,6 +81,19 @@ def test_flicker_of_a_linear_ramp():
     assert np.allclose(f["first"], want, rtol=1e-9)
     assert abs(f["median"] - np.median(want)) < 1e-12
     assert f["median_second"] < 1e-12 and f["ratio"] < 1e-9      # smooth: no second difference
+    assert abs(f["l1"] - np.median(want)) < 1e-12                  # uniform scaling: L1 = RMS
+
+
+def test_flicker_l1_is_not_dominated_by_one_hot_pixel():
+    x = np.full((60, 80, 3), 0.1)
+    frames = []
+    for t in range(6):
+        y = x.copy()
+        y[30, 40] = 3.0 if t % 2 else 0.5   # one junction pixel jumping
+        frames.append(y)
+    f = M.flicker(frames)
+    assert f["median"] > 0.3                 # the RMS form: dominated by that pixel
+    assert f["l1"] < 0.01                    # the L1 form: 1 pixel of 4800
 
 
 def test_flicker_of_an_alternating_sequence_is_jitter():
