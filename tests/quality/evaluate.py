@@ -340,7 +340,10 @@ def quick_line(name, label, e, ref):
 
 
 def _ratio(a, b):
-    return "%.1f" % (a / b) if b and b > 0 else "-"
+    if not b or b <= 0:
+        return "-"
+    r = a / b
+    return "%.1f" % r if r < 100 else "%.0f" % r
 
 
 def markdown(results, args, img_rel):
@@ -404,7 +407,7 @@ def markdown(results, args, img_rel):
                 _f(e["flip"], "%.4f"), fl("light"), fl("camera"))
             body.append(row)
             if label in ("preview", "balanced", "quality"):
-                summary.append("| %s | %s | %.3f | %s | %s | %s (%s) | %s (%s) | %s | %s | %s |" % (
+                summary.append("| %s | %s | %.3f | %s | %s | %s (%sx) | %s (%sx) | %s | %s | %s |" % (
                     name, label, e["seconds"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]),
                     _f(s["Diff"]["structured"], "%.5f"), _ratio(s["Diff"]["structured"], nz["Diff"]["s4"]),
                     _f(s["Gloss"]["structured"], "%.5f"), _ratio(s["Gloss"]["structured"], nz["Gloss"]["s4"]),
