@@ -43,7 +43,9 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "addon", "vsgl_indirect"))
+sys.path.insert(0, os.path.join(ROOT, "tests", "quality"))
 import libvsgl  # noqa: E402  (structs only; functions bound below)
+from imgutil import false_colour, save_png  # noqa: E402,F401  (shared with the quality harness)
 
 TOL_LIGHT = 0.01          # relative, per kernel point
 KERNEL_W = 0.3            # m
@@ -194,25 +196,47 @@ def blender_material(name, spec, dist="GGX"):
 
 
 def build_blender(case):
+    """Build a case dict in the current scene: one mesh of its geometry
+    (entries dict(quad=[4 points], mat=name), or dict(tris=[[3 points], ...],
+    normals=[[3 normals], ...], mat=name): smooth-shaded triangles with those
+    corner normals as custom split normals), its lights and camera. Materials
+    are looked up in case["materials"] if given, else in MATS. Returns
+    (mesh object, light objects, camera object, {material name: index})."""
     sc = bpy.context.scene
     for o in list(bpy.data.objects):
         bpy.data.objects.remove(o)
+    table = case.get("materials", MATS)
     mats = {}
-    verts, faces, fmat = [], [], []
+    verts, faces, fmat, smooth, loop_normals = [], [], [], [], []
+    any_custom = any(q.get("normals") for q in case["geometry"])
     for q in case["geometry"]:
         if q["mat"] not in mats:
             mats[q["mat"]] = len(mats)
-        base = len(verts)
-        verts += [tuple(map(float, p)) for p in q["quad"]]
-        faces.append((base, base + 1, base + 2, base + 3))
-        fmat.append(mats[q["mat"]])
+        polys = [q["quad"]] if "quad" in q else q["tris"]
+        for k, poly in enumerate(polys):
+            base = len(verts)
+            verts += [tuple(map(float, p)) for p in poly]
+            faces.append(tuple(range(base, base + len(poly))))
+            fmat.append(mats[q["mat"]])
+            smooth.append(bool(q.get("normals")))
+            if any_custom:
+                if q.get("normals"):
+                    loop_normals += [tuple(map(float, n)) for n in q["normals"][k]]
+                else:  # flat: the face normal
+                    P = np.array(poly, np.float64)
+                    fn = np.cross(P[1] - P[0], P[2] - P[0])
+                    loop_normals += [tuple(fn / np.linalg.norm(fn))] * len(poly)
     me = bpy.data.meshes.new("geo")
     me.from_pydata(verts, [], faces)
     for name in mats:
-        me.materials.append(blender_material(name, MATS[name], case.get("dist", "GGX")))
-    for p, mi in zip(me.polygons, fmat):
+        me.materials.append(blender_material(name, table[name], case.get("dist", "GGX")))
+    for p, mi, sm in zip(me.polygons, fmat, smooth):
         p.material_index = mi
-        p.use_smooth = False
+        p.use_smooth = sm
+    if any_custom:
+        if hasattr(me, "use_auto_smooth"):  # <= 4.0: custom normals need auto smooth
+            me.use_auto_smooth = True
+        me.normals_split_custom_set(loop_normals)
     ob = bpy.data.objects.new("geo", me)
     sc.collection.objects.link(ob)
     lights = []
@@ -424,22 +448,38 @@ def mat34(M):
     return [float(M[r][c]) for r in range(3) for c in range(4)]
 
 
-def library_scene(lib, ctx, ob, lights, co, mats):
+def library_arrays(ob, lights, co, mats, table=None):
+    """The scene built by build_blender as the library's inputs: a dict with
+    positions (V,3) float32, indices (T,3) uint32 (polygons fanned),
+    corner_normals (T,3,3) float32 or None (None unless the mesh has custom
+    split normals), material_indices (T,) uint32, and the ctypes arrays
+    materials, lights and the camera struct. `table`: the material specs
+    (default MATS)."""
+    table = MATS if table is None else table
     sc = bpy.context.scene
     me = ob.data
     M = np.array(ob.matrix_world, dtype=np.float64)
     V = np.array([M[:3, :3] @ np.array(v.co) + M[:3, 3] for v in me.vertices], dtype=np.float32)
-    tris, tmat = [], []
+    custom = bool(getattr(me, "has_custom_normals", False))
+    if custom and hasattr(me, "calc_normals_split"):  # 3.x-4.0; 4.1+ computes corner_normals on demand
+        me.calc_normals_split()
+    tris, tmat, cn = [], [], []
     for p in me.polygons:
         vs = list(p.vertices)
+        ls = list(p.loop_indices)
         for k in range(1, len(vs) - 1):
             tris.append((vs[0], vs[k], vs[k + 1]))
             tmat.append(p.material_index)
+            if custom:
+                ln = me.corner_normals if hasattr(me, "corner_normals") else None
+                cn.append([tuple(ln[l].vector) if ln is not None else tuple(me.loops[l].normal)
+                           for l in (ls[0], ls[k], ls[k + 1])])
     I = np.array(tris, dtype=np.uint32)
     Mi = np.array(tmat, dtype=np.uint32)
+    CN = np.array(cn, dtype=np.float32) if custom else None
     cmats = (libvsgl.vsgl_material * len(mats))()
     for name, i in mats.items():
-        s = MATS[name]
+        s = table[name]
         m = cmats[i]
         for c in range(3):
             m.base_color[c] = s["color"][c]
@@ -488,18 +528,27 @@ def library_scene(lib, ctx, ob, lights, co, mats):
     cam.clip_start, cam.clip_end = cd.clip_start, cd.clip_end
     cam.width, cam.height = sc.render.resolution_x, sc.render.resolution_y
     cam.pixel_aspect_x = cam.pixel_aspect_y = 1.0
+    return dict(positions=V, indices=I, corner_normals=CN, material_indices=Mi, materials=cmats,
+                lights=clights, camera=cam)
+
+
+def library_scene(lib, ctx, ob, lights, co, mats, table=None):
+    a = library_arrays(ob, lights, co, mats, table)
+    V, I, Mi, CN = a["positions"], a["indices"], a["material_indices"], a["corner_normals"]
     desc = libvsgl.vsgl_scene_desc()
     desc.size = ctypes.sizeof(desc)
     desc.vertex_count = len(V)
     desc.positions = fptr(V)
     desc.triangle_count = len(I)
     desc.indices = I.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32))
+    if CN is not None:
+        desc.corner_normals = fptr(CN)
     desc.material_indices = Mi.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32))
     desc.material_count = len(mats)
-    desc.materials = ctypes.cast(cmats, ctypes.POINTER(libvsgl.vsgl_material))
+    desc.materials = ctypes.cast(a["materials"], ctypes.POINTER(libvsgl.vsgl_material))
     desc.light_count = len(lights)
-    desc.lights = ctypes.cast(clights, ctypes.POINTER(libvsgl.vsgl_light))
-    desc.camera = ctypes.pointer(cam)
+    desc.lights = ctypes.cast(a["lights"], ctypes.POINTER(libvsgl.vsgl_light))
+    desc.camera = ctypes.pointer(a["camera"])
     scene = ctypes.c_void_p()
     rc = lib.vsgl_scene_create(ctx, ctypes.byref(desc), ctypes.byref(scene))
     if rc != 0:
@@ -619,25 +668,6 @@ def suite_lights(lib, ctx, out_dir, report):
 def relmse(a, b, mask=None):
     e = (a - b) ** 2 / (b * b + 0.01)
     return float(np.mean(e if mask is None else e[mask]))
-
-
-def save_png(path, rgb):
-    """rgb: (H, W, 3) in [0, 1], row 0 = top."""
-    h, w, _ = rgb.shape
-    im = bpy.data.images.new("tmp_png", w, h, alpha=False, float_buffer=False)
-    px = np.ones((h, w, 4), np.float32)
-    px[:, :, :3] = np.clip(rgb[::-1], 0, 1)
-    im.pixels[:] = px.ravel()
-    im.filepath_raw = path
-    im.file_format = "PNG"
-    im.save()
-    bpy.data.images.remove(im)
-
-
-def false_colour(err, vmax):
-    """Per-pixel relative squared error -> blue (0) .. green .. red (>= vmax)."""
-    t = np.clip(err / vmax, 0, 1)
-    return np.stack([np.clip(2 * t - 1, 0, 1), 1 - np.abs(2 * t - 1), np.clip(1 - 2 * t, 0, 1)], -1)
 
 
 def interior_mask(col):
@@ -1082,4 +1112,5 @@ def main():
         sys.exit(1)
 
 
-main()
+if __name__ == "__main__":
+    main()

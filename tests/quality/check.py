@@ -1,0 +1,207 @@
+#!/usr/bin/env python3
+"""The quality suite's checks (make test, via tests/blender/run_quality.sh), at test size.
+
+Checks that hold today and can fail; prints PASS/FAIL lines and ends with
+"N passed, N failed":
+
+- the metrics against hand-computed cases (test_metrics.py);
+- each reference: finite and non-negative; its two seeds differ and agree
+  within their noise (|z| < 4 per pass, metrics.seed_agreement); its own 4x4
+  noise small enough to see blotches (< 0.002 per pass);
+- each scene shows what it exists for (checked on the reference, with the
+  library's G-buffer to find the surfaces);
+- the brute-force gather (RSM 128, aa 1) within +-6 % of Cycles per pass
+  (issue 9 measured this on its rooms: the RSM holds the light);
+
+then measures the presets (still and both animations, VSGL_QUALITY_FRAMES
+frames, default 12) and prints their numbers as INFO lines, with issue 9's
+acceptance criteria as INFO too (they fail today; the lead turns them into
+checks when the fixes land). Writes build/quality/check_test.md and .json.
+"""
+import argparse
+import json
+import os
+import sys
+import traceback
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(ROOT, "addon", "vsgl_indirect"))
+import evaluate as E  # noqa: E402
+import imgutil  # noqa: E402
+import libvsgl as L  # noqa: E402
+import metrics as M  # noqa: E402
+import refs  # noqa: E402
+import scenes  # noqa: E402
+import test_metrics  # noqa: E402
+
+TOL_BRUTE = 0.06
+TOL_Z = 4.0
+MAX_NOISE_S4 = 0.002
+
+
+class Counter:
+    def __init__(self):
+        self.passed = self.failed = 0
+
+    def check(self, ok, text):
+        print(("PASS " if ok else "FAIL ") + text, flush=True)
+        self.passed += bool(ok)
+        self.failed += not ok
+
+
+def gbuffer_materials(name):
+    """(material index image (H, W), material names) of a scene at test size, pixel centres."""
+    c = scenes.case(name, "test")
+    ctx = L.Context()
+    with L.Scene(ctx, **scenes.library_arrays(c, L)) as sc:
+        m = L.debug_gbuffer(ctx, sc, 1)["materials"][:, :, 0].astype(np.int64)
+    return m, scenes.material_order(c)
+
+
+def adjacent(m, a, b):
+    """Pixels of material a with a 4-neighbour of material b (a junction in the image)."""
+    h, w = m.shape
+    hit = np.zeros((h, w), bool)
+    for dy, dx in ((0, 1), (0, -1), (1, 0), (-1, 0)):
+        sh = np.full((h, w), -1)
+        ys, yd = slice(max(dy, 0), h + min(dy, 0)), slice(max(-dy, 0), h + min(-dy, 0))
+        xs, xd = slice(max(dx, 0), w + min(dx, 0)), slice(max(-dx, 0), w + min(-dx, 0))
+        sh[yd, xd] = m[ys, xs]
+        hit |= (m == a) & (sh == b)
+    return int(hit.sum())
+
+
+def feature_checks(name, ref, cnt):
+    """What each scene exists for, on the reference (coloured passes)."""
+    m, mats = gbuffer_materials(name)
+    idx = {n: i for i, n in enumerate(mats)}
+    lum = {p: imgutil.luminance(ref[p]) for p in ("Diff", "Gloss", "Combined")}
+    walls = [idx[n] for n in ("wall", "back_wall", "red_wall", "window_wall") if n in idx]
+    junction_ceiling = sum(adjacent(m, idx["ceiling"], w) for w in walls)
+    junction_floor = sum(adjacent(m, f, w) for w in walls for f in [idx[n] for n in mats if "floor" in n])
+    if name == "spot_metal_floor":
+        fl = m == idx["metal_floor"]
+        g = lum["Gloss"][fl]
+        ratio = float(ref["Gloss"][fl].sum() / ref["Diff"].sum())
+        peak = float(np.percentile(g, 99) / max(np.median(g), 1e-9))
+        cnt.check(ratio > 0.5 and peak > 5, "feature %s: the metal floor reflects a bright ellipse (floor Gloss sum "
+                  "%.2f x the image's Diff sum, > 0.5; its 99th percentile %.1f x its median, > 5)" % (name, ratio, peak))
+    elif name == "metal_floor_red_wall":
+        bw = m == idx["back_wall"]
+        r, g = float(ref["Diff"][bw][:, 0].mean()), float(ref["Diff"][bw][:, 1].mean())
+        fl = m == idx["metal_floor"]
+        rg = float(ref["Gloss"][fl][:, 0].sum() / max(ref["Gloss"][fl][:, 1].sum(), 1e-9))
+        cnt.check(r > 2 * g and rg > 2, "feature %s: the back wall receives red light (Diff R/G %.2f, > 2) and the "
+                  "metal floor reflects it (Gloss R/G %.2f, > 2)" % (name, r / max(g, 1e-9), rg))
+    elif name == "box_point_area_glossy_green":
+        gw = m == idx["green_glossy"]
+        gg = ref["Gloss"][gw]
+        sheen = float(gg[:, 1].mean() / max(lum["Diff"][m != idx["green_glossy"]].mean(), 1e-9))
+        cnt.check(sheen > 0.1 and gg[:, 1].mean() > 3 * gg[:, 0].mean(),
+                  "feature %s: the green wall has a green sheen (its Gloss G %.2f x the other walls' Diff, > 0.1; "
+                  "G/R %.1f, > 3)" % (name, sheen, gg[:, 1].mean() / max(gg[:, 0].mean(), 1e-9)))
+        cnt.check(junction_ceiling >= 40 and junction_floor >= 40,
+                  "feature %s: the camera frames the junctions (%d wall/ceiling and %d wall/floor junction pixels, "
+                  ">= 40 each)" % (name, junction_ceiling, junction_floor))
+    elif name == "glossy_sphere_floor":
+        sp, fl = m == idx["sphere"], m == idx["polished_floor"]
+        ys, xs = np.nonzero(sp)
+        # the floor just below the sphere in the image (its columns, 8 rows under its lowest pixel)
+        band = np.zeros_like(fl)
+        band[ys.max() + 1:ys.max() + 9, xs.min():xs.max() + 1] = True
+        band &= fl
+        g = lum["Gloss"]
+        ratio = float(g[band].mean() / max(np.median(g[fl]), 1e-9)) if band.any() else 0.0
+        cnt.check(sp.sum() >= 100 and ratio > 5,
+                  "feature %s: the sphere (%d px) is reflected in the floor below it (the floor's Gloss there %.1f x "
+                  "its median, > 5)" % (name, sp.sum(), ratio))
+    elif name.startswith("sun_opening"):
+        c = scenes.case(name, "test")
+        ctx = L.Context()
+        with L.Scene(ctx, **scenes.library_arrays(c, L)) as sc:
+            rsm = L.reference_rsm(ctx, sc, 0, 128)
+        lit = rsm["materials"] != 0xFFFFFFFF
+        flux = rsm["flux"].sum(1)
+        inside = float(flux[lit & (rsm["materials"] == idx["floor"])].sum() / max(flux.sum(), 1e-9))
+        ceil = float(lum["Diff"][m == idx["ceiling"]].mean())
+        cnt.check(inside > 0.01 and ceil > 0.01,
+                  "feature %s: the sun enters through the window (%.1f %% of its RSM flux lands on the floor inside, "
+                  "> 1 %%) and lights the room (ceiling Diff %.3f, > 0.01)" % (name, 100 * inside, ceil))
+    print("INFO %s: %d wall/ceiling and %d wall/floor junction pixels in view" % (name, junction_ceiling,
+                                                                                  junction_floor))
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--scenes", default=",".join(scenes.NAMES))
+    ap.add_argument("--refs", default=refs.DEFAULT_DIR)
+    ap.add_argument("--out", default=os.path.join(ROOT, "build", "quality"))
+    ap.add_argument("--frames", type=int, default=int(os.environ.get("VSGL_QUALITY_FRAMES", scenes.FRAMES)))
+    args = ap.parse_args(argv)
+    cnt = Counter()
+
+    for t in test_metrics.TESTS:
+        name = t.__name__[5:].replace("_", " ")
+        if t.__name__ == "test_flip_of_identical_images_is_zero" and M.FLIP_ERROR:
+            print("SKIP metrics: %s (flip-evaluator does not import: %s)" % (name, M.FLIP_ERROR))
+            continue
+        try:
+            t()
+            cnt.check(True, "metrics: " + name)
+        except Exception:  # noqa: BLE001  (a failed assertion or an error: report, go on)
+            cnt.check(False, "metrics: %s\n%s" % (name, traceback.format_exc(limit=2)))
+
+    names = [n for n in args.scenes.split(",") if n]
+    try:
+        R = refs.ensure(names, "test", args.refs)
+    except RuntimeError as e:
+        cnt.check(False, "references: %s" % e)
+        print("%d passed, %d failed" % (cnt.passed, cnt.failed))
+        return 1
+    rend = E.Renderer()
+    cfgs = [E.parse_config(c) for c in ("preview", "balanced", "quality", "brute")]
+    results = dict(command="python3 tests/quality/check.py", library=L.version_string(), commit=E.git_commit(),
+                   blender=refs.blender_version(args.refs), spp=scenes.size_of("test")[2],
+                   size=list(scenes.size_of("test")[:2]), anim_size=list(E.ANIM_SIZES["test"]), frames=args.frames,
+                   flip_error=M.FLIP_ERROR, scenes={})
+    for n in names:
+        raw = [p for p, _ in R[n]]
+        ok = all(np.all(np.isfinite(p[k])) and np.all(p[k] >= 0) for p in raw for k in refs.PASSES)
+        cnt.check(ok, "reference %s: both seeds finite and non-negative" % n)
+        seeds = [M.coloured(p) for p in raw]
+        ref = {p: 0.5 * (seeds[0][p] + seeds[1][p]) for p in seeds[0]}
+        z = {p: M.seed_agreement(seeds[0][p], seeds[1][p]) for p in ("Diff", "Gloss")}
+        cnt.check(all(np.isfinite(v) and abs(v) < TOL_Z for v in z.values()),
+                  "reference %s: the seeds differ and agree within their noise (z Diff %.2f, Gloss %.2f; |z| < %g)"
+                  % (n, z["Diff"], z["Gloss"], TOL_Z))
+        s4 = {p: M.ref_noise(seeds[0][p], seeds[1][p], 4) for p in ("Diff", "Gloss")}
+        cnt.check(all(v < MAX_NOISE_S4 for v in s4.values()),
+                  "reference %s: its own 4x4 noise is small (Diff %.5f, Gloss %.5f; < %g)"
+                  % (n, s4["Diff"], s4["Gloss"], MAX_NOISE_S4))
+        feature_checks(n, ref, cnt)
+
+        r, _ = E.evaluate_scene(n, cfgs, "test", E.ANIM_SIZES["test"], args.frames, ["light", "camera"], args.refs,
+                                rend, want_images=False, log=lambda line: print("INFO " + line, flush=True))
+        results["scenes"][n] = r
+        b = r["configs"]["brute"]["still"]
+        cnt.check(all(abs(b[p]["bias"] - 1) <= TOL_BRUTE for p in ("Diff", "Gloss")),
+                  "brute force %s: within %d %% of Cycles per pass (Diff %.3f, Gloss %.3f; %s)"
+                  % (n, 100 * TOL_BRUTE, b["Diff"]["bias"], b["Gloss"]["bias"], r["configs"]["brute"]["describe"]))
+        for label, a in E.acceptance(r).items():
+            print("INFO acceptance %s %s: %s" % (n, label, "; ".join("%s %s" % kv for kv in a.items())))
+    os.makedirs(args.out, exist_ok=True)
+    with open(os.path.join(args.out, "check_test.json"), "w") as fh:
+        json.dump(results, fh, indent=1)
+    with open(os.path.join(args.out, "check_test.md"), "w") as fh:
+        fh.write(E.markdown(results, argparse.Namespace(acceptance=True), None))
+    print("(report: %s)" % os.path.join(args.out, "check_test.md"))
+    print("%d passed, %d failed" % (cnt.passed, cnt.failed))
+    return 1 if cnt.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

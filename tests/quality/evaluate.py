@@ -1,0 +1,606 @@
+#!/usr/bin/env python3
+"""Measure what the eye sees (issue 9): the library against Cycles on the bundled scenes.
+
+Quick (one scene, one configuration, numbers only; a few seconds once the
+references exist):
+
+    python3 tests/quality/evaluate.py --quick                       # balanced on spot_metal_floor
+    python3 tests/quality/evaluate.py --quick --set fit_mode=kmeans vsgl_count=1024
+    python3 tests/quality/evaluate.py --quick --scenes sun_opening --configs preview,brute
+    python3 tests/quality/evaluate.py --quick --set preset=quality visibility=none --anim none
+
+Full (every scene, the presets, brute force, k-means 1024, FIS 128, images
+and a markdown report under --out; --docs writes docs/quality.md and
+docs/img/quality/ instead):
+
+    python3 tests/quality/evaluate.py [--size test|bench] [--acceptance] [--docs]
+
+Configurations (--configs, comma-separated; --set adds one more):
+  preview, balanced, quality   vsgl_render_settings_preset (read from the library at run time)
+  brute                        vsgl_reference_render: every RSM texel a VPL, exact BRDF,
+                               RSM 128, aa 1, one shadow ray per pair
+  km1024, fis128               balanced with fit_mode kmeans / fis and vsgl_count 1024 / 128
+  LABEL:k=v,k=v                a preset (preset=NAME, default balanced; preset=brute for the
+                               brute force) with fields of vsgl_render_settings changed (enum
+                               names or numbers); NAME:k=v,... changes a named configuration,
+                               e.g. brute:rsm_resolution=64,visibility=ray,aa_samples=1 (brute:
+                               visibility auto = no rays in the rooms marked convex)
+  --set k=v k=v ...            the same as one configuration labelled by its changes
+                               (--name LABEL to name it); repeat --set for more
+
+For each scene and configuration: the still (against the mean of two Cycles
+seeds), the light animation and the camera animation (each light or the
+camera moving by extent/1000 per frame), and the metrics of metrics.py per
+pass (Diff, Gloss, Combined). Cycles references are rendered in Blender when
+missing (refs.py; ~35 s for all five scenes at test size).
+
+Times: the `vsgl_render` (or `vsgl_reference_render`) call of the still,
+scene creation excluded, all cores; median over the animation frames beside it.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(ROOT, "addon", "vsgl_indirect"))
+import imgutil  # noqa: E402
+import libvsgl as L  # noqa: E402
+import metrics as M  # noqa: E402
+import refs  # noqa: E402
+import scenes  # noqa: E402
+
+PASSES = ("Diff", "Gloss", "Combined")
+ANIM_SIZES = {"test": (80, 60), "bench": (160, 120)}
+# visibility "auto": no shadow rays in a scene marked convex (a closed box room with nothing in it:
+# the exact BRDF's cosines at both ends already make every pair the rays would test visible), rays otherwise
+BRUTE_DEFAULTS = dict(rsm_resolution=128, aa_samples=1, visibility="auto")
+NAMED = {
+    "preview": ("preview", {}),
+    "balanced": ("balanced", {}),
+    "quality": ("quality", {}),
+    "brute": ("brute", {}),
+    "km1024": ("balanced", dict(fit_mode="kmeans", vsgl_count=1024)),
+    "fis128": ("balanced", dict(fit_mode="fis", vsgl_count=128)),
+}
+FULL_CONFIGS = ["preview", "balanced", "quality", "brute", "km1024", "fis128"]
+ACCEPT = dict(flicker=0.01, bias=0.05, bias_preview=0.30, structured_x=3.0)
+
+
+# ---------------------------------------------------------------------------
+# configurations
+# ---------------------------------------------------------------------------
+
+def _value(v):
+    try:
+        return int(v)
+    except ValueError:
+        try:
+            return float(v)
+        except ValueError:
+            return v
+
+
+class Config:
+    """A labelled way to render: a preset plus changed fields, or the brute force."""
+
+    def __init__(self, label, base, changes):
+        self.label, self.base, self.changes = label, base, dict(changes)
+        if base == "brute":
+            unknown = set(self.changes) - set(BRUTE_DEFAULTS)
+            if unknown:
+                raise SystemExit("brute takes %s, not %s" % (", ".join(BRUTE_DEFAULTS), ", ".join(sorted(unknown))))
+        elif base not in ("preview", "balanced", "quality"):
+            raise SystemExit("unknown preset %r (preview, balanced, quality or brute)" % base)
+
+    @property
+    def brute(self):
+        return self.base == "brute"
+
+    def settings(self):
+        """The vsgl_render_settings (VSGL configurations)."""
+        s = L.render_settings_preset(self.base)
+        names = [f[0] for f in s._fields_]
+        for k, v in self.changes.items():
+            if k not in names:
+                raise SystemExit("vsgl_render_settings has no field %r (fields: %s)" % (k, ", ".join(names[1:])))
+            setattr(s, k, s._convert(k, v))
+        return s
+
+    def brute_params(self, scene=None):
+        """RSM size, aa, visibility (0/1; "auto" resolved for `scene`, or left as "auto")."""
+        p = dict(BRUTE_DEFAULTS, **self.changes)
+        vis = p["visibility"]
+        if vis == "auto":
+            p["visibility"] = "auto" if scene is None else (0 if scene.get("convex") else 1)
+        else:
+            p["visibility"] = L._enum(vis, L.Visibility, "visibility")
+        return p
+
+    def describe(self):
+        if self.brute:
+            p = self.brute_params()
+            return "brute force, RSM %d, aa %d, %s" % (
+                p["rsm_resolution"], p["aa_samples"],
+                {"auto": "visibility rays unless the room is convex", 0: "no visibility", 1: "visibility rays"}[
+                    p["visibility"]])
+        s = self.settings().as_dict()
+        fit = {0: "two VSGLs/light", 1: "FIS %d" % s["vsgl_count"], 2: "k-means %d" % s["vsgl_count"]}[s["fit_mode"]]
+        bits = [fit, "RSM %d" % s["rsm_resolution"], "aa %d" % s["aa_samples"],
+                {0: "accurate cosine", 1: "SG cosine", 2: "pulled-out cosine"}[s["diffuse_mode"]],
+                {0: "ASG", 1: "SG"}[s["glossy_mode"]] + " glossy"]
+        if s["visibility"]:
+            bits.append("visibility rays")
+        if s["leak_correction"]:
+            bits.append("leak correction %s" % {1: "off", 2: "on"}[s["leak_correction"]])
+        if s["method"]:
+            bits.append("brute-force method")
+        return ", ".join(bits)
+
+    def as_dict(self):
+        if self.brute:
+            return dict(brute=self.brute_params())
+        return self.settings().as_dict()
+
+
+def split_configs(text):
+    """"preview,brute:rsm_resolution=64,visibility=0,km1024" -> ["preview",
+    "brute:rsm_resolution=64,visibility=0", "km1024"]: a k=v piece without
+    a label belongs to the LABEL:... spec before it."""
+    out = []
+    for piece in [p for p in text.split(",") if p]:
+        if "=" in piece and ":" not in piece and out and ":" in out[-1]:
+            out[-1] += "," + piece
+        else:
+            out.append(piece)
+    return out
+
+
+def parse_config(spec, label=None):
+    if ":" in spec or "=" in spec:
+        head, _, rest = spec.partition(":") if ":" in spec else ("", "", spec)
+        changes = {}
+        for kv in [x for x in rest.replace(",", " ").split() if x]:
+            k, _, v = kv.partition("=")
+            changes[k] = _value(v)
+        base = changes.pop("preset", None)
+        if head in NAMED and base is None:
+            # a named configuration changed: labelled by the whole spec ("brute:rsm_resolution=64")
+            label = label or (spec if changes else head)
+            base, extra = NAMED[head]
+            changes = dict(extra, **changes)
+        base = base or "balanced"
+        return Config(label or head or " ".join("%s=%s" % kv for kv in changes.items()) or base, base, changes)
+    if spec not in NAMED:
+        raise SystemExit("unknown configuration %r (%s, or LABEL:k=v,...)" % (spec, ", ".join(NAMED)))
+    base, changes = NAMED[spec]
+    return Config(label or spec, base, changes)
+
+
+# ---------------------------------------------------------------------------
+# rendering
+# ---------------------------------------------------------------------------
+
+class Renderer:
+    def __init__(self, threads=0):
+        self.warnings = []
+        self.ctx = L.Context(thread_count=threads, log=self._log, log_level="warning")
+
+    def _log(self, level, message):
+        if level <= int(L.LogLevel.WARNING):
+            self.warnings.append(message)
+
+    def render(self, s, cfg):
+        """Coloured passes of scene dict `s` (with a resolution), seconds of the
+        render call, stats dict, warnings logged during the call."""
+        self.warnings = []
+        with L.Scene(self.ctx, **scenes.library_arrays(s, L)) as sc:
+            if cfg.brute:
+                p = cfg.brute_params(s)
+                t0 = time.perf_counter()
+                im, st = L.reference_render(self.ctx, sc, p["rsm_resolution"], p["aa_samples"], p["visibility"])
+                secs = time.perf_counter() - t0
+                out = M.coloured(dict(DiffInd=im["diffuse_light"], GlossInd=im["glossy_light"],
+                                      DiffCol=im["diffuse_color"], GlossCol=im["glossy_color"]))
+                st = dict(vsgl_count=int(st["vpl_count"]), skipped="")
+            else:
+                t0 = time.perf_counter()
+                im, st = L.render(self.ctx, sc, cfg.settings(), planes=("diffuse", "glossy"))
+                secs = time.perf_counter() - t0
+                d, g = im["diffuse"].astype(np.float64), im["glossy"].astype(np.float64)
+                out = {"Diff": d, "Gloss": g, "Combined": d + g}
+        return out, secs, st, list(self.warnings)
+
+
+def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, brute_anim=False, want_images=True,
+                   log=print, repeat=1):
+    """Every metric of every configuration on one scene. Returns (result
+    dict, images dict for the pictures)."""
+    w, h, spp = scenes.size_of(size)
+    R = refs.ensure([name], (w, h, spp), refdir)[name]
+    seeds = [M.coloured(p) for p, _ in R]
+    ref = {p: 0.5 * (seeds[0][p] + seeds[1][p]) for p in PASSES}
+    res = dict(feature=scenes.scene(name)["feature"], size=[w, h], anim_size=list(anim_size), frames=frames,
+               reference=dict(spp=spp, seeds=[m["seed"] for _, m in R], blender=R[0][1]["blender"],
+                              seconds=[round(m["render_seconds"], 2) for _, m in R],
+                              mean={p: float(ref[p].mean()) for p in PASSES},
+                              noise={p: ref_noise_entry(seeds, p) for p in PASSES},
+                              flip_seeds=M.flip(seeds[0]["Combined"], seeds[1]["Combined"]),
+                              agreement={p: M.seed_agreement(seeds[0][p], seeds[1][p]) for p in PASSES}),
+               configs={})
+    images = dict(ref=ref, seeds=seeds, still={}, anim={})
+    still_case = scenes.case(name, (w, h))
+    for cfg in cfgs:
+        img, secs, st, warns = rend.render(still_case, cfg)
+        for _ in range(1 if cfg.brute else repeat - 1):  # the fastest of `repeat` runs (a shared machine)
+            secs = min(secs, rend.render(still_case, cfg)[1])
+        m = M.all_metrics(img, seeds)
+        entry = dict(describe=cfg.describe(), settings=cfg.as_dict(), seconds=secs, vsgls=int(st["vsgl_count"]),
+                     warnings=warns, skipped=st.get("skipped", ""), flip=m.pop("flip"), still=m,
+                     finite=bool(all(np.all(np.isfinite(img[p])) for p in PASSES)), flicker={}, anim_seconds=None)
+        images["still"][cfg.label] = img
+        anim_t = []
+        for kind in anims:
+            if cfg.brute and not brute_anim:
+                continue
+            seq = []
+            base = scenes.case(name, anim_size)
+            for f in range(frames):
+                fi, fs, _, _ = rend.render(scenes.animate(base, kind, f), cfg)
+                seq.append(fi)
+                anim_t.append(fs)
+            entry["flicker"][kind] = {}
+            for p in PASSES:
+                fl = M.flicker([x[p] for x in seq])
+                entry["flicker"][kind][p] = dict(median=fl["median"], ratio=fl["ratio"],
+                                                 median_second=fl["median_second"], l1=fl["l1"])
+            if want_images and kind == "light":
+                images["anim"][cfg.label] = [x["Combined"] for x in seq]
+        if anim_t:
+            entry["anim_seconds"] = float(np.median(anim_t))
+        res["configs"][cfg.label] = entry
+        log(quick_line(name, cfg.label, entry, res["reference"]))
+    return res, images
+
+
+def ref_noise_entry(seeds, p):
+    return dict(full=M.ref_noise(seeds[0][p], seeds[1][p], 1), s4=M.ref_noise(seeds[0][p], seeds[1][p], 4))
+
+
+# ---------------------------------------------------------------------------
+# acceptance (issue 9), as a report column
+# ---------------------------------------------------------------------------
+
+def acceptance(res):
+    """{config label: {criterion: "PASS" / "FAIL" / "WARN ..."}} for the presets of one scene."""
+    out = {}
+    cfgs = res["configs"]
+    noise = res["reference"]["noise"]
+    for label in ("preview", "balanced", "quality"):
+        e = cfgs.get(label)
+        if e is None:
+            continue
+        a = {}
+        fl = [e["flicker"][k][p]["median"] for k in ("light", "camera") if k in e["flicker"] for p in ("Diff", "Gloss")]
+        a["flicker <= %.2f" % ACCEPT["flicker"]] = ("-" if not fl else
+                                                    "PASS" if max(fl) <= ACCEPT["flicker"] else "FAIL (%.3f)" % max(fl))
+        tol = ACCEPT["bias_preview"] if label == "preview" else ACCEPT["bias"]
+        worst = max(abs(e["still"][p]["bias"] - 1) for p in ("Diff", "Gloss"))
+        if worst <= tol:
+            a["bias"] = "PASS"
+        elif label == "preview" and any("light" in w.lower() for w in e["warnings"]):
+            a["bias"] = "PASS (warned: %s)" % e["warnings"][0][:60]
+        else:
+            a["bias"] = "FAIL (%+.0f %%)" % (100 * max((e["still"][p]["bias"] - 1 for p in ("Diff", "Gloss")), key=abs))
+        if label == "balanced":
+            x = max(e["still"][p]["structured"] / noise[p]["s4"] for p in ("Diff", "Gloss") if noise[p]["s4"] > 0)
+            a["structured <= 3x noise"] = "PASS" if x <= ACCEPT["structured_x"] else "FAIL (%.1fx)" % x
+        if label == "quality" and "balanced" in cfgs:
+            b = cfgs["balanced"]["still"]
+            worse = [p for p in ("Diff", "Gloss") if e["still"][p]["structured"] >= b[p]["structured"]]
+            a["structured < balanced"] = "PASS" if not worse else "FAIL (%s)" % ", ".join(worse)
+        out[label] = a
+    return out
+
+
+# ---------------------------------------------------------------------------
+# output
+# ---------------------------------------------------------------------------
+
+def _f(x, fmt="%.3f"):
+    return "-" if x is None or (isinstance(x, float) and not np.isfinite(x)) else fmt % x
+
+
+def quick_line(name, label, e, ref):
+    s = e["still"]
+    nz = ref["noise"]
+    fl = e["flicker"]
+
+    def flk(kind):
+        if kind not in fl:
+            return "-"
+        return "%s/%s (x%s/%s, L1 %s/%s)" % (
+            _f(fl[kind]["Diff"]["median"], "%.4f"), _f(fl[kind]["Gloss"]["median"], "%.4f"),
+            _f(fl[kind]["Diff"]["ratio"], "%.1f"), _f(fl[kind]["Gloss"]["ratio"], "%.1f"),
+            _f(fl[kind]["Diff"]["l1"], "%.4f"), _f(fl[kind]["Gloss"]["l1"], "%.4f"))
+    return ("%-28s %-16s %6.3fs  bias D %s G %s C %s  relMSE C %s  struct D %s (%sx) G %s (%sx)  FLIP %s  "
+            "flicker light %s camera %s%s" % (
+                name, label, e["seconds"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]), _f(s["Combined"]["bias"]),
+                _f(s["Combined"]["relmse"], "%.4f"),
+                _f(s["Diff"]["structured"], "%.5f"), _ratio(s["Diff"]["structured"], nz["Diff"]["s4"]),
+                _f(s["Gloss"]["structured"], "%.5f"), _ratio(s["Gloss"]["structured"], nz["Gloss"]["s4"]),
+                _f(e["flip"], "%.4f"), flk("light"), flk("camera"),
+                ("  WARN: " + e["warnings"][0][:80]) if e["warnings"] else ""))
+
+
+def _ratio(a, b):
+    if not b or b <= 0:
+        return "-"
+    r = a / b
+    return "%.1f" % r if r < 100 else "%.0f" % r
+
+
+def markdown(results, args, img_rel):
+    size = results["size"]
+    lines = ["# Quality against Cycles: what the eye sees (issue 9)", "",
+             "Generated by `%s` (do not edit by hand). Library %s, commit %s; Cycles references: Blender %s, "
+             "one bounce, two seeds of %d spp each, pixel centres (box filter 0.01 px)." % (
+                 results["command"], results["library"], results["commit"], results["blender"],
+                 results["spp"]), "",
+             "Still images %dx%d, animations %dx%d, %d frames, moving by 1/1000 of the scene's extent per frame. "
+             "Times: the `vsgl_render` / `vsgl_reference_render` call of the still (the fastest of %d runs; brute "
+             "force one) on this %d-core machine, which other jobs share, scene creation excluded." % (
+                 size[0], size[1], results["anim_size"][0], results["anim_size"][1], results["frames"],
+                 results.get("repeat", 1), os.cpu_count() or 0), "",
+             "Metrics (tests/quality/metrics.py), per coloured pass (Diff = DiffInd x DiffCol, Gloss = GlossInd x "
+             "GlossCol): **bias** = sum over the reference's sum; **relMSE** = mean((a-b)^2/(b^2+0.01)); "
+             "**struct** = relMSE after 4x4 box downsampling, with **(Nx)** = over the reference's own noise "
+             "measured the same way (relMSE(seed 1, seed 2)/4 = what a perfect image scores against the two-seed "
+             "mean; a blotch-free image is ~1x); **FLIP** = mean HDR-FLIP of the combined pass; **flicker** = "
+             "median relative RMS of consecutive frames, Diff/Gloss, light moving and camera moving, with "
+             "the second-to-first difference ratio in brackets (> 1: jitter, the fit reshuffling) and the "
+             "L1 form (median sum|f[t+1]-f[t]|/sum|f[t]|; the RMS form is dominated by hot pixels where there "
+             "are any, e.g. the brute force's at junctions).", ""]
+    if results.get("flip_error"):
+        lines += ["FLIP skipped: flip-evaluator does not import (%s)." % results["flip_error"], ""]
+    summary = ["## Summary (presets)", "",
+               "| scene | preset | time s | bias D | bias G | struct D (x noise) | struct G (x noise) | FLIP | "
+               "flicker light D/G | flicker camera D/G |", "|---|---|---|---|---|---|---|---|---|---|"]
+    body = []
+    for name, r in results["scenes"].items():
+        nz = r["reference"]["noise"]
+        body += ["## %s" % name, "", r["feature"] + ".", "",
+                 "Reference: mean of seeds %s (%s s per render), own noise relMSE full/4x4: Diff %s / %s, Gloss "
+                 "%s / %s, Combined %s / %s; FLIP of seed 1 vs seed 2: %s; seed agreement z (Diff/Gloss): %s / %s." % (
+                     ", ".join(map(str, r["reference"]["seeds"])), ", ".join("%.1f" % s for s in r["reference"]["seconds"]),
+                     _f(nz["Diff"]["full"], "%.5f"), _f(nz["Diff"]["s4"], "%.5f"), _f(nz["Gloss"]["full"], "%.5f"),
+                     _f(nz["Gloss"]["s4"], "%.5f"), _f(nz["Combined"]["full"], "%.5f"), _f(nz["Combined"]["s4"], "%.5f"),
+                     _f(r["reference"]["flip_seeds"], "%.4f"), _f(r["reference"]["agreement"]["Diff"], "%.2f"),
+                     _f(r["reference"]["agreement"]["Gloss"], "%.2f")), ""]
+        acc = acceptance(r) if args.acceptance else {}
+        head = ("| config | time s | VSGLs/VPLs | bias D | bias G | bias C | relMSE D | relMSE G | relMSE C | "
+                "struct D | struct G | struct C | FLIP | flicker light D/G | flicker camera D/G |")
+        body += [head, "|" + "---|" * (head.count("|") - 1)]
+        for label, e in r["configs"].items():
+            s = e["still"]
+
+            def fl(kind):
+                if kind not in e["flicker"]:
+                    return "-"
+                f = e["flicker"][kind]
+                return "%s / %s (%s / %s; L1 %s / %s)" % (
+                    _f(f["Diff"]["median"], "%.4f"), _f(f["Gloss"]["median"], "%.4f"),
+                    _f(f["Diff"]["ratio"], "%.1f"), _f(f["Gloss"]["ratio"], "%.1f"),
+                    _f(f["Diff"].get("l1"), "%.4f"), _f(f["Gloss"].get("l1"), "%.4f"))
+            row = "| %s | %.3f | %d | %s | %s | %s | %s | %s | %s | %s (%sx) | %s (%sx) | %s (%sx) | %s | %s | %s |" % (
+                label, e["seconds"], e["vsgls"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]), _f(s["Combined"]["bias"]),
+                _f(s["Diff"]["relmse"], "%.4f"), _f(s["Gloss"]["relmse"], "%.4f"), _f(s["Combined"]["relmse"], "%.4f"),
+                _f(s["Diff"]["structured"], "%.5f"), _ratio(s["Diff"]["structured"], nz["Diff"]["s4"]),
+                _f(s["Gloss"]["structured"], "%.5f"), _ratio(s["Gloss"]["structured"], nz["Gloss"]["s4"]),
+                _f(s["Combined"]["structured"], "%.5f"), _ratio(s["Combined"]["structured"], nz["Combined"]["s4"]),
+                _f(e["flip"], "%.4f"), fl("light"), fl("camera"))
+            body.append(row)
+            if label in ("preview", "balanced", "quality"):
+                summary.append("| %s | %s | %.3f | %s | %s | %s (%sx) | %s (%sx) | %s | %s | %s |" % (
+                    name, label, e["seconds"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]),
+                    _f(s["Diff"]["structured"], "%.5f"), _ratio(s["Diff"]["structured"], nz["Diff"]["s4"]),
+                    _f(s["Gloss"]["structured"], "%.5f"), _ratio(s["Gloss"]["structured"], nz["Gloss"]["s4"]),
+                    _f(e["flip"], "%.4f"), fl("light").split(" (")[0], fl("camera").split(" (")[0]))
+        body.append("")
+        body.append("Configurations: " + "; ".join("**%s** = %s" % (l, e["describe"]) for l, e in r["configs"].items())
+                    + ".")
+        warned = ["%s: %s" % (l, "; ".join(sorted(set(e["warnings"])))[:200]) for l, e in r["configs"].items()
+                  if e["warnings"]]
+        if warned:
+            body += ["", "Warnings logged: " + " | ".join(warned) + "."]
+        body.append("")
+        if acc:
+            crit = []
+            for a in acc.values():
+                crit += [c for c in a if c not in crit]
+            body += ["Acceptance (issue 9):", "", "| preset | " + " | ".join(crit) + " |",
+                     "|---|" + "---|" * len(crit)]
+            for label, a in acc.items():
+                body.append("| %s | %s |" % (label, " | ".join(a.get(c, "") for c in crit)))
+            body.append("")
+        if img_rel:
+            labels = " | ".join(["reference"] + list(r["configs"]))
+            body += ["![%s](%s/%s_still.png)" % (name, img_rel, name), "",
+                     "Top: %s (combined pass, tone-mapped with one exposure per scene). Bottom: the signed "
+                     "error x4 through the same exposure and curve, red = too bright, blue = too dark; under the "
+                     "reference its own noise (seed 1 - seed 2) / 2, under each configuration it - reference." % labels,
+                     ""]
+            if any("light" in e["flicker"] for e in r["configs"].values()):
+                anim_labels = [l for l, e in r["configs"].items() if "light" in e["flicker"]]
+                body += ["![%s light animation](%s/%s_flicker.png)" % (name, img_rel, name), "",
+                         "Light animation, columns %s (labels: median flicker, Diff and Gloss). Rows: frame 0; mean "
+                         "|frame t+1 - frame t|; mean |second difference|; false colour (blue 0, green 1 %%, red >= "
+                         "2 %% of the reference's 99th-percentile luminance per frame; a smooth 1/1000 step changes "
+                         "a pixel by well under that)." % ", ".join(anim_labels), ""]
+    return "\n".join(lines + summary + [""] + body) + "\n"
+
+
+def still_image(name, r, images, up):
+    ref = images["ref"]["Combined"]
+    e = imgutil.exposure_for(ref)
+    top = [imgutil.tonemap(ref, e)]
+    lum = imgutil.luminance
+    noise = (lum(images["seeds"][0]["Combined"]) - lum(images["seeds"][1]["Combined"])) / 2
+    bot = [imgutil.signed_error(noise, 4 * e)]
+    heads = [["reference", "cycles 2x%d spp" % r["reference"]["spp"]]]
+    for label in r["configs"]:
+        c = r["configs"][label]
+        img = images["still"][label]["Combined"]
+        top.append(imgutil.tonemap(img, e))
+        bot.append(imgutil.signed_error(lum(img) - lum(ref), 4 * e))
+        heads.append([label, "bias d %.2f g %.2f" % (c["still"]["Diff"]["bias"], c["still"]["Gloss"]["bias"])])
+    return _grid([top, bot], heads, up)
+
+
+def _grid(rows, heads, up):
+    """Tiles (rows of equal-size images) upscaled, 1-px white gaps, a label strip above each column."""
+    rows = [[imgutil.upscale(t, up) for t in row] for row in rows]
+    h, w = rows[0][0].shape[:2]
+    cols = []
+    for j in range(len(rows[0])):
+        parts = [imgutil.text_strip(heads[j], w)]
+        for row in rows:
+            parts += [np.ones((1, w, 3)), row[j]]
+        cols.append(np.concatenate(parts, axis=0))
+    sep = np.ones((cols[0].shape[0], 1, 3))
+    return np.concatenate(sum([[c, sep] for c in cols], [])[:-1], axis=1)
+
+
+def flicker_image(images, up, ref, r):
+    e = imgutil.exposure_for(ref)
+    p99 = 1.5 / e
+    rows, heads = [[], [], []], []
+    for label, seq in images["anim"].items():
+        lum = [imgutil.luminance(f) for f in seq]
+        d1 = np.mean([np.abs(lum[t + 1] - lum[t]) for t in range(len(lum) - 1)], axis=0)
+        d2 = np.mean([np.abs(lum[t + 2] - 2 * lum[t + 1] + lum[t]) for t in range(len(lum) - 2)], axis=0)
+        rows[0].append(imgutil.tonemap(seq[0], e))
+        rows[1].append(imgutil.false_colour(d1 / p99, 0.02))
+        rows[2].append(imgutil.false_colour(d2 / p99, 0.02))
+        f = r["configs"][label]["flicker"]["light"]
+        heads.append([label, "d %.3f g %.3f" % (f["Diff"]["median"], f["Gloss"]["median"])])
+    if not heads:
+        return None
+    return _grid(rows, heads, up)
+
+
+def git_commit():
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                              text=True).stdout.strip() or "?"
+    except OSError:
+        return "?"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--size", default="test", help="test (80x60, 2x1024 spp), bench (320x240) or WxH[xSPP]")
+    ap.add_argument("--scenes", default=None, help="comma-separated (default: all; --quick: spot_metal_floor)")
+    ap.add_argument("--configs", default=None, help="comma-separated (default: %s; --quick: balanced)"
+                    % ",".join(FULL_CONFIGS))
+    ap.add_argument("--set", nargs="+", action="append", default=[], metavar="K=V",
+                    help="one more configuration: preset=NAME (default balanced) and vsgl_render_settings fields")
+    ap.add_argument("--name", action="append", default=[], help="labels of the --set configurations, in order")
+    ap.add_argument("--anim", default="light,camera", help="animations: light,camera | light | camera | none")
+    ap.add_argument("--frames", type=int, default=scenes.FRAMES)
+    ap.add_argument("--anim-size", default=None, help="WxH of the animations (default: test 80x60, bench 160x120)")
+    ap.add_argument("--brute-anim", action="store_true", help="also animate the brute force (slow)")
+    ap.add_argument("--quick", action="store_true", help="one scene, one configuration, numbers only")
+    ap.add_argument("--acceptance", action="store_true", help="add issue 9's acceptance criteria (PASS/FAIL)")
+    ap.add_argument("--out", default=os.path.join(ROOT, "build", "quality"))
+    ap.add_argument("--docs", action="store_true", help="write docs/quality.md and docs/img/quality/")
+    ap.add_argument("--refs", default=refs.DEFAULT_DIR, help="reference cache directory")
+    ap.add_argument("--no-images", action="store_true")
+    ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--repeat", type=int, default=1, help="time the still as the fastest of N runs (not brute)")
+    ap.add_argument("--json", default=None, help="write the results here (default: under --out)")
+    args = ap.parse_args(argv)
+
+    if args.scenes in (None, "all"):
+        names = ["spot_metal_floor"] if args.quick and args.scenes is None else list(scenes.NAMES)
+    else:
+        names = [n for n in args.scenes.split(",") if n]
+        for n in names:
+            scenes.scene(n)
+    cfgs = []
+    for i, group in enumerate(args.set):
+        label = args.name[i] if i < len(args.name) else None
+        cfgs.append(parse_config(" ".join(group), label))
+    if args.configs is not None:
+        cfgs = [parse_config(c) for c in split_configs(args.configs)] + cfgs
+    elif not cfgs:
+        cfgs = [parse_config(c) for c in (["balanced"] if args.quick else FULL_CONFIGS)]
+    elif not args.quick:
+        cfgs = [parse_config(c) for c in FULL_CONFIGS] + cfgs
+    labels = [c.label for c in cfgs]
+    if len(set(labels)) != len(labels):
+        raise SystemExit("two configurations share a label: %s (use --name)" % labels)
+    anims = [] if args.anim == "none" else [a for a in args.anim.split(",") if a]
+    for a in anims:
+        if a not in ("light", "camera"):
+            raise SystemExit("--anim: light, camera or none")
+    size_key = args.size if args.size in scenes.SIZES else "x".join(map(str, scenes.size_of(args.size)))
+    if args.anim_size:
+        anim_size = tuple(int(v) for v in args.anim_size.lower().split("x")[:2])
+    else:
+        anim_size = ANIM_SIZES.get(args.size, scenes.size_of(args.size)[:2])
+    want_images = not (args.quick or args.no_images)
+
+    rend = Renderer(args.threads)
+    if args.docs:
+        img_dir, md_path = os.path.join(ROOT, "docs", "img", "quality"), os.path.join(ROOT, "docs", "quality.md")
+        img_rel = "img/quality"
+    else:
+        img_dir = os.path.join(args.out, "img_%s" % size_key)
+        md_path = os.path.join(args.out, "report_%s.md" % size_key)
+        img_rel = "img_%s" % size_key
+    w, h, spp = scenes.size_of(args.size)
+    results = dict(command="python3 tests/quality/evaluate.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+                   library=L.version_string(), commit=git_commit(), blender=refs.blender_version(args.refs),
+                   spp=spp, size=[w, h], anim_size=list(anim_size), frames=args.frames, flip_error=M.FLIP_ERROR,
+                   repeat=max(1, args.repeat), scenes={})
+    if M.FLIP_ERROR:
+        print("note: FLIP skipped (flip-evaluator does not import: %s)" % M.FLIP_ERROR)
+    t0 = time.time()
+    for name in names:
+        r, images = evaluate_scene(name, cfgs, args.size, anim_size, args.frames, anims, args.refs, rend,
+                                   args.brute_anim, want_images, repeat=max(1, args.repeat))
+        results["scenes"][name] = r
+        if want_images:
+            os.makedirs(img_dir, exist_ok=True)
+            up = max(1, 240 // h)
+            imgutil.save_png(os.path.join(img_dir, "%s_still.png" % name), still_image(name, r, images, up))
+            # one exposure per scene: the still reference's (a percentile does not depend on the size)
+            fimg = flicker_image(images, max(1, 180 // anim_size[1]), images["ref"]["Combined"], r)
+            if fimg is not None:
+                imgutil.save_png(os.path.join(img_dir, "%s_flicker.png" % name), fimg)
+        if args.acceptance:
+            for label, a in acceptance(r).items():
+                print("  acceptance %-9s %s" % (label, "  ".join("%s: %s" % kv for kv in a.items())))
+    print("(%.1f s)" % (time.time() - t0))
+    if args.quick:
+        return results
+    os.makedirs(args.out, exist_ok=True)
+    jpath = args.json or os.path.join(args.out, "results_%s.json" % size_key)
+    with open(jpath, "w") as fh:
+        json.dump(results, fh, indent=1)
+    os.makedirs(os.path.dirname(md_path), exist_ok=True)
+    with open(md_path, "w") as fh:
+        fh.write(markdown(results, args, img_rel if want_images else None))
+    print("report: %s\nresults: %s%s" % (md_path, jpath, ("\nimages: " + img_dir) if want_images else ""))
+    return results
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,148 @@
+"""What the eye sees: bias, relMSE, structured error, FLIP, flicker (numpy).
+
+Images are float arrays (H, W, 3) of linear RGB, row 0 = top. The passes
+compared are the coloured ones: Diff = DiffInd*DiffCol, Gloss =
+GlossInd*GlossCol, Combined = Diff + Gloss (`coloured`).
+
+- bias(a, ref): sum(a) / sum(ref) (1 = no energy lost or added).
+- relmse(a, ref): mean((a - ref)^2 / (ref^2 + 0.01)) over pixels and
+  channels (GUIDE Sec. 6).
+- structured(a, ref, k=4): relmse after both are box-downsampled k x k; it
+  removes most of the reference's noise but keeps blotches.
+- ref_noise(c1, c2, k): what a perfect image would score against the mean of
+  two independent reference renders c1, c2 (each with per-pixel noise
+  variance s^2): their difference has variance 2 s^2, the mean's error s^2/2,
+  so the mean's own relMSE is relmse(c1, c2) / 4 (k = 1: full resolution,
+  k = 4: the structured error's floor). A method's structured error is its
+  structure plus this floor: "3x the reference noise" leaves 2x for blotches.
+- flip(a, ref): mean FLIP (flip-evaluator, HDR mode, linear input; exposure
+  range chosen by FLIP from the reference), or None if the package does not
+  import (FLIP_ERROR says why).
+- flicker(frames): relative RMS of consecutive frames
+  sqrt(sum((f[t+1] - f[t])^2) / sum(f[t]^2)); the median over the pairs, and
+  the ratio of the median second difference
+  sqrt(sum((f[t+2] - 2 f[t+1] + f[t])^2) / sum(f[t+1]^2)) to it. For a smooth
+  change the second difference is much smaller than the first (ratio << 1);
+  for frame-to-frame noise of equal variance it is sqrt(3) = 1.73x: a ratio
+  > 1 means jitter. Also the L1 form, median of sum|f[t+1] - f[t]| / sum|f[t]|,
+  which a few hot pixels cannot dominate.
+"""
+import numpy as np
+
+EPS = 0.01  # relMSE's regulariser (GUIDE Sec. 6)
+
+try:  # FLIP is optional: the rest of the harness works without it
+    import flip_evaluator as _flip
+    FLIP_ERROR = None
+except Exception as e:  # noqa: BLE001  (any import failure: report it, skip FLIP)
+    _flip = None
+    FLIP_ERROR = "%s: %s" % (type(e).__name__, e)
+
+
+def coloured(p):
+    """Diff, Gloss, Combined from a dict with DiffInd, GlossInd, DiffCol, GlossCol."""
+    d = np.asarray(p["DiffInd"], np.float64) * np.asarray(p["DiffCol"], np.float64)
+    g = np.asarray(p["GlossInd"], np.float64) * np.asarray(p["GlossCol"], np.float64)
+    return {"Diff": d, "Gloss": g, "Combined": d + g}
+
+
+def bias(a, ref):
+    s = float(np.sum(ref, dtype=np.float64))
+    return float(np.sum(a, dtype=np.float64)) / s if s > 0 else float("nan")
+
+
+def relmse(a, ref):
+    a = np.asarray(a, np.float64)
+    b = np.asarray(ref, np.float64)
+    return float(np.mean((a - b) ** 2 / (b * b + EPS)))
+
+
+def downsample(img, k=4):
+    """Box mean over k x k blocks (the image cropped to a multiple of k)."""
+    img = np.asarray(img, np.float64)
+    if k <= 1:
+        return img
+    h, w = img.shape[0] // k * k, img.shape[1] // k * k
+    x = img[:h, :w]
+    return x.reshape(h // k, k, w // k, k, *x.shape[2:]).mean(axis=(1, 3))
+
+
+def structured(a, ref, k=4):
+    return relmse(downsample(a, k), downsample(ref, k))
+
+
+def ref_noise(c1, c2, k=4):
+    """relMSE of the two-seed mean against the truth, estimated as
+    relmse(down(c1), down(c2)) / 4 (see the module docstring)."""
+    return relmse(downsample(c1, k), downsample(c2, k)) / 4.0
+
+
+def seed_agreement(c1, c2):
+    """z = sum(c1 - c2) / sqrt(sum((c1 - c2)^2)): for independent renders of
+    one image, approximately standard normal (the sum of independent
+    per-pixel differences over its own standard error). |z| > 4: the two
+    renders disagree by more than their noise."""
+    d = np.asarray(c1, np.float64) - np.asarray(c2, np.float64)
+    s = float(np.sqrt(np.sum(d * d)))
+    return float(np.sum(d)) / s if s > 0 else float("nan")
+
+
+def flip(a, ref):
+    """Mean HDR-FLIP of a against ref (both linear RGB), or None without the package."""
+    if _flip is None:
+        return None
+    r = np.ascontiguousarray(np.clip(ref, 0, None), np.float32)
+    t = np.ascontiguousarray(np.clip(a, 0, None), np.float32)
+    if not np.any(r > 0):
+        return None
+    _, mean, _ = _flip.evaluate(r, t, "HDR", inputsRGB=False, applyMagma=False)
+    return float(mean)
+
+
+def flip_map(a, ref):
+    """The per-pixel FLIP error map (H, W) in [0, 1], or None."""
+    if _flip is None:
+        return None
+    r = np.ascontiguousarray(np.clip(ref, 0, None), np.float32)
+    t = np.ascontiguousarray(np.clip(a, 0, None), np.float32)
+    m, _, _ = _flip.evaluate(r, t, "HDR", inputsRGB=False, applyMagma=False)
+    return np.asarray(m).reshape(r.shape[:2])
+
+
+def _rel(d, f):
+    s = float(np.sum(np.asarray(f, np.float64) ** 2))
+    return float(np.sqrt(np.sum(np.asarray(d, np.float64) ** 2) / s)) if s > 0 else float("nan")
+
+
+def _rel_l1(d, f):
+    s = float(np.sum(np.abs(np.asarray(f, np.float64))))
+    return float(np.sum(np.abs(np.asarray(d, np.float64)))) / s if s > 0 else float("nan")
+
+
+def flicker(frames):
+    """dict(first=[per pair], second=[per triple], median, median_second,
+    ratio = median_second / median, l1 = median over pairs of
+    sum|f[t+1] - f[t]| / sum|f[t]|) of a frame sequence (>= 3 frames for the
+    ratio). The RMS form (the issue's) is dominated by a few hot pixels when
+    there are any (a junction pixel jumping from 1.5 to 0.4 can carry 99 % of
+    the squared difference); the L1 form shows how much of the image moves."""
+    f = [np.asarray(x, np.float64) for x in frames]
+    first = [_rel(f[t + 1] - f[t], f[t]) for t in range(len(f) - 1)]
+    second = [_rel(f[t + 2] - 2 * f[t + 1] + f[t], f[t + 1]) for t in range(len(f) - 2)]
+    l1 = [_rel_l1(f[t + 1] - f[t], f[t]) for t in range(len(f) - 1)]
+    med = float(np.median(first)) if first else float("nan")
+    med2 = float(np.median(second)) if second else float("nan")
+    return dict(first=first, second=second, median=med, median_second=med2,
+                ratio=med2 / med if med > 0 else float("nan"), l1=float(np.median(l1)) if l1 else float("nan"))
+
+
+def all_metrics(img, ref_seeds, k=4):
+    """Every still metric of one configuration's passes against the
+    reference seeds (each a dict of coloured passes). Returns
+    {pass: dict(bias, relmse, structured)} plus 'flip' (combined)."""
+    ref = {p: 0.5 * (ref_seeds[0][p] + ref_seeds[1][p]) for p in ("Diff", "Gloss", "Combined")}
+    out = {}
+    for p in ("Diff", "Gloss", "Combined"):
+        out[p] = dict(bias=bias(img[p], ref[p]), relmse=relmse(img[p], ref[p]), structured=structured(img[p], ref[p], k))
+    out["flip"] = flip(img["Combined"], ref["Combined"])
+    return out

@@ -1,0 +1,153 @@
+"""Cycles one-bounce references of the quality scenes: cache keys, files, loading.
+
+Pure Python + numpy. A reference is one Cycles render (one seed) of a
+scene's still at a size, stored as build/quality/refs/<scene>_<W>x<H>_<spp>spp_s<seed>_<key>.npz
+with the passes DiffInd, GlossInd, DiffCol, GlossCol (float32 (H, W, 3), row
+0 = top) and its metadata (render seconds, Blender version, samples, seed).
+
+key = sha1 of (the scene as Blender renders it, resolution, samples, seed,
+Blender's version, the source of the functions that build and render it:
+cycles_ref.py's build_blender / blender_material / render_cycles / ... and
+render_refs.py's render_passes). Anything else in those files can change
+without re-rendering.
+
+`ensure(names, size)` renders what is missing by running
+tests/quality/render_refs.py in Blender ($BLENDER, default `blender`).
+"""
+import ast
+import hashlib
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+import scenes  # noqa: E402
+
+PASSES = ("DiffInd", "GlossInd", "DiffCol", "GlossCol")
+DEFAULT_DIR = os.path.join(ROOT, "build", "quality", "refs")
+# the code whose change invalidates every reference (function names per file)
+CODE = {
+    os.path.join("tests", "blender", "cycles_ref.py"): ("_principled_defaults", "blender_material", "build_blender",
+                                                        "render_cycles", "load_exr_rgb", "read_passes_exr"),
+    os.path.join("tests", "quality", "render_refs.py"): ("render_passes",),
+}
+
+
+def code_digest():
+    """sha1 of the source text of the functions in CODE (parsed, not imported)."""
+    h = hashlib.sha1()
+    for rel, funcs in sorted(CODE.items()):
+        src = open(os.path.join(ROOT, rel)).read()
+        tree = ast.parse(src)
+        found = {n.name: ast.get_source_segment(src, n) for n in tree.body if isinstance(n, ast.FunctionDef)}
+        for f in funcs:
+            if f not in found:
+                raise RuntimeError("refs.CODE: %s has no function %s" % (rel, f))
+            h.update(found[f].encode())
+    return h.hexdigest()
+
+
+def blender_binary():
+    return os.environ.get("BLENDER", "blender")
+
+
+def blender_version(refdir=DEFAULT_DIR):
+    """Blender's version string ("3.4.1"), from `blender --version`, cached in
+    refdir keyed by the binary's path, size and mtime."""
+    import shutil
+    exe = shutil.which(blender_binary())
+    if exe is None:
+        return None
+    st = os.stat(exe)
+    stamp = "%s %d %d" % (os.path.realpath(exe), st.st_size, int(st.st_mtime))
+    cache = os.path.join(refdir, "blender_version.json")
+    try:
+        d = json.load(open(cache))
+        if d.get("stamp") == stamp:
+            return d["version"]
+    except (OSError, ValueError):
+        pass
+    out = subprocess.run([exe, "--version"], capture_output=True, text=True).stdout
+    line = next((l for l in out.splitlines() if l.startswith("Blender ")), None)
+    if line is None:
+        return None
+    version = line.split()[1]
+    os.makedirs(refdir, exist_ok=True)
+    with open(cache + ".part", "w") as fh:
+        json.dump(dict(stamp=stamp, version=version), fh)
+    os.replace(cache + ".part", cache)
+    return version
+
+
+def key(case, spp, seed, version, code=None):
+    """The cache key of one reference render (case: scenes.case(...))."""
+    blob = json.dumps(dict(case=scenes.blender_case(case), spp=int(spp), seed=int(seed), version=version,
+                           code=code or code_digest()), sort_keys=True)
+    return hashlib.sha1(blob.encode()).hexdigest()[:16]
+
+
+def path(refdir, name, size, seed, version, code=None):
+    w, h, spp = scenes.size_of(size)
+    c = scenes.case(name, (w, h))
+    k = key(c, spp, seed, version, code)
+    return os.path.join(refdir, "%s_%dx%d_%dspp_s%d_%s.npz" % (name, w, h, spp, seed, k))
+
+
+def load(p):
+    """(passes dict, metadata dict) of a reference file."""
+    with np.load(p) as z:
+        passes = {k: z[k] for k in PASSES}
+        meta = json.loads(str(z["meta"]))
+    return passes, meta
+
+
+def save(p, passes, meta):
+    tmp = p + ".part.npz"
+    np.savez(tmp, meta=np.array(json.dumps(meta)), **{k: np.asarray(passes[k], np.float32) for k in PASSES})
+    os.replace(tmp, p)  # a cache entry is never partial
+
+
+def missing(names, size, refdir=DEFAULT_DIR, version=None, seeds=scenes.SEEDS):
+    version = version or blender_version(refdir)
+    code = code_digest()
+    return [(n, s) for n in names for s in seeds if not os.path.exists(path(refdir, n, size, s, version, code))]
+
+
+def ensure(names, size, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=False):
+    """Make sure every (scene, seed) reference exists; render the missing ones
+    in Blender. Returns {name: [(passes, meta) per seed]}. Raises
+    RuntimeError if Blender is missing or fails."""
+    version = blender_version(refdir)
+    need = missing(names, size, refdir, version, seeds) if version else [(n, s) for n in names for s in seeds]
+    if need:
+        if version is None:
+            raise RuntimeError("references missing and no Blender found ($BLENDER=%s)" % blender_binary())
+        todo = sorted({n for n, _ in need})
+        sz = size if isinstance(size, str) else "x".join(str(v) for v in scenes.size_of(size))
+        cmd = [blender_binary(), "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+               os.path.join(HERE, "render_refs.py"), "--", "--size", sz, "--scenes", ",".join(todo),
+               "--seeds", ",".join(str(s) for s in seeds), "--out", refdir]
+        if not quiet:
+            print("rendering %d Cycles reference(s) in Blender %s: %s" % (len(need), version, " ".join(todo)),
+                  flush=True)
+        log = log or os.path.join(refdir, "render_refs.log")
+        os.makedirs(refdir, exist_ok=True)
+        with open(log, "a") as fh:
+            rc = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT).returncode
+        if rc != 0:
+            raise RuntimeError("render_refs.py failed (exit %d); see %s" % (rc, log))
+    code = code_digest()
+    out = {}
+    for n in names:
+        out[n] = []
+        for s in seeds:
+            p = path(refdir, n, size, s, version, code)
+            if not os.path.exists(p):
+                raise RuntimeError("reference %s was not written" % p)
+            out[n].append(load(p))
+    return out

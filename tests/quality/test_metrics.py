@@ -1,0 +1,118 @@
+"""The metrics against hand-computed cases (pytest, or called by check.py)."""
+import math
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import metrics as M  # noqa: E402
+
+
+def _img(seed=0, h=12, w=16):
+    return np.random.default_rng(seed).uniform(0.1, 1.0, (h, w, 3))
+
+
+def test_bias_of_a_scaled_image():
+    x = _img()
+    assert abs(M.bias(1.25 * x, x) - 1.25) < 1e-12
+    assert abs(M.bias(x, x) - 1.0) < 1e-12
+    assert math.isnan(M.bias(x, np.zeros_like(x)))
+
+
+def test_relmse_by_hand():
+    b = np.full((4, 4, 3), 0.3)
+    a = b + 0.1
+    want = 0.1 ** 2 / (0.3 ** 2 + 0.01)  # = 0.1
+    assert abs(M.relmse(a, b) - want) < 1e-12
+
+
+def test_downsample_is_a_box_mean():
+    x = np.arange(8 * 8, dtype=float).reshape(8, 8, 1)
+    d = M.downsample(x, 4)
+    assert d.shape == (2, 2, 1)
+    assert d[0, 0, 0] == np.mean(x[:4, :4]) and d[1, 1, 0] == np.mean(x[4:, 4:])
+    # a size that is not a multiple of 4 is cropped
+    assert M.downsample(np.ones((10, 9, 3)), 4).shape == (2, 2, 3)
+
+
+def test_structured_error_ignores_pixel_noise_but_keeps_blotches():
+    b = np.full((16, 16, 3), 0.5)
+    checker = (np.indices((16, 16)).sum(0) % 2 * 2 - 1)[..., None] * 0.05  # +-0.05, zero mean per 4x4 block
+    assert abs(M.relmse(b + checker, b) - 0.05 ** 2 / 0.26) < 1e-12
+    assert M.structured(b + checker, b) < 1e-20
+    blotch = np.zeros((16, 16, 3))
+    blotch[:4, :4] = 0.1  # one 4x4 block 0.1 too bright: 1 block of 16
+    assert abs(M.structured(b + blotch, b) - (0.1 ** 2 / 0.26) / 16) < 1e-12
+
+
+def test_reference_noise_of_a_two_seed_mean():
+    # c1 = t + n, c2 = t - n: the mean is exact, its estimate relmse(c1, c2)/4 = mean(4 n^2/(c2^2+eps))/4
+    t = np.full((8, 8, 3), 0.5)
+    n = np.full((8, 8, 3), 0.02)
+    want = np.mean((2 * n) ** 2 / ((t - n) ** 2 + 0.01)) / 4
+    assert abs(M.ref_noise(t + n, t - n, 1) - want) < 1e-12
+    # independent noise: the estimate matches the mean's true error on average, within 10 % (its
+    # denominator is a noisy seed, not the truth: 1/(c^2 + eps) averages a little high, +6 % at 10 % noise)
+    rng = np.random.default_rng(3)
+    t = np.full((64, 64, 3), 0.5)
+    est, true = [], []
+    for _ in range(20):
+        c1, c2 = t + rng.normal(0, 0.05, t.shape), t + rng.normal(0, 0.05, t.shape)
+        est.append(M.ref_noise(c1, c2, 1))
+        true.append(M.relmse(0.5 * (c1 + c2), t))
+    assert abs(np.mean(est) / np.mean(true) - 1) < 0.10
+
+
+def test_seed_agreement():
+    rng = np.random.default_rng(1)
+    t = np.full((60, 80, 3), 0.4)
+    z = [M.seed_agreement(t + rng.normal(0, 0.05, t.shape), t + rng.normal(0, 0.05, t.shape)) for _ in range(50)]
+    assert abs(np.mean(z)) < 0.5 and 0.6 < np.std(z) < 1.4   # ~ standard normal
+    assert M.seed_agreement(t * 1.01 + rng.normal(0, 0.05, t.shape), t + rng.normal(0, 0.05, t.shape)) > 4
+    assert math.isnan(M.seed_agreement(t, t))
+
+
+def test_flicker_of_a_linear_ramp():
+    x = _img(2)
+    frames = [(1 + 0.01 * t) * x for t in range(12)]
+    f = M.flicker(frames)
+    want = [0.01 / (1 + 0.01 * t) for t in range(11)]
+    assert np.allclose(f["first"], want, rtol=1e-9)
+    assert abs(f["median"] - np.median(want)) < 1e-12
+    assert f["median_second"] < 1e-12 and f["ratio"] < 1e-9      # smooth: no second difference
+    assert abs(f["l1"] - np.median(want)) < 1e-12                  # uniform scaling: L1 = RMS
+
+
+def test_flicker_l1_is_not_dominated_by_one_hot_pixel():
+    x = np.full((60, 80, 3), 0.1)
+    frames = []
+    for t in range(6):
+        y = x.copy()
+        y[30, 40] = 3.0 if t % 2 else 0.5   # one junction pixel jumping
+        frames.append(y)
+    f = M.flicker(frames)
+    assert f["median"] > 0.3                 # the RMS form: dominated by that pixel
+    assert f["l1"] < 0.01                    # the L1 form: 1 pixel of 4800
+
+
+def test_flicker_of_an_alternating_sequence_is_jitter():
+    x = _img(4)
+    e = 0.02
+    frames = [(1 + e * (-1) ** t) * x for t in range(12)]
+    f = M.flicker(frames)
+    # first difference 2e/(1 +- e), second 4e/(1 -+ e): ratio ~2
+    assert abs(f["median"] - np.median([2 * e / (1 + e * (-1) ** t) for t in range(11)])) < 1e-12
+    assert 1.9 < f["ratio"] < 2.1
+
+
+def test_flip_of_identical_images_is_zero():
+    if M.FLIP_ERROR:
+        import pytest
+        pytest.skip("flip-evaluator does not import: %s" % M.FLIP_ERROR)
+    x = _img(5, 32, 32).astype(np.float32)
+    assert M.flip(x, x) < 1e-6
+    assert M.flip(1.5 * x, x) > 0.01
+
+
+TESTS = [v for k, v in sorted(globals().items()) if k.startswith("test_")]
