@@ -9,6 +9,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 make --no-print-directory build/libvsgl.so >/dev/null
-PY=${PIP_PYTHON:-python3}
+PY=${BPY_PYTHON:-python3}
 "$PY" -c "import numpy" >/dev/null 2>&1 || PY=${PYTHON:-/usr/bin/python3}
 exec "$PY" tests/quality/evaluate.py --size "${QUALITY_SIZE:-bench}" --acceptance "$@"

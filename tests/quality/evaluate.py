@@ -131,7 +131,8 @@ class Config:
                 {"auto": "visibility rays unless the room is convex", 0: "no visibility", 1: "visibility rays"}[
                     p["visibility"]])
         s = self.settings().as_dict()
-        fit = {0: "two VSGLs/light", 1: "FIS %d" % s["vsgl_count"], 2: "k-means %d" % s["vsgl_count"]}[s["fit_mode"]]
+        fit = {0: "two VSGLs/light", 1: "FIS %d" % s["vsgl_count"], 2: "k-means %d" % s["vsgl_count"],
+               3: "lattice %d" % s["vsgl_count"]}[s["fit_mode"]]
         bits = [fit, "RSM %d" % s["rsm_resolution"], "aa %d" % s["aa_samples"],
                 {0: "accurate cosine", 1: "SG cosine", 2: "pulled-out cosine"}[s["diffuse_mode"]],
                 {0: "ASG", 1: "SG"}[s["glossy_mode"]] + " glossy"]
@@ -287,9 +288,12 @@ def acceptance(res):
         if e is None:
             continue
         a = {}
-        fl = [e["flicker"][k][p]["median"] for k in ("light", "camera") if k in e["flicker"] for p in ("Diff", "Gloss")]
-        a["flicker <= %.2f" % ACCEPT["flicker"]] = ("-" if not fl else
-                                                    "PASS" if max(fl) <= ACCEPT["flicker"] else "FAIL (%.3f)" % max(fl))
+        for k in ("light", "camera"):
+            if k not in e["flicker"]:
+                continue
+            fl = [e["flicker"][k][p]["median"] for p in ("Diff", "Gloss")]
+            a["flicker %s <= %.2f" % (k, ACCEPT["flicker"])] = ("PASS" if max(fl) <= ACCEPT["flicker"]
+                                                               else "FAIL (%.3f)" % max(fl))
         tol = ACCEPT["bias_preview"] if label == "preview" else ACCEPT["bias"]
         worst = max(abs(e["still"][p]["bias"] - 1) for p in ("Diff", "Gloss"))
         if worst <= tol:
@@ -301,6 +305,14 @@ def acceptance(res):
         if label == "balanced":
             x = max(e["still"][p]["structured"] / noise[p]["s4"] for p in ("Diff", "Gloss") if noise[p]["s4"] > 0)
             a["structured <= 3x noise"] = "PASS" if x <= ACCEPT["structured_x"] else "FAIL (%.1fx)" % x
+            # the issue's criterion is out of reach of the brute force itself (the reference's own 4x4 noise is
+            # ~1e-5 / 1e-7 here): the same against max(noise, the brute force's structured error), the RSM's floor
+            bf = cfgs.get("brute")
+            if bf is not None:
+                x2 = max(e["still"][p]["structured"] / max(noise[p]["s4"], bf["still"][p]["structured"], 1e-12)
+                         for p in ("Diff", "Gloss"))
+                a["structured <= 3x max(noise, brute)"] = ("PASS" if x2 <= ACCEPT["structured_x"]
+                                                           else "FAIL (%.1fx)" % x2)
         if label == "quality" and "balanced" in cfgs:
             b = cfgs["balanced"]["still"]
             worse = [p for p in ("Diff", "Gloss") if e["still"][p]["structured"] >= b[p]["structured"]]
@@ -446,6 +458,35 @@ def markdown(results, args, img_rel):
     return "\n".join(lines + summary + [""] + body) + "\n"
 
 
+def before_after(before, after):
+    """Markdown: each preset before (an earlier library's results) and after, per scene."""
+    def cell(e, p, key):
+        return _f(e["still"][p][key], "%.3f" if key == "bias" else "%.5f")
+
+    def flk(e):
+        f = e["flicker"].get("light")
+        return "-" if f is None else "%s / %s" % (_f(f["Diff"]["median"], "%.4f"), _f(f["Gloss"]["median"], "%.4f"))
+    lines = ["## Before and after (presets)", "",
+             "Before: library %s (commit %s, `%s`); after: this run. Same scenes, references and metrics." % (
+                 before.get("library", "?"), before.get("commit", "?"), before.get("command", "?")), "",
+             "| scene | preset | time s before / after | bias D | bias G | struct D | struct G | flicker light D / G |",
+             "|---|---|---|---|---|---|---|---|"]
+    for name, r in after["scenes"].items():
+        b = before.get("scenes", {}).get(name)
+        if not b:
+            continue
+        for label in ("preview", "balanced", "quality"):
+            e1, e0 = r["configs"].get(label), b["configs"].get(label)
+            if not e1 or not e0:
+                continue
+            lines.append("| %s | %s | %.3f / %.3f | %s / %s | %s / %s | %s / %s | %s / %s | %s / %s |" % (
+                name, label, e0["seconds"], e1["seconds"], cell(e0, "Diff", "bias"), cell(e1, "Diff", "bias"),
+                cell(e0, "Gloss", "bias"), cell(e1, "Gloss", "bias"), cell(e0, "Diff", "structured"),
+                cell(e1, "Diff", "structured"), cell(e0, "Gloss", "structured"), cell(e1, "Gloss", "structured"),
+                flk(e0), flk(e1)))
+    return "\n".join(lines) + "\n\n"
+
+
 def still_image(name, r, images, up):
     ref = images["ref"]["Combined"]
     e = imgutil.exposure_for(ref)
@@ -525,6 +566,8 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--repeat", type=int, default=1, help="time the still as the fastest of N runs (not brute)")
     ap.add_argument("--json", default=None, help="write the results here (default: under --out)")
+    ap.add_argument("--before", default=None,
+                    help="a results JSON of an earlier library: the report gains a before/after table of the presets")
     args = ap.parse_args(argv)
 
     if args.scenes in (None, "all"):
@@ -597,7 +640,11 @@ def main(argv=None):
         json.dump(results, fh, indent=1)
     os.makedirs(os.path.dirname(md_path), exist_ok=True)
     with open(md_path, "w") as fh:
-        fh.write(markdown(results, args, img_rel if want_images else None))
+        md = markdown(results, args, img_rel if want_images else None)
+        if args.before:
+            with open(args.before) as bf:
+                md = md.replace("## Summary (presets)", before_after(json.load(bf), results) + "## Summary (presets)", 1)
+        fh.write(md)
     print("report: %s\nresults: %s%s" % (md_path, jpath, ("\nimages: " + img_dir) if want_images else ""))
     return results
 

@@ -1,0 +1,62 @@
+"""The lattice fit holds still: it does not depend on the camera, and a
+light that moves a little changes the AOV a little, without jitter (issue 9).
+The importance-drawn fits are the contrast that shows the checks can fail."""
+import numpy as np
+import pytest
+
+import libvsgl as L
+import scenes
+
+
+def _scene(ctx, light_x=0.0, cam_x=0.0, w=40, h=30):
+    d = scenes.floor_and_wall(wall=True, width=w, height=h)
+    T = np.eye(4)
+    T[:3, 3] = (light_x, 0.0, 2.5)
+    d["lights"] = [L.Light(type="spot", color=(1, 1, 1), power=500.0, world_from_light=T,
+                           spot_size=1.2, spot_blend=0.1, radius=0.05)]
+    d["camera"] = L.Camera(type="perspective", sensor_fit="auto",
+                           world_from_camera=scenes.blender_camera_matrix((cam_x, -6, 1.5)),
+                           lens_mm=35, sensor_width_mm=36, sensor_height_mm=24, clip_start=0.1,
+                           clip_end=100, width=w, height=h, pixel_aspect_x=1, pixel_aspect_y=1)
+    return L.Scene(ctx, **d)
+
+
+def _settings(fit):
+    s = L.render_settings_preset(L.Preset.BALANCED)
+    s.fit_mode = fit
+    s.aa_samples = 1
+    return s
+
+
+def test_lattice_fit_does_not_depend_on_the_camera():
+    with L.Context() as ctx:
+        a = L.debug_vsgls(ctx, _scene(ctx, cam_x=0.0), _settings(L.FitMode.LATTICE))
+        b = L.debug_vsgls(ctx, _scene(ctx, cam_x=0.37), _settings(L.FitMode.LATTICE))
+    assert len(a["power"]) > 16
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+
+
+def _flicker(fit, steps=8, step=0.002):
+    """Median relative RMS of consecutive frames and of second differences, light moving `step` m a frame."""
+    with L.Context() as ctx:
+        frames = []
+        for i in range(steps):
+            img, _ = L.render(ctx, _scene(ctx, light_x=step * i), _settings(fit), planes=("combined",))
+            frames.append(img["combined"].astype(np.float64))
+    f = np.array(frames)
+    d1 = np.sqrt(((f[1:] - f[:-1]) ** 2).sum(axis=(1, 2, 3)) / (f[:-1] ** 2).sum(axis=(1, 2, 3)))
+    d2 = np.sqrt(((f[2:] - 2 * f[1:-1] + f[:-2]) ** 2).sum(axis=(1, 2, 3)) / (f[1:-1] ** 2).sum(axis=(1, 2, 3)))
+    return float(np.median(d1)), float(np.median(d2))
+
+
+def test_lattice_light_motion_is_smooth_and_importance_fits_are_not():
+    first, second = _flicker(L.FitMode.LATTICE)
+    # a 2 mm step in a 4 m room: the light itself changes by well under 1 %
+    assert first < 0.01, first
+    # smooth motion: second differences far below first differences (measured 0.005x; jitter makes
+    # them comparable or larger)
+    assert second < 0.02 * first, (first, second)
+    # k-means centres drawn from the light's power reshuffle: the same check fails for it (0.06x here)
+    km_first, km_second = _flicker(L.FitMode.KMEANS)
+    assert km_second > 0.02 * km_first, (km_first, km_second)
