@@ -14,9 +14,10 @@ Checks that hold today and can fail; prints PASS/FAIL lines and ends with
   (issue 9 measured this on its rooms: the RSM holds the light);
 
 then measures the presets (still and both animations, VSGL_QUALITY_FRAMES
-frames, default 12) and prints their numbers as INFO lines, with issue 9's
-acceptance criteria as INFO too (they fail today; the lead turns them into
-checks when the fixes land). Writes build/quality/check_test.md and .json.
+frames, default 12) and checks what they hold (MAX_FLICKER_LIGHT, MAX_BIAS,
+QUALITY_OVER_BALANCED below; every one fails with the session-1 presets:
+flicker 0.12-0.74, bias up to 3.4x), with issue 9's own acceptance criteria as
+INFO lines. Writes build/quality/check_test.md and .json.
 """
 import argparse
 import json
@@ -39,6 +40,13 @@ import scenes  # noqa: E402
 import test_metrics  # noqa: E402
 
 TOL_BRUTE = 0.06
+# What the presets hold at test size (issue 9; its own thresholds, flicker 0.01 and bias 5 %, are
+# reported as INFO acceptance lines): the median light-animation flicker per pass, the bias per
+# pass, and quality's structured error (combined pass) against balanced's, where a tie within the
+# references' noise is allowed (the spot room: both at its noise floor).
+MAX_FLICKER_LIGHT = 0.015
+MAX_BIAS = dict(preview=0.30, balanced=0.17, quality=0.17)
+QUALITY_OVER_BALANCED = 1.15
 TOL_Z = 4.0
 MAX_NOISE_S4 = 0.002
 
@@ -191,6 +199,20 @@ def main(argv=None):
         cnt.check(all(abs(b[p]["bias"] - 1) <= TOL_BRUTE for p in ("Diff", "Gloss")),
                   "brute force %s: within %d %% of Cycles per pass (Diff %.3f, Gloss %.3f; %s)"
                   % (n, 100 * TOL_BRUTE, b["Diff"]["bias"], b["Gloss"]["bias"], r["configs"]["brute"]["describe"]))
+        for label in ("preview", "balanced", "quality"):
+            e = r["configs"][label]
+            fl = e["flicker"]["light"]
+            cnt.check(all(fl[p]["median"] <= MAX_FLICKER_LIGHT for p in ("Diff", "Gloss")),
+                      "%s %s: the light animation's flicker Diff %.4f, Gloss %.4f (<= %g; second/first %.2f / %.2f)"
+                      % (label, n, fl["Diff"]["median"], fl["Gloss"]["median"], MAX_FLICKER_LIGHT,
+                         fl["Diff"]["ratio"], fl["Gloss"]["ratio"]))
+            s = e["still"]
+            cnt.check(all(abs(s[p]["bias"] - 1) <= MAX_BIAS[label] for p in ("Diff", "Gloss")),
+                      "%s %s: bias Diff %.3f, Gloss %.3f (within %d %%)" % (label, n, s["Diff"]["bias"],
+                                                                         s["Gloss"]["bias"], 100 * MAX_BIAS[label]))
+        q, b = (r["configs"][k]["still"]["Combined"]["structured"] for k in ("quality", "balanced"))
+        cnt.check(q <= QUALITY_OVER_BALANCED * b, "quality %s: structured error %.5f, balanced %.5f (<= %gx)"
+                  % (n, q, b, QUALITY_OVER_BALANCED))
         for label, a in E.acceptance(r).items():
             print("INFO acceptance %s %s: %s" % (n, label, "; ".join("%s %s" % kv for kv in a.items())))
     os.makedirs(args.out, exist_ok=True)
