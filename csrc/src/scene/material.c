@@ -134,6 +134,28 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
         glossy_out[c] = (p->f0[c] * (1.0f - FH) + FH) * common;
 }
 
+void vsgl__specular_factor(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float alpha, float out[3])
+{
+    out[0] = out[1] = out[2] = 0.0f;
+    float co = v3_dot(n, o), ci = v3_dot(n, i);
+    if (!(co > 0.0f) || !(ci > 0.0f) || !p->glossy)
+        return;
+    co = co < 1.0f ? co : 1.0f;
+    ci = ci < 1.0f ? ci : 1.0f;
+    float a = alpha > 1e-4f ? (alpha < 1.0f ? alpha : 1.0f) : 1e-4f, a2 = a * a;
+    float so = sqrtf(a2 + (1.0f - a2) * co * co), si = sqrtf(a2 + (1.0f - a2) * ci * ci);
+    /* G / (4 co): height-correlated 2 ci co / (ci so + co si), separable G1(i) G1(o), G1(c) = 2c / (c + s) */
+    float g4 = p->height_correlated ? ci / (2.0f * (ci * so + co * si)) : ci / ((ci + si) * (co + so));
+    float FH = 0.0f;
+    if (p->eta > 1.0f) {
+        v3 h = v3_normalize(v3_add(i, o));
+        float F0 = fresnel_dielectric(1.0f, p->eta);
+        FH = clampf((fresnel_dielectric(v3_dot(i, h), p->eta) - F0) / (1.0f - F0), 0.0f, 1.0f);
+    }
+    for (int c = 0; c < 3; ++c)
+        out[c] = (p->f0[c] * (1.0f - FH) + FH) * g4;
+}
+
 void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3])
 {
     float g = p->glossy ? 1.0f : 0.0f;

@@ -88,4 +88,12 @@ float vsgl__ms_scale(const vsgl_brdf_params *p, int channel, float cos_view);
  * metal within ~1 % of Schlick's F of its base colour): that is written. */
 void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3]);
 
+/* The smooth factor of the glossy lobe, F G / (4 cos_o), at light direction
+ * i (the receiver lobe's axis) seen from o, per channel: the exact BRDF's
+ * own Fresnel (Cycles 3.x's dielectric-shaped curve between f0 and 1, not
+ * Schlick's: at 55 degrees from a dielectric of F0 0.04 the two are 0.070
+ * and 0.054) and shadowing (separable or height-correlated, as the
+ * material's flags say). 0 when either direction is below the surface. */
+void vsgl__specular_factor(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float alpha, float out[3]);
+
 #endif

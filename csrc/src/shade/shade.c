@@ -255,10 +255,12 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                         float k2 = v->coherence * v->coherence;
                         gi = (1.0f - k2) * gi + k2 * vsgl__planar_glossy(v, r.x, &lobe);
                     }
-                    if (gi > 0.0f)
+                    if (gi > 0.0f) {
+                        float sf[3];
+                        vsgl__specular_factor(&r.bp, r.n, r.o, axis, r.alpha, sf);
                         for (int c = 0; c < 3; ++c)
-                            ls[c] += v->power[c] * gi *
-                                     vsgl_specular_factor(&r.n, &r.o, &axis, r.alpha, r.bp.f0[c]) * r.ms[c];
+                            ls[c] += v->power[c] * gi * sf[c] * r.ms[c];
+                    }
                 }
             }
             for (int c = 0; c < 3; ++c) {
@@ -323,9 +325,11 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
         b->lam[k] = b->mu[k] = b->camp[k] = 0.0f;
     }
     float m[3] = {0.0f, 0.0f, 0.0f};
-    if (r->glossy)
+    if (r->glossy) {
+        vsgl__specular_factor(&r->bp, r->n, r->o, r->asg.z, r->alpha, m);
         for (int c = 0; c < 3; ++c)
-            m[c] = vsgl_specular_factor(&r->n, &r->o, &r->asg.z, r->alpha, r->bp.f0[c]) * r->ms[c];
+            m[c] *= r->ms[c];
+    }
     b->f0r[k] = m[0];
     b->f0g[k] = m[1];
     b->f0b[k] = m[2];
