@@ -21,7 +21,9 @@ extern "C" {
 #define VSGL_METHOD_VSGL        0  /**< VSGL fit + SG/ASG product integrals */
 #define VSGL_METHOD_BRUTE_FORCE 1  /**< every RSM texel as a point light, exact BRDF */
 
-#define VSGL_FIT_TWO    0  /**< poster: one diffuse + one specular VSGL per light */
+#define VSGL_FIT_TWO    0  /**< poster: one diffuse + one specular VSGL per light (one cluster cannot
+                                tell a sunlit roof from the floor under it: a sun room renders 9-16x
+                                too bright, docs/quality.md; the presets use the lattice) */
 #define VSGL_FIT_FIS    1  /**< filtered importance sampling over RSM mips */
 #define VSGL_FIT_KMEANS 2  /**< k-means in image + world space */
 #define VSGL_FIT_LATTICE 3 /**< world-space lattice with tent weights, one cluster per surface orientation:
