@@ -19,7 +19,7 @@ KNOBS = {
     "fis_iterations": (None, 8),
     "sharpness_estimator": (("TOKSVIG", "BANERJEE"), "TOKSVIG"),
     "diffuse_mode": (("SG", "PULLED_OUT", "ACCURATE"), "PULLED_OUT"),
-    "glossy_mode": (("ASG", "SG"), "ASG"),
+    "glossy_mode": (("ASG", "SG", "ASG2"), "ASG"),
     "visibility": (("NONE", "RAY"), "NONE"),
     "seed": (None, 0),
     "leak_correction": (("AUTO", "OFF", "ON"), "AUTO"),

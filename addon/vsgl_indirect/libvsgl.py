@@ -165,6 +165,7 @@ class FitMode(enum.IntEnum):
 class GlossyMode(enum.IntEnum):
     ASG = 0
     SG = 1
+    ASG2 = 2
 
 
 class Visibility(enum.IntEnum):

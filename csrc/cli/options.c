@@ -23,7 +23,7 @@ const char cli_usage[] =
     "  --vsgls N             VSGLs per light (fis, kmeans; 1..65536)\n"
     "  --sharpness NAME      toksvig | banerjee\n"
     "  --diffuse NAME        sg | pulled | accurate   (receiver cosine)\n"
-    "  --glossy NAME         asg | sg\n"
+    "  --glossy NAME         asg | sg | asg2   (one ASG, one SG, GGX core + tail as two ASGs)\n"
     "  --visibility NAME     none | ray\n"
     "  --leak NAME           auto | off | on   (emitter-hemisphere light-leak correction)\n"
     "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
@@ -107,8 +107,8 @@ static const char *const sharp_names[] = {"toksvig", "banerjee", NULL};
 static const int sharp_values[] = {VSGL_SHARPNESS_TOKSVIG, VSGL_SHARPNESS_BANERJEE};
 static const char *const diffuse_names[] = {"sg", "pulled", "accurate", NULL};
 static const int diffuse_values[] = {VSGL_COSINE_SG, VSGL_COSINE_PULLED_OUT, VSGL_COSINE_ACCURATE};
-static const char *const glossy_names[] = {"asg", "sg", NULL};
-static const int glossy_values[] = {VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG};
+static const char *const glossy_names[] = {"asg", "sg", "asg2", NULL};
+static const int glossy_values[] = {VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG, VSGL_GLOSSY_ASG2};
 static const char *const vis_names[] = {"none", "ray", NULL};
 static const int vis_values[] = {VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY};
 static const char *const leak_names[] = {"auto", "off", "on", NULL};

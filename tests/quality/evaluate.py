@@ -70,6 +70,7 @@ NAMED = {
     "fis128": ("balanced", dict(fit_mode="fis", vsgl_count=128)),
 }
 FULL_CONFIGS = ["preview", "balanced", "quality", "brute", "km1024", "fis128"]
+STILL_IMAGE_CONFIGS = ("preview", "balanced", "quality", "brute")
 ACCEPT = dict(flicker=0.01, bias=0.05, bias_preview=0.30, structured_x=3.0)
 
 
@@ -135,7 +136,7 @@ class Config:
                3: "lattice %d" % s["vsgl_count"]}[s["fit_mode"]]
         bits = [fit, "RSM %d" % s["rsm_resolution"], "aa %d" % s["aa_samples"],
                 {0: "accurate cosine", 1: "SG cosine", 2: "pulled-out cosine"}[s["diffuse_mode"]],
-                {0: "ASG", 1: "SG"}[s["glossy_mode"]] + " glossy"]
+                {0: "ASG", 1: "SG", 2: "two-ASG (GGX core + tail)"}[s["glossy_mode"]] + " glossy"]
         if s["visibility"]:
             bits.append("visibility rays")
         if s["leak_correction"]:
@@ -442,7 +443,8 @@ def markdown(results, args, img_rel):
                 body.append("| %s | %s |" % (label, " | ".join(a.get(c, "") for c in crit)))
             body.append("")
         if img_rel:
-            labels = " | ".join(["reference"] + list(r["configs"]))
+            labels = " | ".join(["reference"] + ([l for l in r["configs"] if l in STILL_IMAGE_CONFIGS]
+                                                 or list(r["configs"])))
             body += ["![%s](%s/%s_still.png)" % (name, img_rel, name), "",
                      "Top: %s (combined pass, tone-mapped with one exposure per scene). Bottom: the signed "
                      "error x4 through the same exposure and curve, red = too bright, blue = too dark; under the "
@@ -495,7 +497,9 @@ def still_image(name, r, images, up):
     noise = (lum(images["seeds"][0]["Combined"]) - lum(images["seeds"][1]["Combined"])) / 2
     bot = [imgutil.signed_error(noise, 4 * e)]
     heads = [["reference", "cycles 2x%d spp" % r["reference"]["spp"]]]
-    for label in r["configs"]:
+    # the presets and the brute force (the RSM's floor); other configurations are in the tables only
+    shown = [l for l in r["configs"] if l in STILL_IMAGE_CONFIGS] or list(r["configs"])
+    for label in shown:
         c = r["configs"][label]
         img = images["still"][label]["Combined"]
         top.append(imgutil.tonemap(img, e))

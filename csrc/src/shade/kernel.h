@@ -60,6 +60,16 @@ typedef struct vsgl_kernel_light {
 /* Lobes a block needs (skip the work for lobes no lane has). */
 #define VSGL_KERNEL_DIFFUSE 1
 #define VSGL_KERNEL_GLOSSY  2
+/* The glossy lobe as GGX's core and tail: two ASGs of the lane's frame with
+ * bandwidths x VSGL_GGX_{CORE,TAIL}_K and amplitudes x _C (least squares to
+ * GGX's 1/(1 + x^2)^2, x = tan / alpha, at equal integral: L2 error 0.047
+ * where the one Gaussian of Wang et al. has 0.29; the tail carries 53 % of
+ * the energy, which one ASG puts in its core). */
+#define VSGL_KERNEL_GGX_TAIL 4
+#define VSGL_GGX_CORE_K 1.75f
+#define VSGL_GGX_CORE_C 0.8168f
+#define VSGL_GGX_TAIL_K 0.26f
+#define VSGL_GGX_TAIL_C 0.13864f
 
 /* Accumulate VSGLs lights[0, count) into all VSGL_KERNEL_BLOCK receivers
  * of b (a fixed trip count: the caller fills unused lanes with any finite

@@ -352,11 +352,11 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
  * h_x = nu lam / (nu + lam), h_y = nu mu / (nu + mu), norm = pi / sqrt((lam + nu)(mu + nu)),
  * all from one reciprocal square root of the product. */
 static inline __attribute__((always_inline)) void
-k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t)
+k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t, float kb, float kc)
 {
     float mx = t->mx[i], my = t->my[i], mz = t->mz[i], ilin = t->ilin[i];
     float nu = 0.5f * t->lin[i];
-    float lam = b->lam[i], mu = b->mu[i];
+    float lam = b->lam[i] * kb, mu = b->mu[i] * kb;
     /* the incident axis in the lobe's frame, unnormalised (m = lin p) */
     float gx = mx * b->Xx[i] + my * b->Xy[i] + mz * b->Xz[i];
     float gy = mx * b->Yx[i] + my * b->Yy[i] + mz * b->Yz[i];
@@ -367,14 +367,15 @@ k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t)
     float hx = lam * mun * w2;
     float hy = mu * lamn * w2;
     t->expo[i] = -hx * gx * gx - hy * gy * gy;
-    t->gpre[i] = b->camp[i] * (gz > 0.0f ? gz : 0.0f) * (K_PI * rp * ilin) * t->amp[i];
+    t->gpre[i] = kc * b->camp[i] * (gz > 0.0f ? gz : 0.0f) * (K_PI * rp * ilin) * t->amp[i];
 }
 
 /* Stage 4b: glossy light from a planar cluster (shade.h, vsgl__planar_glossy):
  * the radiance of the cluster's plane where the lobe's axis meets it,
  * blurred by the lobe's footprint there: all but the exp. */
 static inline __attribute__((always_inline)) void
-k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
+k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t,
+         float kb, float kc)
 {
     /* lengths in units of the cluster's sigma, so that nothing overflows:
      * the axis must meet the plane at t <= 1e4 sigma and >= 0.6 degrees
@@ -404,7 +405,9 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     /* the offset from the cluster's mean to where the axis meets its plane: t z - (mean - x) */
     float ox = tt * zx - dx * is, oy = tt * zy - dy * is, oz = tt * zz - dz * is;
     float d1 = ox * L->u1x + oy * L->u1y + oz * L->u1z, e2 = ox * L->u2x + oy * L->u2y + oz * L->u2z;
-    float lam = b->lam[i] > 0.01f ? b->lam[i] : 0.01f, mu = b->mu[i] > 0.01f ? b->mu[i] : 0.01f;
+    float lam = b->lam[i] * kb, mu = b->mu[i] * kb;
+    lam = lam > 0.01f ? lam : 0.01f;
+    mu = mu > 0.01f ? mu : 0.01f;
     float il = 0.5f / lam, im = 0.5f / mu;
     float s11 = 1.0f + a1 * a1 * il + b1 * b1 * im;
     float s22 = 1.0f + a2 * a2 * il + b2 * b2 * im;
@@ -415,7 +418,7 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     float idet = 1.0f / det;
     float qf = (s22 * d1 * d1 - 2.0f * s12 * d1 * e2 + s11 * e2 * e2) * idet;
     t->pexpo[i] = qf > 0.0f ? -0.5f * qf : 0.0f;
-    t->ppre[i] = ok * t->vis[i] * b->camp[i] * (1.0f / K_2PI) * k_rsqrt(det * lam * mu) * (is * is);
+    t->ppre[i] = ok * t->vis[i] * kc * b->camp[i] * (1.0f / K_2PI) * k_rsqrt(det * lam * mu) * (is * is);
 }
 
 /* Stage 5: the glossy lobe's exp and the accumulation, with the smooth
@@ -493,16 +496,23 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
             all_planar &= L[j].planar == 1.0f;
             none_planar &= L[j].planar == 0.0f;
         }
-        if (!all_planar)
-            K_FORN(k_glossy(b, i, t + j));
-        if (!none_planar)
-            K_FORN(k_planar(b, i, L + j, t + j));
-        if (none_planar)
-            K_FORN(k_glossy_sum(b, i, L + j, t + j, 0));
-        else if (all_planar)
-            K_FORN(k_glossy_sum(b, i, L + j, t + j, 1));
-        else
-            K_FORN(k_glossy_sum(b, i, L + j, t + j, 2));
+        /* one ASG, or GGX's core and tail as two (kernel.h, VSGL_KERNEL_GGX_TAIL) */
+        const int two = (lobes & VSGL_KERNEL_GGX_TAIL) != 0;
+        for (int q = 0; q < 1 + two; ++q) {
+            const float kb = two ? (q ? VSGL_GGX_TAIL_K : VSGL_GGX_CORE_K) : 1.0f;
+            const float kc = two ? (q ? VSGL_GGX_TAIL_C : VSGL_GGX_CORE_C) : 1.0f;
+            const int sg_only = none_planar;
+            if (!all_planar)
+                K_FORN(k_glossy(b, i, t + j, kb, kc));
+            if (!sg_only)
+                K_FORN(k_planar(b, i, L + j, t + j, kb, kc));
+            if (sg_only)
+                K_FORN(k_glossy_sum(b, i, L + j, t + j, 0));
+            else if (all_planar)
+                K_FORN(k_glossy_sum(b, i, L + j, t + j, 1));
+            else
+                K_FORN(k_glossy_sum(b, i, L + j, t + j, 2));
+        }
     }
 }
 

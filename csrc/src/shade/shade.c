@@ -184,17 +184,55 @@ static void visibility_rays(const shade_job *j, v3 target, const receiver *rec, 
         vis[k] = blocked[k] ? 0.0f : 1.0f;
 }
 
+/* Part q (0 core, 1 tail) of a GGX lobe's ASG (kernel.h, VSGL_KERNEL_GGX_TAIL). */
+static vsgl_asg ggx_part(const vsgl_asg *a, int q)
+{
+    vsgl_asg r = *a;
+    float k = q ? VSGL_GGX_TAIL_K : VSGL_GGX_CORE_K, c = q ? VSGL_GGX_TAIL_C : VSGL_GGX_CORE_C;
+    r.lambda *= k;
+    r.mu *= k;
+    r.log_amplitude += logf(c);
+    return r;
+}
+
 /* Glossy integral of the receiver's lobe with the incident SG, and the
  * axis where the smooth factor is evaluated: the receiver's lobe axis
  * (Xu et al. Eq. 30), the same for every VSGL, as in the kernel. */
-static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_sg *in, v3 *axis)
+static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_sg *in, v3 *axis, int part)
 {
     if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
         *axis = r->sg.axis;
         return vsgl_sg_product_integral(&r->sg, in);
     }
     *axis = r->asg.z;
-    return vsgl_asg_sg_product_integral(&r->asg, in);
+    if (j->s->glossy_mode != VSGL_GLOSSY_ASG2)
+        return vsgl_asg_sg_product_integral(&r->asg, in);
+    vsgl_asg a = ggx_part(&r->asg, part);
+    return vsgl_asg_sg_product_integral(&a, in);
+}
+
+/* The glossy light of VSGL v through the receiver's lobe (each part of it
+ * for GGX's core and tail): the SG model, and for a coherent diffuse
+ * cluster with the clip the planar model blended in by coherence^2, as the
+ * kernel does. */
+static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl *v, const vsgl_sg *in, v3 *axis)
+{
+    int parts = j->s->glossy_mode == VSGL_GLOSSY_ASG2 ? 2 : 1;
+    float sum = 0.0f;
+    for (int q = 0; q < parts; ++q) {
+        float gi = glossy_integral(j, r, in, axis, q);
+        if (j->leak && v->lobe == VSGL_LOBE_DIFFUSE) {
+            vsgl_asg lobe = r->asg;
+            if (j->s->glossy_mode == VSGL_GLOSSY_SG)
+                vsgl_sg_to_asg(&r->sg, &lobe);
+            else if (parts == 2)
+                lobe = ggx_part(&r->asg, q);
+            float k2 = v->coherence * v->coherence;
+            gi = (1.0f - k2) * gi + k2 * vsgl__planar_glossy(v, r->x, &lobe);
+        }
+        sum += gi;
+    }
+    return sum;
 }
 
 static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
@@ -247,14 +285,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 }
                 if (r.glossy) {
                     v3 axis;
-                    float gi = glossy_integral(j, &r, &in, &axis);
-                    if (j->leak && v->lobe == VSGL_LOBE_DIFFUSE) {
-                        vsgl_asg lobe = r.asg;
-                        if (j->s->glossy_mode == VSGL_GLOSSY_SG)
-                            vsgl_sg_to_asg(&r.sg, &lobe);
-                        float k2 = v->coherence * v->coherence;
-                        gi = (1.0f - k2) * gi + k2 * vsgl__planar_glossy(v, r.x, &lobe);
-                    }
+                    float gi = glossy_light(j, &r, v, &in, &axis);
                     if (gi > 0.0f) {
                         float sf[3];
                         vsgl__specular_factor(&r.bp, r.n, r.o, axis, r.alpha, sf);
@@ -433,6 +464,8 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             }
             lobes |= (blk.diffuse[k] > 0.0f ? VSGL_KERNEL_DIFFUSE : 0) | (blk.camp[k] > 0.0f ? VSGL_KERNEL_GLOSSY : 0);
         }
+        if ((lobes & VSGL_KERNEL_GLOSSY) && j->s->glossy_mode == VSGL_GLOSSY_ASG2)
+            lobes |= VSGL_KERNEL_GGX_TAIL;
         for (size_t k = n; k < VSGL_KERNEL_BLOCK; ++k) {
             /* padding lanes: shaded, never read; at lane 0's position so that
              * they do not change the block's choice of short forms */
