@@ -218,6 +218,7 @@ RSM_RESOLUTION_MIN = 2
 RSM_RESOLUTION_MAX = 8192
 VSGL_COUNT_MAX = 65536
 FIS_ITERATIONS_MAX = 32
+SHADE_STRIDE_MAX = 8
 BUNDLE_VERSION = (1, 1)
 
 
@@ -421,6 +422,7 @@ class vsgl_render_settings(_Struct):
         ("seed", _u32),
         ("leak_correction", _i32),
         ("sample_merging", _i32),
+        ("shade_stride", _u32),
     ]
     _enums = {"method": Method, "fit_mode": FitMode, "sharpness_estimator": SharpnessEstimator,
               "diffuse_mode": CosineMode, "glossy_mode": GlossyMode, "visibility": Visibility,

@@ -383,6 +383,80 @@ VT_TEST(render_sample_merging_cuts_pairs_at_small_error)
     VT_CHECK(same_colour, "DiffCol must not change (every sample weights with its own colour)");
 }
 
+/* The combined plane of the room at w x h with settings s and `threads`. */
+static float *render_room_size(uint32_t w, uint32_t h, uint32_t threads, const vsgl_render_settings *s,
+                               vsgl_render_stats *st, float **dc)
+{
+    fx_scene fx;
+    fx_room(&fx, w, h, 0.25f, 200.0f);
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.size = sizeof cd;
+    cd.thread_count = threads;
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    float *comb = calloc((size_t)w * h * 3, sizeof *comb), *col = calloc((size_t)w * h * 3, sizeof *col);
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = w;
+    o.height = h;
+    o.combined = comb;
+    o.diffuse_color = col;
+    int ok = vsgl_context_create(&cd, &ctx) == VSGL_OK && vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK &&
+             vsgl_render(ctx, scene, s, &o, st) == VSGL_OK;
+    VT_CHECK(ok, "render %ux%u: %s", w, h, ctx ? vsgl_context_last_error(ctx) : "no context");
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+    *dc = col;
+    return comb;
+}
+
+/* Shading one pixel in S x S (shade_stride): the shading pairs fall by about
+ * S^2, the light stays close to every pixel shaded (at 240 x 180, a room of
+ * coloured walls and a glossy floor under a spot), the colours are the
+ * same, and the result does not depend on the thread count. */
+VT_TEST(render_shade_stride_cuts_pairs_at_small_error)
+{
+    enum { SW = 240, SH = 180 };
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.rsm_resolution = 64;
+    s.aa_samples = 1;
+    vsgl_render_stats st_full, st_sparse;
+    float *dc_full, *dc_sparse, *dc1;
+    float *full = render_room_size(SW, SH, 0, &s, &st_full, &dc_full);
+    const uint32_t strides[2] = {2, 4};
+    const double tol[2] = {0.035, 0.07};
+    for (int k = 0; k < 2; ++k) {
+        s.shade_stride = strides[k];
+        float *sparse = render_room_size(SW, SH, 0, &s, &st_sparse, &dc_sparse);
+        double e = 0, ref = 0;
+        for (int i = 0; i < SW * SH * 3; ++i) {
+            double d = (double)sparse[i] - full[i];
+            e += d * d;
+            ref += (double)full[i] * full[i];
+        }
+        double rel = sqrt(e / (ref > 0 ? ref : 1));
+        if (getenv("VSGL_TEST_VERBOSE"))
+            printf("    stride %u: %llu pairs vs %llu, relative RMSE %.3g\n", strides[k],
+                   (unsigned long long)st_sparse.shading_pairs, (unsigned long long)st_full.shading_pairs, rel);
+        VT_CHECK(rel < tol[k], "stride %u: relative RMSE of the combined plane %.3g", strides[k], rel);
+        VT_CHECK(st_sparse.shading_pairs * (uint64_t)(strides[k] * strides[k]) < 2 * st_full.shading_pairs,
+                 "stride %u: pairs %llu vs %llu", strides[k], (unsigned long long)st_sparse.shading_pairs,
+                 (unsigned long long)st_full.shading_pairs);
+        VT_CHECK(memcmp(dc_sparse, dc_full, sizeof(float) * SW * SH * 3) == 0, "stride %u: DiffCol changed",
+                 strides[k]);
+        float *one = render_room_size(SW, SH, 1, &s, NULL, &dc1);
+        VT_CHECK(memcmp(sparse, one, sizeof(float) * SW * SH * 3) == 0, "stride %u: 1 thread differs", strides[k]);
+        free(sparse);
+        free(dc_sparse);
+        free(one);
+        free(dc1);
+    }
+    free(full);
+    free(dc_full);
+}
+
 /* The same room at very different scales and far from the origin: every
  * plane finite and non-negative, and the light (a scale-free quantity once
  * the power is scaled with the area) about the same. */

@@ -74,6 +74,7 @@ extern "C" {
 #define VSGL_RSM_RESOLUTION_MAX    8192
 #define VSGL_VSGL_COUNT_MAX        65536
 #define VSGL_FIS_ITERATIONS_MAX    32
+#define VSGL_SHADE_STRIDE_MAX      8
 
 /**
  * Render settings. Zero-initialised means "default" for every field, so
@@ -95,6 +96,9 @@ typedef struct vsgl_render_settings {
     uint32_t seed;               /**< for FIS / k-means sampling, default 0 */
     int32_t leak_correction;     /**< VSGL_LEAK_*, default AUTO */
     int32_t sample_merging;      /**< VSGL_MERGE_*, default AUTO (on) */
+    uint32_t shade_stride;       /**< shade one pixel in S x S and interpolate the light between them where
+                                      neighbours share a surface (joint bilateral on the G-buffer; edges
+                                      are shaded), 1..VSGL_SHADE_STRIDE_MAX; default 1 (every pixel) */
 } vsgl_render_settings;
 
 /** @brief Fill @p out with a preset (VSGL_PRESET_*); unknown presets give BALANCED. */

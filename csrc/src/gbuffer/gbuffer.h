@@ -6,6 +6,7 @@
 #include "scene/scene_internal.h"
 
 #define VSGL_GBUFFER_MISS 0xFFFFFFFFu
+#define VSGL_GBUFFER_MAX_SPP 256 /* 16 x 16 samples per pixel */
 
 /* Structure of arrays; sample index = (row * width + col) * spp + s,
  * row 0 = top of the image, samples on a stratified aa x aa grid. */

@@ -15,6 +15,7 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
     out->glossy_mode = VSGL_GLOSSY_ASG;
     out->visibility = VSGL_VISIBILITY_NONE;
     out->fis_iterations = 8;
+    out->shade_stride = 1;
     /* Every preset fits on the lattice: the importance-drawn fits flicker
      * as a light moves (0.1-0.75 of the AOV per 1/1000-extent step, docs/
      * quality.md) and break a reflection into blotches; with the emitter
@@ -29,6 +30,9 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
         out->aa_samples = 1;
         out->rsm_resolution = 128;
         out->vsgl_count = 32;
+        /* a quarter of the shading pairs; structured error and FLIP within
+         * 1-3 % of shading every pixel at 320 x 240 (docs/quality.md) */
+        out->shade_stride = 2;
         break;
     case VSGL_PRESET_QUALITY: /* 512 VSGLs/light: structured error ~0.5x again at 1.5x the time */
         out->aa_samples = 2;
@@ -87,6 +91,11 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     if (s->vsgl_count > VSGL_VSGL_COUNT_MAX)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: vsgl_count is %u (valid 1..%d)",
                           s->vsgl_count, VSGL_VSGL_COUNT_MAX);
+    if (!s->shade_stride)
+        s->shade_stride = 1;
+    if (s->shade_stride > VSGL_SHADE_STRIDE_MAX)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: shade_stride is %u (valid 1..%d)",
+                          s->shade_stride, VSGL_SHADE_STRIDE_MAX);
     if (s->fis_iterations > VSGL_FIS_ITERATIONS_MAX)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: fis_iterations is %u (valid 1..%d)",
                           s->fis_iterations, VSGL_FIS_ITERATIONS_MAX);

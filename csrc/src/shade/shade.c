@@ -4,6 +4,7 @@
  * smooth Fresnel/shadowing factor at the integrand's lobe axis. */
 #include "shade/shade.h"
 #include "shade/kernel.h"
+#include "shade/shade_job.h"
 #include "core/context.h"
 #include "core/parallel.h"
 #include "scene/material.h"
@@ -98,34 +99,6 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
     /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
     return expf(lobe->log_amplitude - 0.5f * q) / (TWO_PI * sqrtf(fmaxf(det * lam * mu, 1e-30f)));
 }
-
-typedef struct shade_job {
-    const vsgl_scene *scene;
-    const vsgl_gbuffer *g;
-    const vsgl_vsgl_set *set;
-    const vsgl_render_settings *s;
-    const vsgl_pixel_planes *planes;
-    const vsgl_material *materials;
-    float eps;            /* ray offset, metres */
-    size_t base;          /* first pixel of the current batch */
-    uint64_t *pairs;      /* per chunk of the current batch */
-    const vsgl_kernel_light *klights; /* the VSGLs, kernel layout */
-    int path;             /* VSGL_SHADE_* */
-    int leak;             /* apply the emitter-hemisphere correction */
-    int merge;            /* share light between samples of one surface in a pixel */
-    float plane_tol;      /* step along the normal that separates surfaces, metres */
-} shade_job;
-
-/* Receiver lobe of one sample, set up once and used for every VSGL. */
-typedef struct receiver {
-    v3 x, n, o;
-    vsgl_brdf_params bp;
-    float alpha;
-    int glossy;
-    float ms[3];         /* multiple-scattering compensation towards o (1 unless 4.x+ Multiscatter GGX) */
-    vsgl_asg asg;        /* warped NDF (ASG mode) */
-    vsgl_sg sg;          /* warped NDF (SG mode) */
-} receiver;
 
 static void setup_receiver(const shade_job *j, size_t i, receiver *r)
 {
@@ -394,68 +367,25 @@ static int same_surface(const vsgl_gbuffer *g, const vsgl_material *materials, s
     return fabsf(v3_dot(d, na)) <= plane_tol;
 }
 
-/* Rows of pixels through the vectorised kernel, VSGL_KERNEL_BLOCK shaded
- * samples at a time. */
-static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0)
+/* Shade G-buffer samples list[0..n) through the kernel, VSGL_KERNEL_BLOCK at
+ * a time, each at its own position or, where centroid (4 floats per entry:
+ * a position sum and a count) has a count above 1, at the centroid of a
+ * merged group; writes 6 floats per entry (diffuse light RGB, glossy RGB).
+ * Every listed sample must be a hit. Returns the number of pairs. */
+uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshaded, const float *centroid,
+                          float *light)
 {
-    shade_job *j = user;
-#if defined(__x86_64__) || defined(__i386__)
-    /* Flush denormals to zero while the kernel runs (restored below):
-     * amplitudes far below anything visible otherwise cost microcode
-     * assists of ~100 cycles each. Values stay finite and >= 0. */
-    unsigned int saved_csr = _mm_getcsr();
-    _mm_setcsr(saved_csr | 0x8040u); /* FTZ | DAZ */
-#endif
-    const vsgl_gbuffer *g = j->g;
-    const vsgl_pixel_planes *pl = j->planes;
-    const size_t spp = g->spp;
-    const size_t first = (j->base + b0) * spp, last = (j->base + e0) * spp, ns = last - first;
     vsgl_kernel_block blk;
     receiver rec[VSGL_KERNEL_BLOCK];
     float vis[2 * VSGL_KERNEL_BLOCK]; /* visibility of two VSGLs */
     uint64_t pairs = 0;
-    /* which samples are shaded (shaded[]), and the slot each sample reads its light from */
-    size_t *shaded = malloc((ns + 1) * sizeof *shaded);
-    uint32_t *slot = malloc((ns + 1) * sizeof *slot);
-    float *light = malloc((ns + 1) * 6 * sizeof *light);
-    float *centroid = calloc((ns + 1) * 4, sizeof *centroid); /* per slot: position sum, count */
-    if (!shaded || !slot || !light || !centroid) {
-        free(shaded);
-        free(slot);
-        free(light);
-        free(centroid);
-#if defined(__x86_64__) || defined(__i386__)
-        _mm_setcsr(saved_csr);
-#endif
-        return VSGL_ERROR_OUT_OF_MEMORY;
-    }
-    size_t nshaded = 0;
-    for (size_t i = 0; i < ns; ++i) {
-        size_t si = first + i;
-        slot[i] = UINT32_MAX;
-        if (g->material[si] == VSGL_GBUFFER_MISS)
-            continue;
-        if (j->merge)
-            for (size_t k = i - i % spp; k < i && slot[i] == UINT32_MAX; ++k)
-                if (slot[k] != UINT32_MAX && shaded[slot[k]] == first + k && same_surface(g, j->materials, first + k, si, j->plane_tol))
-                    slot[i] = slot[k];
-        if (slot[i] == UINT32_MAX) {
-            slot[i] = (uint32_t)nshaded;
-            shaded[nshaded++] = si;
-        }
-        float *cg = centroid + (size_t)slot[i] * 4;
-        cg[0] += g->pos[0][si];
-        cg[1] += g->pos[1][si];
-        cg[2] += g->pos[2][si];
-        cg[3] += 1.0f;
-    }
     for (size_t s0 = 0; s0 < nshaded; s0 += VSGL_KERNEL_BLOCK) {
         size_t n = nshaded - s0 < VSGL_KERNEL_BLOCK ? nshaded - s0 : VSGL_KERNEL_BLOCK;
         int32_t lobes = 0;
         for (size_t k = 0; k < n; ++k) {
             fill_lane(j, shaded[s0 + k], &blk, k, &rec[k]); /* every shaded sample is a hit */
-            const float *cg = centroid + (s0 + k) * 4;
-            if (cg[3] > 1.0f) { /* a merged group is shaded at its centroid: its mean light to first order */
+            const float *cg = centroid ? centroid + (s0 + k) * 4 : NULL;
+            if (cg && cg[3] > 1.0f) { /* a merged group is shaded at its centroid: its mean light to first order */
                 float inv = 1.0f / cg[3];
                 rec[k].x = v3_make(cg[0] * inv, cg[1] * inv, cg[2] * inv);
                 blk.x[k] = rec[k].x.x;
@@ -497,39 +427,109 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
                 light[(s0 + k) * 6 + 3 + c] = blk.ls[c][k];
             }
     }
-    /* every covered sample: its own colours, the light of its slot */
-    for (size_t px = j->base + b0; px < j->base + e0; ++px) {
-        float acc[12] = {0};
-        float covered = 0.0f;
-        for (size_t k = 0; k < spp; ++k) {
-            size_t i = (px - j->base - b0) * spp + k, si = first + i;
-            if (slot[i] == UINT32_MAX)
-                continue;
-            vsgl_brdf_params bp;
-            vsgl__material_params(&j->materials[g->material[si]], &bp);
-            v3 n = v3_make(g->nrm[0][si], g->nrm[1][si], g->nrm[2][si]);
-            v3 o = v3_make(g->view[0][si], g->view[1][si], g->view[2][si]);
-            float gcol[3] = {0, 0, 0};
-            if (bp.glossy && v3_dot(n, o) > 0.0f)
-                vsgl__glossy_color(&bp, n, o, gcol);
-            const float *L = light + (size_t)slot[i] * 6;
-            float wd = vsgl__scene_diffuse_weight(j->scene, g->material[si], v3_dot(n, o));
-            for (int c = 0; c < 3; ++c) {
-                acc[c] += bp.diffuse[c] * wd * L[c];
-                acc[3 + c] += L[3 + c];
-                acc[6 + c] += bp.diffuse[c] * wd;
-                acc[9 + c] += gcol[c];
-            }
-            covered += 1.0f;
-        }
-        const float inv_spp = 1.0f / (float)spp;
+    return pairs;
+}
+
+/* Pixel px of the planes from its samples' light (Ls[k]: 6 floats, NULL
+ * for a miss) and their own colours. */
+void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls)
+{
+    const vsgl_gbuffer *g = j->g;
+    const vsgl_pixel_planes *pl = j->planes;
+    const size_t spp = g->spp;
+    float acc[12] = {0};
+    float covered = 0.0f;
+    for (size_t k = 0; k < spp; ++k) {
+        size_t si = px * spp + k;
+        if (!Ls[k])
+            continue;
+        vsgl_brdf_params bp;
+        vsgl__material_params(&j->materials[g->material[si]], &bp);
+        v3 n = v3_make(g->nrm[0][si], g->nrm[1][si], g->nrm[2][si]);
+        v3 o = v3_make(g->view[0][si], g->view[1][si], g->view[2][si]);
+        float gcol[3] = {0, 0, 0};
+        if (bp.glossy && v3_dot(n, o) > 0.0f)
+            vsgl__glossy_color(&bp, n, o, gcol);
+        const float *L = Ls[k];
+        float wd = vsgl__scene_diffuse_weight(j->scene, g->material[si], v3_dot(n, o));
         for (int c = 0; c < 3; ++c) {
-            pl->diffuse[px * 3 + c] = acc[c] * inv_spp;
-            pl->glossy[px * 3 + c] = acc[3 + c] * inv_spp;
-            pl->diffuse_color[px * 3 + c] = acc[6 + c] * inv_spp;
-            pl->glossy_color[px * 3 + c] = acc[9 + c] * inv_spp;
+            acc[c] += bp.diffuse[c] * wd * L[c];
+            acc[3 + c] += L[3 + c];
+            acc[6 + c] += bp.diffuse[c] * wd;
+            acc[9 + c] += gcol[c];
         }
-        pl->coverage[px] = covered * inv_spp;
+        covered += 1.0f;
+    }
+    const float inv_spp = 1.0f / (float)spp;
+    for (int c = 0; c < 3; ++c) {
+        pl->diffuse[px * 3 + c] = acc[c] * inv_spp;
+        pl->glossy[px * 3 + c] = acc[3 + c] * inv_spp;
+        pl->diffuse_color[px * 3 + c] = acc[6 + c] * inv_spp;
+        pl->glossy_color[px * 3 + c] = acc[9 + c] * inv_spp;
+    }
+    pl->coverage[px] = covered * inv_spp;
+}
+
+/* Rows of pixels through the vectorised kernel, VSGL_KERNEL_BLOCK shaded
+ * samples at a time. */
+static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0)
+{
+    shade_job *j = user;
+#if defined(__x86_64__) || defined(__i386__)
+    /* Flush denormals to zero while the kernel runs (restored below):
+     * amplitudes far below anything visible otherwise cost microcode
+     * assists of ~100 cycles each. Values stay finite and >= 0. */
+    unsigned int saved_csr = _mm_getcsr();
+    _mm_setcsr(saved_csr | 0x8040u); /* FTZ | DAZ */
+#endif
+    const vsgl_gbuffer *g = j->g;
+    const size_t spp = g->spp;
+    const size_t first = (j->base + b0) * spp, last = (j->base + e0) * spp, ns = last - first;
+    uint64_t pairs = 0;
+    /* which samples are shaded (shaded[]), and the slot each sample reads its light from */
+    size_t *shaded = malloc((ns + 1) * sizeof *shaded);
+    uint32_t *slot = malloc((ns + 1) * sizeof *slot);
+    float *light = malloc((ns + 1) * 6 * sizeof *light);
+    float *centroid = calloc((ns + 1) * 4, sizeof *centroid); /* per slot: position sum, count */
+    if (!shaded || !slot || !light || !centroid) {
+        free(shaded);
+        free(slot);
+        free(light);
+        free(centroid);
+#if defined(__x86_64__) || defined(__i386__)
+        _mm_setcsr(saved_csr);
+#endif
+        return VSGL_ERROR_OUT_OF_MEMORY;
+    }
+    size_t nshaded = 0;
+    for (size_t i = 0; i < ns; ++i) {
+        size_t si = first + i;
+        slot[i] = UINT32_MAX;
+        if (g->material[si] == VSGL_GBUFFER_MISS)
+            continue;
+        if (j->merge)
+            for (size_t k = i - i % spp; k < i && slot[i] == UINT32_MAX; ++k)
+                if (slot[k] != UINT32_MAX && shaded[slot[k]] == first + k && same_surface(g, j->materials, first + k, si, j->plane_tol))
+                    slot[i] = slot[k];
+        if (slot[i] == UINT32_MAX) {
+            slot[i] = (uint32_t)nshaded;
+            shaded[nshaded++] = si;
+        }
+        float *cg = centroid + (size_t)slot[i] * 4;
+        cg[0] += g->pos[0][si];
+        cg[1] += g->pos[1][si];
+        cg[2] += g->pos[2][si];
+        cg[3] += 1.0f;
+    }
+    pairs += vsgl__shade_list(j, shaded, nshaded, centroid, light);
+    /* every covered sample: its own colours, the light of its slot */
+    const float *Ls[VSGL_GBUFFER_MAX_SPP];
+    for (size_t px = j->base + b0; px < j->base + e0; ++px) {
+        for (size_t k = 0; k < spp; ++k) {
+            size_t i = (px - j->base - b0) * spp + k;
+            Ls[k] = slot[i] == UINT32_MAX ? NULL : light + (size_t)slot[i] * 6;
+        }
+        vsgl__write_pixel(j, px, Ls);
     }
     free(shaded);
     free(slot);
@@ -600,24 +600,51 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
     }
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
                    eps, 0, per_chunk, kl, path, leak,
-                   s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f};
+                   s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
+                   0, 0, 0, NULL, NULL, NULL};
+    vsgl_result r = VSGL_OK;
+    /* One pixel in S x S (sparse.c): the anchors now, the rest row by row below. */
+    int sparse = s->shade_stride > 1 && path != VSGL_SHADE_REFERENCE && g->width && g->height;
+    uint64_t anchor_total = 0;
+    if (sparse) {
+        j.stride = s->shade_stride;
+        j.aw = (g->width - 1) / j.stride + 2;
+        j.ah = (g->height - 1) / j.stride + 2;
+        size_t na = (size_t)j.aw * j.ah;
+        j.anchor_sample = malloc(na * sizeof *j.anchor_sample);
+        j.anchor_light = malloc(na * 6 * sizeof *j.anchor_light);
+        j.anchor_pairs = calloc(j.ah, sizeof *j.anchor_pairs);
+        if (!j.anchor_sample || !j.anchor_light || !j.anchor_pairs)
+            r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory for the sparse anchors");
+        else
+            r = vsgl__shade_anchors(ctx, &j);
+        for (uint32_t a = 0; r == VSGL_OK && a < j.ah; ++a)
+            anchor_total += j.anchor_pairs[a];
+    }
     /* Rows in batches so progress can be reported and cancellation honoured. */
     size_t rows_per_batch = g->height / 20 + 1;
-    vsgl_result r = VSGL_OK;
     for (size_t row = 0; row < g->height && r == VSGL_OK; row += rows_per_batch) {
         size_t end = row + rows_per_batch < g->height ? row + rows_per_batch : g->height;
         j.base = row * chunk;
         j.pairs = per_chunk + row;
-        vsgl__parallel_for(vsgl_context_thread_count(ctx), (end - row) * chunk, chunk,
-                           path == VSGL_SHADE_REFERENCE ? shade_chunk : shade_chunk_kernel, &j);
+        if (vsgl__parallel_for(vsgl_context_thread_count(ctx), (end - row) * chunk, chunk,
+                               path == VSGL_SHADE_REFERENCE ? shade_chunk
+                               : sparse                     ? vsgl__shade_chunk_sparse
+                                                            : shade_chunk_kernel, &j) != 0) {
+            r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
+            break;
+        }
         if (vsgl__progress(ctx, "shade", (float)end / (float)g->height))
             r = vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "shade: cancelled");
     }
-    uint64_t total = 0;
+    uint64_t total = anchor_total;
     for (size_t c = 0; c < chunks; ++c)
         total += per_chunk[c];
     free(per_chunk);
     free(kl);
+    free(j.anchor_sample);
+    free(j.anchor_light);
+    free(j.anchor_pairs);
     if (pairs)
         *pairs = total;
     return r;

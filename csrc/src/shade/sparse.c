@@ -1,0 +1,188 @@
+/* Shading one pixel in S x S (vsgl_render_settings.shade_stride = S > 1).
+ *
+ * Indirect light changes slowly across a surface, so most of a frame can
+ * be interpolated from a sparse set of shaded receivers:
+ *  1. anchors: the pixels (S ax, S ay) of a lattice over the image (the last
+ *     row and column included), each shaded at its first hit sample
+ *     (vsgl__shade_anchors);
+ *  2. every other sample takes the light of the four anchors around it,
+ *     weighted bilinearly and by how much each lies on the same surface
+ *     (same material, normals within ~25 degrees, off the sample's tangent
+ *     plane by at most ~5 % of their distance): a joint bilateral filter on
+ *     the G-buffer; a sample that no anchor shares a surface with (an edge,
+ *     a thin object) is shaded itself (vsgl__shade_chunk_sparse).
+ * The light of a sample, not its colour, is interpolated: DiffCol and
+ * GlossCol stay per pixel. The shading work falls by about S^2 except at
+ * edges; tests/c/test_sparse.c measures what it costs in error. */
+#include "shade/shade_job.h"
+#include "core/context.h"
+#include "core/parallel.h"
+
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+#if defined(__x86_64__) || defined(__i386__)
+#  include <xmmintrin.h>
+#endif
+
+/* A same-surface test's tolerances (see the file comment). */
+#define SPARSE_NORMAL_COS 0.9f
+#define SPARSE_PLANE_REL 0.05f
+
+static size_t anchor_pixel(const shade_job *j, uint32_t ax, uint32_t ay)
+{
+    const vsgl_gbuffer *g = j->g;
+    uint32_t x = ax * j->stride, y = ay * j->stride;
+    x = x < g->width ? x : g->width - 1;
+    y = y < g->height ? y : g->height - 1;
+    return (size_t)y * g->width + x;
+}
+
+/* Anchor rows [b, e): shade each anchor's first hit sample. */
+static int32_t anchor_rows(void *user, size_t chunk, size_t b, size_t e)
+{
+    shade_job *j = user;
+    (void)chunk;
+#if defined(__x86_64__) || defined(__i386__)
+    unsigned int saved_csr = _mm_getcsr();
+    _mm_setcsr(saved_csr | 0x8040u); /* FTZ | DAZ, as the full-resolution path */
+#endif
+    const vsgl_gbuffer *g = j->g;
+    size_t n_max = (e - b) * j->aw;
+    size_t *list = malloc((n_max + 1) * sizeof *list);
+    size_t *where = malloc((n_max + 1) * sizeof *where);
+    float *light = malloc((n_max + 1) * 6 * sizeof *light);
+    int32_t rc = 0;
+    if (!list || !where || !light) {
+        rc = VSGL_ERROR_OUT_OF_MEMORY;
+    } else {
+        size_t n = 0;
+        for (size_t ay = b; ay < e; ++ay)
+            for (uint32_t ax = 0; ax < j->aw; ++ax) {
+                size_t a = ay * j->aw + ax, px = anchor_pixel(j, ax, (uint32_t)ay);
+                j->anchor_sample[a] = SIZE_MAX;
+                for (size_t k = 0; k < g->spp; ++k)
+                    if (g->material[px * g->spp + k] != VSGL_GBUFFER_MISS) {
+                        j->anchor_sample[a] = px * g->spp + k;
+                        list[n] = px * g->spp + k;
+                        where[n++] = a;
+                        break;
+                    }
+            }
+        j->anchor_pairs[b] = vsgl__shade_list(j, list, n, NULL, light);
+        for (size_t k = 0; k < n; ++k)
+            memcpy(j->anchor_light + where[k] * 6, light + k * 6, 6 * sizeof *light);
+    }
+    free(list);
+    free(where);
+    free(light);
+#if defined(__x86_64__) || defined(__i386__)
+    _mm_setcsr(saved_csr);
+#endif
+    return rc;
+}
+
+vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
+{
+    return vsgl__parallel_for(vsgl_context_thread_count(ctx), j->ah, 1, anchor_rows, j) == 0
+               ? VSGL_OK
+               : vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory for the sparse anchors");
+}
+
+/* How much anchor sample a stands on sample s's surface, in [0, 1]. */
+static float same_surface_weight(const shade_job *j, size_t s, size_t a)
+{
+    const vsgl_gbuffer *g = j->g;
+    if (g->material[a] != g->material[s])
+        return 0.0f;
+    v3 ns = v3_make(g->nrm[0][s], g->nrm[1][s], g->nrm[2][s]);
+    v3 na = v3_make(g->nrm[0][a], g->nrm[1][a], g->nrm[2][a]);
+    float c = v3_dot(ns, na);
+    if (!(c > SPARSE_NORMAL_COS))
+        return 0.0f;
+    float wn = (c - SPARSE_NORMAL_COS) * (1.0f / (1.0f - SPARSE_NORMAL_COS));
+    v3 d = v3_make(g->pos[0][a] - g->pos[0][s], g->pos[1][a] - g->pos[1][s], g->pos[2][a] - g->pos[2][s]);
+    float off = fabsf(v3_dot(d, ns)), tol = SPARSE_PLANE_REL * v3_length(d) + j->plane_tol;
+    float wp = 1.0f - off / tol;
+    if (!(wp > 0.0f))
+        return 0.0f;
+    return wn * wp;
+}
+
+int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
+{
+    shade_job *j = user;
+    const vsgl_gbuffer *g = j->g;
+    const size_t spp = g->spp, W = g->width;
+    const size_t first = (j->base + b0) * spp, ns = (e0 - b0) * spp;
+    const float inv_s = 1.0f / (float)j->stride;
+    float *interp = malloc((ns + 1) * 6 * sizeof *interp);
+    size_t *direct = malloc((ns + 1) * sizeof *direct);
+    size_t *direct_of = malloc((ns + 1) * sizeof *direct_of); /* per sample: index in direct, or SIZE_MAX */
+    float *dlight = malloc((ns + 1) * 6 * sizeof *dlight);
+    int32_t rc = 0;
+    if (!interp || !direct || !direct_of || !dlight) {
+        rc = VSGL_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    size_t nd = 0;
+    for (size_t i = 0; i < ns; ++i) {
+        size_t si = first + i, px = si / spp;
+        direct_of[i] = SIZE_MAX;
+        if (g->material[si] == VSGL_GBUFFER_MISS)
+            continue;
+        /* the anchor cell around the pixel centre */
+        float fx = (float)(px % W) * inv_s, fy = (float)(px / W) * inv_s;
+        uint32_t ax = (uint32_t)fx, ay = (uint32_t)fy;
+        float tx = fx - (float)ax, ty = fy - (float)ay;
+        float wsum = 0.0f, L[6] = {0, 0, 0, 0, 0, 0};
+        for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) {
+                uint32_t cx = ax + (uint32_t)dx, cy = ay + (uint32_t)dy;
+                if (cx >= j->aw || cy >= j->ah)
+                    continue;
+                size_t a = (size_t)cy * j->aw + cx, as = j->anchor_sample[a];
+                float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
+                if (as == SIZE_MAX || !(wb > 0.0f))
+                    continue;
+                float w = wb * (as == si ? 1.0f : same_surface_weight(j, si, as));
+                if (!(w > 0.0f))
+                    continue;
+                wsum += w;
+                for (int c = 0; c < 6; ++c)
+                    L[c] += w * j->anchor_light[a * 6 + c];
+            }
+        if (wsum > 0.05f) {
+            for (int c = 0; c < 6; ++c)
+                interp[i * 6 + c] = L[c] / wsum;
+        } else {
+            direct_of[i] = nd;
+            direct[nd++] = si;
+        }
+    }
+#if defined(__x86_64__) || defined(__i386__)
+    unsigned int saved_csr = _mm_getcsr();
+    _mm_setcsr(saved_csr | 0x8040u);
+#endif
+    j->pairs[chunk] = vsgl__shade_list(j, direct, nd, NULL, dlight);
+#if defined(__x86_64__) || defined(__i386__)
+    _mm_setcsr(saved_csr);
+#endif
+    const float *Ls[VSGL_GBUFFER_MAX_SPP];
+    for (size_t px = j->base + b0; px < j->base + e0; ++px) {
+        for (size_t k = 0; k < spp; ++k) {
+            size_t i = (px - j->base - b0) * spp + k;
+            if (g->material[first + i] == VSGL_GBUFFER_MISS)
+                Ls[k] = NULL;
+            else
+                Ls[k] = direct_of[i] != SIZE_MAX ? dlight + direct_of[i] * 6 : interp + i * 6;
+        }
+        vsgl__write_pixel(j, px, Ls);
+    }
+done:
+    free(interp);
+    free(direct);
+    free(direct_of);
+    free(dlight);
+    return rc;
+}
