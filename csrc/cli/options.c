@@ -27,6 +27,7 @@ const char cli_usage[] =
     "  --visibility NAME     none | ray\n"
     "  --leak NAME           auto | off | on   (emitter-hemisphere light-leak correction)\n"
     "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
+    "  --shade-stride N      1..8              (shade one pixel in N x N, interpolate the rest)\n"
     "  --method NAME         vsgl | brute   (brute: every RSM texel, the reference)\n"
     "  --threads N           worker threads (0 = all cores)\n"
     "  --max-memory SIZE     refuse a render estimated to need more (e.g. 8G, 512M;\n"
@@ -138,6 +139,7 @@ static const num_opt num_opts[] = {
     {"--aa", 1, offsetof(cli_options, aa)},
     {"--rsm", 1, offsetof(cli_options, rsm)},
     {"--vsgls", 1, offsetof(cli_options, vsgls)},
+    {"--shade-stride", 1, offsetof(cli_options, stride)},
     {"--threads", 0, offsetof(cli_options, threads)},
     {"--seed", 0, offsetof(cli_options, seed)},
 };
@@ -300,6 +302,7 @@ void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_r
     if (o->aa.set) s->aa_samples = o->aa.value;
     if (o->rsm.set) s->rsm_resolution = o->rsm.value;
     if (o->vsgls.set) s->vsgl_count = o->vsgls.value;
+    if (o->stride.set) s->shade_stride = o->stride.value;
     if (o->seed.set) s->seed = o->seed.value;
     if (o->fit >= 0) s->fit_mode = o->fit;
     if (o->sharpness >= 0) s->sharpness_estimator = o->sharpness;
