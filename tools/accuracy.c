@@ -35,6 +35,8 @@ int main(int argc, char **argv)
         acc_scene(&fx, k, W, H, &name);
         vsgl_render_settings s;
         vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.shade_stride = 1; /* every pixel shaded, no visibility rays: the model alone */
+        s.visibility = VSGL_VISIBILITY_NONE;
         s.aa_samples = 1;
         s.rsm_resolution = rsm;
         s.method = VSGL_METHOD_BRUTE_FORCE;

@@ -12,6 +12,8 @@ VT_TEST(accuracy_fis_error_falls_with_vsgl_count_on_three_scenes)
     for (int k = 0; k < ACC_SCENES; ++k) {
         vsgl_render_settings s;
         vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.shade_stride = 1; /* every pixel shaded, no visibility rays: the model alone */
+        s.visibility = VSGL_VISIBILITY_NONE;
         s.aa_samples = 1;
         s.rsm_resolution = 32;
         s.method = VSGL_METHOD_BRUTE_FORCE;
@@ -63,6 +65,7 @@ VT_TEST(accuracy_visibility_casts_indirect_shadows)
     for (int k = 0; k < 3; ++k) {
         vsgl_render_settings s;
         vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.shade_stride = 1; /* every pixel shaded, no visibility rays: the model alone */
         s.aa_samples = 1;
         s.rsm_resolution = 32;
         s.vsgl_count = 128;

@@ -79,6 +79,8 @@ static int setup(bundle *b, float roughness, uint32_t vsgls, int32_t fit, int32_
     fx_room(&b->fx, 40, 30, roughness, 100.0f);
     vsgl_render_settings in;
     vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &in);
+    in.shade_stride = 1; /* every pixel shaded, no visibility rays: the model alone */
+    in.visibility = VSGL_VISIBILITY_NONE;
     in.vsgl_count = vsgls;
     in.rsm_resolution = 32;
     in.leak_correction = leak;

@@ -356,6 +356,8 @@ VT_TEST(render_sample_merging_cuts_pairs_at_small_error)
     static planes on, off;
     vsgl_render_settings s;
     vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.shade_stride = 1; /* every pixel shaded, no visibility rays: the model alone */
+    s.visibility = VSGL_VISIBILITY_NONE;
     s.aa_samples = 3;
     s.rsm_resolution = 32;
     s.vsgl_count = 32;
@@ -420,6 +422,8 @@ VT_TEST(render_shade_stride_cuts_pairs_at_small_error)
     enum { SW = 240, SH = 180 };
     vsgl_render_settings s;
     vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.shade_stride = 1; /* every pixel shaded, no visibility rays: the model alone */
+    s.visibility = VSGL_VISIBILITY_NONE;
     s.rsm_resolution = 64;
     s.aa_samples = 1;
     vsgl_render_stats st_full, st_sparse;
