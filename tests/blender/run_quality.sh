@@ -7,7 +7,7 @@
 #     each scene's feature, the brute force within 6 % of Cycles per pass; then the presets'
 #     numbers (INFO lines; VSGL_QUALITY_FRAMES animation frames, default 6 here) and issue 9's
 #     acceptance criteria as INFO (not failures yet). Report: build/quality/check_test.md.
-# Python: $PIP_PYTHON (pyenv, with flip-evaluator) if it imports numpy, else $PYTHON (FLIP skipped).
+# Python: $BPY_PYTHON (pyenv, with flip-evaluator) if it imports numpy, else $PYTHON (FLIP skipped).
 # Ends with "N passed, N failed"; exits non-zero on failure.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
@@ -30,7 +30,7 @@ if [ -z "$p1" ]; then
   tail -20 "$OUT/blender_quality.log"; p1=0; f1=1; [ $rc -eq 0 ] && rc=1
 fi
 [ $rc -ne 0 ] && echo "(Blender log: $OUT/blender_quality.log)"
-PY=${PIP_PYTHON:-python3}
+PY=${BPY_PYTHON:-python3}
 "$PY" -c "import numpy" >/dev/null 2>&1 || PY=${PYTHON:-/usr/bin/python3}
 VSGL_QUALITY_FRAMES=${VSGL_QUALITY_FRAMES:-6} "$PY" tests/quality/check.py --out "$OUT" >"$OUT/check.log" 2>&1
 rc2=$?
