@@ -41,7 +41,7 @@ extern "C" {
 
 /** Library version. The add-on refuses a library whose major.minor differ. */
 #define VSGL_VERSION_MAJOR 0
-#define VSGL_VERSION_MINOR 1
+#define VSGL_VERSION_MINOR 2
 #define VSGL_VERSION_PATCH 0
 /** Version packed as major*10000 + minor*100 + patch. */
 #define VSGL_VERSION (VSGL_VERSION_MAJOR * 10000 + VSGL_VERSION_MINOR * 100 + VSGL_VERSION_PATCH)
