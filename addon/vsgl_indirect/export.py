@@ -7,7 +7,7 @@ array comes from ``foreach_get`` and numpy.
 """
 import numpy as np
 
-from . import convert, materials
+from . import convert, materials, textures
 from .convert import ExportError
 
 MESH_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
@@ -24,6 +24,9 @@ class SceneData:
         self.corner_normals = np.zeros((0, 3, 3), np.float32)
         self.corner_uvs = None
         self.corner_tangents = None  # (T,3,4) float32 when a material is anisotropic
+        self.corner_colors = None    # (T,3,3) float32 when a material multiplies a colour attribute
+        self.textures = []           # (pixels (H,W,4) float32, flags) for libvsgl
+        self.material_textures = None  # one dict per material (slot -> field dict) or None
         self.material_indices = np.zeros(0, np.uint32)
         self.materials = []        # vsgl_material field dicts
         self.material_names = []
@@ -58,7 +61,9 @@ class MeshArrays:
         self.tri_verts = tri_verts        # (T,3) int
         self.tri_loops = tri_loops        # (T,3) int
         self.loop_normals = loop_normals  # (L,3) float32
-        self.loop_uvs = loop_uvs          # (L,2) float32 or None
+        self.loop_uvs = loop_uvs          # (L,2) float32 or None: the default (active render) UV map
+        self.uv_layers = {}               # name -> (L,2) float32: every UV map
+        self.loop_colors = {}             # colour attribute name ("" = default) -> (L,3) float32 linear
         self.tri_material = tri_material  # (T,) int: slot index
         self.slots = []                   # material per slot (bpy materials)
         self.texspace = None              # (location, size) of the texture space; None = bounds
@@ -115,7 +120,7 @@ def degenerate_mask(positions, indices, corner_normals):
     return ~(area2 > 0) | ~np.isfinite(area2) | ~np.all(n2 > 1e-20, axis=1)
 
 
-def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None):
+def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None, uv_map_of=None, color_of=None):
     """Concatenate ``chunks`` = [(MeshArrays, matrix 4x4, slot_to_global list)]
     into world-space (positions, indices, corner_normals, corner_uvs,
     material_indices) and, with ``want_tangents``, a sixth item
@@ -127,6 +132,12 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None):
     the same way as in Blender; normals and tangents use the inverse
     transpose (the cofactor matrix where the matrix is singular) and follow
     the flipped corner order.
+
+    ``uv_map_of(g)`` names the UV map the triangles of global material ``g``
+    take their UVs from ("" or None: the mesh's default one); with
+    ``color_of(g)`` (a colour attribute name or None), a last item
+    corner_colors (T,3,3) is returned: that attribute's corner colours, white
+    where the material has none.
 
     Degenerate triangles (:func:`degenerate_mask`: zero area or zero-length
     normal, e.g. an object scaled (1, 1, 0) or (0, 0, 0)) are left out; with
@@ -144,7 +155,7 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None):
         g[1].append(np.asarray(matrix, np.float64).reshape(4, 4))
         g[2].append(list(slot_map) if len(slot_map) else [0])
         g[3].append(ci)
-    pos, idx, nrm, uvs, mats, tan = [], [], [], [], [], []
+    pos, idx, nrm, uvs, mats, tan, cols = [], [], [], [], [], [], []
     base = 0
     for key in order:
         arr, ms, smaps, chunk_ids = groups[key]
@@ -188,31 +199,81 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None):
             t4 = np.ones((k, T, 3, 4), np.float32)
             t4[..., :3] = tc
             tan.append(t4.reshape(-1, 3, 4)[keep])
-        if want_uvs:
-            if arr.loop_uvs is not None:
-                uvs.append(arr.loop_uvs[tl].reshape(-1, 3, 2).astype(np.float32)[keep])
-            else:
-                uvs.append(np.zeros((int(keep.sum()), 3, 2), np.float32))
         width = max(len(sm) for sm in smaps)
         table = np.array([sm + [sm[-1]] * (width - len(sm)) for sm in smaps], np.uint32)
         slot = np.clip(arr.tri_material, 0, None)[None, :]
         last = np.array([len(sm) - 1 for sm in smaps])[:, None]
-        mats.append(table[np.arange(k)[:, None], np.minimum(slot, last)].reshape(-1)[keep])
+        gm = table[np.arange(k)[:, None], np.minimum(slot, last)]                 # (k, T)
+        if want_uvs:
+            uv = np.zeros((k, T, 3, 2), np.float32)
+            for g in np.unique(gm):
+                name = uv_map_of(int(g)) if uv_map_of else ""
+                layer = arr.uv_layers.get(name) if name else None
+                if layer is None and not (name and arr.uv_layers):
+                    layer = arr.loop_uvs
+                if layer is not None:
+                    m = gm == g
+                    uv[m] = layer[tl[m]]
+            uvs.append(uv.reshape(-1, 3, 2)[keep])
+        if color_of is not None:
+            col = np.ones((k, T, 3, 3), np.float32)
+            for g in np.unique(gm):
+                name = color_of(int(g))
+                layer = arr.loop_colors.get(name) if name is not None else None
+                if layer is not None:
+                    m = gm == g
+                    col[m] = layer[tl[m]]
+            cols.append(col.reshape(-1, 3, 3)[keep])
+        mats.append(gm.reshape(-1)[keep])
         base += k * V
     if not idx:
         out = (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.uint32),
                np.zeros((0, 3, 3), np.float32), None, np.zeros(0, np.uint32))
-        return out + (np.zeros((0, 3, 4), np.float32),) if want_tangents else out
+        out = out + (np.zeros((0, 3, 4), np.float32),) if want_tangents else out
+        return out + (np.zeros((0, 3, 3), np.float32),) if color_of is not None else out
     out = (np.concatenate(pos), np.concatenate(idx), np.concatenate(nrm),
            np.concatenate(uvs) if want_uvs else None, np.concatenate(mats).astype(np.uint32))
-    return out + (np.concatenate(tan),) if want_tangents else out
+    out = out + (np.concatenate(tan),) if want_tangents else out
+    return out + (np.concatenate(cols),) if color_of is not None else out
 
 
 # --------------------------------------------------------------------------
 # bpy glue
 # --------------------------------------------------------------------------
 
-def _mesh_arrays(mesh, compat, want_undeformed=False):
+def _color_layer(mesh, name):
+    """(L,3) float32 linear corner colours of colour attribute ``name`` ("" =
+    the default / render one), or None."""
+    attrs = getattr(mesh, "color_attributes", None)
+    layer = None
+    if attrs is not None and len(attrs):
+        if name:
+            layer = attrs.get(name)
+        else:
+            for prop in ("default_color_name", "active_color_name"):
+                n = getattr(mesh.attributes, prop, None) if hasattr(mesh, "attributes") else None
+                if n:
+                    layer = attrs.get(n)
+                    break
+            if layer is None:
+                idx = getattr(attrs, "render_color_index", -1)
+                layer = attrs[idx] if 0 <= idx < len(attrs) else attrs[0]
+    elif getattr(mesh, "vertex_colors", None) is not None and len(mesh.vertex_colors):
+        layer = mesh.vertex_colors.get(name) if name else mesh.vertex_colors.active
+    if layer is None:
+        return None
+    n = len(layer.data)
+    buf = np.empty(n * 4, np.float32)
+    layer.data.foreach_get("color", buf)
+    c = buf.reshape(n, 4)[:, :3]
+    if getattr(layer, "domain", "CORNER") == "POINT":
+        lv = np.empty(len(mesh.loops), np.int32)
+        mesh.loops.foreach_get("vertex_index", lv)
+        c = c[lv]
+    return np.ascontiguousarray(c)
+
+
+def _mesh_arrays(mesh, compat, want_undeformed=False, color_names=()):
     mesh.calc_loop_triangles()
     lt = mesh.loop_triangles
     nt, nv = len(lt), len(mesh.vertices)
@@ -226,12 +287,25 @@ def _mesh_arrays(mesh, compat, want_undeformed=False):
     lt.foreach_get("material_index", mi)
     ln = compat.corner_normals(mesh) if nt else np.zeros((0, 3), np.float32)
     uv = None
-    layer = mesh.uv_layers.active if len(mesh.uv_layers) else None
-    if layer is not None and nt:
-        uv = np.empty(len(mesh.loops) * 2, np.float32)
-        layer.data.foreach_get("uv", uv)
-        uv = uv.reshape(-1, 2)
+    layers = {}
+    if len(mesh.uv_layers) and nt:
+        for layer in mesh.uv_layers:
+            a = np.empty(len(mesh.loops) * 2, np.float32)
+            layer.data.foreach_get("uv", a)
+            layers[layer.name] = a.reshape(-1, 2)
+        # Cycles' default UVs (an Image Texture without a Vector link) are the
+        # active *render* UV map
+        default = next((l_.name for l_ in mesh.uv_layers if getattr(l_, "active_render", False)), None)
+        if default is None and mesh.uv_layers.active is not None:
+            default = mesh.uv_layers.active.name
+        uv = layers.get(default)
     arr = MeshArrays(pos.reshape(nv, 3), tv.reshape(nt, 3), tl.reshape(nt, 3), ln, uv, mi)
+    arr.uv_layers = layers
+    for name in color_names:
+        if nt:
+            c = _color_layer(mesh, name)
+            if c is not None:
+                arr.loop_colors[name] = c
     if nt:
         smooth = np.empty(nt, bool)
         lt.foreach_get("use_smooth", smooth)
@@ -275,6 +349,210 @@ def _socket_value(s):
             return None
 
 
+# --------------------------------------------------------------------------
+# texture node chains (bpy glue; the evaluation is textures.py)
+# --------------------------------------------------------------------------
+
+_image_pixels_cache = {}
+
+
+def _image_pixels(img):
+    """(H, W, 4) float32 of a bpy image, rows bottom to top, or None."""
+    key = (img.as_pointer(), img.name_full, getattr(img, "filepath", ""), tuple(img.size))
+    if key in _image_pixels_cache:
+        return _image_pixels_cache[key]
+    px = None
+    try:
+        w, h = int(img.size[0]), int(img.size[1])
+        if w > 0 and h > 0:
+            buf = np.empty(w * h * 4, np.float32)
+            img.pixels.foreach_get(buf)
+            px = buf.reshape(h, w, 4)
+    except (RuntimeError, ValueError, TypeError):
+        px = None
+    if len(_image_pixels_cache) > 64:
+        _image_pixels_cache.clear()
+    _image_pixels_cache[key] = px
+    return px
+
+
+def _socket_default(sock):
+    v = _socket_value(sock)
+    if v is None:
+        return (0.0, 0.0, 0.0, 1.0)
+    return v
+
+
+def _find_socket(coll, identifier, name=None):
+    for s in coll:
+        if s.identifier == identifier:
+            return s
+    return coll.get(name) if name else None
+
+
+class _ExprBuilder:
+    """Reads the nodes in front of a socket into textures.py expressions."""
+
+    def __init__(self, mat_name):
+        self.mat = mat_name
+        self.images = {}   # key -> textures.ImageRef
+        self.warnings = []
+
+    def socket(self, sock, depth=0):
+        if not sock.is_linked:
+            return ("const", _socket_default(sock))
+        if depth > 48:
+            return ("unsupported", "node chain too deep", _socket_default(sock))
+        link = sock.links[0]
+        if not getattr(link, "is_valid", True) or getattr(link, "is_muted", False):
+            return ("const", _socket_default(sock))
+        out = link.from_socket
+        node = link.from_node
+        while node.bl_idname == "NodeReroute":
+            if not node.inputs[0].is_linked:
+                return ("const", _socket_default(sock))
+            l2 = node.inputs[0].links[0]
+            out, node = l2.from_socket, l2.from_node
+        return self.node(node, out, sock, depth + 1)
+
+    def node(self, node, out, target, depth):
+        t = node.bl_idname
+        inp = node.inputs
+        S = lambda name: self.socket(inp[name], depth)  # noqa: E731
+        default = _socket_default(target)
+        if node.mute:
+            return ("unsupported", "node '%s' is muted" % node.name, default)
+        if t == "ShaderNodeTexImage":
+            key = self.image(node, depth)
+            if key is None:
+                return ("unsupported", "Image Texture '%s' has no image" % node.name, default)
+            return ("alpha", ("img", key)) if out.name == "Alpha" else ("img", key)
+        if t in ("ShaderNodeVertexColor",):
+            e = ("vc", getattr(node, "layer_name", "") or "")
+            return ("alpha", e) if out.name == "Alpha" else e
+        if t == "ShaderNodeAttribute" and getattr(node, "attribute_type", "GEOMETRY") == "GEOMETRY":
+            e = ("vc", node.attribute_name or "")
+            return ("alpha", e) if out.name == "Alpha" else e
+        if t == "ShaderNodeRGB":
+            return ("const", tuple(out.default_value))
+        if t == "ShaderNodeValue":
+            v = float(out.default_value)
+            return ("const", (v, v, v, 1.0))
+        if t == "ShaderNodeMixRGB":
+            if node.blend_type not in textures.MIX_BLENDS:
+                return ("unsupported", "Mix node '%s' blend %s is not evaluated" % (node.name, node.blend_type),
+                        default)
+            return ("mix", node.blend_type, S("Fac"), S("Color1"), S("Color2"), bool(node.use_clamp))
+        if t == "ShaderNodeMix":
+            dt = getattr(node, "data_type", "RGBA")
+            if dt not in ("RGBA", "FLOAT") or node.blend_type not in textures.MIX_BLENDS or \
+                    getattr(node, "factor_mode", "UNIFORM") != "UNIFORM":
+                return ("unsupported", "Mix node '%s' (%s, %s) is not evaluated" % (node.name, dt, node.blend_type),
+                        default)
+            suf = "Color" if dt == "RGBA" else "Float"
+            fac = self.socket(_find_socket(inp, "Factor_Float", "Factor"), depth)
+            a = self.socket(_find_socket(inp, "A_" + suf, "A"), depth)
+            b = self.socket(_find_socket(inp, "B_" + suf, "B"), depth)
+            blend = node.blend_type if dt == "RGBA" else "MIX"
+            clamp = bool(getattr(node, "clamp_result", False)) or (dt == "FLOAT" and False)
+            return ("mix", blend, fac, a, b, clamp)
+        if t == "ShaderNodeInvert":
+            return ("invert", S("Fac"), S("Color"))
+        if t == "ShaderNodeHueSaturation":
+            return ("hsv", S("Hue"), S("Saturation"), S("Value"), S("Fac"), S("Color"))
+        if t == "ShaderNodeGamma":
+            return ("gamma", S("Color"), S("Gamma"))
+        if t == "ShaderNodeBrightContrast":
+            return ("bc", S("Color"), S("Bright"), S("Contrast"))
+        if t == "ShaderNodeValToRGB":
+            ramp = node.color_ramp
+            stops = tuple((float(e.position), tuple(float(c) for c in e.color)) for e in ramp.elements)
+            interp = ramp.interpolation
+            if interp not in ("LINEAR", "CONSTANT", "EASE"):
+                self.warnings.append("material '%s': Color Ramp '%s' interpolation %s is evaluated as linear"
+                                     % (self.mat, node.name, interp))
+                interp = "LINEAR"
+            if getattr(ramp, "color_mode", "RGB") != "RGB":
+                self.warnings.append("material '%s': Color Ramp '%s' colour mode %s is evaluated in RGB"
+                                     % (self.mat, node.name, ramp.color_mode))
+            e = ("ramp", stops, interp, S("Fac"))
+            return ("alpha", e) if out.name == "Alpha" else e
+        if t in ("ShaderNodeSeparateRGB", "ShaderNodeSeparateColor"):
+            if getattr(node, "mode", "RGB") != "RGB":
+                return ("unsupported", "Separate Color '%s' in %s mode" % (node.name, node.mode), default)
+            ch = {"R": 0, "G": 1, "B": 2, "Red": 0, "Green": 1, "Blue": 2}.get(out.name)
+            if ch is None:
+                return ("unsupported", "Separate node '%s' output %s" % (node.name, out.name), default)
+            c = self.socket(_find_socket(inp, "Image", "Image") or _find_socket(inp, "Color", "Color"), depth)
+            return ("sep", ch, c)
+        if t == "ShaderNodeRGBToBW":
+            return ("bw", S("Color"))
+        if t == "ShaderNodeMath" and node.operation in textures.MATH_OPS:
+            return ("math", node.operation, self.socket(inp[0], depth), self.socket(inp[1], depth),
+                    bool(node.use_clamp))
+        return ("unsupported", "node '%s' (%s) is not evaluated" % (node.name, t), default)
+
+    def uv_source(self, node, depth):
+        """(uv_map, uv_transform, problem) of an Image Texture's Vector input."""
+        sock = node.inputs.get("Vector")
+        if sock is None or not sock.is_linked:
+            return "", None, ""
+        transform = None
+        link = sock.links[0]
+        src, out = link.from_node, link.from_socket
+        while src.bl_idname == "NodeReroute" and src.inputs[0].is_linked:
+            l2 = src.inputs[0].links[0]
+            src, out = l2.from_node, l2.from_socket
+        if src.bl_idname == "ShaderNodeMapping":
+            vt = src.vector_type
+            vals = {}
+            for name in ("Location", "Rotation", "Scale"):
+                s_ = src.inputs.get(name)
+                if s_ is not None and s_.is_linked:
+                    return "", None, "has a linked Mapping input"
+                vals[name] = tuple(s_.default_value) if s_ is not None else None
+            if vals["Location"] is None:  # Blender 2.8x-style properties
+                vals = {"Location": tuple(src.translation), "Rotation": tuple(src.rotation),
+                        "Scale": tuple(src.scale)}
+            transform = textures.mapping_uv_transform(vt, vals["Location"], vals["Rotation"], vals["Scale"])
+            if transform is None:
+                return "", None, "has a Mapping node that is not a 2-D transform of the UVs"
+            vin = src.inputs.get("Vector")
+            if vin is None or not vin.is_linked:
+                return "", None, "has a Mapping node without UV input (generated coordinates)"
+            link = vin.links[0]
+            src, out = link.from_node, link.from_socket
+        if src.bl_idname == "ShaderNodeUVMap":
+            return src.uv_map or "", transform, ""
+        if src.bl_idname == "ShaderNodeTexCoord" and out.name == "UV":
+            return "", transform, ""
+        return "", None, "is looked up with '%s' coordinates, not UVs" % (
+            out.name if src.bl_idname == "ShaderNodeTexCoord" else src.bl_idname)
+
+    def image(self, node, depth):
+        img = node.image
+        if img is None:
+            return None
+        uv_map, transform, problem = self.uv_source(node, depth)
+        if getattr(node, "projection", "FLAT") != "FLAT":
+            problem = problem or "uses %s projection" % node.projection
+        if getattr(img, "source", "FILE") == "TILED":
+            problem = problem or "is a UDIM tile set"
+        cs = getattr(img.colorspace_settings, "name", "sRGB")
+        is_float = bool(getattr(img, "is_float", False))
+        srgb = (not is_float) and cs == "sRGB"
+        if cs not in ("sRGB", "Non-Color", "Linear", "Linear Rec.709", "Raw", "Linear CIE-XYZ E", "XYZ"):
+            self.warnings.append("material '%s': image '%s' colour space '%s' is read as %s"
+                                 % (self.mat, img.name, cs, "linear" if is_float else "sRGB"))
+            srgb = not is_float
+        key = "%s|%s|%s|%s|%s|%s" % (img.name_full, node.interpolation, node.extension, uv_map, transform, problem)
+        if key not in self.images:
+            self.images[key] = textures.ImageRef(
+                img.name, _image_pixels(img), srgb=srgb, interpolation=node.interpolation,
+                extension=node.extension, uv_map=uv_map, uv_transform=transform, problem=problem)
+        return key
+
+
 def describe_material(mat, compat):
     """Read a material into a :class:`materials.ShaderDesc` (bpy glue)."""
     vp = (tuple(mat.diffuse_color), float(mat.metallic), float(mat.roughness))
@@ -316,9 +594,16 @@ def describe_material(mat, compat):
             inputs[s.name] = v
         if s.is_linked:
             linked.add(s.name)
+    builder = _ExprBuilder(name)
+    exprs = {}
+    for sock_name in materials.TEXTURED_INPUTS.get(kind, {}):
+        s_ = node.inputs.get(sock_name)
+        if s_ is not None and s_.is_linked:
+            exprs[sock_name] = builder.socket(s_)
     return materials.ShaderDesc(name, kind, inputs, linked, node=node.name, viewport=vp,
                                 version=ver,
-                                multiscatter=getattr(node, "distribution", "") == "MULTI_GGX")
+                                multiscatter=getattr(node, "distribution", "") == "MULTI_GGX",
+                                exprs=exprs, images=builder.images, extra_warnings=builder.warnings)
 
 
 def _holdout_objects(view_layer):
@@ -349,7 +634,8 @@ def collect(depsgraph, scene=None, require_lights=True):
     viewport = depsgraph.mode != "RENDER"
 
     mat_index = {}
-    mapped_cache = {}   # key -> (fields, warnings) of a bpy material, mapped once
+    mapped_cache = {}   # key -> (fields, warnings, slot plans) of a bpy material, mapped once
+    material_plans = []  # per global material: slot -> textures.SlotPlan
 
     def material_key(mat):
         return mat.original.name_full if mat.original else mat.name_full
@@ -363,8 +649,15 @@ def collect(depsgraph, scene=None, require_lights=True):
                 warns = list(warns) + [
                     "material '%s': its Tangent input is linked; Cycles' default tangent "
                     "(radial about the object's Z) is used instead" % key]
-            mapped_cache[key] = (fields, warns)
+            plans, more = _material_slots(key, fields, materials.texture_plans(desc))
+            mapped_cache[key] = (fields, list(warns) + more, plans)
         return mapped_cache[key]
+
+    def vertex_color_of(mat):
+        if mat is None:
+            return None
+        pl = mapped(mat)[2].get("base_color")
+        return pl.vertex_color if pl is not None else None
 
     def anisotropic(mat):
         """Does ``mat`` map to an anisotropic lobe (needs tangents)?"""
@@ -379,6 +672,7 @@ def collect(depsgraph, scene=None, require_lights=True):
             key = material_key(mat)
         if key in mat_index:
             return mat_index[key]
+        plans = {}
         if key == HOLDOUT_KEY:
             fields = materials.default_material()
             fields.update(base_color=(0.0, 0.0, 0.0), specular_f0=0.0)
@@ -386,11 +680,12 @@ def collect(depsgraph, scene=None, require_lights=True):
         elif key == DEFAULT_KEY:
             fields, warns = materials.default_material(), []
         else:
-            fields, warns = mapped(mat)
+            fields, warns, plans = mapped(mat)
         if compat.VERSION >= (4, 0, 0):  # Cycles 4.x+ GGX shadowing (vsgl/scene.h)
             fields = dict(fields, flags=int(fields.get("flags", 0)) | materials.MATERIAL_FLAG_BLENDER_4)
         sd.warnings.extend(warns)
         mat_index[key] = len(sd.materials)
+        material_plans.append(plans)
         sd.materials.append(fields)
         sd.material_names.append(key)
         return mat_index[key]
@@ -435,7 +730,8 @@ def collect(depsgraph, scene=None, require_lights=True):
             else:
                 try:
                     slots = [s.material for s in obj.material_slots] or list(mesh.materials)
-                    arr = _mesh_arrays(mesh, compat, any(anisotropic(m) for m in slots))
+                    vc_names = sorted({n for n in (vertex_color_of(m) for m in slots) if n is not None})
+                    arr = _mesh_arrays(mesh, compat, any(anisotropic(m) for m in slots), vc_names)
                 finally:
                     obj.to_mesh_clear()
                 arr.slots = slots
@@ -448,11 +744,23 @@ def collect(depsgraph, scene=None, require_lights=True):
                                else "%s (instance of %s)" % (orig.name, parent.name if parent else "?"))
         sd.instance_count += int(inst.is_instance)
 
-    want_uvs = any(a.loop_uvs is not None for a, _, _ in chunks)
+    want_uvs = any(a.loop_uvs is not None or a.uv_layers for a, _, _ in chunks)
     # Tangents only matter to anisotropic lobes: skip them (NULL) otherwise.
     want_tangents = any(m.get("anisotropy", 0.0) > 0.0 for m in sd.materials)
     dropped = {}
-    out = assemble(chunks, want_uvs, want_tangents, dropped)
+
+    def uv_map_of(g):
+        for pl in material_plans[g].values():
+            if pl.texture is not None:
+                return pl.texture["uv_map"]
+        return ""
+
+    def color_of(g):
+        pl = material_plans[g].get("base_color") if g < len(material_plans) else None
+        return pl.vertex_color if pl is not None else None
+
+    any_vc = any(color_of(g) is not None for g in range(len(material_plans)))
+    out = assemble(chunks, want_uvs, want_tangents, dropped, uv_map_of, color_of if any_vc else None)
     for ci, (n, total) in sorted(dropped.items()):
         what = ("all %d triangles are" % total) if n == total else ("%d of %d triangles are" % (n, total))
         sd.warnings.append("object '%s': %s degenerate (zero area or zero-length normal, e.g. a "
@@ -460,6 +768,8 @@ def collect(depsgraph, scene=None, require_lights=True):
     (sd.positions, sd.indices, sd.corner_normals, sd.corner_uvs,
      sd.material_indices) = out[:5]
     sd.corner_tangents = out[5] if want_tangents else None
+    sd.corner_colors = out[-1] if any_vc else None
+    _library_textures(sd, material_plans)
     if not sd.materials:
         material_global(None, False)
 
@@ -472,6 +782,57 @@ def collect(depsgraph, scene=None, require_lights=True):
         raise ExportError("scene '%s' (view layer '%s') has no light with non-zero power"
                           % (scene.name, view_layer.name))
     return sd
+
+
+def _material_slots(name, fields, plans):
+    """Keep the textured slots of one material that share one UV map (the
+    library has one UV set per triangle): others are reduced to their mean.
+    Returns (plans, warnings)."""
+    warns, out, uv = [], {}, None
+    for slot in ("base_color", "roughness", "metallic"):
+        pl = plans.get(slot)
+        if pl is None:
+            continue
+        if pl.texture is not None:
+            if uv is None:
+                uv = pl.texture["uv_map"]
+            elif pl.texture["uv_map"] != uv:
+                mean = pl.texture["pixels"].reshape(-1, 4).mean(axis=0)
+                if slot == "base_color":
+                    fields[slot] = tuple(float(min(max(c, 0), 1)) for c in mean[:3])
+                else:
+                    fields[slot] = float(min(max(mean[0] * fields[slot], 0), 1))
+                warns.append("material '%s': its %s texture uses UV map '%s', another input '%s'; "
+                             "its mean is used" % (name, slot, pl.texture["uv_map"], uv))
+                pl = textures.SlotPlan(pl.constant)
+        out[slot] = pl
+    return out, warns
+
+
+def _library_textures(sd, material_plans):
+    """sd.textures and sd.material_textures (vsgl_material_textures fields)
+    from the slot plans; one texture per distinct pixel array."""
+    sd.textures, ids, mts, any_tex = [], {}, [], False
+    for plans in material_plans:
+        mt = {}
+        flags = 0
+        for slot, pl in plans.items():
+            if slot == "base_color" and pl.vertex_color is not None and sd.corner_colors is not None:
+                flags |= textures.VERTEX_COLOR_FLAG
+                any_tex = True
+            t = pl.texture
+            if t is None:
+                continue
+            key = (id(t["pixels"]), t["srgb"])
+            if key not in ids:
+                sd.textures.append((np.ascontiguousarray(t["pixels"], np.float32),
+                                    textures.TEXTURE_FLAG_SRGB if t["srgb"] else 0))
+                ids[key] = len(sd.textures)
+            mt[slot] = dict(texture=ids[key], filter=t["filter"], wrap=t["wrap"], channel=t.get("channel", 0),
+                            uv_transform=t["uv_transform"] or (0.0,) * 6)
+            any_tex = True
+        mts.append(dict(slots=mt, flags=flags))
+    sd.material_textures = mts if any_tex else None
 
 
 def _add_light(sd, obj, matrix, compat):

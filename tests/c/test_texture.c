@@ -115,7 +115,17 @@ VT_TEST(texture_lookup_matches_direct_pixel_arithmetic)
     vsgl__texture_free(&t);
     free(px);
 
-    /* sRGB: decoded before filtering (alpha untouched) */
+    /* sRGB: the finest level is decoded after the bilinear lookup (as Cycles'
+     * 8-bit images), coarser levels average decoded values */
+    float s2[8] = {0.2f, 0.2f, 0.2f, 1.0f, 0.9f, 0.9f, 0.9f, 1.0f};
+    vsgl_texture in4 = {2, 1, s2, VSGL_TEXTURE_FLAG_SRGB, 0};
+    VT_CHECK(vsgl__texture_build(ctx, 0, &in4, &t) == VSGL_OK, "build");
+    vsgl__texture_lookup(&t, 0.5f, 0.5f, 0.0f, VSGL_FILTER_LINEAR, VSGL_WRAP_EXTEND, got);
+    VT_CHECK_REL(got[0], vsgl__srgb_to_linear(0.55f), 1e-5, "decode after interpolation");
+    vsgl__texture_lookup(&t, 0.5f, 0.5f, 1.0f, VSGL_FILTER_LINEAR, VSGL_WRAP_EXTEND, got);
+    VT_CHECK_REL(got[0], 0.5 * (vsgl__srgb_to_linear(0.2f) + vsgl__srgb_to_linear(0.9f)), 1e-5, "mip of decoded values");
+    vsgl__texture_free(&t);
+    /* and a single texel (alpha untouched) */
     float s4[4] = {0.5f, 0.04f, 1.0f, 0.5f};
     vsgl_texture in3 = {1, 1, s4, VSGL_TEXTURE_FLAG_SRGB, 0};
     VT_CHECK(vsgl__texture_build(ctx, 0, &in3, &t) == VSGL_OK, "build");

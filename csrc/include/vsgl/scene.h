@@ -61,8 +61,10 @@ typedef struct vsgl_material {
 
 /** Texture flags. */
 /** The RGB channels hold sRGB-encoded values (an 8-bit image whose colour
- *  space is sRGB, as Blender's Image.pixels hands it over): decoded to linear
- *  before filtering. Alpha is always linear. */
+ *  space is sRGB, as Blender's Image.pixels hands it over). As Cycles does
+ *  for such images, lookups in the full-resolution level interpolate the
+ *  encoded values and decode the result; the coarser mip levels average
+ *  decoded (linear) values. Alpha is always linear. */
 #define VSGL_TEXTURE_FLAG_SRGB 1u
 #define VSGL_TEXTURE_FLAGS_KNOWN VSGL_TEXTURE_FLAG_SRGB
 

@@ -33,19 +33,31 @@ vsgl_result vsgl__texture_build(vsgl_context *ctx, uint32_t index, const vsgl_te
     if (!p)
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "texture %u: out of memory for %ux%u texels", (unsigned)index,
                           (unsigned)w, (unsigned)h);
-    if (in->flags & VSGL_TEXTURE_FLAG_SRGB) {
-        for (size_t i = 0; i < n; ++i)
-            p[i] = (i & 3) == 3 ? in->pixels[i] : vsgl__srgb_to_linear(in->pixels[i]);
-    } else {
-        memcpy(p, in->pixels, n * sizeof(float));
-    }
+    memcpy(p, in->pixels, n * sizeof(float));
     out->lv[0] = (vsgl_tex_level){w, h, p};
     out->levels = 1;
+    out->srgb = (in->flags & VSGL_TEXTURE_FLAG_SRGB) != 0;
+    /* the source of level 1: level 0, decoded for sRGB textures */
+    float *lin = NULL;
+    if (out->srgb && (w > 1 || h > 1)) {
+        lin = malloc(n * sizeof(float));
+        if (!lin) {
+            vsgl__texture_free(out);
+            return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "texture %u: out of memory for %ux%u texels", (unsigned)index,
+                              (unsigned)w, (unsigned)h);
+        }
+        for (size_t i = 0; i < n; ++i)
+            lin[i] = (i & 3) == 3 ? p[i] : vsgl__srgb_to_linear(p[i]);
+    }
     while ((w > 1 || h > 1) && out->levels < VSGL_TEX_MAX_LEVELS) {
-        const vsgl_tex_level *s = &out->lv[out->levels - 1];
+        vsgl_tex_level src0 = out->lv[out->levels - 1];
+        if (out->levels == 1 && lin)
+            src0.p = lin;
+        const vsgl_tex_level *s = &src0;
         uint32_t nw = (s->w + 1) / 2, nh = (s->h + 1) / 2;
         float *q = malloc((size_t)nw * nh * 4 * sizeof(float));
         if (!q) {
+            free(lin);
             vsgl__texture_free(out);
             return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "texture %u: out of memory for its mip levels", (unsigned)index);
         }
@@ -64,6 +76,7 @@ vsgl_result vsgl__texture_build(vsgl_context *ctx, uint32_t index, const vsgl_te
         w = nw;
         h = nh;
     }
+    free(lin);
     return VSGL_OK;
 }
 
@@ -138,11 +151,17 @@ void vsgl__texture_lookup(const vsgl_tex *t, float u, float v, float lod, int32_
         lod = top;
     if (filter == VSGL_FILTER_CLOSEST && lod < 0.5f) {
         level_lookup(&t->lv[0], u, v, 1, wrap, out);
+        if (t->srgb)
+            for (int c = 0; c < 3; ++c)
+                out[c] = vsgl__srgb_to_linear(out[c]);
         return;
     }
     uint32_t l0 = (uint32_t)lod;
     float f = lod - (float)l0;
     level_lookup(&t->lv[l0], u, v, 0, wrap, out);
+    if (l0 == 0 && t->srgb)
+        for (int c = 0; c < 3; ++c)
+            out[c] = vsgl__srgb_to_linear(out[c]);
     if (f > 0.0f && l0 + 1 < t->levels) {
         float b[4];
         level_lookup(&t->lv[l0 + 1], u, v, 0, wrap, b);

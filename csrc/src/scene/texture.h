@@ -15,11 +15,15 @@ typedef struct vsgl_tex_level {
 } vsgl_tex_level;
 
 typedef struct vsgl_tex {
+    int srgb;                /* level 0 holds the caller's sRGB values, decoded after filtering
+                                (as Cycles does for 8-bit sRGB images); levels 1.. are linear */
     uint32_t levels;         /* level 0 = the image, each next 2 x 2 box-filtered, last 1 x 1 */
     vsgl_tex_level lv[VSGL_TEX_MAX_LEVELS];
 } vsgl_tex;
 
-/* Copy (decoding sRGB if flagged) and mip-map one validated texture. */
+/* Copy and mip-map one validated texture. An sRGB texture keeps level 0
+ * encoded (decoded after the bilinear lookup, as Cycles' 8-bit images); its
+ * coarser levels average decoded (linear) values. */
 vsgl_result vsgl__texture_build(vsgl_context *ctx, uint32_t index, const vsgl_texture *in, vsgl_tex *out);
 void vsgl__texture_free(vsgl_tex *t);
 
