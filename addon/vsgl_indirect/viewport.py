@@ -39,11 +39,17 @@ class _Session:
         self.last_edit = time.perf_counter()   # newest edit or view change seen
         self.last_done = 0.0                   # when the newest image arrived
         self.submits = 0                       # renders started
+        self.lib_scene = None                  # libvsgl.Scene reused while geometry stands still
+        self.lib_arrays = None                 # (arrays, materials) it was built from
+        self.scene_builds = 0
         self.updates = 0                       # depsgraph updates seen
         self.current_job = None
 
     def close(self):
         self.renderer.cancel(wait=True)
+        if self.lib_scene is not None:
+            self.lib_scene.close()
+            self.lib_scene = None
         if self.ctx is not None:
             try:
                 self.ctx.close()
@@ -147,25 +153,49 @@ def _render(session, sd, preset, threads, job, exposure, t_export):
                                   progress=lambda stage, f: bool(session.current_job and
                                                                  session.current_job.cancelled.is_set()))
     t0 = time.perf_counter()
-    try:
-        scene = lib.Scene(session.ctx, **engine.scene_arrays(sd, lib))
-    except lib.VsglError as e:
-        raise RuntimeError("the scene was refused: %s" % (e.message or e))
-    t1 = time.perf_counter()
-    try:
-        settings = lib.render_settings_preset(getattr(lib.Preset, preset))
+    arrays = engine.scene_arrays(sd, lib)
+    view = dict(camera=arrays.pop("camera"), lights=arrays.pop("lights"))
+    if session.lib_scene is None or not _same_geometry(session.lib_arrays, arrays, sd.materials):
+        if session.lib_scene is not None:
+            session.lib_scene.close()
+            session.lib_scene = None
         try:
-            images, stats = lib.render(session.ctx, scene, settings, ("combined",))
-        except lib.VsglCancelledError:
-            return None
-    finally:
-        scene.close()
+            session.lib_scene = lib.Scene(session.ctx, **arrays, **view)
+        except lib.VsglError as e:
+            raise RuntimeError("the scene was refused: %s" % (e.message or e))
+        session.lib_arrays = (arrays, list(sd.materials))
+        session.scene_builds += 1
+    else:
+        session.lib_scene.set_view(view["camera"], view["lights"])
+    t1 = time.perf_counter()
+    settings = lib.render_settings_preset(getattr(lib.Preset, preset))
+    try:
+        images, stats = lib.render(session.ctx, session.lib_scene, settings, ("combined",))
+    except lib.VsglCancelledError:
+        return None
     t2 = time.perf_counter()
     rgba = live.display_rgba(images["combined"], exposure)
     t3 = time.perf_counter()
     return dict(rgba=rgba, width=sd.width, height=sd.height,
                 timings=dict(export=t_export, scene=t1 - t0, render=t2 - t1, encode=t3 - t2),
                 triangles=sd.triangle_count, vsgls=int(stats.get("vsgl_count", 0)) if isinstance(stats, dict) else 0)
+
+
+def _same_geometry(prev, arrays, materials):
+    """Did geometry and materials stay as they were? (Then only the camera
+    and lights change: vsgl_scene_set_view keeps the BVH.)"""
+    if prev is None:
+        return False
+    old, old_materials = prev
+    if old_materials != list(materials) or old.keys() != arrays.keys():
+        return False
+    for k, a in arrays.items():
+        b = old[k]
+        if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+            if not (isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and a.shape == b.shape
+                    and np.array_equal(a, b)):
+                return False
+    return True
 
 
 def _tick():

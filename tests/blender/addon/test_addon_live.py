@@ -190,3 +190,32 @@ def test_operator_and_panel_register():
             assert len(p.description) > 20, p.identifier
     assert hasattr(bpy.types, "VIEW3D_PT_vsgl_live")
     assert hasattr(bpy.ops.vsgl, "live_preview")
+
+
+def test_live_keeps_the_library_scene_while_geometry_stands_still(scene):
+    """A light edit reuses the library scene (vsgl_scene_set_view) and gives
+    the image a new scene would; a geometry edit builds a new one."""
+    room(scene)
+    w, h = 40, 30
+    scene.render.resolution_x, scene.render.resolution_y = w, h
+    s = viewport._Session(0)
+    cache = {}
+
+    def live_render():
+        dg = bpy.context.evaluated_depsgraph_get()
+        sd = export.collect(dg, scene, mesh_cache=cache)
+        return sd, viewport._render(s, sd, "PREVIEW", 0, live.Job(1, "k"), 0.0, 0.0)
+
+    try:
+        live_render()
+        bpy.data.objects["Spot"].location.x += 0.7
+        sd, moved = live_render()
+        assert s.scene_builds == 1
+        planes, _ = engine.render_planes(sd, Options(enabled=True, preset="PREVIEW"))
+        np.testing.assert_array_equal(moved["rgba"], live.display_rgba(planes["combined"]))
+        bpy.data.objects["Wall"].location.z += 0.3
+        cache.clear()
+        live_render()
+        assert s.scene_builds == 2
+    finally:
+        s.close()
