@@ -5,6 +5,8 @@ lights, camera, materials) into plain values; ``assemble()`` (no bpy) turns
 mesh chunks into world-space arrays. No per-vertex Python loops: every
 array comes from ``foreach_get`` and numpy.
 """
+import math
+
 import numpy as np
 
 from . import convert, materials, textures
@@ -35,6 +37,7 @@ class SceneData:
         self.camera = None         # vsgl_camera field dict
         self.camera_name = ""
         self.warnings = []
+        self.emissive_log = []     # info lines: emissive meshes turned into lights
         self.object_names = []     # one per exported mesh instance
         self.instance_count = 0    # instances among them
         self.width = self.height = 0
@@ -44,9 +47,12 @@ class SceneData:
         return int(self.indices.shape[0])
 
     def summary(self):
-        return ("%d triangles, %d objects (%d instances), %d materials, %d lights, camera '%s' %dx%d"
+        emissive = sum(1 for n in self.light_names if n.startswith("emission of"))
+        return ("%d triangles, %d objects (%d instances), %d materials, %d lights%s, camera '%s' %dx%d"
                 % (self.triangle_count, len(self.object_names), self.instance_count,
-                   len(self.materials), len(self.lights), self.camera_name, self.width, self.height))
+                   len(self.materials), len(self.lights),
+                   (" (%d from emissive faces)" % emissive) if emissive else "",
+                   self.camera_name, self.width, self.height))
 
 
 # --------------------------------------------------------------------------
@@ -581,7 +587,8 @@ def describe_material(mat, compat):
     kinds = {"ShaderNodeBsdfPrincipled": materials.PRINCIPLED,
              "ShaderNodeBsdfDiffuse": materials.DIFFUSE,
              "ShaderNodeBsdfGlossy": materials.GLOSSY,
-             "ShaderNodeBsdfAnisotropic": materials.ANISOTROPIC}
+             "ShaderNodeBsdfAnisotropic": materials.ANISOTROPIC,
+             "ShaderNodeEmission": materials.EMISSION}
     kind = kinds.get(node.bl_idname)
     if kind is None:
         return materials.ShaderDesc(name, materials.OTHER, viewport=vp, version=ver,
@@ -596,7 +603,7 @@ def describe_material(mat, compat):
             linked.add(s.name)
     builder = _ExprBuilder(name)
     exprs = {}
-    for sock_name in materials.TEXTURED_INPUTS.get(kind, {}):
+    for sock_name in list(materials.TEXTURED_INPUTS.get(kind, {})) + list(materials.EMISSION_INPUTS.get(kind, ())):
         s_ = node.inputs.get(sock_name)
         if s_ is not None and s_.is_linked:
             exprs[sock_name] = builder.socket(s_)
@@ -642,6 +649,7 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
     mat_index = {}
     mapped_cache = {}   # key -> (fields, warnings, slot plans) of a bpy material, mapped once
     material_plans = []  # per global material: slot -> textures.SlotPlan
+    material_emission = {}  # global material -> (rgb, strength) of its emission
 
     def material_key(mat):
         return mat.original.name_full if mat.original else mat.name_full
@@ -656,7 +664,7 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
                     "material '%s': its Tangent input is linked; Cycles' default tangent "
                     "(radial about the object's Z) is used instead" % key]
             plans, more = _material_slots(key, fields, materials.texture_plans(desc))
-            mapped_cache[key] = (fields, list(warns) + more, plans)
+            mapped_cache[key] = (fields, list(warns) + more, plans, materials.emission(desc))
         return mapped_cache[key]
 
     def vertex_color_of(mat):
@@ -686,7 +694,9 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
         elif key == DEFAULT_KEY:
             fields, warns = materials.default_material(), []
         else:
-            fields, warns, plans = mapped(mat)
+            fields, warns, plans, emit = mapped(mat)
+            if emit is not None:
+                material_emission[len(sd.materials)] = emit
         if compat.VERSION >= (4, 0, 0):  # Cycles 4.x+ GGX shadowing (vsgl/scene.h)
             fields = dict(fields, flags=int(fields.get("flags", 0)) | materials.MATERIAL_FLAG_BLENDER_4)
         sd.warnings.extend(warns)
@@ -698,6 +708,9 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
 
     mesh_cache = {} if mesh_cache is None else mesh_cache
     chunks = []
+    warned_objects = set()
+    _world_warnings(sd, scene)
+    _collection_warnings(sd, view_layer)
     for inst in depsgraph.object_instances:
         obj = inst.object
         if obj.type not in MESH_TYPES and obj.type != "LIGHT":
@@ -712,6 +725,7 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
             if not inst.is_instance and orig.parent is not None and \
                     orig.parent.instance_type in {"VERTS", "FACES"}:
                 continue
+        _visibility_warnings(sd, orig, warned_objects)
         if obj.type == "LIGHT":
             _add_light(sd, obj, inst.matrix_world, compat)
             continue
@@ -777,6 +791,7 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
     sd.corner_tangents = out[5] if want_tangents else None
     sd.corner_colors = out[-1] if any_vc else None
     _library_textures(sd, material_plans)
+    _add_emissive_lights(sd, material_emission, compat.VERSION)
     if not sd.materials:
         material_global(None, False)
 
@@ -790,6 +805,72 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
         raise ExportError("scene '%s' (view layer '%s') has no light with non-zero power"
                           % (scene.name, view_layer.name))
     return sd
+
+
+_RAY_VISIBILITY = (("visible_camera", "camera"), ("visible_diffuse", "diffuse"), ("visible_glossy", "glossy"),
+                   ("visible_transmission", "transmission"), ("visible_volume_scatter", "volume scatter"),
+                   ("visible_shadow", "shadow"))
+
+
+def _visibility_warnings(sd, obj, warned):
+    """Per-object settings Cycles honours and the library does not, once per object."""
+    if obj.name in warned:
+        return
+    warned.add(obj.name)
+    what = "light" if obj.type == "LIGHT" else "object"
+    off = [label for prop, label in _RAY_VISIBILITY if not getattr(obj, prop, True)]
+    if off:
+        sd.warnings.append("%s '%s': ray visibility (%s off) is not modelled; it is seen, lights, is lit and "
+                           "casts shadows as if every ray type were on" % (what, obj.name, ", ".join(off)))
+    if getattr(obj, "is_shadow_catcher", False):
+        sd.warnings.append("object '%s': shadow catcher is not modelled; it is shaded as its material" % obj.name)
+    if what == "object" and getattr(obj, "is_holdout", False):
+        sd.warnings.append("object '%s': holdout: it blocks light but reflects none and gets no indirect light "
+                           "in the AOV" % obj.name)
+
+
+def _collection_warnings(sd, view_layer):
+    def walk(lc):
+        if lc.exclude:
+            return
+        if getattr(lc, "holdout", False):
+            sd.warnings.append("collection '%s': holdout: its objects block light but reflect none and get no "
+                               "indirect light in the AOV" % lc.name)
+        if getattr(lc, "indirect_only", False):
+            sd.warnings.append("collection '%s': 'indirect only' is not modelled; its objects are also seen "
+                               "directly in the AOV" % lc.name)
+        for c in lc.children:
+            walk(c)
+    for c in view_layer.layer_collection.children:
+        walk(c)
+
+
+def _world_warnings(sd, scene):
+    """The world lights Cycles' render but is not a light source for the AOV."""
+    w = scene.world
+    if w is None:
+        return
+    strength, what = 0.0, ""
+    if w.use_nodes and w.node_tree is not None:
+        out = next((n for n in w.node_tree.nodes if n.bl_idname == "ShaderNodeOutputWorld" and
+                    getattr(n, "is_active_output", True)), None)
+        sock = out.inputs.get("Surface") if out is not None else None
+        if sock is not None and sock.is_linked:
+            node = sock.links[0].from_node
+            if node.bl_idname == "ShaderNodeBackground":
+                st = node.inputs["Strength"]
+                col = node.inputs["Color"]
+                strength = 1.0 if st.is_linked else float(st.default_value)
+                if not col.is_linked:
+                    strength *= max(tuple(col.default_value)[:3])
+                what = "background" + (" with a texture" if col.is_linked else "")
+            else:
+                strength, what = 1.0, "a '%s' node" % node.bl_idname
+    else:
+        strength, what = max(tuple(w.color)[:3]), "colour"
+    if strength > 0.0:
+        sd.warnings.append("world '%s': world lighting (%s) is not a light source for the indirect AOV; "
+                           "only lamps (and emissive meshes) bounce" % (w.name, what))
 
 
 def _material_slots(name, fields, plans):
@@ -841,6 +922,124 @@ def _library_textures(sd, material_plans):
             any_tex = True
         mts.append(dict(slots=mt, flags=flags))
     sd.material_textures = mts if any_tex else None
+
+
+MAX_EMISSIVE_LIGHTS = 32       # area lights made from emissive faces, at most
+EMISSIVE_MIN_FRACTION = 1e-3   # faces emitting less than this of the brightest light are skipped
+
+
+def emissive_lights(positions, indices, material_indices, emission, version=(3, 4, 0), split=1,
+                    split_above=0.5):
+    """Area lights (vsgl_light field dicts, with a "name" key) standing for
+    the emissive triangles (pure numpy).
+
+    Two triangles in a row that share an edge and form a rectangle become
+    one rectangular light, every other triangle a disk of its area at its
+    centroid. Each face emits on both sides (as Cycles' emission): one light
+    per side, along +-its normal, nudged off the face. A face of area A with
+    emission S (colour C) has radiance S C: a Blender 3.x area light of
+    power 4 A S, a 4.x one of pi A S (docs/units.md)."""
+    P = np.asarray(positions, np.float64)
+    I = np.asarray(indices, np.int64)
+    M = np.asarray(material_indices, np.int64)
+    v4 = tuple(version) >= (4, 0, 0)
+    out = []
+    emissive = [t for t in range(len(I)) if int(M[t]) in emission]
+    done = set()
+    for n, t in enumerate(emissive):
+        if t in done:
+            continue
+        g = int(M[t])
+        rgb, strength = emission[g]
+        tri = P[I[t]]
+        e1, e2 = tri[1] - tri[0], tri[2] - tri[0]
+        nrm = np.cross(e1, e2)
+        area = 0.5 * np.linalg.norm(nrm)
+        if not area > 0:
+            continue
+        nrm = nrm / (2 * area)
+        rect = None
+        u = t + 1
+        if u < len(I) and u not in done and int(M[u]) == g and len(set(I[t]) & set(I[u])) == 2:
+            other = P[[v for v in I[u] if v not in I[t]][0]]
+            # corners in order around the quad: t's vertices with the new one between the shared pair
+            shared = [v for v in I[t] if v in I[u]]
+            lone = [v for v in I[t] if v not in I[u]][0]
+            c = [P[lone], P[shared[0]], other, P[shared[1]]]
+            a, b = c[1] - c[0], c[3] - c[0]
+            la, lb = np.linalg.norm(a), np.linalg.norm(b)
+            if la > 0 and lb > 0 and abs(np.dot(a, b)) < 1e-3 * la * lb and \
+                    np.linalg.norm(c[0] + a + b - c[2]) < 1e-3 * max(la, lb) and \
+                    abs(np.dot(np.cross(a, b) / (la * lb), nrm)) > 0.999:
+                rect = (np.mean(c, axis=0), a / la, la, lb)
+        pieces = []  # (centre, x axis, size x, size y, shape)
+        if rect is not None:
+            done.add(u)
+            centre, xa, sx, sy = rect
+            # the library's area-light RSM starts its rays at the light's centre:
+            # a large panel is split so that each piece is small next to the room
+            ya = np.cross(nrm, xa)
+            if np.dot(np.cross(xa, ya), nrm) < 0:
+                ya = -ya
+            nx, ny = (split, split) if max(sx, sy) > split_above else (1, 1)
+            for i in range(nx):
+                for j in range(ny):
+                    off = xa * sx * ((i + 0.5) / nx - 0.5) + ya * sy * ((j + 0.5) / ny - 0.5)
+                    pieces.append((centre + off, xa, sx / nx, sy / ny, "RECTANGLE"))
+        else:
+            d = 2.0 * math.sqrt(area / math.pi)
+            pieces.append((tri.mean(axis=0), e1 / np.linalg.norm(e1), d, d, "DISK"))
+        for centre, xa, sx, size_y, shape in pieces:
+            a = sx * size_y if shape == "RECTANGLE" else area
+            power = (math.pi if v4 else 4.0) * a * strength
+            for side in (1.0, -1.0):
+                z = -side * nrm                       # an area light emits along its local -Z
+                x = xa
+                y = np.cross(z, x)
+                m = np.eye(4)
+                m[:3, 0], m[:3, 1], m[:3, 2] = x, y, z
+                m[:3, 3] = centre + side * nrm * (1e-4 * max(sx, size_y) + 1e-5)
+                f = convert.light_fields("emissive", "AREA", m, power, rgb, shape=shape, size=sx, size_y=size_y,
+                                         blender_version=version)
+                f["name"] = g
+                out.append(f)
+    return out
+
+
+def _add_emissive_lights(sd, material_emission, version):
+    if not material_emission or sd.triangle_count == 0:
+        return
+    lights = emissive_lights(sd.positions, sd.indices, sd.material_indices, material_emission, version)
+    if not lights:
+        return
+    brightest = max([l["power"] * max(l["color"]) for l in sd.lights + lights] or [0.0])
+    kept, dim = [], {}
+    for l in lights:
+        if l["power"] * max(l["color"]) < EMISSIVE_MIN_FRACTION * brightest:
+            dim[l["name"]] = dim.get(l["name"], 0) + 1
+        else:
+            kept.append(l)
+    for g, n in sorted(dim.items()):
+        sd.warnings.append("material '%s': %d emissive face side(s) emit less than %g of the brightest light "
+                           "and are skipped (too small or too dim to matter)" % (sd.material_names[g], n,
+                                                                                 EMISSIVE_MIN_FRACTION))
+    if len(kept) > MAX_EMISSIVE_LIGHTS:
+        kept.sort(key=lambda l: -l["power"] * max(l["color"]))
+        for l in kept[MAX_EMISSIVE_LIGHTS:]:
+            dim[l["name"]] = dim.get(l["name"], 0) + 1
+        sd.warnings.append("emissive meshes: %d light samples, the brightest %d are used (materials %s)"
+                           % (len(kept), MAX_EMISSIVE_LIGHTS,
+                              ", ".join("'%s'" % sd.material_names[g] for g in sorted({l["name"] for l in kept}))))
+        kept = kept[:MAX_EMISSIVE_LIGHTS]
+    counts = {}
+    for l in kept:
+        g = l.pop("name")
+        counts[g] = counts.get(g, 0) + 1
+        sd.lights.append(l)
+        sd.light_names.append("emission of material '%s'" % sd.material_names[g])
+    for g, n in sorted(counts.items()):
+        sd.emissive_log.append("material '%s': emissive faces exported as %d area light(s) (both sides)"
+                               % (sd.material_names[g], n))
 
 
 def _add_light(sd, obj, matrix, compat):

@@ -18,6 +18,7 @@ PRINCIPLED = "PRINCIPLED"
 DIFFUSE = "DIFFUSE"
 GLOSSY = "GLOSSY"          # Glossy BSDF (4.x: also anisotropic)
 ANISOTROPIC = "ANISOTROPIC"  # 3.x Anisotropic BSDF
+EMISSION = "EMISSION"      # Emission shader: a light source (export.py), reflects nothing
 NO_NODES = "NO_NODES"      # material.use_nodes is False: Cycles shades diffuse_color
 OTHER = "OTHER"            # anything else: viewport values, flagged
 
@@ -60,6 +61,33 @@ TEXTURED_INPUTS = {
     GLOSSY: {"Color": ("base_color", False), "Roughness": ("roughness", True)},
     ANISOTROPIC: {"Color": ("base_color", False), "Roughness": ("roughness", True)},
 }
+
+
+# Emission colour inputs (their textures are reduced to the mean colour)
+EMISSION_INPUTS = {PRINCIPLED: ("Emission", "Emission Color"), EMISSION: ("Color",)}
+
+
+def emission(desc):
+    """(rgb, strength) of an emitting material, or None. Cycles' emission of
+    strength S and colour C has radiance S C (W / m^2 / sr) on both sides of
+    a face; a textured colour is taken as the texture's mean."""
+    inp = desc.inputs
+    if desc.kind == PRINCIPLED:
+        strength = float(inp.get("Emission Strength", 1.0 if desc.version < (4, 0, 0) else 0.0))
+        sock = "Emission" if desc.version < (4, 0, 0) else "Emission Color"
+    elif desc.kind == EMISSION:
+        strength = float(inp.get("Strength", 1.0))
+        sock = "Color"
+    else:
+        return None
+    col = inp.get(sock, (0.0, 0.0, 0.0))
+    if sock in desc.exprs:
+        pl = textures.plan_slot(desc.exprs[sock], desc.images, "material '%s' input '%s'" % (desc.name, sock))
+        col = pl.constant if pl.texture is None else tuple(pl.texture["pixels"].reshape(-1, 4).mean(0)[:3])
+    rgb = tuple(max(float(c), 0.0) for c in list(col)[:3])
+    if not (strength > 0.0 and math.isfinite(strength)) or max(rgb) <= 0.0:
+        return None
+    return rgb, strength
 
 
 def texture_plans(desc):
@@ -152,14 +180,12 @@ def map_material(desc):
                             "normals are used" % who)
         if "Alpha" in desc.linked or float(inp.get("Alpha", 1.0)) < 1.0:
             warnings.append("%s: transparency (Alpha) is not modelled; the surface is opaque" % who)
-        ec = "Emission" if desc.version < (4, 0, 0) else "Emission Color"
-        if float(inp.get("Emission Strength", 0.0)) > 0.0 and \
-                max(list(inp.get(ec, (0.0, 0.0, 0.0)))[:3]) > 0.0:
-            warnings.append("%s: emission is not a light source for the indirect AOV "
-                            "(use a light)" % who)
         tw = "Transmission" if desc.version < (4, 0, 0) else "Transmission Weight"
         if float(inp.get(tw, 0.0)) > 0.0:
             warnings.append("%s: transmission is not modelled (treated as opaque)" % who)
+    elif desc.kind == EMISSION:
+        # pure emission reflects nothing; its light is exported as area lights
+        m.update(base_color=(0.0, 0.0, 0.0), metallic=0.0, roughness=1.0, specular_f0=0.0)
     elif desc.kind in (DIFFUSE, NO_NODES):
         col = inp.get("Color", desc.viewport[0]) if desc.kind == DIFFUSE else desc.viewport[0]
         m.update(base_color=_rgb(col), metallic=0.0, roughness=1.0, specular_f0=0.0)

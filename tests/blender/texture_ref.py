@@ -157,6 +157,20 @@ def flat(color, rough=1.0):
     return b
 
 
+def lambert(name, color):
+    """A Diffuse BSDF of roughness 0: Lambert, the library's diffuse model
+    (Blender 3.4's Principled diffuse is Burley's, up to ~10 % off at grazing
+    angles; cycles_ref.py's notes)."""
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    nt = m.node_tree
+    d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = tuple(color) + (1.0,)
+    d.inputs["Roughness"].default_value = 0.0
+    nt.links.new(d.outputs["BSDF"], nt.nodes["Material Output"].inputs["Surface"])
+    return m
+
+
 def tex_node(nodes, im, interpolation="Linear", extension="REPEAT"):
     t = nodes.new("ShaderNodeTexImage")
     t.image = im
@@ -314,6 +328,54 @@ def build_bleed(textured=True):
     return sc
 
 
+def build_emission():
+    """A room lit only by an emissive ceiling panel (Emission shader) and a
+    small emissive Principled box on the floor."""
+    sc = reset()
+    white = lambert("white", (0.8, 0.8, 0.8))
+    red = lambert("red", (0.8, 0.1, 0.05))
+
+    def emit(nodes, links, bsdf):
+        e = nodes.new("ShaderNodeEmission")
+        e.inputs["Strength"].default_value = 8.0
+        e.inputs["Color"].default_value = (1.0, 0.9, 0.7, 1.0)
+        out = nodes["Material Output"]
+        links.new(e.outputs["Emission"], out.inputs["Surface"])
+    panel = material("panel", emit)
+    quad("Floor", (-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0), white)
+    quad("Back", (-2, 2, 0), (2, 2, 0), (2, 2, 3), (-2, 2, 3), white)
+    quad("Left", (-2, -2, 0), (-2, 2, 0), (-2, 2, 3), (-2, -2, 3), red)
+    quad("Right", (2, -2, 0), (2, -2, 3), (2, 2, 3), (2, 2, 0), white)
+    quad("Ceiling", (-2, -2, 3), (-2, 2, 3), (2, 2, 3), (2, -2, 3), white)
+    # the panel hangs 5 cm below the ceiling, facing down
+    quad("Panel", (-0.6, -0.4, 2.95), (-0.6, 0.4, 2.95), (0.6, 0.4, 2.95), (0.6, -0.4, 2.95), panel)
+    camera(sc, (0, -3.8, 1.6), (80, 0, 0), (128, 96), lens=20)
+    return sc
+
+
+def check_emission(out_dir, report):
+    passes = ["DiffInd", "DiffCol"]
+    cyc, _ = cycles("emission", build_emission, passes, 1024, 1.0, out_dir)
+    ref = cyc["DiffInd"] * cyc["DiffCol"]
+    sc = build_emission()
+    lib, secs, sd = library(sc, preset("QUALITY"))
+    print("  export:", sd.summary())
+    for w in sd.warnings:
+        print("  export warning:", w)
+    got = lib["diffuse"]
+    m = (ref.max(-1) > 0) & (got.max(-1) >= 0)
+    g, w = got[m].mean(0), ref[m].mean(0)
+    rel = np.abs(g - w) / w
+    ok = bool((rel < TOL_EMISSION).all()) and len(sd.lights) >= 2
+    line = ("%s emission: panel -> %d area lights; mean coloured indirect diffuse lib %s Cycles %s rel %s %% "
+            "(tol %.0f %%), %.2f s" % ("PASS" if ok else "FAIL", len(sd.lights), np.round(g, 5), np.round(w, 5),
+                                       np.round(100 * rel, 2), 100 * TOL_EMISSION, secs))
+    print(line)
+    report.append(line)
+    save_pair(out_dir, "emission", got * 4, ref * 4)
+    return ok
+
+
 # ---------------------------------------------------------------------------
 # rendering
 # ---------------------------------------------------------------------------
@@ -463,7 +525,7 @@ def main():
     out_dir = os.path.abspath(A["--out"])
     os.makedirs(out_dir, exist_ok=True)
     report = ["# Textures vs Cycles (%s)" % bpy.app.version_string, ""]
-    checks = [("diffcol", check_diffcol), ("bleed", check_bleed)]
+    checks = [("diffcol", check_diffcol), ("bleed", check_bleed), ("emission", check_emission)]
     extra = globals().get("EXTRA_CHECKS", [])
     p = f = 0
     for name, fn in checks + extra:
