@@ -11,6 +11,8 @@ from .convert import ExportError
 
 #: scene name -> dict(status, error, warnings, timings, skipped, summary, path, frame)
 LAST_RUN = {}
+#: How the panel words each status.
+STATUS_TEXT = {"running": "running", "done": "done", "failed": "failed", "cancelled": "cancelled"}
 
 
 def options_of(scene):
@@ -80,6 +82,13 @@ def finish(scene_name, result, t_export):
     report(scene_name, "INFO", "wrote %s (%s; export %.3fs, render %.3fs, write %.3fs%s)"
            % (result.path, result.summary, t_export, result.timings.get("render", 0),
               result.timings.get("write", 0), "; memory %s" % mem if mem else ""))
+
+
+def cancel(scene_name, what="preview"):
+    """The user cancelled (Esc): not a failure, no error."""
+    info = LAST_RUN.setdefault(scene_name, {})
+    info.update(status="cancelled", error="")
+    report(scene_name, "INFO", "%s cancelled" % what)
 
 
 def fail(scene_name, message):
