@@ -118,6 +118,7 @@ class Options:
     use_diffuse: bool = True        # compositor: add the Diff pass
     use_glossy: bool = True         # compositor: add the Gloss pass
     export_passes: bool = False     # compositor: render passes + VSGL passes in one EXR
+    export_path: str = "{render_dir}/passes/{scene}_"
 
     def max_memory_bytes(self):
         return max(int(float(self.max_memory_gb) * (1 << 30)), 0)

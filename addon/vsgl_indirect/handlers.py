@@ -68,13 +68,20 @@ def setup_scene(scene, frame=None):
         try:
             engine.check_output_path(path)
             with _setup_lock(os.path.dirname(path)):
-                _setup_layer(scene, layer, path, w, h, options.add_to_render and i == 0)
+                _setup_layer(scene, layer, path, w, h, options.add_to_render and i == 0, options)
         except engine.AovError as e:
             errors.append("view layer '%s': %s" % (layer, e))
         except Exception as e:
             import traceback
             traceback.print_exc()
             errors.append("view layer '%s': compositor setup failed: %r" % (layer, e))
+    try:
+        compositor.ensure_export(scene, _layers(scene), runner.export_prefix(scene, options),
+                                 options)
+    except Exception as e:
+        import traceback
+        traceback.print_exc()
+        errors.append("passes file output setup failed: %r" % (e,))
     for e in errors:
         runner.fail(scene.name, e)
     return errors
@@ -139,7 +146,7 @@ def _setup_lock(directory):
         os.close(fd)                 # releases the lock
 
 
-def _setup_layer(scene, layer, path, w, h, add, attempts=6):
+def _setup_layer(scene, layer, path, w, h, add, options=None, attempts=6):
     """compositor.ensure with a file at ``path`` for the pass sockets. Another
     worker's placeholder may vanish while Blender reads it (the sockets then
     come out empty): check and retry with our own placeholder."""
@@ -151,7 +158,7 @@ def _setup_layer(scene, layer, path, w, h, add, attempts=6):
         try:
             # One composite output: only the first rendered view layer's AOV is
             # added onto it; the others get their Image node to wire by hand.
-            node = compositor.ensure(scene, layer, path, add)
+            node = compositor.ensure(scene, layer, path, add, options)
             if compositor.has_passes(node, add):
                 return node
             err = None

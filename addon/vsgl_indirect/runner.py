@@ -51,6 +51,15 @@ def output_path(scene, view_layer, frame, options=None):
     return os.path.normpath(_absolute(p))
 
 
+def export_prefix(scene, options=None):
+    """Absolute path prefix of the passes EXR (Blender appends frame + .exr)."""
+    options = options or options_of(scene)
+    template = options.export_path or "{render_dir}/passes/{scene}_"
+    safe = convert.frame_path("{scene}", 0, scene.name).rsplit("_", 1)[0]   # the file-safe name
+    p = template.replace("{render_dir}", render_dir(scene).rstrip("/\\")).replace("{scene}", safe)
+    return os.path.normpath(_absolute(p)) + (os.sep if p.endswith(("/", "\\")) else "")
+
+
 def begin(scene_name, frame):
     LAST_RUN[scene_name] = {"status": "running", "frame": frame, "messages": [],
                             "timings": {}, "skipped": "", "summary": "", "path": "", "error": "",

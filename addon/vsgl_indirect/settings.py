@@ -265,9 +265,10 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "shown. Off: the frame renders without indirect light and the log says "
                     "VSGL ERROR")
     strength: FloatProperty(
-        name="Strength", default=1.0, min=0.0, soft_max=2.0, precision=3, **_UPDATE,
+        name="Strength", default=1.0, min=0.0, max=1.0, precision=3, subtype="FACTOR", **_UPDATE,
         description="Factor of the indirect light added in the compositor (1 = physical, with "
-                    "Cycles rendering direct light only). Sets the Add nodes' factor; free")
+                    "Cycles rendering direct light only; lower it to grade the bounce down). "
+                    "It is the Add nodes' factor, so it costs nothing and needs no new AOV")
     use_diffuse: BoolProperty(
         name="Diffuse", default=True, **_UPDATE,
         description="Add the diffuse indirect light (pass Diff = DiffInd x DiffCol); off mutes "

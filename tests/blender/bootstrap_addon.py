@@ -29,6 +29,8 @@ if os.environ.get("VSGL_TEST_FAKE_RENDER"):
         if os.environ["VSGL_TEST_FAKE_RENDER"] == "bounds":
             # Encode what was exported: max x of the geometry, light count.
             planes["combined"][:] = (float(sd.positions[:, 0].max()), len(sd.lights), f)
+        # Combined = Diff + Gloss, as the library's (the compositor adds those two).
+        planes["diffuse"][:] = planes["combined"]
         planes["diffuse_light"][:] = (0.5, 0.25 * f, 0.125)
         planes["alpha"] = np.ones((h, w), np.float32)
         return planes, {"seconds_total": 0.0, "skipped": ""}
