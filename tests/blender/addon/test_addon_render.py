@@ -559,3 +559,23 @@ def test_export_passes_one_multilayer_exr_per_frame(scene, tmp_path):
     scene.vsgl_indirect.export_passes = False
     handlers.setup_scene(scene)
     assert compositor.FILE_OUTPUT_NODE not in compat.compositor_tree(scene).nodes
+
+
+@pytest.mark.parametrize("fail", [True, False])
+def test_fail_render_without_aov_exits_non_zero(scene, tmp_path, fail):
+    """Farms: with 'Fail Render Without AOV' a frame whose AOV cannot be
+    computed stops `blender -b -a` with a non-zero status before that frame
+    is written; without it the render goes on and logs VSGL ERROR."""
+    path = setup_blend(scene, tmp_path, fail_render=fail)
+    scene.render.image_settings.file_format = "PNG"
+    save(path)
+    r = render(path, (1, 3), env={"VSGL_TEST_FAKE_RENDER": "fail"})
+    out = sorted(os.listdir(str(tmp_path / "out")))
+    assert "test: the fake renderer fails from frame 2 on" in r.stdout, r.stdout[-3000:]
+    if fail:
+        assert r.returncode == handlers.FAIL_EXIT_CODE, (r.returncode, r.stdout[-3000:])
+        assert "stopping the render (exit status 1)" in r.stdout
+        assert out == ["beauty_0001.png"], out
+    else:
+        assert r.returncode == 0, r.stdout[-3000:]
+        assert out == ["beauty_0001.png", "beauty_0002.png", "beauty_0003.png"], out
