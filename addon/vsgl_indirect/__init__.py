@@ -15,15 +15,15 @@ bl_info = {
 if "bpy" in locals():   # script reload
     import importlib
     for _m in ("compat", "convert", "materials", "config", "checks", "exr", "export", "engine",
-               "runner", "compositor", "settings", "operators", "ui", "handlers"):
+               "runner", "compositor", "settings", "operators", "ui", "handlers", "live", "viewport"):
         if _m in locals():
             importlib.reload(locals()[_m])
 
 import bpy  # noqa: E402
 
-from . import settings, operators, ui, handlers  # noqa: E402
+from . import settings, operators, ui, handlers, viewport  # noqa: E402
 
-_modules = (settings, operators, ui, handlers)
+_modules = (settings, operators, ui, handlers, viewport)
 
 
 def register():

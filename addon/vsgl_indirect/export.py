@@ -335,8 +335,14 @@ def _holdout_objects(view_layer):
     return names
 
 
-def collect(depsgraph, scene=None, require_lights=True):
+def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=None):
     """Export the evaluated ``depsgraph`` (render or viewport) to a SceneData.
+
+    ``camera=False`` leaves ``sd.camera`` unset (the live viewport sets its
+    own). ``mesh_cache``: a dict kept by the caller between exports; meshes
+    found in it are not read again (the caller removes the entries of
+    objects whose geometry changed, keyed by the original object's name in
+    the key's first field).
 
     Raises ExportError (naming the element) when the scene cannot give an
     AOV: no camera, unsupported camera, no geometry, no lights.
@@ -395,7 +401,7 @@ def collect(depsgraph, scene=None, require_lights=True):
         sd.material_names.append(key)
         return mat_index[key]
 
-    mesh_cache = {}
+    mesh_cache = {} if mesh_cache is None else mesh_cache
     chunks = []
     for inst in depsgraph.object_instances:
         obj = inst.object
@@ -419,7 +425,8 @@ def collect(depsgraph, scene=None, require_lights=True):
                                                or parent.original.name in holdout_names)))
         # Instances of one object share its evaluated mesh; Blender reuses one
         # temporary object for geometry-nodes instances, hence the data pointer.
-        key = (obj.as_pointer(), obj.data.as_pointer() if obj.data else 0, inst.is_instance)
+        key = (orig.name_full, obj.as_pointer(), obj.data.as_pointer() if obj.data else 0,
+               inst.is_instance)
         arr = mesh_cache.get(key)
         if arr is None:
             try:
@@ -463,7 +470,8 @@ def collect(depsgraph, scene=None, require_lights=True):
     if not sd.materials:
         material_global(None, False)
 
-    _add_camera(sd, scene, depsgraph, compat)
+    if camera:
+        _add_camera(sd, scene, depsgraph, compat)
 
     if sd.triangle_count == 0:
         raise ExportError("view layer '%s' of scene '%s' has no visible mesh geometry to light"

@@ -615,6 +615,7 @@ PROTOTYPES = (
     ("vsgl_scene_create", _i32, [_VP, _P(vsgl_scene_desc), _PVP]),
     ("vsgl_scene_destroy", None, [_VP]),
     ("vsgl_scene_get_info", _i32, [_VP, _P(vsgl_scene_info)]),
+    ("vsgl_scene_set_view", _i32, [_VP, _VP, _P(vsgl_camera), _P(vsgl_light), _u32]),
     # render.h
     ("vsgl_render_settings_preset", None, [_i32, _P(vsgl_render_settings)]),
     ("vsgl_render_estimate", _i32, [_VP, _VP, _P(vsgl_render_settings), _u32,
@@ -1372,6 +1373,18 @@ class Scene:
         if self._handle is None:
             raise ValueError("the vsgl scene is closed")
         return self._handle
+
+    def set_view(self, camera, lights=()):
+        """Replace the camera and lights, keeping geometry, materials and the
+        BVH (vsgl_scene_set_view). On an error the scene is unchanged."""
+        if not isinstance(camera, vsgl_camera):
+            raise TypeError("camera must be a libvsgl.Camera, got %s" % type(camera).__name__)
+        lits = _struct_array(lights, vsgl_light, "lights")
+        n = len(lits) if lits is not None else 0
+        ptr = ctypes.cast(lits, ctypes.POINTER(vsgl_light)) if n else None
+        rc = self._lib.vsgl_scene_set_view(self._ctx.handle, self.handle, ctypes.byref(camera), ptr, n)
+        self._ctx.check(rc, "vsgl_scene_set_view")
+        self.width, self.height = int(camera.width), int(camera.height)
 
     def info(self):
         """Counts after validation, as a dict (bounds as 3-tuples)."""

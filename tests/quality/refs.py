@@ -56,6 +56,24 @@ def blender_binary():
     return os.environ.get("BLENDER", "blender")
 
 
+def blender_env():
+    """The environment for Blender: PATH without the directories that hold
+    another Python (a pyenv build or a venv puts its bin/ first on PATH when
+    it runs this script, and Debian's Blender then takes that Python's
+    standard library instead of /usr/lib/python3, whose numpy it needs)."""
+    env = dict(os.environ)
+    keep = []
+    for d in env.get("PATH", "").split(os.pathsep):
+        py = os.path.join(d, "python3")
+        if d and os.path.exists(py) and not os.path.realpath(py).startswith("/usr/"):
+            continue
+        keep.append(d)
+    env["PATH"] = os.pathsep.join(keep)
+    for k in ("PYTHONHOME", "PYTHONPATH", "VIRTUAL_ENV"):
+        env.pop(k, None)
+    return env
+
+
 def blender_version(refdir=DEFAULT_DIR):
     """Blender's version string ("3.4.1"), from `blender --version`, cached in
     refdir keyed by the binary's path, size and mtime."""
@@ -72,7 +90,7 @@ def blender_version(refdir=DEFAULT_DIR):
             return d["version"]
     except (OSError, ValueError):
         pass
-    out = subprocess.run([exe, "--version"], capture_output=True, text=True).stdout
+    out = subprocess.run([exe, "--version"], capture_output=True, text=True, env=blender_env()).stdout
     line = next((l for l in out.splitlines() if l.startswith("Blender ")), None)
     if line is None:
         return None
@@ -138,7 +156,7 @@ def ensure(names, size, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=
         log = log or os.path.join(refdir, "render_refs.log")
         os.makedirs(refdir, exist_ok=True)
         with open(log, "a") as fh:
-            rc = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT).returncode
+            rc = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, env=blender_env()).returncode
         if rc != 0:
             raise RuntimeError("render_refs.py failed (exit %d); see %s" % (rc, log))
     code = code_digest()

@@ -161,7 +161,8 @@ typedef struct vsgl_scene_desc {
     const vsgl_camera *camera;     /**< required */
 } vsgl_scene_desc;
 
-/** Opaque validated scene with its acceleration structure. Immutable; may be shared by threads. */
+/** Opaque validated scene with its acceleration structure. Immutable but for
+ *  ::vsgl_scene_set_view; may be shared by threads while nobody changes it. */
 typedef struct vsgl_scene vsgl_scene;
 
 /**
@@ -183,6 +184,25 @@ VSGL_API vsgl_result vsgl_scene_create(vsgl_context *ctx, const vsgl_scene_desc 
 
 /** @brief Release a scene. NULL is allowed. */
 VSGL_API void vsgl_scene_destroy(vsgl_scene *scene);
+
+/**
+ * @brief Replace the camera and the lights of @p scene, keeping its
+ * geometry, materials and acceleration structure (what an interactive
+ * view changes between frames; a new scene costs a BVH build).
+ *
+ * Both are validated as ::vsgl_scene_create validates them; on any error
+ * the scene is left unchanged. Not to be called while another call (e.g.
+ * ::vsgl_render) uses @p scene. A render after it equals a render of a
+ * scene created with the same camera and lights, bit for bit.
+ *
+ * @param[in] camera      required; copied.
+ * @param[in] lights      @p light_count lights (world space, as in
+ *                        vsgl_scene_desc); copied. 0 lights is allowed.
+ * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (message names the light
+ *         or camera field), ::VSGL_ERROR_OUT_OF_MEMORY.
+ */
+VSGL_API vsgl_result vsgl_scene_set_view(vsgl_context *ctx, vsgl_scene *scene, const vsgl_camera *camera,
+                                         const vsgl_light *lights, uint32_t light_count);
 
 /** Counts after validation (degenerate triangles dropped). */
 typedef struct vsgl_scene_info {

@@ -1,0 +1,182 @@
+"""Live preview logic without Blender: the viewport's camera as a
+``vsgl_camera``, the display encoding of a pass, and the scheduler that
+renders the newest edit on a worker thread and drops superseded ones.
+
+viewport.py is the Blender glue (handlers, drawing, panel); everything here
+is testable headless.
+"""
+import threading
+import time
+
+import numpy as np
+
+from . import convert
+
+#: Debounce: an edit is rendered once nothing changed for this long (s).
+DEBOUNCE_S = 0.04
+#: Viewport resolution divisors offered in the panel.
+SCALES = (1, 2, 3, 4)
+
+
+def _rows(m):
+    """4x4 nested sequence / mathutils.Matrix / ndarray -> float64 ndarray."""
+    return np.array([[float(m[r][c]) for c in range(4)] for r in range(4)], np.float64)
+
+
+def view_camera(view_matrix, window_matrix, width, height, clip_start, clip_end,
+                name="viewport"):
+    """``vsgl_camera`` fields of a 3D viewport (Blender's ``region_3d``).
+
+    ``view_matrix`` maps world to view space, ``window_matrix`` is the
+    OpenGL projection of the region. Perspective: the projection's
+    ``P[0][0] = 2 lens / sensor_width`` with a 36 mm horizontal sensor, and
+    its off-centre terms are Blender's lens shift, ``P[0][2] = 2 shift_x``,
+    ``P[1][2] = 2 shift_y width / height`` (shift in units of the fitted
+    width, as ``BKE_camera_params_compute_viewplane`` defines it).
+    Orthographic: ``ortho_scale = 2 / P[0][0]``, ``P[0][3] = -2 shift_x``.
+    """
+    V = _rows(view_matrix)
+    P = _rows(window_matrix)
+    world_from_view = np.linalg.inv(V)
+    aspect = float(width) / float(height)
+    if abs(P[3][3]) > 0.5:      # orthographic: w = 1
+        scale = 2.0 / P[0][0]
+        sx, sy = -P[0][3] / 2.0, -P[1][3] / 2.0 / aspect
+        # Blender's orthographic view volume reaches behind the eye
+        # (clip_start < 0): move the camera back so that it lies in front.
+        back = max(0.0, -float(clip_start))
+        world_from_view[:3, 3] += world_from_view[:3, 2] * back
+        cs, ce = max(float(clip_start) + back, 1e-4), float(clip_end) + back
+        return convert.camera_fields(name, "ORTHO", world_from_view, 50.0, 36.0, 36.0 / aspect,
+                                     "HORIZONTAL", scale, sx, sy, cs, ce, width, height)
+    lens = P[0][0] * 36.0 / 2.0
+    sx, sy = P[0][2] / 2.0, P[1][2] / 2.0 / aspect
+    return convert.camera_fields(name, "PERSP", world_from_view, lens, 36.0, 36.0 / aspect,
+                                 "HORIZONTAL", 1.0, sx, sy, float(clip_start), float(clip_end),
+                                 width, height)
+
+
+def internal_size(region_width, region_height, scale):
+    """The render size for a region drawn at 1/``scale`` resolution (>= 8 x 8)."""
+    s = max(1, int(scale))
+    return max(8, (int(region_width) + s - 1) // s), max(8, (int(region_height) + s - 1) // s)
+
+
+def display_rgba(rgb, exposure=0.0, alpha=1.0):
+    """Linear scene light (H, W, 3), rows top-down -> display-referred RGBA
+    float32 (H, W, 4), rows bottom-up as a GPU texture wants: exposure in
+    stops, the sRGB transfer function (Blender's "Standard" view), clipped
+    to [0, 1]. NaN/negative become 0."""
+    x = np.nan_to_num(np.asarray(rgb, np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+    x = np.clip(x * np.float32(2.0 ** exposure), 0.0, 1.0)
+    lo = x * np.float32(12.92)
+    hi = np.float32(1.055) * np.power(x, np.float32(1 / 2.4)) - np.float32(0.055)
+    x = np.where(x <= 0.0031308, lo, hi)
+    out = np.empty(x.shape[:2] + (4,), np.float32)
+    out[..., :3] = x
+    out[..., 3] = alpha
+    return np.ascontiguousarray(out[::-1])
+
+
+class Job:
+    """One render of one edit: ``cancelled`` is polled by the library's
+    progress callback, so a superseded render stops within a block."""
+
+    def __init__(self, seq, key):
+        self.seq = seq
+        self.key = key
+        self.cancelled = threading.Event()
+        self.t_submit = time.perf_counter()
+
+
+class LiveRenderer:
+    """Renders the newest request on one worker thread.
+
+    ``submit(key, work)`` starts ``work(job)`` for a new edit (``work`` runs
+    on the worker thread and returns the result; it must poll
+    ``job.cancelled``). A newer submit cancels the running job; at most one
+    job waits behind it, the newest, so a burst of edits renders the first
+    and the last, never the ones between. ``poll()`` (main thread) returns a
+    new finished result once, or None. A request whose key equals the last
+    submitted one is ignored.
+    """
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._seq = 0
+        self._running = None       # Job on the worker
+        self._pending = None       # (Job, work) waiting for the worker
+        self._thread = None
+        self._result = None        # (seq, key, value, seconds) newest finished
+        self._delivered = 0
+        self.last_key = None
+        self.errors = []
+        self.dropped = 0
+
+    def submit(self, key, work):
+        with self._lock:
+            if key is not None and key == self.last_key:
+                return None
+            self.last_key = key
+            self._seq += 1
+            job = Job(self._seq, key)
+            if self._running is not None:
+                self._running.cancelled.set()
+            if self._pending is not None:
+                self.dropped += 1
+            self._pending = (job, work)
+            if self._thread is None or not self._thread.is_alive():
+                self._thread = threading.Thread(target=self._loop, name="vsgl-live", daemon=True)
+                self._thread.start()
+            return job
+
+    def _loop(self):
+        while True:
+            with self._lock:
+                if self._pending is None:
+                    self._running = None
+                    self._thread = None
+                    return
+                job, work = self._pending
+                self._pending = None
+                self._running = job
+            try:
+                value = work(job)
+                err = None
+            except Exception as e:  # reported on the main thread by poll()
+                value, err = None, e
+            with self._lock:
+                if err is not None and not job.cancelled.is_set():
+                    self.errors.append(str(err))
+                elif value is not None and not job.cancelled.is_set():
+                    self._result = (job.seq, job.key, value, time.perf_counter() - job.t_submit)
+
+    def busy(self):
+        with self._lock:
+            return self._running is not None or self._pending is not None
+
+    def poll(self):
+        """(seq, key, value, seconds from submit) of a result not returned before, else None."""
+        with self._lock:
+            r = self._result
+            if r is None or r[0] <= self._delivered:
+                return None
+            self._delivered = r[0]
+            return r
+
+    def cancel(self, wait=True):
+        with self._lock:
+            if self._running is not None:
+                self._running.cancelled.set()
+            self._pending = None
+            self.last_key = None
+            t = self._thread
+        if wait and t is not None:
+            t.join(timeout=10)
+
+    def wait(self, timeout=30.0):
+        """Block until the worker is idle (tests, headless timing)."""
+        end = time.perf_counter() + timeout
+        while self.busy() and time.perf_counter() < end:
+            time.sleep(0.002)
+        return not self.busy()

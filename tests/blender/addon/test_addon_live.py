@@ -1,0 +1,221 @@
+"""The live viewport preview (viewport.py, live.py): the viewport camera
+against Blender's own projection, the scheduler's supersede/cancel rules,
+the mesh cache, and the live render against the F12 path."""
+import threading
+import time
+
+import bpy
+import numpy as np
+import pytest
+
+from conftest import camera, cube, link, room
+from vsgl_indirect import engine, export, live, viewport
+from vsgl_indirect.config import Options
+
+
+def _projection(cam, depsgraph, w, h):
+    return cam.calc_matrix_camera(depsgraph, x=w, y=h, scale_x=1.0, scale_y=1.0)
+
+
+@pytest.mark.parametrize("kind,w,h,shift", [("PERSP", 96, 54, (0.0, 0.0)), ("PERSP", 60, 80, (0.1, -0.05)),
+                                            ("ORTHO", 96, 54, (0.07, 0.03))])
+def test_view_camera_matches_blenders_projection(scene, kind, w, h, shift):
+    """A camera described by its view and projection matrices (what a 3D
+    viewport gives) must project every point where Blender's camera does:
+    compare the library camera's fields with the export of the camera itself."""
+    cam = camera(scene, location=(0.3, -5, 1.2), rotation=(1.35, 0.0, 0.2), lens=42.0)
+    cam.data.type = kind
+    cam.data.ortho_scale = 5.5
+    cam.data.sensor_fit = "HORIZONTAL"
+    cam.data.shift_x, cam.data.shift_y = shift
+    cam.data.clip_start, cam.data.clip_end = 0.2, 80.0
+    scene.render.resolution_x, scene.render.resolution_y = w, h
+    dg = bpy.context.evaluated_depsgraph_get()
+    P = _projection(cam, dg, w, h)
+    V = cam.matrix_world.inverted()
+    got = live.view_camera(V, P, w, h, 0.2, 80.0)
+    from vsgl_indirect import compat
+    sd = export.SceneData()
+    export._add_camera(sd, scene, dg, compat)
+    want = sd.camera
+    assert got["type"] == want["type"]
+    assert got["width"], got["height"] == (w, h)
+    if kind == "PERSP":
+        # lens / sensor width is what matters (36 mm sensor here)
+        assert got["lens_mm"] / got["sensor_width_mm"] == pytest.approx(
+            want["lens_mm"] / want["sensor_width_mm"], rel=1e-5)
+        np.testing.assert_allclose(got["world_from_camera"], want["world_from_camera"], atol=1e-5)
+    else:
+        assert got["ortho_scale"] == pytest.approx(want["ortho_scale"], rel=1e-5)
+        # the ortho camera is moved back along its axis; its rotation is the same
+        g = np.array(got["world_from_camera"]).reshape(3, 4)
+        e = np.array(want["world_from_camera"]).reshape(3, 4)
+        np.testing.assert_allclose(g[:, :3], e[:, :3], atol=1e-5)
+        np.testing.assert_allclose(np.cross(g[:, 3] - e[:, 3], e[:, 2]), 0, atol=1e-4)
+    assert (got["shift_x"], got["shift_y"]) == pytest.approx(shift, abs=1e-5)
+
+
+def test_scheduler_renders_first_and_last_of_a_burst():
+    r = live.LiveRenderer()
+    started, release = threading.Event(), threading.Event()
+    ran = []
+
+    def slow(job):
+        ran.append(job.key)
+        started.set()
+        while not job.cancelled.is_set() and not release.is_set():
+            time.sleep(0.001)
+        return "slow"
+
+    def quick(tag):
+        def work(job):
+            ran.append(job.key)
+            return tag
+        return work
+
+    a = r.submit("a", slow)
+    assert started.wait(5)
+    r.submit("b", quick("b"))
+    r.submit("c", quick("c"))
+    assert r.wait(5)
+    assert a.cancelled.is_set()
+    assert ran == ["a", "c"] and r.dropped == 1        # b superseded before it ran
+    got = r.poll()
+    assert got is not None and got[2] == "c" and got[1] == "c"
+    assert r.poll() is None                           # delivered once
+    assert r.submit("c", quick("c")) is None          # same key: nothing to do
+    r.submit("d", lambda job: 1 / 0)
+    assert r.wait(5) and r.errors and "division" in r.errors[0]
+
+
+def test_display_rgba_is_srgb_bottom_up():
+    rgb = np.zeros((2, 3, 3), np.float32)
+    rgb[0, 0] = (0.18, 1.0, 4.0)      # top-left
+    rgb[1, 2] = (np.nan, -1, 0.002)
+    out = live.display_rgba(rgb, exposure=0.0)
+    assert out.shape == (2, 3, 4) and out.dtype == np.float32
+    top_left = out[1, 0]               # the texture's last row is the image's top
+    assert top_left[0] == pytest.approx(1.055 * 0.18 ** (1 / 2.4) - 0.055, rel=1e-5)
+    assert top_left[1] == pytest.approx(1.0) and top_left[2] == pytest.approx(1.0)
+    assert np.all(np.isfinite(out)) and out[0, 2, 0] == 0 and out[0, 2, 1] == 0
+    assert out[0, 2, 2] == pytest.approx(0.002 * 12.92, rel=1e-5)
+    assert np.all(out[..., 3] == 1)
+    assert live.display_rgba(np.full((1, 1, 3), 0.1, np.float32), exposure=1.0)[0, 0, 0] == \
+        pytest.approx(live.display_rgba(np.full((1, 1, 3), 0.2, np.float32))[0, 0, 0], rel=1e-6)
+
+
+def test_mesh_cache_reads_only_changed_geometry(scene, monkeypatch):
+    room(scene)
+    box = link(scene, cube("Box", 1.0, (0.5, 1.0, 0.5)))
+    dg = bpy.context.evaluated_depsgraph_get()
+    cache = {}
+    a = export.collect(dg, scene, camera=False, mesh_cache=cache)
+    assert a.camera is None and len(cache) == 3
+    reads = []
+    real = export._mesh_arrays
+    monkeypatch.setattr(export, "_mesh_arrays", lambda *k, **kw: reads.append(1) or real(*k, **kw))
+    bpy.data.objects["Spot"].location.x += 0.5       # a light moved: no mesh is read
+    dg = bpy.context.evaluated_depsgraph_get()
+    b = export.collect(dg, scene, camera=False, mesh_cache=cache)
+    assert reads == []
+    np.testing.assert_array_equal(a.positions, b.positions)
+    assert not np.array_equal(a.lights[0]["world_from_light"], b.lights[0]["world_from_light"])
+    # the box's geometry changes: the session drops its entry, only it is read again
+    s = viewport._Session(0)
+    s.mesh_cache = cache
+    box.data.vertices[0].co.z -= 0.25
+    box.data.update()
+    dg = bpy.context.evaluated_depsgraph_get()
+
+    class U:
+        def __init__(self, idb):
+            self.id, self.is_updated_geometry = idb, True
+
+    class D:
+        updates = [U(box.evaluated_get(dg))]
+    monkeypatch.setattr(viewport, "_SESSION", s)
+    viewport._on_depsgraph_update(scene, D())
+    assert len(cache) == 2
+    c = export.collect(dg, scene, camera=False, mesh_cache=cache)
+    assert len(reads) == 1 and not np.array_equal(b.positions, c.positions)
+
+
+def test_live_render_equals_the_f12_path(scene):
+    """The worker's render of a viewport at the scene camera's view is the
+    preview preset's Combined pass of the normal path, pixel for pixel."""
+    room(scene)
+    w, h = 48, 27
+    scene.render.resolution_x, scene.render.resolution_y = w, h
+    dg = bpy.context.evaluated_depsgraph_get()
+    cam = scene.camera
+    sd = export.collect(dg, scene, camera=False, mesh_cache={})
+    sd.camera = live.view_camera(cam.matrix_world.inverted(), _projection(cam, dg, w, h), w, h,
+                                 cam.data.clip_start, cam.data.clip_end)
+    sd.width, sd.height = w, h
+    s = viewport._Session(0)
+    job = live.Job(1, "k")
+    try:
+        out = viewport._render(s, sd, "PREVIEW", 0, job, 0.0, 0.0)
+    finally:
+        s.close()
+    ref_sd = export.collect(dg, scene)
+    planes, _ = engine.render_planes(ref_sd, Options(enabled=True, preset="PREVIEW"))
+    want = live.display_rgba(planes["combined"])
+    assert out["width"] == w and out["height"] == h
+    assert float(planes["combined"].mean()) > 0
+    np.testing.assert_allclose(out["rgba"], want, atol=2e-3)
+    assert set(out["timings"]) == {"export", "scene", "render", "encode"}
+
+
+def test_live_render_is_cancelled_when_superseded(scene):
+    room(scene)
+    dg = bpy.context.evaluated_depsgraph_get()
+    sd = export.collect(dg, scene)
+    sd.width, sd.height = sd.camera["width"], sd.camera["height"] = 640, 360
+    s = viewport._Session(0)
+    job = live.Job(1, "k")
+    job.cancelled.set()
+    try:
+        assert viewport._render(s, sd, "PREVIEW", 0, job, 0.0, 0.0) is None
+    finally:
+        s.close()
+
+
+def test_operator_and_panel_register():
+    assert hasattr(bpy.types.WindowManager, "vsgl_live")
+    props = bpy.context.window_manager.vsgl_live
+    assert props.quality == "PREVIEW" and props.scale == 2 and props.display == "INDIRECT"
+    for p in props.bl_rna.properties:
+        if p.identifier != "rna_type":
+            assert len(p.description) > 20, p.identifier
+    assert hasattr(bpy.types, "VIEW3D_PT_vsgl_live")
+    assert hasattr(bpy.ops.vsgl, "live_preview")
+
+
+def test_live_keeps_the_library_scene_while_geometry_stands_still(scene):
+    """A light edit reuses the library scene (vsgl_scene_set_view) and gives
+    the image a new scene would; a geometry edit builds a new one."""
+    room(scene)
+    w, h = 40, 30
+    scene.render.resolution_x, scene.render.resolution_y = w, h
+    s = viewport._Session(0)
+    cache = {}
+
+    def live_render():
+        dg = bpy.context.evaluated_depsgraph_get()
+        sd = export.collect(dg, scene, mesh_cache=cache)
+        return sd, viewport._render(s, sd, "PREVIEW", 0, live.Job(1, "k"), 0.0, 0.0)
+
+    try:
+        live_render()
+        bpy.data.objects["Spot"].location.x += 0.7
+        sd, moved = live_render()
+        assert s.scene_builds == 1
+        planes, _ = engine.render_planes(sd, Options(enabled=True, preset="PREVIEW"))
+        np.testing.assert_array_equal(moved["rgba"], live.display_rgba(planes["combined"]))
+        bpy.data.objects["Wall"].location.z += 0.3
+        cache.clear()
+        live_render()
+        assert s.scene_builds == 2
+    finally:
+        s.close()
