@@ -185,6 +185,9 @@ def s_panel_off():
     area.type = "NODE_EDITOR"
     sp = area.spaces.active
     sp.tree_type = "CompositorNodeTree"
+    sp.show_region_ui = False
+    for n in compat.compositor_tree(scene, create=False).nodes:
+        n.select = False
     check("compositor tree", compat.compositor_tree(scene, create=False) is not None)
 
 
@@ -193,6 +196,8 @@ def s_compositor_view():
     w = bpy.context.window_manager.windows[0]
     with override(w, largest_area(w)):
         bpy.ops.node.view_all()
+        for _ in range(2):
+            bpy.ops.view2d.zoom_in()
 
 
 @step
@@ -271,7 +276,7 @@ def s_second_shot():
     for window in bpy.context.window_manager.windows:
         for area in window.screen.areas:
             if area in editors:
-                screenshot(window, area, "preview_again.png")
+                screenshot(window, area, "preview.png")
     n = sum(1 for _ in operators._image_editors(bpy.context.window_manager))
     check("no second editor opened", n == 1, n)
 

@@ -254,9 +254,10 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "available)")
     half_float: BoolProperty(
         name="Half Float", default=True, **_UPDATE,
-        description="Write 16-bit half floats, like Blender's own EXR default: half the file "
-                    "size and write time (a 1080p AOV: about 44 MB instead of 87 MB) with 3 "
-                    "significant digits, plenty for light added in the compositor")
+        description="Write 16-bit half floats, like Blender's own EXR default: smaller files, "
+                    "faster writes (a 1080p AOV of the test room: 1.6 MB in 2-3 s instead of "
+                    "33 MB in 6 s; noise that does not compress: 38 MB instead of 157 MB) with "
+                    "3 significant digits, plenty for light added in the compositor")
     fail_render: BoolProperty(
         name="Fail Render Without AOV", default=False,
         description="For farms: when a frame's AOV cannot be computed, stop the render. "

@@ -13,7 +13,7 @@ import time
 import bpy
 import numpy as np
 
-from . import export, live
+from . import export, live, settings
 from .convert import ExportError
 
 #: The one live session (None when off): see _Session.
@@ -325,6 +325,11 @@ def _redraw(self, context):
         s.renderer.last_key = None
 
 
+# No update= callbacks in the pip bpy module: its 4.2 LTS build segfaults at
+# exit while one is registered (settings.py; a module has no viewport to redraw).
+_REDRAW = {"update": _redraw} if settings.IN_APPLICATION else {}
+
+
 class VSGLLiveProps(bpy.types.PropertyGroup):
     quality: bpy.props.EnumProperty(
         name="Quality",
@@ -332,10 +337,10 @@ class VSGLLiveProps(bpy.types.PropertyGroup):
                 "in 2 x 2: about 0.1-0.4 s at 960 x 540 on 2 cores, bias within about 20 %"),
                ("BALANCED", "Balanced", "Lattice 128, RSM 256, 2 x 2 samples, visibility rays: "
                 "several times slower than Preview, bias within about 7 %")),
-        default="PREVIEW", update=_redraw,
+        default="PREVIEW", **_REDRAW,
         description="Settings of the live render (the scene's own preset is used for F12)")
     scale: bpy.props.IntProperty(
-        name="Resolution Divider", min=1, max=4, default=2, update=_redraw,
+        name="Resolution Divider", min=1, max=4, default=2, **_REDRAW,
         description="Render the viewport at 1/N of its pixels in each direction: 2 renders a "
                     "quarter of the pixels, about 3-4x faster")
     display: bpy.props.EnumProperty(
@@ -343,7 +348,7 @@ class VSGLLiveProps(bpy.types.PropertyGroup):
         items=(("INDIRECT", "Indirect Only", "Show only the indirect light (the AOV's Combined pass)"),
                ("ADD", "Add to Viewport", "Add the indirect light over what the viewport draws "
                 "(approximate: the addition happens after the view transform)")),
-        default="INDIRECT", update=_redraw,
+        default="INDIRECT", **_REDRAW,
         description="How the live indirect light is drawn over the viewport")
 
 
