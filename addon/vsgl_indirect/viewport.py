@@ -38,6 +38,7 @@ class _Session:
         self.ctx = None              # libvsgl context, created on the worker thread
         self.last_edit = time.perf_counter()   # newest edit or view change seen
         self.last_done = 0.0                   # when the newest image arrived
+        self.last_submit = 0.0                 # when the newest render was started
         self.submits = 0                       # renders started
         self.lib_scene = None                  # libvsgl.Scene reused while geometry stands still
         self.lib_arrays = None                 # (arrays, materials) it was built from
@@ -145,6 +146,7 @@ def _submit(session, context_scene, depsgraph, region, rv3d, space, props):
 
     if session.renderer.submit(key, work) is not None:
         session.submits += 1
+        session.last_submit = time.perf_counter()
 
 
 def _render(session, sd, preset, threads, job, exposure, t_export):
