@@ -335,6 +335,9 @@ def _holdout_objects(view_layer):
     return names
 
 
+_ASSEMBLED = ("", "assembled")   # mesh_cache key of the last assembly (never an object name)
+
+
 def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=None):
     """Export the evaluated ``depsgraph`` (render or viewport) to a SceneData.
 
@@ -459,7 +462,19 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
     # Tangents only matter to anisotropic lobes: skip them (NULL) otherwise.
     want_tangents = any(m.get("anisotropy", 0.0) > 0.0 for m in sd.materials)
     dropped = {}
-    out = assemble(chunks, want_uvs, want_tangents, dropped)
+    # The same meshes at the same places as the last export (an edit of a
+    # light or of the camera): reuse its assembled arrays.
+    # (The arrays objects themselves are kept and compared by identity: a
+    # re-read mesh is a new object, even where it reuses an old address.)
+    signature = (want_uvs, want_tangents, tuple((m.tobytes(), tuple(sm)) for _, m, sm in chunks))
+    members = [a for a, _, _ in chunks]
+    last = mesh_cache.get(_ASSEMBLED)
+    if last is not None and last[0] == signature and len(last[3]) == len(members) and \
+            all(x is y for x, y in zip(last[3], members)):
+        out, dropped = last[1], dict(last[2])
+    else:
+        out = assemble(chunks, want_uvs, want_tangents, dropped)
+        mesh_cache[_ASSEMBLED] = (signature, out, dict(dropped), members)
     for ci, (n, total) in sorted(dropped.items()):
         what = ("all %d triangles are" % total) if n == total else ("%d of %d triangles are" % (n, total))
         sd.warnings.append("object '%s': %s degenerate (zero area or zero-length normal, e.g. a "
