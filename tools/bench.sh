@@ -22,3 +22,10 @@ if [ -x build/bench/bench_gbuffer ]; then
   echo "== scene build and G-buffer"
   build/bench/bench_gbuffer ${BENCH_GBUFFER_ARGS:-}
 fi
+echo "== live viewport preview (issue 12 targets), headless"
+py=${BPY_PYTHON:-python3}
+if "$py" -c 'import bpy' >/dev/null 2>&1; then
+  "$py" tools/bench_live.py --repeat "${BENCH_LIVE_REPEAT:-5}" 2>&1 | grep -v "DeprecationWarning\|use_nodes = True"
+else
+  echo "live preview: skipped: cannot import bpy in $py (tools/install_bpy.sh installs it)"
+fi

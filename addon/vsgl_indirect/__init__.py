@@ -14,7 +14,7 @@ bl_info = {
 
 if "bpy" in locals():   # script reload
     import importlib
-    for _m in ("compat", "convert", "materials", "config", "exr", "export", "engine",
+    for _m in ("compat", "convert", "materials", "config", "checks", "exr", "export", "engine",
                "runner", "compositor", "settings", "operators", "ui", "handlers", "live", "viewport"):
         if _m in locals():
             importlib.reload(locals()[_m])

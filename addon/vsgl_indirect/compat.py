@@ -1,4 +1,6 @@
 """Blender version differences in one place (3.4 ... 5.x)."""
+import os
+
 import bpy
 import numpy as np
 
@@ -113,6 +115,16 @@ def new_add_node(tree):
     return node, node.inputs[1], node.inputs[2], node.outputs[0]
 
 
+def set_add_factor(node, value):
+    """The factor of an Add node made by :func:`new_add_node` (result = A + factor * B)."""
+    if node.bl_idname == "ShaderNodeMix":
+        sock = [s for s in node.inputs if s.name == "Factor" and s.enabled][0]
+    else:
+        sock = node.inputs[0]
+    if abs(sock.default_value - value) > 1e-9:
+        sock.default_value = value
+
+
 def add_node_sockets(node):
     """(a, b, result) sockets of an Add node made by :func:`new_add_node`."""
     if node.bl_idname == "ShaderNodeMix":
@@ -121,3 +133,39 @@ def add_node_sockets(node):
         res = [s for s in node.outputs if s.name == "Result" and s.enabled][0]
         return a, b, res
     return node.inputs[1], node.inputs[2], node.outputs[0]
+
+
+# --- File Output node (5.0 replaced base_path/layer_slots) --------------------
+
+def file_output_set_path(node, prefix):
+    """Write to ``prefix`` + frame number + extension."""
+    if hasattr(node, "file_output_items"):        # 5.0+
+        d, name = os.path.split(prefix)
+        if node.directory != d + os.sep:
+            node.directory = d + os.sep
+        if node.file_name != name:
+            node.file_name = name
+    elif node.base_path != prefix:
+        node.base_path = prefix
+
+
+def file_output_names(node):
+    if hasattr(node, "file_output_items"):
+        return [i.name for i in node.file_output_items]
+    return [s.name for s in node.layer_slots]
+
+
+_ITEM_TYPES = {"VALUE": "FLOAT", "VECTOR": "VECTOR", "RGBA": "RGBA"}
+
+
+def file_output_set_names(node, slots):
+    """Replace the node's inputs by one per (name, source socket type) (a
+    multilayer EXR layer each; 3.x/4.x adapt the channels to what is linked)."""
+    if hasattr(node, "file_output_items"):
+        node.file_output_items.clear()
+        for n, t in slots:
+            node.file_output_items.new(_ITEM_TYPES.get(t, "RGBA"), n)
+        return
+    node.layer_slots.clear()
+    for n, _ in slots:
+        node.layer_slots.new(n)

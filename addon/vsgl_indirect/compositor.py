@@ -11,7 +11,10 @@ import bpy
 from . import compat, engine
 
 IMAGE_NODE = "VSGL Indirect [%s]"
-ADD_NODE = "VSGL Add [%s]"
+ADD_NODE = "VSGL Add [%s]"          # before issue 15 (one Add of Combined): replaced on setup
+ADD_NODES = "VSGL Add %s [%s]"      # kind (Diffuse, Glossy), view layer
+FRAME_NODE = "VSGL Frame"
+FILE_OUTPUT_NODE = "VSGL Passes Output"
 IMAGE_NAME = "VSGL %s %s"   # scene, view layer
 FIRST_FRAME = -500000
 DURATION = 1048574
@@ -19,10 +22,6 @@ DURATION = 1048574
 
 def image_node_name(view_layer):
     return IMAGE_NODE % view_layer
-
-
-def add_node_name(view_layer):
-    return ADD_NODE % view_layer
 
 
 def placeholder(path, width, height, exclusive=False):
@@ -70,9 +69,13 @@ def _render_layers_node(tree, scene, view_layer):
     return n
 
 
+def _ours(node):
+    return node.name.startswith("VSGL ")
+
+
 def has_passes(node, add_to_render=True):
     """The Image node shows the AOV's passes (and, with ``add_to_render``,
-    its Combined output feeds our Add node)."""
+    its Diff output feeds our Add node)."""
     if node is None or "DiffInd" not in node.outputs or not node.outputs["DiffInd"].enabled:
         return False
     src = _combined_socket(node)
@@ -80,16 +83,98 @@ def has_passes(node, add_to_render=True):
         return False
     if not add_to_render:
         return True
-    return any(l.to_node.name.startswith("VSGL Add [") for l in src.links)
+    diff = node.outputs.get("Diff")
+    return diff is not None and any(l.to_node.name.startswith("VSGL Add") for l in diff.links)
 
 
-def ensure(scene, view_layer, path, add_to_render=True):
+# --- layout: our nodes in one labelled Frame beside the user's tree -----------
+
+FRAME_LABEL = "VSGL Indirect Light (add-on; Render Properties > VSGL Indirect Light)"
+NODE_W, NODE_H = 240.0, 320.0     # node size estimates (dimensions are 0 until drawn)
+
+
+def _bounds(nodes):
+    """(xmin, ymin, xmax, ymax) of ``nodes`` in the editor's coordinates."""
+    xs, ys = [], []
+    for n in nodes:
+        x, y = _absolute(n)
+        w = n.width or NODE_W
+        h = n.dimensions[1] if n.dimensions[1] > 0 else NODE_H
+        xs += [x, x + w]
+        ys += [y - h, y]
+    return (min(xs), min(ys), max(xs), max(ys)) if xs else (0.0, 0.0, 0.0, 0.0)
+
+
+def _absolute(node):
+    if hasattr(node, "location_absolute"):
+        return tuple(node.location_absolute)
+    x, y = node.location
+    p = node.parent
+    while p is not None:            # 3.x/4.x: a child's location is its frame's offset
+        x, y = x + p.location[0], y + p.location[1]
+        p = p.parent
+    return x, y
+
+
+def _place(node, frame, x, y):
+    """Put ``node`` in ``frame`` at absolute (x, y)."""
+    if node.parent != frame:
+        node.parent = frame
+    if hasattr(node, "location_absolute"):
+        node.location_absolute = (x, y)
+    else:
+        node.location = (x - frame.location[0], y - frame.location[1])
+
+
+def _frame(tree):
+    frame = tree.nodes.get(FRAME_NODE)
+    if frame is None:
+        frame = tree.nodes.new("NodeFrame")
+        frame.name = FRAME_NODE
+        frame.label = FRAME_LABEL
+        frame.label_size = 14
+        frame.shrink = True
+        frame.use_custom_color = True
+        frame.color = (0.22, 0.27, 0.33)
+        others = [n for n in tree.nodes if not _ours(n) and n.bl_idname != "NodeFrame"]
+        x0, y0, x1, y1 = _bounds(others)
+        # Below the user's tree, left-aligned with it: beside, never over it.
+        frame.location = (x0, y0 - 120.0)
+    return frame
+
+
+def _layout(tree, frame):
+    """Image nodes in a column at the frame's left, the Add nodes of each
+    layer to their right, the File Output node after them."""
+    fx, fy = _absolute(frame)
+    images = sorted((n for n in tree.nodes if n.name.startswith("VSGL Indirect [")),
+                    key=lambda n: n.name)
+    for i, img in enumerate(images):
+        layer = img.name[len("VSGL Indirect ["):-1]
+        y = fy - 40.0 - i * (NODE_H + 60.0)
+        _place(img, frame, fx + 20.0, y)
+        for j, name in enumerate((add_node_name(layer, "Diffuse"), add_node_name(layer, "Glossy"))):
+            n = tree.nodes.get(name)
+            if n is not None:
+                _place(n, frame, fx + 20.0 + NODE_W + 60.0 + j * 200.0, y - 20.0)
+    out = tree.nodes.get(FILE_OUTPUT_NODE)
+    if out is not None:
+        _place(out, frame, fx + 20.0 + NODE_W + 480.0, fy - 40.0)
+
+
+def ensure(scene, view_layer, path, add_to_render=True, options=None):
     """Set up (or update) the nodes for ``view_layer`` to read the sequence
     ``path`` belongs to (any frame's file) and return the Image node.
     ``path`` must exist (see :func:`placeholder`) so Blender creates the pass
     sockets. Call it before a render starts (render_init, file load, settings
     change), never from render_pre: changing the node tree there stops Blender
-    3.4 from calling frame_change_post for the following frames of ``-a``."""
+    3.4 from calling frame_change_post for the following frames of ``-a``.
+
+    Added onto the render: Diff and Gloss, each through an Add node whose
+    factor is ``options.strength`` (0 for a pass switched off):
+    render + strength * (Diff + Gloss) = render + strength * Combined."""
+    from .config import Options
+    options = options or Options()
     tree = compat.compositor_tree(scene, create=True)
     name = IMAGE_NAME % (scene.name, view_layer)
     img = bpy.data.images.get(name)
@@ -101,16 +186,18 @@ def ensure(scene, view_layer, path, add_to_render=True):
     if img.source != "SEQUENCE":
         img.source = "SEQUENCE"
 
+    frame = _frame(tree)
     node = tree.nodes.get(image_node_name(view_layer))
     if node is None:
         node = tree.nodes.new("CompositorNodeImage")
         node.name = image_node_name(view_layer)
-        node.label = "VSGL indirect (%s)" % view_layer
-        node.location = (-300, -400 - 300 * len([n for n in tree.nodes
-                                                 if n.name.startswith("VSGL Indirect")]))
     # File number = scene frame for every frame in [FIRST, FIRST + DURATION):
     # Blender reads clamp(frame - start + 1, 0, duration) + offset. Static, so
-    # nothing changes in the tree while frames render.
+    # nothing changes in the tree while frames render. The node's options
+    # (which would show these numbers) are hidden; the label says it.
+    label = "VSGL AOV %s (file number = frame)" % view_layer
+    if node.label != label:
+        node.label = label
     if node.frame_start != FIRST_FRAME:
         node.frame_start = FIRST_FRAME
     if node.frame_duration != DURATION:
@@ -119,6 +206,8 @@ def ensure(scene, view_layer, path, add_to_render=True):
         node.frame_offset = FIRST_FRAME - 1
     if not node.use_auto_refresh:
         node.use_auto_refresh = True
+    if node.show_options:
+        node.show_options = False
     if node.image != img or _combined_socket(node) is None or "DiffInd" not in node.outputs:
         img.reload()        # a failed read (a file that vanished meanwhile) is cached
         node.image = None
@@ -129,34 +218,142 @@ def ensure(scene, view_layer, path, add_to_render=True):
         except TypeError:
             pass
 
-    add = tree.nodes.get(add_node_name(view_layer))
+    old = tree.nodes.get(ADD_NODE % view_layer)      # before issue 15: one Add of Combined
+    if old is not None:
+        remove_add(tree, old)
+    adds = [tree.nodes.get(add_node_name(view_layer, k)) for k in ("Diffuse", "Glossy")]
     if add_to_render:
-        src = _combined_socket(node)
-        if src is None:
-            raise engine.AovError("compositor: the Image node '%s' shows no Combined pass for "
-                                  "'%s'" % (node.name, path))
+        srcs = [node.outputs.get("Diff"), node.outputs.get("Gloss")]
+        if _combined_socket(node) is None or None in srcs:
+            raise engine.AovError("compositor: the Image node '%s' shows no Diff/Gloss passes "
+                                  "for '%s'" % (node.name, path))
         out = compat.compositor_output_socket(tree)
-        if add is None:
+        if None in adds:
+            for a in adds:
+                if a is not None:
+                    remove_add(tree, a)
             rl = _render_layers_node(tree, scene, view_layer)
             # What currently reaches the output (the beauty chain), else the render layer.
             beauty = out.links[0].from_socket if out.is_linked else rl.outputs["Image"]
-            add, a, b, res = compat.new_add_node(tree)
-            add.name = add_node_name(view_layer)
-            add.label = "Add VSGL indirect (%s)" % view_layer
-            add.location = (out.node.location.x - 200, out.node.location.y - 150)
-            tree.links.new(beauty, a)
-            tree.links.new(res, out)
-        a, b, res = compat.add_node_sockets(add)
-        if not b.is_linked or b.links[0].from_socket != src:
-            tree.links.new(src, b)
-        if not out.is_linked or out.links[0].from_node != add:
+            adds = []
+            for kind in ("Diffuse", "Glossy"):
+                add, a, b, res = compat.new_add_node(tree)
+                add.name = add_node_name(view_layer, kind)
+                tree.links.new(beauty, a)
+                beauty = res
+                adds.append(add)
+            tree.links.new(beauty, out)
+        last_res = compat.add_node_sockets(adds[1])[2]
+        for add, src, kind, on in zip(adds, srcs, ("Diffuse", "Glossy"),
+                                      (options.use_diffuse, options.use_glossy)):
+            a, b, res = compat.add_node_sockets(add)
+            if not b.is_linked or b.links[0].from_socket != src:
+                tree.links.new(src, b)
+            fac = float(options.strength) if on else 0.0
+            compat.set_add_factor(add, fac)
+            label = "Add VSGL %s x %.3g%s" % (kind.lower(), options.strength, "" if on else " (off)")
+            if add.label != label:
+                add.label = label
+        if not out.is_linked or out.links[0].from_node != adds[1]:
             # Something was plugged into the output after us: add onto it.
-            if out.is_linked and out.links[0].from_node != add:
-                tree.links.new(out.links[0].from_socket, a)
-            tree.links.new(res, out)
-    elif add is not None:
-        remove_add(tree, add)
+            if out.is_linked and out.links[0].from_node != adds[1]:
+                tree.links.new(out.links[0].from_socket, compat.add_node_sockets(adds[0])[0])
+            tree.links.new(last_res, out)
+    else:
+        for a in adds:
+            if a is not None:
+                remove_add(tree, a)
+    for n in [node] + [a for a in adds if a is not None and a.name in tree.nodes]:
+        if n.parent != frame:
+            n.parent = frame
+    _layout(tree, frame)
     return node
+
+
+# --- AOV export: the render's passes + the VSGL passes in one EXR per frame --
+
+#: Render Layers socket names (5.0 spells them out) -> Blender's pass names
+#: in a multilayer EXR (what its own render output and Cycles call them).
+PASS_NAMES = {
+    "Image": "Combined", "Diffuse Direct": "DiffDir", "Diffuse Indirect": "DiffInd",
+    "Diffuse Color": "DiffCol", "Glossy Direct": "GlossDir", "Glossy Indirect": "GlossInd",
+    "Glossy Color": "GlossCol", "Transmission Direct": "TransDir",
+    "Transmission Indirect": "TransInd", "Transmission Color": "TransCol",
+    "Volume Direct": "VolumeDir", "Volume Indirect": "VolumeInd", "Emission": "Emit",
+    "Environment": "Env", "Ambient Occlusion": "AO", "Depth": "Depth", "Normal": "Normal",
+    "Position": "Position", "Vector": "Vector", "UV": "UV", "Mist": "Mist",
+    "Shadow Catcher": "Shadow Catcher", "Object Index": "IndexOB", "Material Index": "IndexMA",
+}
+#: The VSGL passes' names in that file: <view layer>.VSGL_<pass>.
+VSGL_PASSES = ("DiffInd", "GlossInd", "DiffCol", "GlossCol", "Diff", "Gloss", "Combined")
+
+
+def export_slots(tree, scene, layers):
+    """[(slot name, source socket)] of the passes file: per rendered view
+    layer its render passes (Blender's names, ``ViewLayer.DiffDir``), the
+    VSGL passes (``ViewLayer.VSGL_DiffInd``, ...), then ``Composite``, the
+    composited image (render + AOV)."""
+    slots = []
+    for layer in layers:
+        rl = _render_layers_node(tree, scene, layer)
+        for o in rl.outputs:
+            if not o.enabled or o.name in ("Alpha", "Noisy Image") or o.name.startswith("Denoising"):
+                continue
+            slots.append(("%s.%s" % (layer, PASS_NAMES.get(o.name, o.name.replace(" ", ""))), o))
+        img = tree.nodes.get(image_node_name(layer))
+        if img is not None:
+            for p in VSGL_PASSES:
+                o = img.outputs.get(p)
+                if o is not None and o.enabled:
+                    slots.append(("%s.VSGL_%s" % (layer, p), o))
+    out = compat.compositor_output_socket(tree)
+    if out.is_linked:
+        slots.append(("Composite", out.links[0].from_socket))
+    return slots
+
+
+def ensure_export(scene, layers, prefix, options):
+    """Create/update the File Output node writing one multilayer EXR per
+    frame (``prefix`` + frame number + .exr) with :func:`export_slots`, or
+    remove it when ``options.export_passes`` is off."""
+    tree = compat.compositor_tree(scene, create=True)
+    node = tree.nodes.get(FILE_OUTPUT_NODE)
+    if not options.export_passes:
+        if node is not None:
+            tree.nodes.remove(node)
+        return None
+    if node is None:
+        node = tree.nodes.new("CompositorNodeOutputFile")
+        node.name = FILE_OUTPUT_NODE
+        node.label = "VSGL + render passes (one EXR per frame)"
+        node.width = 260
+    fmt = node.format
+    if fmt.file_format != "OPEN_EXR_MULTILAYER":
+        fmt.file_format = "OPEN_EXR_MULTILAYER"
+    depth = "16" if options.half_float else "32"
+    if fmt.color_depth != depth:
+        fmt.color_depth = depth
+    if fmt.exr_codec != "ZIP":
+        fmt.exr_codec = "ZIP"
+    compat.file_output_set_path(node, prefix)
+    slots = export_slots(tree, scene, layers)
+    have = compat.file_output_names(node)
+    if have != [n for n, _ in slots]:
+        compat.file_output_set_names(node, [(n, src.type) for n, src in slots])
+    inputs = [i for i in node.inputs if i.enabled and i.name]
+    for (name, src), sock in zip(slots, inputs):
+        if not sock.is_linked or sock.links[0].from_socket != src:
+            tree.links.new(src, sock)
+    frame = tree.nodes.get(FRAME_NODE)
+    if frame is not None and node.parent != frame:
+        node.parent = frame
+    if frame is not None:
+        _layout(tree, frame)
+    return node
+
+
+def add_node_name(view_layer, kind):
+    return ADD_NODES % (kind, view_layer)
 
 
 def remove_add(tree, add):
@@ -176,10 +373,10 @@ def remove(scene):
     if tree is None:
         return
     for n in list(tree.nodes):
-        if n.name.startswith("VSGL Add ["):
+        if n.name.startswith("VSGL Add"):
             remove_add(tree, n)
     for n in list(tree.nodes):
-        if n.name.startswith("VSGL Indirect ["):
+        if n.name.startswith("VSGL Indirect [") or n.name in (FILE_OUTPUT_NODE, FRAME_NODE):
             tree.nodes.remove(n)
     for img in list(bpy.data.images):
         if img.name.startswith("VSGL %s " % scene.name) and img.users == 0:

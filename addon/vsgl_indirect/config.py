@@ -9,22 +9,84 @@ PRESETS = ("PREVIEW", "BALANCED", "QUALITY")
 DEFAULT_TEMPLATE = "{render_dir}/vsgl/{scene}_{view_layer}_####.exr"
 
 # Advanced knobs, mirroring vsgl_render_settings (csrc/include/vsgl/render.h).
-# name -> (enum items or None, default)
+# name -> (enum items or None, default). The defaults are the BALANCED
+# preset's values, so ticking "Advanced" never changes the result by itself.
 KNOBS = {
     "method": (("VSGL", "BRUTE_FORCE"), "VSGL"),
     "aa_samples": (None, 2),
+    "shade_stride": (None, 2),
+    "sample_merging": (("AUTO", "OFF"), "AUTO"),
+    "visibility": (("NONE", "RAY"), "RAY"),
+    "seed": (None, 0),
     "rsm_resolution": (None, 256),
     "fit_mode": (("TWO", "FIS", "KMEANS", "LATTICE"), "LATTICE"),
     "vsgl_count": (None, 128),
     "fis_iterations": (None, 8),
     "sharpness_estimator": (("TOKSVIG", "BANERJEE"), "TOKSVIG"),
+    "leak_correction": (("AUTO", "OFF", "ON"), "AUTO"),
     "diffuse_mode": (("SG", "PULLED_OUT", "ACCURATE"), "PULLED_OUT"),
     "glossy_mode": (("ASG", "SG", "ASG2"), "ASG"),
-    "visibility": (("NONE", "RAY"), "NONE"),
-    "seed": (None, 0),
-    "leak_correction": (("AUTO", "OFF", "ON"), "AUTO"),
-    "sample_merging": (("AUTO", "OFF"), "AUTO"),
 }
+
+# The presets' knob values: vsgl_render_settings_preset (csrc/src/shade/
+# settings.c), mirrored so the panel can show them without the library;
+# tests/blender/addon/test_addon_ui.py checks the two agree.
+_COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", fis_iterations=8,
+               seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
+               diffuse_mode="PULLED_OUT")
+PRESET_VALUES = {
+    "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="NONE",
+                    shade_stride=2),
+    "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=128, visibility="RAY",
+                     shade_stride=2),
+    "QUALITY": dict(_COMMON, aa_samples=2, rsm_resolution=512, vsgl_count=256, visibility="RAY",
+                    shade_stride=2),
+}
+assert all(PRESET_VALUES["BALANCED"][k] == v[1] for k, v in KNOBS.items())
+
+
+def preset_knobs(preset):
+    """The knob values of ``preset`` (a dict; BALANCED for an unknown name)."""
+    return dict(PRESET_VALUES.get(preset, PRESET_VALUES["BALANCED"]))
+
+
+def knobs_of(obj):
+    """The knob values of ``obj`` (an Options, the PropertyGroup, any object)."""
+    return {k: getattr(obj, k) for k in KNOBS}
+
+
+def differing_knobs(obj, preset=None):
+    """Names of the knobs of ``obj`` that differ from ``preset`` (default:
+    ``obj.preset``), in KNOBS order."""
+    want = preset_knobs(preset or obj.preset)
+    return [k for k in KNOBS if getattr(obj, k) != want[k]]
+
+
+def matching_preset(obj):
+    """The preset whose values ``obj``'s knobs equal, or None."""
+    for p in PRESETS:
+        if not differing_knobs(obj, p):
+            return p
+    return None
+
+
+def inactive_knobs(obj):
+    """Knobs that do not apply with ``obj``'s other knobs (the library
+    ignores them): greyed out in the panel."""
+    out = set()
+    if obj.method == "BRUTE_FORCE":   # every RSM texel with the exact BRDF: no fit, no lobes
+        out |= {"fit_mode", "vsgl_count", "fis_iterations", "seed", "sharpness_estimator",
+                "leak_correction", "diffuse_mode", "glossy_mode", "shade_stride",
+                "sample_merging"}
+    if obj.fit_mode == "TWO":
+        out |= {"vsgl_count", "fis_iterations", "seed"}
+    elif obj.fit_mode == "LATTICE":
+        out |= {"fis_iterations", "seed"}
+    elif obj.fit_mode == "KMEANS":
+        out |= {"fis_iterations"}
+    if obj.aa_samples <= 1:
+        out.add("sample_merging")
+    return out
 
 
 @dataclass
@@ -35,6 +97,7 @@ class Options:
     use_advanced: bool = False
     method: str = "VSGL"
     aa_samples: int = 2
+    shade_stride: int = 2
     rsm_resolution: int = 256
     fit_mode: str = "LATTICE"
     vsgl_count: int = 128
@@ -42,14 +105,20 @@ class Options:
     sharpness_estimator: str = "TOKSVIG"
     diffuse_mode: str = "PULLED_OUT"
     glossy_mode: str = "ASG"
-    visibility: str = "NONE"
+    visibility: str = "RAY"
     seed: int = 0
     leak_correction: str = "AUTO"
     sample_merging: str = "AUTO"
     output_path: str = DEFAULT_TEMPLATE
     threads: int = 0
     max_memory_gb: float = 0.0      # 0 = the memory the machine has available
-    half_float: bool = False
+    half_float: bool = True         # Blender's own EXR default; 2x smaller, faster to write
+    fail_render: bool = False       # farms: a frame without its AOV fails the render
+    strength: float = 1.0           # compositor: factor of the added indirect light
+    use_diffuse: bool = True        # compositor: add the Diff pass
+    use_glossy: bool = True         # compositor: add the Gloss pass
+    export_passes: bool = False     # compositor: render passes + VSGL passes in one EXR
+    export_path: str = "{render_dir}/passes/{scene}_"
 
     def max_memory_bytes(self):
         return max(int(float(self.max_memory_gb) * (1 << 30)), 0)

@@ -30,6 +30,13 @@ class AovError(Exception):
     """The AOV could not be computed; the message says which element or part."""
 
 
+class AovCancelled(AovError):
+    """The user cancelled the computation (the progress callback said so)."""
+
+    def __init__(self, message="cancelled"):
+        super().__init__(message)
+
+
 def _binding():
     try:
         from . import libvsgl
@@ -136,7 +143,7 @@ def render_planes(sd, options, progress=None, log=None):
         try:
             planes, stats = libvsgl.render(ctx, scene, settings_for(options, libvsgl), PLANES)
         except libvsgl.VsglCancelledError:
-            raise AovError("cancelled")
+            raise AovCancelled()
         except libvsgl.VsglError as e:
             raise AovError("render failed: %s" % _name_elements(e.message or str(e), sd))
         finally:
@@ -271,8 +278,12 @@ def compute(sd, options, path, progress=None, keep_planes=False, metadata=None):
         if p in planes and np.asarray(planes[p]).shape[:2] != (sd.height, sd.width):
             raise AovError("renderer returned %s of size %s, camera is %dx%d"
                            % (p, np.asarray(planes[p]).shape[:2], sd.width, sd.height))
+    if progress is not None:
+        progress("write", 0.0)   # the status bar says "writing", not "shade 100%"
     write_exr(path, planes, options, metadata, res.warnings)
     t2 = time.perf_counter()
+    if progress is not None:
+        progress("write", 1.0)
     res.path = path
     res.stats = dict(stats or {})
     res.timings = {"render": t1 - t0, "write": t2 - t1}
@@ -284,5 +295,5 @@ def compute(sd, options, path, progress=None, keep_planes=False, metadata=None):
     return res
 
 
-__all__ = ["AovError", "ExportError", "compute", "library_status", "render_missing",
+__all__ = ["AovError", "AovCancelled", "ExportError", "compute", "library_status", "render_missing",
            "can_render", "write_exr", "exr_passes", "RENDER_OVERRIDE"]

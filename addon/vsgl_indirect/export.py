@@ -627,6 +627,9 @@ def _holdout_objects(view_layer):
     return names
 
 
+_ASSEMBLED = ("", "assembled")   # mesh_cache key of the last assembly (never an object name)
+
+
 def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=None):
     """Export the evaluated ``depsgraph`` (render or viewport) to a SceneData.
 
@@ -781,7 +784,21 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
         return pl.vertex_color if pl is not None else None
 
     any_vc = any(color_of(g) is not None for g in range(len(material_plans)))
-    out = assemble(chunks, want_uvs, want_tangents, dropped, uv_map_of, color_of if any_vc else None)
+    # The same meshes at the same places as the last export (an edit of a
+    # light or of the camera): reuse its assembled arrays.
+    # (The arrays objects themselves are kept and compared by identity: a
+    # re-read mesh is a new object, even where it reuses an old address.)
+    per_material = tuple((uv_map_of(g), color_of(g)) for g in range(len(material_plans)))
+    signature = (want_uvs, want_tangents, any_vc, per_material,
+                 tuple((m.tobytes(), tuple(sm)) for _, m, sm in chunks))
+    members = [a for a, _, _ in chunks]
+    last = mesh_cache.get(_ASSEMBLED)
+    if last is not None and last[0] == signature and len(last[3]) == len(members) and \
+            all(x is y for x, y in zip(last[3], members)):
+        out, dropped = last[1], dict(last[2])
+    else:
+        out = assemble(chunks, want_uvs, want_tangents, dropped, uv_map_of, color_of if any_vc else None)
+        mesh_cache[_ASSEMBLED] = (signature, out, dict(dropped), members)
     for ci, (n, total) in sorted(dropped.items()):
         what = ("all %d triangles are" % total) if n == total else ("%d of %d triangles are" % (n, total))
         sd.warnings.append("object '%s': %s degenerate (zero area or zero-length normal, e.g. a "

@@ -26,12 +26,17 @@ where no file exists and only ever removed if it is still the same inode.
 """
 import contextlib
 import os
+import sys
 import time
 
 import bpy
 from bpy.app.handlers import persistent
 
-from . import compositor, convert, engine, runner
+from . import checks, compositor, convert, engine, runner
+
+#: Exit status of ``blender -b ... -f/-a`` when a frame has no AOV and
+#: *Fail Render Without AOV* is on.
+FAIL_EXIT_CODE = 1
 
 _state = {"active": {}, "pending": {}, "done": set(), "job_start": {}}
 
@@ -63,16 +68,60 @@ def setup_scene(scene, frame=None):
         try:
             engine.check_output_path(path)
             with _setup_lock(os.path.dirname(path)):
-                _setup_layer(scene, layer, path, w, h, options.add_to_render and i == 0)
+                _setup_layer(scene, layer, path, w, h, options.add_to_render and i == 0, options)
         except engine.AovError as e:
             errors.append("view layer '%s': %s" % (layer, e))
         except Exception as e:
             import traceback
             traceback.print_exc()
             errors.append("view layer '%s': compositor setup failed: %r" % (layer, e))
+    try:
+        compositor.ensure_export(scene, _layers(scene), runner.export_prefix(scene, options),
+                                 options)
+    except Exception as e:
+        import traceback
+        traceback.print_exc()
+        errors.append("passes file output setup failed: %r" % (e,))
     for e in errors:
         runner.fail(scene.name, e)
     return errors
+
+
+def fail_render(scene, message):
+    """A frame has no AOV: with *Fail Render Without AOV* on, stop. In the
+    background (farm) the process exits with FAIL_EXIT_CODE before the
+    frame is written, so the task fails and is retried; in the UI nothing
+    can stop the render job from Python: the error stays in the panel."""
+    props = getattr(scene, "vsgl_indirect", None)
+    if props is None or not props.fail_render:
+        return
+    if bpy.app.background:
+        runner.report(scene.name, "ERROR", "stopping the render (exit status %d): %s "
+                      "(Fail Render Without AOV is on)" % (FAIL_EXIT_CODE, message))
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(FAIL_EXIT_CODE)
+    runner.report(scene.name, "ERROR", "this frame has no AOV (Fail Render Without AOV is on; "
+                  "the UI cannot stop a running render): %s" % message)
+
+
+def check_scene(scene):
+    """Warnings about the setup around the AOV (logged at render start and
+    shown in the panel): double counting, output in a temporary folder."""
+    out = []
+    dc = checks.double_counting(scene)
+    if dc:
+        out.append(dc)
+    layers = _layers(scene)
+    if layers:
+        try:
+            warn = checks.temp_output_warning(runner.output_path(scene, layers[0],
+                                                                 scene.frame_current))
+        except Exception:
+            warn = ""
+        if warn:
+            out.append(warn)
+    return out
 
 
 SETUP_LOCK = ".vsgl-setup.lock"
@@ -97,7 +146,7 @@ def _setup_lock(directory):
         os.close(fd)                 # releases the lock
 
 
-def _setup_layer(scene, layer, path, w, h, add, attempts=6):
+def _setup_layer(scene, layer, path, w, h, add, options=None, attempts=6):
     """compositor.ensure with a file at ``path`` for the pass sockets. Another
     worker's placeholder may vanish while Blender reads it (the sockets then
     come out empty): check and retry with our own placeholder."""
@@ -109,7 +158,7 @@ def _setup_layer(scene, layer, path, w, h, add, attempts=6):
         try:
             # One composite output: only the first rendered view layer's AOV is
             # added onto it; the others get their Image node to wire by hand.
-            node = compositor.ensure(scene, layer, path, add)
+            node = compositor.ensure(scene, layer, path, add, options)
             if compositor.has_passes(node, add):
                 return node
             err = None
@@ -181,10 +230,14 @@ def on_render_init(scene, *args):
     if props is None or not props.enabled or not engine.can_render():
         return
     _state["job_start"][scene.name] = time.time()
-    setup_scene(scene)
+    errors = setup_scene(scene)
     if scene.vsgl_indirect.add_to_render and not scene.render.use_compositing:
         runner.report(scene.name, "WARNING", "compositing is off (Output Properties > Post "
                       "Processing): the AOV files are written but not added to the render")
+    for w in check_scene(scene):
+        runner.report(scene.name, "WARNING", w)
+    if errors:
+        fail_render(scene, errors[0])
 
 
 @persistent
@@ -196,7 +249,9 @@ def on_render_pre(scene, *args):
     options = runner.options_of(scene)
     runner.begin(scene.name, frame)
     if not engine.can_render():
-        runner.fail(scene.name, "frame %d: no indirect AOV: %s" % (frame, engine.render_missing()))
+        msg = "frame %d: no indirect AOV: %s" % (frame, engine.render_missing())
+        runner.fail(scene.name, msg)
+        fail_render(scene, msg)
         return
     _state["active"][scene.name] = frame
     _state["job_start"].setdefault(scene.name, time.time())
@@ -206,7 +261,9 @@ def on_render_pre(scene, *args):
             engine.check_output_path(path)
             _state["pending"][(scene.name, layer, frame)] = path
         except engine.AovError as e:
-            runner.fail(scene.name, "frame %d, view layer '%s': %s" % (frame, layer, e))
+            msg = "frame %d, view layer '%s': %s" % (frame, layer, e)
+            runner.fail(scene.name, msg)
+            fail_render(scene, msg)
 
 
 @persistent
@@ -229,6 +286,8 @@ def on_frame_change_post(scene, depsgraph=None, *args):
         if retire_stale(path, since):
             runner.report(scene.name, "WARNING", "frame %d, view layer '%s': removed the previous "
                           "run's AOV %s (this frame's could not be computed)" % (frame, layer, path))
+        fail_render(scene, "frame %d, view layer '%s': %s" % (
+            frame, layer, runner.LAST_RUN.get(scene.name, {}).get("error") or "no AOV"))
     img = bpy.data.images.get(compositor.IMAGE_NAME % (scene.name, layer))
     if img is not None:
         img.reload()
@@ -240,8 +299,10 @@ def on_render_post(scene, *args):
     _state["done"] = {k for k in _state["done"] if k[0] != scene.name}
     for key in [k for k in _state["pending"] if k[0] == scene.name]:
         _state["pending"].pop(key)
-        runner.fail(scene.name, "frame %s, view layer '%s': the AOV was not computed "
-                    "(Blender gave no render depsgraph for it)" % (frame, key[1]))
+        msg = ("frame %s, view layer '%s': the AOV was not computed "
+               "(Blender gave no render depsgraph for it)" % (frame, key[1]))
+        runner.fail(scene.name, msg)
+        fail_render(scene, msg)
 
 
 @persistent

@@ -219,6 +219,9 @@ RSM_RESOLUTION_MAX = 8192
 VSGL_COUNT_MAX = 65536
 FIS_ITERATIONS_MAX = 32
 SHADE_STRIDE_MAX = 8
+#: vsgl_render_stats.reused bits (render.h)
+REUSED_GBUFFER = 1
+REUSED_FIT = 2
 BUNDLE_VERSION = (1, 2)
 
 
@@ -501,6 +504,7 @@ class vsgl_render_stats(_Struct):
         ("vsgl_count", _u32),
         ("shading_pairs", ctypes.c_uint64),
         ("skipped", ctypes.c_char * 1024),
+        ("reused", _u32),
     ]
 
 
@@ -665,6 +669,10 @@ PROTOTYPES = (
                                     _P(vsgl_memory_estimate)]),
     ("vsgl_render", _i32, [_VP, _VP, _P(vsgl_render_settings), _P(vsgl_render_output),
                            _P(vsgl_render_stats)]),
+    ("vsgl_render_cache_create", _i32, [_VP, _PVP]),
+    ("vsgl_render_cache_destroy", None, [_VP]),
+    ("vsgl_render_cached", _i32, [_VP, _VP, _P(vsgl_render_settings), _VP, _P(vsgl_render_output),
+                                  _P(vsgl_render_stats)]),
     # io.h
     ("vsgl_check_output_path", _i32, [_VP, ctypes.c_char_p]),
     ("vsgl_exr_write", _i32, [_VP, ctypes.c_char_p, _u32, _u32, _P(vsgl_exr_pass), _u32,
@@ -1539,13 +1547,51 @@ def render_estimate(ctx, scene, settings=None, planes=PLANES):
     return est.as_dict()
 
 
-def render(ctx, scene, settings=None, planes=PLANES):
+class RenderCache:
+    """A vsgl_render_cache: the G-buffer and VSGLs of the last render passed
+    to ``render(..., cache=)``, reused while their inputs stand still. Close
+    it (or use ``with``) before its context."""
+
+    _handle = None
+
+    def __init__(self, ctx):
+        self._ctx, self._lib = ctx, ctx._lib
+        h = ctypes.c_void_p()
+        ctx.check(self._lib.vsgl_render_cache_create(ctx.handle, ctypes.byref(h)), "vsgl_render_cache_create")
+        self._handle = h
+
+    @property
+    def handle(self):
+        if self._handle is None:
+            raise ValueError("the render cache is closed")
+        return self._handle
+
+    def close(self):
+        h, self._handle = self._handle, None
+        if h is not None:
+            self._lib.vsgl_render_cache_destroy(h)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+def render(ctx, scene, settings=None, planes=PLANES, cache=None):
     """Render the indirect planes of ``scene``.
 
     ``settings``: RenderSettings, a dict of its fields, or None (defaults).
-    ``planes``: names from PLANES. Returns ``(images, stats)``: images maps
-    each plane to a float32 array (H, W, 3) ((H, W) for "alpha"), rows from
-    the top; stats is a dict of vsgl_render_stats (``skipped`` a str).
+    ``planes``: names from PLANES. ``cache``: a RenderCache (vsgl_render_cached)
+    or None. Returns ``(images, stats)``: images maps each plane to a float32
+    array (H, W, 3) ((H, W) for "alpha"), rows from the top; stats is a dict
+    of vsgl_render_stats (``skipped`` a str).
     """
     planes = tuple(planes)
     for p in planes:
@@ -1561,7 +1607,11 @@ def render(ctx, scene, settings=None, planes=PLANES):
     for p, a in images.items():
         setattr(out, p, a.ctypes.data_as(_PF32))
     stats = vsgl_render_stats()
-    rc = fn(ctx.handle, scene.handle, ctypes.byref(s), ctypes.byref(out), ctypes.byref(stats))
+    if cache is None:
+        rc = fn(ctx.handle, scene.handle, ctypes.byref(s), ctypes.byref(out), ctypes.byref(stats))
+    else:
+        rc = ctx._lib.vsgl_render_cached(ctx.handle, scene.handle, ctypes.byref(s), cache.handle,
+                                         ctypes.byref(out), ctypes.byref(stats))
     ctx.check(rc, "vsgl_render")
     stats = _stats_dict(stats)
     stats["memory_estimate"] = estimate

@@ -67,15 +67,26 @@ def display_rgba(rgb, exposure=0.0, alpha=1.0):
     float32 (H, W, 4), rows bottom-up as a GPU texture wants: exposure in
     stops, the sRGB transfer function (Blender's "Standard" view), clipped
     to [0, 1]. NaN/negative become 0."""
-    x = np.nan_to_num(np.asarray(rgb, np.float32), nan=0.0, posinf=0.0, neginf=0.0)
-    x = np.clip(x * np.float32(2.0 ** exposure), 0.0, 1.0)
-    lo = x * np.float32(12.92)
-    hi = np.float32(1.055) * np.power(x, np.float32(1 / 2.4)) - np.float32(0.055)
-    x = np.where(x <= 0.0031308, lo, hi)
+    x = np.asarray(rgb, np.float32)
+    # a table of the transfer function, looked up at 1/16384 steps (1/4 of an
+    # 8-bit display step where the curve is steepest); NaN and negative -> 0
+    idx = np.nan_to_num(x * np.float32(2.0 ** exposure * (_LUT_N - 1)), nan=0.0, posinf=_LUT_N - 1, neginf=0.0)
+    np.clip(idx, 0, _LUT_N - 1, out=idx)
     out = np.empty(x.shape[:2] + (4,), np.float32)
-    out[..., :3] = x
+    out[::-1, :, :3] = _srgb_lut()[(idx + np.float32(0.5)).astype(np.int32)]
     out[..., 3] = alpha
-    return np.ascontiguousarray(out[::-1])
+    return out
+
+
+_LUT_N = 16385
+_LUT = []
+
+
+def _srgb_lut():
+    if not _LUT:
+        v = np.linspace(0.0, 1.0, _LUT_N, dtype=np.float64)
+        _LUT.append(np.where(v <= 0.0031308, v * 12.92, 1.055 * np.power(v, 1 / 2.4) - 0.055).astype(np.float32))
+    return _LUT[0]
 
 
 class Job:

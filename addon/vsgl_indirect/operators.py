@@ -1,15 +1,81 @@
 """Operators: preview the AOV (threaded, cancellable), export a scene bundle,
 remove the compositor nodes."""
+import json
 import os
 import threading
 
 import bpy
 from bpy.props import StringProperty
 
-from . import compositor, engine, runner
+from . import checks, compositor, engine, runner
 from .convert import ExportError
 
 PREVIEW_IMAGE = "VSGL Preview"
+
+
+def load_preview_image(path):
+    """The image 'VSGL Preview' reading ``path``, loaded now. Reloading alone
+    frees the buffer, and an Image Editor showing it drew no layer/pass
+    menus until something read the file again: read it here (``size``
+    acquires the buffer, which rebuilds the multilayer layers and passes)."""
+    img = bpy.data.images.get(PREVIEW_IMAGE)
+    if img is None:
+        img = bpy.data.images.load(path, check_existing=False)
+        img.name = PREVIEW_IMAGE
+    else:
+        if os.path.normpath(bpy.path.abspath(img.filepath)) != os.path.normpath(path):
+            img.filepath = path
+        img.reload()
+    tuple(img.size)
+    return img
+
+
+def _image_editors(window_manager):
+    for window in getattr(window_manager, "windows", []):
+        for area in window.screen.areas:
+            if area.type == "IMAGE_EDITOR":
+                yield window, area
+
+
+def find_image_editor(window_manager, image=None):
+    """An Image Editor area: one showing ``image`` first, else one showing no
+    image or a VSGL image, else any; None if there is none."""
+    editors = list(_image_editors(window_manager))
+    for pred in (lambda sp: image is not None and sp.image == image,
+                 lambda sp: sp.image is None or sp.image.name.startswith("VSGL"),
+                 lambda sp: True):
+        for window, area in editors:
+            if pred(area.spaces.active):
+                return area
+    return None
+
+
+def show_image(context, img):
+    """Show ``img`` in an Image Editor: reuse one that is open, else open one
+    the way F11 does (Preferences > Interface > Temporary Editors > Render
+    In; "New Window" if that is set to keep the interface). Returns the area
+    or None (background mode, no window)."""
+    wm = context.window_manager
+    area = find_image_editor(wm, img)
+    if area is None and getattr(context, "window", None) is not None and not bpy.app.background:
+        view = context.preferences.view
+        old = view.render_display_type
+        try:
+            if old == "NONE":
+                view.render_display_type = "WINDOW"
+            bpy.ops.render.view_show("INVOKE_DEFAULT")
+        except RuntimeError as e:
+            print("VSGL WARNING: could not open an Image Editor: %s" % e)
+        finally:
+            if view.render_display_type != old:
+                view.render_display_type = old
+        area = find_image_editor(wm)
+    if area is not None:
+        space = area.spaces.active
+        if space.image != img:
+            space.image = img
+        area.tag_redraw()
+    return area
 
 
 class VSGL_OT_preview_indirect(bpy.types.Operator):
@@ -47,33 +113,23 @@ class VSGL_OT_preview_indirect(bpy.types.Operator):
 
     def _finish(self, context):
         name = self._scene_name
+        if isinstance(self._error, engine.AovCancelled):
+            runner.cancel(name, "preview")
+            self.report({"INFO"}, "VSGL: preview cancelled")
+            return {"CANCELLED"}
         if self._error is not None:
             msg = str(self._error)
             runner.fail(name, "preview: %s" % msg)
-            self.report({"ERROR"} if msg != "cancelled" else {"WARNING"}, "VSGL: %s" % msg)
+            self.report({"ERROR"}, "VSGL: %s" % msg)
             return {"CANCELLED"}
         runner.finish(name, self._result, self._t_export)
         for w in self._result.warnings:
             self.report({"WARNING"}, "VSGL: %s" % w)
-        img = bpy.data.images.get(PREVIEW_IMAGE)
-        if img is None:
-            img = bpy.data.images.load(self._path, check_existing=False)
-            img.name = PREVIEW_IMAGE
-        else:
-            img.filepath = self._path
-            img.reload()
-        shown = False
-        for window in getattr(context.window_manager, "windows", []):
-            for area in window.screen.areas:
-                if area.type == "IMAGE_EDITOR":
-                    area.spaces.active.image = img
-                    area.tag_redraw()
-                    shown = True
-                    break
-            if shown:
-                break
+        img = load_preview_image(self._path)
+        area = show_image(context, img)
         self.report({"INFO"}, "VSGL: indirect light in image '%s'%s (%s)" % (
-            PREVIEW_IMAGE, "" if shown else "; open an Image Editor to see it", self._path))
+            PREVIEW_IMAGE, "" if area is not None else "; open an Image Editor to see it",
+            self._path))
         return {"FINISHED"}
 
     def execute(self, context):   # synchronous (scripts, background mode)
@@ -109,10 +165,14 @@ class VSGL_OT_preview_indirect(bpy.types.Operator):
             return {"PASS_THROUGH"}
         wm = context.window_manager
         stage, frac = self._stage
-        wm.progress_update(int(100 * frac))
+        if stage == "write":   # one call, no fraction: say what it is doing
+            wm.progress_update(99)
+            text = "VSGL indirect: writing the EXR %s" % os.path.basename(self._path)
+        else:
+            wm.progress_update(int(100 * frac))
+            text = "VSGL indirect: %s %d%% (Esc to cancel)" % (stage, int(100 * frac))
         if context.workspace is not None:
-            context.workspace.status_text_set("VSGL indirect: %s %d%% (Esc to cancel)"
-                                              % (stage, int(100 * frac)))
+            context.workspace.status_text_set(text)
         if self._thread.is_alive():
             return {"RUNNING_MODAL"}
         wm.event_timer_remove(self._timer)
@@ -182,7 +242,7 @@ class VSGL_OT_export_bundle(bpy.types.Operator):
 
 
 class VSGL_OT_remove_nodes(bpy.types.Operator):
-    """Remove the compositor nodes this add-on created in this scene"""
+    """Remove the compositor nodes this add-on created in this scene and reconnect the original chain"""
     bl_idname = "vsgl.remove_compositor_nodes"
     bl_label = "Remove VSGL Compositor Nodes"
     bl_options = {"REGISTER", "UNDO"}
@@ -192,11 +252,137 @@ class VSGL_OT_remove_nodes(bpy.types.Operator):
         return {"FINISHED"}
 
 
+class VSGL_OT_setup_compositor(bpy.types.Operator):
+    """Create or update the VSGL compositor nodes now (renders do it by themselves)"""
+    bl_idname = "vsgl.setup_compositor"
+    bl_label = "Update Compositor Nodes"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        props = getattr(context.scene, "vsgl_indirect", None)
+        return props is not None and props.enabled
+
+    def execute(self, context):
+        from . import handlers
+        errors = handlers.setup_scene(context.scene)
+        for e in errors:
+            self.report({"ERROR"}, "VSGL: %s" % e)
+        return {"CANCELLED"} if errors else {"FINISHED"}
+
+
+class VSGL_OT_reset_knobs(bpy.types.Operator):
+    """Set every advanced knob to the selected preset's value"""
+    bl_idname = "vsgl.reset_knobs"
+    bl_label = "Reset to Preset"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        from . import settings
+        settings.load_preset_knobs(context.scene.vsgl_indirect)
+        return {"FINISHED"}
+
+
+class VSGL_OT_cycles_direct_only(bpy.types.Operator):
+    """Set Cycles' Diffuse and Glossy bounces to 0 so that it renders direct light only and the VSGL AOV adds the one-bounce indirect light (saved: 'Restore' puts the previous values back)"""
+    bl_idname = "vsgl.cycles_direct_only"
+    bl_label = "Cycles: Direct Light Only"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None and hasattr(context.scene, "cycles")
+
+    def execute(self, context):
+        scene = context.scene
+        props, cy = scene.vsgl_indirect, scene.cycles
+        if not props.cycles_saved:   # keep the first saved values over repeated clicks
+            props.cycles_saved = json.dumps({k: int(getattr(cy, k)) for k in checks.SAVED_KEYS})
+        for k in checks.BOUNCE_KEYS:
+            setattr(cy, k, 0)
+        runner.report(scene.name, "INFO", "Cycles: diffuse and glossy bounces set to 0 "
+                      "(were %s); the composite is Cycles' direct light + the AOV"
+                      % props.cycles_saved)
+        return {"FINISHED"}
+
+
+class VSGL_OT_cycles_restore_bounces(bpy.types.Operator):
+    """Put back the Cycles bounces 'Cycles: Direct Light Only' changed"""
+    bl_idname = "vsgl.cycles_restore_bounces"
+    bl_label = "Restore Cycles Bounces"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        props = getattr(context.scene, "vsgl_indirect", None)
+        return props is not None and bool(props.cycles_saved) and hasattr(context.scene, "cycles")
+
+    def execute(self, context):
+        scene = context.scene
+        props = scene.vsgl_indirect
+        try:
+            saved = json.loads(props.cycles_saved)
+        except ValueError:
+            saved = {}
+        for k, v in saved.items():
+            if k in checks.SAVED_KEYS:
+                setattr(scene.cycles, k, int(v))
+        props.cycles_saved = ""
+        return {"FINISHED"}
+
+
+class VSGL_OT_select_named(bpy.types.Operator):
+    """Select the objects a message names (objects, lights, and the objects using a named material)"""
+    bl_idname = "vsgl.select_named"
+    bl_label = "Select Named Objects"
+    bl_options = {"REGISTER", "UNDO"}
+
+    message: StringProperty(name="Message", options={"HIDDEN", "SKIP_SAVE"},
+                            description="Text naming object 'X', light 'Y' or material 'Z'")
+
+    def execute(self, context):
+        from .ui import named_elements
+        found = objects_named(context.view_layer, named_elements(self.message))
+        if not found:
+            self.report({"WARNING"}, "VSGL: no object of this view layer is named in the message")
+            return {"CANCELLED"}
+        for ob in context.view_layer.objects:
+            if ob.select_get():
+                ob.select_set(False)
+        for ob in found:
+            ob.select_set(True)
+        context.view_layer.objects.active = found[0]
+        self.report({"INFO"}, "VSGL: selected %s" % ", ".join(o.name for o in found[:10]))
+        return {"FINISHED"}
+
+
+def objects_named(view_layer, named):
+    """Objects of ``view_layer`` for [(kind, name)]: an object or light by its
+    object (or data) name, a material by the objects using it."""
+    out = []
+    for ob in view_layer.objects:
+        hit = False
+        for kind, name in named:
+            if kind in ("object", "light"):
+                hit = ob.name == name or (ob.data is not None and ob.data.name == name
+                                          and (kind == "object" or ob.type == "LIGHT"))
+            elif kind == "material":
+                hit = any(s.material is not None and s.material.name == name
+                          for s in ob.material_slots)
+            if hit:
+                break
+        if hit:
+            out.append(ob)
+    return out
+
+
 def menu_export(self, context):
     self.layout.operator(VSGL_OT_export_bundle.bl_idname, text="VSGL scene bundle (.vsglb)")
 
 
-classes = (VSGL_OT_preview_indirect, VSGL_OT_export_bundle, VSGL_OT_remove_nodes)
+classes = (VSGL_OT_preview_indirect, VSGL_OT_export_bundle, VSGL_OT_remove_nodes,
+           VSGL_OT_setup_compositor, VSGL_OT_reset_knobs, VSGL_OT_cycles_direct_only,
+           VSGL_OT_cycles_restore_bounces, VSGL_OT_select_named)
 
 
 def register():

@@ -11,6 +11,8 @@ from .convert import ExportError
 
 #: scene name -> dict(status, error, warnings, timings, skipped, summary, path, frame)
 LAST_RUN = {}
+#: How the panel words each status.
+STATUS_TEXT = {"running": "running", "done": "done", "failed": "failed", "cancelled": "cancelled"}
 
 
 def options_of(scene):
@@ -49,6 +51,15 @@ def output_path(scene, view_layer, frame, options=None):
     return os.path.normpath(_absolute(p))
 
 
+def export_prefix(scene, options=None):
+    """Absolute path prefix of the passes EXR (Blender appends frame + .exr)."""
+    options = options or options_of(scene)
+    template = options.export_path or "{render_dir}/passes/{scene}_"
+    safe = convert.frame_path("{scene}", 0, scene.name).rsplit("_", 1)[0]   # the file-safe name
+    p = template.replace("{render_dir}", render_dir(scene).rstrip("/\\")).replace("{scene}", safe)
+    return os.path.normpath(_absolute(p)) + (os.sep if p.endswith(("/", "\\")) else "")
+
+
 def begin(scene_name, frame):
     LAST_RUN[scene_name] = {"status": "running", "frame": frame, "messages": [],
                             "timings": {}, "skipped": "", "summary": "", "path": "", "error": "",
@@ -80,6 +91,13 @@ def finish(scene_name, result, t_export):
     report(scene_name, "INFO", "wrote %s (%s; export %.3fs, render %.3fs, write %.3fs%s)"
            % (result.path, result.summary, t_export, result.timings.get("render", 0),
               result.timings.get("write", 0), "; memory %s" % mem if mem else ""))
+
+
+def cancel(scene_name, what="preview"):
+    """The user cancelled (Esc): not a failure, no error."""
+    info = LAST_RUN.setdefault(scene_name, {})
+    info.update(status="cancelled", error="")
+    report(scene_name, "INFO", "%s cancelled" % what)
 
 
 def fail(scene_name, message):

@@ -13,7 +13,7 @@ import time
 import bpy
 import numpy as np
 
-from . import export, live
+from . import export, live, settings
 from .convert import ExportError
 
 #: The one live session (None when off): see _Session.
@@ -38,15 +38,20 @@ class _Session:
         self.ctx = None              # libvsgl context, created on the worker thread
         self.last_edit = time.perf_counter()   # newest edit or view change seen
         self.last_done = 0.0                   # when the newest image arrived
+        self.last_submit = 0.0                 # when the newest render was started
         self.submits = 0                       # renders started
         self.lib_scene = None                  # libvsgl.Scene reused while geometry stands still
         self.lib_arrays = None                 # (arrays, materials) it was built from
         self.scene_builds = 0
+        self.lib_cache = None                  # libvsgl.RenderCache: G-buffer / VSGLs of the last render
         self.updates = 0                       # depsgraph updates seen
         self.current_job = None
 
     def close(self):
         self.renderer.cancel(wait=True)
+        if self.lib_cache is not None:
+            self.lib_cache.close()
+            self.lib_cache = None
         if self.lib_scene is not None:
             self.lib_scene.close()
             self.lib_scene = None
@@ -141,6 +146,7 @@ def _submit(session, context_scene, depsgraph, region, rv3d, space, props):
 
     if session.renderer.submit(key, work) is not None:
         session.submits += 1
+        session.last_submit = time.perf_counter()
 
 
 def _render(session, sd, preset, threads, job, exposure, t_export):
@@ -152,6 +158,8 @@ def _render(session, sd, preset, threads, job, exposure, t_export):
         session.ctx = lib.Context(thread_count=max(int(threads), 0), log_level=lib.LogLevel.ERROR,
                                   progress=lambda stage, f: bool(session.current_job and
                                                                  session.current_job.cancelled.is_set()))
+    if session.lib_cache is None:
+        session.lib_cache = lib.RenderCache(session.ctx)
     t0 = time.perf_counter()
     arrays = engine.scene_arrays(sd, lib)
     view = dict(camera=arrays.pop("camera"), lights=arrays.pop("lights"))
@@ -170,14 +178,17 @@ def _render(session, sd, preset, threads, job, exposure, t_export):
     t1 = time.perf_counter()
     settings = lib.render_settings_preset(getattr(lib.Preset, preset))
     try:
-        images, stats = lib.render(session.ctx, session.lib_scene, settings, ("combined",))
+        images, stats = lib.render(session.ctx, session.lib_scene, settings, ("combined",),
+                                   cache=session.lib_cache)
     except lib.VsglCancelledError:
         return None
     t2 = time.perf_counter()
     rgba = live.display_rgba(images["combined"], exposure)
     t3 = time.perf_counter()
     return dict(rgba=rgba, width=sd.width, height=sd.height,
-                timings=dict(export=t_export, scene=t1 - t0, render=t2 - t1, encode=t3 - t2),
+                timings=dict(export=t_export, scene=t1 - t0, render=t2 - t1, encode=t3 - t2,
+                             **{k: float(stats.get("seconds_" + k, 0.0)) for k in ("gbuffer", "rsm", "fit", "shade")}),
+                reused=int(stats.get("reused", 0)),
                 triangles=sd.triangle_count, vsgls=int(stats.get("vsgl_count", 0)) if isinstance(stats, dict) else 0)
 
 
@@ -325,6 +336,11 @@ def _redraw(self, context):
         s.renderer.last_key = None
 
 
+# No update= callbacks in the pip bpy module: its 4.2 LTS build segfaults at
+# exit while one is registered (settings.py; a module has no viewport to redraw).
+_REDRAW = {"update": _redraw} if settings.IN_APPLICATION else {}
+
+
 class VSGLLiveProps(bpy.types.PropertyGroup):
     quality: bpy.props.EnumProperty(
         name="Quality",
@@ -332,10 +348,10 @@ class VSGLLiveProps(bpy.types.PropertyGroup):
                 "in 2 x 2: about 0.1-0.4 s at 960 x 540 on 2 cores, bias within about 20 %"),
                ("BALANCED", "Balanced", "Lattice 128, RSM 256, 2 x 2 samples, visibility rays: "
                 "several times slower than Preview, bias within about 7 %")),
-        default="PREVIEW", update=_redraw,
+        default="PREVIEW", **_REDRAW,
         description="Settings of the live render (the scene's own preset is used for F12)")
     scale: bpy.props.IntProperty(
-        name="Resolution Divider", min=1, max=4, default=2, update=_redraw,
+        name="Resolution Divider", min=1, max=4, default=2, **_REDRAW,
         description="Render the viewport at 1/N of its pixels in each direction: 2 renders a "
                     "quarter of the pixels, about 3-4x faster")
     display: bpy.props.EnumProperty(
@@ -343,7 +359,7 @@ class VSGLLiveProps(bpy.types.PropertyGroup):
         items=(("INDIRECT", "Indirect Only", "Show only the indirect light (the AOV's Combined pass)"),
                ("ADD", "Add to Viewport", "Add the indirect light over what the viewport draws "
                 "(approximate: the addition happens after the view transform)")),
-        default="INDIRECT", update=_redraw,
+        default="INDIRECT", **_REDRAW,
         description="How the live indirect light is drawn over the viewport")
 
 

@@ -79,3 +79,84 @@ VT_TEST(scene_set_view_renders_as_a_new_scene)
     vsgl_scene_destroy(reused);
     vsgl_context_destroy(ctx);
 }
+
+static vsgl_result render_with(vsgl_context *ctx, const vsgl_scene *scene, vsgl_render_cache *cache, img *out,
+                               vsgl_render_stats *st)
+{
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = W;
+    o.height = H;
+    o.combined = out->comb;
+    return vsgl_render_cached(ctx, scene, &s, cache, &o, st);
+}
+
+VT_TEST(render_cache_reuses_what_stood_still_bit_identically)
+{
+    static img cached, plain;
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.25f, 200.0f);
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    vsgl_render_cache *cache = NULL;
+    vsgl_render_stats st;
+    VT_CHECK(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    VT_CHECK(vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
+    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(render_with(ctx, scene, cache, &cached, &st) == VSGL_OK && st.reused == 0, "first: reused %u", st.reused);
+
+    /* the light moves: the G-buffer is reused */
+    fx.lights[0].world_from_light[3] += 0.2f;
+    VT_CHECK(vsgl_scene_set_view(ctx, scene, &fx.camera, fx.lights, fx.light_count) == VSGL_OK, "set_view");
+    VT_CHECK(render_with(ctx, scene, cache, &cached, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(st.reused == VSGL_REUSED_GBUFFER, "light moved: reused %u", st.reused);
+    VT_CHECK(st.lights_used == 1 && st.vsgl_count > 0, "stats %u %u", st.lights_used, st.vsgl_count);
+    VT_CHECK(render_with(ctx, scene, NULL, &plain, NULL) == VSGL_OK, "uncached");
+    VT_CHECK(memcmp(&cached, &plain, sizeof cached) == 0, "light moved: cached render differs");
+
+    /* the camera moves: the VSGLs are reused, with the fit's stats */
+    uint32_t vsgls = st.vsgl_count;
+    const float eye[3] = {0.4f, -3.0f, 1.2f}, at[3] = {0.0f, 0.0f, 0.7f};
+    fx_look_at(fx.camera.world_from_camera, eye, at);
+    VT_CHECK(vsgl_scene_set_view(ctx, scene, &fx.camera, fx.lights, fx.light_count) == VSGL_OK, "set_view");
+    VT_CHECK(render_with(ctx, scene, cache, &cached, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(st.reused == VSGL_REUSED_FIT && st.vsgl_count == vsgls && st.lights_used == 1,
+             "camera moved: reused %u, %u VSGLs", st.reused, st.vsgl_count);
+    VT_CHECK(render_with(ctx, scene, NULL, &plain, NULL) == VSGL_OK, "uncached");
+    VT_CHECK(memcmp(&cached, &plain, sizeof cached) == 0, "camera moved: cached render differs");
+
+    /* nothing moved: both reused */
+    VT_CHECK(render_with(ctx, scene, cache, &cached, &st) == VSGL_OK, "again");
+    VT_CHECK(st.reused == (VSGL_REUSED_GBUFFER | VSGL_REUSED_FIT), "unchanged: reused %u", st.reused);
+    VT_CHECK(memcmp(&cached, &plain, sizeof cached) == 0, "unchanged: cached render differs");
+
+    /* a new scene with other geometry, most likely at the old one's address,
+     * with the same camera and lights: nothing may be reused */
+    vsgl_scene_destroy(scene);
+    scene = NULL;
+    for (uint32_t v = 0; v < fx.vertex_count; ++v)
+        fx.positions[v * 3 + 2] *= 0.9f;
+    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(render_with(ctx, scene, cache, &cached, &st) == VSGL_OK && st.reused == 0, "new scene: reused %u",
+             st.reused);
+    VT_CHECK(render_with(ctx, scene, NULL, &plain, NULL) == VSGL_OK, "uncached");
+    VT_CHECK(memcmp(&cached, &plain, sizeof cached) == 0, "new scene: cached render differs");
+
+    /* a failed render empties the cache */
+    vsgl_render_settings bad;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &bad);
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = W + 1; /* wrong size */
+    o.height = H;
+    o.combined = cached.comb;
+    VT_CHECK(vsgl_render_cached(ctx, scene, &bad, cache, &o, &st) == VSGL_ERROR_INVALID_ARGUMENT, "bad size");
+    VT_CHECK(render_with(ctx, scene, cache, &cached, &st) == VSGL_OK, "after failure");
+    VT_CHECK(memcmp(&cached, &plain, sizeof cached) == 0, "after failure: cached render differs");
+    vsgl_render_cache_destroy(cache);
+    vsgl_render_cache_destroy(NULL);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}

@@ -88,7 +88,7 @@ def test_struct_fields_match_header_order():
     assert not unmirrored, "structs in the headers without a ctypes mirror: %s" % unmirrored
 
 
-OPAQUE = {"vsgl_context", "vsgl_scene", "vsgl_bundle"}
+OPAQUE = {"vsgl_context", "vsgl_scene", "vsgl_bundle", "vsgl_render_cache"}
 SCALARS = {"float": ctypes.c_float, "double": ctypes.c_double, "int32_t": ctypes.c_int32,
            "uint32_t": ctypes.c_uint32, "size_t": ctypes.c_size_t, "vsgl_result": ctypes.c_int32,
            "uint64_t": ctypes.c_uint64}
@@ -162,7 +162,8 @@ SCALAR_CONSTANTS = {"VSGL_SHARPNESS_MAX": "SHARPNESS_MAX", "VSGL_ALPHA_MIN": "AL
                     "VSGL_MATERIAL_FLAG_MULTISCATTER": "MATERIAL_FLAG_MULTISCATTER",
                     "VSGL_AA_SAMPLES_MAX": "AA_SAMPLES_MAX", "VSGL_RSM_RESOLUTION_MIN": "RSM_RESOLUTION_MIN",
                     "VSGL_RSM_RESOLUTION_MAX": "RSM_RESOLUTION_MAX", "VSGL_VSGL_COUNT_MAX": "VSGL_COUNT_MAX",
-                    "VSGL_FIS_ITERATIONS_MAX": "FIS_ITERATIONS_MAX", "VSGL_SHADE_STRIDE_MAX": "SHADE_STRIDE_MAX"}
+                    "VSGL_FIS_ITERATIONS_MAX": "FIS_ITERATIONS_MAX", "VSGL_SHADE_STRIDE_MAX": "SHADE_STRIDE_MAX",
+                    "VSGL_REUSED_GBUFFER": "REUSED_GBUFFER", "VSGL_REUSED_FIT": "REUSED_FIT"}
 
 
 def _binding_name(define):

@@ -135,7 +135,11 @@ typedef struct vsgl_render_stats {
     uint32_t vsgl_count;         /**< VSGLs shaded, all lights */
     uint64_t shading_pairs;      /**< sample x VSGL evaluations */
     char skipped[1024];          /**< what was skipped and why, one item per line */
+    uint32_t reused;             /**< stages taken from a vsgl_render_cache: VSGL_REUSED_* bits */
 } vsgl_render_stats;
+
+#define VSGL_REUSED_GBUFFER 1u /**< the G-buffer (same scene, camera, AA) */
+#define VSGL_REUSED_FIT     2u /**< the RSMs' VSGLs (same scene, lights, settings) */
 
 /**
  * What a render will allocate, in bytes, before it allocates anything
@@ -187,6 +191,38 @@ VSGL_API vsgl_result vsgl_render_estimate(vsgl_context *ctx, const vsgl_scene *s
 VSGL_API vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene,
                                  const vsgl_render_settings *settings,
                                  vsgl_render_output *out, vsgl_render_stats *stats);
+
+/** Stage results kept between renders (see ::vsgl_render_cached). */
+typedef struct vsgl_render_cache vsgl_render_cache;
+
+/** @brief An empty render cache. @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT, ::VSGL_ERROR_OUT_OF_MEMORY. */
+VSGL_API vsgl_result vsgl_render_cache_create(vsgl_context *ctx, vsgl_render_cache **out);
+
+/** @brief Release a cache and what it holds. NULL is allowed. */
+VSGL_API void vsgl_render_cache_destroy(vsgl_render_cache *cache);
+
+/**
+ * @brief ::vsgl_render, reusing the stages whose inputs did not change
+ * since the last render through @p cache (the live viewport: a light moved,
+ * or the camera).
+ *
+ * The G-buffer is reused while the scene (the same ::vsgl_scene, its
+ * geometry and materials: a scene is identified by its address and its
+ * creation, so a new scene at a destroyed one's address is never taken
+ * for it), its camera and the AA samples are unchanged; the VSGLs while the
+ * scene, its lights and the settings are unchanged. Both are compared
+ * bytewise, so a render through a cache is bit-identical to one without.
+ * @p stats: reused stages report 0 seconds, and `reused` says which.
+ * A render that fails once started (e.g. cancelled) leaves the cache
+ * empty; one refused up front (bad settings or sizes) leaves it as it was.
+ * The cache holds
+ * memory (the G-buffer: width x height x aa^2 x 52 bytes) until the next
+ * render through it or its destruction; one cache must not be used by two
+ * calls at once. @p cache NULL is ::vsgl_render.
+ */
+VSGL_API vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene,
+                                        const vsgl_render_settings *settings, vsgl_render_cache *cache,
+                                        vsgl_render_output *out, vsgl_render_stats *stats);
 
 #ifdef __cplusplus
 }

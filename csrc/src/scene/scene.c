@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* At most this many "dropped" warnings are logged individually. */
 #define VSGL_MAX_DROP_WARNINGS 10
@@ -359,6 +360,9 @@ vsgl_result vsgl_scene_create(vsgl_context *ctx, const vsgl_scene_desc *caller_d
         vsgl_scene_destroy(s);
         return r;
     }
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    s->identity = (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
     *out = s;
     return VSGL_OK;
 }
@@ -403,6 +407,11 @@ const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count)
     if (count)
         *count = scene->light_count;
     return scene->lights;
+}
+
+uint64_t vsgl__scene_identity(const vsgl_scene *scene)
+{
+    return scene->identity;
 }
 
 const vsgl_camera *vsgl__scene_camera(const vsgl_scene *scene)

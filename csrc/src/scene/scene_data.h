@@ -39,6 +39,9 @@ struct vsgl_scene {
     float *uv_density;           /* triangle_count: UV area / world area (0 without UVs); NULL if untextured */
     int textured;                /* some material reads a texture or corner colours */
     v3 lo, hi;                   /* bounds of the valid triangles (0,0,0 when empty) */
+    uint64_t identity;           /* creation time (CLOCK_MONOTONIC ns): with the address, tells this scene's
+                                    geometry and materials from a destroyed one's at the same address;
+                                    kept by vsgl_scene_set_view (render caches key on both) */
     char embree_message[VSGL_SCENE_EMBREE_MESSAGE]; /* first Embree error seen */
 };
 

@@ -73,6 +73,9 @@ const struct vsgl_albedo_table *vsgl__scene_glossy_albedo(const vsgl_scene *scen
 float vsgl__scene_diffuse_weight(const vsgl_scene *scene, uint32_t material, float cos_view);
 const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count);
 const vsgl_camera *vsgl__scene_camera(const vsgl_scene *scene);
+/* With the scene's address, distinguishes scenes whose geometry or
+ * materials may differ, also a new scene at a destroyed one's address. */
+uint64_t vsgl__scene_identity(const vsgl_scene *scene);
 /* Bounding box of the valid triangles; lo = hi = (0,0,0) when there are none. */
 void vsgl__scene_bounds(const vsgl_scene *scene, v3 *lo, v3 *hi);
 

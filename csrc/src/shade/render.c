@@ -211,6 +211,12 @@ static vsgl_result check_output(vsgl_context *ctx, const vsgl_scene *scene, cons
 vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *settings,
                         vsgl_render_output *out, vsgl_render_stats *stats)
 {
+    return vsgl_render_cached(ctx, scene, settings, NULL, out, stats);
+}
+
+vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *settings,
+                               vsgl_render_cache *cache, vsgl_render_output *out, vsgl_render_stats *stats)
+{
     vsgl__clear_error(ctx);
     if (!ctx || !scene || !out)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "render: %s is NULL",
@@ -244,7 +250,15 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
     double t0 = now_seconds();
     /* overall progress: G-buffer 0-10 %, RSMs and fits 10-40 % (brute force 10-30 %), shading the rest */
     vsgl__progress_window(ctx, 0.0f, 0.1f);
-    r = vsgl__gbuffer_build(ctx, scene, s.aa_samples, &g);
+    const vsgl_gbuffer *gb = &g; /* the cache's, or this render's own */
+    int built_g = 0, built_set = 0;
+    if (vsgl__cache_gbuffer_hit(cache, scene, s.aa_samples)) {
+        gb = &cache->g;
+        st.reused |= VSGL_REUSED_GBUFFER;
+    } else {
+        r = vsgl__gbuffer_build(ctx, scene, s.aa_samples, &g);
+        built_g = 1;
+    }
     st.seconds_gbuffer = now_seconds() - t0;
     if (r != VSGL_OK)
         goto done;
@@ -255,14 +269,24 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
     }
     vsgl_pixel_planes planes = {buf, buf + 3 * pixels, buf + 6 * pixels, buf + 9 * pixels, buf + 12 * pixels};
     if (s.method == VSGL_METHOD_BRUTE_FORCE) {
-        r = brute_force(ctx, scene, &s, &g, &planes, &st);
+        r = brute_force(ctx, scene, &s, gb, &planes, &st);
     } else {
-        r = vsgl__fit_lights(ctx, scene, &s, &set, &st);
-        st.vsgl_count = (uint32_t)set.count;
+        const vsgl_vsgl_set *vs = &set;
+        if (vsgl__cache_fit_hit(cache, scene, &s)) {
+            vs = &cache->set;
+            st.reused |= VSGL_REUSED_FIT;
+            st.lights_used = cache->f_lights_used;
+            st.lights_skipped = cache->f_lights_skipped;
+            memcpy(st.skipped, cache->f_skipped, sizeof st.skipped);
+        } else {
+            r = vsgl__fit_lights(ctx, scene, &s, &set, &st);
+            built_set = 1;
+        }
+        st.vsgl_count = (uint32_t)vs->count;
         if (r == VSGL_OK) {
             t0 = now_seconds();
             vsgl__progress_window(ctx, 0.4f, 0.6f);
-            r = vsgl__shade(ctx, scene, &g, &set, &s, &planes, VSGL_SHADE_KERNEL, &st.shading_pairs);
+            r = vsgl__shade(ctx, scene, gb, vs, &s, &planes, VSGL_SHADE_KERNEL, &st.shading_pairs);
             st.seconds_shade = now_seconds() - t0;
         }
     }
@@ -280,6 +304,14 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
 done:
     vsgl__progress_window(ctx, 0.0f, 1.0f);
     free(buf);
+    if (cache && r != VSGL_OK) {
+        vsgl__cache_clear(cache);
+    } else if (cache) {
+        if (built_g)
+            vsgl__cache_keep_gbuffer(cache, scene, s.aa_samples, &g);
+        if (built_set)
+            vsgl__cache_keep_fit(cache, scene, &s, &set, &st);
+    }
     vsgl__vsgl_set_free(&set);
     vsgl__gbuffer_free(&g);
     st.seconds_total = now_seconds() - t_start;

@@ -4,6 +4,7 @@
 
 #include "vsgl/render.h"
 #include "fit/vsgl_set.h"
+#include "gbuffer/gbuffer.h"
 
 /* Copy `in` (NULL = defaults) into `s`, fill defaults for zero fields and
  * validate; the error names the field. */
@@ -21,5 +22,33 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
  * time; skipped lights are noted in `st`. */
 vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                              vsgl_vsgl_set *set, vsgl_render_stats *st);
+
+/* What a vsgl_render_cache holds (render_cache.c). */
+struct vsgl_render_cache {
+    int has_g;                   /* the G-buffer of g_scene seen by g_camera with g_aa */
+    const vsgl_scene *g_scene;
+    uint64_t g_identity;
+    vsgl_camera g_camera;
+    uint32_t g_aa;
+    vsgl_gbuffer g;
+    int has_f;                   /* the VSGLs of f_scene's f_lights with f_settings, and the fit's stats */
+    const vsgl_scene *f_scene;
+    uint64_t f_identity;
+    vsgl_light *f_lights;
+    uint32_t f_light_count;
+    vsgl_render_settings f_settings;
+    vsgl_vsgl_set set;
+    uint32_t f_lights_used, f_lights_skipped;
+    char f_skipped[sizeof(((vsgl_render_stats *)0)->skipped)];
+};
+
+void vsgl__cache_clear(vsgl_render_cache *c);
+int vsgl__cache_gbuffer_hit(const vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa);
+/* Takes `g` (zeroed afterwards). */
+void vsgl__cache_keep_gbuffer(vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, vsgl_gbuffer *g);
+int vsgl__cache_fit_hit(const vsgl_render_cache *c, const vsgl_scene *scene, const vsgl_render_settings *s);
+/* Takes `set` (zeroed afterwards) with the fit's stats from `st`. */
+vsgl_result vsgl__cache_keep_fit(vsgl_render_cache *c, const vsgl_scene *scene, const vsgl_render_settings *s,
+                                 vsgl_vsgl_set *set, const vsgl_render_stats *st);
 
 #endif

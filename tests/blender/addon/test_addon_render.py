@@ -49,7 +49,7 @@ def test_handler_fake_renderer_two_frames_composited(scene, tmp_path):
     for f in (1, 2):
         comb = read_pass(aov(tmp_path, f), "VSGL.Combined", "RGBA")
         assert comb.shape == (H, W, 4)
-        assert np.allclose(comb[..., :3], (0.1 * f, 0.2, 0.3), atol=1e-6)
+        assert np.allclose(comb[..., :3], (0.1 * f, 0.2, 0.3), atol=1e-3)   # half float (the default)
         out = image(str(tmp_path / "out" / ("beauty_%04d.exr" % f)))
         assert np.allclose(out[..., :3], (0.1 * f, 0.2, 0.3), atol=1e-3), (f, out[0, 0])
 
@@ -224,23 +224,78 @@ def _nodes(tree, prefix):
 def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     room(scene, str(tmp_path / "aov" / "{scene}_{view_layer}_####.exr"))
     scene.render.filepath = str(tmp_path / "out" / "b_")
+    tree = compat.compositor_tree(scene, create=True)
+    user = [n for n in tree.nodes]
     for _ in range(3):
         assert handlers.setup_scene(scene) == []
         # the sockets' placeholder is gone again, and nothing beside it
         assert os.listdir(str(tmp_path / "aov")) == [handlers.SETUP_LOCK], os.listdir(str(tmp_path / "aov"))
-    tree = compat.compositor_tree(scene, create=False)
-    assert len(_nodes(tree, "VSGL Indirect [")) == 1 and len(_nodes(tree, "VSGL Add [")) == 1
+    assert len(_nodes(tree, "VSGL Indirect [")) == 1 and len(_nodes(tree, "VSGL Add ")) == 2
+    assert len(_nodes(tree, "VSGL Frame")) == 1
     out = compat.compositor_output_socket(tree)
-    assert out.links[0].from_node.name == "VSGL Add [ViewLayer]"
+    assert out.links[0].from_node.name == "VSGL Add Glossy [ViewLayer]"
     node = tree.nodes["VSGL Indirect [ViewLayer]"]
     assert {"DiffInd", "GlossInd", "DiffCol", "GlossCol"} <= set(node.outputs.keys())
     assert node.image.source == "SEQUENCE"
+    # Explained, not shown: the frame numbers are hidden with the options.
+    assert not node.show_options and "file number = frame" in node.label
+    # Every VSGL node inside the labelled frame, which is beside (below) the
+    # user's nodes, not over them.
+    frame = tree.nodes["VSGL Frame"]
+    assert "VSGL" in frame.label
+    ours = [n for n in tree.nodes if n.name.startswith("VSGL ") and n != frame]
+    assert all(n.parent == frame for n in ours)
+    theirs = [n for n in tree.nodes if not n.name.startswith("VSGL ")]
+    assert {n.name for n in theirs} == {n.name for n in user if not n.name.startswith("VSGL ")}
+    x0, y0, x1, y1 = compositor._bounds(theirs)
+    for n in ours:
+        nx, ny = compositor._absolute(n)
+        assert ny <= y0, (n.name, (nx, ny), (x0, y0, x1, y1))   # top below their bottom
+    # Strength and per-pass toggles: the Add nodes' factors.
+    def facs():
+        return [compositor.compat.add_node_sockets(tree.nodes["VSGL Add %s [ViewLayer]" % k])
+                for k in ("Diffuse", "Glossy")]
+    def factor(add):
+        if add.bl_idname == "ShaderNodeMix":
+            return [s for s in add.inputs if s.name == "Factor" and s.enabled][0].default_value
+        return add.inputs[0].default_value
+    adds = [tree.nodes["VSGL Add %s [ViewLayer]" % k] for k in ("Diffuse", "Glossy")]
+    assert [round(factor(a), 6) for a in adds] == [1.0, 1.0]
+    assert adds[0].inputs and compat.add_node_sockets(adds[0])[1].links[0].from_socket.name == "Diff"
+    assert compat.add_node_sockets(adds[1])[1].links[0].from_socket.name == "Gloss"
+    scene.vsgl_indirect.strength = 0.5
+    scene.vsgl_indirect.use_glossy = False
+    assert handlers.setup_scene(scene) == []
+    assert [round(factor(a), 6) for a in adds] == [0.5, 0.0]
+    assert "(off)" in adds[1].label
     scene.vsgl_indirect.add_to_render = False
     handlers.setup_scene(scene)
-    assert not _nodes(tree, "VSGL Add [")
+    assert not _nodes(tree, "VSGL Add")
     assert out.links[0].from_node.bl_idname == "CompositorNodeRLayers"
     compositor.remove(scene)
     assert not _nodes(tree, "VSGL")
+    assert out.links[0].from_node.bl_idname == "CompositorNodeRLayers"
+
+
+def test_compositor_replaces_the_old_single_add_node(scene, tmp_path):
+    """Files set up before issue 15 have one 'VSGL Add [layer]' of Combined."""
+    room(scene, str(tmp_path / "aov" / "{scene}_{view_layer}_####.exr"))
+    scene.render.filepath = str(tmp_path / "out" / "b_")
+    compositor.remove(scene)      # what the update callback set up (inside Blender)
+    tree = compat.compositor_tree(scene, create=True)
+    out = compat.compositor_output_socket(tree)
+    rl = out.links[0].from_node.name
+    add, a, b, res = compat.new_add_node(tree)
+    add.name = "VSGL Add [ViewLayer]"
+    tree.links.new(tree.nodes[rl].outputs["Image"], a)
+    tree.links.new(res, out)
+    assert handlers.setup_scene(scene) == []
+    assert "VSGL Add [ViewLayer]" not in tree.nodes
+    chain, n = [], out.links[0].from_node
+    while n.name.startswith("VSGL Add"):
+        chain.append(n.name)
+        n = compat.add_node_sockets(n)[0].links[0].from_node
+    assert chain == ["VSGL Add Glossy [ViewLayer]", "VSGL Add Diffuse [ViewLayer]"] and n.name == rl
 
 
 def test_settings_update_callbacks_only_in_the_application():
@@ -476,3 +531,51 @@ def test_animation_exports_each_frames_state(scene, tmp_path):
         assert c[2] == f
         assert c[0] == pytest.approx(max(4.0, 4 * f - 3 + 0.5), abs=1e-4), (f, c)
         assert c[1] == (1 if f == 1 else 2), (f, c)
+
+
+def test_export_passes_one_multilayer_exr_per_frame(scene, tmp_path):
+    """Export Passes: a File Output node writes the render's passes
+    (Blender's names), the VSGL passes and the composite into one
+    multilayer EXR per frame; removed again when the option is off."""
+    path = setup_blend(scene, tmp_path, export_passes=True,
+                       export_path=str(tmp_path / "passes" / "{scene}_"))
+    scene.view_layers[0].use_pass_diffuse_direct = True
+    scene.objects["Spot"].data.energy = 1e-9
+    save(path)
+    r = render(path, (1, 2), env={"VSGL_TEST_FAKE_RENDER": "1"})
+    assert r.returncode == 0, r.stdout[-3000:]
+    assert "VSGL ERROR" not in r.stdout, r.stdout
+    for f in (1, 2):
+        p = str(tmp_path / "passes" / ("Scene_%04d.exr" % f))
+        assert os.path.exists(p), os.listdir(str(tmp_path))
+        ch, _ = read_exr(p)
+        names = set(ch)
+        for want in ("ViewLayer.Combined.R", "ViewLayer.Combined.A", "ViewLayer.DiffDir.R",
+                     "ViewLayer.VSGL_DiffInd.R", "ViewLayer.VSGL_Combined.G",
+                     "ViewLayer.VSGL_Diff.B", "Composite.R"):
+            assert want in names, (want, sorted(names))
+        assert np.allclose(ch["ViewLayer.VSGL_Combined.R"], 0.1 * f, atol=1e-3)
+        assert np.allclose(ch["Composite.R"], 0.1 * f, atol=2e-3)
+    scene.vsgl_indirect.export_passes = False
+    handlers.setup_scene(scene)
+    assert compositor.FILE_OUTPUT_NODE not in compat.compositor_tree(scene).nodes
+
+
+@pytest.mark.parametrize("fail", [True, False])
+def test_fail_render_without_aov_exits_non_zero(scene, tmp_path, fail):
+    """Farms: with 'Fail Render Without AOV' a frame whose AOV cannot be
+    computed stops `blender -b -a` with a non-zero status before that frame
+    is written; without it the render goes on and logs VSGL ERROR."""
+    path = setup_blend(scene, tmp_path, fail_render=fail)
+    scene.render.image_settings.file_format = "PNG"
+    save(path)
+    r = render(path, (1, 3), env={"VSGL_TEST_FAKE_RENDER": "fail"})
+    out = sorted(os.listdir(str(tmp_path / "out")))
+    assert "test: the fake renderer fails from frame 2 on" in r.stdout, r.stdout[-3000:]
+    if fail:
+        assert r.returncode == handlers.FAIL_EXIT_CODE, (r.returncode, r.stdout[-3000:])
+        assert "stopping the render (exit status 1)" in r.stdout
+        assert out == ["beauty_0001.png"], out
+    else:
+        assert r.returncode == 0, r.stdout[-3000:]
+        assert out == ["beauty_0001.png", "beauty_0002.png", "beauty_0003.png"], out

@@ -1,0 +1,141 @@
+"""Live viewport preview timings, headless (make bench): what an edit costs
+from Blender's data to a displayable image, without Blender's drawing.
+
+    python3 tools/bench_live.py [--triangles N] [--size 960x540] [--repeat 5]
+
+Runs in the pip bpy module (or `blender -b --python tools/bench_live.py --`).
+Builds a room with a subdivided object of about N triangles (default 100k),
+then times, each the median of --repeat edits:
+  * light moved:  export (mesh cache warm) + library (scene reused) + encode
+  * camera moved: the same with another view
+  * geometry edit: export of the changed object + a new library scene + render
+for the viewport at full size and at the panel's default 1/2, preview preset.
+Targets (issue 12): library time <= 50 ms at 960x540; <= 200 ms with the
+export for a 100k-triangle scene. Prints measured/target ratios.
+"""
+import argparse
+import math
+import os
+import statistics
+import sys
+import time
+
+REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+sys.path.insert(0, os.path.join(REPO, "addon"))
+
+import bpy  # noqa: E402
+
+import vsgl_indirect  # noqa: E402
+
+argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
+ap = argparse.ArgumentParser()
+ap.add_argument("--triangles", type=int, default=100_000)
+ap.add_argument("--size", default="960x540")
+ap.add_argument("--repeat", type=int, default=5)
+args = ap.parse_args(argv)
+W, H = (int(v) for v in args.size.lower().split("x"))
+
+if "vsgl_indirect" not in bpy.types.Scene.bl_rna.properties:
+    vsgl_indirect.register()
+from vsgl_indirect import export, live, viewport  # noqa: E402
+
+
+def build(triangles):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    s = bpy.context.scene
+
+    def mat(name, rgb, rough=0.5, metal=0.0):
+        m = bpy.data.materials.new(name)
+        m.use_nodes = True
+        b = m.node_tree.nodes["Principled BSDF"]
+        b.inputs["Base Color"].default_value = rgb + (1,)
+        b.inputs["Roughness"].default_value = rough
+        b.inputs["Metallic"].default_value = metal
+        return m
+
+    def quad(name, verts, m):
+        me = bpy.data.meshes.new(name)
+        me.from_pydata(verts, [], [(0, 1, 2, 3)])
+        me.materials.append(m)
+        ob = bpy.data.objects.new(name, me)
+        s.collection.objects.link(ob)
+        return ob
+
+    white = mat("White", (0.8, 0.8, 0.8))
+    quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], mat("Floor", (0.7, 0.7, 0.7), 0.25, 1.0))
+    quad("Back", [(-3, 3, 0), (3, 3, 0), (3, 3, 3), (-3, 3, 3)], white)
+    quad("Left", [(-3, -3, 0), (-3, 3, 0), (-3, 3, 3), (-3, -3, 3)], mat("Red", (0.8, 0.05, 0.05)))
+    quad("Right", [(3, 3, 0), (3, -3, 0), (3, -3, 3), (3, 3, 3)], mat("Green", (0.05, 0.6, 0.1)))
+    # a grid bent into a wave: ~triangles triangles
+    n = max(2, int(math.sqrt(triangles / 2)))
+    verts = [(-1.5 + 3.0 * i / n, -1.0 + 2.0 * j / n, 0.6 + 0.2 * math.sin(6.0 * i / n) * math.cos(5.0 * j / n))
+             for j in range(n + 1) for i in range(n + 1)]
+    faces = [(j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i)
+             for j in range(n) for i in range(n)]
+    me = bpy.data.meshes.new("Wave")
+    me.from_pydata(verts, [], faces)
+    me.materials.append(mat("Gold", (0.9, 0.6, 0.2), 0.3, 1.0))
+    wave = bpy.data.objects.new("Wave", me)
+    s.collection.objects.link(wave)
+    ld = bpy.data.lights.new("Spot", "SPOT")
+    ld.energy, ld.spot_size = 800.0, 1.0
+    light = bpy.data.objects.new("Spot", ld)
+    light.location = (-1.5, 0.0, 2.8)
+    light.rotation_euler = (0.0, math.radians(-60), 0.0)
+    s.collection.objects.link(light)
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    cam.location, cam.rotation_euler = (0, -7.5, 1.6), (math.radians(85), 0, 0)
+    cam.data.lens = 24
+    s.collection.objects.link(cam)
+    s.camera = cam
+    return light, cam, wave
+
+
+def edit_cost(session, cache, w, h, scene, cam, edit):
+    """Apply ``edit``, then export + library + encode as the live preview does."""
+    edit()
+    t0 = time.perf_counter()
+    dg = bpy.context.evaluated_depsgraph_get()
+    sd = export.collect(dg, scene, require_lights=False, camera=False, mesh_cache=cache)
+    dg_cam = cam.evaluated_get(dg)
+    P = dg_cam.calc_matrix_camera(dg, x=w, y=h, scale_x=1.0, scale_y=1.0)
+    sd.camera = live.view_camera(dg_cam.matrix_world.inverted(), P, w, h, cam.data.clip_start, cam.data.clip_end)
+    sd.width, sd.height = w, h
+    t_export = time.perf_counter() - t0
+    out = viewport._render(session, sd, "PREVIEW", 0, live.Job(1, None), 0.0, t_export)
+    return dict(out["timings"], triangles=sd.triangle_count)
+
+
+def main():
+    light, cam, wave = build(args.triangles)
+    scene = bpy.context.scene
+    rows = []
+    for div in (1, 2):
+        w, h = live.internal_size(W, H, div)
+        session = viewport._Session(0)
+        cache = {}
+        try:
+            edit_cost(session, cache, w, h, scene, cam, lambda: None)       # warm: first export, first scene
+            for name, edit in (
+                    ("light moved", lambda: setattr(light.location, "x", light.location.x + 0.01)),
+                    ("camera moved", lambda: setattr(cam.location, "x", cam.location.x + 0.01)),
+                    ("geometry edit", lambda: (cache.clear(), setattr(wave.location, "z", wave.location.z + 0.001)))):
+                ts = [edit_cost(session, cache, w, h, scene, cam, edit) for _ in range(args.repeat)]
+                med = {k: statistics.median(t[k] for t in ts) for k in ("export", "scene", "render", "encode", "gbuffer", "rsm", "fit", "shade")}
+                rows.append((w, h, div, name, med, ts[0]["triangles"]))
+        finally:
+            session.close()
+    print("live preview, preview preset, %d triangles, median of %d edits (s); machine: %d cores, load %s"
+          % (rows[0][5], args.repeat, os.cpu_count(), " ".join("%.1f" % v for v in os.getloadavg())))
+    print("%-10s %-14s %8s %8s %8s %8s %8s  %-26s %s" % ("size", "edit", "export", "scene", "render", "encode",
+                                                         "total", "library/50 ms, all/200 ms",
+                                                         "render = gbuffer + rsm + fit + shade"))
+    for w, h, div, name, m, _ in rows:
+        lib = m["scene"] + m["render"]
+        total = m["export"] + lib + m["encode"]
+        print("%-10s %-14s %8.3f %8.3f %8.3f %8.3f %8.3f  %-26s %.3f + %.3f + %.3f + %.3f"
+              % ("%dx%d" % (w, h), name, m["export"], m["scene"], m["render"], m["encode"], total,
+                 "%.1fx, %.1fx" % (lib / 0.050, total / 0.200), m["gbuffer"], m["rsm"], m["fit"], m["shade"]))
+
+
+main()
