@@ -24,7 +24,8 @@ extern "C" {
 /* ------------------------------------------------------------------------ */
 
 /** Material flags. */
-#define VSGL_MATERIAL_UNSUPPORTED 1u /**< caller could not map the material; shaded as given, reported */
+#define VSGL_MATERIAL_UNSUPPORTED 1u /**< the caller's mark that it could not map the material: kept (bundles
+                                          carry it) but not read by the library, which shades it as given */
 /** GGX shadowing as Cycles in Blender 4.x and later: height-correlated Smith
  *  1 / (1 + L(i) + L(o)); without it Blender 3.x's separable G1(i) G1(o). */
 #define VSGL_MATERIAL_FLAG_BLENDER_4 2u
