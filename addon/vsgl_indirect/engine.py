@@ -102,7 +102,22 @@ def scene_arrays(sd, libvsgl):
                 material_indices=np.ascontiguousarray(sd.material_indices, np.uint32),
                 materials=_material_structs(libvsgl, sd),
                 lights=[libvsgl.Light(**l) for l in sd.lights],
-                camera=libvsgl.Camera(**sd.camera))
+                camera=libvsgl.Camera(**sd.camera),
+                **_texture_arrays(sd, libvsgl))
+
+
+def _texture_arrays(sd, libvsgl):
+    """The textures, material texture slots and corner colours of ``sd`` (export.py)."""
+    mts = getattr(sd, "material_textures", None)
+    if not mts:
+        return {}
+    structs = []
+    for mt in mts:
+        kw = {slot: libvsgl.TextureSlot(**f) for slot, f in mt["slots"].items()}
+        structs.append(libvsgl.MaterialTextures(flags=mt["flags"], **kw))
+    cc = getattr(sd, "corner_colors", None)
+    return dict(textures=list(sd.textures), material_textures=structs,
+                corner_colors=None if cc is None else np.ascontiguousarray(cc, np.float32))
 
 
 def render_planes(sd, options, progress=None, log=None):

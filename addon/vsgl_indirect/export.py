@@ -5,9 +5,11 @@ lights, camera, materials) into plain values; ``assemble()`` (no bpy) turns
 mesh chunks into world-space arrays. No per-vertex Python loops: every
 array comes from ``foreach_get`` and numpy.
 """
+import math
+
 import numpy as np
 
-from . import convert, materials
+from . import convert, materials, textures
 from .convert import ExportError
 
 MESH_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
@@ -24,6 +26,9 @@ class SceneData:
         self.corner_normals = np.zeros((0, 3, 3), np.float32)
         self.corner_uvs = None
         self.corner_tangents = None  # (T,3,4) float32 when a material is anisotropic
+        self.corner_colors = None    # (T,3,3) float32 when a material multiplies a colour attribute
+        self.textures = []           # (pixels (H,W,4) float32, flags) for libvsgl
+        self.material_textures = None  # one dict per material (slot -> field dict) or None
         self.material_indices = np.zeros(0, np.uint32)
         self.materials = []        # vsgl_material field dicts
         self.material_names = []
@@ -32,6 +37,7 @@ class SceneData:
         self.camera = None         # vsgl_camera field dict
         self.camera_name = ""
         self.warnings = []
+        self.emissive_log = []     # info lines: emissive meshes turned into lights
         self.object_names = []     # one per exported mesh instance
         self.instance_count = 0    # instances among them
         self.width = self.height = 0
@@ -41,9 +47,12 @@ class SceneData:
         return int(self.indices.shape[0])
 
     def summary(self):
-        return ("%d triangles, %d objects (%d instances), %d materials, %d lights, camera '%s' %dx%d"
+        emissive = sum(1 for n in self.light_names if n.startswith("emission of"))
+        return ("%d triangles, %d objects (%d instances), %d materials, %d lights%s, camera '%s' %dx%d"
                 % (self.triangle_count, len(self.object_names), self.instance_count,
-                   len(self.materials), len(self.lights), self.camera_name, self.width, self.height))
+                   len(self.materials), len(self.lights),
+                   (" (%d from emissive faces)" % emissive) if emissive else "",
+                   self.camera_name, self.width, self.height))
 
 
 # --------------------------------------------------------------------------
@@ -58,7 +67,9 @@ class MeshArrays:
         self.tri_verts = tri_verts        # (T,3) int
         self.tri_loops = tri_loops        # (T,3) int
         self.loop_normals = loop_normals  # (L,3) float32
-        self.loop_uvs = loop_uvs          # (L,2) float32 or None
+        self.loop_uvs = loop_uvs          # (L,2) float32 or None: the default (active render) UV map
+        self.uv_layers = {}               # name -> (L,2) float32: every UV map
+        self.loop_colors = {}             # colour attribute name ("" = default) -> (L,3) float32 linear
         self.tri_material = tri_material  # (T,) int: slot index
         self.slots = []                   # material per slot (bpy materials)
         self.texspace = None              # (location, size) of the texture space; None = bounds
@@ -115,7 +126,7 @@ def degenerate_mask(positions, indices, corner_normals):
     return ~(area2 > 0) | ~np.isfinite(area2) | ~np.all(n2 > 1e-20, axis=1)
 
 
-def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None):
+def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None, uv_map_of=None, color_of=None):
     """Concatenate ``chunks`` = [(MeshArrays, matrix 4x4, slot_to_global list)]
     into world-space (positions, indices, corner_normals, corner_uvs,
     material_indices) and, with ``want_tangents``, a sixth item
@@ -127,6 +138,12 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None):
     the same way as in Blender; normals and tangents use the inverse
     transpose (the cofactor matrix where the matrix is singular) and follow
     the flipped corner order.
+
+    ``uv_map_of(g)`` names the UV map the triangles of global material ``g``
+    take their UVs from ("" or None: the mesh's default one); with
+    ``color_of(g)`` (a colour attribute name or None), a last item
+    corner_colors (T,3,3) is returned: that attribute's corner colours, white
+    where the material has none.
 
     Degenerate triangles (:func:`degenerate_mask`: zero area or zero-length
     normal, e.g. an object scaled (1, 1, 0) or (0, 0, 0)) are left out; with
@@ -144,7 +161,7 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None):
         g[1].append(np.asarray(matrix, np.float64).reshape(4, 4))
         g[2].append(list(slot_map) if len(slot_map) else [0])
         g[3].append(ci)
-    pos, idx, nrm, uvs, mats, tan = [], [], [], [], [], []
+    pos, idx, nrm, uvs, mats, tan, cols = [], [], [], [], [], [], []
     base = 0
     for key in order:
         arr, ms, smaps, chunk_ids = groups[key]
@@ -188,31 +205,81 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None):
             t4 = np.ones((k, T, 3, 4), np.float32)
             t4[..., :3] = tc
             tan.append(t4.reshape(-1, 3, 4)[keep])
-        if want_uvs:
-            if arr.loop_uvs is not None:
-                uvs.append(arr.loop_uvs[tl].reshape(-1, 3, 2).astype(np.float32)[keep])
-            else:
-                uvs.append(np.zeros((int(keep.sum()), 3, 2), np.float32))
         width = max(len(sm) for sm in smaps)
         table = np.array([sm + [sm[-1]] * (width - len(sm)) for sm in smaps], np.uint32)
         slot = np.clip(arr.tri_material, 0, None)[None, :]
         last = np.array([len(sm) - 1 for sm in smaps])[:, None]
-        mats.append(table[np.arange(k)[:, None], np.minimum(slot, last)].reshape(-1)[keep])
+        gm = table[np.arange(k)[:, None], np.minimum(slot, last)]                 # (k, T)
+        if want_uvs:
+            uv = np.zeros((k, T, 3, 2), np.float32)
+            for g in np.unique(gm):
+                name = uv_map_of(int(g)) if uv_map_of else ""
+                layer = arr.uv_layers.get(name) if name else None
+                if layer is None and not (name and arr.uv_layers):
+                    layer = arr.loop_uvs
+                if layer is not None:
+                    m = gm == g
+                    uv[m] = layer[tl[m]]
+            uvs.append(uv.reshape(-1, 3, 2)[keep])
+        if color_of is not None:
+            col = np.ones((k, T, 3, 3), np.float32)
+            for g in np.unique(gm):
+                name = color_of(int(g))
+                layer = arr.loop_colors.get(name) if name is not None else None
+                if layer is not None:
+                    m = gm == g
+                    col[m] = layer[tl[m]]
+            cols.append(col.reshape(-1, 3, 3)[keep])
+        mats.append(gm.reshape(-1)[keep])
         base += k * V
     if not idx:
         out = (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.uint32),
                np.zeros((0, 3, 3), np.float32), None, np.zeros(0, np.uint32))
-        return out + (np.zeros((0, 3, 4), np.float32),) if want_tangents else out
+        out = out + (np.zeros((0, 3, 4), np.float32),) if want_tangents else out
+        return out + (np.zeros((0, 3, 3), np.float32),) if color_of is not None else out
     out = (np.concatenate(pos), np.concatenate(idx), np.concatenate(nrm),
            np.concatenate(uvs) if want_uvs else None, np.concatenate(mats).astype(np.uint32))
-    return out + (np.concatenate(tan),) if want_tangents else out
+    out = out + (np.concatenate(tan),) if want_tangents else out
+    return out + (np.concatenate(cols),) if color_of is not None else out
 
 
 # --------------------------------------------------------------------------
 # bpy glue
 # --------------------------------------------------------------------------
 
-def _mesh_arrays(mesh, compat, want_undeformed=False):
+def _color_layer(mesh, name):
+    """(L,3) float32 linear corner colours of colour attribute ``name`` ("" =
+    the default / render one), or None."""
+    attrs = getattr(mesh, "color_attributes", None)
+    layer = None
+    if attrs is not None and len(attrs):
+        if name:
+            layer = attrs.get(name)
+        else:
+            for prop in ("default_color_name", "active_color_name"):
+                n = getattr(mesh.attributes, prop, None) if hasattr(mesh, "attributes") else None
+                if n:
+                    layer = attrs.get(n)
+                    break
+            if layer is None:
+                idx = getattr(attrs, "render_color_index", -1)
+                layer = attrs[idx] if 0 <= idx < len(attrs) else attrs[0]
+    elif getattr(mesh, "vertex_colors", None) is not None and len(mesh.vertex_colors):
+        layer = mesh.vertex_colors.get(name) if name else mesh.vertex_colors.active
+    if layer is None:
+        return None
+    n = len(layer.data)
+    buf = np.empty(n * 4, np.float32)
+    layer.data.foreach_get("color", buf)
+    c = buf.reshape(n, 4)[:, :3]
+    if getattr(layer, "domain", "CORNER") == "POINT":
+        lv = np.empty(len(mesh.loops), np.int32)
+        mesh.loops.foreach_get("vertex_index", lv)
+        c = c[lv]
+    return np.ascontiguousarray(c)
+
+
+def _mesh_arrays(mesh, compat, want_undeformed=False, color_names=()):
     mesh.calc_loop_triangles()
     lt = mesh.loop_triangles
     nt, nv = len(lt), len(mesh.vertices)
@@ -226,12 +293,25 @@ def _mesh_arrays(mesh, compat, want_undeformed=False):
     lt.foreach_get("material_index", mi)
     ln = compat.corner_normals(mesh) if nt else np.zeros((0, 3), np.float32)
     uv = None
-    layer = mesh.uv_layers.active if len(mesh.uv_layers) else None
-    if layer is not None and nt:
-        uv = np.empty(len(mesh.loops) * 2, np.float32)
-        layer.data.foreach_get("uv", uv)
-        uv = uv.reshape(-1, 2)
+    layers = {}
+    if len(mesh.uv_layers) and nt:
+        for layer in mesh.uv_layers:
+            a = np.empty(len(mesh.loops) * 2, np.float32)
+            layer.data.foreach_get("uv", a)
+            layers[layer.name] = a.reshape(-1, 2)
+        # Cycles' default UVs (an Image Texture without a Vector link) are the
+        # active *render* UV map
+        default = next((l_.name for l_ in mesh.uv_layers if getattr(l_, "active_render", False)), None)
+        if default is None and mesh.uv_layers.active is not None:
+            default = mesh.uv_layers.active.name
+        uv = layers.get(default)
     arr = MeshArrays(pos.reshape(nv, 3), tv.reshape(nt, 3), tl.reshape(nt, 3), ln, uv, mi)
+    arr.uv_layers = layers
+    for name in color_names:
+        if nt:
+            c = _color_layer(mesh, name)
+            if c is not None:
+                arr.loop_colors[name] = c
     if nt:
         smooth = np.empty(nt, bool)
         lt.foreach_get("use_smooth", smooth)
@@ -275,6 +355,210 @@ def _socket_value(s):
             return None
 
 
+# --------------------------------------------------------------------------
+# texture node chains (bpy glue; the evaluation is textures.py)
+# --------------------------------------------------------------------------
+
+_image_pixels_cache = {}
+
+
+def _image_pixels(img):
+    """(H, W, 4) float32 of a bpy image, rows bottom to top, or None."""
+    key = (img.as_pointer(), img.name_full, getattr(img, "filepath", ""), tuple(img.size))
+    if key in _image_pixels_cache:
+        return _image_pixels_cache[key]
+    px = None
+    try:
+        w, h = int(img.size[0]), int(img.size[1])
+        if w > 0 and h > 0:
+            buf = np.empty(w * h * 4, np.float32)
+            img.pixels.foreach_get(buf)
+            px = buf.reshape(h, w, 4)
+    except (RuntimeError, ValueError, TypeError):
+        px = None
+    if len(_image_pixels_cache) > 64:
+        _image_pixels_cache.clear()
+    _image_pixels_cache[key] = px
+    return px
+
+
+def _socket_default(sock):
+    v = _socket_value(sock)
+    if v is None:
+        return (0.0, 0.0, 0.0, 1.0)
+    return v
+
+
+def _find_socket(coll, identifier, name=None):
+    for s in coll:
+        if s.identifier == identifier:
+            return s
+    return coll.get(name) if name else None
+
+
+class _ExprBuilder:
+    """Reads the nodes in front of a socket into textures.py expressions."""
+
+    def __init__(self, mat_name):
+        self.mat = mat_name
+        self.images = {}   # key -> textures.ImageRef
+        self.warnings = []
+
+    def socket(self, sock, depth=0):
+        if not sock.is_linked:
+            return ("const", _socket_default(sock))
+        if depth > 48:
+            return ("unsupported", "node chain too deep", _socket_default(sock))
+        link = sock.links[0]
+        if not getattr(link, "is_valid", True) or getattr(link, "is_muted", False):
+            return ("const", _socket_default(sock))
+        out = link.from_socket
+        node = link.from_node
+        while node.bl_idname == "NodeReroute":
+            if not node.inputs[0].is_linked:
+                return ("const", _socket_default(sock))
+            l2 = node.inputs[0].links[0]
+            out, node = l2.from_socket, l2.from_node
+        return self.node(node, out, sock, depth + 1)
+
+    def node(self, node, out, target, depth):
+        t = node.bl_idname
+        inp = node.inputs
+        S = lambda name: self.socket(inp[name], depth)  # noqa: E731
+        default = _socket_default(target)
+        if node.mute:
+            return ("unsupported", "node '%s' is muted" % node.name, default)
+        if t == "ShaderNodeTexImage":
+            key = self.image(node, depth)
+            if key is None:
+                return ("unsupported", "Image Texture '%s' has no image" % node.name, default)
+            return ("alpha", ("img", key)) if out.name == "Alpha" else ("img", key)
+        if t in ("ShaderNodeVertexColor",):
+            e = ("vc", getattr(node, "layer_name", "") or "")
+            return ("alpha", e) if out.name == "Alpha" else e
+        if t == "ShaderNodeAttribute" and getattr(node, "attribute_type", "GEOMETRY") == "GEOMETRY":
+            e = ("vc", node.attribute_name or "")
+            return ("alpha", e) if out.name == "Alpha" else e
+        if t == "ShaderNodeRGB":
+            return ("const", tuple(out.default_value))
+        if t == "ShaderNodeValue":
+            v = float(out.default_value)
+            return ("const", (v, v, v, 1.0))
+        if t == "ShaderNodeMixRGB":
+            if node.blend_type not in textures.MIX_BLENDS:
+                return ("unsupported", "Mix node '%s' blend %s is not evaluated" % (node.name, node.blend_type),
+                        default)
+            return ("mix", node.blend_type, S("Fac"), S("Color1"), S("Color2"), bool(node.use_clamp))
+        if t == "ShaderNodeMix":
+            dt = getattr(node, "data_type", "RGBA")
+            if dt not in ("RGBA", "FLOAT") or node.blend_type not in textures.MIX_BLENDS or \
+                    getattr(node, "factor_mode", "UNIFORM") != "UNIFORM":
+                return ("unsupported", "Mix node '%s' (%s, %s) is not evaluated" % (node.name, dt, node.blend_type),
+                        default)
+            suf = "Color" if dt == "RGBA" else "Float"
+            fac = self.socket(_find_socket(inp, "Factor_Float", "Factor"), depth)
+            a = self.socket(_find_socket(inp, "A_" + suf, "A"), depth)
+            b = self.socket(_find_socket(inp, "B_" + suf, "B"), depth)
+            blend = node.blend_type if dt == "RGBA" else "MIX"
+            clamp = bool(getattr(node, "clamp_result", False)) or (dt == "FLOAT" and False)
+            return ("mix", blend, fac, a, b, clamp)
+        if t == "ShaderNodeInvert":
+            return ("invert", S("Fac"), S("Color"))
+        if t == "ShaderNodeHueSaturation":
+            return ("hsv", S("Hue"), S("Saturation"), S("Value"), S("Fac"), S("Color"))
+        if t == "ShaderNodeGamma":
+            return ("gamma", S("Color"), S("Gamma"))
+        if t == "ShaderNodeBrightContrast":
+            return ("bc", S("Color"), S("Bright"), S("Contrast"))
+        if t == "ShaderNodeValToRGB":
+            ramp = node.color_ramp
+            stops = tuple((float(e.position), tuple(float(c) for c in e.color)) for e in ramp.elements)
+            interp = ramp.interpolation
+            if interp not in ("LINEAR", "CONSTANT", "EASE"):
+                self.warnings.append("material '%s': Color Ramp '%s' interpolation %s is evaluated as linear"
+                                     % (self.mat, node.name, interp))
+                interp = "LINEAR"
+            if getattr(ramp, "color_mode", "RGB") != "RGB":
+                self.warnings.append("material '%s': Color Ramp '%s' colour mode %s is evaluated in RGB"
+                                     % (self.mat, node.name, ramp.color_mode))
+            e = ("ramp", stops, interp, S("Fac"))
+            return ("alpha", e) if out.name == "Alpha" else e
+        if t in ("ShaderNodeSeparateRGB", "ShaderNodeSeparateColor"):
+            if getattr(node, "mode", "RGB") != "RGB":
+                return ("unsupported", "Separate Color '%s' in %s mode" % (node.name, node.mode), default)
+            ch = {"R": 0, "G": 1, "B": 2, "Red": 0, "Green": 1, "Blue": 2}.get(out.name)
+            if ch is None:
+                return ("unsupported", "Separate node '%s' output %s" % (node.name, out.name), default)
+            c = self.socket(_find_socket(inp, "Image", "Image") or _find_socket(inp, "Color", "Color"), depth)
+            return ("sep", ch, c)
+        if t == "ShaderNodeRGBToBW":
+            return ("bw", S("Color"))
+        if t == "ShaderNodeMath" and node.operation in textures.MATH_OPS:
+            return ("math", node.operation, self.socket(inp[0], depth), self.socket(inp[1], depth),
+                    bool(node.use_clamp))
+        return ("unsupported", "node '%s' (%s) is not evaluated" % (node.name, t), default)
+
+    def uv_source(self, node, depth):
+        """(uv_map, uv_transform, problem) of an Image Texture's Vector input."""
+        sock = node.inputs.get("Vector")
+        if sock is None or not sock.is_linked:
+            return "", None, ""
+        transform = None
+        link = sock.links[0]
+        src, out = link.from_node, link.from_socket
+        while src.bl_idname == "NodeReroute" and src.inputs[0].is_linked:
+            l2 = src.inputs[0].links[0]
+            src, out = l2.from_node, l2.from_socket
+        if src.bl_idname == "ShaderNodeMapping":
+            vt = src.vector_type
+            vals = {}
+            for name in ("Location", "Rotation", "Scale"):
+                s_ = src.inputs.get(name)
+                if s_ is not None and s_.is_linked:
+                    return "", None, "has a linked Mapping input"
+                vals[name] = tuple(s_.default_value) if s_ is not None else None
+            if vals["Location"] is None:  # Blender 2.8x-style properties
+                vals = {"Location": tuple(src.translation), "Rotation": tuple(src.rotation),
+                        "Scale": tuple(src.scale)}
+            transform = textures.mapping_uv_transform(vt, vals["Location"], vals["Rotation"], vals["Scale"])
+            if transform is None:
+                return "", None, "has a Mapping node that is not a 2-D transform of the UVs"
+            vin = src.inputs.get("Vector")
+            if vin is None or not vin.is_linked:
+                return "", None, "has a Mapping node without UV input (generated coordinates)"
+            link = vin.links[0]
+            src, out = link.from_node, link.from_socket
+        if src.bl_idname == "ShaderNodeUVMap":
+            return src.uv_map or "", transform, ""
+        if src.bl_idname == "ShaderNodeTexCoord" and out.name == "UV":
+            return "", transform, ""
+        return "", None, "is looked up with '%s' coordinates, not UVs" % (
+            out.name if src.bl_idname == "ShaderNodeTexCoord" else src.bl_idname)
+
+    def image(self, node, depth):
+        img = node.image
+        if img is None:
+            return None
+        uv_map, transform, problem = self.uv_source(node, depth)
+        if getattr(node, "projection", "FLAT") != "FLAT":
+            problem = problem or "uses %s projection" % node.projection
+        if getattr(img, "source", "FILE") == "TILED":
+            problem = problem or "is a UDIM tile set"
+        cs = getattr(img.colorspace_settings, "name", "sRGB")
+        is_float = bool(getattr(img, "is_float", False))
+        srgb = (not is_float) and cs == "sRGB"
+        if cs not in ("sRGB", "Non-Color", "Linear", "Linear Rec.709", "Raw", "Linear CIE-XYZ E", "XYZ"):
+            self.warnings.append("material '%s': image '%s' colour space '%s' is read as %s"
+                                 % (self.mat, img.name, cs, "linear" if is_float else "sRGB"))
+            srgb = not is_float
+        key = "%s|%s|%s|%s|%s|%s" % (img.name_full, node.interpolation, node.extension, uv_map, transform, problem)
+        if key not in self.images:
+            self.images[key] = textures.ImageRef(
+                img.name, _image_pixels(img), srgb=srgb, interpolation=node.interpolation,
+                extension=node.extension, uv_map=uv_map, uv_transform=transform, problem=problem)
+        return key
+
+
 def describe_material(mat, compat):
     """Read a material into a :class:`materials.ShaderDesc` (bpy glue)."""
     vp = (tuple(mat.diffuse_color), float(mat.metallic), float(mat.roughness))
@@ -303,7 +587,8 @@ def describe_material(mat, compat):
     kinds = {"ShaderNodeBsdfPrincipled": materials.PRINCIPLED,
              "ShaderNodeBsdfDiffuse": materials.DIFFUSE,
              "ShaderNodeBsdfGlossy": materials.GLOSSY,
-             "ShaderNodeBsdfAnisotropic": materials.ANISOTROPIC}
+             "ShaderNodeBsdfAnisotropic": materials.ANISOTROPIC,
+             "ShaderNodeEmission": materials.EMISSION}
     kind = kinds.get(node.bl_idname)
     if kind is None:
         return materials.ShaderDesc(name, materials.OTHER, viewport=vp, version=ver,
@@ -316,9 +601,16 @@ def describe_material(mat, compat):
             inputs[s.name] = v
         if s.is_linked:
             linked.add(s.name)
+    builder = _ExprBuilder(name)
+    exprs = {}
+    for sock_name in list(materials.TEXTURED_INPUTS.get(kind, {})) + list(materials.EMISSION_INPUTS.get(kind, ())):
+        s_ = node.inputs.get(sock_name)
+        if s_ is not None and s_.is_linked:
+            exprs[sock_name] = builder.socket(s_)
     return materials.ShaderDesc(name, kind, inputs, linked, node=node.name, viewport=vp,
                                 version=ver,
-                                multiscatter=getattr(node, "distribution", "") == "MULTI_GGX")
+                                multiscatter=getattr(node, "distribution", "") == "MULTI_GGX",
+                                exprs=exprs, images=builder.images, extra_warnings=builder.warnings)
 
 
 def _holdout_objects(view_layer):
@@ -358,7 +650,9 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
     viewport = depsgraph.mode != "RENDER"
 
     mat_index = {}
-    mapped_cache = {}   # key -> (fields, warnings) of a bpy material, mapped once
+    mapped_cache = {}   # key -> (fields, warnings, slot plans) of a bpy material, mapped once
+    material_plans = []  # per global material: slot -> textures.SlotPlan
+    material_emission = {}  # global material -> (rgb, strength) of its emission
 
     def material_key(mat):
         return mat.original.name_full if mat.original else mat.name_full
@@ -372,8 +666,15 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
                 warns = list(warns) + [
                     "material '%s': its Tangent input is linked; Cycles' default tangent "
                     "(radial about the object's Z) is used instead" % key]
-            mapped_cache[key] = (fields, warns)
+            plans, more = _material_slots(key, fields, materials.texture_plans(desc))
+            mapped_cache[key] = (fields, list(warns) + more, plans, materials.emission(desc))
         return mapped_cache[key]
+
+    def vertex_color_of(mat):
+        if mat is None:
+            return None
+        pl = mapped(mat)[2].get("base_color")
+        return pl.vertex_color if pl is not None else None
 
     def anisotropic(mat):
         """Does ``mat`` map to an anisotropic lobe (needs tangents)?"""
@@ -388,6 +689,7 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
             key = material_key(mat)
         if key in mat_index:
             return mat_index[key]
+        plans = {}
         if key == HOLDOUT_KEY:
             fields = materials.default_material()
             fields.update(base_color=(0.0, 0.0, 0.0), specular_f0=0.0)
@@ -395,17 +697,23 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
         elif key == DEFAULT_KEY:
             fields, warns = materials.default_material(), []
         else:
-            fields, warns = mapped(mat)
+            fields, warns, plans, emit = mapped(mat)
+            if emit is not None:
+                material_emission[len(sd.materials)] = emit
         if compat.VERSION >= (4, 0, 0):  # Cycles 4.x+ GGX shadowing (vsgl/scene.h)
             fields = dict(fields, flags=int(fields.get("flags", 0)) | materials.MATERIAL_FLAG_BLENDER_4)
         sd.warnings.extend(warns)
         mat_index[key] = len(sd.materials)
+        material_plans.append(plans)
         sd.materials.append(fields)
         sd.material_names.append(key)
         return mat_index[key]
 
     mesh_cache = {} if mesh_cache is None else mesh_cache
     chunks = []
+    warned_objects = set()
+    _world_warnings(sd, scene)
+    _collection_warnings(sd, view_layer)
     for inst in depsgraph.object_instances:
         obj = inst.object
         if obj.type not in MESH_TYPES and obj.type != "LIGHT":
@@ -420,6 +728,7 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
             if not inst.is_instance and orig.parent is not None and \
                     orig.parent.instance_type in {"VERTS", "FACES"}:
                 continue
+        _visibility_warnings(sd, orig, warned_objects)
         if obj.type == "LIGHT":
             _add_light(sd, obj, inst.matrix_world, compat)
             continue
@@ -445,7 +754,8 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
             else:
                 try:
                     slots = [s.material for s in obj.material_slots] or list(mesh.materials)
-                    arr = _mesh_arrays(mesh, compat, any(anisotropic(m) for m in slots))
+                    vc_names = sorted({n for n in (vertex_color_of(m) for m in slots) if n is not None})
+                    arr = _mesh_arrays(mesh, compat, any(anisotropic(m) for m in slots), vc_names)
                 finally:
                     obj.to_mesh_clear()
                 arr.slots = slots
@@ -458,22 +768,36 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
                                else "%s (instance of %s)" % (orig.name, parent.name if parent else "?"))
         sd.instance_count += int(inst.is_instance)
 
-    want_uvs = any(a.loop_uvs is not None for a, _, _ in chunks)
+    want_uvs = any(a.loop_uvs is not None or a.uv_layers for a, _, _ in chunks)
     # Tangents only matter to anisotropic lobes: skip them (NULL) otherwise.
     want_tangents = any(m.get("anisotropy", 0.0) > 0.0 for m in sd.materials)
     dropped = {}
+
+    def uv_map_of(g):
+        for pl in material_plans[g].values():
+            if pl.texture is not None:
+                return pl.texture["uv_map"]
+        return ""
+
+    def color_of(g):
+        pl = material_plans[g].get("base_color") if g < len(material_plans) else None
+        return pl.vertex_color if pl is not None else None
+
+    any_vc = any(color_of(g) is not None for g in range(len(material_plans)))
     # The same meshes at the same places as the last export (an edit of a
     # light or of the camera): reuse its assembled arrays.
     # (The arrays objects themselves are kept and compared by identity: a
     # re-read mesh is a new object, even where it reuses an old address.)
-    signature = (want_uvs, want_tangents, tuple((m.tobytes(), tuple(sm)) for _, m, sm in chunks))
+    per_material = tuple((uv_map_of(g), color_of(g)) for g in range(len(material_plans)))
+    signature = (want_uvs, want_tangents, any_vc, per_material,
+                 tuple((m.tobytes(), tuple(sm)) for _, m, sm in chunks))
     members = [a for a, _, _ in chunks]
     last = mesh_cache.get(_ASSEMBLED)
     if last is not None and last[0] == signature and len(last[3]) == len(members) and \
             all(x is y for x, y in zip(last[3], members)):
         out, dropped = last[1], dict(last[2])
     else:
-        out = assemble(chunks, want_uvs, want_tangents, dropped)
+        out = assemble(chunks, want_uvs, want_tangents, dropped, uv_map_of, color_of if any_vc else None)
         mesh_cache[_ASSEMBLED] = (signature, out, dict(dropped), members)
     for ci, (n, total) in sorted(dropped.items()):
         what = ("all %d triangles are" % total) if n == total else ("%d of %d triangles are" % (n, total))
@@ -482,6 +806,9 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
     (sd.positions, sd.indices, sd.corner_normals, sd.corner_uvs,
      sd.material_indices) = out[:5]
     sd.corner_tangents = out[5] if want_tangents else None
+    sd.corner_colors = out[-1] if any_vc else None
+    _library_textures(sd, material_plans)
+    _add_emissive_lights(sd, material_emission, compat.VERSION)
     if not sd.materials:
         material_global(None, False)
 
@@ -495,6 +822,241 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
         raise ExportError("scene '%s' (view layer '%s') has no light with non-zero power"
                           % (scene.name, view_layer.name))
     return sd
+
+
+_RAY_VISIBILITY = (("visible_camera", "camera"), ("visible_diffuse", "diffuse"), ("visible_glossy", "glossy"),
+                   ("visible_transmission", "transmission"), ("visible_volume_scatter", "volume scatter"),
+                   ("visible_shadow", "shadow"))
+
+
+def _visibility_warnings(sd, obj, warned):
+    """Per-object settings Cycles honours and the library does not, once per object."""
+    if obj.name in warned:
+        return
+    warned.add(obj.name)
+    what = "light" if obj.type == "LIGHT" else "object"
+    off = [label for prop, label in _RAY_VISIBILITY if not getattr(obj, prop, True)]
+    if off:
+        sd.warnings.append("%s '%s': ray visibility (%s off) is not modelled; it is seen, lights, is lit and "
+                           "casts shadows as if every ray type were on" % (what, obj.name, ", ".join(off)))
+    if getattr(obj, "is_shadow_catcher", False):
+        sd.warnings.append("object '%s': shadow catcher is not modelled; it is shaded as its material" % obj.name)
+    if what == "object" and getattr(obj, "is_holdout", False):
+        sd.warnings.append("object '%s': holdout: it blocks light but reflects none and gets no indirect light "
+                           "in the AOV" % obj.name)
+
+
+def _collection_warnings(sd, view_layer):
+    def walk(lc):
+        if lc.exclude:
+            return
+        if getattr(lc, "holdout", False):
+            sd.warnings.append("collection '%s': holdout: its objects block light but reflect none and get no "
+                               "indirect light in the AOV" % lc.name)
+        if getattr(lc, "indirect_only", False):
+            sd.warnings.append("collection '%s': 'indirect only' is not modelled; its objects are also seen "
+                               "directly in the AOV" % lc.name)
+        for c in lc.children:
+            walk(c)
+    for c in view_layer.layer_collection.children:
+        walk(c)
+
+
+def _world_warnings(sd, scene):
+    """The world lights Cycles' render but is not a light source for the AOV."""
+    w = scene.world
+    if w is None:
+        return
+    strength, what = 0.0, ""
+    if w.use_nodes and w.node_tree is not None:
+        out = next((n for n in w.node_tree.nodes if n.bl_idname == "ShaderNodeOutputWorld" and
+                    getattr(n, "is_active_output", True)), None)
+        sock = out.inputs.get("Surface") if out is not None else None
+        if sock is not None and sock.is_linked:
+            node = sock.links[0].from_node
+            if node.bl_idname == "ShaderNodeBackground":
+                st = node.inputs["Strength"]
+                col = node.inputs["Color"]
+                strength = 1.0 if st.is_linked else float(st.default_value)
+                if not col.is_linked:
+                    strength *= max(tuple(col.default_value)[:3])
+                what = "background" + (" with a texture" if col.is_linked else "")
+            else:
+                strength, what = 1.0, "a '%s' node" % node.bl_idname
+    else:
+        strength, what = max(tuple(w.color)[:3]), "colour"
+    if strength > 0.0:
+        sd.warnings.append("world '%s': world lighting (%s) is not a light source for the indirect AOV; "
+                           "only lamps (and emissive meshes) bounce" % (w.name, what))
+
+
+def _material_slots(name, fields, plans):
+    """Keep the textured slots of one material that share one UV map (the
+    library has one UV set per triangle): others are reduced to their mean.
+    Returns (plans, warnings)."""
+    warns, out, uv = [], {}, None
+    for slot in ("base_color", "roughness", "metallic"):
+        pl = plans.get(slot)
+        if pl is None:
+            continue
+        if pl.texture is not None:
+            if uv is None:
+                uv = pl.texture["uv_map"]
+            elif pl.texture["uv_map"] != uv:
+                mean = pl.texture["pixels"].reshape(-1, 4).mean(axis=0)
+                if slot == "base_color":
+                    fields[slot] = tuple(float(min(max(c, 0), 1)) for c in mean[:3])
+                else:
+                    fields[slot] = float(min(max(mean[0] * fields[slot], 0), 1))
+                warns.append("material '%s': its %s texture uses UV map '%s', another input '%s'; "
+                             "its mean is used" % (name, slot, pl.texture["uv_map"], uv))
+                pl = textures.SlotPlan(pl.constant)
+        out[slot] = pl
+    return out, warns
+
+
+def _library_textures(sd, material_plans):
+    """sd.textures and sd.material_textures (vsgl_material_textures fields)
+    from the slot plans; one texture per distinct pixel array."""
+    sd.textures, ids, mts, any_tex = [], {}, [], False
+    for plans in material_plans:
+        mt = {}
+        flags = 0
+        for slot, pl in plans.items():
+            if slot == "base_color" and pl.vertex_color is not None and sd.corner_colors is not None:
+                flags |= textures.VERTEX_COLOR_FLAG
+                any_tex = True
+            t = pl.texture
+            if t is None:
+                continue
+            key = (id(t["pixels"]), t["srgb"])
+            if key not in ids:
+                sd.textures.append((np.ascontiguousarray(t["pixels"], np.float32),
+                                    textures.TEXTURE_FLAG_SRGB if t["srgb"] else 0))
+                ids[key] = len(sd.textures)
+            mt[slot] = dict(texture=ids[key], filter=t["filter"], wrap=t["wrap"], channel=t.get("channel", 0),
+                            uv_transform=t["uv_transform"] or (0.0,) * 6)
+            any_tex = True
+        mts.append(dict(slots=mt, flags=flags))
+    sd.material_textures = mts if any_tex else None
+
+
+MAX_EMISSIVE_LIGHTS = 32       # area lights made from emissive faces, at most
+EMISSIVE_MIN_FRACTION = 1e-3   # faces emitting less than this of the brightest light are skipped
+
+
+def emissive_lights(positions, indices, material_indices, emission, version=(3, 4, 0), split=1,
+                    split_above=0.5):
+    """Area lights (vsgl_light field dicts, with a "name" key) standing for
+    the emissive triangles (pure numpy).
+
+    Two triangles in a row that share an edge and form a rectangle become
+    one rectangular light, every other triangle a disk of its area at its
+    centroid. Each face emits on both sides (as Cycles' emission): one light
+    per side, along +-its normal, nudged off the face. A face of area A with
+    emission S (colour C) has radiance S C: a Blender 3.x area light of
+    power 4 A S, a 4.x one of pi A S (docs/units.md)."""
+    P = np.asarray(positions, np.float64)
+    I = np.asarray(indices, np.int64)
+    M = np.asarray(material_indices, np.int64)
+    v4 = tuple(version) >= (4, 0, 0)
+    out = []
+    emissive = [t for t in range(len(I)) if int(M[t]) in emission]
+    done = set()
+    for n, t in enumerate(emissive):
+        if t in done:
+            continue
+        g = int(M[t])
+        rgb, strength = emission[g]
+        tri = P[I[t]]
+        e1, e2 = tri[1] - tri[0], tri[2] - tri[0]
+        nrm = np.cross(e1, e2)
+        area = 0.5 * np.linalg.norm(nrm)
+        if not area > 0:
+            continue
+        nrm = nrm / (2 * area)
+        rect = None
+        u = t + 1
+        if u < len(I) and u not in done and int(M[u]) == g and len(set(I[t]) & set(I[u])) == 2:
+            other = P[[v for v in I[u] if v not in I[t]][0]]
+            # corners in order around the quad: t's vertices with the new one between the shared pair
+            shared = [v for v in I[t] if v in I[u]]
+            lone = [v for v in I[t] if v not in I[u]][0]
+            c = [P[lone], P[shared[0]], other, P[shared[1]]]
+            a, b = c[1] - c[0], c[3] - c[0]
+            la, lb = np.linalg.norm(a), np.linalg.norm(b)
+            if la > 0 and lb > 0 and abs(np.dot(a, b)) < 1e-3 * la * lb and \
+                    np.linalg.norm(c[0] + a + b - c[2]) < 1e-3 * max(la, lb) and \
+                    abs(np.dot(np.cross(a, b) / (la * lb), nrm)) > 0.999:
+                rect = (np.mean(c, axis=0), a / la, la, lb)
+        pieces = []  # (centre, x axis, size x, size y, shape)
+        if rect is not None:
+            done.add(u)
+            centre, xa, sx, sy = rect
+            # the library's area-light RSM starts its rays at the light's centre:
+            # a large panel is split so that each piece is small next to the room
+            ya = np.cross(nrm, xa)
+            if np.dot(np.cross(xa, ya), nrm) < 0:
+                ya = -ya
+            nx, ny = (split, split) if max(sx, sy) > split_above else (1, 1)
+            for i in range(nx):
+                for j in range(ny):
+                    off = xa * sx * ((i + 0.5) / nx - 0.5) + ya * sy * ((j + 0.5) / ny - 0.5)
+                    pieces.append((centre + off, xa, sx / nx, sy / ny, "RECTANGLE"))
+        else:
+            d = 2.0 * math.sqrt(area / math.pi)
+            pieces.append((tri.mean(axis=0), e1 / np.linalg.norm(e1), d, d, "DISK"))
+        for centre, xa, sx, size_y, shape in pieces:
+            a = sx * size_y if shape == "RECTANGLE" else area
+            power = (math.pi if v4 else 4.0) * a * strength
+            for side in (1.0, -1.0):
+                z = -side * nrm                       # an area light emits along its local -Z
+                x = xa
+                y = np.cross(z, x)
+                m = np.eye(4)
+                m[:3, 0], m[:3, 1], m[:3, 2] = x, y, z
+                m[:3, 3] = centre + side * nrm * (1e-4 * max(sx, size_y) + 1e-5)
+                f = convert.light_fields("emissive", "AREA", m, power, rgb, shape=shape, size=sx, size_y=size_y,
+                                         blender_version=version)
+                f["name"] = g
+                out.append(f)
+    return out
+
+
+def _add_emissive_lights(sd, material_emission, version):
+    if not material_emission or sd.triangle_count == 0:
+        return
+    lights = emissive_lights(sd.positions, sd.indices, sd.material_indices, material_emission, version)
+    if not lights:
+        return
+    brightest = max([l["power"] * max(l["color"]) for l in sd.lights + lights] or [0.0])
+    kept, dim = [], {}
+    for l in lights:
+        if l["power"] * max(l["color"]) < EMISSIVE_MIN_FRACTION * brightest:
+            dim[l["name"]] = dim.get(l["name"], 0) + 1
+        else:
+            kept.append(l)
+    for g, n in sorted(dim.items()):
+        sd.warnings.append("material '%s': %d emissive face side(s) emit less than %g of the brightest light "
+                           "and are skipped (too small or too dim to matter)" % (sd.material_names[g], n,
+                                                                                 EMISSIVE_MIN_FRACTION))
+    if len(kept) > MAX_EMISSIVE_LIGHTS:
+        kept.sort(key=lambda l: -l["power"] * max(l["color"]))
+        for l in kept[MAX_EMISSIVE_LIGHTS:]:
+            dim[l["name"]] = dim.get(l["name"], 0) + 1
+        sd.warnings.append("emissive meshes: %d light samples, the brightest %d are used (materials %s)"
+                           % (len(kept), MAX_EMISSIVE_LIGHTS,
+                              ", ".join("'%s'" % sd.material_names[g] for g in sorted({l["name"] for l in kept}))))
+        kept = kept[:MAX_EMISSIVE_LIGHTS]
+    counts = {}
+    for l in kept:
+        g = l.pop("name")
+        counts[g] = counts.get(g, 0) + 1
+        sd.lights.append(l)
+        sd.light_names.append("emission of material '%s'" % sd.material_names[g])
+    for g, n in sorted(counts.items()):
+        sd.emissive_log.append("material '%s': emissive faces exported as %d area light(s) (both sides)"
+                               % (sd.material_names[g], n))
 
 
 def _add_light(sd, obj, matrix, compat):

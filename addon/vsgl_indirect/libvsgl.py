@@ -42,7 +42,7 @@ __all__ = [
 _logger = logging.getLogger("vsgl_indirect.libvsgl")
 
 #: (major, minor) of the C API this binding was written for.
-BINDING_VERSION = (0, 1)
+BINDING_VERSION = (0, 2)
 
 # --------------------------------------------------------------------------
 # Errors
@@ -222,7 +222,7 @@ SHADE_STRIDE_MAX = 8
 #: vsgl_render_stats.reused bits (render.h)
 REUSED_GBUFFER = 1
 REUSED_FIT = 2
-BUNDLE_VERSION = (1, 1)
+BUNDLE_VERSION = (1, 2)
 
 
 def _enum(value, cls, what):
@@ -379,6 +379,42 @@ class vsgl_camera(_Struct):
     _enums = {"type": CameraType, "sensor_fit": SensorFit}
 
 
+class vsgl_texture(_Struct):
+    _fields_ = [
+        ("width", _u32),
+        ("height", _u32),
+        ("pixels", _PF32),
+        ("flags", _u32),
+        ("reserved", _u32),
+    ]
+
+
+TEXTURE_FLAG_SRGB = 1
+FILTER_LINEAR, FILTER_CLOSEST = 0, 1
+WRAP_REPEAT, WRAP_EXTEND, WRAP_CLIP = 0, 1, 2
+MATERIAL_TEXTURES_VERTEX_COLOR = 1
+
+
+class vsgl_texture_slot(_Struct):
+    _fields_ = [
+        ("texture", _u32),
+        ("filter", _i32),
+        ("wrap", _i32),
+        ("channel", _i32),
+        ("uv_transform", _f32 * 6),
+    ]
+
+
+class vsgl_material_textures(_Struct):
+    _fields_ = [
+        ("base_color", vsgl_texture_slot),
+        ("roughness", vsgl_texture_slot),
+        ("metallic", vsgl_texture_slot),
+        ("flags", _u32),
+        ("reserved", _u32),
+    ]
+
+
 class vsgl_scene_desc(_Struct):
     _fields_ = [
         ("size", _u32),
@@ -395,6 +431,10 @@ class vsgl_scene_desc(_Struct):
         ("light_count", _u32),
         ("lights", ctypes.POINTER(vsgl_light)),
         ("camera", ctypes.POINTER(vsgl_camera)),
+        ("texture_count", _u32),
+        ("textures", ctypes.POINTER(vsgl_texture)),
+        ("material_textures", ctypes.POINTER(vsgl_material_textures)),
+        ("corner_colors", _PF32),
     ]
 
 
@@ -545,11 +585,14 @@ class vsgl_reference_stats(_Struct):
 Material = vsgl_material
 Light = vsgl_light
 Camera = vsgl_camera
+TextureSlot = vsgl_texture_slot
+MaterialTextures = vsgl_material_textures
 RenderSettings = vsgl_render_settings
 
 #: Every mirrored struct, by its C name (the layout test checks each).
 STRUCTS = {cls.__name__: cls for cls in (
     vsgl_vec3, vsgl_context_desc, vsgl_sg, vsgl_asg, vsgl_material, vsgl_light,
+    vsgl_texture, vsgl_texture_slot, vsgl_material_textures,
     vsgl_camera, vsgl_scene_desc, vsgl_scene_info, vsgl_render_settings,
     vsgl_render_output, vsgl_memory_estimate, vsgl_render_stats, vsgl_exr_pass, vsgl_exr_metadata,
     vsgl_exr_options, vsgl_bundle_options, vsgl_bundle_info, vsgl_debug_vsgl, vsgl_reference_stats)}
@@ -1283,7 +1326,8 @@ def _ptr(a, ctype):
     return None if a is None else a.ctypes.data_as(ctypes.POINTER(ctype))
 
 
-_FRIENDLY = {"vsgl_material": "Material", "vsgl_light": "Light", "vsgl_camera": "Camera"}
+_FRIENDLY = {"vsgl_material": "Material", "vsgl_light": "Light", "vsgl_camera": "Camera",
+             "vsgl_material_textures": "MaterialTextures"}
 
 
 def _struct_array(items, cls, name):
@@ -1301,9 +1345,29 @@ def _u32_count(n, name):
     return n
 
 
+def _texture_array(textures):
+    """vsgl_texture[] from a sequence of (H,W,4) float32 arrays (rows bottom to
+    top, as Blender's Image.pixels) or (array, flags) pairs; returns (array, keep)."""
+    items, keep = [], []
+    for i, t in enumerate(textures or ()):
+        flags = 0
+        if isinstance(t, tuple):
+            t, flags = t
+        a = np.asarray(t)
+        if a.ndim != 3 or a.shape[2] != 4 or a.shape[0] < 1 or a.shape[1] < 1:
+            raise ValueError("textures[%d] must have shape (height, width, 4), got %s" % (i, a.shape))
+        a = np.ascontiguousarray(a, dtype=np.float32)
+        keep.append(a)
+        tex = vsgl_texture(width=a.shape[1], height=a.shape[0], flags=int(flags))
+        tex.pixels = _ptr(a, ctypes.c_float)
+        items.append(tex)
+    return ((vsgl_texture * len(items))(*items) if items else None), keep
+
+
 def _build_scene_desc(positions, indices, corner_normals=None, corner_uvs=None,
                       corner_tangents=None, material_indices=None, materials=(),
-                      lights=(), camera=None):
+                      lights=(), camera=None, textures=(), material_textures=None,
+                      corner_colors=None):
     """Validate numpy inputs and fill a vsgl_scene_desc. Returns (desc, keep)
     where ``keep`` holds every object the desc points into."""
     if not isinstance(positions, np.ndarray) or positions.ndim != 2:
@@ -1320,7 +1384,15 @@ def _build_scene_desc(positions, indices, corner_normals=None, corner_uvs=None,
     corner_tangents = _check_array(corner_tangents, "corner_tangents", np.float32,
                                    [(T, 3, 4), (T, 12)])
     material_indices = _check_array(material_indices, "material_indices", np.uint32, [(T,)])
+    corner_colors = _check_array(corner_colors, "corner_colors", np.float32, [(T, 3, 3), (T, 9)])
     mats = _struct_array(materials, vsgl_material, "materials")
+    texs, tex_keep = _texture_array(textures)
+    mtex = None
+    if material_textures is not None:
+        mtex = _struct_array(material_textures, vsgl_material_textures, "material_textures")
+        if mtex is not None and len(mtex) != len(list(materials or ())):
+            raise ValueError("material_textures has %d entries, materials %d (one per material)"
+                             % (len(mtex), len(list(materials or ()))))
     lits = _struct_array(lights, vsgl_light, "lights")
     if camera is None:
         raise ValueError("camera is required (a libvsgl.Camera)")
@@ -1342,8 +1414,14 @@ def _build_scene_desc(positions, indices, corner_normals=None, corner_uvs=None,
     if lits is not None:
         desc.lights = ctypes.cast(lits, ctypes.POINTER(vsgl_light))
     desc.camera = ctypes.pointer(camera)
+    if texs is not None:
+        desc.texture_count = len(texs)
+        desc.textures = ctypes.cast(texs, ctypes.POINTER(vsgl_texture))
+    if mtex is not None:
+        desc.material_textures = ctypes.cast(mtex, ctypes.POINTER(vsgl_material_textures))
+    desc.corner_colors = _ptr(corner_colors, ctypes.c_float)
     keep = (positions, indices, corner_normals, corner_uvs, corner_tangents,
-            material_indices, mats, lits, camera)
+            material_indices, mats, lits, camera, texs, tex_keep, mtex, corner_colors)
     return desc, keep
 
 
@@ -1354,7 +1432,10 @@ class Scene:
     positions (V,3) float32; indices (T,3) uint32; optional corner_normals
     (T,3,3) float32, corner_uvs (T,3,2), corner_tangents (T,3,4),
     material_indices (T,) uint32; materials: sequence of Material; lights:
-    sequence of Light; camera: Camera. Raises TypeError/ValueError for
+    sequence of Light; camera: Camera; textures: sequence of (H,W,4) float32
+    arrays or (array, flags) pairs (TEXTURE_FLAG_SRGB); material_textures:
+    one MaterialTextures per material (slot ``texture`` is 1-based) or None;
+    corner_colors (T,3,3) float32. Raises TypeError/ValueError for
     bad arrays and VsglError (with the library's message) for bad content.
     """
 
@@ -1362,10 +1443,11 @@ class Scene:
 
     def __init__(self, ctx, positions, indices, corner_normals=None, corner_uvs=None,
                  corner_tangents=None, material_indices=None, materials=(), lights=(),
-                 camera=None):
+                 camera=None, textures=(), material_textures=None, corner_colors=None):
         desc, keep = _build_scene_desc(positions, indices, corner_normals, corner_uvs,
                                        corner_tangents, material_indices, materials,
-                                       lights, camera)
+                                       lights, camera, textures, material_textures,
+                                       corner_colors)
         self._ctx = ctx  # destroy the scene before its context
         self._lib = ctx._lib
         fn = self._lib.vsgl_scene_create  # raises VsglMissingSymbolError if absent

@@ -7,7 +7,8 @@
 #     each scene's feature, the brute force within 6 % of Cycles per pass; then the presets'
 #     numbers (INFO lines; VSGL_QUALITY_FRAMES animation frames, default 6 here) and issue 9's
 #     acceptance criteria as INFO (not failures yet). Report: build/quality/check_test.md.
-# Python: $BPY_PYTHON (pyenv, with flip-evaluator) if it imports numpy, else $PYTHON (FLIP skipped).
+# Python: $BPY_PYTHON if it imports numpy, else $PYTHON; flip-evaluator is pip-installed into it when
+# missing (FLIP skipped, with the reason printed, if that fails, e.g. Debian's externally managed Python).
 # Ends with "N passed, N failed"; exits non-zero on failure.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
@@ -32,6 +33,12 @@ fi
 [ $rc -ne 0 ] && echo "(Blender log: $OUT/blender_quality.log)"
 PY=${BPY_PYTHON:-python3}
 "$PY" -c "import numpy" >/dev/null 2>&1 || PY=${PYTHON:-/usr/bin/python3}
+# FLIP (the perceptual error) needs the reference implementation from PyPI.
+if ! "$PY" -c "import flip_evaluator" >/dev/null 2>&1; then
+  echo "run_quality.sh: installing flip-evaluator into $("$PY" -c 'import sys; print(sys.executable)')"
+  "$PY" -m pip install -q --disable-pip-version-check flip-evaluator >/dev/null 2>&1 ||
+    echo "run_quality.sh: could not install flip-evaluator (pip failed): FLIP is skipped"
+fi
 VSGL_QUALITY_FRAMES=${VSGL_QUALITY_FRAMES:-6} "$PY" tests/quality/check.py --out "$OUT" >"$OUT/check.log" 2>&1
 rc2=$?
 grep -E "^(PASS|FAIL|SKIP|INFO|\(report)" "$OUT/check.log"

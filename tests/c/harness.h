@@ -9,6 +9,7 @@
 #define VSGL_TEST_HARNESS_H
 
 #include <math.h>
+#include <setjmp.h>
 #include <stdio.h>
 
 typedef void (*vt_fn)(void);
@@ -16,6 +17,11 @@ void vt_register(const char *name, const char *file, vt_fn fn);
 void vt_fail_at(const char *file, int line);
 extern int vt_current_failures;
 extern const char *vt_current_name;
+/* Where VT_REQUIRE jumps: back to the runner, the test counted as failed. */
+extern jmp_buf vt_stop;
+/* Print `indent` and the printf-style message on one line, while the
+ * current test has printed fewer than VT_MAX_MESSAGES failures. */
+void vt_note(const char *indent, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Print at most this many failure messages per test (all are counted). */
 #define VT_MAX_MESSAGES 8
 
@@ -30,11 +36,7 @@ extern const char *vt_current_name;
 #define VT_REPORT(...)                                                      \
     do {                                                                    \
         vt_fail_at(__FILE__, __LINE__);                                     \
-        if (vt_current_failures <= VT_MAX_MESSAGES) {                       \
-            fprintf(stderr, "    ");                                        \
-            fprintf(stderr, __VA_ARGS__);                                   \
-            fprintf(stderr, "\n");                                          \
-        }                                                                   \
+        vt_note("    ", __VA_ARGS__);                                       \
     } while (0)
 
 /* Check a condition; the message (printf-style) should print the inputs. */
@@ -42,11 +44,19 @@ extern const char *vt_current_name;
     do {                                                                    \
         if (!(cond)) {                                                      \
             VT_REPORT("check failed: %s", #cond);                           \
-            if (vt_current_failures <= VT_MAX_MESSAGES) {                   \
-                fprintf(stderr, "      ");                                  \
-                fprintf(stderr, __VA_ARGS__);                               \
-                fprintf(stderr, "\n");                                      \
-            }                                                               \
+            vt_note("      ", __VA_ARGS__);                                 \
+        }                                                                   \
+    } while (0)
+
+/* VT_CHECK that ends the test when it fails (e.g. a create whose result
+ * the rest of the test would use). What the test allocated before leaks:
+ * use it where going on would crash, not in place of cleanup. */
+#define VT_REQUIRE(cond, ...)                                               \
+    do {                                                                    \
+        if (!(cond)) {                                                      \
+            VT_REPORT("required check failed (test stopped): %s", #cond);   \
+            vt_note("      ", __VA_ARGS__);                                 \
+            longjmp(vt_stop, 1);                                            \
         }                                                                   \
     } while (0)
 
@@ -58,11 +68,7 @@ extern const char *vt_current_name;
         if (!(fabs(vt_g - vt_w) <= (tol) * vt_s)) {                         \
             VT_REPORT("%s = %.9g, want %.9g (rel err %.3g > %.3g)", #got,   \
                       vt_g, vt_w, fabs(vt_g - vt_w) / vt_s, (double)(tol)); \
-            if (vt_current_failures <= VT_MAX_MESSAGES) {                   \
-                fprintf(stderr, "      ");                                  \
-                fprintf(stderr, __VA_ARGS__);                               \
-                fprintf(stderr, "\n");                                      \
-            }                                                               \
+            vt_note("      ", __VA_ARGS__);                                 \
         }                                                                   \
     } while (0)
 
@@ -73,11 +79,7 @@ extern const char *vt_current_name;
         if (!(fabs(vt_g - vt_w) <= (tol))) {                                \
             VT_REPORT("%s = %.9g, want %.9g (abs err %.3g > %.3g)", #got,   \
                       vt_g, vt_w, fabs(vt_g - vt_w), (double)(tol));        \
-            if (vt_current_failures <= VT_MAX_MESSAGES) {                   \
-                fprintf(stderr, "      ");                                  \
-                fprintf(stderr, __VA_ARGS__);                               \
-                fprintf(stderr, "\n");                                      \
-            }                                                               \
+            vt_note("      ", __VA_ARGS__);                                 \
         }                                                                   \
     } while (0)
 

@@ -185,7 +185,7 @@ VT_TEST(bundle_roundtrip_memory_is_bit_exact)
         VT_CHECK(memcmp(st, &s.settings, sizeof *st) == 0, "settings seed %u aa %u", st->seed, st->aa_samples);
         vsgl_bundle_info info;
         VT_CHECK(vsgl_bundle_get_info(bd, &info) == VSGL_OK, "info");
-        VT_CHECK(info.version_major == 1 && info.version_minor == 1 && info.has_frame && info.frame == -42 && info.has_settings &&
+        VT_CHECK(info.version_major == 1 && info.version_minor == 2 && info.has_frame && info.frame == -42 && info.has_settings &&
                      strcmp(info.output_path, "/tmp/out dir/frame_0042.exr") == 0,
                  "info %u.%u frame %d/%d settings %u path '%s'", info.version_major, info.version_minor, info.has_frame,
                  info.frame, info.has_settings, info.output_path);
@@ -271,7 +271,7 @@ VT_TEST(bundle_file_matches_independent_python_reader)
     snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s '%s'", script, path);
     int rc = run_capture(cmd, out, sizeof out);
     VT_CHECK(rc == 0 && strstr(out, "\nok\n"), "reference reader exit %d:\n%s", rc, out);
-    VT_CHECK(strstr(out, "version 1.1\n") && strstr(out, "section POS  esize 12 count 7 crc ok") &&
+    VT_CHECK(strstr(out, "version 1.2\n") && strstr(out, "section POS  esize 12 count 7 crc ok") &&
                  strstr(out, "section IDX  esize 12 count 5 crc ok") && strstr(out, "section LGHT esize 104 count 3 crc ok") &&
                  strstr(out, "camera type 0 fit 0 lens 50 size 320x240") && strstr(out, "light 2 type 2 power 300") &&
                  strstr(out, "output out.exr") && strstr(out, "frame 12") && strstr(out, "seed 1234567"),
@@ -367,9 +367,9 @@ VT_TEST(bundle_bad_headers_give_clear_errors)
 
     memcpy(t, b, n);
     wr32(t + 8, 2);
-    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 2.1, this library reads 1.x", "major 2");
+    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 2.2, this library reads 1.x", "major 2");
     wr32(t + 8, 0);
-    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 0.1", "major 0");
+    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 0.2", "major 0");
 
     memcpy(t, b, n);
     memset(t + n, 0, 16);

@@ -43,8 +43,8 @@ VT_TEST(scene_set_view_renders_as_a_new_scene)
     fx_room(&fx, W, H, 0.25f, 200.0f);
     vsgl_context *ctx = NULL;
     vsgl_scene *reused = NULL, *fresh = NULL;
-    VT_CHECK(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
-    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &reused) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &reused) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     VT_CHECK(render(ctx, reused, &before) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
 
     other_view(&fx);
@@ -102,9 +102,9 @@ VT_TEST(render_cache_reuses_what_stood_still_bit_identically)
     vsgl_scene *scene = NULL;
     vsgl_render_cache *cache = NULL;
     vsgl_render_stats st;
-    VT_CHECK(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
-    VT_CHECK(vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
-    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    VT_REQUIRE(vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     VT_CHECK(render_with(ctx, scene, cache, &cached, &st) == VSGL_OK && st.reused == 0, "first: reused %u", st.reused);
 
     /* the light moves: the G-buffer is reused */
@@ -138,7 +138,7 @@ VT_TEST(render_cache_reuses_what_stood_still_bit_identically)
     scene = NULL;
     for (uint32_t v = 0; v < fx.vertex_count; ++v)
         fx.positions[v * 3 + 2] *= 0.9f;
-    VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     VT_CHECK(render_with(ctx, scene, cache, &cached, &st) == VSGL_OK && st.reused == 0, "new scene: reused %u",
              st.reused);
     VT_CHECK(render_with(ctx, scene, NULL, &plain, NULL) == VSGL_OK, "uncached");

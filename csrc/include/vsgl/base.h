@@ -9,8 +9,9 @@
  *   W/(m^2 sr) with Cycles' light-unit conventions (docs/units.md).
  * - Every fallible function returns a ::vsgl_result. Pure maths functions
  *   cannot fail: they return their value and have a defined result for
- *   every input (NaN in gives NaN out; otherwise finite or +/-inf only
- *   where documented).
+ *   every input (NaN in gives NaN out unless the function documents another
+ *   value, e.g. ::vsgl_sharpness_from_mean_length's 0; otherwise finite, or
+ *   +/-inf only where documented).
  * - The library keeps no global mutable state. A ::vsgl_context holds the
  *   thread count, callbacks and the last error message of calls made with
  *   it; use one context per thread that calls the library concurrently.
@@ -41,7 +42,7 @@ extern "C" {
 
 /** Library version. The add-on refuses a library whose major.minor differ. */
 #define VSGL_VERSION_MAJOR 0
-#define VSGL_VERSION_MINOR 1
+#define VSGL_VERSION_MINOR 2
 #define VSGL_VERSION_PATCH 0
 /** Version packed as major*10000 + minor*100 + patch. */
 #define VSGL_VERSION (VSGL_VERSION_MAJOR * 10000 + VSGL_VERSION_MINOR * 100 + VSGL_VERSION_PATCH)
@@ -55,7 +56,7 @@ typedef int32_t vsgl_result;
 #define VSGL_ERROR_IO                3  /**< a file could not be read or written */
 #define VSGL_ERROR_BAD_FORMAT        4  /**< a file is truncated, corrupt or not of the expected kind */
 #define VSGL_ERROR_VERSION_MISMATCH  5  /**< a file or caller was made for another version */
-#define VSGL_ERROR_UNSUPPORTED       6  /**< a valid request this build does not implement */
+#define VSGL_ERROR_UNSUPPORTED       6  /**< reserved for a valid request a build does not implement; no 0.x function returns it */
 #define VSGL_ERROR_CANCELLED         7  /**< the progress callback asked to stop */
 #define VSGL_ERROR_INTERNAL          8  /**< a bug or a failure of a dependency (Embree, OpenEXR) */
 #define VSGL_RESULT_COUNT            9

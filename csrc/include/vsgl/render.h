@@ -125,7 +125,7 @@ typedef struct vsgl_render_output {
 /** What a render did, for logs and the add-on's panel. */
 typedef struct vsgl_render_stats {
     double seconds_total;
-    double seconds_scene_prep;
+    double seconds_scene_prep;   /**< settings, memory estimate, output checks: everything before the G-buffer */
     double seconds_gbuffer;
     double seconds_rsm;
     double seconds_fit;

@@ -24,7 +24,8 @@ extern "C" {
 /* ------------------------------------------------------------------------ */
 
 /** Material flags. */
-#define VSGL_MATERIAL_UNSUPPORTED 1u /**< caller could not map the material; shaded as given, reported */
+#define VSGL_MATERIAL_UNSUPPORTED 1u /**< the caller's mark that it could not map the material: kept (bundles
+                                          carry it) but not read by the library, which shades it as given */
 /** GGX shadowing as Cycles in Blender 4.x and later: height-correlated Smith
  *  1 / (1 + L(i) + L(o)); without it Blender 3.x's separable G1(i) G1(o). */
 #define VSGL_MATERIAL_FLAG_BLENDER_4 2u
@@ -54,6 +55,87 @@ typedef struct vsgl_material {
     uint32_t flags;          /**< VSGL_MATERIAL_* */
     uint32_t reserved;       /**< must be 0 (room for texture slots) */
 } vsgl_material;
+
+/* ------------------------------------------------------------------------ */
+/* Textures                                                                   */
+/* ------------------------------------------------------------------------ */
+
+/** Texture flags. */
+/** The RGB channels hold sRGB-encoded values (an 8-bit image whose colour
+ *  space is sRGB, as Blender's Image.pixels hands it over). As Cycles does
+ *  for such images, lookups in the full-resolution level interpolate the
+ *  encoded values and decode the result; the coarser mip levels average
+ *  decoded (linear) values. Alpha is always linear. */
+#define VSGL_TEXTURE_FLAG_SRGB 1u
+#define VSGL_TEXTURE_FLAGS_KNOWN VSGL_TEXTURE_FLAG_SRGB
+
+/**
+ * An image, as caller-owned float RGBA pixels; copied (and mip-mapped: 2 x 2
+ * box-filtered levels down to 1 x 1) by ::vsgl_scene_create.
+ * Rows run bottom to top: texel (i, j) covers u in [i/w, (i+1)/w],
+ * v in [j/h, (j+1)/h], i.e. Blender's Image.pixels order, with UV (0, 0) at
+ * the image's bottom-left corner. Pixels are linear RGB unless
+ * ::VSGL_TEXTURE_FLAG_SRGB; they must be finite (values outside [0, 1] are
+ * allowed: colour slots clamp the product to [0, 1]).
+ */
+typedef struct vsgl_texture {
+    uint32_t width, height;  /**< texels, 1..65536 each */
+    const float *pixels;     /**< width * height * 4 floats (RGBA) */
+    uint32_t flags;          /**< VSGL_TEXTURE_FLAG_* */
+    uint32_t reserved;       /**< must be 0 */
+} vsgl_texture;
+
+#define VSGL_FILTER_LINEAR  0 /**< bilinear (Blender "Linear"; "Cubic"/"Smart" are taken as this) */
+#define VSGL_FILTER_CLOSEST 1 /**< nearest texel (Blender "Closest") */
+
+#define VSGL_WRAP_REPEAT 0    /**< Blender "Repeat" */
+#define VSGL_WRAP_EXTEND 1    /**< Blender "Extend": edge texels continue */
+#define VSGL_WRAP_CLIP   2    /**< Blender "Clip": transparent black outside [0, 1] */
+
+/**
+ * Where a material input reads a texture. Zero-initialised = unused.
+ * The lookup point is the surface's UV (vsgl_scene_desc.corner_uvs,
+ * interpolated; (0, 0) without UVs) mapped by @p uv_transform. Lookups are
+ * filtered over the footprint of what asks (a camera sample's share of its
+ * pixel, an RSM texel's patch): trilinear between mip levels chosen from the
+ * footprint's area in texels (isotropic), so a distant wall averages its
+ * texture instead of aliasing. ::VSGL_FILTER_CLOSEST takes the nearest
+ * texel of level 0 while the footprint is under one texel.
+ */
+typedef struct vsgl_texture_slot {
+    uint32_t texture;        /**< 1 + index into vsgl_scene_desc.textures; 0 = unused */
+    int32_t filter;          /**< VSGL_FILTER_* */
+    int32_t wrap;            /**< VSGL_WRAP_* */
+    int32_t channel;         /**< scalar inputs: 0..3 = R, G, B, A; colour inputs ignore it */
+    /** (u', v') = (m[0] u + m[1] v + m[2], m[3] u + m[4] v + m[5]); all zero = identity
+     *  (Blender's Mapping node of type Point/Texture, folded in by the caller) */
+    float uv_transform[6];
+} vsgl_texture_slot;
+
+/** Base colour is also multiplied by the interpolated corner colour
+ *  (vsgl_scene_desc.corner_colors; white where the scene has none). */
+#define VSGL_MATERIAL_TEXTURES_VERTEX_COLOR 1u
+#define VSGL_MATERIAL_TEXTURES_FLAGS_KNOWN VSGL_MATERIAL_TEXTURES_VERTEX_COLOR
+
+/**
+ * Textured inputs of one material (vsgl_scene_desc.material_textures,
+ * parallel to materials). Each used slot multiplies the material's constant:
+ * base colour = clamp01(base_color x texture RGB [x corner colour]),
+ * roughness = clamp01(roughness x texture channel), metallic likewise. A
+ * caller mapping a texture linked straight into an input sets the constant
+ * to 1; node chains in front of the input (mix, multiply, invert, hue /
+ * saturation, colour ramps) are baked into the texture's pixels by the
+ * caller. The material's constants are its untextured values for
+ * everything the library precomputes per material (the glossy albedo
+ * tables: a textured roughness or metallic uses the constants' tables).
+ */
+typedef struct vsgl_material_textures {
+    vsgl_texture_slot base_color;
+    vsgl_texture_slot roughness;
+    vsgl_texture_slot metallic;
+    uint32_t flags;          /**< VSGL_MATERIAL_TEXTURES_* */
+    uint32_t reserved;       /**< must be 0 */
+} vsgl_material_textures;
 
 /* ------------------------------------------------------------------------ */
 /* Lights                                                                     */
@@ -159,7 +241,16 @@ typedef struct vsgl_scene_desc {
     uint32_t light_count;
     const vsgl_light *lights;
     const vsgl_camera *camera;     /**< required */
+    /* Since 0.2: textures. A caller built against 0.1 passes the smaller
+     * size (or 0 with these fields zeroed): no textures. */
+    uint32_t texture_count;
+    const vsgl_texture *textures;  /**< texture_count; NULL if 0 */
+    const vsgl_material_textures *material_textures; /**< material_count entries; NULL = none textured */
+    const float *corner_colors;    /**< triangle_count * 9 linear RGB (colour attribute); NULL = white */
 } vsgl_scene_desc;
+
+/** Size of a vsgl_scene_desc of library 0.1 (before textures): accepted as @c size. */
+#define VSGL_SCENE_DESC_SIZE_0_1 ((uint32_t)offsetof(vsgl_scene_desc, texture_count))
 
 /** Opaque validated scene with its acceleration structure. Immutable but for
  *  ::vsgl_scene_set_view; may be shared by threads while nobody changes it. */

@@ -88,8 +88,10 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
     const vsgl_material *materials = vsgl__scene_materials(scene, &material_count);
     if (mat >= material_count)
         return 0;
+    vsgl_material tm;
+    vsgl__rsm_material(rsm, materials, t, &tm);
     vsgl_brdf_params bp;
-    vsgl__material_params(&materials[mat], &bp);
+    vsgl__material_params(&tm, &bp);
 
     v3 p = v3_make(rsm->pos[0][t], rsm->pos[1][t], rsm->pos[2][t]);
     v3 n = v3_make(rsm->nrm[0][t], rsm->nrm[1][t], rsm->nrm[2][t]);

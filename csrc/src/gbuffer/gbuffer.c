@@ -10,6 +10,7 @@
 #include "core/parallel.h"
 #include "scene/camera.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -68,6 +69,9 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
                     store3(g->nrm, i, zero);
                     store3(g->tan, i, zero);
                     g->material[i] = VSGL_GBUFFER_MISS;
+                    if (g->surf[0])
+                        for (int q = 0; q < VSGL_SURF_N; ++q)
+                            g->surf[q][i] = 0.0f;
                     continue;
                 }
                 vsgl_surface sf;
@@ -76,6 +80,28 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
                 store3(g->nrm, i, sf.normal);
                 store3(g->tan, i, sf.tangent);
                 g->material[i] = sf.material;
+                if (g->surf[0]) {
+                    /* the sample's footprint: its share of the pixel (1/aa of a
+                     * side each way) at the hit, on the surface */
+                    size_t idx = b + k;
+                    uint32_t col = (uint32_t)(idx / spp), s = (uint32_t)(idx % spp);
+                    float px = (float)col + ((float)(s % aa) + 0.5f) * inv;
+                    float py = (float)row + ((float)(s / aa) + 0.5f) * inv;
+                    v3 o1, d1, o2, d2;
+                    float t0, t1;
+                    vsgl__camera_ray(&j->cam, px + inv, py, &o1, &d1, &t0, &t1);
+                    vsgl__camera_ray(&j->cam, px, py + inv, &o2, &d2, &t0, &t1);
+                    float t = hit[k].t;
+                    v3 p0 = v3_add(org[k], v3_scale(dir[k], t));
+                    v3 ex = v3_sub(v3_add(o1, v3_scale(d1, t)), p0), ey = v3_sub(v3_add(o2, v3_scale(d2, t)), p0);
+                    v3 cr = v3_cross(ex, ey);
+                    float cs = fabsf(v3_dot(sf.geometric_normal, dir[k]));
+                    float area = sqrtf(v3_dot(cr, cr)) / fmaxf(cs, 0.02f);
+                    float in[VSGL_SURF_N];
+                    vsgl__scene_inputs(j->scene, &hit[k], area, in);
+                    for (int q = 0; q < VSGL_SURF_N; ++q)
+                        g->surf[q][i] = in[q];
+                }
             }
         }
     }
@@ -93,6 +119,8 @@ void vsgl__gbuffer_free(vsgl_gbuffer *g)
         free(g->tan[k]);
     }
     free(g->material);
+    for (int k = 0; k < VSGL_SURF_N; ++k)
+        free(g->surf[k]);
     memset(g, 0, sizeof *g);
 }
 
@@ -125,6 +153,9 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
         ok &= (out->tan[k] = malloc(n * sizeof(float))) != NULL;
     }
     ok &= (out->material = malloc(n * sizeof(uint32_t))) != NULL;
+    if (vsgl__scene_textured(scene))
+        for (int k = 0; k < VSGL_SURF_N; ++k)
+            ok &= (out->surf[k] = malloc(n * sizeof(float))) != NULL;
     if (!ok) {
         vsgl__gbuffer_free(out);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "gbuffer: out of memory for %ux%u pixels x %u samples",
@@ -151,4 +182,17 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
         return vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "gbuffer: cancelled after the last row");
     }
     return VSGL_OK;
+}
+
+void vsgl__gbuffer_material(const vsgl_gbuffer *g, const vsgl_material *materials, size_t i, vsgl_material *out)
+{
+    const vsgl_material *m = &materials[g->material[i]];
+    if (!g->surf[0]) {
+        *out = *m;
+        return;
+    }
+    float in[VSGL_SURF_N];
+    for (int q = 0; q < VSGL_SURF_N; ++q)
+        in[q] = g->surf[q][i];
+    vsgl__material_with_inputs(m, in, out);
 }

@@ -21,7 +21,14 @@ typedef struct vsgl_gbuffer {
     float *tan[3];                 /* unit tangent (anisotropy frame), orthogonal to nrm */
     uint32_t *material;            /* material index, VSGL_GBUFFER_MISS where nothing was hit
                                       (then pos, nrm, tan are 0; view is still set) */
+    float *surf[VSGL_SURF_N];      /* textured scenes only (else NULL): the material inputs at the
+                                      sample (scene_internal.h VSGL_SURF_*), textures filtered over the
+                                      sample's 1/spp share of its pixel; 0 for misses */
 } vsgl_gbuffer;
+
+/* Material of sample i with its own inputs (textured scenes), else its
+ * material's constants. The sample must be a hit. */
+void vsgl__gbuffer_material(const vsgl_gbuffer *g, const vsgl_material *materials, size_t i, vsgl_material *out);
 
 /* Trace the camera's primary rays (aa x aa per pixel, aa in 1..16, 0 means 1;
  * sample s = j*aa + i at raster (col + (i+0.5)/aa, row + (j+0.5)/aa)) in

@@ -119,6 +119,19 @@ static const field settings_fields[] = {
     /* format 1.1 */
     F(vsgl_render_settings, leak_correction, 'i', 1), F(vsgl_render_settings, sample_merging, 'i', 1),
 };
+#define SLOT(m) F(vsgl_material_textures, m.texture, 'u', 1), F(vsgl_material_textures, m.filter, 'i', 1), \
+    F(vsgl_material_textures, m.wrap, 'i', 1), F(vsgl_material_textures, m.channel, 'i', 1), \
+    F(vsgl_material_textures, m.uv_transform, 'f', 6)
+/* format 1.2 */
+static const field mtex_fields[] = {
+    SLOT(base_color), SLOT(roughness), SLOT(metallic),
+    F(vsgl_material_textures, flags, 'u', 1), F(vsgl_material_textures, reserved, 'u', 1),
+};
+#undef SLOT
+static const field texh_fields[] = {
+    F(vsgl_texture, width, 'u', 1), F(vsgl_texture, height, 'u', 1),
+    F(vsgl_texture, flags, 'u', 1), F(vsgl_texture, reserved, 'u', 1),
+};
 #undef F
 
 typedef struct layout { const field *fields; size_t count; } layout;
@@ -196,7 +209,8 @@ static suffix index_suffix(field f, unsigned k)
 
 /* ---- sections ----------------------------------------------------------- */
 
-enum { S_POS, S_IDX, S_NRM, S_UV, S_TAN, S_MIDX, S_MATL, S_LGHT, S_CAM, S_RSET, S_OUTP, S_FRME, S_COUNT };
+enum { S_POS, S_IDX, S_NRM, S_UV, S_TAN, S_MIDX, S_MATL, S_LGHT, S_CAM, S_RSET, S_OUTP, S_FRME,
+       S_CCOL, S_MTEX, S_TEXH, S_TEXP, S_COUNT };
 
 typedef struct section_kind {
     char tag[5];
@@ -221,7 +235,14 @@ static const section_kind kinds[S_COUNT] = {
     {"RSET", "render settings", "settings", 52, 1, 0, 44},
     {"OUTP", "output path", "byte", 1, 0, 0, 0},
     {"FRME", "frame", "frame", 4, 0, 0, 0},
+    /* format 1.2: textures */
+    {"CCOL", "corner colours", "triangle", 36, 0, 9, 0},
+    {"MTEX", "material textures", "material", 128, 1, 0, 0},
+    {"TEXH", "texture headers", "texture", 16, 1, 0, 0},
+    {"TEXP", "texture pixels", "float", 4, 0, 1, 0},
 };
+/* Largest texture side a bundle may hold (as vsgl_scene_create). */
+#define MAX_TEXTURE_SIDE 65536u
 
 static uint64_t padded(uint64_t n)
 {
@@ -238,6 +259,10 @@ struct vsgl_bundle {
     uint32_t *material_indices;
     vsgl_material *materials;
     vsgl_light *lights;
+    float *corner_colors;
+    vsgl_material_textures *material_textures;
+    vsgl_texture *textures;
+    float *texture_pixels;
     char *output_path;
     uint32_t version_major, version_minor;
     int32_t has_frame, frame;
@@ -333,6 +358,25 @@ vsgl_result vsgl_bundle_write_memory(vsgl_context *ctx, const vsgl_scene_desc *s
         return r;
     if ((r = check_records(ctx, S_CAM, (layout)LAYOUT(camera_fields), d.camera, sizeof(vsgl_camera), 1)))
         return r;
+    if (d.corner_colors && (r = check_floats(ctx, S_CCOL, d.corner_colors, nt)))
+        return r;
+    if (d.material_textures &&
+        (r = check_records(ctx, S_MTEX, (layout)LAYOUT(mtex_fields), d.material_textures, sizeof(vsgl_material_textures),
+                           d.material_count)))
+        return r;
+    if (d.texture_count && !d.textures)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u textures but textures is NULL", d.texture_count);
+    uint64_t texel_floats = 0;
+    for (uint32_t i = 0; i < d.texture_count; ++i) {
+        const vsgl_texture *t = &d.textures[i];
+        if (!t->pixels || t->width < 1 || t->height < 1 || t->width > MAX_TEXTURE_SIDE || t->height > MAX_TEXTURE_SIDE)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: texture %u is %ux%u with pixels %s", i, t->width,
+                              t->height, t->pixels ? "given" : "NULL");
+        uint64_t nf = (uint64_t)t->width * t->height * 4;
+        if ((r = check_floats(ctx, S_TEXP, t->pixels, nf)))
+            return r;
+        texel_floats += nf;
+    }
 
     int32_t frame = o.frame;
     out_section sec[S_COUNT];
@@ -356,6 +400,14 @@ vsgl_result vsgl_bundle_write_memory(vsgl_context *ctx, const vsgl_scene_desc *s
         sec[ns++] = (out_section){S_OUTP, path_len, o.output_path};
     if (o.has_frame)
         sec[ns++] = (out_section){S_FRME, 1, &frame};
+    if (d.corner_colors && nt)
+        sec[ns++] = (out_section){S_CCOL, nt, d.corner_colors};
+    if (d.material_textures && d.material_count)
+        sec[ns++] = (out_section){S_MTEX, d.material_count, d.material_textures};
+    if (d.texture_count) {
+        sec[ns++] = (out_section){S_TEXH, d.texture_count, d.textures};
+        sec[ns++] = (out_section){S_TEXP, texel_floats, d.textures}; /* the textures' pixels, in order */
+    }
 
     uint64_t total = HEADER_SIZE;
     for (int i = 0; i < ns; ++i)
@@ -395,9 +447,23 @@ vsgl_result vsgl_bundle_write_memory(vsgl_context *ctx, const vsgl_scene_desc *s
         case S_LGHT: l = (layout)LAYOUT(light_fields); rec_size = sizeof(vsgl_light); break;
         case S_CAM: l = (layout)LAYOUT(camera_fields); rec_size = sizeof(vsgl_camera); break;
         case S_RSET: l = (layout)LAYOUT(settings_fields); rec_size = sizeof(vsgl_render_settings); break;
+        case S_MTEX: l = (layout)LAYOUT(mtex_fields); rec_size = sizeof(vsgl_material_textures); break;
+        case S_TEXH: l = (layout)LAYOUT(texh_fields); rec_size = sizeof(vsgl_texture); break;
         default: break;
         }
-        if (l.fields) {
+        if (sec[i].kind == S_TEXP) {
+            unsigned char *q = p;
+            for (uint32_t t = 0; t < d.texture_count; ++t) {
+                const float *src = d.textures[t].pixels;
+                size_t nf = (size_t)d.textures[t].width * d.textures[t].height * 4;
+                for (size_t w = 0; w < nf; ++w) {
+                    uint32_t v;
+                    memcpy(&v, src + w, 4);
+                    put_u32(q, v);
+                    q += 4;
+                }
+            }
+        } else if (l.fields) {
             for (uint64_t e = 0; e < sec[i].count; ++e)
                 encode_record(l, (const unsigned char *)sec[i].data + e * rec_size, p + e * k->element_size);
         } else if (sec[i].kind == S_OUTP) {
@@ -450,6 +516,10 @@ void vsgl_bundle_destroy(vsgl_bundle *b)
     free(b->material_indices);
     free(b->materials);
     free(b->lights);
+    free(b->corner_colors);
+    free(b->material_textures);
+    free(b->textures);
+    free(b->texture_pixels);
     free(b->output_path);
     free(b);
 }
@@ -591,8 +661,8 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
     if (where[S_OUTP] && counts[S_OUTP] > MAX_OUTPUT_PATH)
         return BAD("bundle section OUTP (output path): %llu bytes, at most %u", ULL(counts[S_OUTP]), MAX_OUTPUT_PATH);
     uint64_t nt = counts[S_IDX];
-    static const int per_triangle[] = {S_NRM, S_UV, S_TAN, S_MIDX};
-    for (size_t i = 0; i < 4; ++i) {
+    static const int per_triangle[] = {S_NRM, S_UV, S_TAN, S_MIDX, S_CCOL};
+    for (size_t i = 0; i < 5; ++i) {
         int kk = per_triangle[i];
         if (where[kk] && counts[kk] != nt)
             return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section %s (%s): %llu elements, want %llu (one per triangle)",
@@ -639,6 +709,53 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
         return r;
     if ((r = read_records(ctx, S_CAM, (layout)LAYOUT(camera_fields), where[S_CAM], 1, esizes[S_CAM], &out->camera, sizeof(vsgl_camera))))
         return r;
+    /* format 1.2: textures */
+    a = NULL;
+    if (where[S_CCOL] && nt && (r = read_words(ctx, S_CCOL, where[S_CCOL], nt, &a)))
+        return r;
+    out->corner_colors = a;
+    if (where[S_MTEX]) {
+        if (counts[S_MTEX] != nm)
+            return BAD("bundle section MTEX (material textures): %llu elements, want %llu (one per material)",
+                       ULL(counts[S_MTEX]), ULL(nm));
+        out->material_textures = calloc(nm ? (size_t)nm : 1, sizeof(vsgl_material_textures));
+        if (!out->material_textures)
+            return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory for material textures");
+        if ((r = read_records(ctx, S_MTEX, (layout)LAYOUT(mtex_fields), where[S_MTEX], nm, esizes[S_MTEX],
+                              out->material_textures, sizeof(vsgl_material_textures))))
+            return r;
+    }
+    uint64_t ntex = where[S_TEXH] ? counts[S_TEXH] : 0;
+    if (ntex) {
+        out->textures = calloc((size_t)ntex, sizeof(vsgl_texture));
+        if (!out->textures)
+            return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory for %llu textures", ULL(ntex));
+        if ((r = read_records(ctx, S_TEXH, (layout)LAYOUT(texh_fields), where[S_TEXH], ntex, esizes[S_TEXH], out->textures,
+                              sizeof(vsgl_texture))))
+            return r;
+        uint64_t want = 0;
+        for (uint64_t i = 0; i < ntex; ++i) {
+            const vsgl_texture *t = &out->textures[i];
+            if (t->width < 1 || t->height < 1 || t->width > MAX_TEXTURE_SIDE || t->height > MAX_TEXTURE_SIDE)
+                return BAD("bundle section TEXH (texture headers): texture %llu is %ux%u (sides 1..%u)", ULL(i), t->width,
+                           t->height, MAX_TEXTURE_SIDE);
+            want += (uint64_t)t->width * t->height * 4;
+        }
+        if (!where[S_TEXP] || counts[S_TEXP] != want)
+            return BAD("bundle section TEXP (texture pixels): %llu floats, the headers need %llu", ULL(counts[S_TEXP]),
+                       ULL(want));
+        a = NULL;
+        if ((r = read_words(ctx, S_TEXP, where[S_TEXP], want, &a)))
+            return r;
+        out->texture_pixels = a;
+        uint64_t off = 0;
+        for (uint64_t i = 0; i < ntex; ++i) {
+            out->textures[i].pixels = out->texture_pixels + off;
+            off += (uint64_t)out->textures[i].width * out->textures[i].height * 4;
+        }
+    } else if (where[S_TEXP] && counts[S_TEXP]) {
+        return BAD("bundle section TEXP (texture pixels) without TEXH (texture headers)");
+    }
     if (where[S_RSET]) {
         if ((r = read_records(ctx, S_RSET, (layout)LAYOUT(settings_fields), where[S_RSET], 1, esizes[S_RSET], &out->settings,
                               sizeof(vsgl_render_settings))))
@@ -677,6 +794,10 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
     d->light_count = (uint32_t)nl;
     d->lights = nl ? out->lights : NULL;
     d->camera = &out->camera;
+    d->texture_count = (uint32_t)ntex;
+    d->textures = ntex ? out->textures : NULL;
+    d->material_textures = out->material_textures;
+    d->corner_colors = out->corner_colors;
     return VSGL_OK;
 }
 

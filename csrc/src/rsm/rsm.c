@@ -25,7 +25,22 @@ void vsgl__rsm_free(vsgl_rsm *r)
     }
     free(r->material);
     free(r->area);
+    for (int k = 0; k < VSGL_SURF_N; ++k)
+        free(r->surf[k]);
     memset(r, 0, sizeof *r);
+}
+
+void vsgl__rsm_material(const vsgl_rsm *r, const vsgl_material *materials, size_t i, vsgl_material *out)
+{
+    const vsgl_material *m = &materials[r->material[i]];
+    if (!r->surf[0]) {
+        *out = *m;
+        return;
+    }
+    float in[VSGL_SURF_N];
+    for (int q = 0; q < VSGL_SURF_N; ++q)
+        in[q] = r->surf[q][i];
+    vsgl__material_with_inputs(m, in, out);
 }
 
 typedef struct rsm_job {
@@ -70,6 +85,9 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
                     o->pos[k][i] = o->nrm[k][i] = o->tan[k][i] = o->wi[k][i] = o->flux[k][i] = 0.0f;
                 o->material[i] = VSGL_RSM_EMPTY;
                 o->area[i] = 0.0f;
+                if (o->surf[0])
+                    for (int q = 0; q < VSGL_SURF_N; ++q)
+                        o->surf[q][i] = 0.0f;
                 continue;
             }
             vsgl_surface sf;
@@ -88,6 +106,12 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
                 s[k] += (double)o->flux[k][i];
             }
             o->material[i] = sf.material;
+            if (o->surf[0]) {
+                float in[VSGL_SURF_N];
+                vsgl__scene_inputs(j->scene, &hits[c], o->area[i], in);
+                for (int q = 0; q < VSGL_SURF_N; ++q)
+                    o->surf[q][i] = in[q];
+            }
         }
         for (int k = 0; k < 3; ++k)
             j->partial[3 * (grow - j->first_row) + k] = s[k];
@@ -122,6 +146,9 @@ vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
     }
     ok &= (out->material = malloc(n * sizeof(uint32_t))) != NULL;
     ok &= (out->area = malloc(n * sizeof(float))) != NULL;
+    if (vsgl__scene_textured(scene))
+        for (int k = 0; k < VSGL_SURF_N; ++k)
+            ok &= (out->surf[k] = malloc(n * sizeof(float))) != NULL;
     size_t rows = (size_t)l.faces * res;
     double *partial = ok ? malloc(rows * 3 * sizeof *partial) : NULL;
     if (!ok || !partial) {

@@ -29,7 +29,13 @@ typedef struct vsgl_rsm {
     float *flux[3];                /* incident power on the texel's patch, W (RGB) */
     uint32_t *material;            /* VSGL_RSM_EMPTY where the texel saw nothing */
     double total_flux[3];          /* sum of flux */
+    float *surf[VSGL_SURF_N];      /* textured scenes only (else NULL): the material inputs at the VPL
+                                      (VSGL_SURF_*), textures filtered over the texel's patch */
 } vsgl_rsm;
+
+/* Material of texel i with its own inputs (textured scenes), else its
+ * material's constants. The texel must not be empty. */
+void vsgl__rsm_material(const vsgl_rsm *r, const vsgl_material *materials, size_t i, vsgl_material *out);
 
 /* Build the RSM of light `light` at `res` texels per side. */
 vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res, vsgl_rsm *out);

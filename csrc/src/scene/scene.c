@@ -50,6 +50,12 @@ void vsgl_scene_destroy(vsgl_scene *s)
     free(s->materials);
     free(s->glossy_albedo);
     free(s->lights);
+    for (uint32_t i = 0; i < s->texture_count; ++i)
+        vsgl__texture_free(&s->textures[i]);
+    free(s->textures);
+    free(s->material_textures);
+    free(s->corner_colors);
+    free(s->uv_density);
     free(s);
 }
 
@@ -134,6 +140,14 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
         s->corner_uvs = malloc((k ? k : 1) * 6 * sizeof(float));
     if (d->corner_tangents)
         s->corner_tangents = malloc((k ? k : 1) * 12 * sizeof(float));
+    if (s->textured && d->corner_colors)
+        s->corner_colors = malloc((k ? k : 1) * 9 * sizeof(float));
+    if (s->textured)
+        s->uv_density = calloc(k ? k : 1, sizeof(float));
+    if ((s->textured && d->corner_colors && !s->corner_colors) || (s->textured && !s->uv_density)) {
+        free(keep);
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u triangles", (unsigned)kept);
+    }
     if (!s->corner_normals || !s->face_normals || !s->tri_material || !s->source_triangle ||
         (d->corner_uvs && !s->corner_uvs) || (d->corner_tangents && !s->corner_tangents)) {
         free(keep);
@@ -209,6 +223,26 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
                 memcpy(s->corner_uvs + (size_t)o * 6, d->corner_uvs + (size_t)t * 6, 6 * sizeof(float));
             if (s->corner_tangents)
                 memcpy(s->corner_tangents + (size_t)o * 12, d->corner_tangents + (size_t)t * 12, 12 * sizeof(float));
+            if (s->corner_colors)
+                memcpy(s->corner_colors + (size_t)o * 9, d->corner_colors + (size_t)t * 9, 9 * sizeof(float));
+            if (s->uv_density && d->corner_uvs) {
+                /* texture-space area per world area, for the lookups' footprints */
+                const float *uv = d->corner_uvs + (size_t)t * 6;
+                double a_uv = 0.5 * fabs(((double)uv[2] - uv[0]) * ((double)uv[5] - uv[1]) -
+                                         ((double)uv[4] - uv[0]) * ((double)uv[3] - uv[1]));
+                const float *p0 = d->positions + (size_t)ix[0] * 3, *p1 = d->positions + (size_t)ix[1] * 3,
+                            *p2 = d->positions + (size_t)ix[2] * 3;
+                double e1[3], e2[3];
+                for (int q = 0; q < 3; ++q) {
+                    e1[q] = (double)p1[q] - p0[q];
+                    e2[q] = (double)p2[q] - p0[q];
+                }
+                double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+                       cz = e1[0] * e2[1] - e1[1] * e2[0];
+                double a_w = 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
+                double dens = a_w > 0.0 ? a_uv / a_w : 0.0;
+                s->uv_density[o] = dens < 3e38 ? (float)dens : 3e38f;
+            }
             s->tri_material[o] = d->material_indices ? d->material_indices[t] : 0u;
             s->source_triangle[o] = t;
             ++o;
@@ -240,20 +274,62 @@ static int32_t albedo_range(void *user, size_t chunk, size_t begin, size_t end)
     return 0;
 }
 
-vsgl_result vsgl_scene_create(vsgl_context *ctx, const vsgl_scene_desc *desc, vsgl_scene **out)
+/* Copy the texture tables and build the mip pyramids. */
+static vsgl_result copy_textures(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene *s)
+{
+    if (d->material_textures && d->material_count) {
+        for (uint32_t m = 0; m < d->material_count; ++m) {
+            const vsgl_material_textures *mt = &d->material_textures[m];
+            if (mt->base_color.texture || mt->roughness.texture || mt->metallic.texture ||
+                ((mt->flags & VSGL_MATERIAL_TEXTURES_VERTEX_COLOR) && d->corner_colors))
+                s->textured = 1;
+        }
+        if (s->textured) {
+            s->material_textures = malloc((size_t)d->material_count * sizeof *s->material_textures);
+            if (!s->material_textures)
+                return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for material textures");
+            memcpy(s->material_textures, d->material_textures, (size_t)d->material_count * sizeof *s->material_textures);
+        }
+    }
+    if (!s->textured || !d->texture_count)
+        return VSGL_OK;
+    s->textures = calloc(d->texture_count, sizeof *s->textures);
+    if (!s->textures)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u textures", (unsigned)d->texture_count);
+    for (uint32_t i = 0; i < d->texture_count; ++i) {
+        vsgl_result r = vsgl__texture_build(ctx, i, &d->textures[i], &s->textures[i]);
+        if (r != VSGL_OK)
+            return r;
+        s->texture_count = i + 1;
+    }
+    return VSGL_OK;
+}
+
+vsgl_result vsgl_scene_create(vsgl_context *ctx, const vsgl_scene_desc *caller_desc, vsgl_scene **out)
 {
     vsgl__clear_error(ctx);
     if (!out)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: out is NULL");
     *out = NULL;
-    if (!desc)
+    if (!caller_desc)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: desc is NULL");
+    if (caller_desc->size != 0 && caller_desc->size != sizeof(vsgl_scene_desc) &&
+        caller_desc->size != VSGL_SCENE_DESC_SIZE_0_1)
+        return vsgl__validate_scene_desc(ctx, caller_desc); /* names the size */
+    vsgl_scene_desc full;
+    vsgl__scene_desc_normalise(caller_desc, &full);
+    const vsgl_scene_desc *desc = &full;
     vsgl_result r = vsgl__validate_scene_desc(ctx, desc);
     if (r != VSGL_OK)
         return r;
     vsgl_scene *s = calloc(1, sizeof *s);
     if (!s)
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory");
+    r = copy_textures(ctx, desc, s);
+    if (r != VSGL_OK) {
+        vsgl_scene_destroy(s);
+        return r;
+    }
     s->camera = *desc->camera;
     s->material_count = desc->material_count;
     s->light_count = desc->light_count;

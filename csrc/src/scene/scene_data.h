@@ -7,6 +7,7 @@
 
 #include "scene/scene_internal.h"
 #include "scene/material.h"
+#include "scene/texture.h"
 #include "core/context.h"
 
 #define VSGL_SCENE_EMBREE_MESSAGE 256
@@ -31,6 +32,12 @@ struct vsgl_scene {
     uint32_t light_count;
     vsgl_light *lights;
     vsgl_camera camera;
+    uint32_t texture_count;
+    vsgl_tex *textures;          /* texture_count mip pyramids */
+    vsgl_material_textures *material_textures; /* material_count or NULL */
+    float *corner_colors;        /* triangle_count * 9 or NULL */
+    float *uv_density;           /* triangle_count: UV area / world area (0 without UVs); NULL if untextured */
+    int textured;                /* some material reads a texture or corner colours */
     v3 lo, hi;                   /* bounds of the valid triangles (0,0,0 when empty) */
     uint64_t identity;           /* creation time (CLOCK_MONOTONIC ns): with the address, tells this scene's
                                     geometry and materials from a destroyed one's at the same address;
@@ -40,6 +47,8 @@ struct vsgl_scene {
 
 /* Validation (validate.c): first error -> vsgl__fail with a message naming the element. */
 vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *d);
+/* The caller's desc as this version's struct (fields past its size zeroed). */
+void vsgl__scene_desc_normalise(const vsgl_scene_desc *in, vsgl_scene_desc *out);
 vsgl_result vsgl__validate_camera(vsgl_context *ctx, const vsgl_camera *c);
 vsgl_result vsgl__validate_light(vsgl_context *ctx, uint32_t index, const vsgl_light *l);
 vsgl_result vsgl__validate_material(vsgl_context *ctx, uint32_t index, const vsgl_material *m);

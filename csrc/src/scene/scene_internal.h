@@ -47,6 +47,21 @@ uint32_t vsgl__scene_source_triangle(const vsgl_scene *scene, uint32_t triangle)
 /* Surface attributes at a hit seen along ray direction dir. */
 void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, vsgl_surface *out);
 
+/* Textures (scene/texture.h). A scene whose materials read textures or
+ * corner colours is "textured": the stages then evaluate the material
+ * inputs per point (G-buffer sample, RSM texel) instead of per material. */
+#define VSGL_SURF_BASE 0       /* base colour RGB */
+#define VSGL_SURF_ROUGHNESS 3
+#define VSGL_SURF_METALLIC 4
+#define VSGL_SURF_N 5
+int vsgl__scene_textured(const vsgl_scene *scene);
+/* The material inputs (VSGL_SURF_*) at a hit, textures filtered over a
+ * footprint of `area` m^2 on the surface (a camera sample's share of its
+ * pixel, an RSM texel's patch). Thread-safe. */
+void vsgl__scene_inputs(const vsgl_scene *scene, const vsgl_hit *hit, float area, float out[VSGL_SURF_N]);
+/* *m with base colour, roughness and metallic replaced by in (VSGL_SURF_*). */
+void vsgl__material_with_inputs(const vsgl_material *m, const float in[VSGL_SURF_N], vsgl_material *out);
+
 /* Validated copies (never NULL when the count is > 0). */
 const vsgl_material *vsgl__scene_materials(const vsgl_scene *scene, uint32_t *count);
 /* The glossy lobe's directional albedo table of a material (scene/material.h),

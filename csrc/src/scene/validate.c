@@ -6,6 +6,7 @@
 #include "scene/scene_data.h"
 
 #include <math.h>
+#include <string.h>
 #include <stdio.h>
 
 /* Largest accepted coordinate magnitude: keeps products of coordinates
@@ -173,12 +174,89 @@ static vsgl_result need_array(vsgl_context *ctx, const void *p, uint32_t count, 
     return VSGL_OK;
 }
 
+void vsgl__scene_desc_normalise(const vsgl_scene_desc *in, vsgl_scene_desc *out)
+{
+    memset(out, 0, sizeof *out);
+    size_t n = in->size == VSGL_SCENE_DESC_SIZE_0_1 ? VSGL_SCENE_DESC_SIZE_0_1 : sizeof *out;
+    memcpy(out, in, n);
+}
+
+static vsgl_result validate_slot(vsgl_context *ctx, uint32_t m, const char *name, const vsgl_texture_slot *s,
+                                 uint32_t texture_count)
+{
+    if (s->texture == 0)
+        return VSGL_OK;
+    if (s->texture > texture_count)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: %s texture is %u (1-based; texture_count %u)",
+                          (unsigned)m, name, (unsigned)s->texture, (unsigned)texture_count);
+    if (s->filter != VSGL_FILTER_LINEAR && s->filter != VSGL_FILTER_CLOSEST)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: %s filter is %d (unknown)", (unsigned)m, name,
+                          (int)s->filter);
+    if (s->wrap < VSGL_WRAP_REPEAT || s->wrap > VSGL_WRAP_CLIP)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: %s wrap is %d (unknown)", (unsigned)m, name,
+                          (int)s->wrap);
+    if (s->channel < 0 || s->channel > 3)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: %s channel is %d (must be 0..3)", (unsigned)m,
+                          name, (int)s->channel);
+    for (int k = 0; k < 6; ++k)
+        if (!finite_f(s->uv_transform[k]) || fabsf(s->uv_transform[k]) > VSGL_MAX_COORD)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: %s uv_transform[%d] is %g (must be finite)",
+                              (unsigned)m, name, k, (double)s->uv_transform[k]);
+    return VSGL_OK;
+}
+
+static vsgl_result validate_textures(vsgl_context *ctx, const vsgl_scene_desc *d)
+{
+    vsgl_result r;
+    if ((r = need_array(ctx, d->textures, d->texture_count, "textures", "texture_count")) != VSGL_OK)
+        return r;
+    for (uint32_t i = 0; i < d->texture_count; ++i) {
+        const vsgl_texture *t = &d->textures[i];
+        if (t->width < 1 || t->width > 65536 || t->height < 1 || t->height > 65536)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "texture %u: size %ux%u (each side must be in [1, 65536])",
+                              (unsigned)i, (unsigned)t->width, (unsigned)t->height);
+        if (!t->pixels)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "texture %u: pixels is NULL", (unsigned)i);
+        if (t->flags & ~(uint32_t)VSGL_TEXTURE_FLAGS_KNOWN)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "texture %u: flags 0x%x has unknown bits", (unsigned)i,
+                              (unsigned)t->flags);
+        if (t->reserved != 0)
+            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "texture %u: reserved is %u (must be 0)", (unsigned)i,
+                              (unsigned)t->reserved);
+        size_t n = (size_t)t->width * t->height * 4;
+        for (size_t k = 0; k < n; ++k)
+            if (!finite_f(t->pixels[k]) || fabsf(t->pixels[k]) > VSGL_MAX_COORD)
+                return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "texture %u: texel (%zu, %zu) channel %zu is %g (must be finite)",
+                                  (unsigned)i, (k / 4) % t->width, (k / 4) / t->width, k % 4, (double)t->pixels[k]);
+    }
+    if (d->material_textures)
+        for (uint32_t m = 0; m < d->material_count; ++m) {
+            const vsgl_material_textures *mt = &d->material_textures[m];
+            if ((r = validate_slot(ctx, m, "base_color", &mt->base_color, d->texture_count)) != VSGL_OK ||
+                (r = validate_slot(ctx, m, "roughness", &mt->roughness, d->texture_count)) != VSGL_OK ||
+                (r = validate_slot(ctx, m, "metallic", &mt->metallic, d->texture_count)) != VSGL_OK)
+                return r;
+            if (mt->flags & ~(uint32_t)VSGL_MATERIAL_TEXTURES_FLAGS_KNOWN)
+                return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: textures flags 0x%x has unknown bits",
+                                  (unsigned)m, (unsigned)mt->flags);
+            if (mt->reserved != 0)
+                return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: textures reserved is %u (must be 0)",
+                                  (unsigned)m, (unsigned)mt->reserved);
+        }
+    if (d->corner_colors)
+        for (size_t k = 0; k < (size_t)d->triangle_count * 9; ++k)
+            if (!finite_f(d->corner_colors[k]) || fabsf(d->corner_colors[k]) > VSGL_MAX_COORD)
+                return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "triangle %zu: corner %zu colour channel %zu is %g (must be finite)",
+                                  k / 9, (k % 9) / 3, k % 3, (double)d->corner_colors[k]);
+    return VSGL_OK;
+}
+
 vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *d)
 {
     vsgl_result r;
-    if (d->size != 0 && d->size != sizeof(vsgl_scene_desc))
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: desc size is %u (this library expects %u or 0)",
-                          (unsigned)d->size, (unsigned)sizeof(vsgl_scene_desc));
+    if (d->size != 0 && d->size != sizeof(vsgl_scene_desc) && d->size != VSGL_SCENE_DESC_SIZE_0_1)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: desc size is %u (this library expects %u, %u or 0)",
+                          (unsigned)d->size, (unsigned)sizeof(vsgl_scene_desc), (unsigned)VSGL_SCENE_DESC_SIZE_0_1);
     if ((r = need_array(ctx, d->positions, d->vertex_count, "positions", "vertex_count")) != VSGL_OK ||
         (r = need_array(ctx, d->indices, d->triangle_count, "indices", "triangle_count")) != VSGL_OK ||
         (r = need_array(ctx, d->materials, d->material_count, "materials", "material_count")) != VSGL_OK ||
@@ -200,6 +278,8 @@ vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *
     for (uint32_t i = 0; i < d->light_count; ++i)
         if ((r = vsgl__validate_light(ctx, i, &d->lights[i])) != VSGL_OK)
             return r;
+    if ((r = validate_textures(ctx, d)) != VSGL_OK)
+        return r;
     static const char axis[3] = {'x', 'y', 'z'};
     for (uint32_t i = 0; i < d->vertex_count; ++i)
         for (int k = 0; k < 3; ++k) {

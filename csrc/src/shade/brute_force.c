@@ -21,6 +21,8 @@ typedef struct bf_job {
     const bf_vpl *vpl;
     size_t vpl_count;
     const vsgl_brdf_params *params;
+    const vsgl_brdf_params *vpl_params; /* textured scenes: per VPL (else NULL: params[material]) */
+    const vsgl_material *materials;
     uint32_t material_count;
     int visibility;
     float eps;
@@ -48,7 +50,14 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
         float dcol[3] = {0, 0, 0}, gcol[3] = {0, 0, 0}, dl[3] = {0, 0, 0}, gl[3] = {0, 0, 0};
         uint32_t m = g->material[s];
         if (m != VSGL_GBUFFER_MISS && m < j->material_count) {
+            vsgl_brdf_params own;
             const vsgl_brdf_params *P = &j->params[m];
+            if (g->surf[0]) {
+                vsgl_material tm;
+                vsgl__gbuffer_material(g, j->materials, s, &tm);
+                vsgl__material_params(&tm, &own);
+                P = &own;
+            }
             v3 x = load(g->pos, s), n = load(g->nrm, s), v = load(g->view, s), t = load(g->tan, s);
             memcpy(dcol, P->diffuse, sizeof dcol);
             float ms[3]; /* the receiver's glossy compensation towards the viewer */
@@ -67,14 +76,15 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 if (!(v3_dot(n, w) > 0.0f) || !(v3_dot(q->n, w) < 0.0f))
                     continue;
                 float vd[3], vg[3], rd[3], rg[3];
-                vsgl__brdf_eval(&j->params[q->material], q->n, q->t, v3_neg(w), q->wi, vd, vg);
+                const vsgl_brdf_params *Q = j->vpl_params ? &j->vpl_params[k] : &j->params[q->material];
+                vsgl__brdf_eval(Q, q->n, q->t, v3_neg(w), q->wi, vd, vg);
                 /* Blender 4.x+: the VPL's diffuse base dimmed and its glossy lobe
                  * compensated as seen from x (its view) */
                 float cq = -v3_dot(q->n, w);
                 float wq = vsgl__scene_diffuse_weight(j->scene, q->material, cq);
                 float e[3];
                 for (int c = 0; c < 3; ++c)
-                    e[c] = q->flux[c] * (vd[c] * wq + vg[c] * vsgl__ms_scale(&j->params[q->material], c, cq));
+                    e[c] = q->flux[c] * (vd[c] * wq + vg[c] * vsgl__ms_scale(Q, c, cq));
                 if (!(e[0] + e[1] + e[2] > 0.0f))
                     continue;
                 vsgl__brdf_eval(P, n, t, w, v, rd, rg);
@@ -126,6 +136,15 @@ vsgl_result vsgl__brute_force_shade(vsgl_context *ctx, const vsgl_scene *scene, 
     }
     for (uint32_t i = 0; i < mc; ++i)
         vsgl__material_params(&mats[i], &params[i]);
+    vsgl_brdf_params *vpl_params = NULL;
+    if (vsgl__scene_textured(scene)) {
+        vpl_params = malloc((nv ? nv : 1) * sizeof *vpl_params);
+        if (!vpl_params) {
+            free(params);
+            free(vpl);
+            return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "gather: out of memory for %zu VPLs", nv);
+        }
+    }
     size_t k = 0;
     for (uint32_t r = 0; r < rsm_count; ++r) {
         const vsgl_rsm *R = &rsms[r];
@@ -142,6 +161,11 @@ vsgl_result vsgl__brute_force_shade(vsgl_context *ctx, const vsgl_scene *scene, 
                 q->flux[c] = R->flux[c][i];
             q->area = R->area[i];
             q->material = R->material[i];
+            if (vpl_params) {
+                vsgl_material tm;
+                vsgl__rsm_material(R, mats, i, &tm);
+                vsgl__material_params(&tm, &vpl_params[k - 1]);
+            }
         }
     }
     v3 lo, hi;
@@ -157,7 +181,7 @@ vsgl_result vsgl__brute_force_shade(vsgl_context *ctx, const vsgl_scene *scene, 
     vsgl_result res = VSGL_OK;
     for (size_t b = 0; b < n && res == VSGL_OK; b += batch) {
         size_t e = b + batch < n ? b + batch : n;
-        bf_job j = {scene, g, vpl, nv, params, mc, visibility, eps, b,
+        bf_job j = {scene, g, vpl, nv, params, vpl_params, mats, mc, visibility, eps, b,
                     diffuse_light, glossy_light, diffuse_color, glossy_color};
         res = vsgl__parallel_for(threads, e - b, 64, bf_chunk, &j);
         if (res != VSGL_OK)
@@ -166,6 +190,7 @@ vsgl_result vsgl__brute_force_shade(vsgl_context *ctx, const vsgl_scene *scene, 
             res = vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "gather: cancelled");
     }
     free(params);
+    free(vpl_params);
     free(vpl);
     return res;
 }

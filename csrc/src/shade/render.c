@@ -217,6 +217,7 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
 vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *settings,
                                vsgl_render_cache *cache, vsgl_render_output *out, vsgl_render_stats *stats)
 {
+    double t_start = now_seconds();
     vsgl__clear_error(ctx);
     if (!ctx || !scene || !out)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "render: %s is NULL",
@@ -239,7 +240,6 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
 
     vsgl_render_stats st;
     memset(&st, 0, sizeof st);
-    double t_start = now_seconds();
     vsgl_gbuffer g;
     memset(&g, 0, sizeof g);
     vsgl_vsgl_set set;
@@ -248,6 +248,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     float *buf = NULL;
 
     double t0 = now_seconds();
+    st.seconds_scene_prep = t0 - t_start;
     /* overall progress: G-buffer 0-10 %, RSMs and fits 10-40 % (brute force 10-30 %), shading the rest */
     vsgl__progress_window(ctx, 0.0f, 0.1f);
     const vsgl_gbuffer *gb = &g; /* the cache's, or this render's own */

@@ -106,7 +106,9 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->x = v3_make(g->pos[0][i], g->pos[1][i], g->pos[2][i]);
     r->n = v3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
     r->o = v3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
-    vsgl__material_params(&j->materials[g->material[i]], &r->bp);
+    vsgl_material m;
+    vsgl__gbuffer_material(g, j->materials, i, &m);
+    vsgl__material_params(&m, &r->bp);
     r->alpha = sqrtf(r->bp.alpha_x * r->bp.alpha_y);
     r->glossy = r->bp.glossy && v3_dot(r->n, r->o) > 0.0f;
     if (!r->glossy)
@@ -443,8 +445,10 @@ void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls)
         size_t si = px * spp + k;
         if (!Ls[k])
             continue;
+        vsgl_material m;
+        vsgl__gbuffer_material(g, j->materials, si, &m);
         vsgl_brdf_params bp;
-        vsgl__material_params(&j->materials[g->material[si]], &bp);
+        vsgl__material_params(&m, &bp);
         v3 n = v3_make(g->nrm[0][si], g->nrm[1][si], g->nrm[2][si]);
         v3 o = v3_make(g->view[0][si], g->view[1][si], g->view[2][si]);
         float gcol[3] = {0, 0, 0};

@@ -168,9 +168,10 @@ def test_materials_from_nodes_both_versions(scene):
     assert by["P"]["specular_f0"] == pytest.approx(f0, rel=1e-5)
     assert by["P"]["base_color"] == pytest.approx((0.1, 0.2, 0.3))
     assert (by["P"]["metallic"], by["P"]["roughness"]) == pytest.approx((0.5, 0.25))
-    assert by["Emit"]["flags"] & materials.MATERIAL_UNSUPPORTED
-    assert by["Emit"]["base_color"] == pytest.approx((0.3, 0.6, 0.9))
-    assert any("'Emit'" in w for w in sd.warnings)
+    # an Emission shader reflects nothing; its faces are area lights (issue 13)
+    assert not by["Emit"]["flags"] & materials.MATERIAL_UNSUPPORTED
+    assert by["Emit"]["base_color"] == pytest.approx((0.0, 0.0, 0.0))
+    assert any("'Emit'" in n for n in sd.light_names)
     assert by["Diff"]["base_color"] == pytest.approx((0.7, 0.6, 0.5))
     assert by["Diff"]["specular_f0"] == 0
     # the running Blender's GGX shadowing (height-correlated from 4.0 on)

@@ -107,13 +107,17 @@ def test_exr_writer_layout(tmp_path):
 
 
 @pytest.mark.parametrize("version,color", [((3, 4, 1), "Emission"), ((4, 2, 0), "Emission Color")])
-def test_principled_emission_warns(version, color):
-    _, w = materials.map_material(desc(materials.PRINCIPLED, {
-        "Emission Strength": 2.0, color: (1, 1, 1, 1)}, version))
-    assert len(w) == 1 and "emission" in w[0] and "'M'" in w[0]
-    _, w = materials.map_material(desc(materials.PRINCIPLED, {
-        "Emission Strength": 1.0, color: (0, 0, 0, 1)}, version))
+def test_principled_emission_is_a_light(version, color):
+    """Emission is exported as area lights (export.py), not warned about here."""
+    d = desc(materials.PRINCIPLED, {"Emission Strength": 2.0, color: (1, 0.5, 0.25, 1)}, version)
+    _, w = materials.map_material(d)
     assert w == []
+    assert materials.emission(d) == ((1.0, 0.5, 0.25), 2.0)
+    d = desc(materials.PRINCIPLED, {"Emission Strength": 1.0, color: (0, 0, 0, 1)}, version)
+    assert materials.map_material(d)[1] == [] and materials.emission(d) is None
+    e = desc(materials.EMISSION, {"Strength": 3.0, "Color": (1, 1, 1, 1)}, version)
+    fields, w = materials.map_material(e)
+    assert w == [] and fields["base_color"] == (0.0, 0.0, 0.0) and materials.emission(e) == ((1.0, 1.0, 1.0), 3.0)
 
 
 def test_library_messages_get_blender_names():
@@ -162,3 +166,27 @@ def test_multiscatter_ggx_flag_from_4_0():
     d = materials.ShaderDesc("M", materials.DIFFUSE, {"Color": (1, 1, 1, 1)}, node="BSDF", version=(5, 0, 1),
                              multiscatter=True)
     assert materials.map_material(d)[0]["flags"] == 0
+
+
+def test_emissive_faces_become_area_lights_of_the_emitted_power():
+    """A 2 x 1 m emissive rectangle (two triangles) of strength 3: one
+    rectangular light per side whose emitted power is pi A S (radiance S):
+    a Blender 3.x area light of 4 A S watts, a 4.x one of pi A S."""
+    from vsgl_indirect import export
+    P = np.array([(0, 0, 2), (2, 0, 2), (2, 1, 2), (0, 1, 2), (5, 5, 0), (6, 5, 0), (5, 6, 0)], np.float32)
+    I = np.array([(0, 2, 1), (0, 3, 2), (4, 5, 6)], np.uint32)   # the rectangle faces down; a grey triangle
+    M = np.array([1, 1, 0], np.uint32)
+    for version, power in (((3, 4, 1), 4 * 2 * 3.0), ((4, 2, 0), np.pi * 2 * 3.0)):
+        L = export.emissive_lights(P, I, M, {1: ((1.0, 0.5, 0.25), 3.0)}, version)
+        assert len(L) == 2
+        for lt in L:
+            assert lt["area_shape"] == 1 and abs(lt["power"] - power) < 1e-4 * power
+            assert sorted((lt["size_x"], lt["size_y"])) == [1.0, 2.0]
+            assert lt["color"] == (1.0, 0.5, 0.25)
+        # one emits down (-z), the other up: the light's local -Z column
+        z = sorted(-np.asarray(lt["world_from_light"]).reshape(3, 4)[2, 2] for lt in L)
+        assert np.allclose(z, [-1.0, 1.0], atol=1e-6)
+    # a lone triangle: a disk of its area
+    L = export.emissive_lights(P, I, M, {0: ((1.0, 1.0, 1.0), 1.0)})
+    assert len(L) == 2 and L[0]["area_shape"] == 2
+    assert abs(np.pi * (L[0]["size_x"] / 2) ** 2 - 0.5) < 1e-5
