@@ -14,6 +14,7 @@ IMAGE_NODE = "VSGL Indirect [%s]"
 ADD_NODE = "VSGL Add [%s]"          # before issue 15 (one Add of Combined): replaced on setup
 ADD_NODES = "VSGL Add %s [%s]"      # kind (Diffuse, Glossy), view layer
 FRAME_NODE = "VSGL Frame"
+RLAYERS_NODE = "VSGL Render Layers [%s]"   # only for a view layer the tree has none for
 FILE_OUTPUT_NODE = "VSGL Passes Output"
 IMAGE_NAME = "VSGL %s %s"   # scene, view layer
 FIRST_FRAME = -500000
@@ -58,7 +59,7 @@ def _combined_socket(node):
     return None
 
 
-def _render_layers_node(tree, scene, view_layer):
+def _render_layers_node(tree, scene, view_layer, ours=False):
     for n in tree.nodes:
         if n.bl_idname == "CompositorNodeRLayers" and n.layer == view_layer and \
                 (n.scene is None or n.scene == scene):
@@ -66,6 +67,15 @@ def _render_layers_node(tree, scene, view_layer):
     n = tree.nodes.new("CompositorNodeRLayers")
     n.scene = scene
     n.layer = view_layer
+    if ours:
+        # Only the passes file reads it: ours (in the frame, removed with it).
+        # One feeding the composite stays the user's (removing it would
+        # leave the output unlinked).
+        n.name = RLAYERS_NODE % view_layer
+        n.label = "Render Layers %s (for VSGL)" % view_layer
+        frame = tree.nodes.get(FRAME_NODE)
+        if frame is not None:
+            n.parent = frame
     return n
 
 
@@ -164,6 +174,11 @@ def _layout(tree, frame):
     out = tree.nodes.get(FILE_OUTPUT_NODE)
     if out is not None:
         _place(out, frame, fx + 20.0 + NODE_W + 480.0, fy - 40.0)
+    rls = sorted((n for n in tree.nodes if n.name.startswith("VSGL Render Layers [")),
+                 key=lambda n: n.name)
+    for i, rl in enumerate(rls):
+        _place(rl, frame, fx + 20.0 + i * (NODE_W + 40.0),
+               fy - 40.0 - len(images) * (NODE_H + 60.0))
 
 
 def ensure(scene, view_layer, path, add_to_render=True, options=None):
@@ -233,7 +248,8 @@ def ensure(scene, view_layer, path, add_to_render=True, options=None):
                                   "for '%s'" % (node.name, path))
         if getattr(options, "use_cycles_colors", False):    # issue 13: cycles_colors.py
             try:
-                srcs = cycles_colors.sources(tree, scene, view_layer, node)
+                srcs = cycles_colors.sources(tree, scene, view_layer, node,
+                                             _render_layers_node(tree, scene, view_layer))
             except RuntimeError as e:
                 raise engine.AovError(str(e))
         else:
@@ -307,7 +323,7 @@ def export_slots(tree, scene, layers):
     composited image (render + AOV)."""
     slots = []
     for layer in layers:
-        rl = _render_layers_node(tree, scene, layer)
+        rl = _render_layers_node(tree, scene, layer, ours=True)
         for o in rl.outputs:
             if not o.enabled or o.name in ("Alpha", "Noisy Image") or o.name.startswith("Denoising"):
                 continue
@@ -388,8 +404,8 @@ def remove(scene):
         if n.name.startswith("VSGL Add"):
             remove_add(tree, n)
     for n in list(tree.nodes):
-        if n.name.startswith("VSGL Indirect [") or n.name in (FILE_OUTPUT_NODE, FRAME_NODE) or \
-                n.name.startswith("VSGL Cycles Colours "):
+        if n.name.startswith(("VSGL Indirect [", "VSGL Render Layers [", "VSGL Cycles Colours ")) or \
+                n.name in (FILE_OUTPUT_NODE, FRAME_NODE):
             tree.nodes.remove(n)
     for img in list(bpy.data.images):
         if img.name.startswith("VSGL %s " % scene.name) and img.users == 0:

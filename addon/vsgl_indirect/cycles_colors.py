@@ -27,33 +27,20 @@ def _multiply_node(tree, name):
     if node is None:
         node, a, b, res = compat.new_add_node(tree)
         node.name = name
-    if node.bl_idname == "ShaderNodeMix":
-        if node.blend_type != "MULTIPLY":
-            node.blend_type = "MULTIPLY"
-    elif node.blend_type != "MULTIPLY":
+    if node.blend_type != "MULTIPLY":
         node.blend_type = "MULTIPLY"
     compat.set_add_factor(node, 1.0)
     return node
 
 
-def _render_layers(tree, scene, view_layer):
-    for n in tree.nodes:
-        if n.bl_idname == "CompositorNodeRLayers" and n.scene == scene and n.layer == view_layer:
-            return n
-    rl = tree.nodes.new("CompositorNodeRLayers")
-    rl.scene = scene
-    rl.layer = view_layer
-    return rl
-
-
-def sources(tree, scene, view_layer, image_node):
+def sources(tree, scene, view_layer, image_node, rl):
     """[diffuse, glossy] sockets: VSGL DiffInd x Cycles DiffCol, VSGL GlossInd x
-    Cycles GlossCol. Turns the view layer's colour passes on."""
+    Cycles GlossCol (``rl``: the view layer's Render Layers node). Turns the
+    view layer's colour passes on."""
     vl = scene.view_layers.get(view_layer)
     for _, _, _, flag in KINDS:
         if vl is not None and not getattr(vl, flag):
             setattr(vl, flag, True)
-    rl = _render_layers(tree, scene, view_layer)
     out = []
     for kind, light, colour_names, _ in KINDS:
         node = _multiply_node(tree, MULTIPLY_NODE % (kind, view_layer))

@@ -579,3 +579,27 @@ def test_fail_render_without_aov_exits_non_zero(scene, tmp_path, fail):
     else:
         assert r.returncode == 0, r.stdout[-3000:]
         assert out == ["beauty_0001.png", "beauty_0002.png", "beauty_0003.png"], out
+
+
+def test_export_passes_with_two_view_layers_setup_and_removal(scene, tmp_path):
+    """A second rendered view layer gets its own Render Layers node for the
+    passes file, inside the frame, and removal takes it away again."""
+    room(scene, str(tmp_path / "aov" / "{scene}_{view_layer}_####.exr"))
+    scene.render.filepath = str(tmp_path / "out" / "b_")
+    scene.view_layers.new("Second")
+    scene.vsgl_indirect.export_passes = True
+    assert handlers.setup_scene(scene) == []
+    tree = compat.compositor_tree(scene, create=False)
+    fo = tree.nodes[compositor.FILE_OUTPUT_NODE]
+    names = compat.file_output_names(fo)
+    assert "ViewLayer.Combined" in names and "Second.Combined" in names, names
+    assert "Second.VSGL_DiffInd" in names and names[-1] == "Composite", names
+    rl2 = tree.nodes["VSGL Render Layers [Second]"]
+    assert rl2.parent == tree.nodes["VSGL Frame"] and fo.parent == tree.nodes["VSGL Frame"]
+    assert handlers.setup_scene(scene) == []          # idempotent
+    assert compat.file_output_names(fo) == names
+    assert len([n for n in tree.nodes if n.bl_idname == "CompositorNodeOutputFile"]) == 1
+    compositor.remove(scene)
+    assert not [n for n in tree.nodes if n.name.startswith("VSGL")]
+    out = compat.compositor_output_socket(tree)
+    assert out.is_linked and out.links[0].from_node.bl_idname == "CompositorNodeRLayers"
