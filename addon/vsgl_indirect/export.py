@@ -835,11 +835,13 @@ def _visibility_warnings(sd, obj, warned):
         return
     warned.add(obj.name)
     what = "light" if obj.type == "LIGHT" else "object"
-    off = [label for prop, label in _RAY_VISIBILITY if not getattr(obj, prop, True)]
+    off = [label for prop, label in _RAY_VISIBILITY if not getattr(obj, prop, True)
+           and not (what == "light" and prop in ("visible_camera", "visible_transmission",
+                                                  "visible_volume_scatter", "visible_shadow"))]
     if off:
         sd.warnings.append("%s '%s': ray visibility (%s off) is not modelled; it is seen, lights, is lit and "
                            "casts shadows as if every ray type were on" % (what, obj.name, ", ".join(off)))
-    if getattr(obj, "is_shadow_catcher", False):
+    if what == "object" and getattr(obj, "is_shadow_catcher", False):
         sd.warnings.append("object '%s': shadow catcher is not modelled; it is shaded as its material" % obj.name)
     if what == "object" and getattr(obj, "is_holdout", False):
         sd.warnings.append("object '%s': holdout: it blocks light but reflects none and gets no indirect light "
@@ -945,8 +947,33 @@ MAX_EMISSIVE_LIGHTS = 32       # area lights made from emissive faces, at most
 EMISSIVE_MIN_FRACTION = 1e-3   # faces emitting less than this of the brightest light are skipped
 
 
+def _ray_distance(P, I, org, d, exclude=(), chunk=65536):
+    """Distance along unit ``d`` from ``org`` to the nearest triangle (numpy
+    Moller-Trumbore over every triangle, in chunks), inf if none."""
+    best = np.inf
+    for c0 in range(0, len(I), chunk):
+        tri = P[I[c0:c0 + chunk]]
+        e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+        pv = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, pv)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        tv = org - tri[:, 0]
+        u = np.einsum("ij,ij->i", tv, pv) * inv
+        qv = np.cross(tv, e1)
+        v = np.einsum("j,ij->i", d, qv) * inv
+        t = np.einsum("ij,ij->i", e2, qv) * inv
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6)
+        for x in exclude:
+            if x is not None and c0 <= x < c0 + len(tri):
+                hit[x - c0] = False
+        if hit.any():
+            best = min(best, float(t[hit].min()))
+    return best
+
+
 def emissive_lights(positions, indices, material_indices, emission, version=(3, 4, 0), split=1,
-                    split_above=0.5):
+                    split_above=0.5, skipped=None):
     """Area lights (vsgl_light field dicts, with a "name" key) standing for
     the emissive triangles (pure numpy).
 
@@ -1010,6 +1037,13 @@ def emissive_lights(positions, indices, material_indices, emission, version=(3, 
             a = sx * size_y if shape == "RECTANGLE" else area
             power = (math.pi if v4 else 4.0) * a * strength
             for side in (1.0, -1.0):
+                # a side facing a surface closer than a tenth of its size (a panel
+                # mounted on a ceiling) keeps its light in the gap: skipped
+                gap = _ray_distance(P, I, centre, side * nrm, exclude=(t, u))
+                if gap < 0.1 * max(sx, size_y):
+                    if skipped is not None:
+                        skipped.append((g, side, gap))
+                    continue
                 z = -side * nrm                       # an area light emits along its local -Z
                 x = xa
                 y = np.cross(z, x)
@@ -1026,7 +1060,13 @@ def emissive_lights(positions, indices, material_indices, emission, version=(3, 
 def _add_emissive_lights(sd, material_emission, version):
     if not material_emission or sd.triangle_count == 0:
         return
-    lights = emissive_lights(sd.positions, sd.indices, sd.material_indices, material_emission, version)
+    blocked = []
+    lights = emissive_lights(sd.positions, sd.indices, sd.material_indices, material_emission, version,
+                             skipped=blocked)
+    for g, side, gap in blocked[:10]:
+        sd.warnings.append("material '%s': the %s side of an emissive face is %.3g m from a surface it faces; "
+                           "its light stays in the gap and is skipped" % (sd.material_names[g],
+                                                                           "front" if side > 0 else "back", gap))
     if not lights:
         return
     brightest = max([l["power"] * max(l["color"]) for l in sd.lights + lights] or [0.0])

@@ -1,0 +1,41 @@
+"""Cycles one-bounce reference of the demo scene (run inside Blender on
+out/demo/demo.blend): max_bounces 1 (diffuse and glossy 1), no clamps, no
+blur, fixed seed, no denoising, SPP samples; no compositor (the add-on is
+not enabled here). Writes //reference.exr, a multilayer EXR with
+Combined, DiffInd, DiffCol, GlossInd and GlossCol.
+
+    blender -b out/demo/demo.blend --python tools/demo_reference.py -- SPP
+"""
+import sys
+
+import bpy
+
+argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+spp = int(argv[0]) if argv else 32
+sc = bpy.context.scene
+c = sc.cycles
+c.samples = spp
+c.max_bounces = 1
+c.diffuse_bounces = 1
+c.glossy_bounces = 1
+c.transmission_bounces = 0
+c.volume_bounces = 0
+c.transparent_max_bounces = 0
+c.sample_clamp_direct = 0.0
+c.sample_clamp_indirect = 0.0
+c.blur_glossy = 0.0
+c.light_sampling_threshold = 0.0
+c.use_denoising = False
+c.seed = 0
+vl = sc.view_layers[0]
+for flag in ("use_pass_diffuse_indirect", "use_pass_diffuse_color", "use_pass_glossy_indirect",
+             "use_pass_glossy_color"):
+    setattr(vl, flag, True)
+sc.use_nodes = False
+s = sc.render.image_settings
+s.file_format = "OPEN_EXR_MULTILAYER"
+s.color_depth = "32"
+s.exr_codec = "ZIP"
+sc.render.filepath = "//reference"
+sc.frame_set(1)
+bpy.ops.render.render(write_still=True)
