@@ -70,20 +70,23 @@ _PATH_OPTIONS = ({"options": {"PATH_SUPPORTS_BLEND_RELATIVE"}}
 
 # Labels and tooltips of the enum items: (identifier, label, description).
 ITEMS = {
+    # Times: tools/curve.sh's gather room at 80x60 (docs/accuracy.md), rerun
+    # with the current presets on a loaded 2-core machine, where Cycles took
+    # 1.75 s for 256 spp (relMSE 0.0133); compare them with each other.
     "preset": [
         ("PREVIEW", "Preview",
          "Fastest: lattice 32 VSGLs per light, RSM 128, 1 sample, one pixel in 2 x 2 shaded, "
          "no indirect shadows. Within 21 % of Cycles per pass on the bundled scenes; the gather "
-         "room at 80x60 in 0.016 s (relMSE 0.082, light leaks past occluders)"),
+         "room in 0.024 s at relMSE 0.090 (light leaks past occluders)"),
         ("BALANCED", "Balanced",
          "Lattice 128 VSGLs per light, RSM 256, 2 x 2 AA, one pixel in 2 x 2 shaded, visibility "
-         "rays: within 5 % of Cycles where nothing blocks the light; the rays cost 1.1-1.5x and "
-         "cut a sun room's structured error from 1400x to 73x the reference's noise. "
-         "A 1080p frame in about 1 s on 2 cores"),
+         "rays: the gather room in 0.23 s at relMSE 0.0078, below Cycles at 256 spp (0.0133 in "
+         "1.75 s); within 5 % of Cycles where nothing blocks the light. About 1 s per 1080p "
+         "frame on 2 cores"),
         ("QUALITY", "Quality",
-         "Lattice 256 VSGLs per light, RSM 512, 2 x 2 AA, visibility rays: within 4 % of Cycles "
-         "per pass on every bundled scene; relMSE 0.0050 in 0.67 s on the gather room, where "
-         "Cycles needs ~680 spp (~1.6 s) to match it. About 10x Balanced's time"),
+         "Lattice 256 VSGLs per light, RSM 512, 2 x 2 AA, one pixel in 2 x 2 shaded, visibility "
+         "rays: within 4 % of Cycles per pass on every bundled scene; the gather room in 0.91 s "
+         "at relMSE 0.0070, about 4x Balanced's time"),
     ],
     "method": [
         ("VSGL", "VSGL",
@@ -181,8 +184,9 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "node with the passes is set up")
     preset: EnumProperty(
         name="Preset", default="BALANCED", items=ITEMS["preset"], **_upd(_update_preset),
-        description="Speed against accuracy. Preview: 0.016 s, Balanced: 0.07 s, Quality: 0.67 s "
-                    "for the gather room at 80x60 (docs/accuracy.md); the advanced knobs start "
+        description="Speed against accuracy. The gather room at 80x60 (docs/accuracy.md): "
+                    "Preview 0.024 s, Balanced 0.23 s, Quality 0.91 s, where Cycles needs 1.75 s "
+                    "for 256 spp and is still noisier than Balanced. The advanced knobs start "
                     "from the selected preset's values")
     use_advanced: BoolProperty(
         name="Advanced", default=False, **_upd(_update_advanced),
