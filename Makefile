@@ -37,6 +37,7 @@ help:
 	@echo "make test       every test suite; ends with 'N passed, N failed'"
 	@echo "make asan       C tests under AddressSanitizer + UBSan (clang)"
 	@echo "make bench      speed/memory benchmarks, reported as ratios"
+	@echo "make screenshots  the add-on's panels in Blender's UI under Xvfb -> docs/img/"
 
 deps:
 	@tools/deps.sh build
@@ -168,6 +169,12 @@ fuzz:
 	  -dict=tests/fuzz/bundle.dict -artifact_prefix=$(BUILD)/fuzz/scene- -print_final_stats=1 $(BUILD)/fuzz/corpus_scene
 	$(FUZZ_RUN) $(BUILD)/fuzz/fuzz_cli -max_total_time=$(FUZZ_SECONDS) \
 	  -dict=tests/fuzz/cli.dict -artifact_prefix=$(BUILD)/fuzz/cli- -print_final_stats=1 $(BUILD)/fuzz/corpus_cli
+
+# The add-on's panels, compositor setup and preview in Blender's real UI under
+# Xvfb (issue 15): docs/img/panel*.png, compositor.png, preview.png.
+.PHONY: screenshots
+screenshots: $(BUILD)/libvsgl.so
+	@tools/panel_screenshots.sh
 
 # Blender add-on zip (issue 5): build/vsgl_indirect.zip with lib/libvsgl.so inside.
 .PHONY: addon

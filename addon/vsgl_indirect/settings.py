@@ -191,7 +191,8 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
     use_advanced: BoolProperty(
         name="Advanced", default=False, **_upd(_update_advanced),
         description="Render with the knobs below instead of the preset. They start from the "
-                    "selected preset's values; knobs that differ from it are marked")
+                    "selected preset's values (picking a preset loads its values again); knobs "
+                    "that differ from it show the preset's value beside them")
     method: _enum("method", "Method", "How the light of each reflective shadow map is gathered")
     aa_samples: IntProperty(
         name="AA Samples", default=config.KNOBS["aa_samples"][1], min=1, max=AA_SAMPLES_MAX,
