@@ -16,6 +16,9 @@ LIGHT_KNOBS = ("rsm_resolution", "fit_mode", "vsgl_count", "fis_iterations",
 MATERIAL_KNOBS = ("diffuse_mode", "glossy_mode")
 assert set(QUALITY_KNOBS + LIGHT_KNOBS + MATERIAL_KNOBS) == set(config.KNOBS)
 
+#: Blender's report icons: an error is a cross, a warning a triangle.
+LEVEL_ICONS = {"ERROR": "CANCEL", "WARNING": "ERROR", "INFO": "INFO"}
+
 _NAMED = re.compile(r"\b(object|light|material) '([^']+)'")
 
 
@@ -254,7 +257,7 @@ class VSGL_PT_last_run(_Sub, bpy.types.Panel):
             box = layout.box()
             box.label(text="Warnings and errors (%d)" % len(messages), icon="ERROR")
             for level, m in messages[-20:]:
-                wrapped(box, context, m, icon="ERROR" if level == "ERROR" else "INFO",
+                wrapped(box, context, m, icon=LEVEL_ICONS.get(level, "INFO"),
                         select=bool(named_elements(m)))
             if len(messages) > 20:
                 box.label(text="... %d earlier (see the console)" % (len(messages) - 20))
