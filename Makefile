@@ -27,7 +27,7 @@ TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/obj/%.o)
 ASAN_LIB_OBJ  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 ASAN_TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/asan/%.o)
 
-.PHONY: all help deps test test-c test-python test-blender asan demo bench clean headers-cxx check-exports
+.PHONY: all help deps test test-c test-python test-blender asan demo bench lint clean headers-cxx check-exports
 
 all: $(BUILD)/libvsgl.so check-exports headers-cxx $(if $(CLI_SRC),$(BUILD)/vsgl)
 
@@ -38,6 +38,7 @@ help:
 	@echo "make asan       C tests under AddressSanitizer + UBSan (clang)"
 	@echo "make bench      speed/memory benchmarks, reported as ratios"
 	@echo "make screenshots  the add-on's panels in Blender's UI under Xvfb -> docs/img/"
+	@echo "make lint       flake8 (setup.cfg) and cppcheck over the sources"
 
 deps:
 	@tools/deps.sh build
@@ -110,6 +111,13 @@ bench:
 	@tools/deps.sh bench
 	@$(MAKE) --no-print-directory all
 	@if [ -x tools/bench.sh ]; then tools/bench.sh; else echo "make bench: no benchmarks yet"; fi
+
+# Debian's flake8 and cppcheck (tools/deps.sh lint); both must report nothing.
+lint:
+	@tools/deps.sh lint
+	/usr/bin/python3 -m flake8 addon tests tools
+	cppcheck --quiet --error-exitcode=1 --std=c11 --enable=warning,portability,performance --inline-suppr \
+	  -D__GNUC__ -I csrc/include -I csrc/src csrc/src csrc/cli
 
 clean:
 	rm -rf $(BUILD)

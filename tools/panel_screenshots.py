@@ -264,7 +264,6 @@ def s_wait_preview():
           img and img.type)
     check("preview shown in an image editor", bool(editors), "none shows it")
     if img is not None:
-        layers = [l.name for l in getattr(img, "render_slots", [])]
         print("VSGL-UI info preview size", tuple(img.size), "type", img.type, flush=True)
 
 

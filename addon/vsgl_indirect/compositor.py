@@ -8,7 +8,7 @@ import os
 
 import bpy
 
-from . import compat, engine
+from . import compat, cycles_colors, engine
 
 IMAGE_NODE = "VSGL Indirect [%s]"
 ADD_NODE = "VSGL Add [%s]"          # before issue 15 (one Add of Combined): replaced on setup
@@ -94,7 +94,11 @@ def has_passes(node, add_to_render=True):
     if not add_to_render:
         return True
     diff = node.outputs.get("Diff")
-    return diff is not None and any(l.to_node.name.startswith("VSGL Add") for l in diff.links)
+    if diff is not None and any(l.to_node.name.startswith("VSGL Add") for l in diff.links):
+        return True
+    # "Cycles Colours" (cycles_colors.py): DiffInd feeds its Multiply node instead
+    light = node.outputs.get("DiffInd")
+    return any(l.to_node.name.startswith("VSGL Cycles Colours") for l in light.links)
 
 
 # --- layout: our nodes in one labelled Frame beside the user's tree -----------
@@ -242,6 +246,14 @@ def ensure(scene, view_layer, path, add_to_render=True, options=None):
         if _combined_socket(node) is None or None in srcs:
             raise engine.AovError("compositor: the Image node '%s' shows no Diff/Gloss passes "
                                   "for '%s'" % (node.name, path))
+        if getattr(options, "use_cycles_colors", False):    # issue 13: cycles_colors.py
+            try:
+                srcs = cycles_colors.sources(tree, scene, view_layer, node,
+                                             _render_layers_node(tree, scene, view_layer))
+            except RuntimeError as e:
+                raise engine.AovError(str(e))
+        else:
+            cycles_colors.remove(tree, view_layer)
         out = compat.compositor_output_socket(tree)
         if None in adds:
             for a in adds:
@@ -278,7 +290,8 @@ def ensure(scene, view_layer, path, add_to_render=True, options=None):
         for a in adds:
             if a is not None:
                 remove_add(tree, a)
-    for n in [node] + [a for a in adds if a is not None and a.name in tree.nodes]:
+    for n in [node] + [a for a in adds if a is not None and a.name in tree.nodes] + \
+            cycles_colors.nodes(tree, view_layer):
         if n.parent != frame:
             n.parent = frame
     _layout(tree, frame)
@@ -391,7 +404,7 @@ def remove(scene):
         if n.name.startswith("VSGL Add"):
             remove_add(tree, n)
     for n in list(tree.nodes):
-        if n.name.startswith(("VSGL Indirect [", "VSGL Render Layers [")) or \
+        if n.name.startswith(("VSGL Indirect [", "VSGL Render Layers [", "VSGL Cycles Colours ")) or \
                 n.name in (FILE_OUTPUT_NODE, FRAME_NODE):
             tree.nodes.remove(n)
     for img in list(bpy.data.images):

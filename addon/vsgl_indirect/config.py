@@ -117,6 +117,7 @@ class Options:
     strength: float = 1.0           # compositor: factor of the added indirect light
     use_diffuse: bool = True        # compositor: add the Diff pass
     use_glossy: bool = True         # compositor: add the Gloss pass
+    use_cycles_colors: bool = False  # compositor: DiffInd x Cycles' DiffCol (+ glossy) instead of Diff/Gloss
     export_passes: bool = False     # compositor: render passes + VSGL passes in one EXR
     export_path: str = "{render_dir}/passes/{scene}_"
 

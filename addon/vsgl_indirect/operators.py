@@ -286,7 +286,8 @@ class VSGL_OT_reset_knobs(bpy.types.Operator):
 
 
 class VSGL_OT_cycles_direct_only(bpy.types.Operator):
-    """Set Cycles' Diffuse and Glossy bounces to 0 so that it renders direct light only and the VSGL AOV adds the one-bounce indirect light (saved: 'Restore' puts the previous values back)"""
+    """Set Cycles' Diffuse and Glossy bounces to 0 so that it renders direct light only and the \
+VSGL AOV adds the one-bounce indirect light (saved: 'Restore' puts the previous values back)"""
     bl_idname = "vsgl.cycles_direct_only"
     bl_label = "Cycles: Direct Light Only"
     bl_options = {"REGISTER", "UNDO"}

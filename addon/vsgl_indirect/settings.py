@@ -283,6 +283,11 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
         name="Glossy", default=True, **_UPDATE,
         description="Add the glossy indirect light (pass Gloss = GlossInd x GlossCol); off "
                     "mutes its Add node")
+    use_cycles_colors: BoolProperty(
+        name="Cycles Colours", default=False, **_UPDATE,
+        description="Multiply the light-only passes (DiffInd, GlossInd) by Cycles' own DiffCol and "
+                    "GlossCol of the same render instead of adding Diff and Gloss: exact receiver "
+                    "colours for any node setup (turns the view layer's colour passes on)")
     export_passes: BoolProperty(
         name="Export Passes", default=False, **_UPDATE,
         description="Also write one multilayer EXR per frame with the render's passes and the "

@@ -208,6 +208,7 @@ class VSGL_PT_compositing(_Sub, bpy.types.Panel):
         row = col.row(heading="Passes") if bpy.app.version >= (2, 90, 0) else col.row()
         row.prop(props, "use_diffuse", toggle=True)
         row.prop(props, "use_glossy", toggle=True)
+        col.prop(props, "use_cycles_colors")
         layout.prop(props, "export_passes")
         sub = layout.column()
         sub.active = props.export_passes

@@ -196,7 +196,7 @@ def test_constants_match_header_defines():
             problems.append("%s (= %r) missing from libvsgl.%s" % (define, value, cls_name))
         elif int(cls[member]) != value:
             problems.append("%s = %r, binding %s.%s = %d" % (define, value, cls_name, member,
-                                                              int(cls[member])))
+                                                             int(cls[member])))
     for _, cls_name in ENUM_PREFIXES + [("", "SharpnessEstimator"), ("", "Result")]:
         for member in getattr(libvsgl, cls_name).__members__:
             if (cls_name, member) not in seen:

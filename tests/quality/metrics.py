@@ -143,6 +143,7 @@ def all_metrics(img, ref_seeds, k=4):
     ref = {p: 0.5 * (ref_seeds[0][p] + ref_seeds[1][p]) for p in ("Diff", "Gloss", "Combined")}
     out = {}
     for p in ("Diff", "Gloss", "Combined"):
-        out[p] = dict(bias=bias(img[p], ref[p]), relmse=relmse(img[p], ref[p]), structured=structured(img[p], ref[p], k))
+        out[p] = dict(bias=bias(img[p], ref[p]), relmse=relmse(img[p], ref[p]),
+                      structured=structured(img[p], ref[p], k))
     out["flip"] = flip(img["Combined"], ref["Combined"])
     return out

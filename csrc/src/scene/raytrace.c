@@ -114,7 +114,7 @@ void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *or
         }
         if (scene->triangle_count > 0) {
             /* Embree marks a blocked ray with tfar = -inf; remember inactive ones */
-            unsigned char active[BATCH];
+            unsigned char active[BATCH] = {0};
             for (uint32_t i = 0; i < m; ++i)
                 active[i] = r[i].tfar != -INFINITY;
             rtcOccluded1M(scene->rtc, &ic, r, m, sizeof(struct RTCRay));

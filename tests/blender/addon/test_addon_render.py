@@ -251,10 +251,12 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     for n in ours:
         nx, ny = compositor._absolute(n)
         assert ny <= y0, (n.name, (nx, ny), (x0, y0, x1, y1))   # top below their bottom
+
     # Strength and per-pass toggles: the Add nodes' factors.
     def facs():
         return [compositor.compat.add_node_sockets(tree.nodes["VSGL Add %s [ViewLayer]" % k])
                 for k in ("Diffuse", "Glossy")]
+
     def factor(add):
         if add.bl_idname == "ShaderNodeMix":
             return [s for s in add.inputs if s.name == "Factor" and s.enabled][0].default_value
@@ -458,8 +460,8 @@ def _diffuse(name, color):
 
 
 @pytest.mark.parametrize("fit,shift,ctype", [("AUTO", (0.0, 0.0), "PERSP"),
-                                              ("VERTICAL", (0.15, -0.1), "PERSP"),
-                                              ("HORIZONTAL", (0.05, 0.1), "ORTHO")])
+                                             ("VERTICAL", (0.15, -0.1), "PERSP"),
+                                             ("HORIZONTAL", (0.05, 0.1), "ORTHO")])
 def test_aov_diffcol_aligns_with_cycles_diffcol(scene, tmp_path, fit, shift, ctype):
     """Camera, transforms and materials at once: the AOV's DiffCol plane must
     match Cycles' own DiffCol pass pixel for pixel (away from edges)."""

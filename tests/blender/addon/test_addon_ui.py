@@ -9,7 +9,7 @@ import bpy
 import pytest
 
 import vsgl_indirect
-from conftest import cube, link, principled, room
+from conftest import room
 from vsgl_indirect import checks, config, engine, operators, runner, settings, ui
 
 
@@ -157,7 +157,7 @@ def test_knob_tooltips_carry_figures():
 def test_preset_table_matches_the_library():
     from vsgl_indirect import libvsgl
     try:
-        lib = libvsgl.library()
+        libvsgl.library()
     except Exception as e:
         pytest.skip("no libvsgl: %s" % e)
     for p in config.PRESETS:
