@@ -30,6 +30,19 @@ def _update_compositor(self, context):
         print("VSGL WARNING: compositor update failed: %r" % (e,))
 
 
+def _update_grading(self, context):
+    """Strength, Diffuse, Glossy: only the Add nodes' factors change."""
+    from . import compositor, config
+    scene = self.id_data
+    if not isinstance(scene, bpy.types.Scene) or not self.enabled:
+        return
+    try:
+        if not compositor.update_grading(scene, config.Options.from_props(self)):
+            _update_compositor(self, context)
+    except Exception as e:  # never break a property edit
+        print("VSGL WARNING: compositor update failed: %r" % (e,))
+
+
 def load_preset_knobs(props, preset=None):
     """Copy ``preset``'s (default: the selected preset's) values into the knobs."""
     for k, v in config.preset_knobs(preset or props.preset).items():
@@ -271,16 +284,17 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "shown. Off: the frame renders without indirect light and the log says "
                     "VSGL ERROR")
     strength: FloatProperty(
-        name="Strength", default=1.0, min=0.0, max=1.0, precision=3, subtype="FACTOR", **_UPDATE,
+        name="Strength", default=1.0, min=0.0, max=1.0, precision=3, subtype="FACTOR",
+        **_upd(_update_grading),
         description="Factor of the indirect light added in the compositor (1 = physical, with "
                     "Cycles rendering direct light only; lower it to grade the bounce down). "
                     "It is the Add nodes' factor, so it costs nothing and needs no new AOV")
     use_diffuse: BoolProperty(
-        name="Diffuse", default=True, **_UPDATE,
+        name="Diffuse", default=True, **_upd(_update_grading),
         description="Add the diffuse indirect light (pass Diff = DiffInd x DiffCol); off mutes "
                     "its Add node")
     use_glossy: BoolProperty(
-        name="Glossy", default=True, **_UPDATE,
+        name="Glossy", default=True, **_upd(_update_grading),
         description="Add the glossy indirect light (pass Gloss = GlossInd x GlossCol); off "
                     "mutes its Add node")
     use_cycles_colors: BoolProperty(

@@ -270,6 +270,10 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     assert handlers.setup_scene(scene) == []
     assert [round(factor(a), 6) for a in adds] == [0.5, 0.0]
     assert "(off)" in adds[1].label
+    # A slider drag only touches the factors (update_grading, the callback).
+    from vsgl_indirect.config import Options
+    assert compositor.update_grading(scene, Options(strength=0.25, use_diffuse=False))
+    assert [round(factor(a), 6) for a in adds] == [0.0, 0.25]
     scene.vsgl_indirect.add_to_render = False
     handlers.setup_scene(scene)
     assert not _nodes(tree, "VSGL Add")
@@ -277,6 +281,7 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     compositor.remove(scene)
     assert not _nodes(tree, "VSGL")
     assert out.links[0].from_node.bl_idname == "CompositorNodeRLayers"
+    assert not compositor.update_grading(scene, Options())
 
 
 def test_compositor_replaces_the_old_single_add_node(scene, tmp_path):
