@@ -126,14 +126,16 @@ def _rna(name):
 
 
 def test_every_property_and_enum_item_has_a_label_and_a_tooltip():
-    for name, p in settings.VSGLIndirectSettings.bl_rna.properties.items():
-        if name in ("rna_type", "name"):
-            continue
-        assert p.name and p.name != name, (name, p.name)
-        assert len(p.description) >= 30, (name, p.description)
-        if p.type == "ENUM":
-            for item in p.enum_items:
-                assert item.name and len(item.description) >= 20, (name, item.identifier)
+    from vsgl_indirect import viewport
+    for group in (settings.VSGLIndirectSettings, viewport.VSGLLiveProps):
+        for name, p in group.bl_rna.properties.items():
+            if name in ("rna_type", "name"):
+                continue
+            assert p.name and p.name != name, (group, name, p.name)
+            assert len(p.description) >= 30, (group, name, p.description)
+            if p.type == "ENUM":
+                for item in p.enum_items:
+                    assert item.name and len(item.description) >= 20, (group, name, item.identifier)
     # proper names, not title-cased identifiers
     assert _rna("method").enum_items["VSGL"].name == "VSGL"
     assert _rna("glossy_mode").enum_items["ASG"].name == "ASG"
