@@ -165,6 +165,11 @@ class VSGL_PT_lights_materials(_Sub, bpy.types.Panel):
         if not props.use_advanced:
             layout.label(text="Values of the preset; tick Advanced (Quality) to edit", icon="INFO")
         layout.label(text="Lights")
+        lights = (runner.LAST_RUN.get(context.scene.name) or {}).get("lights") or {}
+        if lights:
+            layout.label(text="Last run: %d light(s) used, %d skipped, %d VSGLs" % (
+                lights.get("lights_used", 0), lights.get("lights_skipped", 0),
+                lights.get("vsgl_count", 0)), icon="LIGHT")
         draw_knobs(layout, props, LIGHT_KNOBS)
         layout.label(text="Materials")
         draw_knobs(layout, props, MATERIAL_KNOBS)

@@ -371,8 +371,10 @@ def test_last_run_box_shows_the_memory_estimate(scene):
     runner.begin(scene.name, 4)
     res = engine.Result()
     res.path, res.summary = "/tmp/x.exr", "2 triangles"
-    res.stats = {"memory_estimate": {"total": 3 << 29, "limit": 22 << 30}}
+    res.stats = {"memory_estimate": {"total": 3 << 29, "limit": 22 << 30},
+                 "lights_used": 2, "lights_skipped": 1, "vsgl_count": 398}
     res.timings = {"render": 0.1, "write": 0.01}
     runner.finish(scene.name, res, 0.01)
     assert "Memory: about 1.5 GiB of 22.0 GiB" in texts(draw(scene))
     assert "max_memory_gb" in props_by_name(draw(scene))
+    assert "Last run: 2 light(s) used, 1 skipped, 398 VSGLs" in texts(draw(scene))
