@@ -151,7 +151,8 @@ def s_setup():
     runner.LAST_RUN[scene.name].update(
         status="done", summary="4 triangles, 2 objects, 2 materials, 1 light, camera 320x240",
         timings={"export": 0.004, "render": 0.41, "write": 0.05, "lib gbuffer": 0.02,
-                 "lib rsm": 0.05, "lib fit": 0.03, "lib shade": 0.28})
+                 "lib rsm": 0.05, "lib fit": 0.03, "lib shade": 0.28},
+        lights={"lights_used": 1, "lights_skipped": 0, "vsgl_count": 146})
     w = bpy.context.window_manager.windows[0]
     for a in list(w.screen.areas):
         if a.type == "IMAGE_EDITOR":
