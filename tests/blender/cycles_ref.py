@@ -655,7 +655,7 @@ def suite_lights(lib, ctx, out_dir, report):
         bad = [e for e in errs if e[0] > max(TOL_LIGHT, 3 * e[5] / e[4])]
         worst = max(errs) if errs else (0, 0, 0, 0, 0, 0)
         ok = not bad and len(errs) > 0
-        if analytic is not None:  # Cycles itself against the closed form (GUIDE section 5)
+        if analytic is not None:  # Cycles itself against the closed form (docs/references.md §5)
             ok = ok and abs(dd_centre / analytic - 1) < 0.003
         passed += ok
         failed += not ok
@@ -808,7 +808,7 @@ def suite_gather(lib, ctx, out_dir, report):
     return passed, failed
 
 
-# The product curve (GUIDE Sec. 6): error against time for the library's
+# The product curve (docs/references.md §6): error against time for the library's
 # settings next to Cycles at increasing samples per pixel, on the gather
 # room, against the same two-seed reference. A report, not a test.
 CURVE_SPP = [int(v) for v in os.environ.get("VSGL_CURVE_SPP", "1,4,16,64,256").split(",")]
@@ -890,7 +890,7 @@ def suite_curve(lib, ctx, out_dir, report):
     report.append("The gather room (spot 300 W + area 60 W, red/green walls, glossy floor, GGX metal block), "
                   "%dx%d px, one bounce. Reference: mean of two %d-spp Cycles renders (its own noise, "
                   "relMSE %.4f). relMSE of the coloured indirect light DiffInd*DiffCol + GlossInd*GlossCol "
-                  "(GUIDE Sec. 6). Cycles time: a whole `bpy.ops.render.render` of this scene (scene sync "
+                  "(docs/references.md §6). Cycles time: a whole `bpy.ops.render.render` of this scene (scene sync "
                   "included), seed 3; library time: the fastest of 3 `vsgl_render` calls (scene built once), "
                   "2 threads on a shared 2-core machine.\n" % (W, H, half, floor))
     report.append("| method | seconds | relMSE vs reference | VSGLs |")

@@ -60,7 +60,7 @@ static void free_rsm(hand_rsm *h)
     free(h->r.material);
 }
 
-/* The poster's sums (Sec. 2.1-2.2, errata GUIDE Sec. 3) in double. */
+/* The poster's sums (Sec. 2.1-2.2, errata docs/references.md §3) in double. */
 typedef struct ref_vsgl { double power[3], axis[3], sharpness, mean[3], variance; int present; } ref_vsgl;
 
 static void reference_two(const vsgl_scene *scene, const vsgl_rsm *r, int32_t est, ref_vsgl out[2])

@@ -1,5 +1,5 @@
 /* VPL lobes -> moment sums -> VSGL parameters (poster Sec. 2, FIS Sec. 3,
- * with the errata of GUIDE Sec. 3: the mean direction averages the
+ * with the errata of docs/references.md §3: the mean direction averages the
  * *filtered* directions). */
 #include "fit/vsgl_set.h"
 #include "scene/material.h"
@@ -157,7 +157,7 @@ int vsgl__moments_to_vsgl(const vsgl_moments *m, v3 origin, int32_t estimator,
     double mx = m->pos[0] * inv, my = m->pos[1] * inv, mz = m->pos[2] * inv;
     out->mean = v3_make((float)(origin.x + mx), (float)(origin.y + my), (float)(origin.z + mz));
     /* Positions of VPLs lie on surfaces: the spread is 2-D, so the variance
-     * per axis is half the total (GUIDE Sec. 4). Cancellation can make it
+     * per axis is half the total (docs/references.md §4). Cancellation can make it
      * slightly negative: clamp. */
     double var = (m->pos2 * inv - (mx * mx + my * my + mz * mz)) * 0.5;
     out->variance = var > 0.0 ? (float)var : 0.0f;

@@ -19,7 +19,7 @@
 
 #define TWO_PI 6.28318530717958647692f
 #define INV_PI 0.31830988618379067154f
-/* Variance floor relative to the squared receiver distance (GUIDE Sec. 4): 2^-41. */
+/* Variance floor relative to the squared receiver distance (docs/references.md §4): 2^-41. */
 #define VARIANCE_FLOOR 4.547473508864641e-13f
 
 int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
