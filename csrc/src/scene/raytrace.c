@@ -1,10 +1,10 @@
 /* Ray queries on a built scene (Embree 3) and surface attributes at hits. */
 #include "scene/scene_data.h"
+#include "math/constants.h"
 
 #include <math.h>
 #include <string.h>
 
-#define VSGL_TWO_PI_F 6.28318530717958647692f
 
 static void fill_ray(struct RTCRay *r, v3 org, v3 dir, float tmin, float tmax)
 {
@@ -190,7 +190,7 @@ void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, v
     float rot = scene->materials[mat].anisotropic_rotation;
     if (rot != 0.0f) {
         /* rotate about n by 2 pi rot, counter-clockwise (Rodrigues, t orthogonal to n) */
-        float a = VSGL_TWO_PI_F * rot;
+        float a = VSGL__2PI * rot;
         t = v3_normalize(v3_add(v3_scale(t, cosf(a)), v3_scale(v3_cross(n, t), sinf(a))));
     }
     out->tangent = t;

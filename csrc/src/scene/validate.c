@@ -4,6 +4,7 @@
  * (vertex_count 40)". Checks run in a fixed order: header, camera,
  * materials, lights, vertices, triangles. */
 #include "scene/scene_data.h"
+#include "math/constants.h"
 
 #include <math.h>
 #include <string.h>
@@ -12,7 +13,6 @@
 /* Largest accepted coordinate magnitude: keeps products of coordinates
  * (cross products, squared distances) finite in float. */
 #define VSGL_MAX_COORD 1e18f
-#define VSGL_PI_F 3.14159265358979323846f
 
 static int finite_f(float x) { return isfinite(x) != 0; }
 
@@ -149,16 +149,16 @@ vsgl_result vsgl__validate_light(vsgl_context *ctx, uint32_t index, const vsgl_l
     CHECK_FINITE(ctx, who, "size_y", l->size_y);
     CHECK_FINITE(ctx, who, "spread", l->spread);
     if (l->type == VSGL_LIGHT_SPOT) {
-        if (!(l->spot_size > 0.0f) || l->spot_size > VSGL_PI_F)
+        if (!(l->spot_size > 0.0f) || l->spot_size > VSGL__PI)
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: spot size is %g", who, (double)l->spot_size);
         CHECK_RANGE(ctx, who, "spot_blend", l->spot_blend, 0.0f, 1.0f);
     } else if (l->type == VSGL_LIGHT_SUN) {
-        CHECK_RANGE(ctx, who, "sun_angle", l->sun_angle, 0.0f, VSGL_PI_F);
+        CHECK_RANGE(ctx, who, "sun_angle", l->sun_angle, 0.0f, VSGL__PI);
     } else if (l->type == VSGL_LIGHT_AREA) {
         CHECK_POSITIVE(ctx, who, "size_x", l->size_x);
         if (l->area_shape == VSGL_AREA_RECTANGLE || l->area_shape == VSGL_AREA_ELLIPSE)
             CHECK_POSITIVE(ctx, who, "size_y", l->size_y);
-        if (!(l->spread > 0.0f) || l->spread > VSGL_PI_F)
+        if (!(l->spread > 0.0f) || l->spread > VSGL__PI)
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: spread is %g (must be in (0, pi])", who, (double)l->spread);
     }
     if (l->flags & ~VSGL_LIGHT_FLAGS_KNOWN)

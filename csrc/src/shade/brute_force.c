@@ -1,5 +1,6 @@
 /* Brute-force VPL gathering with the exact BRDF (see brute_force.h). */
 #include "shade/brute_force.h"
+#include "math/constants.h"
 
 #include "core/context.h"
 #include "core/parallel.h"
@@ -93,7 +94,7 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 if (j->visibility &&
                     vsgl__scene_occluded(j->scene, x, w, j->eps, dist * (1.0f - 1e-4f) - j->eps))
                     continue;
-                double inv = 1.0 / ((double)d2 + (double)q->area * (1.0 / 3.14159265358979323846));
+                double inv = 1.0 / ((double)d2 + (double)q->area * (1.0 / VSGL__PI_D));
                 for (int c = 0; c < 3; ++c) {
                     sd[c] += (double)e[c] * rd[c] * inv;
                     sg[c] += (double)e[c] * rg[c] * ms[c] * inv;

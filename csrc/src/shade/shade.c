@@ -3,6 +3,7 @@
  * receiver NDF as an ASG (or SG) convolved with the incident SG, with the
  * smooth Fresnel/shadowing factor at the integrand's lobe axis. */
 #include "shade/shade.h"
+#include "math/constants.h"
 #include "shade/kernel.h"
 #include "shade/shade_job.h"
 #include "core/context.h"
@@ -17,8 +18,6 @@
 #  include <xmmintrin.h>
 #endif
 
-#define TWO_PI 6.28318530717958647692f
-#define INV_PI 0.31830988618379067154f
 /* Variance floor relative to the squared receiver distance (docs/references.md §4): 2^-41. */
 #define VARIANCE_FLOOR 4.547473508864641e-13f
 
@@ -38,7 +37,7 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
     spread.log_amplitude = 0.0f;
     vsgl_sg_product(&light_lobe, &spread, sg);
     /* c_v / (2 pi var) with c_v = power / A(lambda_v); power applied by the caller */
-    sg->log_amplitude -= logf(TWO_PI * var) + logf(vsgl_sg_integral(v->sharpness));
+    sg->log_amplitude -= logf(VSGL__2PI * var) + logf(vsgl_sg_integral(v->sharpness));
     return 1;
 }
 
@@ -60,11 +59,11 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
     float w = s / (s + VSGL_CLIP_NEAR);
     /* the parallel clip in the near field only: far away the receiver's own cosine does it */
     float par = 1.0f - (1.0f - smoothstep01((1.0f - v3_dot(n, v->normal)) * (1.0f / VSGL_CLIP_PARALLEL))) * (1.0f - w);
-    float e = smoothstep01(h / (VSGL_CLIP_BEHIND * sqrtf(var) + 1e-30f)) * par;
+    float e = smoothstep01(h / (VSGL_CLIP_BEHIND * sqrtf(var) + VSGL__TINY)) * par;
     if (v->lobe == VSGL_LOBE_DIFFUSE) {
         float c = d2 > 0.0f ? clampf(h / sqrtf(d2), 0.0f, 1.0f) : 0.0f;
         float ld = vsgl_sg_cosine_sharpness();
-        float rho = vsgl_sg_integral(ld) * INV_PI * c * expf(ld * (1.0f - c));
+        float rho = vsgl_sg_integral(ld) * VSGL__INV_PI * c * expf(ld * (1.0f - c));
         e *= (1.0f - w) + w * rho;
     }
     return 1.0f - v->coherence * v->coherence * (1.0f - e);
@@ -97,7 +96,7 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
         return 0.0f;
     float q = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
     /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
-    return expf(lobe->log_amplitude - 0.5f * q) / (TWO_PI * sqrtf(fmaxf(det * lam * mu, 1e-30f)));
+    return expf(lobe->log_amplitude - 0.5f * q) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
 }
 
 static void setup_receiver(const shade_job *j, size_t i, receiver *r)
@@ -246,7 +245,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 if (!vsgl__vsgl_incident_sg(v, r.x, &in))
                     continue;
                 if (j->leak)
-                    in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), 1e-30f));
+                    in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), VSGL__TINY));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
                     float vis;
                     visibility_rays(j, ray_target(v), &r, 1, &vis);
@@ -254,7 +253,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                         continue;
                 }
                 if (has_diffuse) {
-                    float e_d = vsgl_sg_cosine_integral(&in, &r.n, j->s->diffuse_mode) * INV_PI;
+                    float e_d = vsgl_sg_cosine_integral(&in, &r.n, j->s->diffuse_mode) * VSGL__INV_PI;
                     for (int c = 0; c < 3; ++c)
                         ld[c] += v->power[c] * e_d;
                 }
@@ -588,12 +587,12 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
             o->ax = -v->axis.x; o->ay = -v->axis.y; o->az = -v->axis.z;
             o->lv = v->sharpness;
             o->lax = o->lv * o->ax; o->lay = o->lv * o->ay; o->laz = o->lv * o->az;
-            o->c0 = 1.0f / (TWO_PI * vsgl_sg_integral(v->sharpness));
+            o->c0 = 1.0f / (VSGL__2PI * vsgl_sg_integral(v->sharpness));
             o->pr = v->power[0]; o->pg = v->power[1]; o->pb = v->power[2];
             o->nx = v->normal.x; o->ny = v->normal.y; o->nz = v->normal.z;
             o->clip = leak ? v->coherence * v->coherence : 0.0f;
             o->conv = v->lobe == VSGL_LOBE_DIFFUSE ? 1.0f : 0.0f;
-            o->ibehind = 1.0f / (VSGL_CLIP_BEHIND * sqrtf(v->variance) + 1e-30f);
+            o->ibehind = 1.0f / (VSGL_CLIP_BEHIND * sqrtf(v->variance) + VSGL__TINY);
             o->planar = leak && v->lobe == VSGL_LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
             o->pvar = v->variance + v->widen;
             v3 u1, u2;
