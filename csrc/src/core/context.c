@@ -82,7 +82,7 @@ void vsgl__log(const vsgl_context *ctx, int32_t level, const char *fmt, ...)
 {
     if (!ctx || !ctx->log || level > ctx->log_level)
         return;
-    char line[VSGL_MESSAGE_MAX];
+    char line[VSGL__MESSAGE_MAX];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(line, sizeof line, fmt, ap);

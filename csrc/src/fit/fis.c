@@ -34,7 +34,7 @@ double *vsgl__importance_cdf(const vsgl_grid *g, size_t n)
     cdf[0] = 0.0;
     const float *d = g->level[0].data;
     for (size_t t = 0; t < n; ++t) {
-        double w = (double)d[t * VSGL_GRID_STRIDE] + (double)d[t * VSGL_GRID_STRIDE + VSGL_GRID_FIELDS];
+        double w = (double)d[t * VSGL__GRID_STRIDE] + (double)d[t * VSGL__GRID_STRIDE + VSGL__GRID_FIELDS];
         cdf[t + 1] = cdf[t] + (w > 0.0 ? w : 0.0);
     }
     return cdf;
@@ -56,7 +56,7 @@ size_t vsgl__find_texel(const double *cdf, size_t n, double target)
 static double mass_at(const vsgl_grid *g, uint32_t face, float x, float y, float l, double total, double *s)
 {
     vsgl__grid_sample(g, face, x, y, l, s);
-    return (s[0] + s[VSGL_GRID_FIELDS]) / total;
+    return (s[0] + s[VSGL__GRID_FIELDS]) / total;
 }
 
 static vsgl_result push_cluster(const double *s, double scale, const vsgl_grid *g, int32_t estimator,
@@ -64,7 +64,7 @@ static vsgl_result push_cluster(const double *s, double scale, const vsgl_grid *
 {
     for (uint32_t lobe = 0; lobe < 2; ++lobe) {
         vsgl_moments m, scaled;
-        vsgl__grid_moments(s + lobe * VSGL_GRID_FIELDS, &m);
+        vsgl__grid_moments(s + lobe * VSGL__GRID_FIELDS, &m);
         memset(&scaled, 0, sizeof scaled);
         vsgl__moments_add(&scaled, &m, scale);
         vsgl_vsgl v;
@@ -85,7 +85,7 @@ vsgl_result vsgl__fit_fis(vsgl_context *ctx, const vsgl_scene *scene, const vsgl
     vsgl_result r = vsgl__grid_build(ctx, scene, rsm, s->sharpness_estimator, n_clusters > 1, &g);
     if (r != VSGL_OK)
         return r;
-    double total = g.total[0] + g.total[VSGL_GRID_FIELDS];
+    double total = g.total[0] + g.total[VSGL__GRID_FIELDS];
     if (!(total > 0.0)) {
         vsgl__grid_free(&g);
         return VSGL_OK;
@@ -104,7 +104,7 @@ vsgl_result vsgl__fit_fis(vsgl_context *ctx, const vsgl_scene *scene, const vsgl
     double cdf_total = cdf[n];
     uint32_t iterations = s->fis_iterations ? s->fis_iterations : 8;
     double target = 1.0 / n_clusters; /* K / N with K = 1 */
-    double sums[VSGL_GRID_STRIDE];
+    double sums[VSGL__GRID_STRIDE];
     for (uint32_t i = 0; i < n_clusters && r == VSGL_OK; ++i) {
         double u = (i + vsgl__hash_uniform(s->seed, rsm->light, i, 0)) / n_clusters;
         size_t t = vsgl__find_texel(cdf, n, u * cdf_total);

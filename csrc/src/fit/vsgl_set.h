@@ -11,8 +11,8 @@
 #include "rsm/rsm.h"
 #include "vsgl/render.h"
 
-#define VSGL_LOBE_DIFFUSE  0
-#define VSGL_LOBE_SPECULAR 1
+#define VSGL__LOBE_DIFFUSE  0
+#define VSGL__LOBE_SPECULAR 1
 
 typedef struct vsgl_vsgl {
     v3 mean;            /* mean VPL position, world */

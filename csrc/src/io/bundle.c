@@ -865,7 +865,7 @@ vsgl_result vsgl_bundle_read(vsgl_context *ctx, const char *path, vsgl_bundle **
     free(buf);
     if (r && ctx) {
         /* Prefix the file name to the reader's message. */
-        char msg[VSGL_MESSAGE_MAX];
+        char msg[VSGL__MESSAGE_MAX];
         snprintf(msg, sizeof msg, "%s", vsgl_context_last_error(ctx));
         vsgl__fail(ctx, r, "%s: %s", path, msg);
     }

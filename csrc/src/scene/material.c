@@ -179,8 +179,8 @@ void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out
         return;
     const v3 n = v3_make(0.0f, 0.0f, 1.0f), t = v3_make(1.0f, 0.0f, 0.0f);
     const float ax = p->alpha_x, ay = p->alpha_y;
-    for (int k = 0; k < VSGL_ALBEDO_N; ++k) {
-        double ci = k == 0 ? 0.01 : (double)k / (VSGL_ALBEDO_N - 1);
+    for (int k = 0; k < VSGL__ALBEDO_N; ++k) {
+        double ci = k == 0 ? 0.01 : (double)k / (VSGL__ALBEDO_N - 1);
         double si = sqrt(fmax(0.0, 1.0 - ci * ci));
         double acc[3] = {0.0, 0.0, 0.0};
         for (int a = 0; a < S; ++a)
@@ -240,7 +240,7 @@ void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t)
     vsgl_brdf_params bw;
     vsgl__material_params(&w, &bw);
     vsgl__glossy_albedo_table(&bw, &white);
-    for (int k = 0; k < VSGL_ALBEDO_N; ++k)
+    for (int k = 0; k < VSGL__ALBEDO_N; ++k)
         t->diel[k] = clampf(tmp.a[k][0] / fmaxf(white.a[k][0], 1e-6f), 0.0f, 1.0f);
     /* 2 int (1 - diel) mu dmu over the piecewise-linear table, 64 midpoints */
     double acc = 0.0;
@@ -264,20 +264,20 @@ float vsgl__diffuse_view_weight(const vsgl_albedo_table *t, float cos_o)
 {
     if (!t)
         return 1.0f;
-    float x = clampf(cos_o, 0.0f, 1.0f) * (VSGL_ALBEDO_N - 1);
+    float x = clampf(cos_o, 0.0f, 1.0f) * (VSGL__ALBEDO_N - 1);
     int k = (int)x;
-    if (k >= VSGL_ALBEDO_N - 1)
-        return 1.0f - t->diel[VSGL_ALBEDO_N - 1];
+    if (k >= VSGL__ALBEDO_N - 1)
+        return 1.0f - t->diel[VSGL__ALBEDO_N - 1];
     float f = x - (float)k;
     return 1.0f - (t->diel[k] * (1.0f - f) + t->diel[k + 1] * f);
 }
 
 float vsgl__glossy_albedo(const vsgl_albedo_table *t, int channel, float cos_i)
 {
-    float x = clampf(cos_i, 0.0f, 1.0f) * (VSGL_ALBEDO_N - 1);
+    float x = clampf(cos_i, 0.0f, 1.0f) * (VSGL__ALBEDO_N - 1);
     int k = (int)x;
-    if (k >= VSGL_ALBEDO_N - 1)
-        return t->a[VSGL_ALBEDO_N - 1][channel];
+    if (k >= VSGL__ALBEDO_N - 1)
+        return t->a[VSGL__ALBEDO_N - 1][channel];
     float f = x - (float)k;
     return t->a[k][channel] * (1.0f - f) + t->a[k + 1][channel] * f;
 }

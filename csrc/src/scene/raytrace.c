@@ -82,7 +82,7 @@ void vsgl__scene_intersect_many(const vsgl_scene *scene, uint32_t n, const v3 *o
             vsgl_hit *h = &hits[b + i];
             if (rh[i].hit.geomID == RTC_INVALID_GEOMETRY_ID) {
                 h->t = INFINITY;
-                h->triangle = VSGL_HIT_NONE;
+                h->triangle = VSGL__HIT_NONE;
                 h->u = h->v = 0.0f;
             } else {
                 h->t = rh[i].ray.tfar;

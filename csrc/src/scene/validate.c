@@ -12,7 +12,7 @@
 
 /* Largest accepted coordinate magnitude: keeps products of coordinates
  * (cross products, squared distances) finite in float. */
-#define VSGL_MAX_COORD 1e18f
+#define VSGL__MAX_COORD 1e18f
 
 static int finite_f(float x) { return isfinite(x) != 0; }
 
@@ -21,7 +21,7 @@ const char *vsgl__matrix_problem(const float m[12])
     for (int i = 0; i < 12; ++i) {
         if (!finite_f(m[i]))
             return "is not finite";
-        if (fabsf(m[i]) > VSGL_MAX_COORD)
+        if (fabsf(m[i]) > VSGL__MAX_COORD)
             return "has an element above 1e18";
     }
     /* determinant of the 3x3 part, relative to the product of column lengths */
@@ -61,7 +61,7 @@ const char *vsgl__matrix_problem(const float m[12])
 #define CHECK_FINITE(ctx, who, field, value)                                              \
     do {                                                                                  \
         float v_ = (value);                                                               \
-        if (!finite_f(v_) || fabsf(v_) > VSGL_MAX_COORD)                                  \
+        if (!finite_f(v_) || fabsf(v_) > VSGL__MAX_COORD)                                  \
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT,                           \
                               "%s: %s is %g (must be finite, |x| <= 1e18)", who, field,   \
                               (double)v_);                                                \
@@ -199,7 +199,7 @@ static vsgl_result validate_slot(vsgl_context *ctx, uint32_t m, const char *name
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: %s channel is %d (must be 0..3)", (unsigned)m,
                           name, (int)s->channel);
     for (int k = 0; k < 6; ++k)
-        if (!finite_f(s->uv_transform[k]) || fabsf(s->uv_transform[k]) > VSGL_MAX_COORD)
+        if (!finite_f(s->uv_transform[k]) || fabsf(s->uv_transform[k]) > VSGL__MAX_COORD)
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: %s uv_transform[%d] is %g (must be finite)",
                               (unsigned)m, name, k, (double)s->uv_transform[k]);
     return VSGL_OK;
@@ -225,7 +225,7 @@ static vsgl_result validate_textures(vsgl_context *ctx, const vsgl_scene_desc *d
                               (unsigned)t->reserved);
         size_t n = (size_t)t->width * t->height * 4;
         for (size_t k = 0; k < n; ++k)
-            if (!finite_f(t->pixels[k]) || fabsf(t->pixels[k]) > VSGL_MAX_COORD)
+            if (!finite_f(t->pixels[k]) || fabsf(t->pixels[k]) > VSGL__MAX_COORD)
                 return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "texture %u: texel (%zu, %zu) channel %zu is %g (must be finite)",
                                   (unsigned)i, (k / 4) % t->width, (k / 4) / t->width, k % 4, (double)t->pixels[k]);
     }
@@ -245,7 +245,7 @@ static vsgl_result validate_textures(vsgl_context *ctx, const vsgl_scene_desc *d
         }
     if (d->corner_colors)
         for (size_t k = 0; k < (size_t)d->triangle_count * 9; ++k)
-            if (!finite_f(d->corner_colors[k]) || fabsf(d->corner_colors[k]) > VSGL_MAX_COORD)
+            if (!finite_f(d->corner_colors[k]) || fabsf(d->corner_colors[k]) > VSGL__MAX_COORD)
                 return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "triangle %zu: corner %zu colour channel %zu is %g (must be finite)",
                                   k / 9, (k % 9) / 3, k % 3, (double)d->corner_colors[k]);
     return VSGL_OK;
@@ -284,7 +284,7 @@ vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *
     for (uint32_t i = 0; i < d->vertex_count; ++i)
         for (int k = 0; k < 3; ++k) {
             float v = d->positions[(size_t)i * 3 + k];
-            if (!finite_f(v) || fabsf(v) > VSGL_MAX_COORD)
+            if (!finite_f(v) || fabsf(v) > VSGL__MAX_COORD)
                 return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vertex %u: %c is %g (must be finite, |x| <= 1e18)",
                                   (unsigned)i, axis[k], (double)v);
         }
@@ -310,14 +310,14 @@ vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *
         if (d->corner_uvs)
             for (int k = 0; k < 6; ++k) {
                 float u = d->corner_uvs[(size_t)t * 6 + k];
-                if (!finite_f(u) || fabsf(u) > VSGL_MAX_COORD)
+                if (!finite_f(u) || fabsf(u) > VSGL__MAX_COORD)
                     return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "triangle %u: corner %d uv %c is %g (must be finite)",
                                       (unsigned)t, k / 2, k % 2 ? 'v' : 'u', (double)u);
             }
         if (d->corner_tangents)
             for (int k = 0; k < 12; ++k) {
                 float u = d->corner_tangents[(size_t)t * 12 + k];
-                if (!finite_f(u) || fabsf(u) > VSGL_MAX_COORD)
+                if (!finite_f(u) || fabsf(u) > VSGL__MAX_COORD)
                     return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "triangle %u: corner %d tangent component %d is %g (must be finite)",
                                       (unsigned)t, k / 4, k % 4, (double)u);
             }

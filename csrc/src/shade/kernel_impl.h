@@ -209,18 +209,18 @@ static inline __attribute__((always_inline)) float k_sg_integral(float l)
  * loops keep it busy (the ASG lobe alone: 2.9 -> 2.4 ns per pair when split
  * in two stages; docs/performance.md has the whole history). */
 typedef struct k_scratch {
-    float mx[VSGL_KERNEL_BLOCK], my[VSGL_KERNEL_BLOCK], mz[VSGL_KERNEL_BLOCK]; /* lin times the incident axis */
-    float lin[VSGL_KERNEL_BLOCK], ilin[VSGL_KERNEL_BLOCK];                    /* its sharpness and 1/it */
-    float amp[VSGL_KERNEL_BLOCK];                                             /* its amplitude */
-    float expo[VSGL_KERNEL_BLOCK];                                            /* an exp's argument */
-    float gpre[VSGL_KERNEL_BLOCK];                                            /* the glossy integral's factor */
-    float r[VSGL_KERNEL_BLOCK], d2[VSGL_KERNEL_BLOCK], ls[VSGL_KERNEL_BLOCK];
+    float mx[VSGL__KERNEL_BLOCK], my[VSGL__KERNEL_BLOCK], mz[VSGL__KERNEL_BLOCK]; /* lin times the incident axis */
+    float lin[VSGL__KERNEL_BLOCK], ilin[VSGL__KERNEL_BLOCK];                    /* its sharpness and 1/it */
+    float amp[VSGL__KERNEL_BLOCK];                                             /* its amplitude */
+    float expo[VSGL__KERNEL_BLOCK];                                            /* an exp's argument */
+    float gpre[VSGL__KERNEL_BLOCK];                                            /* the glossy integral's factor */
+    float r[VSGL__KERNEL_BLOCK], d2[VSGL__KERNEL_BLOCK], ls[VSGL__KERNEL_BLOCK];
     /* the accurate cosine's part that depends on lin alone (k_cos_l) */
-    float low[VSGL_KERNEL_BLOCK], u[VSGL_KERNEL_BLOCK], t[VSGL_KERNEL_BLOCK], it[VSGL_KERNEL_BLOCK];
-    float h[VSGL_KERNEL_BLOCK];                                               /* height above the cluster's plane */
-    float vis[VSGL_KERNEL_BLOCK];                                             /* visibility x validity */
-    float pexpo[VSGL_KERNEL_BLOCK], ppre[VSGL_KERNEL_BLOCK];                  /* the planar glossy's exp argument, factor */
-    float kappa[VSGL_KERNEL_BLOCK], ct[VSGL_KERNEL_BLOCK];
+    float low[VSGL__KERNEL_BLOCK], u[VSGL__KERNEL_BLOCK], t[VSGL__KERNEL_BLOCK], it[VSGL__KERNEL_BLOCK];
+    float h[VSGL__KERNEL_BLOCK];                                               /* height above the cluster's plane */
+    float vis[VSGL__KERNEL_BLOCK];                                             /* visibility x validity */
+    float pexpo[VSGL__KERNEL_BLOCK], ppre[VSGL__KERNEL_BLOCK];                  /* the planar glossy's exp argument, factor */
+    float kappa[VSGL__KERNEL_BLOCK], ct[VSGL__KERNEL_BLOCK];
 } k_scratch;
 
 /* Stage 1: the incident radiance as one SG (Eq. 7), all but the exp.
@@ -246,13 +246,13 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
     t->h[i] = h;
     float sb = h * L->ibehind;
     sb = sb < 0.0f ? 0.0f : (sb > 1.0f ? 1.0f : sb);
-    float sp = (1.0f - (b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz)) * (1.0f / VSGL_CLIP_PARALLEL);
+    float sp = (1.0f - (b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz)) * (1.0f / VSGL__CLIP_PARALLEL);
     sp = sp > 1.0f ? 1.0f : sp;
     float c = h * r;
     c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
     float rho = K_CLIP_RHO * c * k_exp(VSGL__COSINE_SHARPNESS * (1.0f - c));
     float s = d2 * L->ivar;
-    float wn = s / (s + VSGL_CLIP_NEAR), w = wn * L->conv;
+    float wn = s / (s + VSGL__CLIP_NEAR), w = wn * L->conv;
     /* the parallel clip in the near field only: far away the receiver's own cosine does it */
     float par = 1.0f - (1.0f - sp * sp * (3.0f - 2.0f * sp)) * (1.0f - wn);
     float e = sb * sb * (3.0f - 2.0f * sb) * par * ((1.0f - w) + w * rho);
@@ -444,7 +444,7 @@ k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
  * two independent chains, which the core overlaps. Sums are added in VSGL
  * order, as one VSGL at a time would. */
 #define K_FORN(STMT)                                   \
-    for (size_t i = 0; i < VSGL_KERNEL_BLOCK; ++i) \
+    for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) \
         for (int j = 0; j < NL; ++j)                   \
             STMT
 
@@ -456,13 +456,13 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
     const float ld_sharp = VSGL__COSINE_SHARPNESS;
     const float ld_norm = VSGL__PI / k_sg_integral(VSGL__COSINE_SHARPNESS);
     if (visibility)
-        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL_KERNEL_BLOCK + i], t + j));
+        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j));
     else
         K_FORN(k_geometry(b, i, L + j, 1.0f, t + j));
     K_FORN(k_axis(b, i, L + j, t + j));
     K_FORN(k_exponent(b, i, L + j, t + j));
     K_FORN(k_amplitude(i, t + j));
-    if (lobes & VSGL_KERNEL_DIFFUSE) {
+    if (lobes & VSGL__KERNEL_DIFFUSE) {
         /* blocks where every incident lobe is sharp take short forms */
         float lmin = K_SHARP_MAX;
         K_FORN(lmin = t[j].lin[i] < lmin ? t[j].lin[i] : lmin);
@@ -488,18 +488,18 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         }
 #undef K_DIFFUSE
     }
-    if (lobes & VSGL_KERNEL_GLOSSY) {
+    if (lobes & VSGL__KERNEL_GLOSSY) {
         /* the SG model, the planar one (coherent diffuse clusters) or a blend */
         int all_planar = 1, none_planar = 1;
         for (int j = 0; j < NL; ++j) {
             all_planar &= L[j].planar == 1.0f;
             none_planar &= L[j].planar == 0.0f;
         }
-        /* one ASG, or GGX's core and tail as two (kernel.h, VSGL_KERNEL_GGX_TAIL) */
-        const int two = (lobes & VSGL_KERNEL_GGX_TAIL) != 0;
+        /* one ASG, or GGX's core and tail as two (kernel.h, VSGL__KERNEL_GGX_TAIL) */
+        const int two = (lobes & VSGL__KERNEL_GGX_TAIL) != 0;
         for (int q = 0; q < 1 + two; ++q) {
-            const float kb = two ? (q ? VSGL_GGX_TAIL_K : VSGL_GGX_CORE_K) : 1.0f;
-            const float kc = two ? (q ? VSGL_GGX_TAIL_C : VSGL_GGX_CORE_C) : 1.0f;
+            const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
+            const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
             const int sg_only = none_planar;
             if (!all_planar)
                 K_FORN(k_glossy(b, i, t + j, kb, kc));
@@ -524,10 +524,10 @@ KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_li
     for (; v + 2 <= count; v += 2) {
         local[0] = lights[v];
         local[1] = lights[v + 1];
-        k_shade(b, local, 2, visibility ? visibility + v * VSGL_KERNEL_BLOCK : NULL, mode, lobes, t);
+        k_shade(b, local, 2, visibility ? visibility + v * VSGL__KERNEL_BLOCK : NULL, mode, lobes, t);
     }
     if (v < count) {
         local[0] = lights[v];
-        k_shade(b, local, 1, visibility ? visibility + v * VSGL_KERNEL_BLOCK : NULL, mode, lobes, t);
+        k_shade(b, local, 1, visibility ? visibility + v * VSGL__KERNEL_BLOCK : NULL, mode, lobes, t);
     }
 }

@@ -74,7 +74,7 @@ vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const v
             return r;
         size_t spec = 0;
         for (size_t k = before; k < set->count; ++k)
-            spec += set->items[k].lobe == VSGL_LOBE_SPECULAR;
+            spec += set->items[k].lobe == VSGL__LOBE_SPECULAR;
         if (spec == 0)
             note_skip(ctx, st, "light %u: no glossy surface it lights: specular VSGLs skipped", l);
         if (set->count == before) {
@@ -146,7 +146,7 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
             for (size_t p = 0; p < pixels; ++p) {
                 size_t hits = 0;
                 for (size_t k = 0; k < g->spp; ++k)
-                    hits += g->material[p * g->spp + k] != VSGL_GBUFFER_MISS;
+                    hits += g->material[p * g->spp + k] != VSGL__GBUFFER_MISS;
                 planes->coverage[p] = (float)hits / (float)g->spp;
             }
             for (uint32_t k = 0; k < used; ++k)
@@ -287,7 +287,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
         if (r == VSGL_OK) {
             t0 = now_seconds();
             vsgl__progress_window(ctx, 0.4f, 0.6f);
-            r = vsgl__shade(ctx, scene, gb, vs, &s, &planes, VSGL_SHADE_KERNEL, &st.shading_pairs);
+            r = vsgl__shade(ctx, scene, gb, vs, &s, &planes, VSGL__SHADE_KERNEL, &st.shading_pairs);
             st.seconds_shade = now_seconds() - t0;
         }
     }
