@@ -15,7 +15,7 @@ struct vsgl_context {
     void *progress_user;
     char last_error[VSGL__MESSAGE_MAX];
     float progress_base, progress_span; /* stage window of the overall progress */
-    uint64_t max_memory;    /* 0 = what the machine has available (shade/memory.c) */
+    uint64_t max_memory;    /* 0 = what the machine has available (render/memory.c) */
 };
 
 #if defined(__GNUC__)

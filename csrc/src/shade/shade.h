@@ -51,7 +51,7 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
  *    near field by w = s / (s + 4), s = |x - mean|^2 / var (the spread's
  *    sharpness), where the SG product is the better model.
  * docs/accuracy.md measures it against a planar emitter's exact irradiance. */
-/* (VSGL_CLIP_* in shade/kernel.h) */
+/* (VSGL__CLIP_* in shade/kernel.h) */
 
 /* The clip factor of VSGL v for a receiver at x with unit normal n, in [0, 1]
  * (the kernel computes the same inline); `on` selects the clip. */

@@ -1,5 +1,5 @@
 /* Render settings: presets, defaults for zero fields, validation. */
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
 #include "core/context.h"
 
 #include <string.h>

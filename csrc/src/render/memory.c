@@ -6,7 +6,7 @@
  * fit/grid.c, fit/kmeans.c, fit/fis.c, shade.c, brute_force.c, render.c);
  * tests/cli/run_cli.sh compares the estimate with the peak RSS of real
  * renders. */
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
 #include "shade/kernel.h"
 #include "fit/grid.h"
 #include "fit/vsgl_set.h"

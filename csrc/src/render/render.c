@@ -1,7 +1,7 @@
 /* vsgl_render: G-buffer -> per-light RSM -> VSGL fit -> shading -> planes.
  * Lights that contribute nothing are skipped and reported; outputs are
  * written only when everything succeeded. */
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
 #include "shade/shade.h"
 #include "shade/brute_force.h"
 #include "core/context.h"
@@ -226,7 +226,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     vsgl_result r = vsgl__settings_resolve(ctx, settings, &s);
     if (r == VSGL_OK)
         r = check_output(ctx, scene, out);
-    if (r == VSGL_OK) { /* refuse what cannot fit before allocating (shade/memory.c) */
+    if (r == VSGL_OK) { /* refuse what cannot fit before allocating (render/memory.c) */
         const float *const rgb[7] = {out->diffuse_light, out->glossy_light, out->diffuse_color, out->glossy_color,
                                      out->diffuse, out->glossy, out->combined};
         uint64_t floats = out->alpha ? 1u : 0u;
