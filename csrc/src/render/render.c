@@ -34,33 +34,52 @@ static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt,
         snprintf(st->skipped + used, sizeof st->skipped - used, "%s\n", line);
 }
 
+/* The RSM of light `l`, or a noted skip: *lit = 0 when the light has no
+ * power or its RSM is empty (then `rsm` holds nothing to free). The
+ * progress window of the step is [p0, p0 + dp). */
+static vsgl_result light_rsm(vsgl_context *ctx, const vsgl_scene *scene, uint32_t l, uint32_t resolution,
+                             float p0, float dp, vsgl_rsm *rsm, int *lit, vsgl_render_stats *st)
+{
+    uint32_t light_count = 0;
+    const vsgl_light *L = &vsgl__scene_lights(scene, &light_count)[l];
+    *lit = 0;
+    memset(rsm, 0, sizeof *rsm);
+    if (!(L->power * (L->color[0] + L->color[1] + L->color[2]) > 0.0f)) {
+        note_skip(ctx, st, "light %u: zero power or black colour", l);
+        ++st->lights_skipped;
+        return VSGL_OK;
+    }
+    double t0 = now_seconds();
+    vsgl__progress_window(ctx, p0, dp);
+    vsgl_result r = vsgl__rsm_build(ctx, scene, l, resolution, rsm);
+    st->seconds_rsm += now_seconds() - t0;
+    if (r != VSGL_OK)
+        return r;
+    if (!(rsm->total_flux[0] + rsm->total_flux[1] + rsm->total_flux[2] > 0.0)) {
+        note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
+        ++st->lights_skipped;
+        vsgl__rsm_free(rsm);
+        return VSGL_OK;
+    }
+    *lit = 1;
+    return VSGL_OK;
+}
+
 vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                              vsgl_vsgl_set *set, vsgl_render_stats *st)
 {
     uint32_t light_count = 0;
-    const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
+    (void)vsgl__scene_lights(scene, &light_count);
     for (uint32_t l = 0; l < light_count; ++l) {
-        const vsgl_light *L = &lights[l];
-        float emitted = L->power * (L->color[0] + L->color[1] + L->color[2]);
-        if (!(emitted > 0.0f)) {
-            note_skip(ctx, st, "light %u: zero power or black colour", l);
-            ++st->lights_skipped;
-            continue;
-        }
-        double t0 = now_seconds();
         vsgl_rsm rsm;
-        vsgl__progress_window(ctx, 0.1f + 0.3f * (float)l / (float)light_count, 0.3f / (float)light_count);
-        vsgl_result r = vsgl__rsm_build(ctx, scene, l, s->rsm_resolution, &rsm);
-        st->seconds_rsm += now_seconds() - t0;
+        int lit;
+        vsgl_result r = light_rsm(ctx, scene, l, s->rsm_resolution, 0.1f + 0.3f * (float)l / (float)light_count,
+                                  0.3f / (float)light_count, &rsm, &lit, st);
         if (r != VSGL_OK)
             return r;
-        if (!(rsm.total_flux[0] + rsm.total_flux[1] + rsm.total_flux[2] > 0.0)) {
-            note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
-            ++st->lights_skipped;
-            vsgl__rsm_free(&rsm);
+        if (!lit)
             continue;
-        }
-        t0 = now_seconds();
+        double t0 = now_seconds();
         size_t before = set->count;
         switch (s->fit_mode) {
         case VSGL_FIT_FIS: r = vsgl__fit_fis(ctx, scene, &rsm, s, set); break;
@@ -96,7 +115,7 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
                                const vsgl_gbuffer *g, const vsgl_pixel_planes *planes, vsgl_render_stats *st)
 {
     uint32_t light_count = 0;
-    const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
+    (void)vsgl__scene_lights(scene, &light_count);
     vsgl_rsm *rsms = calloc(light_count + 1, sizeof *rsms);
     float *sample = calloc(g->count * 12 + 1, sizeof(float));
     uint32_t used = 0;
@@ -106,27 +125,13 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
         goto done;
     }
     for (uint32_t l = 0; l < light_count && r == VSGL_OK; ++l) {
-        const vsgl_light *L = &lights[l];
-        if (!(L->power * (L->color[0] + L->color[1] + L->color[2]) > 0.0f)) {
-            note_skip(ctx, st, "light %u: zero power or black colour", l);
-            ++st->lights_skipped;
-            continue;
+        int lit;
+        r = light_rsm(ctx, scene, l, s->rsm_resolution, 0.1f + 0.2f * (float)l / (float)light_count,
+                      0.2f / (float)light_count, &rsms[used], &lit, st);
+        if (r == VSGL_OK && lit) {
+            ++used;
+            ++st->lights_used;
         }
-        double t0 = now_seconds();
-        vsgl__progress_window(ctx, 0.1f + 0.2f * (float)l / (float)light_count, 0.2f / (float)light_count);
-        r = vsgl__rsm_build(ctx, scene, l, s->rsm_resolution, &rsms[used]);
-        st->seconds_rsm += now_seconds() - t0;
-        if (r != VSGL_OK)
-            break;
-        const vsgl_rsm *m = &rsms[used];
-        if (!(m->total_flux[0] + m->total_flux[1] + m->total_flux[2] > 0.0)) {
-            note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
-            ++st->lights_skipped;
-            vsgl__rsm_free(&rsms[used]);
-            continue;
-        }
-        ++used;
-        ++st->lights_used;
     }
     if (r == VSGL_OK) {
         double t0 = now_seconds();
