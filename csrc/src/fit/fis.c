@@ -53,6 +53,18 @@ size_t vsgl__find_texel(const double *cdf, size_t n, double target)
     return lo < n ? lo : n - 1;
 }
 
+size_t vsgl__stratified_texel(const vsgl_grid *g, const double *cdf, size_t n, uint32_t seed, uint32_t light,
+                              uint32_t i, uint32_t count, uint32_t *face, uint32_t *x, uint32_t *y)
+{
+    double u = (i + vsgl__hash_uniform(seed, light, i, 0)) / count;
+    size_t t = vsgl__find_texel(cdf, n, u * cdf[n]);
+    size_t per_face = (size_t)g->res * g->res, rem = t % per_face;
+    *face = (uint32_t)(t / per_face);
+    *x = (uint32_t)(rem % g->res);
+    *y = (uint32_t)(rem / g->res);
+    return t;
+}
+
 static double mass_at(const vsgl_grid *g, uint32_t face, float x, float y, float l, double total, double *s)
 {
     vsgl__grid_sample(g, face, x, y, l, s);
@@ -101,17 +113,14 @@ vsgl_result vsgl__fit_fis(vsgl_context *ctx, const vsgl_scene *scene, const vsgl
         vsgl__grid_free(&g);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "fit: out of memory for the importance table");
     }
-    double cdf_total = cdf[n];
     uint32_t iterations = s->fis_iterations ? s->fis_iterations : 8;
     double target = 1.0 / n_clusters; /* K / N with K = 1 */
     double sums[VSGL__GRID_STRIDE];
     for (uint32_t i = 0; i < n_clusters && r == VSGL_OK; ++i) {
-        double u = (i + vsgl__hash_uniform(s->seed, rsm->light, i, 0)) / n_clusters;
-        size_t t = vsgl__find_texel(cdf, n, u * cdf_total);
-        uint32_t face = (uint32_t)(t / ((size_t)g.res * g.res));
-        size_t rem = t % ((size_t)g.res * g.res);
-        float x = (float)(rem % g.res) + vsgl__hash_uniform(s->seed, rsm->light, i, 1);
-        float y = (float)(rem / g.res) + vsgl__hash_uniform(s->seed, rsm->light, i, 2);
+        uint32_t face, tx, ty;
+        (void)vsgl__stratified_texel(&g, cdf, n, s->seed, rsm->light, i, n_clusters, &face, &tx, &ty);
+        float x = (float)tx + vsgl__hash_uniform(s->seed, rsm->light, i, 1);
+        float y = (float)ty + vsgl__hash_uniform(s->seed, rsm->light, i, 2);
         float lmin = 0.0f, lmax = (float)(g.levels - 1);
         for (uint32_t k = 0; k < iterations; ++k) {
             float l = 0.5f * (lmin + lmax);

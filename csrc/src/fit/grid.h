@@ -45,4 +45,11 @@ double *vsgl__importance_cdf(const vsgl_grid *g, size_t n);
 /* The texel t with cdf[t] <= target < cdf[t + 1]. */
 size_t vsgl__find_texel(const double *cdf, size_t n, double target);
 
+/* Stratified importance sampling of level-0 texels: sample i of `count`
+ * (u = (i + hash) / count through the CDF) for (seed, light); returns the
+ * texel index and its face and integer texel coordinates. FIS and k-means
+ * seed their clusters with it. */
+size_t vsgl__stratified_texel(const vsgl_grid *g, const double *cdf, size_t n, uint32_t seed, uint32_t light,
+                              uint32_t i, uint32_t count, uint32_t *face, uint32_t *x, uint32_t *y);
+
 #endif

@@ -83,12 +83,10 @@ vsgl_result vsgl__fit_kmeans(vsgl_context *ctx, const vsgl_scene *scene, const v
     if (!(cdf[n] > 0.0))
         goto done;
     for (uint32_t i = 0; i < n_clusters; ++i) {
-        double u = (i + vsgl__hash_uniform(s->seed, rsm->light, i, 0)) / n_clusters;
-        size_t t = vsgl__find_texel(cdf, n, u * cdf[n]);
-        c[i].face = (uint32_t)(t / ((size_t)g.res * g.res));
-        size_t rem = t % ((size_t)g.res * g.res);
-        c[i].x = (float)(rem % g.res) + 0.5f;
-        c[i].y = (float)(rem / g.res) + 0.5f;
+        uint32_t tx, ty;
+        size_t t = vsgl__stratified_texel(&g, cdf, n, s->seed, rsm->light, i, n_clusters, &c[i].face, &tx, &ty);
+        c[i].x = (float)tx + 0.5f;
+        c[i].y = (float)ty + 0.5f;
         /* the texel's mean position from its moments */
         const float *m = g.level[0].data + t * VSGL__GRID_STRIDE;
         double w = (double)m[0] + m[VSGL__GRID_FIELDS];
