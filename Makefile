@@ -45,7 +45,7 @@ deps:
 
 $(BUILD)/obj/%.o: %.c $(HEADERS) | deps
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_COMMON) $(OPT) -MMD -c $< -o $@
+	$(CC) $(CFLAGS_COMMON) $(OPT) -MMD -MP -c $< -o $@
 
 # RPATH (not RUNPATH: it also applies to the dependencies' own dependencies,
 # e.g. embree -> tbb) $ORIGIN: the add-on zip ships libembree3, libOpenEXRCore
@@ -91,7 +91,7 @@ test-python: $(BUILD)/libvsgl.so
 ASAN_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
 $(BUILD)/asan/%.o: %.c $(HEADERS)
 	@mkdir -p $(dir $@)
-	clang $(CFLAGS_COMMON) $(ASAN_FLAGS) -MMD -c $< -o $@
+	clang $(CFLAGS_COMMON) $(ASAN_FLAGS) -MMD -MP -c $< -o $@
 
 $(BUILD)/asan/vsgl_tests: $(ASAN_TEST_OBJ) $(ASAN_LIB_OBJ)
 	clang $(ASAN_FLAGS) -o $@ $^ $(LDLIBS)

@@ -222,7 +222,7 @@ static const bad_case bad_cases[] = {
     {"materials NULL", m_materials_null, "scene: materials is NULL but material_count is 2"},
     {"lights NULL", m_lights_null, "scene: lights is NULL but light_count is 2"},
     {"camera NULL", m_camera_null, "scene: camera is NULL (a camera is required)"},
-    {"desc size", m_size, "scene: desc size is 7 (this library expects " /* prefix */},
+    {"desc size", m_size, "vsgl_scene_desc.size is 7: this library knows multiples of 4" /* prefix */},
     {"no material", m_no_material, "scene: material_count is 0 but triangle_count is 4 (need >= 1 material)"},
     {"no vertices", m_no_vertices, "scene: vertex_count is 0 but triangle_count is 4"},
     {"vertex NaN", m_vertex_nan, "vertex 3: y is nan (must be finite, |x| <= 1e18)"},

@@ -313,8 +313,8 @@ vsgl_result vsgl_scene_create(vsgl_context *ctx, const vsgl_scene_desc *caller_d
     *out = NULL;
     if (!caller_desc)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: desc is NULL");
-    if (caller_desc->size != 0 && caller_desc->size != sizeof(vsgl_scene_desc) &&
-        caller_desc->size != VSGL_SCENE_DESC_SIZE_0_1)
+    if (caller_desc->size > sizeof(vsgl_scene_desc) ||
+        (caller_desc->size && (caller_desc->size < sizeof caller_desc->size || caller_desc->size % 4 != 0)))
         return vsgl__validate_scene_desc(ctx, caller_desc); /* names the size */
     vsgl_scene_desc full;
     vsgl__scene_desc_normalise(caller_desc, &full);

@@ -4,6 +4,7 @@
  * (vertex_count 40)". Checks run in a fixed order: header, camera,
  * materials, lights, vertices, triangles. */
 #include "scene/scene_data.h"
+#include "core/versioned.h"
 #include "math/constants.h"
 
 #include <math.h>
@@ -176,9 +177,11 @@ static vsgl_result need_array(vsgl_context *ctx, const void *p, uint32_t count, 
 
 void vsgl__scene_desc_normalise(const vsgl_scene_desc *in, vsgl_scene_desc *out)
 {
-    memset(out, 0, sizeof *out);
-    size_t n = in->size == VSGL_SCENE_DESC_SIZE_0_1 ? VSGL_SCENE_DESC_SIZE_0_1 : sizeof *out;
-    memcpy(out, in, n);
+    /* an older, shorter desc (e.g. VSGL_SCENE_DESC_SIZE_0_1) gets zero
+     * (absent) new fields; a size the library cannot read gives an empty
+     * desc, which validation refuses */
+    if (vsgl__copy_versioned(NULL, out, sizeof *out, in, "vsgl_scene_desc") != VSGL_OK)
+        memset(out, 0, sizeof *out);
 }
 
 static vsgl_result validate_slot(vsgl_context *ctx, uint32_t m, const char *name, const vsgl_texture_slot *s,
@@ -254,9 +257,11 @@ static vsgl_result validate_textures(vsgl_context *ctx, const vsgl_scene_desc *d
 vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *d)
 {
     vsgl_result r;
-    if (d->size != 0 && d->size != sizeof(vsgl_scene_desc) && d->size != VSGL_SCENE_DESC_SIZE_0_1)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: desc size is %u (this library expects %u, %u or 0)",
-                          (unsigned)d->size, (unsigned)sizeof(vsgl_scene_desc), (unsigned)VSGL_SCENE_DESC_SIZE_0_1);
+    if (d->size > sizeof(vsgl_scene_desc) || (d->size != 0 && (d->size < sizeof d->size || d->size % 4 != 0)))
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT,
+                          "vsgl_scene_desc.size is %u: this library knows multiples of 4 from %zu to %zu (0 = %zu; %u is 0.1's)",
+                          (unsigned)d->size, sizeof d->size, sizeof(vsgl_scene_desc), sizeof(vsgl_scene_desc),
+                          (unsigned)VSGL_SCENE_DESC_SIZE_0_1);
     if ((r = need_array(ctx, d->positions, d->vertex_count, "positions", "vertex_count")) != VSGL_OK ||
         (r = need_array(ctx, d->indices, d->triangle_count, "indices", "triangle_count")) != VSGL_OK ||
         (r = need_array(ctx, d->materials, d->material_count, "materials", "material_count")) != VSGL_OK ||
