@@ -37,11 +37,6 @@ def require(lib, *names):
     assert not missing, "libvsgl does not export: %s" % ", ".join(missing)
 
 
-def require_complete(lib):
-    """The library must have no undefined vsgl_ references."""
-    assert not lib.undefined, "libvsgl has undefined references: %s" % ", ".join(lib.undefined)
-
-
 @pytest.fixture
 def rng(request):
     """A generator seeded from the test's name: reproducible and independent."""
