@@ -27,7 +27,7 @@ TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/obj/%.o)
 ASAN_LIB_OBJ  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 ASAN_TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/asan/%.o)
 
-.PHONY: all help deps test test-c test-python test-blender asan demo bench clean headers-cxx check-exports
+.PHONY: all help deps test test-c test-python test-blender asan demo bench lint clean headers-cxx check-exports
 
 all: $(BUILD)/libvsgl.so check-exports headers-cxx $(if $(CLI_SRC),$(BUILD)/vsgl)
 
@@ -37,13 +37,15 @@ help:
 	@echo "make test       every test suite; ends with 'N passed, N failed'"
 	@echo "make asan       C tests under AddressSanitizer + UBSan (clang)"
 	@echo "make bench      speed/memory benchmarks, reported as ratios"
+	@echo "make screenshots  the add-on's panels in Blender's UI under Xvfb -> docs/img/"
+	@echo "make lint       flake8 (setup.cfg) and cppcheck over the sources"
 
 deps:
 	@tools/deps.sh build
 
 $(BUILD)/obj/%.o: %.c $(HEADERS) | deps
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_COMMON) $(OPT) -MMD -c $< -o $@
+	$(CC) $(CFLAGS_COMMON) $(OPT) -MMD -MP -c $< -o $@
 
 # RPATH (not RUNPATH: it also applies to the dependencies' own dependencies,
 # e.g. embree -> tbb) $ORIGIN: the add-on zip ships libembree3, libOpenEXRCore
@@ -89,7 +91,7 @@ test-python: $(BUILD)/libvsgl.so
 ASAN_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
 $(BUILD)/asan/%.o: %.c $(HEADERS)
 	@mkdir -p $(dir $@)
-	clang $(CFLAGS_COMMON) $(ASAN_FLAGS) -MMD -c $< -o $@
+	clang $(CFLAGS_COMMON) $(ASAN_FLAGS) -MMD -MP -c $< -o $@
 
 $(BUILD)/asan/vsgl_tests: $(ASAN_TEST_OBJ) $(ASAN_LIB_OBJ)
 	clang $(ASAN_FLAGS) -o $@ $^ $(LDLIBS)
@@ -102,13 +104,19 @@ asan:
 
 demo:
 	@tools/deps.sh demo
-	@if [ -x tools/demo.sh ]; then tools/demo.sh; else \
-	  echo "make demo: the demo (issue 5) is not built yet; 'make test' runs what exists."; exit 1; fi
+	@tools/demo.sh
 
 bench:
 	@tools/deps.sh bench
 	@$(MAKE) --no-print-directory all
-	@if [ -x tools/bench.sh ]; then tools/bench.sh; else echo "make bench: no benchmarks yet"; fi
+	@tools/bench.sh
+
+# Debian's flake8 and cppcheck (tools/deps.sh lint); both must report nothing.
+lint:
+	@tools/deps.sh lint
+	/usr/bin/python3 -m flake8 addon tests tools
+	cppcheck --quiet --error-exitcode=1 --std=c11 --enable=warning,portability,performance --inline-suppr \
+	  -D__GNUC__ -I csrc/include -I csrc/src csrc/src csrc/cli
 
 clean:
 	rm -rf $(BUILD)
@@ -147,7 +155,7 @@ $(BUILD)/fuzz/make_corpus: tests/fuzz/make_corpus.c $(FUZZ_LIB_SRC) $(HEADERS)
 $(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c $(LIB_SRC) $(HEADERS)
 	@mkdir -p $(dir $@)
 	clang $(CFLAGS_COMMON) $(FUZZ_FLAGS) -fsanitize=fuzzer -DFUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION -o $@ tests/fuzz/fuzz_scene.c $(LIB_SRC) $(LDLIBS)
-FUZZ_CLI_SRC := csrc/cli/options.c csrc/src/shade/settings.c csrc/src/core/context.c csrc/src/core/result.c
+FUZZ_CLI_SRC := csrc/cli/options.c csrc/src/render/settings.c csrc/src/core/context.c csrc/src/core/result.c
 $(BUILD)/fuzz/fuzz_cli: tests/fuzz/fuzz_cli.c $(FUZZ_CLI_SRC) $(HEADERS) csrc/cli/options.h
 	@mkdir -p $(dir $@)
 	clang $(CFLAGS_COMMON) -Icsrc/cli $(FUZZ_FLAGS) -fsanitize=fuzzer -o $@ tests/fuzz/fuzz_cli.c $(FUZZ_CLI_SRC) -lm
@@ -168,6 +176,12 @@ fuzz:
 	  -dict=tests/fuzz/bundle.dict -artifact_prefix=$(BUILD)/fuzz/scene- -print_final_stats=1 $(BUILD)/fuzz/corpus_scene
 	$(FUZZ_RUN) $(BUILD)/fuzz/fuzz_cli -max_total_time=$(FUZZ_SECONDS) \
 	  -dict=tests/fuzz/cli.dict -artifact_prefix=$(BUILD)/fuzz/cli- -print_final_stats=1 $(BUILD)/fuzz/corpus_cli
+
+# The add-on's panels, compositor setup and preview in Blender's real UI under
+# Xvfb (issue 15): docs/img/panel*.png, compositor.png, preview.png.
+.PHONY: screenshots
+screenshots: $(BUILD)/libvsgl.so
+	@tools/panel_screenshots.sh
 
 # Blender add-on zip (issue 5): build/vsgl_indirect.zip with lib/libvsgl.so inside.
 .PHONY: addon

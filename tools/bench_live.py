@@ -121,7 +121,8 @@ def main():
                     ("camera moved", lambda: setattr(cam.location, "x", cam.location.x + 0.01)),
                     ("geometry edit", lambda: (cache.clear(), setattr(wave.location, "z", wave.location.z + 0.001)))):
                 ts = [edit_cost(session, cache, w, h, scene, cam, edit) for _ in range(args.repeat)]
-                med = {k: statistics.median(t[k] for t in ts) for k in ("export", "scene", "render", "encode", "gbuffer", "rsm", "fit", "shade")}
+                med = {k: statistics.median(t[k] for t in ts)
+                       for k in ("export", "scene", "render", "encode", "gbuffer", "rsm", "fit", "shade")}
                 rows.append((w, h, div, name, med, ts[0]["triangles"]))
         finally:
             session.close()

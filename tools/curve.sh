@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The product curve (GUIDE Sec. 6): relMSE against time for the library's
+# The product curve (docs/references.md §6): relMSE against time for the library's
 # presets and knobs next to Cycles at 1..256 spp, on the gather room of
 # tests/blender/cycles_ref.py, against a two-seed 1024-spp Cycles reference.
 # Writes build/blender/cycles/report_curve.md (docs/accuracy.md quotes it).

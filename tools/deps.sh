@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Check (and, as root, install) the Debian 12 packages a make target needs.
-# Usage: tools/deps.sh build|test|asan|demo|bench
+# Usage: tools/deps.sh build|test|asan|demo|bench|lint
 # Without root it prints the exact apt-get line and exits 1.
 set -euo pipefail
 
@@ -12,6 +12,7 @@ case "${1:-build}" in
   asan)  pkgs="$build_pkgs clang libclang-rt-14-dev" ;;
   demo)  pkgs="$build_pkgs $python_pkgs blender" ;;
   bench) pkgs="$build_pkgs $python_pkgs" ;;
+  lint)  pkgs="flake8 cppcheck" ;;
   *) echo "deps.sh: unknown target '$1'" >&2; exit 2 ;;
 esac
 

@@ -40,7 +40,9 @@ def K(u, c):
 
 def exact(l, c):
     s = np.sqrt(max(0.0, 1 - c * c))
-    f = lambda u: np.exp(l * (u - 1)) * K(u, c)
+
+    def f(u):
+        return np.exp(l * (u - 1)) * K(u, c)
     pts = sorted(set([-1.0, -s, s, 1.0]))
     return sum(integrate.quad(f, x0, x1, epsabs=0, epsrel=1e-12, limit=200)[0]
                for x0, x1 in zip(pts[:-1], pts[1:]) if x1 > x0)
@@ -48,7 +50,8 @@ def exact(l, c):
 
 def lambda_d():
     def J(ld):
-        f = lambda u: 2 * np.pi * (max(u, 0) / np.pi - np.exp(ld * (u - 1)) / A(ld)) ** 2
+        def f(u):
+            return 2 * np.pi * (max(u, 0) / np.pi - np.exp(ld * (u - 1)) / A(ld)) ** 2
         return (integrate.quad(f, -1, 0, epsabs=0, epsrel=1e-13)[0]
                 + integrate.quad(f, 0, 1, epsabs=0, epsrel=1e-13)[0])
     r = optimize.minimize_scalar(J, bracket=(1, 2, 3), tol=1e-12)
@@ -73,7 +76,9 @@ def model(l, c, p):
     t = t_of(l, p)
     a1, a2, b1, b2, a = p[5:10]
     kappa = -((a1 + a2 * l) / (1 + b1 * l + b2 * l * l)) / t
-    psi = lambda x: (x * x - a) * np.exp(-x * x)
+
+    def psi(x):
+        return (x * x - a) * np.exp(-x * x)
     s = (0.5 * c * special.erfc(-t * c) + 0.5 * special.erfc(t)
          - np.exp(-t * t * c * c) * np.expm1(-t * t * (1 - c * c)) / (2 * np.sqrt(np.pi) * t))
     s = s + kappa * (psi(t * c) - psi(t))
@@ -112,7 +117,8 @@ def main():
         err = model(l, cs2, shipped) - ex2
         m = ex2 > 1e-2 * i_up(l)
         worst = [max(worst[0], np.abs(err).max() / A(l)), max(worst[1], (np.abs(err[m]) / ex2[m]).max())]
-    print(f"shipped constants, validation grid: max |err|/A = {worst[0]:.3g}, max rel (>= 1e-2 of peak) = {worst[1]:.3g}")
+    print(f"shipped constants, validation grid: max |err|/A = {worst[0]:.3g}, "
+          f"max rel (>= 1e-2 of peak) = {worst[1]:.3g}")
 
 
 if __name__ == "__main__":

@@ -130,8 +130,17 @@ def step(fn):
     return fn
 
 
+def park_mouse():
+    """Keep the pointer off buttons (a tooltip would cover the screenshot)."""
+    import shutil
+    import subprocess
+    if shutil.which("xdotool") and os.environ.get("DISPLAY"):
+        subprocess.call(["xdotool", "mousemove", "2000", "2000"])
+
+
 @step
 def s_setup():
+    park_mouse()
     scene = build_scene()
     only_our_render_panels()
     runner.begin(scene.name, 1)
@@ -139,6 +148,11 @@ def s_setup():
                   "(textures are not supported); their unlinked values are used")
     runner.report(scene.name, "WARNING", "light 'Spot': its node setup is ignored "
                   "(colour x power only)")
+    runner.LAST_RUN[scene.name].update(
+        status="done", summary="4 triangles, 2 objects, 2 materials, 1 light, camera 320x240",
+        timings={"export": 0.004, "render": 0.41, "write": 0.05, "lib gbuffer": 0.02,
+                 "lib rsm": 0.05, "lib fit": 0.03, "lib shade": 0.28},
+        lights={"lights_used": 1, "lights_skipped": 0, "vsgl_count": 146})
     w = bpy.context.window_manager.windows[0]
     for a in list(w.screen.areas):
         if a.type == "IMAGE_EDITOR":
@@ -161,12 +175,31 @@ def s_panel():
     with override(w, largest_area(w)):
         bpy.ops.vsgl.cycles_direct_only()
     check("direct light only", scene.cycles.diffuse_bounces == 0 and scene.cycles.glossy_bounces == 0)
+    largest_area(w).tag_redraw()
+
+
+@step
+def s_redraw():
+    w = bpy.context.window_manager.windows[0]
+    largest_area(w).tag_redraw()
 
 
 @step
 def s_panel_fixed():
     w = bpy.context.window_manager.windows[0]
     screenshot(w, largest_area(w), "panel_direct_only.png")
+    with override(w, largest_area(w)):
+        for _ in range(4):
+            bpy.ops.view2d.scroll_down(page=True)
+
+
+@step
+def s_panel_bottom():
+    w = bpy.context.window_manager.windows[0]
+    screenshot(w, largest_area(w), "panel_last_run.png")
+    with override(w, largest_area(w)):
+        for _ in range(4):
+            bpy.ops.view2d.scroll_up(page=True)
     bpy.context.scene.vsgl_indirect.enabled = False
 
 
@@ -232,7 +265,6 @@ def s_wait_preview():
           img and img.type)
     check("preview shown in an image editor", bool(editors), "none shows it")
     if img is not None:
-        layers = [l.name for l in getattr(img, "render_slots", [])]
         print("VSGL-UI info preview size", tuple(img.size), "type", img.type, flush=True)
 
 

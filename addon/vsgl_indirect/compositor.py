@@ -271,16 +271,11 @@ def ensure(scene, view_layer, path, add_to_render=True, options=None):
                 adds.append(add)
             tree.links.new(beauty, out)
         last_res = compat.add_node_sockets(adds[1])[2]
-        for add, src, kind, on in zip(adds, srcs, ("Diffuse", "Glossy"),
-                                      (options.use_diffuse, options.use_glossy)):
+        for add, src in zip(adds, srcs):
             a, b, res = compat.add_node_sockets(add)
             if not b.is_linked or b.links[0].from_socket != src:
                 tree.links.new(src, b)
-            fac = float(options.strength) if on else 0.0
-            compat.set_add_factor(add, fac)
-            label = "Add VSGL %s x %.3g%s" % (kind.lower(), options.strength, "" if on else " (off)")
-            if add.label != label:
-                add.label = label
+        _grade(adds, options)
         if not out.is_linked or out.links[0].from_node != adds[1]:
             # Something was plugged into the output after us: add onto it.
             if out.is_linked and out.links[0].from_node != adds[1]:
@@ -378,6 +373,33 @@ def ensure_export(scene, layers, prefix, options):
     if frame is not None:
         _layout(tree, frame)
     return node
+
+
+def _grade(adds, options):
+    """Strength and the per-pass switches: the Add nodes' factors and labels."""
+    for add, kind, on in zip(adds, ("Diffuse", "Glossy"), (options.use_diffuse, options.use_glossy)):
+        compat.set_add_factor(add, float(options.strength) if on else 0.0)
+        label = "Add VSGL %s x %.3g%s" % (kind.lower(), options.strength, "" if on else " (off)")
+        if add.label != label:
+            add.label = label
+
+
+def update_grading(scene, options):
+    """Apply Strength and the Diffuse/Glossy switches to the Add nodes that
+    exist (a slider drag must not redo the whole setup). False if there are
+    none (the caller then sets everything up)."""
+    tree = compat.compositor_tree(scene, create=False)
+    if tree is None:
+        return False
+    found = False
+    for n in tree.nodes:
+        if n.name.startswith("VSGL Add Diffuse ["):
+            layer = n.name[len("VSGL Add Diffuse ["):-1]
+            gloss = tree.nodes.get(add_node_name(layer, "Glossy"))
+            if gloss is not None:
+                _grade([n, gloss], options)
+                found = True
+    return found
 
 
 def add_node_name(view_layer, kind):

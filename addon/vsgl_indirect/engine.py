@@ -156,6 +156,7 @@ def render_planes(sd, options, progress=None, log=None):
 def _name_elements(message, sd):
     """Append Blender names to library messages that cite 'light 3', 'material 2'."""
     import re
+
     def sub(kind, names):
         def f(m):
             i = int(m.group(1))
@@ -269,6 +270,7 @@ def compute(sd, options, path, progress=None, keep_planes=False, metadata=None):
     res.summary = sd.summary()
     check_output_path(path)
     t0 = time.perf_counter()
+
     def log(level, message):
         if message:
             res.warnings.append("libvsgl: %s" % _name_elements(message, sd))

@@ -15,9 +15,9 @@ Library lookup, first match wins:
 3. ``../../build/libvsgl.so`` relative to this module (a dev checkout).
 
 The library is loaded once, on first use, and every ``argtypes``/``restype``
-is set at that moment. A symbol the library does not export (a function not
-written yet) does not stop the load: calling it raises
-:class:`VsglMissingSymbolError` naming it. See docs/python.md.
+is set at that moment. A library that lacks a bound function, or has
+another major.minor version, is refused with :class:`VsglLibraryError`
+naming what is wrong. See docs/python.md.
 """
 
 import ctypes
@@ -32,9 +32,9 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = [
-    "BINDING_VERSION", "VsglLibraryError", "VsglMissingSymbolError", "VsglError",
+    "BINDING_VERSION", "VsglLibraryError", "VsglError",
     "VsglCancelledError", "library", "load_library", "find_library", "version",
-    "version_string", "result_string", "missing_symbols",
+    "version_string", "result_string",
     "SG", "ASG", "Context", "Scene", "render", "render_estimate", "render_settings_preset",
     "Material", "Light", "Camera", "RenderSettings",
 ]
@@ -51,17 +51,6 @@ BINDING_VERSION = (0, 2)
 
 class VsglLibraryError(RuntimeError):
     """libvsgl could not be found or loaded, or has another major.minor."""
-
-
-class VsglMissingSymbolError(VsglLibraryError, NotImplementedError):
-    """The loaded library does not export a function (not implemented yet)."""
-
-    def __init__(self, symbol, path):
-        self.symbol = symbol
-        self.path = path
-        super().__init__(
-            "%s is not exported by %s (not implemented in this build of libvsgl; "
-            "rebuild with `make` once it is)" % (symbol, path))
 
 
 class VsglError(Exception):
@@ -610,6 +599,7 @@ def header_of(name):
         return "reference.h"
     return "vsgl.h"
 
+
 # --------------------------------------------------------------------------
 # Prototypes: (name, restype, argtypes), as in the headers
 # --------------------------------------------------------------------------
@@ -733,37 +723,6 @@ def find_library():
         "(it writes build/libvsgl.so), or set VSGL_LIBRARY to its path." % ", ".join(tried))
 
 
-def _undefined_vsgl_symbols(path):
-    """Undefined ``vsgl_*`` symbols in the dynamic symbol table of an ELF64
-    little-endian shared object (pure Python; [] if it cannot be parsed)."""
-    import struct
-    try:
-        with open(path, "rb") as f:
-            data = f.read()
-        if data[:4] != b"\x7fELF" or data[4] != 2 or data[5] != 1:
-            return []
-        shoff, = struct.unpack_from("<Q", data, 0x28)
-        shentsize, shnum = struct.unpack_from("<HH", data, 0x3A)
-        sections = [struct.unpack_from("<IIQQQQIIQQ", data, shoff + i * shentsize)
-                    for i in range(shnum)]
-        out = []
-        for sh in sections:
-            if sh[1] != 11:  # SHT_DYNSYM
-                continue
-            stroff = sections[sh[6]][4]
-            for off in range(sh[4], sh[4] + sh[5], sh[9] or 24):
-                name_off, info, other, shndx = struct.unpack_from("<IBBH", data, off)
-                if shndx != 0 or name_off == 0:
-                    continue
-                end = data.index(b"\0", stroff + name_off)
-                name = data[stroff + name_off:end].decode("ascii", "replace")
-                if name.startswith("vsgl_"):
-                    out.append(name)
-        return sorted(set(out))
-    except (OSError, struct.error, ValueError, IndexError):
-        return []
-
-
 #: sonames libvsgl links against -> (what it is, Debian/Ubuntu package).
 DEPENDENCIES = {
     "libembree3.so.3": ("Intel Embree 3", "libembree3-3"),
@@ -807,21 +766,10 @@ class _Library:
 
     def __init__(self, path):
         self.path = os.path.abspath(path)
-        #: vsgl_ functions the library calls but does not define (a build
-        #: of a half-written tree); empty for a complete library.
-        self.undefined = ()
         try:
             self.cdll = ctypes.CDLL(self.path)
         except OSError as e:
-            if "undefined symbol" not in str(e):
-                raise VsglLibraryError(load_error_message(self.path, str(e))) from None
-            # Incomplete build: load lazily so the defined functions work; a
-            # call that reaches an undefined one would abort the process, so
-            # they are listed (callers such as the tests check `undefined`).
-            self.cdll = ctypes.CDLL(self.path, mode=os.RTLD_LAZY)
-            self.undefined = tuple(_undefined_vsgl_symbols(self.path)) or (str(e),)
-            _logger.warning("%s is incomplete (%s); loaded lazily", self.path,
-                            ", ".join(self.undefined))
+            raise VsglLibraryError(load_error_message(self.path, str(e))) from None
         missing = []
         for name, restype, argtypes in PROTOTYPES:
             try:
@@ -832,7 +780,6 @@ class _Library:
             fn.restype = restype
             fn.argtypes = argtypes
             self.__dict__[name] = fn
-        self.missing = tuple(missing)
         if "vsgl_version" in missing:
             raise VsglLibraryError("%s does not export vsgl_version: not a libvsgl "
                                    "(build it with `make`)" % self.path)
@@ -843,13 +790,14 @@ class _Library:
                 "%s is libvsgl %d.%d.%d but this add-on needs %d.%d.x; rebuild the library "
                 "from the same checkout with `make` (or reinstall the add-on)"
                 % ((self.path,) + self.version + BINDING_VERSION))
-
-    def __getattr__(self, name):  # only reached for names not bound above
-        if name.startswith("vsgl_"):
-            raise VsglMissingSymbolError(name, self.path)
-        raise AttributeError(name)
+        if missing:
+            raise VsglLibraryError(
+                "%s (libvsgl %d.%d.%d) does not export %s, which this binding calls: it was built "
+                "from another checkout; rebuild it with `make` (or reinstall the add-on)"
+                % ((self.path,) + self.version + (", ".join(missing),)))
 
     def has(self, name):
+        """Is ``name`` a bound function of the library (every prototype is)."""
         return name in self.__dict__
 
 
@@ -870,11 +818,6 @@ def library():
             if _lib is None:
                 _lib = load_library()
     return _lib
-
-
-def missing_symbols():
-    """Names of bound C functions the loaded library does not export."""
-    return library().missing
 
 
 def version():
@@ -1450,7 +1393,7 @@ class Scene:
                                        corner_colors)
         self._ctx = ctx  # destroy the scene before its context
         self._lib = ctx._lib
-        fn = self._lib.vsgl_scene_create  # raises VsglMissingSymbolError if absent
+        fn = self._lib.vsgl_scene_create
         handle = ctypes.c_void_p()
         rc = fn(ctx.handle, ctypes.byref(desc), ctypes.byref(handle))
         del keep

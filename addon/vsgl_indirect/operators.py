@@ -14,10 +14,12 @@ PREVIEW_IMAGE = "VSGL Preview"
 
 
 def load_preview_image(path):
-    """The image 'VSGL Preview' reading ``path``, loaded now. Reloading alone
-    frees the buffer, and an Image Editor showing it drew no layer/pass
-    menus until something read the file again: read it here (``size``
-    acquires the buffer, which rebuilds the multilayer layers and passes)."""
+    """The image 'VSGL Preview' reading ``path``, reloaded in place (the same
+    datablock, so an editor showing it keeps it and its layer/pass choice).
+    The file path is only assigned when it changed, and the file is read
+    here (asking for ``size`` reads it and rebuilds the multilayer layers
+    and passes the editor's menus list; the size itself stays 0 x 0 for a
+    multilayer image without an image user)."""
     img = bpy.data.images.get(PREVIEW_IMAGE)
     if img is None:
         img = bpy.data.images.load(path, check_existing=False)
@@ -284,7 +286,8 @@ class VSGL_OT_reset_knobs(bpy.types.Operator):
 
 
 class VSGL_OT_cycles_direct_only(bpy.types.Operator):
-    """Set Cycles' Diffuse and Glossy bounces to 0 so that it renders direct light only and the VSGL AOV adds the one-bounce indirect light (saved: 'Restore' puts the previous values back)"""
+    """Set Cycles' Diffuse and Glossy bounces to 0 so that it renders direct light only and the \
+VSGL AOV adds the one-bounce indirect light (saved: 'Restore' puts the previous values back)"""
     bl_idname = "vsgl.cycles_direct_only"
     bl_label = "Cycles: Direct Light Only"
     bl_options = {"REGISTER", "UNDO"}

@@ -81,7 +81,8 @@ def finish(scene_name, result, t_export):
         if "seconds_" + k in st:
             timings["lib " + k] = st["seconds_" + k]
     info.update(status="done", timings=timings, skipped=st.get("skipped", ""),
-                summary=result.summary, path=result.path, memory=engine.memory_summary(st))
+                summary=result.summary, path=result.path, memory=engine.memory_summary(st),
+                lights={k: st[k] for k in ("lights_used", "lights_skipped", "vsgl_count") if k in st})
     for w in result.warnings:
         report(scene_name, "WARNING", w)
     for line in (st.get("skipped") or "").splitlines():

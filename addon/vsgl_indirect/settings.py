@@ -30,6 +30,19 @@ def _update_compositor(self, context):
         print("VSGL WARNING: compositor update failed: %r" % (e,))
 
 
+def _update_grading(self, context):
+    """Strength, Diffuse, Glossy: only the Add nodes' factors change."""
+    from . import compositor, config
+    scene = self.id_data
+    if not isinstance(scene, bpy.types.Scene) or not self.enabled:
+        return
+    try:
+        if not compositor.update_grading(scene, config.Options.from_props(self)):
+            _update_compositor(self, context)
+    except Exception as e:  # never break a property edit
+        print("VSGL WARNING: compositor update failed: %r" % (e,))
+
+
 def load_preset_knobs(props, preset=None):
     """Copy ``preset``'s (default: the selected preset's) values into the knobs."""
     for k, v in config.preset_knobs(preset or props.preset).items():
@@ -70,20 +83,23 @@ _PATH_OPTIONS = ({"options": {"PATH_SUPPORTS_BLEND_RELATIVE"}}
 
 # Labels and tooltips of the enum items: (identifier, label, description).
 ITEMS = {
+    # Times: tools/curve.sh's gather room at 80x60 (docs/accuracy.md), rerun
+    # with the current presets on a loaded 2-core machine, where Cycles took
+    # 1.75 s for 256 spp (relMSE 0.0133); compare them with each other.
     "preset": [
         ("PREVIEW", "Preview",
          "Fastest: lattice 32 VSGLs per light, RSM 128, 1 sample, one pixel in 2 x 2 shaded, "
          "no indirect shadows. Within 21 % of Cycles per pass on the bundled scenes; the gather "
-         "room at 80x60 in 0.016 s (relMSE 0.082, light leaks past occluders)"),
+         "room in 0.024 s at relMSE 0.090 (light leaks past occluders)"),
         ("BALANCED", "Balanced",
          "Lattice 128 VSGLs per light, RSM 256, 2 x 2 AA, one pixel in 2 x 2 shaded, visibility "
-         "rays: within 5 % of Cycles where nothing blocks the light; the rays cost 1.1-1.5x and "
-         "cut a sun room's structured error from 1400x to 73x the reference's noise. "
-         "A 1080p frame in about 1 s on 2 cores"),
+         "rays: the gather room in 0.23 s at relMSE 0.0078, below Cycles at 256 spp (0.0133 in "
+         "1.75 s); within 5 % of Cycles where nothing blocks the light. About 1 s per 1080p "
+         "frame on 2 cores"),
         ("QUALITY", "Quality",
-         "Lattice 256 VSGLs per light, RSM 512, 2 x 2 AA, visibility rays: within 4 % of Cycles "
-         "per pass on every bundled scene; relMSE 0.0050 in 0.67 s on the gather room, where "
-         "Cycles needs ~680 spp (~1.6 s) to match it. About 10x Balanced's time"),
+         "Lattice 256 VSGLs per light, RSM 512, 2 x 2 AA, one pixel in 2 x 2 shaded, visibility "
+         "rays: within 4 % of Cycles per pass on every bundled scene; the gather room in 0.91 s "
+         "at relMSE 0.0070, about 4x Balanced's time"),
     ],
     "method": [
         ("VSGL", "VSGL",
@@ -181,13 +197,15 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "node with the passes is set up")
     preset: EnumProperty(
         name="Preset", default="BALANCED", items=ITEMS["preset"], **_upd(_update_preset),
-        description="Speed against accuracy. Preview: 0.016 s, Balanced: 0.07 s, Quality: 0.67 s "
-                    "for the gather room at 80x60 (docs/accuracy.md); the advanced knobs start "
+        description="Speed against accuracy. The gather room at 80x60 (docs/accuracy.md): "
+                    "Preview 0.024 s, Balanced 0.23 s, Quality 0.91 s, where Cycles needs 1.75 s "
+                    "for 256 spp and is still noisier than Balanced. The advanced knobs start "
                     "from the selected preset's values")
     use_advanced: BoolProperty(
         name="Advanced", default=False, **_upd(_update_advanced),
         description="Render with the knobs below instead of the preset. They start from the "
-                    "selected preset's values; knobs that differ from it are marked")
+                    "selected preset's values (picking a preset loads its values again); knobs "
+                    "that differ from it show the preset's value beside them")
     method: _enum("method", "Method", "How the light of each reflective shadow map is gathered")
     aa_samples: IntProperty(
         name="AA Samples", default=config.KNOBS["aa_samples"][1], min=1, max=AA_SAMPLES_MAX,
@@ -266,16 +284,17 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "shown. Off: the frame renders without indirect light and the log says "
                     "VSGL ERROR")
     strength: FloatProperty(
-        name="Strength", default=1.0, min=0.0, max=1.0, precision=3, subtype="FACTOR", **_UPDATE,
+        name="Strength", default=1.0, min=0.0, max=1.0, precision=3, subtype="FACTOR",
+        **_upd(_update_grading),
         description="Factor of the indirect light added in the compositor (1 = physical, with "
                     "Cycles rendering direct light only; lower it to grade the bounce down). "
                     "It is the Add nodes' factor, so it costs nothing and needs no new AOV")
     use_diffuse: BoolProperty(
-        name="Diffuse", default=True, **_UPDATE,
+        name="Diffuse", default=True, **_upd(_update_grading),
         description="Add the diffuse indirect light (pass Diff = DiffInd x DiffCol); off mutes "
                     "its Add node")
     use_glossy: BoolProperty(
-        name="Glossy", default=True, **_UPDATE,
+        name="Glossy", default=True, **_upd(_update_grading),
         description="Add the glossy indirect light (pass Gloss = GlossInd x GlossCol); off "
                     "mutes its Add node")
     use_cycles_colors: BoolProperty(

@@ -16,6 +16,9 @@ LIGHT_KNOBS = ("rsm_resolution", "fit_mode", "vsgl_count", "fis_iterations",
 MATERIAL_KNOBS = ("diffuse_mode", "glossy_mode")
 assert set(QUALITY_KNOBS + LIGHT_KNOBS + MATERIAL_KNOBS) == set(config.KNOBS)
 
+#: Blender's report icons: an error is a cross, a warning a triangle.
+LEVEL_ICONS = {"ERROR": "CANCEL", "WARNING": "ERROR", "INFO": "INFO"}
+
 _NAMED = re.compile(r"\b(object|light|material) '([^']+)'")
 
 
@@ -162,6 +165,11 @@ class VSGL_PT_lights_materials(_Sub, bpy.types.Panel):
         if not props.use_advanced:
             layout.label(text="Values of the preset; tick Advanced (Quality) to edit", icon="INFO")
         layout.label(text="Lights")
+        lights = (runner.LAST_RUN.get(context.scene.name) or {}).get("lights") or {}
+        if lights:
+            layout.label(text="Last run: %d light(s) used, %d skipped, %d VSGLs" % (
+                lights.get("lights_used", 0), lights.get("lights_skipped", 0),
+                lights.get("vsgl_count", 0)), icon="LIGHT")
         draw_knobs(layout, props, LIGHT_KNOBS)
         layout.label(text="Materials")
         draw_knobs(layout, props, MATERIAL_KNOBS)
@@ -255,7 +263,7 @@ class VSGL_PT_last_run(_Sub, bpy.types.Panel):
             box = layout.box()
             box.label(text="Warnings and errors (%d)" % len(messages), icon="ERROR")
             for level, m in messages[-20:]:
-                wrapped(box, context, m, icon="ERROR" if level == "ERROR" else "INFO",
+                wrapped(box, context, m, icon=LEVEL_ICONS.get(level, "INFO"),
                         select=bool(named_elements(m)))
             if len(messages) > 20:
                 box.label(text="... %d earlier (see the console)" % (len(messages) - 20))

@@ -285,8 +285,8 @@ def _draw():
     tex = _texture(s)
     shader = _image_shader()
     w, h = region.width, region.height
-    batch = batch_for_shader(shader, "TRI_FAN", {"pos": ((0, 0), (w, 0), (w, h), (0, h)),
-                                                  "texCoord": ((0, 0), (1, 0), (1, 1), (0, 1))})
+    quad = {"pos": ((0, 0), (w, 0), (w, h), (0, h)), "texCoord": ((0, 0), (1, 0), (1, 1), (0, 1))}
+    batch = batch_for_shader(shader, "TRI_FAN", quad)
     gpu.state.blend_set("ADDITIVE" if props.display == "ADD" else "NONE")
     shader.bind()
     shader.uniform_sampler("image", tex)
@@ -413,8 +413,8 @@ class VIEW3D_PT_vsgl_live(bpy.types.Panel):
                 layout.label(text="%.0f ms: render %.0f, scene %.0f, export %.0f" % (
                     1000 * t["total"], 1000 * t["render"], 1000 * t["scene"], 1000 * t["export"]))
             if s.image is not None:
-                layout.label(text="%d x %d, %d triangles" % (s.image["width"], s.image["height"],
-                                                           s.image["triangles"]))
+                img = s.image
+                layout.label(text="%d x %d, %d triangles" % (img["width"], img["height"], img["triangles"]))
 
 
 def _wrap(text, width):

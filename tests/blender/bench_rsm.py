@@ -5,7 +5,8 @@
 Scene: a 1000 x 500 heightfield (1 M triangles) plus 2000 boxes (24 k
 triangles) in 40 x 20 m; a point, a spot, a sun and an area light. Times
 vsgl_reference_rsm (RSM build + copy-out of positions and flux) per light,
-median of 3 (wall clock and process CPU time: the machine may be shared), and the RSM's memory (68 bytes per texel: position, normal,
+median of 3 (wall clock and process CPU time: the machine may be shared), \
+and the RSM's memory (68 bytes per texel: position, normal,
 tangent, incident direction, flux, footprint, material).
 """
 import ctypes

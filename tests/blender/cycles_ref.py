@@ -83,7 +83,8 @@ LIGHT_CASES = [
     ("point", dict(type="POINT", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0)), 100 / (4 * math.pi ** 2 * 4)),
     ("spot_90_blend03", dict(type="SPOT", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), spot_size=90, spot_blend=0.3),
      100 / (4 * math.pi ** 2 * 4)),
-    ("spot_tilted_60", dict(type="SPOT", energy=100.0, loc=(-0.5, 0, 2), rot=(0, 20, 0), spot_size=60, spot_blend=0.25), None),
+    ("spot_tilted_60", dict(type="SPOT", energy=100.0, loc=(-0.5, 0, 2), rot=(0, 20, 0), spot_size=60,
+                            spot_blend=0.25), None),
     # a non-uniform scale: 3.x ignores it, 4.x+ makes the cone elliptical
     ("spot_scaled_y05", dict(type="SPOT", energy=100.0, loc=(0.2, 0, 2), rot=(0, 0, 30), spot_size=80, spot_blend=0.2,
                              scale=(1.0, 0.5, 1.0)), None),
@@ -91,9 +92,12 @@ LIGHT_CASES = [
     ("area_square_5cm", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="SQUARE", size=0.05),
      100 / (4 * math.pi * 4)),
     ("area_square_05", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="SQUARE", size=0.5), None),
-    ("area_rect_tilted", dict(type="AREA", energy=100.0, loc=(0.3, 0, 1.5), rot=(30, 0, 15), shape="RECTANGLE", size=0.6, size_y=0.3), None),
-    ("area_disk_spread90", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="DISK", size=0.1, spread=90), None),
-    ("area_ellipse_spread150", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(10, 0, 0), shape="ELLIPSE", size=0.15, size_y=0.06, spread=150), None),
+    ("area_rect_tilted", dict(type="AREA", energy=100.0, loc=(0.3, 0, 1.5), rot=(30, 0, 15), shape="RECTANGLE",
+                              size=0.6, size_y=0.3), None),
+    ("area_disk_spread90", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(0, 0, 0), shape="DISK", size=0.1,
+                                spread=90), None),
+    ("area_ellipse_spread150", dict(type="AREA", energy=100.0, loc=(0, 0, 2), rot=(10, 0, 0), shape="ELLIPSE",
+                                    size=0.15, size_y=0.06, spread=150), None),
 ]
 
 
@@ -106,6 +110,7 @@ def room_geometry():
     q.append(dict(quad=[(-1, -1, 2), (-1, 1, 2), (1, 1, 2), (1, -1, 2)], mat="white"))
     # a metal block (0.5 x 0.5 x 0.7) rotated 30 degrees about z
     c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
+
     def P(x, y, z):
         return (0.35 + c * x - s * y, 0.3 + s * x + c * y, z)
     a, b, h = 0.25, 0.25, 0.7
@@ -588,10 +593,13 @@ def suite_lights(lib, ctx, out_dir, report):
                   "%.2f m at 25 points in [-1.2, 1.2]^2 (those above 2 %% of the brightest); RSM %d^2 per "
                   "face; Cycles 96x96 px over 4 x 4 m, 128 spp (delta lights) or 256 spp (area). "
                   "Tolerance per point: %.0f %% or 3 standard errors of Cycles' noise (from the pixel "
-                  "residual against a 3x3 mean), whichever is larger; the RSM is deterministic. Where a closed form exists, "
+                  "residual against a 3x3 mean), whichever is larger; the RSM is deterministic. "
+                  "Where a closed form exists, "
                   "Cycles' DiffDir at the point below the light (mean of the 2x2 centre pixels) must "
                   "match it within 0.3 %%.\n" % (KERNEL_W, RSM_RES_LIGHT, TOL_LIGHT * 100))
-    report.append("| case | Cycles DiffDir below the light | analytic | RSM-implied E vs Cycles: max rel. diff (1-sigma there) | mean rel. diff | points | RSM time (s) | result |")
+    report.append("| case | Cycles DiffDir below the light | analytic | "
+                  "RSM-implied E vs Cycles: max rel. diff (1-sigma there) | mean rel. diff | points | "
+                  "RSM time (s) | result |")
     report.append("|---|---|---|---|---|---|---|---|")
     for name, ls, analytic in LIGHT_CASES:
         case = dict(geometry=FLOOR, lights=[ls], camera=TOPCAM)
@@ -641,19 +649,19 @@ def suite_lights(lib, ctx, out_dir, report):
         # points where the light is at least 2 % of its brightest point (the
         # tails of a cone edge are sampled by too few pixels to compare)
         emax = max(p[3] for p in pts)
-        centre = [p[3] for p in pts if p[0] == 0 and p[1] == 0][0]
         errs = [(abs(er - ec) / ec, gx, gy, er, ec, se) for gx, gy, er, ec, se in pts if ec > 0.02 * emax]
         # tolerance: 1 % or 3 standard errors of Cycles' noise, whichever is
         # larger (the RSM is deterministic)
         bad = [e for e in errs if e[0] > max(TOL_LIGHT, 3 * e[5] / e[4])]
         worst = max(errs) if errs else (0, 0, 0, 0, 0, 0)
         ok = not bad and len(errs) > 0
-        if analytic is not None:  # Cycles itself against the closed form (GUIDE section 5)
+        if analytic is not None:  # Cycles itself against the closed form (docs/references.md §5)
             ok = ok and abs(dd_centre / analytic - 1) < 0.003
         passed += ok
         failed += not ok
         line = "| %s | %.4f | %s | %.3f %% at (%.1f, %.1f) (%.2f %%) | %.3f %% | %d | %.2f | %s |" % (
-            name, dd_centre, "-" if analytic is None else "%.4f" % analytic, 100 * worst[0], worst[1], worst[2], 100 * worst[5] / max(worst[4], 1e-12),
+            name, dd_centre, "-" if analytic is None else "%.4f" % analytic, 100 * worst[0], worst[1], worst[2],
+            100 * worst[5] / max(worst[4], 1e-12),
             100 * np.mean([e[0] for e in errs]), len(errs), rsecs, "PASS" if ok else "FAIL")
         report.append(line)
         print(("PASS " if ok else "FAIL ") + "light %s: worst %.3f %% (RSM %.4f vs Cycles %.4f at %.1f,%.1f); "
@@ -728,17 +736,24 @@ def suite_gather(lib, ctx, out_dir, report):
             dl, gl, dc, gc = planes
             D, G = dl * dc, gl * gc
             err = ((D + G - D_c - G_c) ** 2 / ((D_c + G_c) ** 2 + 0.01)).mean(2)
-            tone = lambda x: (np.clip(x, 0, None) / (1 + np.clip(x, 0, None))) ** (1 / 2.2)
+
+            def tone(x):
+                return (np.clip(x, 0, None) / (1 + np.clip(x, 0, None))) ** (1 / 2.2)
+
             save_png(os.path.join(out_dir, "gather_%d.png" % res),
                      np.concatenate([tone(D_c + G_c), tone(D + G), false_colour(err, 0.1)], axis=1))
             rows.append(dict(res=res, rd=relmse(D, D_c), rg=relmse(G, G_c), rc=relmse(D + G, D_c + G_c),
                              rmse=float(np.sqrt(np.mean((D + G - D_c - G_c) ** 2))),
                              rci=relmse(D + G, D_c + G_c, inner),
-                             md=float(D.mean() / max(D_c.mean(), 1e-12)), mg=float(G.mean() / max(G_c.mean(), 1e-12)),
+                             md=float(D.mean() / max(D_c.mean(), 1e-12)),
+                             mg=float(G.mean() / max(G_c.mean(), 1e-12)),
                              t_rsm=st.seconds_rsm, t_gather=st.seconds_gather, vpl=st.vpl_count,
-                             gcol=float(np.abs(gc - cyc["GlossCol"]).mean()), dcol=float(np.abs(dc - cyc["DiffCol"]).mean())))
-            print("gather res %d: relMSE diffuse %.4f glossy %.4f combined %.4f (interior %.4f); mean ratio diffuse %.4f glossy %.4f; "
-                  "VPLs %d, rsm %.2f s, gather %.2f s" % (res, rows[-1]["rd"], rows[-1]["rg"], rows[-1]["rc"], rows[-1]["rci"],
+                             gcol=float(np.abs(gc - cyc["GlossCol"]).mean()),
+                             dcol=float(np.abs(dc - cyc["DiffCol"]).mean())))
+            print("gather res %d: relMSE diffuse %.4f glossy %.4f combined %.4f (interior %.4f); "
+                  "mean ratio diffuse %.4f glossy %.4f; "
+                  "VPLs %d, rsm %.2f s, gather %.2f s" % (res, rows[-1]["rd"], rows[-1]["rg"], rows[-1]["rc"],
+                                                          rows[-1]["rci"],
                                                           rows[-1]["md"], rows[-1]["mg"], st.vpl_count,
                                                           st.seconds_rsm, st.seconds_gather))
             np.save(os.path.join(out_dir, "gather_%d.npy" % res), np.stack(planes))
@@ -749,7 +764,8 @@ def suite_gather(lib, ctx, out_dir, report):
     report.append("Room 2 x 2 x 2 m (open front), red/green side walls, grey floor (Lambert + Principled specular "
                   "layer, roughness 0.25), GGX metal block (Glossy BSDF, roughness 0.35); "
                   "spot 300 W + square area 60 W. %dx%d px. Cycles 3.4 one bounce, "
-                  "%d spp%s. Library: brute-force gather, aa %d, visibility rays, RSM per light at the given size.\n"
+                  "%d spp%s. Library: brute-force gather, aa %d, visibility rays, "
+                  "RSM per light at the given size.\n"
                   % (W, H, case["samples"], "" if secs is None else " (rendered in %.0f s)" % secs, GATHER_AA))
     report.append("Cycles reference = mean of two %d-spp renders (seeds 1, 2), pixel centres only (box filter "
                   "0.01 px, like the G-buffer at aa 1); its own noise, relMSE(c1, c2)/4: diffuse %.4f, "
@@ -757,14 +773,17 @@ def suite_gather(lib, ctx, out_dir, report):
                   "of the coloured planes DiffInd*DiffCol, GlossInd*GlossCol.\n" % (half, floor_d, floor_g, floor_c))
     report.append("Interior pixels (3x3 neighbourhood of one material colour, %.0f %% of the image): Cycles "
                   "noise there %.4f.\n" % (100 * inner.mean(), floor_ci))
-    report.append("| RSM | VPLs | relMSE diffuse | relMSE glossy | relMSE combined | combined, interior | RMSE combined | mean D / Cycles | mean G / Cycles | RSM s | gather s |")
+    report.append("| RSM | VPLs | relMSE diffuse | relMSE glossy | relMSE combined | combined, interior | "
+                  "RMSE combined | mean D / Cycles | mean G / Cycles | RSM s | gather s |")
     report.append("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         report.append("| %d | %d | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | %.2f | %.2f |" % (
-            r["res"], r["vpl"], r["rd"], r["rg"], r["rc"], r["rci"], r["rmse"], r["md"], r["mg"], r["t_rsm"], r["t_gather"]))
+            r["res"], r["vpl"], r["rd"], r["rg"], r["rc"], r["rci"], r["rmse"], r["md"], r["mg"], r["t_rsm"],
+            r["t_gather"]))
     report.append("\nImages `gather_<RSM>.png`: Cycles | brute force | per-pixel relative squared error "
                   "(blue 0, green 0.05, red >= 0.1), combined plane, tone-mapped x/(1+x).")
-    report.append("\nDiffCol mean abs diff %.2e, GlossCol %.2e (silhouette pixels).\n" % (rows[-1]["dcol"], rows[-1]["gcol"]))
+    report.append("\nDiffCol mean abs diff %.2e, GlossCol %.2e (silhouette pixels).\n"
+                  % (rows[-1]["dcol"], rows[-1]["gcol"]))
     # checks: the finest RSM agrees with Cycles, error falls with RSM size, colours match
     best = rows[-1]
     checks = [
@@ -789,7 +808,7 @@ def suite_gather(lib, ctx, out_dir, report):
     return passed, failed
 
 
-# The product curve (GUIDE Sec. 6): error against time for the library's
+# The product curve (docs/references.md §6): error against time for the library's
 # settings next to Cycles at increasing samples per pixel, on the gather
 # room, against the same two-seed reference. A report, not a test.
 CURVE_SPP = [int(v) for v in os.environ.get("VSGL_CURVE_SPP", "1,4,16,64,256").split(",")]
@@ -806,20 +825,20 @@ CURVE_SETTINGS = [
     ("FIS 16, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=16, rsm_resolution=128, aa_samples=1)),
     ("FIS 64, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=64, rsm_resolution=128, aa_samples=1)),
     ("FIS 256, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1)),
-    ("FIS 256, RSM 128, aa 1, visibility", "BALANCED", dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1,
-                                                             visibility=1)),
-    ("k-means 256, RSM 128, aa 1, visibility", "BALANCED", dict(fit_mode=2, vsgl_count=256, rsm_resolution=128,
-                                                                 aa_samples=1, visibility=1)),
-    ("FIS 1024, RSM 256, aa 1, visibility", "BALANCED", dict(fit_mode=1, vsgl_count=1024, rsm_resolution=256, aa_samples=1,
-                                                              visibility=1)),
-    ("k-means 64, RSM 256, aa 1, visibility", "BALANCED", dict(fit_mode=2, vsgl_count=64, rsm_resolution=256,
-                                                                aa_samples=1, visibility=1)),
-    ("k-means 128, RSM 256, aa 1, visibility", "BALANCED", dict(fit_mode=2, vsgl_count=128, rsm_resolution=256,
-                                                                 aa_samples=1, visibility=1)),
-    ("k-means 128, RSM 256, aa 2, visibility", "BALANCED", dict(fit_mode=2, vsgl_count=128, rsm_resolution=256,
-                                                                 aa_samples=2, visibility=1)),
-    ("brute force, RSM 128, aa 1, visibility", "BALANCED", dict(method=1, rsm_resolution=128, aa_samples=1,
-                                                                 visibility=1)),
+    ("FIS 256, RSM 128, aa 1, visibility", "BALANCED",
+     dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1, visibility=1)),
+    ("k-means 256, RSM 128, aa 1, visibility", "BALANCED",
+     dict(fit_mode=2, vsgl_count=256, rsm_resolution=128, aa_samples=1, visibility=1)),
+    ("FIS 1024, RSM 256, aa 1, visibility", "BALANCED",
+     dict(fit_mode=1, vsgl_count=1024, rsm_resolution=256, aa_samples=1, visibility=1)),
+    ("k-means 64, RSM 256, aa 1, visibility", "BALANCED",
+     dict(fit_mode=2, vsgl_count=64, rsm_resolution=256, aa_samples=1, visibility=1)),
+    ("k-means 128, RSM 256, aa 1, visibility", "BALANCED",
+     dict(fit_mode=2, vsgl_count=128, rsm_resolution=256, aa_samples=1, visibility=1)),
+    ("k-means 128, RSM 256, aa 2, visibility", "BALANCED",
+     dict(fit_mode=2, vsgl_count=128, rsm_resolution=256, aa_samples=2, visibility=1)),
+    ("brute force, RSM 128, aa 1, visibility", "BALANCED",
+     dict(method=1, rsm_resolution=128, aa_samples=1, visibility=1)),
 ]
 
 
@@ -871,7 +890,7 @@ def suite_curve(lib, ctx, out_dir, report):
     report.append("The gather room (spot 300 W + area 60 W, red/green walls, glossy floor, GGX metal block), "
                   "%dx%d px, one bounce. Reference: mean of two %d-spp Cycles renders (its own noise, "
                   "relMSE %.4f). relMSE of the coloured indirect light DiffInd*DiffCol + GlossInd*GlossCol "
-                  "(GUIDE Sec. 6). Cycles time: a whole `bpy.ops.render.render` of this scene (scene sync "
+                  "(docs/references.md §6). Cycles time: a whole `bpy.ops.render.render` of this scene (scene sync "
                   "included), seed 3; library time: the fastest of 3 `vsgl_render` calls (scene built once), "
                   "2 threads on a shared 2-core machine.\n" % (W, H, half, floor))
     report.append("| method | seconds | relMSE vs reference | VSGLs |")
@@ -995,9 +1014,11 @@ def suite_brdf(lib, ctx, out_dir, report, camera=None, tag="", multiscatter=Fals
     lib.vsgl_reference_brdf.restype = ctypes.c_int32
     regions = [("rough", -2.0, -0.7), ("floor", -0.6, 0.6), ("aniso", 0.7, 2.0)]
     passed = failed = 0
-    report.append("## Exact BRDF vs Cycles (direct light%s)\n" % (", view elevation %.0f deg" % math.degrees(math.asin(-fwd[2])) if tag else ""))
+    report.append("## Exact BRDF vs Cycles (direct light%s)\n"
+                  % (", view elevation %.0f deg" % math.degrees(math.asin(-fwd[2])) if tag else ""))
     report.append("Floor of three Principled materials (GGX) under three 40 W point lights (one render each, "
-                  "summed), orthographic view straight down, %dx%d px over 4 x 3 m, 16 spp, pixel centres. Expected per pixel: the "
+                  "summed), orthographic view straight down, %dx%d px over 4 x 3 m, 16 spp, pixel centres. "
+                  "Expected per pixel: the "
                   "library's BRDF (vsgl_reference_brdf) x cos x P/(4 pi d^2), summed over lights, divided by "
                   "the colour pass. Compared where the expected value exceeds 1 %% of its maximum, pixels at "
                   "least 1.5 px from a material boundary. Tolerance: mean %.1f %%, worst pixel %.0f %%. "

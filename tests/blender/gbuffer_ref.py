@@ -24,14 +24,13 @@ Blender's version. Writes report.md and summary.txt (last line
 """
 import ctypes
 import hashlib
-import math
 import os
 import struct
 import sys
 
 import bpy
 import numpy as np
-from mathutils import Matrix, Vector
+from mathutils import Vector
 
 # ---- tolerances (interior pixels) -------------------------------------------
 TOL_POS_MAX = 2e-3      # m: 0.005 px of jitter at <= 0.15 m per pixel, grazing x4
@@ -46,14 +45,19 @@ CONFIGS = [
     # name, camera settings, render settings
     ("persp_auto_64x48", dict(type="PERSP", lens=35.0, sensor_fit="AUTO"), dict(x=64, y=48)),
     ("persp_auto_portrait_48x64", dict(type="PERSP", lens=30.0, sensor_fit="AUTO"), dict(x=48, y=64)),
-    ("persp_horizontal_portrait", dict(type="PERSP", lens=30.0, sensor_fit="HORIZONTAL", sensor_width=32.0), dict(x=40, y=60)),
-    ("persp_vertical_64x40", dict(type="PERSP", lens=40.0, sensor_fit="VERTICAL", sensor_height=20.0), dict(x=64, y=40)),
-    ("persp_shift_pct50", dict(type="PERSP", lens=35.0, sensor_fit="AUTO", shift_x=0.12, shift_y=-0.08), dict(x=128, y=80, pct=50)),
+    ("persp_horizontal_portrait", dict(type="PERSP", lens=30.0, sensor_fit="HORIZONTAL", sensor_width=32.0),
+     dict(x=40, y=60)),
+    ("persp_vertical_64x40", dict(type="PERSP", lens=40.0, sensor_fit="VERTICAL", sensor_height=20.0),
+     dict(x=64, y=40)),
+    ("persp_shift_pct50", dict(type="PERSP", lens=35.0, sensor_fit="AUTO", shift_x=0.12, shift_y=-0.08),
+     dict(x=128, y=80, pct=50)),
     ("persp_pixel_aspect_2x1", dict(type="PERSP", lens=35.0, sensor_fit="AUTO"), dict(x=48, y=48, ax=2.0, ay=1.0)),
-    ("persp_vertical_aspect_shift", dict(type="PERSP", lens=28.0, sensor_fit="VERTICAL", sensor_height=18.0, shift_y=0.1),
+    ("persp_vertical_aspect_shift", dict(type="PERSP", lens=28.0, sensor_fit="VERTICAL", sensor_height=18.0,
+                                         shift_y=0.1),
      dict(x=56, y=42, ax=1.0, ay=1.5)),
     ("ortho_auto_shift", dict(type="ORTHO", ortho_scale=7.0, sensor_fit="AUTO", shift_x=-0.1), dict(x=64, y=48)),
-    ("ortho_vertical_aspect", dict(type="ORTHO", ortho_scale=5.0, sensor_fit="VERTICAL", shift_y=0.05), dict(x=60, y=40, ax=1.0, ay=1.5)),
+    ("ortho_vertical_aspect", dict(type="ORTHO", ortho_scale=5.0, sensor_fit="VERTICAL", shift_y=0.05),
+     dict(x=60, y=40, ax=1.0, ay=1.5)),
 ]
 
 
@@ -236,7 +240,8 @@ def read_exr(path):
     out = {}
     for pi, h in enumerate(parts):
         w = h["width"]
-        full = {c: ((h["name"] + "." + c) if multipart and "name" in h and "." not in c else c) for c, _ in h["channels"]}
+        full = {c: ((h["name"] + "." + c) if multipart and "name" in h and "." not in c else c)
+                for c, _ in h["channels"]}
         img = {c: np.zeros((h["height"], w), np.float32) for c, _ in h["channels"]}
         for off in h["offsets"]:
             if multipart:
@@ -273,7 +278,8 @@ def cycles_passes(exr):
 
 class Material(ctypes.Structure):
     _fields_ = [("base_color", ctypes.c_float * 3), ("metallic", ctypes.c_float), ("roughness", ctypes.c_float),
-                ("specular_f0", ctypes.c_float), ("anisotropy", ctypes.c_float), ("anisotropic_rotation", ctypes.c_float),
+                ("specular_f0", ctypes.c_float), ("anisotropy", ctypes.c_float),
+                ("anisotropic_rotation", ctypes.c_float),
                 ("flags", ctypes.c_uint32), ("reserved", ctypes.c_uint32)]
 
 
@@ -464,7 +470,8 @@ def main():
     lib = load_lib(args["--lib"])
     sc, cam, objects = build_scene()
     passed = failed = skipped = 0
-    lines = ["| configuration | pixels | coverage match | interior px | pos max (m) | pos mean (m) | normal max (deg) | "
+    lines = ["| configuration | pixels | coverage match | interior px | pos max (m) | pos mean (m) | "
+             "normal max (deg) | "
              "normal mean (deg) | tangent p99.5 (deg) | tangent mean (deg) | result |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, cam_opts, res in CONFIGS:
@@ -506,7 +513,8 @@ def main():
             s["tmax"], s["tmean"], "pass" if ok else "FAIL"))
         print("gbuffer_ref %s: %s" % (name, lines[-1]), flush=True)
     report = "\n".join(lines) + "\n"
-    tol = ("Tolerances: coverage match >= %.3f; interior pixels (3x3 neighbourhood on one object) >= 30%% of the image, "
+    tol = ("Tolerances: coverage match >= %.3f; interior pixels (3x3 neighbourhood on one object) "
+           ">= 30%% of the image, "
            "position max <= %g m, mean <= %g m; normal angle max <= %g deg, mean <= %g deg; tangent angle "
            "(where Cycles' |T| > 0.5, >= half the interior pixels) 99.5th percentile <= %g deg, mean <= %g deg.\n"
            % (TOL_COVERAGE, TOL_POS_MAX, TOL_POS_MEAN, TOL_NRM_MAX, TOL_NRM_MEAN, TOL_TAN_P995, TOL_TAN_MEAN))

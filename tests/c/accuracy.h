@@ -1,6 +1,6 @@
 /* Accuracy helpers shared by the accuracy test and tools/accuracy.c:
  * scenes with each light type, rendering into planes, and the relative
- * MSE of GUIDE Sec. 6: mean((a - b)^2 / (b^2 + 0.01)) over pixels and
+ * MSE of docs/references.md §6: mean((a - b)^2 / (b^2 + 0.01)) over pixels and
  * channels. */
 #ifndef VSGL_TEST_ACCURACY_H
 #define VSGL_TEST_ACCURACY_H

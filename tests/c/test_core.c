@@ -3,6 +3,7 @@
 #include "vsgl.h"
 #include "core/context.h"
 #include "core/parallel.h"
+#include "core/versioned.h"
 
 #include <string.h>
 
@@ -82,4 +83,37 @@ VT_TEST(core_parallel_for_reports_lowest_failing_chunk)
 {
     for (uint32_t t = 1; t <= 4; ++t)
         VT_CHECK(vsgl__parallel_for(t, 100, 7, fail_some, NULL) == 7, "threads %u", t);
+}
+
+/* One rule for every size-prefixed struct: 0 = current, smaller = older
+ * (tail zero), larger or shorter than the size field = refused, named. */
+VT_TEST(core_versioned_structs_follow_one_rule)
+{
+    vsgl_context *ctx = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    vsgl_render_settings in, out;
+    memset(&in, 0x5a, sizeof in);
+    in.size = 0;
+    VT_CHECK(vsgl__copy_versioned(ctx, &out, sizeof out, &in, "vsgl_render_settings") == VSGL_OK, "size 0");
+    VT_CHECK(memcmp(&in, &out, sizeof in) == 0, "size 0 copies the whole struct");
+    in.size = (uint32_t)offsetof(vsgl_render_settings, aa_samples) + sizeof in.aa_samples;
+    VT_CHECK(vsgl__copy_versioned(ctx, &out, sizeof out, &in, "vsgl_render_settings") == VSGL_OK, "older size");
+    VT_CHECK(out.aa_samples == in.aa_samples && out.shade_stride == 0, "older: prefix copied, tail zero");
+    in.size = sizeof in + 4;
+    VT_CHECK(vsgl__copy_versioned(ctx, &out, sizeof out, &in, "vsgl_render_settings") == VSGL_ERROR_INVALID_ARGUMENT,
+             "newer size accepted");
+    VT_CHECK(strstr(vsgl_context_last_error(ctx), "vsgl_render_settings.size") != NULL, "message: %s",
+             vsgl_context_last_error(ctx));
+    in.size = 2;
+    VT_CHECK(vsgl__copy_versioned(ctx, &out, sizeof out, &in, "x") == VSGL_ERROR_INVALID_ARGUMENT, "size 2");
+    in.size = 10; /* ends inside a field */
+    VT_CHECK(vsgl__copy_versioned(ctx, &out, sizeof out, &in, "x") == VSGL_ERROR_INVALID_ARGUMENT, "size 10");
+    VT_CHECK(vsgl__copy_versioned(ctx, &out, sizeof out, NULL, "x") == VSGL_OK && out.size == 0, "NULL = zeros");
+    /* the public entry points use it: a newer render settings struct is refused by vsgl_render_settings checks */
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.size = sizeof cd + 8;
+    vsgl_context *c2 = NULL;
+    VT_CHECK(vsgl_context_create(&cd, &c2) == VSGL_ERROR_INVALID_ARGUMENT && c2 == NULL, "newer context desc");
+    vsgl_context_destroy(ctx);
 }

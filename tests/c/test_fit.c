@@ -35,7 +35,7 @@ static void make_rsm(hand_rsm *h, uint32_t res, uint64_t seed, float offset, flo
     vt_rng rng = {seed};
     for (size_t t = 0; t < r->count; ++t) {
         if (vt_uniform(&rng) < 1.0 / 6.0) {
-            r->material[t] = VSGL_RSM_EMPTY;
+            r->material[t] = VSGL__RSM_EMPTY;
             continue;
         }
         r->material[t] = (uint32_t)(vt_uniform(&rng) * 4.0) % 4;
@@ -60,7 +60,7 @@ static void free_rsm(hand_rsm *h)
     free(h->r.material);
 }
 
-/* The poster's sums (Sec. 2.1-2.2, errata GUIDE Sec. 3) in double. */
+/* The poster's sums (Sec. 2.1-2.2, errata docs/references.md §3) in double. */
 typedef struct ref_vsgl { double power[3], axis[3], sharpness, mean[3], variance; int present; } ref_vsgl;
 
 static void reference_two(const vsgl_scene *scene, const vsgl_rsm *r, int32_t est, ref_vsgl out[2])
@@ -69,7 +69,7 @@ static void reference_two(const vsgl_scene *scene, const vsgl_rsm *r, int32_t es
     const vsgl_material *mats = vsgl__scene_materials(scene, &mc);
     double W[2] = {0, 0}, P[2][3] = {{0}}, D[2][3] = {{0}}, X[2][3] = {{0}}, X2[2] = {0, 0};
     for (size_t t = 0; t < r->count; ++t) {
-        if (r->material[t] == VSGL_RSM_EMPTY)
+        if (r->material[t] == VSGL__RSM_EMPTY)
             continue;
         vsgl_brdf_params bp;
         vsgl__material_params(&mats[r->material[t]], &bp);
@@ -231,9 +231,9 @@ VT_TEST(fit_fis_single_cluster_equals_two_and_top_mip_equals_total)
     /* the pyramid's top level holds the whole map */
     vsgl_grid g;
     VT_CHECK(vsgl__grid_build(ctx, scene, &h.r, s.sharpness_estimator, 1, &g) == VSGL_OK, "grid");
-    double top[VSGL_GRID_STRIDE];
+    double top[VSGL__GRID_STRIDE];
     vsgl__grid_sample(&g, 0, 3.7f, 20.1f, (float)(g.levels - 1), top);
-    for (int k = 0; k < VSGL_GRID_STRIDE; ++k)
+    for (int k = 0; k < VSGL__GRID_STRIDE; ++k)
         VT_CHECK_ABS(top[k], g.total[k], 1e-5 * (fabs(g.total[k]) + 1.0), "field %d", k);
     vsgl__grid_free(&g);
     vsgl__vsgl_set_free(&two);

@@ -133,7 +133,7 @@ VT_TEST(gbuffer_misses_backfaces_and_clipping)
                 analytic_point(-5.0, col, row, 0, 0, 1, w);
                 int inside = fabs(w[0]) < 1.0 && fabs(w[1]) < 1.0;
                 int edge = fabs(fabs(w[0]) - 1.0) < 1e-3 || fabs(fabs(w[1]) - 1.0) < 1e-3;
-                int hit = g.material[e] != VSGL_GBUFFER_MISS;
+                int hit = g.material[e] != VSGL__GBUFFER_MISS;
                 want_hits += (size_t)inside;
                 hits += (size_t)hit;
                 if (!edge)
@@ -161,7 +161,7 @@ VT_TEST(gbuffer_misses_backfaces_and_clipping)
             if (s && vsgl__gbuffer_build(ctx, s, 1, &g) == VSGL_OK) {
                 size_t hits = 0;
                 for (size_t e = 0; e < g.count; ++e)
-                    hits += g.material[e] != VSGL_GBUFFER_MISS;
+                    hits += g.material[e] != VSGL__GBUFFER_MISS;
                 VT_CHECK(hits == (k == 2 ? g.count : 0), "type %d clip [%g, %g]: %zu hits of %zu", type, ranges[k][0],
                          ranges[k][1], hits, g.count);
                 vsgl__gbuffer_free(&g);
@@ -251,7 +251,7 @@ VT_TEST(gbuffer_is_deterministic_across_thread_counts)
     }
     size_t hits = 0;
     for (size_t e = 0; e < ref.count; ++e)
-        hits += ref.material[e] != VSGL_GBUFFER_MISS;
+        hits += ref.material[e] != VSGL__GBUFFER_MISS;
     VT_CHECK(hits > ref.count / 10 && hits < ref.count, "soup covers %zu of %zu samples", hits, ref.count);
     vsgl__gbuffer_free(&ref);
 }

@@ -135,9 +135,9 @@ VT_TEST(kernel_shading_matches_reference_path)
             b.s.diffuse_mode = mode;
             /* the glossy lobe as one ASG, or as GGX's core and tail */
             b.s.glossy_mode = (k + mode) % 2 ? VSGL_GLOSSY_ASG2 : VSGL_GLOSSY_ASG;
-            float *ref = shade(&b, VSGL_SHADE_REFERENCE);
-            float *vec = shade(&b, VSGL_SHADE_KERNEL);
-            float *sca = shade(&b, VSGL_SHADE_KERNEL_SCALAR);
+            float *ref = shade(&b, VSGL__SHADE_REFERENCE);
+            float *vec = shade(&b, VSGL__SHADE_KERNEL);
+            float *sca = shade(&b, VSGL__SHADE_KERNEL_SCALAR);
             double ed = relmse(vec, ref, 3 * px), eg = relmse(vec + 3 * px, ref + 3 * px, 3 * px);
             double sd = relmse(sca, ref, 3 * px), sg = relmse(sca + 3 * px, ref + 3 * px, 3 * px);
             VT_CHECK(ed < 1e-10 && sd < 1e-10, "roughness %g mode %d: diffuse relMSE vec %.3g scalar %.3g", rough[k % 3], mode, ed, sd);
@@ -163,7 +163,7 @@ VT_TEST(kernel_shading_matches_reference_path)
 static void random_block(vt_rng *r, vsgl_kernel_block *b)
 {
     memset(b, 0, sizeof *b);
-    for (int k = 0; k < VSGL_KERNEL_BLOCK; ++k) {
+    for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k) {
         b->x[k] = (float)(4.0 * vt_uniform(r) - 2.0);
         b->y[k] = (float)(4.0 * vt_uniform(r) - 2.0);
         b->z[k] = (float)(4.0 * vt_uniform(r) - 2.0);
@@ -228,7 +228,7 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
                        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl")};
     vt_rng r = {2024};
     static vsgl_kernel_block base, ref, got;
-    static float vis[8 * VSGL_KERNEL_BLOCK];
+    static float vis[8 * VSGL__KERNEL_BLOCK];
     double worst[3] = {0, 0, 0}, worst_c[3] = {0, 0, 0};
     for (int trial = 0; trial < 60; ++trial) {
         random_block(&r, &base);
@@ -239,31 +239,31 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
          * operations rounds differently near the plane */
         int plain = trial % 4 < 2;
         /* every third trial with the glossy lobe as GGX's core and tail */
-        const int32_t lob = VSGL_KERNEL_DIFFUSE | VSGL_KERNEL_GLOSSY | (trial % 3 == 0 ? VSGL_KERNEL_GGX_TAIL : 0);
+        const int32_t lob = VSGL__KERNEL_DIFFUSE | VSGL__KERNEL_GLOSSY | (trial % 3 == 0 ? VSGL__KERNEL_GGX_TAIL : 0);
         for (int k = 0; k < 8; ++k) {
             random_light(&r, &L[k], trial % 2);
             if (plain)
                 L[k].clip = L[k].planar = 0.0f;
         }
-        for (int k = 0; k < 8 * VSGL_KERNEL_BLOCK; ++k)
+        for (int k = 0; k < 8 * VSGL__KERNEL_BLOCK; ++k)
             vis[k] = (float)vt_uniform(&r);
         for (int mode = 0; mode < 3; ++mode)
             for (int withvis = 0; withvis < 2; ++withvis) {
                 ref = base;
                 for (int k = 0; k < 8; ++k) /* one at a time */
-                    vsgl__kernel_shade_scalar(&ref, &L[k], 1, withvis ? vis + k * VSGL_KERNEL_BLOCK : NULL, mode, lob);
+                    vsgl__kernel_shade_scalar(&ref, &L[k], 1, withvis ? vis + k * VSGL__KERNEL_BLOCK : NULL, mode, lob);
                 double scale = 0.0;
                 for (int c = 0; c < 3; ++c)
-                    for (int k = 0; k < VSGL_KERNEL_BLOCK; ++k)
+                    for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k)
                         scale = fmax(scale, fmax(ref.ld[c][k], ref.ls[c][k]));
                 for (int f = 0; f < 3; ++f) {
                     if (!have[f])
                         continue;
                     got = base;
                     fns[f](&got, L, 7, withvis ? vis : NULL, mode, lob); /* in pairs, one left over */
-                    fns[f](&got, L + 7, 1, withvis ? vis + 7 * VSGL_KERNEL_BLOCK : NULL, mode, lob);
+                    fns[f](&got, L + 7, 1, withvis ? vis + 7 * VSGL__KERNEL_BLOCK : NULL, mode, lob);
                     for (int c = 0; c < 3; ++c)
-                        for (int k = 0; k < VSGL_KERNEL_BLOCK; ++k) {
+                        for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k) {
                             double ed = fabs((double)got.ld[c][k] - ref.ld[c][k]) / (fabs(ref.ld[c][k]) + 1e-6 * scale);
                             double es = fabs((double)got.ls[c][k] - ref.ls[c][k]) / (fabs(ref.ls[c][k]) + 1e-6 * scale);
                             VT_CHECK(isfinite(got.ld[c][k]) && isfinite(got.ls[c][k]), "%s: non-finite", names[f]);

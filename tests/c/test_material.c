@@ -250,7 +250,7 @@ VT_TEST(material_glossy_albedo_table_matches_quadrature)
             vsgl__glossy_albedo_table(&p, &t);
             const int ks[] = {1, 4, 8, 12, 16};
             for (int q = 0; q < 5; ++q) {
-                float c = (float)ks[q] / (VSGL_ALBEDO_N - 1), s = sqrtf(1 - c * c);
+                float c = (float)ks[q] / (VSGL__ALBEDO_N - 1), s = sqrtf(1 - c * c);
                 double want[3] = {0, 0, 0};
                 int az = kind == 2 ? 8 : 1;
                 for (int k = 0; k < az; ++k) {

@@ -131,7 +131,7 @@ VT_TEST(rsm_closed_box_total_flux_equals_emitted_power)
         }
         size_t empty = 0;
         for (size_t i = 0; i < r.count; ++i)
-            empty += r.material[i] == VSGL_RSM_EMPTY && r.flux[0][i] > 0;
+            empty += r.material[i] == VSGL__RSM_EMPTY && r.flux[0][i] > 0;
         VT_CHECK(empty == 0, "%zu texels with flux but no surface", empty);
         vsgl__rsm_free(&r);
         vsgl_scene_destroy(sc);
@@ -183,7 +183,7 @@ static double rsm_irradiance(const vsgl_rsm *r, int c, double x, double y, doubl
 {
     double s = 0;
     for (size_t i = 0; i < r->count; ++i)
-        if (r->material[i] != VSGL_RSM_EMPTY)
+        if (r->material[i] != VSGL__RSM_EMPTY)
             s += r->flux[c][i] * kern(r->pos[0][i] - x, r->pos[1][i] - y, w);
     return s;
 }

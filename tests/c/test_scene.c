@@ -222,7 +222,7 @@ static const bad_case bad_cases[] = {
     {"materials NULL", m_materials_null, "scene: materials is NULL but material_count is 2"},
     {"lights NULL", m_lights_null, "scene: lights is NULL but light_count is 2"},
     {"camera NULL", m_camera_null, "scene: camera is NULL (a camera is required)"},
-    {"desc size", m_size, "scene: desc size is 7 (this library expects " /* prefix */},
+    {"desc size", m_size, "vsgl_scene_desc.size is 7: this library knows multiples of 4" /* prefix */},
     {"no material", m_no_material, "scene: material_count is 0 but triangle_count is 4 (need >= 1 material)"},
     {"no vertices", m_no_vertices, "scene: vertex_count is 0 but triangle_count is 4"},
     {"vertex NaN", m_vertex_nan, "vertex 3: y is nan (must be finite, |x| <= 1e18)"},
@@ -586,7 +586,7 @@ VT_TEST(scene_ray_queries_match_an_analytic_box)
     for (int i = 0; i < n; ++i) {
         vsgl_hit h;
         int got = vsgl__scene_intersect(s, orgs[i], dirs[i], 0.0f, 100.0f, &h);
-        if (got != (many[i].triangle != VSGL_HIT_NONE) || (got && (h.t != many[i].t || h.triangle != many[i].triangle)))
+        if (got != (many[i].triangle != VSGL__HIT_NONE) || (got && (h.t != many[i].t || h.triangle != many[i].triangle)))
             ++diff;
     }
     VT_CHECK(diff == 0, "%d of %d stream results differ from rtcIntersect1", diff, n);
@@ -612,7 +612,7 @@ VT_TEST(scene_ray_queries_match_an_analytic_box)
     /* empty intervals never hit */
     t0s[0] = 5.0f; t1s[0] = 1.0f;
     vsgl__scene_intersect_many(s, 1, orgs, dirs, t0s, t1s, 0, many);
-    VT_CHECK(many[0].triangle == VSGL_HIT_NONE, "tmin > tmax hit");
+    VT_CHECK(many[0].triangle == VSGL__HIT_NONE, "tmin > tmax hit");
     free(orgs); free(dirs); free(t0s); free(t1s); free(many);
     vsgl_scene_destroy(s);
     vsgl_context_destroy(ctx);

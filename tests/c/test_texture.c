@@ -207,7 +207,7 @@ VT_TEST(texture_gbuffer_colour_is_the_texels_each_pixel_covers)
                     for (uint32_t j = j0; j < j0 + scale; ++j)
                         for (uint32_t i = i0; i < i0 + scale; ++i)
                             want += px[((size_t)j * tw + i) * 4 + c] / (double)(scale * scale);
-                    double got = g.surf[VSGL_SURF_BASE + c][row * W + col];
+                    double got = g.surf[VSGL__SURF_BASE + c][row * W + col];
                     worst = fmax(worst, fabs(got - want));
                 }
             }
@@ -254,7 +254,7 @@ VT_TEST(texture_rsm_reflected_power_matches_analytic)
             vsgl_moments mo[2];
             if (vsgl__vpl_moments(sc, &r, t, v3_make(0, 0, 0), VSGL_SHARPNESS_TOKSVIG, mo))
                 for (int c = 0; c < 3; ++c)
-                    pd[c] += mo[VSGL_LOBE_DIFFUSE].power[c];
+                    pd[c] += mo[VSGL__LOBE_DIFFUSE].power[c];
         }
         for (int c = 0; c < 3; ++c)
             VT_CHECK_REL(pd[c], 3.0 * 4.0 * mean[c], 0.01, "res %u channel %d (mean albedo %g)", res, c, mean[c]);

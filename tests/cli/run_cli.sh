@@ -69,7 +69,10 @@ if want help; then
 fi
 if want version; then
   v=$("$VSGL" --version); rc=$?
-  if [ $rc -eq 0 ] && [[ "$v" =~ ^vsgl\ [0-9]+\.[0-9]+\.[0-9]+ ]] && [[ "$v" == *"bundle format 1.1"* ]]; then ok version
+  # the bundle format the header declares
+  bmaj=$(awk '/#define VSGL_BUNDLE_VERSION_MAJOR/ {print $3}' csrc/include/vsgl/io.h)
+  bmin=$(awk '/#define VSGL_BUNDLE_VERSION_MINOR/ {print $3}' csrc/include/vsgl/io.h)
+  if [ $rc -eq 0 ] && [[ "$v" =~ ^vsgl\ [0-9]+\.[0-9]+\.[0-9]+ ]] && [[ "$v" == *"bundle format $bmaj.$bmin"* ]]; then ok version
   else bad version "got exit $rc: $v"; fi
 fi
 

@@ -3,8 +3,8 @@
 The binding is imported the way the tests of the add-on do it
 (``addon/vsgl_indirect`` on sys.path). The library is the one the binding
 finds ($VSGL_LIBRARY, else build/libvsgl.so); build it with ``make``.
-Tests of functions the library does not export yet are skipped with the
-symbol's name, so the suite gets stricter as the C code lands.
+Nothing here skips: a missing symbol or an unloadable library fails
+(tools/run_tests.sh fails the run on any skip of this suite).
 """
 
 import os
@@ -28,21 +28,13 @@ def lib():
     try:
         return libvsgl.library()
     except libvsgl.VsglLibraryError as e:
-        pytest.skip("libvsgl not loadable (test_library.py reports why): %s" % e)
+        pytest.fail("libvsgl not loadable (test_library.py says why): %s" % e)
 
 
 def require(lib, *names):
-    """Skip the calling test unless every symbol is exported."""
+    """Every symbol a test calls must be exported (a missing one fails)."""
     missing = [n for n in names if not lib.has(n)]
-    if missing:
-        pytest.skip("not implemented in libvsgl yet: %s" % ", ".join(missing))
-
-
-def require_complete(lib):
-    """Skip unless the library has no undefined vsgl_ references (calls into
-    the pipeline of an incomplete build would abort the process)."""
-    if lib.undefined:
-        pytest.skip("libvsgl build is incomplete (undefined: %s)" % ", ".join(lib.undefined))
+    assert not missing, "libvsgl does not export: %s" % ", ".join(missing)
 
 
 @pytest.fixture

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import libvsgl as L
-from conftest import require, require_complete
+from conftest import require
 from scenes import floor_and_wall
 
 
@@ -88,7 +88,6 @@ def _render(ctx, **kw):
 
 def test_progress_callback_reports_and_cancels(lib):
     require(lib, "vsgl_scene_create", "vsgl_render", "vsgl_render_settings_preset")
-    require_complete(lib)
     seen = []
     with L.Context(progress=lambda stage, f: seen.append((stage, f)) and False) as ctx:
         _render(ctx)
@@ -102,7 +101,6 @@ def test_progress_callback_reports_and_cancels(lib):
 
 def test_keyboard_interrupt_in_progress_cancels_and_reraises(lib):
     require(lib, "vsgl_scene_create", "vsgl_render", "vsgl_render_settings_preset")
-    require_complete(lib)
     calls = []
 
     def progress(stage, f):
@@ -118,7 +116,6 @@ def test_keyboard_interrupt_in_progress_cancels_and_reraises(lib):
 
 def test_other_exception_in_progress_is_logged_and_ignored(lib, caplog):
     require(lib, "vsgl_scene_create", "vsgl_render", "vsgl_render_settings_preset")
-    require_complete(lib)
 
     def progress(stage, f):
         raise ValueError("boom in progress")

@@ -2,7 +2,6 @@
 light that moves a little changes the AOV a little, without jitter (issue 9).
 The importance-drawn fits are the contrast that shows the checks can fail."""
 import numpy as np
-import pytest
 
 import libvsgl as L
 import scenes

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import libvsgl as L
-from conftest import require, require_complete
+from conftest import require
 from scenes import floor_and_wall
 
 EXR_MAGIC = struct.pack("<I", 20000630)
@@ -74,7 +74,6 @@ def test_exr_write_io_error_names_path(lib, ctx, tmp_path):
 
 def test_exr_write_render(lib, ctx, tmp_path):
     require(lib, "vsgl_exr_write_render", "vsgl_render", "vsgl_scene_create")
-    require_complete(lib)
     scene = L.Scene(ctx, **floor_and_wall())
     images, _ = L.render(ctx, scene, L.render_settings_preset("preview"))
     path = tmp_path / "render.exr"

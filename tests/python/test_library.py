@@ -108,7 +108,7 @@ def test_missing_library_message_says_make(tmp_path):
 def _fake_library(tmp_path, version):
     """A tiny shared library exporting only vsgl_version (and result strings)."""
     if CC is None:
-        pytest.skip("no C compiler to build a fake library")
+        pytest.fail("no C compiler to build a fake library (the build needs one)")
     src = tmp_path / "fake.c"
     src.write_text(textwrap.dedent("""
         #include <stdint.h>
@@ -130,15 +130,15 @@ def test_version_mismatch_names_both_versions(tmp_path):
     assert "make" in msg, msg
 
 
-def test_missing_symbols_raise_naming_the_symbol(tmp_path):
+def test_a_library_lacking_functions_is_refused_naming_them(tmp_path):
+    """A libvsgl of the right version that lacks bound functions (built from
+    another checkout) is a load error that names them, not a later crash."""
     maj, mnr = libvsgl.BINDING_VERSION
-    fake = libvsgl.load_library(_fake_library(tmp_path, maj * 10000 + mnr * 100 + 9))
-    assert "vsgl_sg_integral" in fake.missing
-    assert not fake.has("vsgl_sg_integral") and fake.has("vsgl_version")
-    with pytest.raises(libvsgl.VsglMissingSymbolError) as e:
-        fake.vsgl_sg_integral(1.0)
-    assert e.value.symbol == "vsgl_sg_integral" and "vsgl_sg_integral" in str(e.value)
-    assert isinstance(e.value, NotImplementedError)
+    so = _fake_library(tmp_path, maj * 10000 + mnr * 100 + 9)
+    with pytest.raises(libvsgl.VsglLibraryError) as e:
+        libvsgl.load_library(so)
+    msg = str(e.value)
+    assert so in msg and "vsgl_sg_integral" in msg and "vsgl_render" in msg and "make" in msg, msg
 
 
 def test_not_a_library_gives_clear_error(tmp_path):
@@ -154,7 +154,7 @@ def test_missing_dependency_names_it_and_its_package(tmp_path):
     (rebuild it with `make`)', which a zip user cannot do. The message names
     the missing library and the package that provides it."""
     if CC is None:
-        pytest.skip("no C compiler")
+        pytest.fail("no C compiler (the build needs one)")
     dep, user = tmp_path / "dep.c", tmp_path / "user.c"
     dep.write_text("int vsgl_test_dep(void) { return 1; }\n")
     user.write_text("int vsgl_test_dep(void);\nint vsgl_version(void) { return vsgl_test_dep(); }\n")
@@ -195,16 +195,3 @@ def test_binding_does_not_import_bpy_or_use_star_imports():
     src = open(os.path.join(ADDON, "libvsgl.py")).read()
     assert "import bpy" not in src and "from ctypes import *" not in src
     assert not re.search(r"^\s*from \.", src, re.M), "no relative imports: the tests import the module directly"
-
-
-def test_wrappers_raise_missing_symbol_from_an_incomplete_library(tmp_path, monkeypatch):
-    maj, mnr = libvsgl.BINDING_VERSION
-    fake = libvsgl.load_library(_fake_library(tmp_path, maj * 10000 + mnr * 100))
-    monkeypatch.setattr(libvsgl, "_lib", fake)
-    for call, symbol in [(lambda: libvsgl.sg_integral(1.0), "vsgl_sg_integral"),
-                         (lambda: libvsgl.asg_eval(libvsgl.ASG([1, 0, 0], [0, 1, 0], [0, 0, 1], 1, 1),
-                                                   [0, 0, 1]), "vsgl_asg_eval"),
-                         (lambda: libvsgl.Context(), "vsgl_context_create")]:
-        with pytest.raises(libvsgl.VsglMissingSymbolError) as e:
-            call()
-        assert e.value.symbol == symbol and symbol in str(e.value)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import libvsgl as L
-from conftest import require, require_complete
+from conftest import require
 from scenes import floor_and_wall
 
 ALL = ("vsgl_scene_create", "vsgl_scene_get_info", "vsgl_render", "vsgl_render_settings_preset")
@@ -98,7 +98,6 @@ def test_scene_info(lib, ctx):
 
 def test_scene_arrays_may_be_freed_after_construction(lib, ctx):
     require(lib, *ALL)
-    require_complete(lib)
     s = floor_and_wall()
     scene = L.Scene(ctx, **s)
     s["positions"][:] = np.nan  # the library copied them
@@ -112,7 +111,6 @@ def test_scene_arrays_may_be_freed_after_construction(lib, ctx):
 @pytest.fixture(scope="module")
 def rendered(lib):
     require(lib, *ALL)
-    require_complete(lib)
     with L.Context(thread_count=2) as ctx:
         scene = L.Scene(ctx, **floor_and_wall())
         a = L.render(ctx, scene, L.render_settings_preset("preview"))
@@ -157,7 +155,6 @@ def test_render_is_deterministic(rendered):
 
 def test_render_plane_subset_and_settings_forms(lib, ctx):
     require(lib, *ALL)
-    require_complete(lib)
     scene = L.Scene(ctx, **floor_and_wall())
     images, _ = L.render(ctx, scene, {"aa_samples": 1, "fit_mode": "two"}, planes=("combined",))
     assert list(images) == ["combined"]
@@ -184,7 +181,6 @@ def test_floor_alone_has_no_brute_force_indirect_light(lib, ctx):
     """Physics, independent of the method: a single plane cannot light
     itself, so the brute-force reference is exactly black on it."""
     require(lib, "vsgl_scene_create", "vsgl_reference_render")
-    require_complete(lib)
     scene = L.Scene(ctx, **floor_and_wall(wall=False))
     images, stats = L.reference_render(ctx, scene, rsm_res=32)
     assert stats["vpl_count"] > 0
@@ -196,7 +192,6 @@ def test_floor_alone_has_no_brute_force_indirect_light(lib, ctx):
 
 def test_reference_rsm_flux_is_bounded_by_light_power(lib, ctx):
     require(lib, "vsgl_scene_create", "vsgl_reference_rsm")
-    require_complete(lib)
     scene = L.Scene(ctx, **floor_and_wall(wall=False))
     rsm = L.reference_rsm(ctx, scene, 0, 32)
     N = len(rsm["areas"])
@@ -212,7 +207,6 @@ def test_reference_rsm_flux_is_bounded_by_light_power(lib, ctx):
 
 def test_debug_gbuffer_hits_the_scene(lib, ctx):
     require(lib, "vsgl_scene_create", "vsgl_debug_gbuffer")
-    require_complete(lib)
     scene = L.Scene(ctx, **floor_and_wall())
     g = L.debug_gbuffer(ctx, scene, aa=2)
     assert g["positions"].shape == (12, 16, 4, 3) and g["materials"].shape == (12, 16, 4)
@@ -227,7 +221,6 @@ def test_debug_gbuffer_hits_the_scene(lib, ctx):
 
 def test_debug_gbuffer_frames(lib, ctx):
     require(lib, "vsgl_scene_create", "vsgl_debug_gbuffer", "vsgl_debug_gbuffer_frames")
-    require_complete(lib)
     scene = L.Scene(ctx, **floor_and_wall())
     g = L.debug_gbuffer(ctx, scene, aa=1)
     f = L.debug_gbuffer_frames(ctx, scene, aa=1)

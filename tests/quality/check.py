@@ -97,7 +97,8 @@ def feature_checks(name, ref, cnt):
         ratio = float(ref["Gloss"][fl].sum() / ref["Diff"].sum())
         peak = float(np.percentile(g, 99) / max(np.median(g), 1e-9))
         cnt.check(ratio > 0.5 and peak > 5, "feature %s: the metal floor reflects a bright ellipse (floor Gloss sum "
-                  "%.2f x the image's Diff sum, > 0.5; its 99th percentile %.1f x its median, > 5)" % (name, ratio, peak))
+                  "%.2f x the image's Diff sum, > 0.5; its 99th percentile %.1f x its median, > 5)"
+                  % (name, ratio, peak))
     elif name == "metal_floor_red_wall":
         bw = m == idx["back_wall"]
         r, g = float(ref["Diff"][bw][:, 0].mean()), float(ref["Diff"][bw][:, 1].mean())
@@ -209,7 +210,7 @@ def main(argv=None):
             s = e["still"]
             cnt.check(all(abs(s[p]["bias"] - 1) <= MAX_BIAS[label] for p in ("Diff", "Gloss")),
                       "%s %s: bias Diff %.3f, Gloss %.3f (within %d %%)" % (label, n, s["Diff"]["bias"],
-                                                                         s["Gloss"]["bias"], 100 * MAX_BIAS[label]))
+                                                                            s["Gloss"]["bias"], 100 * MAX_BIAS[label]))
         q, b = (r["configs"][k]["still"]["Combined"]["structured"] for k in ("quality", "balanced"))
         cnt.check(q <= QUALITY_OVER_BALANCED * b, "quality %s: structured error %.5f, balanced %.5f (<= %gx)"
                   % (n, q, b, QUALITY_OVER_BALANCED))

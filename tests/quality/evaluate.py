@@ -294,7 +294,7 @@ def acceptance(res):
                 continue
             fl = [e["flicker"][k][p]["median"] for p in ("Diff", "Gloss")]
             a["flicker %s <= %.2f" % (k, ACCEPT["flicker"])] = ("PASS" if max(fl) <= ACCEPT["flicker"]
-                                                               else "FAIL (%.3f)" % max(fl))
+                                                                else "FAIL (%.3f)" % max(fl))
         tol = ACCEPT["bias_preview"] if label == "preview" else ACCEPT["bias"]
         worst = max(abs(e["still"][p]["bias"] - 1) for p in ("Diff", "Gloss"))
         if worst <= tol:
@@ -391,9 +391,11 @@ def markdown(results, args, img_rel):
         body += ["## %s" % name, "", r["feature"] + ".", "",
                  "Reference: mean of seeds %s (%s s per render), own noise relMSE full/4x4: Diff %s / %s, Gloss "
                  "%s / %s, Combined %s / %s; FLIP of seed 1 vs seed 2: %s; seed agreement z (Diff/Gloss): %s / %s." % (
-                     ", ".join(map(str, r["reference"]["seeds"])), ", ".join("%.1f" % s for s in r["reference"]["seconds"]),
+                     ", ".join(map(str, r["reference"]["seeds"])),
+                     ", ".join("%.1f" % s for s in r["reference"]["seconds"]),
                      _f(nz["Diff"]["full"], "%.5f"), _f(nz["Diff"]["s4"], "%.5f"), _f(nz["Gloss"]["full"], "%.5f"),
-                     _f(nz["Gloss"]["s4"], "%.5f"), _f(nz["Combined"]["full"], "%.5f"), _f(nz["Combined"]["s4"], "%.5f"),
+                     _f(nz["Gloss"]["s4"], "%.5f"), _f(nz["Combined"]["full"], "%.5f"),
+                     _f(nz["Combined"]["s4"], "%.5f"),
                      _f(r["reference"]["flip_seeds"], "%.4f"), _f(r["reference"]["agreement"]["Diff"], "%.2f"),
                      _f(r["reference"]["agreement"]["Gloss"], "%.2f")), ""]
         acc = acceptance(r) if args.acceptance else {}
@@ -412,7 +414,8 @@ def markdown(results, args, img_rel):
                     _f(f["Diff"]["ratio"], "%.1f"), _f(f["Gloss"]["ratio"], "%.1f"),
                     _f(f["Diff"].get("l1"), "%.4f"), _f(f["Gloss"].get("l1"), "%.4f"))
             row = "| %s | %.3f | %d | %s | %s | %s | %s | %s | %s | %s (%sx) | %s (%sx) | %s (%sx) | %s | %s | %s |" % (
-                label, e["seconds"], e["vsgls"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]), _f(s["Combined"]["bias"]),
+                label, e["seconds"], e["vsgls"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]),
+                _f(s["Combined"]["bias"]),
                 _f(s["Diff"]["relmse"], "%.4f"), _f(s["Gloss"]["relmse"], "%.4f"), _f(s["Combined"]["relmse"], "%.4f"),
                 _f(s["Diff"]["structured"], "%.5f"), _ratio(s["Diff"]["structured"], nz["Diff"]["s4"]),
                 _f(s["Gloss"]["structured"], "%.5f"), _ratio(s["Gloss"]["structured"], nz["Gloss"]["s4"]),
@@ -647,7 +650,8 @@ def main(argv=None):
         md = markdown(results, args, img_rel if want_images else None)
         if args.before:
             with open(args.before) as bf:
-                md = md.replace("## Summary (presets)", before_after(json.load(bf), results) + "## Summary (presets)", 1)
+                md = md.replace("## Summary (presets)",
+                                before_after(json.load(bf), results) + "## Summary (presets)", 1)
         fh.write(md)
     print("report: %s\nresults: %s%s" % (md_path, jpath, ("\nimages: " + img_dir) if want_images else ""))
     return results

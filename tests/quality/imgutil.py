@@ -64,7 +64,9 @@ def signed_error(diff, scale):
     mid-bright pixel)."""
     v = np.asarray(diff, np.float64) * scale
     pos, neg = np.clip(v, 0, None), np.clip(-v, 0, None)
-    t = lambda x: (x / (1.0 + x)) ** (1 / 2.2)
+
+    def t(x):
+        return (x / (1.0 + x)) ** (1 / 2.2)
     return np.stack([t(pos), np.zeros_like(v), t(neg)], -1)
 
 
@@ -92,7 +94,6 @@ def upscale(img, k):
     if k <= 1:
         return img
     return np.repeat(np.repeat(img, k, axis=0), k, axis=1)
-
 
 
 # A 3x5 pixel font (upper case, digits, a little punctuation) for the labels

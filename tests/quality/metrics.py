@@ -6,7 +6,7 @@ GlossInd*GlossCol, Combined = Diff + Gloss (`coloured`).
 
 - bias(a, ref): sum(a) / sum(ref) (1 = no energy lost or added).
 - relmse(a, ref): mean((a - ref)^2 / (ref^2 + 0.01)) over pixels and
-  channels (GUIDE Sec. 6).
+  channels (docs/references.md §6).
 - structured(a, ref, k=4): relmse after both are box-downsampled k x k; it
   removes most of the reference's noise but keeps blotches.
 - ref_noise(c1, c2, k): what a perfect image would score against the mean of
@@ -29,7 +29,7 @@ GlossInd*GlossCol, Combined = Diff + Gloss (`coloured`).
 """
 import numpy as np
 
-EPS = 0.01  # relMSE's regulariser (GUIDE Sec. 6)
+EPS = 0.01  # relMSE's regulariser (docs/references.md §6)
 
 try:  # FLIP is optional: the rest of the harness works without it
     import flip_evaluator as _flip
@@ -143,6 +143,7 @@ def all_metrics(img, ref_seeds, k=4):
     ref = {p: 0.5 * (ref_seeds[0][p] + ref_seeds[1][p]) for p in ("Diff", "Gloss", "Combined")}
     out = {}
     for p in ("Diff", "Gloss", "Combined"):
-        out[p] = dict(bias=bias(img[p], ref[p]), relmse=relmse(img[p], ref[p]), structured=structured(img[p], ref[p], k))
+        out[p] = dict(bias=bias(img[p], ref[p]), relmse=relmse(img[p], ref[p]),
+                      structured=structured(img[p], ref[p], k))
     out["flip"] = flip(img["Combined"], ref["Combined"])
     return out

@@ -422,7 +422,8 @@ def library_light(L, ls):
     o.type = _LIGHT_TYPES[t]
     o.color[:] = (1.0, 1.0, 1.0)
     o.power = float(ls["energy"])
-    o.world_from_light[:] = [float(v) for v in world_matrix(ls["loc"], ls["rot"], ls.get("scale", (1, 1, 1)))[:3, :].reshape(-1)]
+    o.world_from_light[:] = [float(v) for v in
+                             world_matrix(ls["loc"], ls["rot"], ls.get("scale", (1, 1, 1)))[:3, :].reshape(-1)]
     # radius: shadow_soft_size as Blender 3.4 reports it: 0 for point/spot as
     # built, the default 0.25 for a sun, the size for an area light
     o.radius = {"POINT": 0.0, "SPOT": 0.0, "SUN": 0.25}.get(t, ls.get("size", 0.25))

@@ -66,7 +66,7 @@ int main(int argc, char **argv)
         l->conv = 1.0f;
         l->ibehind = 1.0f / (0.02f * sqrtf(l->var));
     }
-    for (int i = 0; i < VSGL_KERNEL_BLOCK; ++i) {
+    for (int i = 0; i < VSGL__KERNEL_BLOCK; ++i) {
         b.x[i] = uniform(&s); b.y[i] = uniform(&s); b.z[i] = -1.0f;
         b.nz[i] = 1.0f;
         b.diffuse[i] = 1.0f;
@@ -78,10 +78,10 @@ int main(int argc, char **argv)
     }
     const char *mode_name[3] = {"accurate", "SG (poster)", "pulled-out"};
     const char *lobe_name[4] = {"", "diffuse only", "glossy only", "diffuse + glossy"};
-    printf("kernel alone, one thread, one block of %d receivers x %d VSGLs, best of 5:\n", VSGL_KERNEL_BLOCK, NL);
+    printf("kernel alone, one thread, one block of %d receivers x %d VSGLs, best of 5:\n", VSGL__KERNEL_BLOCK, NL);
     for (int lobes = 1; lobes <= 3; ++lobes)
         for (int mode = 0; mode < 3; ++mode) {
-            if (lobes == VSGL_KERNEL_GLOSSY && mode > 0)
+            if (lobes == VSGL__KERNEL_GLOSSY && mode > 0)
                 continue;
             double best = 1e30;
             for (int t = 0; t < 5; ++t) {
@@ -93,9 +93,9 @@ int main(int argc, char **argv)
                 double dt = now() - t0;
                 best = dt < best ? dt : best;
             }
-            double pairs = (double)reps * NL * VSGL_KERNEL_BLOCK;
+            double pairs = (double)reps * NL * VSGL__KERNEL_BLOCK;
             printf("kernel  %-16s %-12s %.3g pairs/s  (%.2f ns per pair)\n", lobe_name[lobes],
-                   lobes == VSGL_KERNEL_GLOSSY ? "" : mode_name[mode], pairs / best, 1e9 * best / pairs);
+                   lobes == VSGL__KERNEL_GLOSSY ? "" : mode_name[mode], pairs / best, 1e9 * best / pairs);
             if (!(b.ld[0][0] >= 0.0f && b.ls[0][0] >= 0.0f)) /* keep the sums alive */
                 printf("kernel  unexpected sum\n");
         }

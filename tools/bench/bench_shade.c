@@ -100,11 +100,11 @@ int main(int argc, char **argv)
     if (reps < 1) reps = 1;
     for (int r = 0; r < reps; ++r) {
         double t0 = now();
-        vsgl__shade(ctx, scene, &g, &set, &rs, &pl, VSGL_SHADE_KERNEL, &pairs);
+        vsgl__shade(ctx, scene, &g, &set, &rs, &pl, VSGL__SHADE_KERNEL, &pairs);
         tv[r] = now() - t0;
         if (r == 0) { /* the scalar build is ~8x slower: once */
             t0 = now();
-            vsgl__shade(ctx, scene, &g, &set, &rs, &pl, VSGL_SHADE_KERNEL_SCALAR, &pairs);
+            vsgl__shade(ctx, scene, &g, &set, &rs, &pl, VSGL__SHADE_KERNEL_SCALAR, &pairs);
             ts[r] = now() - t0;
         }
     }
@@ -122,7 +122,7 @@ int main(int argc, char **argv)
         double tm[16];
         for (int r = 0; r < reps; ++r) {
             double t0 = now();
-            vsgl__shade(ctx, scene, &g, &set, &po, &pl, VSGL_SHADE_KERNEL, &pairs);
+            vsgl__shade(ctx, scene, &g, &set, &po, &pl, VSGL__SHADE_KERNEL, &pairs);
             tm[r] = now() - t0;
         }
         double mm = median(tm, reps);

@@ -19,7 +19,7 @@
  * CRC32-checked, and non-finite floats are refused with a message naming
  * the section and element (see ::vsgl_context_last_error).
  *
- * Formats: docs/bundle-format.md (bundle), GUIDE §5 and this header (EXR).
+ * Formats: docs/bundle-format.md (bundle), docs/references.md §5 and this header (EXR).
  */
 #ifndef VSGL_IO_H
 #define VSGL_IO_H

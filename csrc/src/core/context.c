@@ -1,5 +1,6 @@
 /* Context lifetime, last-error message, logging and progress. */
 #include "context.h"
+#include "core/versioned.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -18,17 +19,12 @@ vsgl_result vsgl_context_create(const vsgl_context_desc *desc, vsgl_context **ou
     if (!out)
         return VSGL_ERROR_INVALID_ARGUMENT;
     *out = NULL;
-    if (desc && desc->size > sizeof(vsgl_context_desc))
+    vsgl_context_desc d;
+    if (vsgl__copy_versioned(NULL, &d, sizeof d, desc, "vsgl_context_desc") != VSGL_OK)
         return VSGL_ERROR_INVALID_ARGUMENT;
     vsgl_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
         return VSGL_ERROR_OUT_OF_MEMORY;
-    vsgl_context_desc d;
-    memset(&d, 0, sizeof d);
-    if (desc) {
-        size_t n = desc->size ? desc->size : sizeof d;
-        memcpy(&d, desc, n);
-    }
     ctx->thread_count = d.thread_count ? d.thread_count : online_cores();
     if (ctx->thread_count > 1024)
         ctx->thread_count = 1024;
@@ -82,7 +78,7 @@ void vsgl__log(const vsgl_context *ctx, int32_t level, const char *fmt, ...)
 {
     if (!ctx || !ctx->log || level > ctx->log_level)
         return;
-    char line[VSGL_MESSAGE_MAX];
+    char line[VSGL__MESSAGE_MAX];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(line, sizeof line, fmt, ap);

@@ -4,7 +4,7 @@
 
 #include "vsgl/base.h"
 
-#define VSGL_MESSAGE_MAX 512
+#define VSGL__MESSAGE_MAX 512
 
 struct vsgl_context {
     uint32_t thread_count;
@@ -13,9 +13,9 @@ struct vsgl_context {
     void *log_user;
     vsgl_progress_fn progress;
     void *progress_user;
-    char last_error[VSGL_MESSAGE_MAX];
+    char last_error[VSGL__MESSAGE_MAX];
     float progress_base, progress_span; /* stage window of the overall progress */
-    uint64_t max_memory;    /* 0 = what the machine has available (shade/memory.c) */
+    uint64_t max_memory;    /* 0 = what the machine has available (render/memory.c) */
 };
 
 #if defined(__GNUC__)

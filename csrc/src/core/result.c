@@ -24,10 +24,10 @@ int32_t vsgl_version(void)
     return VSGL_VERSION;
 }
 
-#define VSGL_STR2(x) #x
-#define VSGL_STR(x) VSGL_STR2(x)
+#define VSGL__STR2(x) #x
+#define VSGL__STR(x) VSGL__STR2(x)
 
 const char *vsgl_version_string(void)
 {
-    return VSGL_STR(VSGL_VERSION_MAJOR) "." VSGL_STR(VSGL_VERSION_MINOR) "." VSGL_STR(VSGL_VERSION_PATCH);
+    return VSGL__STR(VSGL_VERSION_MAJOR) "." VSGL__STR(VSGL_VERSION_MINOR) "." VSGL__STR(VSGL_VERSION_PATCH);
 }

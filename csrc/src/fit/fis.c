@@ -34,7 +34,7 @@ double *vsgl__importance_cdf(const vsgl_grid *g, size_t n)
     cdf[0] = 0.0;
     const float *d = g->level[0].data;
     for (size_t t = 0; t < n; ++t) {
-        double w = (double)d[t * VSGL_GRID_STRIDE] + (double)d[t * VSGL_GRID_STRIDE + VSGL_GRID_FIELDS];
+        double w = (double)d[t * VSGL__GRID_STRIDE] + (double)d[t * VSGL__GRID_STRIDE + VSGL__GRID_FIELDS];
         cdf[t + 1] = cdf[t] + (w > 0.0 ? w : 0.0);
     }
     return cdf;
@@ -53,10 +53,22 @@ size_t vsgl__find_texel(const double *cdf, size_t n, double target)
     return lo < n ? lo : n - 1;
 }
 
+size_t vsgl__stratified_texel(const vsgl_grid *g, const double *cdf, size_t n, uint32_t seed, uint32_t light,
+                              uint32_t i, uint32_t count, uint32_t *face, uint32_t *x, uint32_t *y)
+{
+    double u = (i + vsgl__hash_uniform(seed, light, i, 0)) / count;
+    size_t t = vsgl__find_texel(cdf, n, u * cdf[n]);
+    size_t per_face = (size_t)g->res * g->res, rem = t % per_face;
+    *face = (uint32_t)(t / per_face);
+    *x = (uint32_t)(rem % g->res);
+    *y = (uint32_t)(rem / g->res);
+    return t;
+}
+
 static double mass_at(const vsgl_grid *g, uint32_t face, float x, float y, float l, double total, double *s)
 {
     vsgl__grid_sample(g, face, x, y, l, s);
-    return (s[0] + s[VSGL_GRID_FIELDS]) / total;
+    return (s[0] + s[VSGL__GRID_FIELDS]) / total;
 }
 
 static vsgl_result push_cluster(const double *s, double scale, const vsgl_grid *g, int32_t estimator,
@@ -64,7 +76,7 @@ static vsgl_result push_cluster(const double *s, double scale, const vsgl_grid *
 {
     for (uint32_t lobe = 0; lobe < 2; ++lobe) {
         vsgl_moments m, scaled;
-        vsgl__grid_moments(s + lobe * VSGL_GRID_FIELDS, &m);
+        vsgl__grid_moments(s + lobe * VSGL__GRID_FIELDS, &m);
         memset(&scaled, 0, sizeof scaled);
         vsgl__moments_add(&scaled, &m, scale);
         vsgl_vsgl v;
@@ -85,7 +97,7 @@ vsgl_result vsgl__fit_fis(vsgl_context *ctx, const vsgl_scene *scene, const vsgl
     vsgl_result r = vsgl__grid_build(ctx, scene, rsm, s->sharpness_estimator, n_clusters > 1, &g);
     if (r != VSGL_OK)
         return r;
-    double total = g.total[0] + g.total[VSGL_GRID_FIELDS];
+    double total = g.total[0] + g.total[VSGL__GRID_FIELDS];
     if (!(total > 0.0)) {
         vsgl__grid_free(&g);
         return VSGL_OK;
@@ -101,17 +113,14 @@ vsgl_result vsgl__fit_fis(vsgl_context *ctx, const vsgl_scene *scene, const vsgl
         vsgl__grid_free(&g);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "fit: out of memory for the importance table");
     }
-    double cdf_total = cdf[n];
     uint32_t iterations = s->fis_iterations ? s->fis_iterations : 8;
     double target = 1.0 / n_clusters; /* K / N with K = 1 */
-    double sums[VSGL_GRID_STRIDE];
+    double sums[VSGL__GRID_STRIDE];
     for (uint32_t i = 0; i < n_clusters && r == VSGL_OK; ++i) {
-        double u = (i + vsgl__hash_uniform(s->seed, rsm->light, i, 0)) / n_clusters;
-        size_t t = vsgl__find_texel(cdf, n, u * cdf_total);
-        uint32_t face = (uint32_t)(t / ((size_t)g.res * g.res));
-        size_t rem = t % ((size_t)g.res * g.res);
-        float x = (float)(rem % g.res) + vsgl__hash_uniform(s->seed, rsm->light, i, 1);
-        float y = (float)(rem / g.res) + vsgl__hash_uniform(s->seed, rsm->light, i, 2);
+        uint32_t face, tx, ty;
+        (void)vsgl__stratified_texel(&g, cdf, n, s->seed, rsm->light, i, n_clusters, &face, &tx, &ty);
+        float x = (float)tx + vsgl__hash_uniform(s->seed, rsm->light, i, 1);
+        float y = (float)ty + vsgl__hash_uniform(s->seed, rsm->light, i, 2);
         float lmin = 0.0f, lmax = (float)(g.levels - 1);
         for (uint32_t k = 0; k < iterations; ++k) {
             float l = 0.5f * (lmin + lmax);

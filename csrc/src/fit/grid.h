@@ -5,19 +5,19 @@
 
 #include "fit/vsgl_set.h"
 
-#define VSGL_GRID_FIELDS 14 /* weight, power[3], dir[3], pos[3], pos2, nrm[3] */
-#define VSGL_GRID_STRIDE (2 * VSGL_GRID_FIELDS) /* diffuse then specular */
+#define VSGL__GRID_FIELDS 14 /* weight, power[3], dir[3], pos[3], pos2, nrm[3] */
+#define VSGL__GRID_STRIDE (2 * VSGL__GRID_FIELDS) /* diffuse then specular */
 
 typedef struct vsgl_grid_level {
     uint32_t side;       /* texels per side of each face at this level */
-    float *data;         /* faces * side * side * VSGL_GRID_STRIDE block sums */
+    float *data;         /* faces * side * side * VSGL__GRID_STRIDE block sums */
 } vsgl_grid_level;
 
 typedef struct vsgl_grid {
     uint32_t faces, res, levels; /* level 0 = res (padded to a power of two) */
     vsgl_grid_level level[24];
     v3 origin;
-    double total[VSGL_GRID_STRIDE]; /* whole-map sums (double, fixed order) */
+    double total[VSGL__GRID_STRIDE]; /* whole-map sums (double, fixed order) */
     size_t valid;        /* texels carrying power */
 } vsgl_grid;
 
@@ -30,7 +30,7 @@ void vsgl__grid_free(vsgl_grid *g);
  * coordinates (x, y) of `face`: bilinear within a level, linear between
  * levels, clamp to edge. */
 void vsgl__grid_sample(const vsgl_grid *g, uint32_t face, float x, float y, float l,
-                       double out[VSGL_GRID_STRIDE]);
+                       double out[VSGL__GRID_STRIDE]);
 
 /* Unpack one lobe of a sample into moments. */
 void vsgl__grid_moments(const double *lobe_fields, vsgl_moments *out);
@@ -44,5 +44,12 @@ double *vsgl__importance_cdf(const vsgl_grid *g, size_t n);
 
 /* The texel t with cdf[t] <= target < cdf[t + 1]. */
 size_t vsgl__find_texel(const double *cdf, size_t n, double target);
+
+/* Stratified importance sampling of level-0 texels: sample i of `count`
+ * (u = (i + hash) / count through the CDF) for (seed, light); returns the
+ * texel index and its face and integer texel coordinates. FIS and k-means
+ * seed their clusters with it. */
+size_t vsgl__stratified_texel(const vsgl_grid *g, const double *cdf, size_t n, uint32_t seed, uint32_t light,
+                              uint32_t i, uint32_t count, uint32_t *face, uint32_t *x, uint32_t *y);
 
 #endif

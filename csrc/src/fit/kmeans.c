@@ -35,8 +35,8 @@ static int32_t assign_chunk(void *user, size_t chunk, size_t b, size_t e)
         uint32_t face = (uint32_t)(t / per_face);
         size_t rem = t % per_face;
         size_t gi = ((size_t)face * j->g->res + rem / r->res) * j->g->res + rem % r->res;
-        const float *m = j->g->level[0].data + gi * VSGL_GRID_STRIDE;
-        if (!(m[0] + m[VSGL_GRID_FIELDS] > 0.0f)) {
+        const float *m = j->g->level[0].data + gi * VSGL__GRID_STRIDE;
+        if (!(m[0] + m[VSGL__GRID_FIELDS] > 0.0f)) {
             j->label[t] = UINT32_MAX;
             continue;
         }
@@ -75,7 +75,7 @@ vsgl_result vsgl__fit_kmeans(vsgl_context *ctx, const vsgl_scene *scene, const v
     double *cdf = vsgl__importance_cdf(&g, n);
     centre *c = malloc((size_t)n_clusters * sizeof *c);
     uint32_t *label = malloc(rsm->count * sizeof *label);
-    double *sums = calloc((size_t)n_clusters * VSGL_GRID_STRIDE, sizeof *sums);
+    double *sums = calloc((size_t)n_clusters * VSGL__GRID_STRIDE, sizeof *sums);
     if (!cdf || !c || !label || !sums) {
         r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "fit: out of memory for %u k-means clusters", n_clusters);
         goto done;
@@ -83,18 +83,16 @@ vsgl_result vsgl__fit_kmeans(vsgl_context *ctx, const vsgl_scene *scene, const v
     if (!(cdf[n] > 0.0))
         goto done;
     for (uint32_t i = 0; i < n_clusters; ++i) {
-        double u = (i + vsgl__hash_uniform(s->seed, rsm->light, i, 0)) / n_clusters;
-        size_t t = vsgl__find_texel(cdf, n, u * cdf[n]);
-        c[i].face = (uint32_t)(t / ((size_t)g.res * g.res));
-        size_t rem = t % ((size_t)g.res * g.res);
-        c[i].x = (float)(rem % g.res) + 0.5f;
-        c[i].y = (float)(rem / g.res) + 0.5f;
+        uint32_t tx, ty;
+        size_t t = vsgl__stratified_texel(&g, cdf, n, s->seed, rsm->light, i, n_clusters, &c[i].face, &tx, &ty);
+        c[i].x = (float)tx + 0.5f;
+        c[i].y = (float)ty + 0.5f;
         /* the texel's mean position from its moments */
-        const float *m = g.level[0].data + t * VSGL_GRID_STRIDE;
-        double w = (double)m[0] + m[VSGL_GRID_FIELDS];
-        c[i].p = v3_make((float)(g.origin.x + (m[7] + m[VSGL_GRID_FIELDS + 7]) / w),
-                         (float)(g.origin.y + (m[8] + m[VSGL_GRID_FIELDS + 8]) / w),
-                         (float)(g.origin.z + (m[9] + m[VSGL_GRID_FIELDS + 9]) / w));
+        const float *m = g.level[0].data + t * VSGL__GRID_STRIDE;
+        double w = (double)m[0] + m[VSGL__GRID_FIELDS];
+        c[i].p = v3_make((float)(g.origin.x + (m[7] + m[VSGL__GRID_FIELDS + 7]) / w),
+                         (float)(g.origin.y + (m[8] + m[VSGL__GRID_FIELDS + 8]) / w),
+                         (float)(g.origin.z + (m[9] + m[VSGL__GRID_FIELDS + 9]) / w));
     }
     v3 lo, hi;
     vsgl__scene_bounds(scene, &lo, &hi);
@@ -110,16 +108,16 @@ vsgl_result vsgl__fit_kmeans(vsgl_context *ctx, const vsgl_scene *scene, const v
             continue;
         size_t rem = t % per_face;
         size_t gi = ((t / per_face) * g.res + rem / rsm->res) * g.res + rem % rsm->res;
-        const float *m = g.level[0].data + gi * VSGL_GRID_STRIDE;
-        double *dst = sums + (size_t)label[t] * VSGL_GRID_STRIDE;
-        for (int k = 0; k < VSGL_GRID_STRIDE; ++k)
+        const float *m = g.level[0].data + gi * VSGL__GRID_STRIDE;
+        double *dst = sums + (size_t)label[t] * VSGL__GRID_STRIDE;
+        for (int k = 0; k < VSGL__GRID_STRIDE; ++k)
             dst[k] += m[k];
     }
     for (uint32_t k = 0; k < n_clusters && r == VSGL_OK; ++k)
         for (uint32_t lobe = 0; lobe < 2 && r == VSGL_OK; ++lobe) {
             vsgl_moments m;
             vsgl_vsgl v;
-            vsgl__grid_moments(sums + (size_t)k * VSGL_GRID_STRIDE + lobe * VSGL_GRID_FIELDS, &m);
+            vsgl__grid_moments(sums + (size_t)k * VSGL__GRID_STRIDE + lobe * VSGL__GRID_FIELDS, &m);
             if (vsgl__moments_to_vsgl(&m, g.origin, s->sharpness_estimator, rsm->light, lobe, &v))
                 r = vsgl__vsgl_set_push(out, &v);
         }

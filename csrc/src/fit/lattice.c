@@ -25,7 +25,7 @@
  * a sharp glossy lobe, the sum of Gaussians of the tents' own variance
  * (h^2 / 6 per axis) still ripples by ~7 % (stripes in a metal floor's
  * reflection of a lit wall); the planar glossy model widens each by
- * VSGL_LATTICE_OVERLAP h^2 (ripple ~0.3 %). The diffuse light is not
+ * VSGL__LATTICE_OVERLAP h^2 (ripple ~0.3 %). The diffuse light is not
  * widened: wider Gaussians spill light past a junction, where the wall
  * beside the floor cannot see it (-4 % of the diffuse light in a box). */
 #include "fit/grid.h"
@@ -36,17 +36,17 @@
 #include <string.h>
 
 /* Slab thickness along a bin's axis, in units of h. */
-#define VSGL_LATTICE_SLAB 1.0
+#define VSGL__LATTICE_SLAB 1.0
 /* Extra positional variance of a VSGL seen through a glossy lobe, in
  * units of h^2 (vsgl_vsgl.widen). */
-#define VSGL_LATTICE_OVERLAP (1.0 / 6.0)
+#define VSGL__LATTICE_OVERLAP (1.0 / 6.0)
 
 /* Open-addressing map from a packed lattice key to a cluster's sums. */
 typedef struct cell_map {
     uint64_t *keys;      /* 0 = empty (packed keys are never 0) */
     uint32_t *slot;      /* index into sums, in first-touch order */
     size_t cap, count;
-    double *sums;        /* count * VSGL_GRID_STRIDE */
+    double *sums;        /* count * VSGL__GRID_STRIDE */
     size_t sums_cap;
 } cell_map;
 
@@ -101,10 +101,10 @@ static double *map_get(cell_map *m, uint64_t key)
     while (m->keys[p] && m->keys[p] != key)
         p = (p + 1) & (m->cap - 1);
     if (m->keys[p])
-        return m->sums + (size_t)m->slot[p] * VSGL_GRID_STRIDE;
+        return m->sums + (size_t)m->slot[p] * VSGL__GRID_STRIDE;
     if (m->count == m->sums_cap) {
         size_t cap = m->sums_cap ? m->sums_cap * 2 : 256;
-        double *s = realloc(m->sums, cap * VSGL_GRID_STRIDE * sizeof *s);
+        double *s = realloc(m->sums, cap * VSGL__GRID_STRIDE * sizeof *s);
         if (!s)
             return NULL;
         m->sums = s;
@@ -112,8 +112,8 @@ static double *map_get(cell_map *m, uint64_t key)
     }
     m->keys[p] = key;
     m->slot[p] = (uint32_t)m->count;
-    double *s = m->sums + m->count * VSGL_GRID_STRIDE;
-    memset(s, 0, VSGL_GRID_STRIDE * sizeof *s);
+    double *s = m->sums + m->count * VSGL__GRID_STRIDE;
+    memset(s, 0, VSGL__GRID_STRIDE * sizeof *s);
     ++m->count;
     return s;
 }
@@ -134,8 +134,8 @@ static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, uint32_t 
     for (size_t t = 0; t < rsm->count; ++t) {
         size_t rem = t % per_face;
         size_t gi = ((t / per_face) * g->res + rem / rsm->res) * g->res + rem % rsm->res;
-        const float *m = g->level[0].data + gi * VSGL_GRID_STRIDE;
-        double w = (double)m[0] + m[VSGL_GRID_FIELDS];
+        const float *m = g->level[0].data + gi * VSGL__GRID_STRIDE;
+        double w = (double)m[0] + m[VSGL__GRID_FIELDS];
         double a = rsm->area[t];
         if (!(w > 0.0) || !(a > 0.0) || !(a < INFINITY))
             continue;
@@ -178,8 +178,8 @@ vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const 
     for (size_t t = 0; t < rsm->count && r == VSGL_OK; ++t) {
         size_t rem = t % per_face;
         size_t gi = ((t / per_face) * g.res + rem / rsm->res) * g.res + rem % rsm->res;
-        const float *m = g.level[0].data + gi * VSGL_GRID_STRIDE;
-        if (!(m[0] + m[VSGL_GRID_FIELDS] > 0.0f))
+        const float *m = g.level[0].data + gi * VSGL__GRID_STRIDE;
+        if (!(m[0] + m[VSGL__GRID_FIELDS] > 0.0f))
             continue;
         const double p[3] = {rsm->pos[0][t], rsm->pos[1][t], rsm->pos[2][t]};
         const double nrm[3] = {rsm->nrm[0][t], rsm->nrm[1][t], rsm->nrm[2][t]};
@@ -193,7 +193,7 @@ vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const 
                 continue;
             double wb = na * na;
             int u = (a + 1) % 3, v = (a + 2) % 3;
-            int32_t k = (int32_t)floor(q[a] * (1.0 / VSGL_LATTICE_SLAB));
+            int32_t k = (int32_t)floor(q[a] * (1.0 / VSGL__LATTICE_SLAB));
             double fu = floor(q[u]), fv = floor(q[v]);
             double tu = q[u] - fu, tv = q[v] - fv;
             for (int du = 0; du < 2; ++du)
@@ -206,16 +206,16 @@ vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const 
                         r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "fit: out of memory for the lattice clusters");
                         break;
                     }
-                    for (int f = 0; f < VSGL_GRID_STRIDE; ++f)
+                    for (int f = 0; f < VSGL__GRID_STRIDE; ++f)
                         dst[f] += w * m[f];
                 }
         }
     }
-    double total = g.total[0] + g.total[VSGL_GRID_FIELDS];
-    double widen = VSGL_LATTICE_OVERLAP * h * h;
+    double total = g.total[0] + g.total[VSGL__GRID_FIELDS];
+    double widen = VSGL__LATTICE_OVERLAP * h * h;
     for (size_t c = 0; c < map.count && r == VSGL_OK; ++c)
         for (uint32_t lobe = 0; lobe < 2 && r == VSGL_OK; ++lobe) {
-            const double *f = map.sums + c * VSGL_GRID_STRIDE + lobe * VSGL_GRID_FIELDS;
+            const double *f = map.sums + c * VSGL__GRID_STRIDE + lobe * VSGL__GRID_FIELDS;
             if (!(f[0] > 1e-9 * total)) /* a sliver of a tent: nothing a pixel could show */
                 continue;
             vsgl_moments mo;

@@ -1,5 +1,5 @@
 /* VPL lobes -> moment sums -> VSGL parameters (poster Sec. 2, FIS Sec. 3,
- * with the errata of GUIDE Sec. 3: the mean direction averages the
+ * with the errata of docs/references.md §3: the mean direction averages the
  * *filtered* directions). */
 #include "fit/vsgl_set.h"
 #include "scene/material.h"
@@ -31,7 +31,7 @@ void vsgl__vsgl_set_free(vsgl_vsgl_set *set)
 v3 vsgl__rsm_origin(const vsgl_rsm *rsm)
 {
     for (size_t t = 0; t < rsm->count; ++t)
-        if (rsm->material[t] != VSGL_RSM_EMPTY)
+        if (rsm->material[t] != VSGL__RSM_EMPTY)
             return v3_make(rsm->pos[0][t], rsm->pos[1][t], rsm->pos[2][t]);
     return v3_make(0.0f, 0.0f, 0.0f);
 }
@@ -79,7 +79,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
 {
     memset(out, 0, 2 * sizeof *out);
     uint32_t mat = rsm->material[t];
-    if (mat == VSGL_RSM_EMPTY)
+    if (mat == VSGL__RSM_EMPTY)
         return 0;
     double flux[3] = {rsm->flux[0][t], rsm->flux[1][t], rsm->flux[2][t]};
     if (!(flux[0] + flux[1] + flux[2] > 0.0))
@@ -110,7 +110,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
         pd[c] = flux[c] * bp.diffuse[c] * alb->diffuse_power;
     if (pd[0] + pd[1] + pd[2] > 0.0) {
         float ld = vsgl_sg_cosine_sharpness();
-        fill(&out[VSGL_LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel, n, foot);
+        fill(&out[VSGL__LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel, n, foot);
         any = 1;
     }
     /* Specular lobe: Phi R_s G(w; reflect(wi, n), l_h / (4 |wi.n|)) / A(.), with
@@ -129,7 +129,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
             vsgl_sg ndf, warped;
             vsgl_ndf_to_sg(&n, alpha, VSGL_NDF_GGX, &ndf);
             vsgl_warp_ndf_sg(&ndf, &wi, &warped);
-            fill(&out[VSGL_LOBE_SPECULAR], ps, warped.axis,
+            fill(&out[VSGL__LOBE_SPECULAR], ps, warped.axis,
                  vsgl_mean_length_from_sharpness(warped.sharpness, estimator), rel, n, foot);
             any = 1;
         }
@@ -157,7 +157,7 @@ int vsgl__moments_to_vsgl(const vsgl_moments *m, v3 origin, int32_t estimator,
     double mx = m->pos[0] * inv, my = m->pos[1] * inv, mz = m->pos[2] * inv;
     out->mean = v3_make((float)(origin.x + mx), (float)(origin.y + my), (float)(origin.z + mz));
     /* Positions of VPLs lie on surfaces: the spread is 2-D, so the variance
-     * per axis is half the total (GUIDE Sec. 4). Cancellation can make it
+     * per axis is half the total (docs/references.md §4). Cancellation can make it
      * slightly negative: clamp. */
     double var = (m->pos2 * inv - (mx * mx + my * my + mz * mz)) * 0.5;
     out->variance = var > 0.0 ? (float)var : 0.0f;

@@ -11,8 +11,8 @@
 #include "rsm/rsm.h"
 #include "vsgl/render.h"
 
-#define VSGL_LOBE_DIFFUSE  0
-#define VSGL_LOBE_SPECULAR 1
+#define VSGL__LOBE_DIFFUSE  0
+#define VSGL__LOBE_SPECULAR 1
 
 typedef struct vsgl_vsgl {
     v3 mean;            /* mean VPL position, world */
@@ -41,7 +41,7 @@ void vsgl__vsgl_set_free(vsgl_vsgl_set *set);
 typedef struct vsgl_moments {
     double weight;      /* sum w_i, w_i = Phi_i R_i summed over RGB */
     double power[3];    /* sum Phi_i R_i (RGB) */
-    double dir[3];      /* sum w_i * mean_vector_i (filtered directions, GUIDE Sec. 3) */
+    double dir[3];      /* sum w_i * mean_vector_i (filtered directions, docs/references.md §3) */
     double pos[3];      /* sum w_i (x_i - origin) */
     double pos2;        /* sum w_i |x_i - origin|^2 */
     double nrm[3];      /* sum w_i n_i (surface normals) */

@@ -15,11 +15,11 @@
 #include <string.h>
 
 /* Largest aa accepted (aa x aa = 256 samples per pixel). */
-#define VSGL_GBUFFER_MAX_AA 16
+#define VSGL__GBUFFER_MAX_AA 16
 /* Rays traced per Embree stream call. */
-#define VSGL_GBUFFER_BATCH 64
+#define VSGL__GBUFFER_BATCH 64
 /* Progress is reported (and cancellation checked) this many times. */
-#define VSGL_GBUFFER_STEPS 32
+#define VSGL__GBUFFER_STEPS 32
 
 typedef struct gb_job {
     const vsgl_scene *scene;
@@ -43,16 +43,16 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
     vsgl_gbuffer *g = j->g;
     const uint32_t aa = j->aa, spp = aa * aa, width = g->width;
     const float inv = 1.0f / (float)aa;
-    v3 org[VSGL_GBUFFER_BATCH], dir[VSGL_GBUFFER_BATCH];
-    float tmin[VSGL_GBUFFER_BATCH], tmax[VSGL_GBUFFER_BATCH];
-    vsgl_hit hit[VSGL_GBUFFER_BATCH];
+    v3 org[VSGL__GBUFFER_BATCH], dir[VSGL__GBUFFER_BATCH];
+    float tmin[VSGL__GBUFFER_BATCH], tmax[VSGL__GBUFFER_BATCH];
+    vsgl_hit hit[VSGL__GBUFFER_BATCH];
     const v3 zero = v3_make(0.0f, 0.0f, 0.0f);
     for (size_t r = begin; r < end; ++r) {
         uint32_t row = j->row0 + (uint32_t)r;
         size_t base = (size_t)row * width * spp;
         size_t n = (size_t)width * spp;
-        for (size_t b = 0; b < n; b += VSGL_GBUFFER_BATCH) {
-            uint32_t m = (uint32_t)(n - b < VSGL_GBUFFER_BATCH ? n - b : VSGL_GBUFFER_BATCH);
+        for (size_t b = 0; b < n; b += VSGL__GBUFFER_BATCH) {
+            uint32_t m = (uint32_t)(n - b < VSGL__GBUFFER_BATCH ? n - b : VSGL__GBUFFER_BATCH);
             for (uint32_t k = 0; k < m; ++k) {
                 size_t idx = b + k;
                 uint32_t col = (uint32_t)(idx / spp), s = (uint32_t)(idx % spp);
@@ -64,13 +64,13 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
             for (uint32_t k = 0; k < m; ++k) {
                 size_t i = base + b + k;
                 store3(g->view, i, v3_neg(dir[k]));
-                if (hit[k].triangle == VSGL_HIT_NONE) {
+                if (hit[k].triangle == VSGL__HIT_NONE) {
                     store3(g->pos, i, zero);
                     store3(g->nrm, i, zero);
                     store3(g->tan, i, zero);
-                    g->material[i] = VSGL_GBUFFER_MISS;
+                    g->material[i] = VSGL__GBUFFER_MISS;
                     if (g->surf[0])
-                        for (int q = 0; q < VSGL_SURF_N; ++q)
+                        for (int q = 0; q < VSGL__SURF_N; ++q)
                             g->surf[q][i] = 0.0f;
                     continue;
                 }
@@ -97,9 +97,9 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
                     v3 cr = v3_cross(ex, ey);
                     float cs = fabsf(v3_dot(sf.geometric_normal, dir[k]));
                     float area = sqrtf(v3_dot(cr, cr)) / fmaxf(cs, 0.02f);
-                    float in[VSGL_SURF_N];
+                    float in[VSGL__SURF_N];
                     vsgl__scene_inputs(j->scene, &hit[k], area, in);
-                    for (int q = 0; q < VSGL_SURF_N; ++q)
+                    for (int q = 0; q < VSGL__SURF_N; ++q)
                         g->surf[q][i] = in[q];
                 }
             }
@@ -119,7 +119,7 @@ void vsgl__gbuffer_free(vsgl_gbuffer *g)
         free(g->tan[k]);
     }
     free(g->material);
-    for (int k = 0; k < VSGL_SURF_N; ++k)
+    for (int k = 0; k < VSGL__SURF_N; ++k)
         free(g->surf[k]);
     memset(g, 0, sizeof *g);
 }
@@ -131,9 +131,9 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
     memset(out, 0, sizeof *out);
     if (aa == 0)
         aa = 1;
-    if (aa > VSGL_GBUFFER_MAX_AA)
+    if (aa > VSGL__GBUFFER_MAX_AA)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "gbuffer: aa_samples is %u (must be in [1, %d])",
-                          (unsigned)aa, VSGL_GBUFFER_MAX_AA);
+                          (unsigned)aa, VSGL__GBUFFER_MAX_AA);
     const vsgl_camera *cam = vsgl__scene_camera(scene);
     gb_job job;
     job.scene = scene;
@@ -154,7 +154,7 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
     }
     ok &= (out->material = malloc(n * sizeof(uint32_t))) != NULL;
     if (vsgl__scene_textured(scene))
-        for (int k = 0; k < VSGL_SURF_N; ++k)
+        for (int k = 0; k < VSGL__SURF_N; ++k)
             ok &= (out->surf[k] = malloc(n * sizeof(float))) != NULL;
     if (!ok) {
         vsgl__gbuffer_free(out);
@@ -163,7 +163,7 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
     }
     uint32_t threads = vsgl_context_thread_count(ctx);
     uint32_t h = cam->height;
-    uint32_t step = (h + VSGL_GBUFFER_STEPS - 1) / VSGL_GBUFFER_STEPS;
+    uint32_t step = (h + VSGL__GBUFFER_STEPS - 1) / VSGL__GBUFFER_STEPS;
     for (uint32_t row = 0; row < h; row += step) {
         uint32_t rows = h - row < step ? h - row : step;
         if (vsgl__progress(ctx, "gbuffer", (float)row / (float)h)) {
@@ -191,8 +191,8 @@ void vsgl__gbuffer_material(const vsgl_gbuffer *g, const vsgl_material *material
         *out = *m;
         return;
     }
-    float in[VSGL_SURF_N];
-    for (int q = 0; q < VSGL_SURF_N; ++q)
+    float in[VSGL__SURF_N];
+    for (int q = 0; q < VSGL__SURF_N; ++q)
         in[q] = g->surf[q][i];
     vsgl__material_with_inputs(m, in, out);
 }

@@ -5,8 +5,8 @@
 
 #include "scene/scene_internal.h"
 
-#define VSGL_GBUFFER_MISS 0xFFFFFFFFu
-#define VSGL_GBUFFER_MAX_SPP 256 /* 16 x 16 samples per pixel */
+#define VSGL__GBUFFER_MISS 0xFFFFFFFFu
+#define VSGL__GBUFFER_MAX_SPP 256 /* 16 x 16 samples per pixel */
 
 /* Structure of arrays; sample index = (row * width + col) * spp + s,
  * row 0 = top of the image, samples on a stratified aa x aa grid. */
@@ -19,9 +19,9 @@ typedef struct vsgl_gbuffer {
                                       n.view may be slightly negative at smooth-shaded silhouettes */
     float *view[3];                /* unit direction from the point towards the camera */
     float *tan[3];                 /* unit tangent (anisotropy frame), orthogonal to nrm */
-    uint32_t *material;            /* material index, VSGL_GBUFFER_MISS where nothing was hit
+    uint32_t *material;            /* material index, VSGL__GBUFFER_MISS where nothing was hit
                                       (then pos, nrm, tan are 0; view is still set) */
-    float *surf[VSGL_SURF_N];      /* textured scenes only (else NULL): the material inputs at the
+    float *surf[VSGL__SURF_N];      /* textured scenes only (else NULL): the material inputs at the
                                       sample (scene_internal.h VSGL_SURF_*), textures filtered over the
                                       sample's 1/spp share of its pixel; 0 for misses */
 } vsgl_gbuffer;

@@ -2,6 +2,7 @@
  * vsgl_render_settings (docs/bundle-format.md). The reader trusts nothing:
  * every size is checked against the bytes present before allocating. */
 #include "vsgl/io.h"
+#include "core/versioned.h"
 #include "core/context.h"
 #include "io/atomic.h"
 
@@ -309,25 +310,17 @@ vsgl_result vsgl_bundle_write_memory(vsgl_context *ctx, const vsgl_scene_desc *s
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: scene and size must not be NULL");
     *size = 0;
     vsgl_scene_desc d;
-    memset(&d, 0, sizeof d);
-    if (scene->size > sizeof d)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vsgl_scene_desc.size %u is larger than this library knows", scene->size);
-    memcpy(&d, scene, scene->size ? scene->size : sizeof d);
     vsgl_render_settings s;
-    memset(&s, 0, sizeof s);
-    if (settings) {
-        if (settings->size > sizeof s)
-            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vsgl_render_settings.size %u is larger than this library knows", settings->size);
-        memcpy(&s, settings, settings->size ? settings->size : sizeof s);
-        s.size = sizeof s;
-    }
     vsgl_bundle_options o;
-    memset(&o, 0, sizeof o);
-    if (opt) {
-        if (opt->size > sizeof o)
-            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vsgl_bundle_options.size %u is larger than this library knows", opt->size);
-        memcpy(&o, opt, opt->size ? opt->size : sizeof o);
-    }
+    vsgl_result rv = vsgl__copy_versioned(ctx, &d, sizeof d, scene, "vsgl_scene_desc");
+    if (rv == VSGL_OK)
+        rv = vsgl__copy_versioned(ctx, &s, sizeof s, settings, "vsgl_render_settings");
+    if (rv == VSGL_OK)
+        rv = vsgl__copy_versioned(ctx, &o, sizeof o, opt, "vsgl_bundle_options");
+    if (rv != VSGL_OK)
+        return rv;
+    if (settings)
+        s.size = sizeof s;
     if (!d.camera)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: scene has no camera");
     if (d.vertex_count && !d.positions)
@@ -865,7 +858,7 @@ vsgl_result vsgl_bundle_read(vsgl_context *ctx, const char *path, vsgl_bundle **
     free(buf);
     if (r && ctx) {
         /* Prefix the file name to the reader's message. */
-        char msg[VSGL_MESSAGE_MAX];
+        char msg[VSGL__MESSAGE_MAX];
         snprintf(msg, sizeof msg, "%s", vsgl_context_last_error(ctx));
         vsgl__fail(ctx, r, "%s: %s", path, msg);
     }

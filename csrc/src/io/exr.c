@@ -1,5 +1,6 @@
 /* Multilayer OpenEXR writer on OpenEXR Core's C API, written atomically. */
 #include "vsgl/io.h"
+#include "core/versioned.h"
 #include "core/context.h"
 #include "io/atomic.h"
 #include "core/parallel.h"
@@ -389,13 +390,9 @@ vsgl_result vsgl_exr_write(vsgl_context *ctx, const char *path, uint32_t width, 
 {
     vsgl__clear_error(ctx);
     vsgl_exr_options o;
-    memset(&o, 0, sizeof o);
-    if (opt) {
-        if (opt->size > sizeof o)
-            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vsgl_exr_options.size %u is larger than this library knows (%zu)",
-                              opt->size, sizeof o);
-        memcpy(&o, opt, opt->size ? opt->size : sizeof o);
-    }
+    vsgl_result rv = vsgl__copy_versioned(ctx, &o, sizeof o, opt, "vsgl_exr_options");
+    if (rv != VSGL_OK)
+        return rv;
     if (!path || !*path)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR path is empty");
     src_channel *chans = calloc(MAX_CHANNELS_TOTAL, sizeof *chans);

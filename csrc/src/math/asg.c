@@ -4,6 +4,7 @@
  * errors and the treatment of every extreme: docs/math_asg.md. All internal
  * arithmetic is double; results are rounded to float once. */
 #include "math/asg_internal.h"
+#include "math/constants.h"
 #include "math/bessel.h"
 #include "math/eigen3.h"
 #include "math/vec.h"
@@ -11,7 +12,6 @@
 #include <float.h>
 #include <math.h>
 
-#define PI_D 3.14159265358979323846
 
 /* ---------------------------------------------------------------- frames */
 
@@ -132,10 +132,10 @@ double vsgl__asg_integral_eq10(double lambda, double mu)
         mu = t;
     }
     if (!(mu > 0.0))
-        return lambda > 0.0 ? INFINITY : PI_D;
+        return lambda > 0.0 ? INFINITY : VSGL__PI_D;
     double nu = lambda - mu;
     double second = exp(-mu) / (2.0 * lambda) * (vsgl__bessel_f(nu) + nu / mu * vsgl__bessel_f(nu + nu / mu));
-    return PI_D / sqrt(lambda * mu) - second;
+    return VSGL__PI_D / sqrt(lambda * mu) - second;
 }
 
 /* 10-point Gauss-Legendre on [-1, 1]. */
@@ -182,7 +182,7 @@ double vsgl__asg_integral_exact(double lambda, double mu)
         u0 = hi;
         u1 = 4.0 * hi;
     }
-    return PI_D * sum;
+    return VSGL__PI_D * sum;
 }
 
 double vsgl__asg_integral_unit(double lambda, double mu)
@@ -211,7 +211,7 @@ float vsgl_asg_integral_approx(const vsgl_asg *a)
     double lm = vsgl__asg_clamp_bw(a->lambda) * vsgl__asg_clamp_bw(a->mu);
     /* Eq. 11, capped at the bound c pi (the integral of c max(v.z, 0)),
      * which it exceeds only for lambda mu < 1 where Eq. 11 is meaningless. */
-    double i = lm > 1.0 ? PI_D / sqrt(lm) : (isnan(lm) ? NAN : PI_D);
+    double i = lm > 1.0 ? VSGL__PI_D / sqrt(lm) : (isnan(lm) ? NAN : VSGL__PI_D);
     return (float)(exp((double)a->log_amplitude) * i);
 }
 
@@ -307,7 +307,7 @@ void vsgl_asg_product(const vsgl_asg *a, const vsgl_asg *b, vsgl_asg *out)
 static double conv_norm(double lam, double mu, double nu, int mode)
 {
     if (mode == VSGL__CONV_PAPER)
-        return PI_D / sqrt((lam + nu) * (mu + nu));
+        return VSGL__PI_D / sqrt((lam + nu) * (mu + nu));
     return vsgl__asg_integral_unit(lam + nu, mu + nu);
 }
 

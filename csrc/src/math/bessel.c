@@ -1,5 +1,6 @@
 /* Exponentially scaled I0 without tables (docs/math_asg.md, "F(a)"). */
 #include "math/bessel.h"
+#include "math/constants.h"
 
 #include <math.h>
 
@@ -33,10 +34,10 @@ double vsgl__i0e(double x)
         if (term < 1e-17 * sum)
             break;
     }
-    return sum / sqrt(2.0 * 3.14159265358979323846 * ax);
+    return sum / sqrt(2.0 * VSGL__PI_D * ax);
 }
 
 double vsgl__bessel_f(double a)
 {
-    return 2.0 * 3.14159265358979323846 * vsgl__i0e(0.5 * a);
+    return 2.0 * VSGL__PI_D * vsgl__i0e(0.5 * a);
 }

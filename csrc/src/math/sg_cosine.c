@@ -1,6 +1,7 @@
 /* Integral of an SG times the clamped cosine max(w.n, 0), three modes
  * (docs/math.md, "SG x clamped cosine"). Fit: tools/fit_cosine_sharpness.py. */
 #include "vsgl/sg.h"
+#include "math/constants.h"
 #include "math/sg_internal.h"
 
 /* Shorthands for the fitted constants (sg_internal.h, shared with the
@@ -48,7 +49,7 @@ float vsgl__sg_cosine_accurate(float l, float c)
      * an even correction kappa (psi(t c) - psi(t)) that keeps all three
      * constraints (docs/math.md 3.2). */
     float t = l * sqrtf(0.5f * ((l + T_A) * l + T_B) / (((l + T_C) * l + T_D) * l + T_E));
-    t = t > 1e-30f ? t : 1e-30f;
+    t = t > VSGL__TINY ? t : VSGL__TINY;
     float ac = fabsf(c);
     float x = t * ac;
     float ex = expf(-x * x);

@@ -4,12 +4,9 @@
 #define VSGL_MATH_SG_INTERNAL_H
 
 #include "vsgl/sg.h"
+#include "math/constants.h"
 #include "math/vec.h"
 
-#define VSGL__PI      3.14159265358979323846f
-#define VSGL__2PI     6.28318530717958647692f
-#define VSGL__LOG_2PI 1.83787706640934548356f
-#define VSGL__LOG_PI  1.14472988584940017414f
 
 /* Least-squares sharpness of the poster's SG cosine lobe (docs/math.md):
  * argmin over l of the L2 norm on the sphere of max(w.n,0)/pi - G(w;n,l)/A(l). */

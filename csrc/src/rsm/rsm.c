@@ -25,7 +25,7 @@ void vsgl__rsm_free(vsgl_rsm *r)
     }
     free(r->material);
     free(r->area);
-    for (int k = 0; k < VSGL_SURF_N; ++k)
+    for (int k = 0; k < VSGL__SURF_N; ++k)
         free(r->surf[k]);
     memset(r, 0, sizeof *r);
 }
@@ -37,8 +37,8 @@ void vsgl__rsm_material(const vsgl_rsm *r, const vsgl_material *materials, size_
         *out = *m;
         return;
     }
-    float in[VSGL_SURF_N];
-    for (int q = 0; q < VSGL_SURF_N; ++q)
+    float in[VSGL__SURF_N];
+    for (int q = 0; q < VSGL__SURF_N; ++q)
         in[q] = r->surf[q][i];
     vsgl__material_with_inputs(m, in, out);
 }
@@ -80,13 +80,13 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
         double s[3] = {0, 0, 0};
         for (uint32_t c = 0; c < res; ++c) {
             size_t i = grow * res + c;
-            if (hits[c].triangle == VSGL_HIT_NONE || !(tmax[c] >= 0.0f)) {
+            if (hits[c].triangle == VSGL__HIT_NONE || !(tmax[c] >= 0.0f)) {
                 for (int k = 0; k < 3; ++k)
                     o->pos[k][i] = o->nrm[k][i] = o->tan[k][i] = o->wi[k][i] = o->flux[k][i] = 0.0f;
-                o->material[i] = VSGL_RSM_EMPTY;
+                o->material[i] = VSGL__RSM_EMPTY;
                 o->area[i] = 0.0f;
                 if (o->surf[0])
-                    for (int q = 0; q < VSGL_SURF_N; ++q)
+                    for (int q = 0; q < VSGL__SURF_N; ++q)
                         o->surf[q][i] = 0.0f;
                 continue;
             }
@@ -107,9 +107,9 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
             }
             o->material[i] = sf.material;
             if (o->surf[0]) {
-                float in[VSGL_SURF_N];
+                float in[VSGL__SURF_N];
                 vsgl__scene_inputs(j->scene, &hits[c], o->area[i], in);
-                for (int q = 0; q < VSGL_SURF_N; ++q)
+                for (int q = 0; q < VSGL__SURF_N; ++q)
                     o->surf[q][i] = in[q];
             }
         }
@@ -147,7 +147,7 @@ vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
     ok &= (out->material = malloc(n * sizeof(uint32_t))) != NULL;
     ok &= (out->area = malloc(n * sizeof(float))) != NULL;
     if (vsgl__scene_textured(scene))
-        for (int k = 0; k < VSGL_SURF_N; ++k)
+        for (int k = 0; k < VSGL__SURF_N; ++k)
             ok &= (out->surf[k] = malloc(n * sizeof(float))) != NULL;
     size_t rows = (size_t)l.faces * res;
     double *partial = ok ? malloc(rows * 3 * sizeof *partial) : NULL;

@@ -5,7 +5,7 @@
 
 #include "scene/scene_internal.h"
 
-#define VSGL_RSM_EMPTY 0xFFFFFFFFu
+#define VSGL__RSM_EMPTY 0xFFFFFFFFu
 
 /* Structure of arrays; texel index = (face * res + row) * res + col.
  * faces = 6 for point lights and spots wider than 120 degrees (cube map in
@@ -27,9 +27,9 @@ typedef struct vsgl_rsm {
                                     * (solid angle x d^2 / cos, or beam area / cos) */
     float *wi[3];                  /* unit direction from the VPL towards the light */
     float *flux[3];                /* incident power on the texel's patch, W (RGB) */
-    uint32_t *material;            /* VSGL_RSM_EMPTY where the texel saw nothing */
+    uint32_t *material;            /* VSGL__RSM_EMPTY where the texel saw nothing */
     double total_flux[3];          /* sum of flux */
-    float *surf[VSGL_SURF_N];      /* textured scenes only (else NULL): the material inputs at the VPL
+    float *surf[VSGL__SURF_N];      /* textured scenes only (else NULL): the material inputs at the VPL
                                       (VSGL_SURF_*), textures filtered over the texel's patch */
 } vsgl_rsm;
 

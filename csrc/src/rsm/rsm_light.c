@@ -22,11 +22,11 @@
  * Texel weights are integrated exactly (rectangle solid angles) and the
  * masks are supersampled 4x4 per texel; rays go through texel centres. */
 #include "rsm/rsm_light.h"
+#include "math/constants.h"
 
 #include <math.h>
 #include <string.h>
 
-#define PI_D 3.14159265358979323846
 #define SUB 4 /* mask supersampling per texel axis */
 
 double vsgl__rsm_rect_solid_angle(double x0, double x1, double y0, double y1)
@@ -130,14 +130,14 @@ void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res
             double s3[3] = {v3_dot(sx, out->ax), v3_dot(sy, out->ay), v3_length(sz)};
             for (int k = 0; k < 3; ++k)
                 out->inv_scale[k] = s3[k] > 0.0 ? 1.0 / fabs(s3[k]) : 1.0;
-            if (half < 0.5 * PI_D) {
+            if (half < 0.5 * VSGL__PI_D) {
                 double t = tan(half) * fmax(s3[0], s3[1]) / s3[2];
                 widest = atan(t);
             } else {
-                widest = PI_D; /* a cone past the horizon stays past it */
+                widest = VSGL__PI_D; /* a cone past the horizon stays past it */
             }
         }
-        if (widest <= PI_D / 3.0)
+        if (widest <= VSGL__PI_D / 3.0)
             out->tan_half = tan(widest) * (1.0 + 1e-6);
         else
             out->faces = 6;
@@ -174,12 +174,12 @@ void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res
     }
     case VSGL_LIGHT_AREA: {
         out->shape = L->area_shape;
-        out->area_power = (L->flags & VSGL_LIGHT_FLAG_BLENDER_4) ? 1.0 : 0.25 * PI_D;
+        out->area_power = (L->flags & VSGL_LIGHT_FLAG_BLENDER_4) ? 1.0 : 0.25 * VSGL__PI_D;
         int square = L->area_shape == VSGL_AREA_SQUARE || L->area_shape == VSGL_AREA_DISK;
         out->size_x = (double)L->size_x * v3_length(sx);
         out->size_y = (double)(square ? L->size_x : L->size_y) * v3_length(sy);
         double half = 0.5 * (double)L->spread;
-        if (half < 0.5 * PI_D - 1e-6) {
+        if (half < 0.5 * VSGL__PI_D - 1e-6) {
             double T = tan(half);
             out->tan_half_spread = T;
             out->spread_norm = T / (T - half);
@@ -203,10 +203,10 @@ static void concentric(double a, double b, double *x, double *y)
     double r, phi;
     if (fabs(a) > fabs(b)) {
         r = a;
-        phi = (PI_D / 4.0) * (b / a);
+        phi = (VSGL__PI_D / 4.0) * (b / a);
     } else {
         r = b;
-        phi = (PI_D / 2.0) - (PI_D / 4.0) * (a / b);
+        phi = (VSGL__PI_D / 2.0) - (VSGL__PI_D / 4.0) * (a / b);
     }
     *x = r * cos(phi);
     *y = r * sin(phi);
@@ -246,7 +246,7 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
         *org = l->pos;
         *beam = vsgl__rsm_rect_solid_angle(x0, x1, y0, y1);
         if (l->type == VSGL_LIGHT_POINT) {
-            w = *beam / (4.0 * PI_D);
+            w = *beam / (4.0 * VSGL__PI_D);
         } else {
             /* the mask's cosine for plane point (x, y) of this face */
 #define SPOT_COS(xx, yy) spot_cos(l, axis == 0 ? sign : (ua == 0 ? (xx) : (yy)), \
@@ -260,7 +260,7 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
                 w = 0.0; /* wholly outside the cone */
             } else if (cmin >= l->cos_half + l->smooth) {
                 /* inside the blend: the mask is 1 (4.0+) or the cosine to the axis (3.4), smooth */
-                w = (l->spot_v4 ? 1.0 : cc) * *beam / (4.0 * PI_D);
+                w = (l->spot_v4 ? 1.0 : cc) * *beam / (4.0 * VSGL__PI_D);
             } else {
                 /* straddles the cone edge or the blend: supersample the mask,
                  * sub-rectangle solid angles from the (SUB+1)^2 corner values */
@@ -277,7 +277,7 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
                         if (mk > 0.0)
                             w += mk * (F[j + 1][i + 1] - F[j][i + 1] - F[j + 1][i] + F[j][i]);
                     }
-                w /= 4.0 * PI_D;
+                w /= 4.0 * VSGL__PI_D;
             }
 #undef SPOT_COS
         }
@@ -309,7 +309,7 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
             mk = 1.0;
         }
         w = l->area_power / (res * res) * mk; /* radiance x area x projected solid angle pi/res^2 */
-        *beam = PI_D / (res * res) / fmax(z, 0.5 / res); /* solid angle = projected / cos */
+        *beam = VSGL__PI_D / (res * res) / fmax(z, 0.5 / res); /* solid angle = projected / cos */
         /* origin on the shape: the centre of stratum (bitrev(col & 7),
          * bitrev(row & 7)) of an 8x8 grid on the light. Every aligned
          * 2x2, 4x4 and 8x8 block of texels (nearly one direction) then
@@ -362,7 +362,7 @@ void vsgl__rsm_light_emitted(const vsgl_rsm_light *l, double out[3])
             /* elliptical cone: (1/4pi) int mask dw over the sphere in the
              * light frame, midpoint rule in (cos theta, phi) about the axis */
             enum { NT = 2000, NP = 720 };
-            double s = 0.0, ht = 2.0 / NT, hp = 2.0 * PI_D / NP;
+            double s = 0.0, ht = 2.0 / NT, hp = 2.0 * VSGL__PI_D / NP;
             for (int i = 0; i < NT; ++i) {
                 double c = 1.0 - (i + 0.5) * ht, r = sqrt(fmax(0.0, 1.0 - c * c));
                 for (int j = 0; j < NP; ++j) {
@@ -370,7 +370,7 @@ void vsgl__rsm_light_emitted(const vsgl_rsm_light *l, double out[3])
                     s += spot_mask(l, spot_cos(l, r * cos(ph), r * sin(ph), -c));
                 }
             }
-            w = s * ht * hp / (4.0 * PI_D);
+            w = s * ht * hp / (4.0 * VSGL__PI_D);
         }
         break;
     case VSGL_LIGHT_SUN:
@@ -382,7 +382,7 @@ void vsgl__rsm_light_emitted(const vsgl_rsm_light *l, double out[3])
         } else {
             /* (L A / P) * 2 pi * int_0^{pi/2} mask cos sin dtheta, L A / P = area_power / pi */
             enum { N = 200000 };
-            double s = 0.0, h = 0.5 * PI_D / N;
+            double s = 0.0, h = 0.5 * VSGL__PI_D / N;
             for (int i = 0; i < N; ++i) {
                 double th = (i + 0.5) * h;
                 s += spread_mask(l, cos(th)) * cos(th) * sin(th);

@@ -37,15 +37,15 @@ static void slot_lookup(const vsgl_scene *s, const vsgl_texture_slot *slot, uint
     vsgl__texture_lookup(t, tu, tv, lod, slot->filter, slot->wrap, out);
 }
 
-void vsgl__scene_inputs(const vsgl_scene *s, const vsgl_hit *hit, float area, float out[VSGL_SURF_N])
+void vsgl__scene_inputs(const vsgl_scene *s, const vsgl_hit *hit, float area, float out[VSGL__SURF_N])
 {
     uint32_t tri = hit->triangle;
     uint32_t mat = s->tri_material[tri];
     const vsgl_material *m = &s->materials[mat];
     for (int c = 0; c < 3; ++c)
-        out[VSGL_SURF_BASE + c] = m->base_color[c];
-    out[VSGL_SURF_ROUGHNESS] = m->roughness;
-    out[VSGL_SURF_METALLIC] = m->metallic;
+        out[VSGL__SURF_BASE + c] = m->base_color[c];
+    out[VSGL__SURF_ROUGHNESS] = m->roughness;
+    out[VSGL__SURF_METALLIC] = m->metallic;
     if (!s->material_textures)
         return;
     const vsgl_material_textures *mt = &s->material_textures[mat];
@@ -56,30 +56,30 @@ void vsgl__scene_inputs(const vsgl_scene *s, const vsgl_hit *hit, float area, fl
     if (mt->base_color.texture) {
         slot_lookup(s, &mt->base_color, tri, w, u, v, area, px);
         for (int c = 0; c < 3; ++c)
-            out[VSGL_SURF_BASE + c] *= px[c];
+            out[VSGL__SURF_BASE + c] *= px[c];
     }
     if ((mt->flags & VSGL_MATERIAL_TEXTURES_VERTEX_COLOR) && s->corner_colors) {
         const float *cc = s->corner_colors + (size_t)tri * 9;
         for (int c = 0; c < 3; ++c)
-            out[VSGL_SURF_BASE + c] *= w * cc[c] + u * cc[3 + c] + v * cc[6 + c];
+            out[VSGL__SURF_BASE + c] *= w * cc[c] + u * cc[3 + c] + v * cc[6 + c];
     }
     if (mt->roughness.texture) {
         slot_lookup(s, &mt->roughness, tri, w, u, v, area, px);
-        out[VSGL_SURF_ROUGHNESS] *= px[mt->roughness.channel];
+        out[VSGL__SURF_ROUGHNESS] *= px[mt->roughness.channel];
     }
     if (mt->metallic.texture) {
         slot_lookup(s, &mt->metallic, tri, w, u, v, area, px);
-        out[VSGL_SURF_METALLIC] *= px[mt->metallic.channel];
+        out[VSGL__SURF_METALLIC] *= px[mt->metallic.channel];
     }
-    for (int k = 0; k < VSGL_SURF_N; ++k)
+    for (int k = 0; k < VSGL__SURF_N; ++k)
         out[k] = clamp01(out[k]);
 }
 
-void vsgl__material_with_inputs(const vsgl_material *m, const float in[VSGL_SURF_N], vsgl_material *out)
+void vsgl__material_with_inputs(const vsgl_material *m, const float in[VSGL__SURF_N], vsgl_material *out)
 {
     *out = *m;
     for (int c = 0; c < 3; ++c)
-        out->base_color[c] = in[VSGL_SURF_BASE + c];
-    out->roughness = in[VSGL_SURF_ROUGHNESS];
-    out->metallic = in[VSGL_SURF_METALLIC];
+        out->base_color[c] = in[VSGL__SURF_BASE + c];
+    out->roughness = in[VSGL__SURF_ROUGHNESS];
+    out->metallic = in[VSGL__SURF_METALLIC];
 }

@@ -22,13 +22,13 @@
  *   energy single scattering loses (up to ~25 % at roughness 1).
  */
 #include "material.h"
+#include "math/constants.h"
 
 #include "vsgl/lobes.h"
 
 #include <math.h>
 #include <string.h>
 
-#define VSGL_PI_F 3.14159265358979323846f
 
 static float saturate(float x) { return x != x ? 0.0f : clampf(x, 0.0f, 1.0f); }
 
@@ -96,7 +96,7 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
         diffuse_out[c] = glossy_out[c] = 0.0f;
     if (!(ci > 0.0f && co > 0.0f))
         return;
-    float kd = ci * (1.0f / VSGL_PI_F);
+    float kd = ci * (1.0f / VSGL__PI);
     for (int c = 0; c < 3; ++c)
         diffuse_out[c] = p->diffuse[c] * kd;
     if (!p->glossy)
@@ -116,7 +116,7 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
     float ax = p->alpha_x, ay = p->alpha_y;
     float sx = hx / ax, sy = hy / ay;
     float q = sx * sx + sy * sy + hz * hz;
-    float D = 1.0f / (VSGL_PI_F * ax * ay * q * q);
+    float D = 1.0f / (VSGL__PI * ax * ay * q * q);
     float li = ggx_lambda(ax, ay, v3_dot(wi, tx), v3_dot(wi, ty), ci);
     float lo = ggx_lambda(ax, ay, v3_dot(wo, tx), v3_dot(wo, ty), co);
     float G = p->height_correlated ? 1.0f / (1.0f + li + lo) : 1.0f / ((1.0f + li) * (1.0f + lo));
@@ -179,8 +179,8 @@ void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out
         return;
     const v3 n = v3_make(0.0f, 0.0f, 1.0f), t = v3_make(1.0f, 0.0f, 0.0f);
     const float ax = p->alpha_x, ay = p->alpha_y;
-    for (int k = 0; k < VSGL_ALBEDO_N; ++k) {
-        double ci = k == 0 ? 0.01 : (double)k / (VSGL_ALBEDO_N - 1);
+    for (int k = 0; k < VSGL__ALBEDO_N; ++k) {
+        double ci = k == 0 ? 0.01 : (double)k / (VSGL__ALBEDO_N - 1);
         double si = sqrt(fmax(0.0, 1.0 - ci * ci));
         double acc[3] = {0.0, 0.0, 0.0};
         for (int a = 0; a < S; ++a)
@@ -188,11 +188,11 @@ void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out
                 /* wi's azimuth (anisotropic lobes only): a golden-ratio sequence
                  * over the samples, independent of the normal's strata */
                 double gi = (a * S + b) * 0.6180339887498949;
-                double phi_i = p->alpha_x == p->alpha_y ? 0.0 : 2.0 * 3.14159265358979323846 * (gi - floor(gi));
+                double phi_i = p->alpha_x == p->alpha_y ? 0.0 : 2.0 * VSGL__PI_D * (gi - floor(gi));
                 v3 wi = v3_make((float)(si * cos(phi_i)), (float)(si * sin(phi_i)), (float)ci);
                 /* GGX normal with pdf D(h) (h.n): a stretched slope */
                 double u = (a + 0.5) / S, v = (b + 0.5) / S;
-                double r = sqrt(u / (1.0 - u)), ph = 2.0 * 3.14159265358979323846 * v;
+                double r = sqrt(u / (1.0 - u)), ph = 2.0 * VSGL__PI_D * v;
                 double mx = -r * cos(ph) * ax, my = -r * sin(ph) * ay;
                 double len = sqrt(mx * mx + my * my + 1.0);
                 v3 h = v3_make((float)(mx / len), (float)(my / len), (float)(1.0 / len));
@@ -205,7 +205,7 @@ void vsgl__glossy_albedo_table(const vsgl_brdf_params *p, vsgl_albedo_table *out
                 float dif[3], gl[3];
                 vsgl__brdf_eval(p, n, t, wo, wi, dif, gl); /* f cos(wo) (reciprocal) */
                 double hx = h.x / ax, hy = h.y / ay, q = hx * hx + hy * hy + (double)h.z * h.z;
-                double D = 1.0 / (3.14159265358979323846 * ax * ay * q * q);
+                double D = 1.0 / (VSGL__PI_D * ax * ay * q * q);
                 double pdf = D * h.z / (4.0 * ih); /* of wo */
                 for (int c = 0; c < 3; ++c) /* seen from wo (multiple scattering, 4.x+) */
                     acc[c] += gl[c] * vsgl__ms_scale(p, c, wo.z) / pdf;
@@ -240,7 +240,7 @@ void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t)
     vsgl_brdf_params bw;
     vsgl__material_params(&w, &bw);
     vsgl__glossy_albedo_table(&bw, &white);
-    for (int k = 0; k < VSGL_ALBEDO_N; ++k)
+    for (int k = 0; k < VSGL__ALBEDO_N; ++k)
         t->diel[k] = clampf(tmp.a[k][0] / fmaxf(white.a[k][0], 1e-6f), 0.0f, 1.0f);
     /* 2 int (1 - diel) mu dmu over the piecewise-linear table, 64 midpoints */
     double acc = 0.0;
@@ -264,20 +264,20 @@ float vsgl__diffuse_view_weight(const vsgl_albedo_table *t, float cos_o)
 {
     if (!t)
         return 1.0f;
-    float x = clampf(cos_o, 0.0f, 1.0f) * (VSGL_ALBEDO_N - 1);
+    float x = clampf(cos_o, 0.0f, 1.0f) * (VSGL__ALBEDO_N - 1);
     int k = (int)x;
-    if (k >= VSGL_ALBEDO_N - 1)
-        return 1.0f - t->diel[VSGL_ALBEDO_N - 1];
+    if (k >= VSGL__ALBEDO_N - 1)
+        return 1.0f - t->diel[VSGL__ALBEDO_N - 1];
     float f = x - (float)k;
     return 1.0f - (t->diel[k] * (1.0f - f) + t->diel[k + 1] * f);
 }
 
 float vsgl__glossy_albedo(const vsgl_albedo_table *t, int channel, float cos_i)
 {
-    float x = clampf(cos_i, 0.0f, 1.0f) * (VSGL_ALBEDO_N - 1);
+    float x = clampf(cos_i, 0.0f, 1.0f) * (VSGL__ALBEDO_N - 1);
     int k = (int)x;
-    if (k >= VSGL_ALBEDO_N - 1)
-        return t->a[VSGL_ALBEDO_N - 1][channel];
+    if (k >= VSGL__ALBEDO_N - 1)
+        return t->a[VSGL__ALBEDO_N - 1][channel];
     float f = x - (float)k;
     return t->a[k][channel] * (1.0f - f) + t->a[k + 1][channel] * f;
 }

@@ -36,19 +36,19 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
 /* Directional albedo of the glossy lobe, int f(wi, wo) cos(wo) dwo: the
  * fraction of the power arriving from wi that the lobe reflects (Fresnel,
  * shadowing and the GGX lobe's spread together), per RGB channel, averaged
- * over wi's azimuth about the normal. Tabulated at VSGL_ALBEDO_N cosines
+ * over wi's azimuth about the normal. Tabulated at VSGL__ALBEDO_N cosines
  * cos_k = k / (N - 1) (the first at 0.01) by stratified importance sampling
  * of the GGX normals (32 x 32 samples per cosine, ~2 ms per glossy
  * material). */
-#define VSGL_ALBEDO_N 17
+#define VSGL__ALBEDO_N 17
 typedef struct vsgl_albedo_table {
-    float a[VSGL_ALBEDO_N][3];
+    float a[VSGL__ALBEDO_N][3];
     /* Blender 4.x+ (VSGL_MATERIAL_FLAG_BLENDER_4): the albedo of the
      * dielectric specular layer alone (white, F0 = specular_f0) over the same
      * lobe's albedo with F = 1 (shadowing loss compensated, as Cycles' albedo
      * scaling), which Cycles takes off the diffuse base seen from a
      * direction; 0 otherwise */
-    float diel[VSGL_ALBEDO_N];
+    float diel[VSGL__ALBEDO_N];
     /* the diffuse base's emitted power with that weight, relative to
      * Lambert's: 2 int_0^1 (1 - diel(mu)) mu dmu (1 without the flag) */
     float diffuse_power;

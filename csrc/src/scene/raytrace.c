@@ -1,10 +1,10 @@
 /* Ray queries on a built scene (Embree 3) and surface attributes at hits. */
 #include "scene/scene_data.h"
+#include "math/constants.h"
 
 #include <math.h>
 #include <string.h>
 
-#define VSGL_TWO_PI_F 6.28318530717958647692f
 
 static void fill_ray(struct RTCRay *r, v3 org, v3 dir, float tmin, float tmax)
 {
@@ -82,7 +82,7 @@ void vsgl__scene_intersect_many(const vsgl_scene *scene, uint32_t n, const v3 *o
             vsgl_hit *h = &hits[b + i];
             if (rh[i].hit.geomID == RTC_INVALID_GEOMETRY_ID) {
                 h->t = INFINITY;
-                h->triangle = VSGL_HIT_NONE;
+                h->triangle = VSGL__HIT_NONE;
                 h->u = h->v = 0.0f;
             } else {
                 h->t = rh[i].ray.tfar;
@@ -114,7 +114,7 @@ void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *or
         }
         if (scene->triangle_count > 0) {
             /* Embree marks a blocked ray with tfar = -inf; remember inactive ones */
-            unsigned char active[BATCH];
+            unsigned char active[BATCH] = {0};
             for (uint32_t i = 0; i < m; ++i)
                 active[i] = r[i].tfar != -INFINITY;
             rtcOccluded1M(scene->rtc, &ic, r, m, sizeof(struct RTCRay));
@@ -190,7 +190,7 @@ void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, v
     float rot = scene->materials[mat].anisotropic_rotation;
     if (rot != 0.0f) {
         /* rotate about n by 2 pi rot, counter-clockwise (Rodrigues, t orthogonal to n) */
-        float a = VSGL_TWO_PI_F * rot;
+        float a = VSGL__2PI * rot;
         t = v3_normalize(v3_add(v3_scale(t, cosf(a)), v3_scale(v3_cross(n, t), sinf(a))));
     }
     out->tangent = t;

@@ -10,9 +10,9 @@
 #include <time.h>
 
 /* At most this many "dropped" warnings are logged individually. */
-#define VSGL_MAX_DROP_WARNINGS 10
+#define VSGL__MAX_DROP_WARNINGS 10
 /* Embree worker threads are capped: BVH builds gain little past this here. */
-#define VSGL_EMBREE_MAX_THREADS 64
+#define VSGL__EMBREE_MAX_THREADS 64
 
 static void embree_error(void *user, enum RTCError code, const char *str)
 {
@@ -112,7 +112,7 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
         if (keep[t]) {
             ++kept;
         } else {
-            if (dropped < VSGL_MAX_DROP_WARNINGS) {
+            if (dropped < VSGL__MAX_DROP_WARNINGS) {
                 if (zero_corner >= 0) {
                     const float *cn = d->corner_normals + (size_t)t * 9 + zero_corner * 3;
                     vsgl__log(ctx, VSGL_LOG_WARNING, "triangle %u: corner %d normal (%g, %g, %g) has zero length, dropped",
@@ -125,7 +125,7 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
             ++dropped;
         }
     }
-    if (dropped > VSGL_MAX_DROP_WARNINGS)
+    if (dropped > VSGL__MAX_DROP_WARNINGS)
         vsgl__log(ctx, VSGL_LOG_WARNING, "scene: %u degenerate triangles (zero area or zero-length normal) dropped in all",
                   (unsigned)dropped);
     s->triangle_count = kept;
@@ -157,8 +157,8 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
     /* Embree device and geometry: its buffers hold the positions and indices */
     char config[96];
     uint32_t threads = vsgl_context_thread_count(ctx);
-    if (threads > VSGL_EMBREE_MAX_THREADS)
-        threads = VSGL_EMBREE_MAX_THREADS;
+    if (threads > VSGL__EMBREE_MAX_THREADS)
+        threads = VSGL__EMBREE_MAX_THREADS;
     snprintf(config, sizeof config, "threads=%u,set_affinity=0,verbose=0", (unsigned)threads);
     s->device = rtcNewDevice(config);
     if (!s->device) {
@@ -313,8 +313,8 @@ vsgl_result vsgl_scene_create(vsgl_context *ctx, const vsgl_scene_desc *caller_d
     *out = NULL;
     if (!caller_desc)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: desc is NULL");
-    if (caller_desc->size != 0 && caller_desc->size != sizeof(vsgl_scene_desc) &&
-        caller_desc->size != VSGL_SCENE_DESC_SIZE_0_1)
+    if (caller_desc->size > sizeof(vsgl_scene_desc) ||
+        (caller_desc->size && (caller_desc->size < sizeof caller_desc->size || caller_desc->size % 4 != 0)))
         return vsgl__validate_scene_desc(ctx, caller_desc); /* names the size */
     vsgl_scene_desc full;
     vsgl__scene_desc_normalise(caller_desc, &full);

@@ -10,7 +10,7 @@
 #include "scene/texture.h"
 #include "core/context.h"
 
-#define VSGL_SCENE_EMBREE_MESSAGE 256
+#define VSGL__SCENE_EMBREE_MESSAGE 256
 
 struct vsgl_scene {
     RTCDevice device;
@@ -42,7 +42,7 @@ struct vsgl_scene {
     uint64_t identity;           /* creation time (CLOCK_MONOTONIC ns): with the address, tells this scene's
                                     geometry and materials from a destroyed one's at the same address;
                                     kept by vsgl_scene_set_view (render caches key on both) */
-    char embree_message[VSGL_SCENE_EMBREE_MESSAGE]; /* first Embree error seen */
+    char embree_message[VSGL__SCENE_EMBREE_MESSAGE]; /* first Embree error seen */
 };
 
 /* Validation (validate.c): first error -> vsgl__fail with a message naming the element. */

@@ -30,9 +30,9 @@ int vsgl__scene_intersect(const vsgl_scene *scene, v3 org, v3 dir, float tmin, f
 int vsgl__scene_occluded(const vsgl_scene *scene, v3 org, v3 dir, float tmin, float tmax);
 
 /* Batch of n closest-hit queries (Embree ray streams; faster for many rays).
- * Rays with tmin > tmax, or misses, give hits[i].triangle = VSGL_HIT_NONE
+ * Rays with tmin > tmax, or misses, give hits[i].triangle = VSGL__HIT_NONE
  * and t = +inf. coherent = 1 for camera-like bundles. Thread-safe. */
-#define VSGL_HIT_NONE 0xFFFFFFFFu
+#define VSGL__HIT_NONE 0xFFFFFFFFu
 void vsgl__scene_intersect_many(const vsgl_scene *scene, uint32_t n, const v3 *org, const v3 *dir,
                                 const float *tmin, const float *tmax, int coherent, vsgl_hit *hits);
 
@@ -50,17 +50,17 @@ void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, v
 /* Textures (scene/texture.h). A scene whose materials read textures or
  * corner colours is "textured": the stages then evaluate the material
  * inputs per point (G-buffer sample, RSM texel) instead of per material. */
-#define VSGL_SURF_BASE 0       /* base colour RGB */
-#define VSGL_SURF_ROUGHNESS 3
-#define VSGL_SURF_METALLIC 4
-#define VSGL_SURF_N 5
+#define VSGL__SURF_BASE 0       /* base colour RGB */
+#define VSGL__SURF_ROUGHNESS 3
+#define VSGL__SURF_METALLIC 4
+#define VSGL__SURF_N 5
 int vsgl__scene_textured(const vsgl_scene *scene);
 /* The material inputs (VSGL_SURF_*) at a hit, textures filtered over a
  * footprint of `area` m^2 on the surface (a camera sample's share of its
  * pixel, an RSM texel's patch). Thread-safe. */
-void vsgl__scene_inputs(const vsgl_scene *scene, const vsgl_hit *hit, float area, float out[VSGL_SURF_N]);
+void vsgl__scene_inputs(const vsgl_scene *scene, const vsgl_hit *hit, float area, float out[VSGL__SURF_N]);
 /* *m with base colour, roughness and metallic replaced by in (VSGL_SURF_*). */
-void vsgl__material_with_inputs(const vsgl_material *m, const float in[VSGL_SURF_N], vsgl_material *out);
+void vsgl__material_with_inputs(const vsgl_material *m, const float in[VSGL__SURF_N], vsgl_material *out);
 
 /* Validated copies (never NULL when the count is > 0). */
 const vsgl_material *vsgl__scene_materials(const vsgl_scene *scene, uint32_t *count);

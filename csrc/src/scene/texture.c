@@ -49,7 +49,7 @@ vsgl_result vsgl__texture_build(vsgl_context *ctx, uint32_t index, const vsgl_te
         for (size_t i = 0; i < n; ++i)
             lin[i] = (i & 3) == 3 ? p[i] : vsgl__srgb_to_linear(p[i]);
     }
-    while ((w > 1 || h > 1) && out->levels < VSGL_TEX_MAX_LEVELS) {
+    while ((w > 1 || h > 1) && out->levels < VSGL__TEX_MAX_LEVELS) {
         vsgl_tex_level src0 = out->lv[out->levels - 1];
         if (out->levels == 1 && lin)
             src0.p = lin;

@@ -7,7 +7,7 @@
 #include "vsgl/scene.h"
 #include "core/context.h"
 
-#define VSGL_TEX_MAX_LEVELS 18
+#define VSGL__TEX_MAX_LEVELS 18
 
 typedef struct vsgl_tex_level {
     uint32_t w, h;
@@ -18,7 +18,7 @@ typedef struct vsgl_tex {
     int srgb;                /* level 0 holds the caller's sRGB values, decoded after filtering
                                 (as Cycles does for 8-bit sRGB images); levels 1.. are linear */
     uint32_t levels;         /* level 0 = the image, each next 2 x 2 box-filtered, last 1 x 1 */
-    vsgl_tex_level lv[VSGL_TEX_MAX_LEVELS];
+    vsgl_tex_level lv[VSGL__TEX_MAX_LEVELS];
 } vsgl_tex;
 
 /* Copy and mip-map one validated texture. An sRGB texture keeps level 0

@@ -4,6 +4,8 @@
  * (vertex_count 40)". Checks run in a fixed order: header, camera,
  * materials, lights, vertices, triangles. */
 #include "scene/scene_data.h"
+#include "core/versioned.h"
+#include "math/constants.h"
 
 #include <math.h>
 #include <string.h>
@@ -11,8 +13,7 @@
 
 /* Largest accepted coordinate magnitude: keeps products of coordinates
  * (cross products, squared distances) finite in float. */
-#define VSGL_MAX_COORD 1e18f
-#define VSGL_PI_F 3.14159265358979323846f
+#define VSGL__MAX_COORD 1e18f
 
 static int finite_f(float x) { return isfinite(x) != 0; }
 
@@ -21,7 +22,7 @@ const char *vsgl__matrix_problem(const float m[12])
     for (int i = 0; i < 12; ++i) {
         if (!finite_f(m[i]))
             return "is not finite";
-        if (fabsf(m[i]) > VSGL_MAX_COORD)
+        if (fabsf(m[i]) > VSGL__MAX_COORD)
             return "has an element above 1e18";
     }
     /* determinant of the 3x3 part, relative to the product of column lengths */
@@ -61,7 +62,7 @@ const char *vsgl__matrix_problem(const float m[12])
 #define CHECK_FINITE(ctx, who, field, value)                                              \
     do {                                                                                  \
         float v_ = (value);                                                               \
-        if (!finite_f(v_) || fabsf(v_) > VSGL_MAX_COORD)                                  \
+        if (!finite_f(v_) || fabsf(v_) > VSGL__MAX_COORD)                                  \
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT,                           \
                               "%s: %s is %g (must be finite, |x| <= 1e18)", who, field,   \
                               (double)v_);                                                \
@@ -149,16 +150,16 @@ vsgl_result vsgl__validate_light(vsgl_context *ctx, uint32_t index, const vsgl_l
     CHECK_FINITE(ctx, who, "size_y", l->size_y);
     CHECK_FINITE(ctx, who, "spread", l->spread);
     if (l->type == VSGL_LIGHT_SPOT) {
-        if (!(l->spot_size > 0.0f) || l->spot_size > VSGL_PI_F)
+        if (!(l->spot_size > 0.0f) || l->spot_size > VSGL__PI)
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: spot size is %g", who, (double)l->spot_size);
         CHECK_RANGE(ctx, who, "spot_blend", l->spot_blend, 0.0f, 1.0f);
     } else if (l->type == VSGL_LIGHT_SUN) {
-        CHECK_RANGE(ctx, who, "sun_angle", l->sun_angle, 0.0f, VSGL_PI_F);
+        CHECK_RANGE(ctx, who, "sun_angle", l->sun_angle, 0.0f, VSGL__PI);
     } else if (l->type == VSGL_LIGHT_AREA) {
         CHECK_POSITIVE(ctx, who, "size_x", l->size_x);
         if (l->area_shape == VSGL_AREA_RECTANGLE || l->area_shape == VSGL_AREA_ELLIPSE)
             CHECK_POSITIVE(ctx, who, "size_y", l->size_y);
-        if (!(l->spread > 0.0f) || l->spread > VSGL_PI_F)
+        if (!(l->spread > 0.0f) || l->spread > VSGL__PI)
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "%s: spread is %g (must be in (0, pi])", who, (double)l->spread);
     }
     if (l->flags & ~VSGL_LIGHT_FLAGS_KNOWN)
@@ -176,9 +177,11 @@ static vsgl_result need_array(vsgl_context *ctx, const void *p, uint32_t count, 
 
 void vsgl__scene_desc_normalise(const vsgl_scene_desc *in, vsgl_scene_desc *out)
 {
-    memset(out, 0, sizeof *out);
-    size_t n = in->size == VSGL_SCENE_DESC_SIZE_0_1 ? VSGL_SCENE_DESC_SIZE_0_1 : sizeof *out;
-    memcpy(out, in, n);
+    /* an older, shorter desc (e.g. VSGL_SCENE_DESC_SIZE_0_1) gets zero
+     * (absent) new fields; a size the library cannot read gives an empty
+     * desc, which validation refuses */
+    if (vsgl__copy_versioned(NULL, out, sizeof *out, in, "vsgl_scene_desc") != VSGL_OK)
+        memset(out, 0, sizeof *out);
 }
 
 static vsgl_result validate_slot(vsgl_context *ctx, uint32_t m, const char *name, const vsgl_texture_slot *s,
@@ -199,7 +202,7 @@ static vsgl_result validate_slot(vsgl_context *ctx, uint32_t m, const char *name
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: %s channel is %d (must be 0..3)", (unsigned)m,
                           name, (int)s->channel);
     for (int k = 0; k < 6; ++k)
-        if (!finite_f(s->uv_transform[k]) || fabsf(s->uv_transform[k]) > VSGL_MAX_COORD)
+        if (!finite_f(s->uv_transform[k]) || fabsf(s->uv_transform[k]) > VSGL__MAX_COORD)
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "material %u: %s uv_transform[%d] is %g (must be finite)",
                               (unsigned)m, name, k, (double)s->uv_transform[k]);
     return VSGL_OK;
@@ -225,7 +228,7 @@ static vsgl_result validate_textures(vsgl_context *ctx, const vsgl_scene_desc *d
                               (unsigned)t->reserved);
         size_t n = (size_t)t->width * t->height * 4;
         for (size_t k = 0; k < n; ++k)
-            if (!finite_f(t->pixels[k]) || fabsf(t->pixels[k]) > VSGL_MAX_COORD)
+            if (!finite_f(t->pixels[k]) || fabsf(t->pixels[k]) > VSGL__MAX_COORD)
                 return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "texture %u: texel (%zu, %zu) channel %zu is %g (must be finite)",
                                   (unsigned)i, (k / 4) % t->width, (k / 4) / t->width, k % 4, (double)t->pixels[k]);
     }
@@ -245,7 +248,7 @@ static vsgl_result validate_textures(vsgl_context *ctx, const vsgl_scene_desc *d
         }
     if (d->corner_colors)
         for (size_t k = 0; k < (size_t)d->triangle_count * 9; ++k)
-            if (!finite_f(d->corner_colors[k]) || fabsf(d->corner_colors[k]) > VSGL_MAX_COORD)
+            if (!finite_f(d->corner_colors[k]) || fabsf(d->corner_colors[k]) > VSGL__MAX_COORD)
                 return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "triangle %zu: corner %zu colour channel %zu is %g (must be finite)",
                                   k / 9, (k % 9) / 3, k % 3, (double)d->corner_colors[k]);
     return VSGL_OK;
@@ -254,9 +257,11 @@ static vsgl_result validate_textures(vsgl_context *ctx, const vsgl_scene_desc *d
 vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *d)
 {
     vsgl_result r;
-    if (d->size != 0 && d->size != sizeof(vsgl_scene_desc) && d->size != VSGL_SCENE_DESC_SIZE_0_1)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "scene: desc size is %u (this library expects %u, %u or 0)",
-                          (unsigned)d->size, (unsigned)sizeof(vsgl_scene_desc), (unsigned)VSGL_SCENE_DESC_SIZE_0_1);
+    if (d->size > sizeof(vsgl_scene_desc) || (d->size != 0 && (d->size < sizeof d->size || d->size % 4 != 0)))
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT,
+                          "vsgl_scene_desc.size is %u: this library knows multiples of 4 from %zu to %zu (0 = %zu; %u is 0.1's)",
+                          (unsigned)d->size, sizeof d->size, sizeof(vsgl_scene_desc), sizeof(vsgl_scene_desc),
+                          (unsigned)VSGL_SCENE_DESC_SIZE_0_1);
     if ((r = need_array(ctx, d->positions, d->vertex_count, "positions", "vertex_count")) != VSGL_OK ||
         (r = need_array(ctx, d->indices, d->triangle_count, "indices", "triangle_count")) != VSGL_OK ||
         (r = need_array(ctx, d->materials, d->material_count, "materials", "material_count")) != VSGL_OK ||
@@ -284,7 +289,7 @@ vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *
     for (uint32_t i = 0; i < d->vertex_count; ++i)
         for (int k = 0; k < 3; ++k) {
             float v = d->positions[(size_t)i * 3 + k];
-            if (!finite_f(v) || fabsf(v) > VSGL_MAX_COORD)
+            if (!finite_f(v) || fabsf(v) > VSGL__MAX_COORD)
                 return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "vertex %u: %c is %g (must be finite, |x| <= 1e18)",
                                   (unsigned)i, axis[k], (double)v);
         }
@@ -310,14 +315,14 @@ vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *
         if (d->corner_uvs)
             for (int k = 0; k < 6; ++k) {
                 float u = d->corner_uvs[(size_t)t * 6 + k];
-                if (!finite_f(u) || fabsf(u) > VSGL_MAX_COORD)
+                if (!finite_f(u) || fabsf(u) > VSGL__MAX_COORD)
                     return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "triangle %u: corner %d uv %c is %g (must be finite)",
                                       (unsigned)t, k / 2, k % 2 ? 'v' : 'u', (double)u);
             }
         if (d->corner_tangents)
             for (int k = 0; k < 12; ++k) {
                 float u = d->corner_tangents[(size_t)t * 12 + k];
-                if (!finite_f(u) || fabsf(u) > VSGL_MAX_COORD)
+                if (!finite_f(u) || fabsf(u) > VSGL__MAX_COORD)
                     return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "triangle %u: corner %d tangent component %d is %g (must be finite)",
                                       (unsigned)t, k / 4, k % 4, (double)u);
             }

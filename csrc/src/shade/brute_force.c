@@ -1,5 +1,6 @@
 /* Brute-force VPL gathering with the exact BRDF (see brute_force.h). */
 #include "shade/brute_force.h"
+#include "math/constants.h"
 
 #include "core/context.h"
 #include "core/parallel.h"
@@ -49,7 +50,7 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
     for (size_t s = j->first + begin; s < j->first + end; ++s) {
         float dcol[3] = {0, 0, 0}, gcol[3] = {0, 0, 0}, dl[3] = {0, 0, 0}, gl[3] = {0, 0, 0};
         uint32_t m = g->material[s];
-        if (m != VSGL_GBUFFER_MISS && m < j->material_count) {
+        if (m != VSGL__GBUFFER_MISS && m < j->material_count) {
             vsgl_brdf_params own;
             const vsgl_brdf_params *P = &j->params[m];
             if (g->surf[0]) {
@@ -93,7 +94,7 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 if (j->visibility &&
                     vsgl__scene_occluded(j->scene, x, w, j->eps, dist * (1.0f - 1e-4f) - j->eps))
                     continue;
-                double inv = 1.0 / ((double)d2 + (double)q->area * (1.0 / 3.14159265358979323846));
+                double inv = 1.0 / ((double)d2 + (double)q->area * (1.0 / VSGL__PI_D));
                 for (int c = 0; c < 3; ++c) {
                     sd[c] += (double)e[c] * rd[c] * inv;
                     sg[c] += (double)e[c] * rg[c] * ms[c] * inv;
@@ -125,7 +126,7 @@ vsgl_result vsgl__brute_force_shade(vsgl_context *ctx, const vsgl_scene *scene, 
     size_t nv = 0;
     for (uint32_t r = 0; r < rsm_count; ++r)
         for (size_t i = 0; i < rsms[r].count; ++i)
-            nv += rsms[r].material[i] != VSGL_RSM_EMPTY && rsms[r].material[i] < mc &&
+            nv += rsms[r].material[i] != VSGL__RSM_EMPTY && rsms[r].material[i] < mc &&
                   rsms[r].flux[0][i] + rsms[r].flux[1][i] + rsms[r].flux[2][i] > 0.0f;
     vsgl_brdf_params *params = malloc((mc ? mc : 1) * sizeof *params);
     bf_vpl *vpl = malloc((nv ? nv : 1) * sizeof *vpl);
@@ -149,7 +150,7 @@ vsgl_result vsgl__brute_force_shade(vsgl_context *ctx, const vsgl_scene *scene, 
     for (uint32_t r = 0; r < rsm_count; ++r) {
         const vsgl_rsm *R = &rsms[r];
         for (size_t i = 0; i < R->count; ++i) {
-            if (!(R->material[i] != VSGL_RSM_EMPTY && R->material[i] < mc &&
+            if (!(R->material[i] != VSGL__RSM_EMPTY && R->material[i] < mc &&
                   R->flux[0][i] + R->flux[1][i] + R->flux[2][i] > 0.0f))
                 continue;
             bf_vpl *q = &vpl[k++];

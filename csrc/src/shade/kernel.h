@@ -1,5 +1,5 @@
 /* Internal: the vectorised shading kernel. One call shades a block of
- * receivers (structure of arrays, up to VSGL_KERNEL_BLOCK) with one VSGL
+ * receivers (structure of arrays, up to VSGL__KERNEL_BLOCK) with one VSGL
  * and accumulates diffuse light (irradiance / pi, before albedo) and
  * glossy radiance per channel. The same source is compiled twice: with
  * vectorisation and ISA clones (kernel.c) and as a plain scalar build
@@ -10,30 +10,30 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define VSGL_KERNEL_BLOCK 64
+#define VSGL__KERNEL_BLOCK 64
 
 /* The emitter-hemisphere clip's constants (shade.h explains the clip). */
-#define VSGL_CLIP_BEHIND 0.02f   /* the behind fade, in units of sigma */
-#define VSGL_CLIP_PARALLEL 0.3f  /* the parallel fade, in 1 - n.n_v */
-#define VSGL_CLIP_NEAR 4.0f      /* the spread sharpness where conv is half-way */
+#define VSGL__CLIP_BEHIND 0.02f   /* the behind fade, in units of sigma */
+#define VSGL__CLIP_PARALLEL 0.3f  /* the parallel fade, in 1 - n.n_v */
+#define VSGL__CLIP_NEAR 4.0f      /* the spread sharpness where conv is half-way */
 
 /* Receivers of one block. Non-glossy receivers have camp = 0 (and any
  * frame); receivers without a diffuse lobe have diffuse = 0. */
 typedef struct vsgl_kernel_block {
-    float x[VSGL_KERNEL_BLOCK], y[VSGL_KERNEL_BLOCK], z[VSGL_KERNEL_BLOCK];
-    float nx[VSGL_KERNEL_BLOCK], ny[VSGL_KERNEL_BLOCK], nz[VSGL_KERNEL_BLOCK];
-    float ox[VSGL_KERNEL_BLOCK], oy[VSGL_KERNEL_BLOCK], oz[VSGL_KERNEL_BLOCK];
-    float diffuse[VSGL_KERNEL_BLOCK];   /* 1 if the diffuse lobe is shaded, else 0 */
+    float x[VSGL__KERNEL_BLOCK], y[VSGL__KERNEL_BLOCK], z[VSGL__KERNEL_BLOCK];
+    float nx[VSGL__KERNEL_BLOCK], ny[VSGL__KERNEL_BLOCK], nz[VSGL__KERNEL_BLOCK];
+    float ox[VSGL__KERNEL_BLOCK], oy[VSGL__KERNEL_BLOCK], oz[VSGL__KERNEL_BLOCK];
+    float diffuse[VSGL__KERNEL_BLOCK];   /* 1 if the diffuse lobe is shaded, else 0 */
     /* warped NDF lobe: ASG frame (X, Y, Z), bandwidths, linear amplitude */
-    float Xx[VSGL_KERNEL_BLOCK], Xy[VSGL_KERNEL_BLOCK], Xz[VSGL_KERNEL_BLOCK];
-    float Yx[VSGL_KERNEL_BLOCK], Yy[VSGL_KERNEL_BLOCK], Yz[VSGL_KERNEL_BLOCK];
-    float Zx[VSGL_KERNEL_BLOCK], Zy[VSGL_KERNEL_BLOCK], Zz[VSGL_KERNEL_BLOCK];
-    float lam[VSGL_KERNEL_BLOCK], mu[VSGL_KERNEL_BLOCK], camp[VSGL_KERNEL_BLOCK];
+    float Xx[VSGL__KERNEL_BLOCK], Xy[VSGL__KERNEL_BLOCK], Xz[VSGL__KERNEL_BLOCK];
+    float Yx[VSGL__KERNEL_BLOCK], Yy[VSGL__KERNEL_BLOCK], Yz[VSGL__KERNEL_BLOCK];
+    float Zx[VSGL__KERNEL_BLOCK], Zy[VSGL__KERNEL_BLOCK], Zz[VSGL__KERNEL_BLOCK];
+    float lam[VSGL__KERNEL_BLOCK], mu[VSGL__KERNEL_BLOCK], camp[VSGL__KERNEL_BLOCK];
     /* the smooth Fresnel/shadowing factor M(z, o) per channel at the lobe axis */
-    float f0r[VSGL_KERNEL_BLOCK], f0g[VSGL_KERNEL_BLOCK], f0b[VSGL_KERNEL_BLOCK];
+    float f0r[VSGL__KERNEL_BLOCK], f0g[VSGL__KERNEL_BLOCK], f0b[VSGL__KERNEL_BLOCK];
     /* accumulators */
-    float ld[3][VSGL_KERNEL_BLOCK];     /* diffuse light: sum power * cosine integral / pi */
-    float ls[3][VSGL_KERNEL_BLOCK];     /* glossy radiance */
+    float ld[3][VSGL__KERNEL_BLOCK];     /* diffuse light: sum power * cosine integral / pi */
+    float ls[3][VSGL__KERNEL_BLOCK];     /* glossy radiance */
 } vsgl_kernel_block;
 
 /* One VSGL, with the per-VSGL constants precomputed. */
@@ -51,31 +51,31 @@ typedef struct vsgl_kernel_light {
     float nx, ny, nz;        /* mean surface normal of the cluster */
     float clip;              /* emitter-hemisphere clip: coherence^2 of the normals, 0 = off (shade.h) */
     float conv;              /* 1 for a diffuse lobe: clamped-cosine emission in the far field */
-    float ibehind;           /* 1 / (VSGL_CLIP_BEHIND sigma) */
+    float ibehind;           /* 1 / (VSGL__CLIP_BEHIND sigma) */
     float planar;            /* weight of the planar glossy model (coherence^2 of a diffuse lobe, clip on), else 0 */
     float pvar;              /* its positional variance (var + the fit's overlap widening) */
     float u1x, u1y, u1z, u2x, u2y, u2z; /* an orthonormal basis of the cluster's plane */
 } vsgl_kernel_light;
 
 /* Lobes a block needs (skip the work for lobes no lane has). */
-#define VSGL_KERNEL_DIFFUSE 1
-#define VSGL_KERNEL_GLOSSY  2
+#define VSGL__KERNEL_DIFFUSE 1
+#define VSGL__KERNEL_GLOSSY  2
 /* The glossy lobe as GGX's core and tail: two ASGs of the lane's frame with
  * bandwidths x VSGL_GGX_{CORE,TAIL}_K and amplitudes x _C (least squares to
  * GGX's 1/(1 + x^2)^2, x = tan / alpha, at equal integral: L2 error 0.047
  * where the one Gaussian of Wang et al. has 0.29; the tail carries 53 % of
  * the energy, which one ASG puts in its core). */
-#define VSGL_KERNEL_GGX_TAIL 4
-#define VSGL_GGX_CORE_K 1.75f
-#define VSGL_GGX_CORE_C 0.8168f
-#define VSGL_GGX_TAIL_K 0.26f
-#define VSGL_GGX_TAIL_C 0.13864f
+#define VSGL__KERNEL_GGX_TAIL 4
+#define VSGL__GGX_CORE_K 1.75f
+#define VSGL__GGX_CORE_C 0.8168f
+#define VSGL__GGX_TAIL_K 0.26f
+#define VSGL__GGX_TAIL_C 0.13864f
 
-/* Accumulate VSGLs lights[0, count) into all VSGL_KERNEL_BLOCK receivers
+/* Accumulate VSGLs lights[0, count) into all VSGL__KERNEL_BLOCK receivers
  * of b (a fixed trip count: the caller fills unused lanes with any finite
  * receiver and ignores their sums), in that order. Diffuse modes as in
  * vsgl/sg.h (VSGL_COSINE_*); the glossy lobe is the block's ASG.
- * visibility: NULL or count x VSGL_KERNEL_BLOCK factors in [0, 1]
+ * visibility: NULL or count x VSGL__KERNEL_BLOCK factors in [0, 1]
  * (VSGL-major). */
 void vsgl__kernel_shade(vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count,
                         const float *visibility, int32_t diffuse_mode, int32_t lobes);

@@ -6,17 +6,16 @@
  * ASG x SG product integral (Xu et al. Eq. 18 with Eq. 11's normalisation)
  * with vsgl_specular_factor at the integrand's axis (docs/math.md). */
 #include "shade/kernel.h"
+#include "math/constants.h"
 #include "vsgl/sg.h"
 #include "math/sg_internal.h" /* the accurate cosine form's fitted constants */
 
 #include <math.h>
 #include <string.h>
 
-#define K_PI 3.14159265358979323846f
-#define K_2PI 6.28318530717958647692f
 #define K_SHARP_MAX 2199023255552.0f       /* 2^41 */
 /* A(2.29) / pi: the clamped cosine over the diffuse lobe's SG at the axis */
-#define K_CLIP_RHO ((float)(VSGL__COSINE_A_LD / 3.14159265358979323846))
+#define K_CLIP_RHO ((float)(VSGL__COSINE_A_LD / VSGL__PI_D))
 
 /* e^x, 0 below -87 and e^88 above 88: Cephes-style degree-5 polynomial
  * after rintf range reduction (not the 1.5*2^23 trick, which the
@@ -99,7 +98,7 @@ static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart(float l)
     k_cos_l o;
     l = l < K_SHARP_MAX ? l : K_SHARP_MAX;
     float small = l < 0.5f ? 1.0f : 0.0f;
-    float ls = l > 1e-30f ? l : 1e-30f;
+    float ls = l > VSGL__TINY ? l : VSGL__TINY;
     float inv = 1.0f / ls;
     float e1 = k_exp(-l);
     /* expm1(-l): Taylor below 0.5 */
@@ -118,16 +117,16 @@ static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart(float l)
                + l2 * (2.0f / 93555.0f + l2 * (-1382.0f / 638512875.0f + l2 * (4.0f / 18243225.0f
                + l2 * (-3617.0f / 162820783125.0f + l2 * (87734.0f / 38979295480125.0f)))))))));
     float ml = below1 > 0.0f ? ml_t : ml_c;
-    o.low = K_2PI * e1 * q;
-    o.u = K_2PI * (-em * (2.0f + em) * inv) * ml;
+    o.low = VSGL__2PI * e1 * q;
+    o.u = VSGL__2PI * (-em * (2.0f + em) * inv) * ml;
     /* t = l sqrt(h), h = 0.5 N(l) / D(l): one reciprocal square root gives t and 1/t */
     float h = 0.5f * ((l + VSGL__COS_T_A) * l + VSGL__COS_T_B) /
               (((l + VSGL__COS_T_C) * l + VSGL__COS_T_D) * l + VSGL__COS_T_E);
     float rh = k_rsqrt_fine(h);
     float t = l * h * rh;
-    t = t > 1e-30f ? t : 1e-30f;
+    t = t > VSGL__TINY ? t : VSGL__TINY;
     float it = rh * inv;
-    it = t > 1e-30f ? it : 1e30f;
+    it = t > VSGL__TINY ? it : 1e30f;
     float et = k_exp(-t * t);
     o.kappa = -((VSGL__COS_K_A1 + VSGL__COS_K_A2 * l) / (1.0f + l * (VSGL__COS_K_B1 + VSGL__COS_K_B2 * l))) * it;
     o.it = 0.28209479177387814f * it;
@@ -150,7 +149,7 @@ static inline __attribute__((always_inline)) k_cos_l k_cosine_lpart_sharp(float 
     l = l < K_SHARP_MAX ? l : K_SHARP_MAX;
     float inv = 1.0f / l;
     o.low = 0.0f;
-    o.u = K_2PI * inv * (1.0f - inv);
+    o.u = VSGL__2PI * inv * (1.0f - inv);
     float h = 0.5f * ((l + VSGL__COS_T_A) * l + VSGL__COS_T_B) /
               (((l + VSGL__COS_T_C) * l + VSGL__COS_T_D) * l + VSGL__COS_T_E);
     float rh = k_rsqrt_fine(h);
@@ -178,10 +177,10 @@ static inline __attribute__((always_inline)) float k_cosine_cpart_s(float l, flo
     if (sharp)
         return r;
     float omc2 = (1.0f - ac) * (1.0f + ac);
-    float bound = K_PI * k_exp(-l * c * c / (1.0f + sqrtf(omc2)));
+    float bound = VSGL__PI * k_exp(-l * c * c / (1.0f + sqrtf(omc2)));
     float rb = bound < r ? bound : r;
     r = c < 0.0f ? rb : r; /* no && : a combined mask does not vectorise (GCC 12) */
-    return l > 0.0f ? r : K_PI;
+    return l > 0.0f ? r : VSGL__PI;
 }
 
 static inline __attribute__((always_inline)) float k_cosine_cpart(float l, float c, k_cos_l o)
@@ -198,8 +197,8 @@ static inline __attribute__((always_inline)) float k_cosine_accurate(float l, fl
 static inline __attribute__((always_inline)) float k_sg_integral(float l)
 {
     float e = k_exp(-2.0f * l);
-    float taylor = 4.0f * K_PI * (1.0f - l * (1.0f - l * (2.0f / 3.0f)));
-    return l < 1e-3f ? taylor : K_2PI * (1.0f - e) / l;
+    float taylor = 4.0f * VSGL__PI * (1.0f - l * (1.0f - l * (2.0f / 3.0f)));
+    return l < 1e-3f ? taylor : VSGL__2PI * (1.0f - e) / l;
 }
 
 
@@ -210,18 +209,18 @@ static inline __attribute__((always_inline)) float k_sg_integral(float l)
  * loops keep it busy (the ASG lobe alone: 2.9 -> 2.4 ns per pair when split
  * in two stages; docs/performance.md has the whole history). */
 typedef struct k_scratch {
-    float mx[VSGL_KERNEL_BLOCK], my[VSGL_KERNEL_BLOCK], mz[VSGL_KERNEL_BLOCK]; /* lin times the incident axis */
-    float lin[VSGL_KERNEL_BLOCK], ilin[VSGL_KERNEL_BLOCK];                    /* its sharpness and 1/it */
-    float amp[VSGL_KERNEL_BLOCK];                                             /* its amplitude */
-    float expo[VSGL_KERNEL_BLOCK];                                            /* an exp's argument */
-    float gpre[VSGL_KERNEL_BLOCK];                                            /* the glossy integral's factor */
-    float r[VSGL_KERNEL_BLOCK], d2[VSGL_KERNEL_BLOCK], ls[VSGL_KERNEL_BLOCK];
+    float mx[VSGL__KERNEL_BLOCK], my[VSGL__KERNEL_BLOCK], mz[VSGL__KERNEL_BLOCK]; /* lin times the incident axis */
+    float lin[VSGL__KERNEL_BLOCK], ilin[VSGL__KERNEL_BLOCK];                    /* its sharpness and 1/it */
+    float amp[VSGL__KERNEL_BLOCK];                                             /* its amplitude */
+    float expo[VSGL__KERNEL_BLOCK];                                            /* an exp's argument */
+    float gpre[VSGL__KERNEL_BLOCK];                                            /* the glossy integral's factor */
+    float r[VSGL__KERNEL_BLOCK], d2[VSGL__KERNEL_BLOCK], ls[VSGL__KERNEL_BLOCK];
     /* the accurate cosine's part that depends on lin alone (k_cos_l) */
-    float low[VSGL_KERNEL_BLOCK], u[VSGL_KERNEL_BLOCK], t[VSGL_KERNEL_BLOCK], it[VSGL_KERNEL_BLOCK];
-    float h[VSGL_KERNEL_BLOCK];                                               /* height above the cluster's plane */
-    float vis[VSGL_KERNEL_BLOCK];                                             /* visibility x validity */
-    float pexpo[VSGL_KERNEL_BLOCK], ppre[VSGL_KERNEL_BLOCK];                  /* the planar glossy's exp argument, factor */
-    float kappa[VSGL_KERNEL_BLOCK], ct[VSGL_KERNEL_BLOCK];
+    float low[VSGL__KERNEL_BLOCK], u[VSGL__KERNEL_BLOCK], t[VSGL__KERNEL_BLOCK], it[VSGL__KERNEL_BLOCK];
+    float h[VSGL__KERNEL_BLOCK];                                               /* height above the cluster's plane */
+    float vis[VSGL__KERNEL_BLOCK];                                             /* visibility x validity */
+    float pexpo[VSGL__KERNEL_BLOCK], ppre[VSGL__KERNEL_BLOCK];                  /* the planar glossy's exp argument, factor */
+    float kappa[VSGL__KERNEL_BLOCK], ct[VSGL__KERNEL_BLOCK];
 } k_scratch;
 
 /* Stage 1: the incident radiance as one SG (Eq. 7), all but the exp.
@@ -247,13 +246,13 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
     t->h[i] = h;
     float sb = h * L->ibehind;
     sb = sb < 0.0f ? 0.0f : (sb > 1.0f ? 1.0f : sb);
-    float sp = (1.0f - (b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz)) * (1.0f / VSGL_CLIP_PARALLEL);
+    float sp = (1.0f - (b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz)) * (1.0f / VSGL__CLIP_PARALLEL);
     sp = sp > 1.0f ? 1.0f : sp;
     float c = h * r;
     c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
     float rho = K_CLIP_RHO * c * k_exp(VSGL__COSINE_SHARPNESS * (1.0f - c));
     float s = d2 * L->ivar;
-    float wn = s / (s + VSGL_CLIP_NEAR), w = wn * L->conv;
+    float wn = s / (s + VSGL__CLIP_NEAR), w = wn * L->conv;
     /* the parallel clip in the near field only: far away the receiver's own cosine does it */
     float par = 1.0f - (1.0f - sp * sp * (3.0f - 2.0f * sp)) * (1.0f - wn);
     float e = sb * sb * (3.0f - 2.0f * sb) * par * ((1.0f - w) + w * rho);
@@ -276,7 +275,7 @@ k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
     t->ls[i] = ls;
     t->mx[i] = mx; t->my[i] = my; t->mz[i] = mz;
     float lin2 = mx * mx + my * my + mz * mz;
-    float ilin = lin2 > 1e-30f ? k_rsqrt(lin2 > 1e-30f ? lin2 : 1.0f) : 0.0f;
+    float ilin = lin2 > VSGL__TINY ? k_rsqrt(lin2 > VSGL__TINY ? lin2 : 1.0f) : 0.0f;
     t->lin[i] = lin2 * ilin; t->ilin[i] = ilin;
 }
 
@@ -287,7 +286,7 @@ k_exponent(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
     float r = t->r[i], ls = t->ls[i];
     float ddx = L->ax - dx * r, ddy = L->ay - dy * r, ddz = L->az - dz * r;
     float diff2 = ddx * ddx + ddy * ddy + ddz * ddz;
-    t->expo[i] = -L->lv * ls * diff2 / (t->lin[i] + L->lv + ls + 1e-30f);
+    t->expo[i] = -L->lv * ls * diff2 / (t->lin[i] + L->lv + ls + VSGL__TINY);
 }
 
 /* Stage 2: the amplitude's exp. */
@@ -320,21 +319,21 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
     float cosint;
     if (mode == K_COSINE_PULLED_OUT_SHARP) {
         /* every lobe of the block has lin >= K_SHARP_COSINE: e^{-2 lin} < 2e-28 */
-        cosint = (mn > 0.0f ? mn : 0.0f) * (K_2PI * ilin * ilin);
+        cosint = (mn > 0.0f ? mn : 0.0f) * (VSGL__2PI * ilin * ilin);
     } else if (mode == VSGL_COSINE_PULLED_OUT) {
         /* max(c, 0) A(lin) with c = m.n / lin, A(l) = 2 pi (1 - e^{-2l}) / l */
         float e = k_exp(-2.0f * lin);
-        float big = K_2PI * (1.0f - e) * ilin * ilin;
-        float taylor = 4.0f * K_PI * (1.0f - lin * (1.0f - lin * (2.0f / 3.0f))) * ilin;
+        float big = VSGL__2PI * (1.0f - e) * ilin * ilin;
+        float taylor = 4.0f * VSGL__PI * (1.0f - lin * (1.0f - lin * (2.0f / 3.0f))) * ilin;
         cosint = (mn > 0.0f ? mn : 0.0f) * (lin < 1e-3f ? taylor : big);
     } else if (mode == VSGL_COSINE_SG || mode == K_COSINE_SG_SHARP) {
         float qx = mx + ld_sharp * b->nx[i], qy = my + ld_sharp * b->ny[i], qz = mz + ld_sharp * b->nz[i];
         float lm2 = qx * qx + qy * qy + qz * qz;
-        float ilm = k_rsqrt(lm2 > 1e-30f ? lm2 : 1e-30f);
+        float ilm = k_rsqrt(lm2 > VSGL__TINY ? lm2 : VSGL__TINY);
         float lm = lm2 * ilm;
         float ex = mx * ilin - b->nx[i], ey = my * ilin - b->ny[i], ez = mz * ilin - b->nz[i];
         float dd = ex * ex + ey * ey + ez * ez;
-        float alm = mode == K_COSINE_SG_SHARP ? K_2PI * ilm : k_sg_integral(lm);
+        float alm = mode == K_COSINE_SG_SHARP ? VSGL__2PI * ilm : k_sg_integral(lm);
         cosint = k_exp(-lin * ld_sharp * dd / (lm + lin + ld_sharp)) * alm * ld_norm;
     } else {
         float c = mn * ilin;
@@ -342,7 +341,7 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
         k_cos_l o = {t->low[i], t->u[i], t->t[i], t->it[i], t->kappa[i], t->ct[i]};
         cosint = k_cosine_cpart_s(lin, c, o, mode == K_COSINE_ACCURATE_SHARP);
     }
-    float ed = t->amp[i] * cosint * (1.0f / K_PI) * b->diffuse[i];
+    float ed = t->amp[i] * cosint * (1.0f / VSGL__PI) * b->diffuse[i];
     b->ld[0][i] += L->pr * ed;
     b->ld[1][i] += L->pg * ed;
     b->ld[2][i] += L->pb * ed;
@@ -362,12 +361,12 @@ k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t, f
     float gy = mx * b->Yx[i] + my * b->Yy[i] + mz * b->Yz[i];
     float gz = mx * b->Zx[i] + my * b->Zy[i] + mz * b->Zz[i];
     float lamn = lam + nu, mun = mu + nu;
-    float rp = k_rsqrt(lamn * mun + 1e-30f);
+    float rp = k_rsqrt(lamn * mun + VSGL__TINY);
     float w2 = rp * rp * nu * ilin * ilin;
     float hx = lam * mun * w2;
     float hy = mu * lamn * w2;
     t->expo[i] = -hx * gx * gx - hy * gy * gy;
-    t->gpre[i] = kc * b->camp[i] * (gz > 0.0f ? gz : 0.0f) * (K_PI * rp * ilin) * t->amp[i];
+    t->gpre[i] = kc * b->camp[i] * (gz > 0.0f ? gz : 0.0f) * (VSGL__PI * rp * ilin) * t->amp[i];
 }
 
 /* Stage 4b: glossy light from a planar cluster (shade.h, vsgl__planar_glossy):
@@ -384,7 +383,7 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
     float d2 = t->d2[i];
     float var = L->pvar > d2 * 4.547473508864641e-13f ? L->pvar : d2 * 4.547473508864641e-13f;
-    var = var > 1e-30f ? var : 1e-30f;
+    var = var > VSGL__TINY ? var : VSGL__TINY;
     float is = k_rsqrt_fine(var); /* the offsets scale with it and q amplifies their error */
     float h = t->h[i] * is;
     float nz = zx * L->nx + zy * L->ny + zz * L->nz;
@@ -418,7 +417,7 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     float idet = 1.0f / det;
     float qf = (s22 * d1 * d1 - 2.0f * s12 * d1 * e2 + s11 * e2 * e2) * idet;
     t->pexpo[i] = qf > 0.0f ? -0.5f * qf : 0.0f;
-    t->ppre[i] = ok * t->vis[i] * kc * b->camp[i] * (1.0f / K_2PI) * k_rsqrt(det * lam * mu) * (is * is);
+    t->ppre[i] = ok * t->vis[i] * kc * b->camp[i] * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu) * (is * is);
 }
 
 /* Stage 5: the glossy lobe's exp and the accumulation, with the smooth
@@ -445,7 +444,7 @@ k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
  * two independent chains, which the core overlaps. Sums are added in VSGL
  * order, as one VSGL at a time would. */
 #define K_FORN(STMT)                                   \
-    for (size_t i = 0; i < VSGL_KERNEL_BLOCK; ++i) \
+    for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) \
         for (int j = 0; j < NL; ++j)                   \
             STMT
 
@@ -455,15 +454,15 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
 {
     /* the poster's SG-cosine lobe: constants (no call on the hot path) */
     const float ld_sharp = VSGL__COSINE_SHARPNESS;
-    const float ld_norm = K_PI / k_sg_integral(VSGL__COSINE_SHARPNESS);
+    const float ld_norm = VSGL__PI / k_sg_integral(VSGL__COSINE_SHARPNESS);
     if (visibility)
-        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL_KERNEL_BLOCK + i], t + j));
+        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j));
     else
         K_FORN(k_geometry(b, i, L + j, 1.0f, t + j));
     K_FORN(k_axis(b, i, L + j, t + j));
     K_FORN(k_exponent(b, i, L + j, t + j));
     K_FORN(k_amplitude(i, t + j));
-    if (lobes & VSGL_KERNEL_DIFFUSE) {
+    if (lobes & VSGL__KERNEL_DIFFUSE) {
         /* blocks where every incident lobe is sharp take short forms */
         float lmin = K_SHARP_MAX;
         K_FORN(lmin = t[j].lin[i] < lmin ? t[j].lin[i] : lmin);
@@ -489,18 +488,18 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         }
 #undef K_DIFFUSE
     }
-    if (lobes & VSGL_KERNEL_GLOSSY) {
+    if (lobes & VSGL__KERNEL_GLOSSY) {
         /* the SG model, the planar one (coherent diffuse clusters) or a blend */
         int all_planar = 1, none_planar = 1;
         for (int j = 0; j < NL; ++j) {
             all_planar &= L[j].planar == 1.0f;
             none_planar &= L[j].planar == 0.0f;
         }
-        /* one ASG, or GGX's core and tail as two (kernel.h, VSGL_KERNEL_GGX_TAIL) */
-        const int two = (lobes & VSGL_KERNEL_GGX_TAIL) != 0;
+        /* one ASG, or GGX's core and tail as two (kernel.h, VSGL__KERNEL_GGX_TAIL) */
+        const int two = (lobes & VSGL__KERNEL_GGX_TAIL) != 0;
         for (int q = 0; q < 1 + two; ++q) {
-            const float kb = two ? (q ? VSGL_GGX_TAIL_K : VSGL_GGX_CORE_K) : 1.0f;
-            const float kc = two ? (q ? VSGL_GGX_TAIL_C : VSGL_GGX_CORE_C) : 1.0f;
+            const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
+            const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
             const int sg_only = none_planar;
             if (!all_planar)
                 K_FORN(k_glossy(b, i, t + j, kb, kc));
@@ -525,10 +524,10 @@ KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_li
     for (; v + 2 <= count; v += 2) {
         local[0] = lights[v];
         local[1] = lights[v + 1];
-        k_shade(b, local, 2, visibility ? visibility + v * VSGL_KERNEL_BLOCK : NULL, mode, lobes, t);
+        k_shade(b, local, 2, visibility ? visibility + v * VSGL__KERNEL_BLOCK : NULL, mode, lobes, t);
     }
     if (v < count) {
         local[0] = lights[v];
-        k_shade(b, local, 1, visibility ? visibility + v * VSGL_KERNEL_BLOCK : NULL, mode, lobes, t);
+        k_shade(b, local, 1, visibility ? visibility + v * VSGL__KERNEL_BLOCK : NULL, mode, lobes, t);
     }
 }

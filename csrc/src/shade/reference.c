@@ -116,7 +116,7 @@ vsgl_result vsgl_reference_render(vsgl_context *ctx, const vsgl_scene *scene, ui
         for (int c = 0; c < 3; ++c)
             st.total_flux[c] += R->total_flux[c];
         for (size_t i = 0; i < R->count; ++i)
-            st.vpl_count += R->material[i] != VSGL_RSM_EMPTY;
+            st.vpl_count += R->material[i] != VSGL__RSM_EMPTY;
     }
     st.seconds_rsm = now_s() - t0;
     if (rc == VSGL_OK) {

@@ -3,6 +3,7 @@
  * receiver NDF as an ASG (or SG) convolved with the incident SG, with the
  * smooth Fresnel/shadowing factor at the integrand's lobe axis. */
 #include "shade/shade.h"
+#include "math/constants.h"
 #include "shade/kernel.h"
 #include "shade/shade_job.h"
 #include "core/context.h"
@@ -17,9 +18,7 @@
 #  include <xmmintrin.h>
 #endif
 
-#define TWO_PI 6.28318530717958647692f
-#define INV_PI 0.31830988618379067154f
-/* Variance floor relative to the squared receiver distance (GUIDE Sec. 4): 2^-41. */
+/* Variance floor relative to the squared receiver distance (docs/references.md §4): 2^-41. */
 #define VARIANCE_FLOOR 4.547473508864641e-13f
 
 int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
@@ -38,7 +37,7 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
     spread.log_amplitude = 0.0f;
     vsgl_sg_product(&light_lobe, &spread, sg);
     /* c_v / (2 pi var) with c_v = power / A(lambda_v); power applied by the caller */
-    sg->log_amplitude -= logf(TWO_PI * var) + logf(vsgl_sg_integral(v->sharpness));
+    sg->log_amplitude -= logf(VSGL__2PI * var) + logf(vsgl_sg_integral(v->sharpness));
     return 1;
 }
 
@@ -57,14 +56,14 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
     float var = fmaxf(v->variance, d2 * VARIANCE_FLOOR);
     float h = v3_dot(d, v->normal);
     float s = var > 0.0f ? d2 / var : 0.0f;
-    float w = s / (s + VSGL_CLIP_NEAR);
+    float w = s / (s + VSGL__CLIP_NEAR);
     /* the parallel clip in the near field only: far away the receiver's own cosine does it */
-    float par = 1.0f - (1.0f - smoothstep01((1.0f - v3_dot(n, v->normal)) * (1.0f / VSGL_CLIP_PARALLEL))) * (1.0f - w);
-    float e = smoothstep01(h / (VSGL_CLIP_BEHIND * sqrtf(var) + 1e-30f)) * par;
-    if (v->lobe == VSGL_LOBE_DIFFUSE) {
+    float par = 1.0f - (1.0f - smoothstep01((1.0f - v3_dot(n, v->normal)) * (1.0f / VSGL__CLIP_PARALLEL))) * (1.0f - w);
+    float e = smoothstep01(h / (VSGL__CLIP_BEHIND * sqrtf(var) + VSGL__TINY)) * par;
+    if (v->lobe == VSGL__LOBE_DIFFUSE) {
         float c = d2 > 0.0f ? clampf(h / sqrtf(d2), 0.0f, 1.0f) : 0.0f;
         float ld = vsgl_sg_cosine_sharpness();
-        float rho = vsgl_sg_integral(ld) * INV_PI * c * expf(ld * (1.0f - c));
+        float rho = vsgl_sg_integral(ld) * VSGL__INV_PI * c * expf(ld * (1.0f - c));
         e *= (1.0f - w) + w * rho;
     }
     return 1.0f - v->coherence * v->coherence * (1.0f - e);
@@ -97,7 +96,7 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
         return 0.0f;
     float q = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
     /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
-    return expf(lobe->log_amplitude - 0.5f * q) / (TWO_PI * sqrtf(fmaxf(det * lam * mu, 1e-30f)));
+    return expf(lobe->log_amplitude - 0.5f * q) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
 }
 
 static void setup_receiver(const shade_job *j, size_t i, receiver *r)
@@ -138,14 +137,14 @@ static v3 ray_target(const vsgl_vsgl *v)
 }
 
 /* Visibility of `target` (a VSGL's ray target) from receivers rec[0..n), n <=
- * VSGL_KERNEL_BLOCK: one batched occlusion query (Embree ray streams) from
+ * VSGL__KERNEL_BLOCK: one batched occlusion query (Embree ray streams) from
  * each receiver offset along its normal; vis[k] = 0 if blocked, else 1. A
  * receiver at the target traces an empty segment (visible). */
 static void visibility_rays(const shade_job *j, v3 target, const receiver *rec, size_t n, float *vis)
 {
-    v3 org[VSGL_KERNEL_BLOCK], dir[VSGL_KERNEL_BLOCK];
-    float tmin[VSGL_KERNEL_BLOCK], tmax[VSGL_KERNEL_BLOCK];
-    unsigned char blocked[VSGL_KERNEL_BLOCK];
+    v3 org[VSGL__KERNEL_BLOCK], dir[VSGL__KERNEL_BLOCK];
+    float tmin[VSGL__KERNEL_BLOCK], tmax[VSGL__KERNEL_BLOCK];
+    unsigned char blocked[VSGL__KERNEL_BLOCK];
     for (size_t k = 0; k < n; ++k) {
         org[k] = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
         v3 d = v3_sub(target, org[k]);
@@ -159,11 +158,11 @@ static void visibility_rays(const shade_job *j, v3 target, const receiver *rec, 
         vis[k] = blocked[k] ? 0.0f : 1.0f;
 }
 
-/* Part q (0 core, 1 tail) of a GGX lobe's ASG (kernel.h, VSGL_KERNEL_GGX_TAIL). */
+/* Part q (0 core, 1 tail) of a GGX lobe's ASG (kernel.h, VSGL__KERNEL_GGX_TAIL). */
 static vsgl_asg ggx_part(const vsgl_asg *a, int q)
 {
     vsgl_asg r = *a;
-    float k = q ? VSGL_GGX_TAIL_K : VSGL_GGX_CORE_K, c = q ? VSGL_GGX_TAIL_C : VSGL_GGX_CORE_C;
+    float k = q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K, c = q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C;
     r.lambda *= k;
     r.mu *= k;
     r.log_amplitude += logf(c);
@@ -196,7 +195,7 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
     float sum = 0.0f;
     for (int q = 0; q < parts; ++q) {
         float gi = glossy_integral(j, r, in, axis, q);
-        if (j->leak && v->lobe == VSGL_LOBE_DIFFUSE) {
+        if (j->leak && v->lobe == VSGL__LOBE_DIFFUSE) {
             vsgl_asg lobe = r->asg;
             if (j->s->glossy_mode == VSGL_GLOSSY_SG)
                 vsgl_sg_to_asg(&r->sg, &lobe);
@@ -223,7 +222,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
         float covered = 0.0f;
         for (size_t sidx = 0; sidx < spp; ++sidx) {
             size_t i = px * spp + sidx;
-            if (g->material[i] == VSGL_GBUFFER_MISS)
+            if (g->material[i] == VSGL__GBUFFER_MISS)
                 continue;
             covered += 1.0f;
             receiver r;
@@ -246,7 +245,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 if (!vsgl__vsgl_incident_sg(v, r.x, &in))
                     continue;
                 if (j->leak)
-                    in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), 1e-30f));
+                    in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), VSGL__TINY));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
                     float vis;
                     visibility_rays(j, ray_target(v), &r, 1, &vis);
@@ -254,7 +253,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                         continue;
                 }
                 if (has_diffuse) {
-                    float e_d = vsgl_sg_cosine_integral(&in, &r.n, j->s->diffuse_mode) * INV_PI;
+                    float e_d = vsgl_sg_cosine_integral(&in, &r.n, j->s->diffuse_mode) * VSGL__INV_PI;
                     for (int c = 0; c < 3; ++c)
                         ld[c] += v->power[c] * e_d;
                 }
@@ -307,7 +306,7 @@ static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z
 /* Fill lane `k` of a kernel block from G-buffer sample i; returns 0 for a miss. */
 static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t k, receiver *r)
 {
-    if (j->g->material[i] == VSGL_GBUFFER_MISS) {
+    if (j->g->material[i] == VSGL__GBUFFER_MISS) {
         memset(r, 0, sizeof *r);
         clear_lane(b, k, 0.0f, 0.0f, 0.0f);
         return 0;
@@ -353,7 +352,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
 
 static int same_surface(const vsgl_gbuffer *g, const vsgl_material *materials, size_t a, size_t b, float plane_tol)
 {
-    if (g->material[a] != g->material[b] || g->material[a] == VSGL_GBUFFER_MISS)
+    if (g->material[a] != g->material[b] || g->material[a] == VSGL__GBUFFER_MISS)
         return 0;
     /* glossy reflections change across a pixel with the view: only rough
      * (alpha >= 0.25, roughness >= 0.5) or non-glossy surfaces merge */
@@ -369,7 +368,7 @@ static int same_surface(const vsgl_gbuffer *g, const vsgl_material *materials, s
     return fabsf(v3_dot(d, na)) <= plane_tol;
 }
 
-/* Shade G-buffer samples list[0..n) through the kernel, VSGL_KERNEL_BLOCK at
+/* Shade G-buffer samples list[0..n) through the kernel, VSGL__KERNEL_BLOCK at
  * a time, each at its own position or, where centroid (4 floats per entry:
  * a position sum and a count) has a count above 1, at the centroid of a
  * merged group; writes 6 floats per entry (diffuse light RGB, glossy RGB).
@@ -378,11 +377,11 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
                           float *light)
 {
     vsgl_kernel_block blk;
-    receiver rec[VSGL_KERNEL_BLOCK];
-    float vis[2 * VSGL_KERNEL_BLOCK]; /* visibility of two VSGLs */
+    receiver rec[VSGL__KERNEL_BLOCK];
+    float vis[2 * VSGL__KERNEL_BLOCK]; /* visibility of two VSGLs */
     uint64_t pairs = 0;
-    for (size_t s0 = 0; s0 < nshaded; s0 += VSGL_KERNEL_BLOCK) {
-        size_t n = nshaded - s0 < VSGL_KERNEL_BLOCK ? nshaded - s0 : VSGL_KERNEL_BLOCK;
+    for (size_t s0 = 0; s0 < nshaded; s0 += VSGL__KERNEL_BLOCK) {
+        size_t n = nshaded - s0 < VSGL__KERNEL_BLOCK ? nshaded - s0 : VSGL__KERNEL_BLOCK;
         int32_t lobes = 0;
         for (size_t k = 0; k < n; ++k) {
             fill_lane(j, shaded[s0 + k], &blk, k, &rec[k]); /* every shaded sample is a hit */
@@ -394,28 +393,28 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
                 blk.y[k] = rec[k].x.y;
                 blk.z[k] = rec[k].x.z;
             }
-            lobes |= (blk.diffuse[k] > 0.0f ? VSGL_KERNEL_DIFFUSE : 0) | (blk.camp[k] > 0.0f ? VSGL_KERNEL_GLOSSY : 0);
+            lobes |= (blk.diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk.camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0);
         }
-        if ((lobes & VSGL_KERNEL_GLOSSY) && j->s->glossy_mode == VSGL_GLOSSY_ASG2)
-            lobes |= VSGL_KERNEL_GGX_TAIL;
-        for (size_t k = n; k < VSGL_KERNEL_BLOCK; ++k) {
+        if ((lobes & VSGL__KERNEL_GLOSSY) && j->s->glossy_mode == VSGL_GLOSSY_ASG2)
+            lobes |= VSGL__KERNEL_GGX_TAIL;
+        for (size_t k = n; k < VSGL__KERNEL_BLOCK; ++k) {
             /* padding lanes: shaded, never read; at lane 0's position so that
              * they do not change the block's choice of short forms */
             clear_lane(&blk, k, blk.x[0], blk.y[0], blk.z[0]);
-            vis[k] = vis[VSGL_KERNEL_BLOCK + k] = 0.0f;
+            vis[k] = vis[VSGL__KERNEL_BLOCK + k] = 0.0f;
         }
         memset(blk.ld, 0, sizeof blk.ld);
         memset(blk.ls, 0, sizeof blk.ls);
         if (lobes) {
             void (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t) =
-                j->path == VSGL_SHADE_KERNEL_SCALAR ? vsgl__kernel_shade_scalar : vsgl__kernel_shade;
+                j->path == VSGL__SHADE_KERNEL_SCALAR ? vsgl__kernel_shade_scalar : vsgl__kernel_shade;
             const size_t count = j->set->count;
             if (j->s->visibility == VSGL_VISIBILITY_RAY) {
                 /* two VSGLs per kernel call, the pairs it interleaves */
                 for (size_t v = 0; v < count; v += 2) {
                     size_t m = count - v < 2 ? count - v : 2;
                     for (size_t q = 0; q < m; ++q)
-                        visibility_rays(j, ray_target(&j->set->items[v + q]), rec, n, vis + q * VSGL_KERNEL_BLOCK);
+                        visibility_rays(j, ray_target(&j->set->items[v + q]), rec, n, vis + q * VSGL__KERNEL_BLOCK);
                     kernel(&blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
                 }
             } else {
@@ -474,7 +473,7 @@ void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls)
     pl->coverage[px] = covered * inv_spp;
 }
 
-/* Rows of pixels through the vectorised kernel, VSGL_KERNEL_BLOCK shaded
+/* Rows of pixels through the vectorised kernel, VSGL__KERNEL_BLOCK shaded
  * samples at a time. */
 static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0)
 {
@@ -509,7 +508,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
     for (size_t i = 0; i < ns; ++i) {
         size_t si = first + i;
         slot[i] = UINT32_MAX;
-        if (g->material[si] == VSGL_GBUFFER_MISS)
+        if (g->material[si] == VSGL__GBUFFER_MISS)
             continue;
         if (j->merge)
             for (size_t k = i - i % spp; k < i && slot[i] == UINT32_MAX; ++k)
@@ -527,7 +526,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
     }
     pairs += vsgl__shade_list(j, shaded, nshaded, centroid, light);
     /* every covered sample: its own colours, the light of its slot */
-    const float *Ls[VSGL_GBUFFER_MAX_SPP];
+    const float *Ls[VSGL__GBUFFER_MAX_SPP];
     for (size_t px = j->base + b0; px < j->base + e0; ++px) {
         for (size_t k = 0; k < spp; ++k) {
             size_t i = (px - j->base - b0) * spp + k;
@@ -567,11 +566,11 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
     uint32_t material_count;
     /* The kernel models the ASG glossy lobe; the SG lobe uses the reference path. */
     if (s->glossy_mode == VSGL_GLOSSY_SG)
-        path = VSGL_SHADE_REFERENCE;
+        path = VSGL__SHADE_REFERENCE;
     int leak = s->leak_correction == VSGL_LEAK_ON ||
                s->leak_correction == VSGL_LEAK_AUTO;
     vsgl_kernel_light *kl = NULL;
-    if (path != VSGL_SHADE_REFERENCE) {
+    if (path != VSGL__SHADE_REFERENCE) {
         kl = malloc((set->count + 1) * sizeof *kl);
         if (!kl) {
             free(per_chunk);
@@ -588,13 +587,13 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
             o->ax = -v->axis.x; o->ay = -v->axis.y; o->az = -v->axis.z;
             o->lv = v->sharpness;
             o->lax = o->lv * o->ax; o->lay = o->lv * o->ay; o->laz = o->lv * o->az;
-            o->c0 = 1.0f / (TWO_PI * vsgl_sg_integral(v->sharpness));
+            o->c0 = 1.0f / (VSGL__2PI * vsgl_sg_integral(v->sharpness));
             o->pr = v->power[0]; o->pg = v->power[1]; o->pb = v->power[2];
             o->nx = v->normal.x; o->ny = v->normal.y; o->nz = v->normal.z;
             o->clip = leak ? v->coherence * v->coherence : 0.0f;
-            o->conv = v->lobe == VSGL_LOBE_DIFFUSE ? 1.0f : 0.0f;
-            o->ibehind = 1.0f / (VSGL_CLIP_BEHIND * sqrtf(v->variance) + 1e-30f);
-            o->planar = leak && v->lobe == VSGL_LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
+            o->conv = v->lobe == VSGL__LOBE_DIFFUSE ? 1.0f : 0.0f;
+            o->ibehind = 1.0f / (VSGL__CLIP_BEHIND * sqrtf(v->variance) + VSGL__TINY);
+            o->planar = leak && v->lobe == VSGL__LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
             o->pvar = v->variance + v->widen;
             v3 u1, u2;
             v3_basis(v->normal, &u1, &u2);
@@ -608,7 +607,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
                    0, 0, 0, NULL, NULL, NULL};
     vsgl_result r = VSGL_OK;
     /* One pixel in S x S (sparse.c): the anchors now, the rest row by row below. */
-    int sparse = s->shade_stride > 1 && path != VSGL_SHADE_REFERENCE && g->width && g->height;
+    int sparse = s->shade_stride > 1 && path != VSGL__SHADE_REFERENCE && g->width && g->height;
     uint64_t anchor_total = 0;
     if (sparse) {
         j.stride = s->shade_stride;
@@ -632,7 +631,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
         j.base = row * chunk;
         j.pairs = per_chunk + row;
         if (vsgl__parallel_for(vsgl_context_thread_count(ctx), (end - row) * chunk, chunk,
-                               path == VSGL_SHADE_REFERENCE ? shade_chunk
+                               path == VSGL__SHADE_REFERENCE ? shade_chunk
                                : sparse                     ? vsgl__shade_chunk_sparse
                                                             : shade_chunk_kernel, &j) != 0) {
             r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");

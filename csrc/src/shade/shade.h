@@ -29,9 +29,9 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
 /* Shading paths: the vectorised kernel (default), the same kernel built
  * scalar (benchmark baseline), and the reference path through the public
  * operator functions (slow; exact ASG normalisation; SG glossy lobes). */
-#define VSGL_SHADE_KERNEL        0
-#define VSGL_SHADE_KERNEL_SCALAR 1
-#define VSGL_SHADE_REFERENCE     2
+#define VSGL__SHADE_KERNEL        0
+#define VSGL__SHADE_KERNEL_SCALAR 1
+#define VSGL__SHADE_REFERENCE     2
 
 /* Emitter-hemisphere clip (the leak correction). A cluster's VPLs lie on
  * a surface and emit only in front of it, with a clamped cosine; the
@@ -51,7 +51,7 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
  *    near field by w = s / (s + 4), s = |x - mean|^2 / var (the spread's
  *    sharpness), where the SG product is the better model.
  * docs/accuracy.md measures it against a planar emitter's exact irradiance. */
-/* (VSGL_CLIP_* in shade/kernel.h) */
+/* (VSGL__CLIP_* in shade/kernel.h) */
 
 /* The clip factor of VSGL v for a receiver at x with unit normal n, in [0, 1]
  * (the kernel computes the same inline); `on` selects the clip. */

@@ -62,7 +62,7 @@ static int32_t anchor_rows(void *user, size_t chunk, size_t b, size_t e)
                 size_t a = ay * j->aw + ax, px = anchor_pixel(j, ax, (uint32_t)ay);
                 j->anchor_sample[a] = SIZE_MAX;
                 for (size_t k = 0; k < g->spp; ++k)
-                    if (g->material[px * g->spp + k] != VSGL_GBUFFER_MISS) {
+                    if (g->material[px * g->spp + k] != VSGL__GBUFFER_MISS) {
                         j->anchor_sample[a] = px * g->spp + k;
                         list[n] = px * g->spp + k;
                         where[n++] = a;
@@ -129,7 +129,7 @@ int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
     for (size_t i = 0; i < ns; ++i) {
         size_t si = first + i, px = si / spp;
         direct_of[i] = SIZE_MAX;
-        if (g->material[si] == VSGL_GBUFFER_MISS)
+        if (g->material[si] == VSGL__GBUFFER_MISS)
             continue;
         /* the anchor cell around the pixel centre */
         float fx = (float)(px % W) * inv_s, fy = (float)(px / W) * inv_s;
@@ -168,11 +168,11 @@ int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
 #if defined(__x86_64__) || defined(__i386__)
     _mm_setcsr(saved_csr);
 #endif
-    const float *Ls[VSGL_GBUFFER_MAX_SPP];
+    const float *Ls[VSGL__GBUFFER_MAX_SPP];
     for (size_t px = j->base + b0; px < j->base + e0; ++px) {
         for (size_t k = 0; k < spp; ++k) {
             size_t i = (px - j->base - b0) * spp + k;
-            if (g->material[first + i] == VSGL_GBUFFER_MISS)
+            if (g->material[first + i] == VSGL__GBUFFER_MISS)
                 Ls[k] = NULL;
             else
                 Ls[k] = direct_of[i] != SIZE_MAX ? dlight + direct_of[i] * 6 : interp + i * 6;

@@ -1,12 +1,10 @@
 """Export of the evaluated depsgraph against the scene built in each test and
 Blender's own values (matrix_world, loop counts, light settings)."""
-import math
 import os
 
 import bpy
 import numpy as np
 import pytest
-from mathutils import Matrix, Vector
 
 from conftest import VERSION, camera, cube, light, link, mesh_object, plane, principled, shader_material
 from vsgl_indirect import export, materials

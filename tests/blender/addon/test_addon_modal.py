@@ -6,7 +6,6 @@ import types
 
 import bpy
 import numpy as np
-import pytest
 
 from conftest import real_render_or_skip, room
 from vsgl_indirect import engine, operators, runner
@@ -97,7 +96,6 @@ def test_modal_shows_the_write_phase(scene, monkeypatch):
     """The status bar says the EXR is being written (it sat at 'shade 100%'
     through a 4-7 s write)."""
     room(scene)
-    seen = []
     real_write = engine.write_exr
 
     def slow_write(*a, **kw):

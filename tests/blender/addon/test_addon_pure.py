@@ -1,6 +1,5 @@
 """Pure mapping logic: materials (3.x and 4.x Principled), lights, camera,
 paths, EXR writer. Independent facts: Fresnel formula, Blender's rules."""
-import math
 import os
 
 import numpy as np

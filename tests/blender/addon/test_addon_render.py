@@ -251,10 +251,12 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     for n in ours:
         nx, ny = compositor._absolute(n)
         assert ny <= y0, (n.name, (nx, ny), (x0, y0, x1, y1))   # top below their bottom
+
     # Strength and per-pass toggles: the Add nodes' factors.
     def facs():
         return [compositor.compat.add_node_sockets(tree.nodes["VSGL Add %s [ViewLayer]" % k])
                 for k in ("Diffuse", "Glossy")]
+
     def factor(add):
         if add.bl_idname == "ShaderNodeMix":
             return [s for s in add.inputs if s.name == "Factor" and s.enabled][0].default_value
@@ -268,6 +270,10 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     assert handlers.setup_scene(scene) == []
     assert [round(factor(a), 6) for a in adds] == [0.5, 0.0]
     assert "(off)" in adds[1].label
+    # A slider drag only touches the factors (update_grading, the callback).
+    from vsgl_indirect.config import Options
+    assert compositor.update_grading(scene, Options(strength=0.25, use_diffuse=False))
+    assert [round(factor(a), 6) for a in adds] == [0.0, 0.25]
     scene.vsgl_indirect.add_to_render = False
     handlers.setup_scene(scene)
     assert not _nodes(tree, "VSGL Add")
@@ -275,6 +281,7 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     compositor.remove(scene)
     assert not _nodes(tree, "VSGL")
     assert out.links[0].from_node.bl_idname == "CompositorNodeRLayers"
+    assert not compositor.update_grading(scene, Options())
 
 
 def test_compositor_replaces_the_old_single_add_node(scene, tmp_path):
@@ -458,8 +465,8 @@ def _diffuse(name, color):
 
 
 @pytest.mark.parametrize("fit,shift,ctype", [("AUTO", (0.0, 0.0), "PERSP"),
-                                              ("VERTICAL", (0.15, -0.1), "PERSP"),
-                                              ("HORIZONTAL", (0.05, 0.1), "ORTHO")])
+                                             ("VERTICAL", (0.15, -0.1), "PERSP"),
+                                             ("HORIZONTAL", (0.05, 0.1), "ORTHO")])
 def test_aov_diffcol_aligns_with_cycles_diffcol(scene, tmp_path, fit, shift, ctype):
     """Camera, transforms and materials at once: the AOV's DiffCol plane must
     match Cycles' own DiffCol pass pixel for pixel (away from edges)."""

@@ -162,7 +162,7 @@ def test_instances_batched_like_normals(scene):
     size = np.array(me.texspace_size)
     co = np.array([v.co for v in me.vertices], np.float64)
     mats = [np.array(src.matrix_world)] + [np.array(e.matrix_world) @ np.array(src.matrix_world)
-                                          for e in insts]
+                                           for e in insts]
     P = sd.positions[sd.indices.astype(np.int64)].astype(np.float64)
     got = sd.corner_tangents[..., :3].astype(np.float64)
     matched = np.zeros(P.shape[:2], bool)
@@ -363,7 +363,7 @@ def test_gbuffer_tangent_matches_cycles(scene):
         assert m.sum() >= 20, "material %d: only %d pixels" % (mi, m.sum())
         assert np.percentile(ang[m], 99.5) < TOL_P995_DEG, \
             "material %s: tangent p99.5 %.3f deg" % (sd.material_names[mi],
-                                                      np.percentile(ang[m], 99.5))
+                                                     np.percentile(ang[m], 99.5))
     assert p995 < TOL_P995_DEG, "tangent angle p99.5 %.3f deg (mean %.3f)" % (p995, ang.mean())
 
 

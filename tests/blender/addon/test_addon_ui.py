@@ -9,7 +9,7 @@ import bpy
 import pytest
 
 import vsgl_indirect
-from conftest import cube, link, principled, room
+from conftest import room
 from vsgl_indirect import checks, config, engine, operators, runner, settings, ui
 
 
@@ -126,14 +126,16 @@ def _rna(name):
 
 
 def test_every_property_and_enum_item_has_a_label_and_a_tooltip():
-    for name, p in settings.VSGLIndirectSettings.bl_rna.properties.items():
-        if name in ("rna_type", "name"):
-            continue
-        assert p.name and p.name != name, (name, p.name)
-        assert len(p.description) >= 30, (name, p.description)
-        if p.type == "ENUM":
-            for item in p.enum_items:
-                assert item.name and len(item.description) >= 20, (name, item.identifier)
+    from vsgl_indirect import viewport
+    for group in (settings.VSGLIndirectSettings, viewport.VSGLLiveProps):
+        for name, p in group.bl_rna.properties.items():
+            if name in ("rna_type", "name"):
+                continue
+            assert p.name and p.name != name, (group, name, p.name)
+            assert len(p.description) >= 30, (group, name, p.description)
+            if p.type == "ENUM":
+                for item in p.enum_items:
+                    assert item.name and len(item.description) >= 20, (group, name, item.identifier)
     # proper names, not title-cased identifiers
     assert _rna("method").enum_items["VSGL"].name == "VSGL"
     assert _rna("glossy_mode").enum_items["ASG"].name == "ASG"
@@ -157,7 +159,7 @@ def test_knob_tooltips_carry_figures():
 def test_preset_table_matches_the_library():
     from vsgl_indirect import libvsgl
     try:
-        lib = libvsgl.library()
+        libvsgl.library()
     except Exception as e:
         pytest.skip("no libvsgl: %s" % e)
     for p in config.PRESETS:
@@ -369,8 +371,10 @@ def test_last_run_box_shows_the_memory_estimate(scene):
     runner.begin(scene.name, 4)
     res = engine.Result()
     res.path, res.summary = "/tmp/x.exr", "2 triangles"
-    res.stats = {"memory_estimate": {"total": 3 << 29, "limit": 22 << 30}}
+    res.stats = {"memory_estimate": {"total": 3 << 29, "limit": 22 << 30},
+                 "lights_used": 2, "lights_skipped": 1, "vsgl_count": 398}
     res.timings = {"render": 0.1, "write": 0.01}
     runner.finish(scene.name, res, 0.01)
     assert "Memory: about 1.5 GiB of 22.0 GiB" in texts(draw(scene))
     assert "max_memory_gb" in props_by_name(draw(scene))
+    assert "Last run: 2 light(s) used, 1 skipped, 398 VSGLs" in texts(draw(scene))

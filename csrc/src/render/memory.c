@@ -6,7 +6,7 @@
  * fit/grid.c, fit/kmeans.c, fit/fis.c, shade.c, brute_force.c, render.c);
  * tests/cli/run_cli.sh compares the estimate with the peak RSS of real
  * renders. */
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
 #include "shade/kernel.h"
 #include "fit/grid.h"
 #include "fit/vsgl_set.h"
@@ -138,7 +138,7 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
         uint64_t fit = 0;
         if (s->fit_mode != VSGL_FIT_TWO) {
             uint64_t cells = (uint64_t)rl.faces * side * side;
-            uint64_t grid = mul(cells, VSGL_GRID_STRIDE * sizeof(float));
+            uint64_t grid = mul(cells, VSGL__GRID_STRIDE * sizeof(float));
             if (s->fit_mode == VSGL_FIT_FIS) {
                 fit = add(grid + grid / 3u, mul(cells + 1u, sizeof(double))); /* mips; importance CDF */
             } else if (s->fit_mode == VSGL_FIT_LATTICE) {
@@ -147,10 +147,10 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
                 uint64_t lattice_cells = mul(s->vsgl_count, 16u);
                 if (lattice_cells > mul(texels, 4u))
                     lattice_cells = mul(texels, 4u);
-                fit = add(grid, mul(lattice_cells, VSGL_GRID_STRIDE * sizeof(double) + 2u * 12u));
+                fit = add(grid, mul(lattice_cells, VSGL__GRID_STRIDE * sizeof(double) + 2u * 12u));
             } else {
                 fit = add(grid, add(mul(texels, sizeof(uint32_t)), /* labels, centres, sums */
-                                    mul(s->vsgl_count, 64u + VSGL_GRID_STRIDE * sizeof(double))));
+                                    mul(s->vsgl_count, 64u + VSGL__GRID_STRIDE * sizeof(double))));
             }
         }
         fit_max = fit > fit_max ? fit : fit_max;

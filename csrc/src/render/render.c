@@ -1,7 +1,7 @@
 /* vsgl_render: G-buffer -> per-light RSM -> VSGL fit -> shading -> planes.
  * Lights that contribute nothing are skipped and reported; outputs are
  * written only when everything succeeded. */
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
 #include "shade/shade.h"
 #include "shade/brute_force.h"
 #include "core/context.h"
@@ -34,33 +34,52 @@ static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt,
         snprintf(st->skipped + used, sizeof st->skipped - used, "%s\n", line);
 }
 
+/* The RSM of light `l`, or a noted skip: *lit = 0 when the light has no
+ * power or its RSM is empty (then `rsm` holds nothing to free). The
+ * progress window of the step is [p0, p0 + dp). */
+static vsgl_result light_rsm(vsgl_context *ctx, const vsgl_scene *scene, uint32_t l, uint32_t resolution,
+                             float p0, float dp, vsgl_rsm *rsm, int *lit, vsgl_render_stats *st)
+{
+    uint32_t light_count = 0;
+    const vsgl_light *L = &vsgl__scene_lights(scene, &light_count)[l];
+    *lit = 0;
+    memset(rsm, 0, sizeof *rsm);
+    if (!(L->power * (L->color[0] + L->color[1] + L->color[2]) > 0.0f)) {
+        note_skip(ctx, st, "light %u: zero power or black colour", l);
+        ++st->lights_skipped;
+        return VSGL_OK;
+    }
+    double t0 = now_seconds();
+    vsgl__progress_window(ctx, p0, dp);
+    vsgl_result r = vsgl__rsm_build(ctx, scene, l, resolution, rsm);
+    st->seconds_rsm += now_seconds() - t0;
+    if (r != VSGL_OK)
+        return r;
+    if (!(rsm->total_flux[0] + rsm->total_flux[1] + rsm->total_flux[2] > 0.0)) {
+        note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
+        ++st->lights_skipped;
+        vsgl__rsm_free(rsm);
+        return VSGL_OK;
+    }
+    *lit = 1;
+    return VSGL_OK;
+}
+
 vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                              vsgl_vsgl_set *set, vsgl_render_stats *st)
 {
     uint32_t light_count = 0;
-    const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
+    (void)vsgl__scene_lights(scene, &light_count);
     for (uint32_t l = 0; l < light_count; ++l) {
-        const vsgl_light *L = &lights[l];
-        float emitted = L->power * (L->color[0] + L->color[1] + L->color[2]);
-        if (!(emitted > 0.0f)) {
-            note_skip(ctx, st, "light %u: zero power or black colour", l);
-            ++st->lights_skipped;
-            continue;
-        }
-        double t0 = now_seconds();
         vsgl_rsm rsm;
-        vsgl__progress_window(ctx, 0.1f + 0.3f * (float)l / (float)light_count, 0.3f / (float)light_count);
-        vsgl_result r = vsgl__rsm_build(ctx, scene, l, s->rsm_resolution, &rsm);
-        st->seconds_rsm += now_seconds() - t0;
+        int lit;
+        vsgl_result r = light_rsm(ctx, scene, l, s->rsm_resolution, 0.1f + 0.3f * (float)l / (float)light_count,
+                                  0.3f / (float)light_count, &rsm, &lit, st);
         if (r != VSGL_OK)
             return r;
-        if (!(rsm.total_flux[0] + rsm.total_flux[1] + rsm.total_flux[2] > 0.0)) {
-            note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
-            ++st->lights_skipped;
-            vsgl__rsm_free(&rsm);
+        if (!lit)
             continue;
-        }
-        t0 = now_seconds();
+        double t0 = now_seconds();
         size_t before = set->count;
         switch (s->fit_mode) {
         case VSGL_FIT_FIS: r = vsgl__fit_fis(ctx, scene, &rsm, s, set); break;
@@ -74,7 +93,7 @@ vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const v
             return r;
         size_t spec = 0;
         for (size_t k = before; k < set->count; ++k)
-            spec += set->items[k].lobe == VSGL_LOBE_SPECULAR;
+            spec += set->items[k].lobe == VSGL__LOBE_SPECULAR;
         if (spec == 0)
             note_skip(ctx, st, "light %u: no glossy surface it lights: specular VSGLs skipped", l);
         if (set->count == before) {
@@ -96,7 +115,7 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
                                const vsgl_gbuffer *g, const vsgl_pixel_planes *planes, vsgl_render_stats *st)
 {
     uint32_t light_count = 0;
-    const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
+    (void)vsgl__scene_lights(scene, &light_count);
     vsgl_rsm *rsms = calloc(light_count + 1, sizeof *rsms);
     float *sample = calloc(g->count * 12 + 1, sizeof(float));
     uint32_t used = 0;
@@ -106,27 +125,13 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
         goto done;
     }
     for (uint32_t l = 0; l < light_count && r == VSGL_OK; ++l) {
-        const vsgl_light *L = &lights[l];
-        if (!(L->power * (L->color[0] + L->color[1] + L->color[2]) > 0.0f)) {
-            note_skip(ctx, st, "light %u: zero power or black colour", l);
-            ++st->lights_skipped;
-            continue;
+        int lit;
+        r = light_rsm(ctx, scene, l, s->rsm_resolution, 0.1f + 0.2f * (float)l / (float)light_count,
+                      0.2f / (float)light_count, &rsms[used], &lit, st);
+        if (r == VSGL_OK && lit) {
+            ++used;
+            ++st->lights_used;
         }
-        double t0 = now_seconds();
-        vsgl__progress_window(ctx, 0.1f + 0.2f * (float)l / (float)light_count, 0.2f / (float)light_count);
-        r = vsgl__rsm_build(ctx, scene, l, s->rsm_resolution, &rsms[used]);
-        st->seconds_rsm += now_seconds() - t0;
-        if (r != VSGL_OK)
-            break;
-        const vsgl_rsm *m = &rsms[used];
-        if (!(m->total_flux[0] + m->total_flux[1] + m->total_flux[2] > 0.0)) {
-            note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
-            ++st->lights_skipped;
-            vsgl__rsm_free(&rsms[used]);
-            continue;
-        }
-        ++used;
-        ++st->lights_used;
     }
     if (r == VSGL_OK) {
         double t0 = now_seconds();
@@ -146,7 +151,7 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
             for (size_t p = 0; p < pixels; ++p) {
                 size_t hits = 0;
                 for (size_t k = 0; k < g->spp; ++k)
-                    hits += g->material[p * g->spp + k] != VSGL_GBUFFER_MISS;
+                    hits += g->material[p * g->spp + k] != VSGL__GBUFFER_MISS;
                 planes->coverage[p] = (float)hits / (float)g->spp;
             }
             for (uint32_t k = 0; k < used; ++k)
@@ -226,7 +231,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     vsgl_result r = vsgl__settings_resolve(ctx, settings, &s);
     if (r == VSGL_OK)
         r = check_output(ctx, scene, out);
-    if (r == VSGL_OK) { /* refuse what cannot fit before allocating (shade/memory.c) */
+    if (r == VSGL_OK) { /* refuse what cannot fit before allocating (render/memory.c) */
         const float *const rgb[7] = {out->diffuse_light, out->glossy_light, out->diffuse_color, out->glossy_color,
                                      out->diffuse, out->glossy, out->combined};
         uint64_t floats = out->alpha ? 1u : 0u;
@@ -287,7 +292,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
         if (r == VSGL_OK) {
             t0 = now_seconds();
             vsgl__progress_window(ctx, 0.4f, 0.6f);
-            r = vsgl__shade(ctx, scene, gb, vs, &s, &planes, VSGL_SHADE_KERNEL, &st.shading_pairs);
+            r = vsgl__shade(ctx, scene, gb, vs, &s, &planes, VSGL__SHADE_KERNEL, &st.shading_pairs);
             st.seconds_shade = now_seconds() - t0;
         }
     }

@@ -1,6 +1,6 @@
 /* Internal: render orchestration helpers. */
-#ifndef VSGL_SHADE_RENDER_INTERNAL_H
-#define VSGL_SHADE_RENDER_INTERNAL_H
+#ifndef VSGL_RENDER_RENDER_INTERNAL_H
+#define VSGL_RENDER_RENDER_INTERNAL_H
 
 #include "vsgl/render.h"
 #include "fit/vsgl_set.h"
@@ -14,7 +14,7 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
 /* Estimate what a render of `scene` with resolved settings `s` allocates
  * (plus `output_bytes` of caller planes) into `e`, and fail with
  * VSGL_ERROR_OUT_OF_MEMORY, naming the size and the limit, above the
- * context's limit (shade/memory.c). */
+ * context's limit (render/memory.c). */
 vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                                   uint64_t output_bytes, vsgl_memory_estimate *e);
 

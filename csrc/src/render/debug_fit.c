@@ -1,6 +1,6 @@
 /* vsgl_debug_vsgls: the fitted VSGLs, for tests and inspection. */
 #include "vsgl/debug.h"
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
 #include "core/context.h"
 
 #include <string.h>

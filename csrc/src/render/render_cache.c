@@ -1,6 +1,6 @@
 /* vsgl_render_cache: the G-buffer and the VSGLs of the last render, with
  * the inputs they were made from (compared bytewise by vsgl_render_cached). */
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
 #include "scene/scene_internal.h"
 #include "core/context.h"
 

@@ -1,5 +1,6 @@
 /* Render settings: presets, defaults for zero fields, validation. */
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
+#include "core/versioned.h"
 #include "core/context.h"
 
 #include <string.h>
@@ -57,14 +58,9 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
 vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings *in,
                                    vsgl_render_settings *s)
 {
-    memset(s, 0, sizeof *s);
-    if (in) {
-        if (in->size > sizeof *in)
-            return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT,
-                              "settings: size %u is larger than this library's %zu (newer header?)",
-                              in->size, sizeof *in);
-        memcpy(s, in, in->size ? in->size : sizeof *in);
-    }
+    vsgl_result r = vsgl__copy_versioned(ctx, s, sizeof *s, in, "vsgl_render_settings");
+    if (r != VSGL_OK)
+        return r;
     s->size = sizeof *s;
     if (!s->aa_samples)
         s->aa_samples = 1;
