@@ -234,8 +234,12 @@ sph.name = "Gold sphere"
 sph.data.materials.append(gold)
 for p in sph.data.polygons:
     p.use_smooth = True
-quad("Lamp panel", (-1.2, -0.5, Z1 - 0.02), (-1.2, 0.3, Z1 - 0.02), (0.2, 0.3, Z1 - 0.02),
-     (0.2, -0.5, Z1 - 0.02), lamp)
+# a flat LED fixture hanging 10 cm under the ceiling: a 3 cm box whose bottom
+# face emits (the emission's back side faces the box's top 3 cm away: the
+# export skips it and says so)
+fixture = box("Lamp panel", (-1.2, -0.5, Z1 - 0.13), (0.2, 0.3, Z1 - 0.10), white)
+fixture.data.materials.append(lamp)
+fixture.data.polygons[0].material_index = 1        # the bottom face (0, 3, 2, 1) faces down
 
 sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
 sun.data.energy = 8.0

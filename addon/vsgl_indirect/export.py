@@ -1037,10 +1037,10 @@ def emissive_lights(positions, indices, material_indices, emission, version=(3, 
             a = sx * size_y if shape == "RECTANGLE" else area
             power = (math.pi if v4 else 4.0) * a * strength
             for side in (1.0, -1.0):
-                # a side facing a surface closer than a tenth of its size (a panel
+                # a side facing a surface closer than 1/40 of its size (a panel
                 # mounted on a ceiling) keeps its light in the gap: skipped
                 gap = _ray_distance(P, I, centre, side * nrm, exclude=(t, u))
-                if gap < 0.1 * max(sx, size_y):
+                if gap < 0.025 * max(sx, size_y):
                     if skipped is not None:
                         skipped.append((g, side, gap))
                     continue
