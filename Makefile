@@ -155,7 +155,8 @@ $(BUILD)/fuzz/make_corpus: tests/fuzz/make_corpus.c $(FUZZ_LIB_SRC) $(HEADERS)
 $(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c $(LIB_SRC) $(HEADERS)
 	@mkdir -p $(dir $@)
 	clang $(CFLAGS_COMMON) $(FUZZ_FLAGS) -fsanitize=fuzzer -DFUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION -o $@ tests/fuzz/fuzz_scene.c $(LIB_SRC) $(LDLIBS)
-FUZZ_CLI_SRC := csrc/cli/options.c csrc/src/render/settings.c csrc/src/core/context.c csrc/src/core/result.c
+FUZZ_CLI_SRC := csrc/cli/options.c csrc/src/render/settings.c csrc/src/core/context.c csrc/src/core/result.c \
+  csrc/src/core/versioned.c
 $(BUILD)/fuzz/fuzz_cli: tests/fuzz/fuzz_cli.c $(FUZZ_CLI_SRC) $(HEADERS) csrc/cli/options.h
 	@mkdir -p $(dir $@)
 	clang $(CFLAGS_COMMON) -Icsrc/cli $(FUZZ_FLAGS) -fsanitize=fuzzer -o $@ tests/fuzz/fuzz_cli.c $(FUZZ_CLI_SRC) -lm

@@ -29,3 +29,5 @@ if "$py" -c 'import bpy' >/dev/null 2>&1; then
 else
   echo "live preview: skipped: cannot import bpy in $py (tools/install_bpy.sh installs it)"
 fi
+echo "== EXR writing: every compression, float and half"
+tools/bench_exr.sh

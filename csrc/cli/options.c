@@ -33,8 +33,10 @@ const char cli_usage[] =
     "  --max-memory SIZE     refuse a render estimated to need more (e.g. 8G, 512M;\n"
     "                        default: the memory available on this machine)\n"
     "  --seed N              seed of FIS / k-means sampling\n"
-    "  --half                16-bit half EXR (default 32-bit float)\n"
-    "  --compression NAME    zip | zips | piz | none   (EXR compression, default piz)\n"
+    "  --half                16-bit half EXR samples (the default, as Blender's)\n"
+    "  --float               32-bit float EXR samples\n"
+    "  --compression NAME    zip | zips | piz | none | rle | pxr24 | b44 | b44a\n"
+    "                        (EXR compression, default zip; pxr24 and b44* are lossy)\n"
     "  --dry-run             read and validate the scene and settings, estimate the\n"
     "                        memory, check the output path; do not render\n"
     "  -v, --verbose         per-stage timings and statistics on stderr\n"
@@ -119,8 +121,17 @@ static const int merge_values[] = {VSGL_MERGE_AUTO, VSGL_MERGE_OFF};
 static const char *const method_names[] = {"vsgl", "brute", NULL};
 static const int method_values[] = {VSGL_METHOD_VSGL, VSGL_METHOD_BRUTE_FORCE};
 
-static const char *const comp_names[] = {"zip", "zips", "piz", "none", NULL};
-static const int comp_values[] = {VSGL_EXR_ZIP, VSGL_EXR_ZIPS, VSGL_EXR_PIZ, VSGL_EXR_NONE};
+static const char *const comp_names[] = {"zip", "zips", "piz", "none", "rle", "pxr24", "b44", "b44a", NULL};
+static const int comp_values[] = {VSGL_EXR_ZIP, VSGL_EXR_ZIPS, VSGL_EXR_PIZ, VSGL_EXR_NONE, VSGL_EXR_RLE, VSGL_EXR_PXR24,
+                                  VSGL_EXR_B44, VSGL_EXR_B44A};
+
+const char *cli_compression_name(int compression)
+{
+    for (int i = 0; comp_names[i]; ++i)
+        if (comp_values[i] == compression)
+            return comp_names[i];
+    return "?";
+}
 
 static const enum_opt enum_opts[] = {
     {"--compression", comp_names, comp_values, offsetof(cli_options, compression)},
@@ -168,7 +179,11 @@ int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
 static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t err_size)
 {
     memset(o, 0, sizeof *o);
-    o->compression = VSGL_EXR_PIZ; /* 1080p, 22 float channels: PIZ 1.06 s / 60 MB, ZIP 1.73 s / 63 MB */
+    /* Blender's own EXR defaults: half, ZIP. At 1080p with 22 channels ZIP
+     * half wrote 3.3 MB in 0.8-0.9 s here, PIZ float 65 MB in 2.0 s
+     * (tools/bench_exr.sh, docs/performance.md). */
+    o->compression = VSGL_EXR_ZIP;
+    o->half = 1;
     o->command = CLI_HELP;
     o->preset = o->fit = o->sharpness = o->diffuse = o->glossy = o->visibility = o->method = o->leak = o->merge = -1;
     err[0] = '\0';
@@ -225,6 +240,10 @@ static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t e
             o->verbose = 1;
         } else if (!strcmp(name, "--half")) {
             o->half = 1;
+            o->pixel_type_given = 1;
+        } else if (!strcmp(name, "--float")) {
+            o->half = 0;
+            o->pixel_type_given = 1;
         } else if (!strcmp(name, "--dry-run")) {
             o->dry_run = 1;
         } else {
@@ -287,7 +306,7 @@ static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t e
     }
     if (!o->scene_path)
         return set_err(err, err_size, "%s: no scene bundle given%s (see vsgl --help)", cmd, "");
-    if (o->command == CLI_INFO && (o->output_path || o->half || o->dry_run))
+    if (o->command == CLI_INFO && (o->output_path || o->pixel_type_given || o->dry_run))
         return set_err(err, err_size, "info takes only a scene bundle (and -v)%s%s", "", "");
     return 0;
 }

@@ -22,6 +22,7 @@ typedef struct cli_options {
     int leak, merge;          /* VSGL_LEAK_*, VSGL_MERGE_*; -1 = not given */
     int compression;          /* VSGL_EXR_*, default ZIP */
     int half, verbose, dry_run;
+    int pixel_type_given;   /* --half or --float was given */
     uint64_t max_memory;      /* --max-memory in bytes; 0 = what the machine has available */
 } cli_options;
 
@@ -38,6 +39,9 @@ void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_r
 
 /* "method=vsgl aa=2 rsm=256 ..." for logs and EXR metadata. */
 void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size);
+
+/* The --compression name of a VSGL_EXR_* compression ("?" if unknown). */
+const char *cli_compression_name(int compression);
 
 /* The --help text. */
 extern const char cli_usage[];

@@ -299,9 +299,9 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
                 stats.seconds_shade);
         fprintf(stderr, "vsgl: lights used %u, skipped %u; VSGLs %u; shading pairs %llu\n", stats.lights_used,
                 stats.lights_skipped, stats.vsgl_count, (unsigned long long)stats.shading_pairs);
-        static const char *const comp[] = {"zip", "none", "zips", "piz"};
         fprintf(stderr, "vsgl: write %.3f s; wall %.3f s; wrote %s (%ux%u, %s, %s)\n", t_written - t_rendered,
-                t_written - t_start, out_path, cam->width, cam->height, o->half ? "half" : "float", comp[o->compression]);
+                t_written - t_start, out_path, cam->width, cam->height, o->half ? "half" : "float",
+                cli_compression_name(o->compression));
     }
 done:
     for (int i = 0; i < 7; ++i)

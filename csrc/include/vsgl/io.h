@@ -55,6 +55,13 @@ VSGL_API vsgl_result vsgl_check_output_path(vsgl_context *ctx, const char *path)
 #define VSGL_EXR_NONE 1 /**< uncompressed */
 #define VSGL_EXR_ZIPS 2 /**< ZIP, one scanline per block */
 #define VSGL_EXR_PIZ  3 /**< wavelet, good for noisy images */
+#define VSGL_EXR_RLE  4 /**< run-length */
+#define VSGL_EXR_PXR24 5 /**< lossy for float: 24-bit floats, then ZIP (half stored exactly) */
+#define VSGL_EXR_B44  6 /**< lossy, half channels only (float channels stored uncompressed) */
+#define VSGL_EXR_B44A 7 /**< B44, flat areas smaller */
+/** Number of compressions: Blender's list but DWAA/DWAB, which OpenEXR Core
+ *  3.1 (Debian 12's) cannot encode (docs/performance.md measures them). */
+#define VSGL_EXR_COMPRESSION_COUNT 8
 
 /** Largest number of channels of one pass. */
 #define VSGL_EXR_MAX_CHANNELS 4
@@ -83,7 +90,7 @@ typedef struct vsgl_exr_options {
     uint32_t size;           /**< sizeof(vsgl_exr_options) or 0 */
     const char *layer;       /**< layer name, same rules as a pass name; NULL = "VSGL" */
     int32_t pixel_type;      /**< VSGL_EXR_FLOAT (default) or VSGL_EXR_HALF */
-    int32_t compression;     /**< VSGL_EXR_ZIP (default), NONE, ZIPS, PIZ */
+    int32_t compression;     /**< VSGL_EXR_ZIP (default), NONE, ZIPS, PIZ, RLE, PXR24, B44, B44A */
     uint32_t metadata_count;
     const vsgl_exr_metadata *metadata; /**< copied into the header as string attributes */
 } vsgl_exr_options;

@@ -110,7 +110,7 @@ static vsgl_result check_args(vsgl_context *ctx, uint32_t width, uint32_t height
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR layer name '%s' must be 1-%d characters of [A-Za-z0-9_-]", layer, MAX_NAME);
     if (o->pixel_type != VSGL_EXR_FLOAT && o->pixel_type != VSGL_EXR_HALF)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR pixel type %d is not VSGL_EXR_FLOAT or VSGL_EXR_HALF", o->pixel_type);
-    if (o->compression < VSGL_EXR_ZIP || o->compression > VSGL_EXR_PIZ)
+    if (o->compression < VSGL_EXR_ZIP || o->compression >= VSGL_EXR_COMPRESSION_COUNT)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR compression %d is unknown", o->compression);
     if (o->metadata_count && !o->metadata)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR metadata: %u entries but NULL array", o->metadata_count);
@@ -291,7 +291,9 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
     if (rv != EXR_ERR_SUCCESS)
         return exr_failed(ctx, sink, path, "start", rv);
 
-    static const exr_compression_t comp[] = {EXR_COMPRESSION_ZIP, EXR_COMPRESSION_NONE, EXR_COMPRESSION_ZIPS, EXR_COMPRESSION_PIZ};
+    static const exr_compression_t comp[VSGL_EXR_COMPRESSION_COUNT] = {
+        EXR_COMPRESSION_ZIP, EXR_COMPRESSION_NONE, EXR_COMPRESSION_ZIPS, EXR_COMPRESSION_PIZ, EXR_COMPRESSION_RLE,
+        EXR_COMPRESSION_PXR24, EXR_COMPRESSION_B44, EXR_COMPRESSION_B44A};
     exr_pixel_type_t ptype = o->pixel_type == VSGL_EXR_HALF ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT;
     int part = 0;
     const char *what = "header";

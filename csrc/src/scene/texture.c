@@ -42,7 +42,8 @@ vsgl_result vsgl__texture_build(vsgl_context *ctx, uint32_t index, const vsgl_te
     if (out->srgb && (w > 1 || h > 1)) {
         lin = malloc(n * sizeof(float));
         if (!lin) {
-            vsgl__texture_free(out);
+            vsgl__texture_free(out); /* frees p: it is out->lv[0].p */
+            // cppcheck-suppress memleak
             return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "texture %u: out of memory for %ux%u texels", (unsigned)index,
                               (unsigned)w, (unsigned)h);
         }
