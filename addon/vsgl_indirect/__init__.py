@@ -12,22 +12,33 @@ bl_info = {
     "category": "Render",
 }
 
-if "bpy" in locals():   # script reload
+# The package imports nothing from Blender itself: its pure modules
+# (convert, materials, textures, config, engine, live, exr) are importable and
+# tested without bpy (tests/python/test_addon_pure.py). The Blender glue is
+# imported when Blender registers the add-on.
+# Executed again (F8, addon_utils reload): the globals of the first run are
+# still here, and register() reloads the submodules once.
+_reload_pending = "_GLUE" in globals()
+_GLUE = ("settings", "operators", "ui", "handlers", "viewport")
+_RELOAD = ("compat", "convert", "textures", "materials", "config", "checks", "exr", "export", "engine",
+           "runner", "compositor", "cycles_colors", "live") + _GLUE
+
+
+def _glue_modules():
+    global _reload_pending
     import importlib
-    for _m in ("compat", "convert", "materials", "config", "checks", "exr", "export", "engine",
-               "runner", "compositor", "settings", "operators", "ui", "handlers", "live", "viewport"):
-        if _m in locals():
-            importlib.reload(locals()[_m])
-
-import bpy  # noqa: E402
-
-from . import settings, operators, ui, handlers, viewport  # noqa: E402
-
-_modules = (settings, operators, ui, handlers, viewport)
+    import sys
+    if _reload_pending:
+        _reload_pending = False
+        for name in _RELOAD:
+            m = sys.modules.get(__name__ + "." + name)
+            if m is not None:
+                importlib.reload(m)
+    return [importlib.import_module(__name__ + "." + name) for name in _GLUE]
 
 
 def register():
-    for m in _modules:
+    for m in _glue_modules():
         m.register()
     # The pip bpy 4.2 LTS module segfaults at exit (status 139, after every
     # render) while any of our functions is still stored in Blender (a
@@ -44,13 +55,15 @@ def register():
 
 def unregister():
     import atexit
+    import importlib
     atexit.unregister(_unregister_at_exit)
-    for m in reversed(_modules):
-        m.unregister()
+    for name in reversed(_GLUE):
+        importlib.import_module(__name__ + "." + name).unregister()
 
 
 def _unregister_at_exit():
     try:
+        import bpy
         if "vsgl_indirect" in bpy.types.Scene.bl_rna.properties:
             unregister()
     except Exception:  # never turn a clean exit into a failure

@@ -1,13 +1,21 @@
-"""Pure mapping logic: materials (3.x and 4.x Principled), lights, camera,
-paths, EXR writer. Independent facts: Fresnel formula, Blender's rules."""
+"""Pure mapping logic of the add-on: materials (3.x and 4.x Principled),
+lights, camera, paths, EXR writer. Independent facts: Fresnel formula,
+Blender's rules. No bpy: the add-on package imports Blender only when it
+registers, so this runs in the fast suite with Debian's Python."""
 import os
+import sys
 
 import numpy as np
 import pytest
 
-from vsgl_indirect import convert, materials
-from vsgl_indirect.exr import write_multilayer_exr
-from exr_read import read_exr
+_REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+for _p in (os.path.join(_REPO, "addon"), os.path.join(_REPO, "tests", "blender", "addon")):
+    if _p not in sys.path:
+        sys.path.insert(0, _p)
+
+from vsgl_indirect import convert, materials  # noqa: E402
+from vsgl_indirect.exr import write_multilayer_exr  # noqa: E402
+from exr_read import read_exr  # noqa: E402
 
 
 def desc(kind, inputs, version, linked=()):
