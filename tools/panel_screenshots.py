@@ -37,7 +37,7 @@ def check(what, ok, why=""):
         FAILED.append(what)
 
 
-if engine.render_missing():
+if engine.library_error():
     import numpy as np
 
     def fake(sd, options):

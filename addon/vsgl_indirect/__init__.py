@@ -13,14 +13,14 @@ bl_info = {
 }
 
 # The package imports nothing from Blender itself: its pure modules
-# (convert, materials, textures, config, engine, live, exr) are importable and
+# (convert, materials, textures, config, engine, live) are importable and
 # tested without bpy (tests/python/test_addon_pure.py). The Blender glue is
 # imported when Blender registers the add-on.
 # Executed again (F8, addon_utils reload): the globals of the first run are
 # still here, and register() reloads the submodules once.
 _reload_pending = "_GLUE" in globals()
 _GLUE = ("settings", "operators", "ui", "handlers", "viewport")
-_RELOAD = ("compat", "convert", "textures", "materials", "config", "checks", "exr", "export", "engine",
+_RELOAD = ("compat", "convert", "textures", "materials", "config", "checks", "export", "engine",
            "runner", "compositor", "cycles_colors", "live") + _GLUE
 
 

@@ -9,7 +9,6 @@ import time
 
 import numpy as np
 
-from . import exr
 from .convert import ExportError
 
 # Planes requested from the library and their EXR pass names (vsgl/io.h).
@@ -53,30 +52,17 @@ def library_status():
         return False, str(e)
     except Exception as e:  # VsglLibraryError and anything the loader raises
         return False, str(e)
-    msg = "libvsgl %d.%d.%d (%s)" % (lib.version + (lib.path,))
-    missing = render_missing(lib)
-    if missing:
-        return False, "%s: %s" % (msg, missing)
-    return True, msg
+    return True, "libvsgl %d.%d.%d (%s)" % (lib.version + (lib.path,))
 
 
-def render_missing(lib=None):
-    """'' if the library can render, else a message saying what is missing."""
-    try:
-        lib = lib or _binding().library()
-    except Exception as e:
-        return str(e)
-    if not lib.has("vsgl_render"):
-        return "vsgl_render is not built yet (the C renderer is missing from %s)" % lib.path
-    undefined = getattr(lib, "undefined", ())
-    if undefined:
-        return ("the library build is incomplete: %s undefined (vsgl_render cannot run "
-                "until they are implemented; rebuild with `make`)" % ", ".join(undefined))
-    return ""
+def library_error():
+    """'' if libvsgl loads, else why not (the loader's message)."""
+    ok, msg = library_status()
+    return "" if ok else msg
 
 
 def can_render():
-    return RENDER_OVERRIDE is not None or not render_missing()
+    return RENDER_OVERRIDE is not None or not library_error()
 
 
 def settings_for(options, libvsgl):
@@ -125,7 +111,7 @@ def render_planes(sd, options, progress=None, log=None):
     cancel; ``log(level, message)`` receives the library's warnings/errors."""
     if RENDER_OVERRIDE is not None:
         return RENDER_OVERRIDE(sd, options)
-    missing = render_missing()
+    missing = library_error()
     if missing:
         raise AovError(missing)
     libvsgl = _binding()
@@ -214,42 +200,25 @@ def exr_passes(planes):
 
 
 def write_exr(path, planes, options, metadata=None, warnings=None):
-    """Write the planes as a multilayer EXR (library writer if built, else exr.py)."""
+    """Write the planes as a multilayer EXR with libvsgl's writer (atomic, chunks
+    compressed in parallel); any failure is an AovError naming the path."""
     passes = exr_passes(planes)
     bad = [n for n, a in passes.items() if not np.all(np.isfinite(a))]
     if bad:
         raise AovError("the AOV has non-finite values in pass(es) %s; not written" % ", ".join(bad))
     try:
         libvsgl = _binding()
-        lib = libvsgl.library()
-        use_lib = lib.has("vsgl_exr_write") and not getattr(lib, "undefined", ())
-    except Exception:
-        use_lib = False
-    fallback = ""
-    try:
-        if use_lib:
-            ctx = libvsgl.Context()
-            try:
-                libvsgl.exr_write(ctx, path, passes, layer=LAYER,
-                                  pixel_type="half" if options.half_float else "float",
-                                  metadata=metadata)
-            except libvsgl.VsglError as e:
-                if e.code != libvsgl.Result.ERROR_INTERNAL:
-                    raise
-                # OpenEXR itself refused: keep the AOV, say so.
-                fallback = ("libvsgl's EXR writer failed (%s); '%s' written by the add-on's "
-                            "own writer instead" % (e, path))
-                exr.write_multilayer_exr(path, passes, layer=LAYER, half=options.half_float)
-            finally:
-                ctx.close()
-        else:
-            exr.write_multilayer_exr(path, passes, layer=LAYER, half=options.half_float)
+        ctx = libvsgl.Context()
+        try:
+            libvsgl.exr_write(ctx, path, passes, layer=LAYER,
+                              pixel_type="half" if options.half_float else "float",
+                              metadata=metadata)
+        finally:
+            ctx.close()
     except OSError as e:
         raise AovError("cannot write '%s': %s" % (path, e.strerror or e))
     except Exception as e:
         raise AovError("cannot write '%s': %s" % (path, e))
-    if warnings is not None and fallback:
-        warnings.append(fallback)
     return path
 
 
@@ -297,5 +266,5 @@ def compute(sd, options, path, progress=None, keep_planes=False, metadata=None):
     return res
 
 
-__all__ = ["AovError", "AovCancelled", "ExportError", "compute", "library_status", "render_missing",
+__all__ = ["AovError", "AovCancelled", "ExportError", "compute", "library_status", "library_error",
            "can_render", "write_exr", "exr_passes", "RENDER_OVERRIDE"]

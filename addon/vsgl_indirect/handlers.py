@@ -249,7 +249,7 @@ def on_render_pre(scene, *args):
     options = runner.options_of(scene)
     runner.begin(scene.name, frame)
     if not engine.can_render():
-        msg = "frame %d: no indirect AOV: %s" % (frame, engine.render_missing())
+        msg = "frame %d: no indirect AOV: %s" % (frame, engine.library_error())
         runner.fail(scene.name, msg)
         fail_render(scene, msg)
         return

@@ -1,5 +1,5 @@
 """Pure mapping logic of the add-on: materials (3.x and 4.x Principled),
-lights, camera, paths, EXR writer. Independent facts: Fresnel formula,
+lights, camera, paths. Independent facts: Fresnel formula,
 Blender's rules. No bpy: the add-on package imports Blender only when it
 registers, so this runs in the fast suite with Debian's Python."""
 import os
@@ -9,13 +9,10 @@ import numpy as np
 import pytest
 
 _REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-for _p in (os.path.join(_REPO, "addon"), os.path.join(_REPO, "tests", "blender", "addon")):
-    if _p not in sys.path:
-        sys.path.insert(0, _p)
+if os.path.join(_REPO, "addon") not in sys.path:
+    sys.path.insert(0, os.path.join(_REPO, "addon"))
 
 from vsgl_indirect import convert, materials  # noqa: E402
-from vsgl_indirect.exr import write_multilayer_exr  # noqa: E402
-from exr_read import read_exr  # noqa: E402
 
 
 def desc(kind, inputs, version, linked=()):
@@ -99,18 +96,6 @@ def test_frame_path_template():
     assert p == "/r/vsgl/My_Scene_View_Layer_0007.exr"
     assert convert.frame_path("/a/b", 12) == "/a/b_0012.exr"
     assert convert.frame_path("/a/x##.exr", 3) != convert.frame_path("/a/x##.exr", 4)
-
-
-def test_exr_writer_layout(tmp_path):
-    a = np.random.RandomState(1).rand(6, 9, 3).astype(np.float32)
-    c = np.random.RandomState(2).rand(6, 9, 4).astype(np.float32)
-    path = write_multilayer_exr(str(tmp_path / "x.exr"), {"DiffInd": a, "Combined": c})
-    ch, attrs = read_exr(path)
-    assert sorted(ch) == ["VSGL.Combined.A", "VSGL.Combined.B", "VSGL.Combined.G",
-                          "VSGL.Combined.R", "VSGL.DiffInd.B", "VSGL.DiffInd.G", "VSGL.DiffInd.R"]
-    assert np.array_equal(ch["VSGL.DiffInd.G"], a[:, :, 1])
-    assert np.array_equal(ch["VSGL.Combined.A"], c[:, :, 3])
-    assert not [f for f in os.listdir(str(tmp_path)) if "tmp" in f]
 
 
 @pytest.mark.parametrize("version,color", [((3, 4, 1), "Emission"), ((4, 2, 0), "Emission Color")])

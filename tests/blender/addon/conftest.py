@@ -28,7 +28,7 @@ BPY_RENDER = os.path.join(HERE, "bpy_render.py")
 
 
 def real_render_or_skip():
-    missing = engine.render_missing()
+    missing = engine.library_error()
     if missing:
         pytest.skip("libvsgl cannot render yet: %s" % missing)
 

@@ -64,7 +64,7 @@ def run_modal(op, first_event="TIMER"):
 
 def test_modal_polls_until_done_and_shows_progress(scene, monkeypatch):
     room(scene)
-    if engine.render_missing():
+    if engine.library_error():
         monkeypatch.setattr(engine, "RENDER_OVERRIDE", lambda sd, o: (time.sleep(0.3), (
             {p: __import__("numpy").zeros((sd.height, sd.width, 3), "float32")
              for p in engine.PLANES if p != "alpha"}, {}))[1])
@@ -102,7 +102,7 @@ def test_modal_shows_the_write_phase(scene, monkeypatch):
         time.sleep(0.4)
         return real_write(*a, **kw)
     monkeypatch.setattr(engine, "write_exr", slow_write)
-    if engine.render_missing():
+    if engine.library_error():
         monkeypatch.setattr(engine, "RENDER_OVERRIDE", lambda sd, o: (
             {p: np.zeros((sd.height, sd.width, 3), "float32") for p in engine.PLANES if p != "alpha"}, {}))
     op = make_op()

@@ -337,7 +337,7 @@ def test_preview_operator_writes_and_loads_image(scene, monkeypatch):
         calls.append(sd.summary())
         z = np.full((sd.height, sd.width, 3), 0.5, np.float32)
         return {p: z for p in engine.PLANES if p != "alpha"}, {"skipped": "light 'X': test"}
-    if engine.render_missing():
+    if engine.library_error():
         monkeypatch.setattr(engine, "RENDER_OVERRIDE", fake)
     assert bpy.ops.vsgl.preview_indirect() == {"FINISHED"}
     img = bpy.data.images["VSGL Preview"]
@@ -367,7 +367,7 @@ def test_addons_route_with_user_scripts(scene, tmp_path):
                         "vsgl_indirect", "-f", "1"], env=env, stdout=subprocess.PIPE,
                        stderr=subprocess.STDOUT, universal_newlines=True, timeout=240)
     assert r.returncode == 0, r.stdout
-    if engine.render_missing():
+    if engine.library_error():
         assert "VSGL ERROR" in r.stdout and "vsgl_render" in r.stdout, r.stdout
     else:
         assert "VSGL INFO: wrote" in r.stdout and str(dst / "lib") in r.stdout or \
