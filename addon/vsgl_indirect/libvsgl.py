@@ -189,6 +189,10 @@ class ExrCompression(enum.IntEnum):
     NONE = 1
     ZIPS = 2
     PIZ = 3
+    RLE = 4
+    PXR24 = 5
+    B44 = 6
+    B44A = 7
 
 
 MATERIAL_UNSUPPORTED = 1
