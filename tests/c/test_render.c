@@ -193,6 +193,41 @@ VT_TEST(render_skips_dark_lights_and_says_why)
     vsgl_context_destroy(ctx);
 }
 
+/* Many skipped lights: stats.skipped keeps whole lines and ends by saying
+ * that the rest is in the log, never a cut line. */
+VT_TEST(render_skipped_list_says_when_it_is_full)
+{
+    enum { N = 64 };
+    static planes p;
+    static vsgl_light lights[N];
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.3f, 100.0f);
+    lights[0] = fx.lights[0];
+    for (int i = 1; i < N; ++i) {
+        lights[i] = fx.lights[0];
+        lights[i].power = 0.0f;
+    }
+    vsgl_scene_desc d = *fx_desc(&fx);
+    d.lights = lights;
+    d.light_count = N;
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    VT_REQUIRE(vsgl_scene_create(ctx, &d, &scene) == VSGL_OK, "scene: %s", vsgl_context_last_error(ctx));
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    vsgl_render_output o = bind(&p);
+    vsgl_render_stats st;
+    VT_CHECK(vsgl_render(ctx, scene, &s, &o, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(st.lights_skipped == N - 1, "skipped %u", st.lights_skipped);
+    size_t len = strlen(st.skipped);
+    VT_CHECK(len > 0 && len < sizeof st.skipped && st.skipped[len - 1] == '\n', "ends with a whole line");
+    VT_CHECK(strstr(st.skipped, "(more: every skipped item is logged") != NULL, "no 'more' line: %s", st.skipped);
+    VT_CHECK(strstr(st.skipped, "light 1: zero power") != NULL, "first item missing");
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
 /* Issue 10: a render that cannot fit is refused before anything is
  * allocated, with a message naming the size, the estimate and the limit;
  * the estimate validates settings exactly as the render does. */

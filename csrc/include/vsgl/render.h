@@ -134,7 +134,8 @@ typedef struct vsgl_render_stats {
     uint32_t lights_skipped;
     uint32_t vsgl_count;         /**< VSGLs shaded, all lights */
     uint64_t shading_pairs;      /**< sample x VSGL evaluations */
-    char skipped[1024];          /**< what was skipped and why, one item per line */
+    char skipped[1024];          /**< what was skipped and why, one item per line; when they do not all
+                                      fit, the last line says so (the log has every item) */
     uint32_t reused;             /**< stages taken from a vsgl_render_cache: VSGL_REUSED_* bits */
 } vsgl_render_stats;
 

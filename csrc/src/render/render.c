@@ -29,9 +29,14 @@ static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt,
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
     vsgl__log(ctx, VSGL_LOG_INFO, "skipped: %s", line);
-    size_t used = strlen(st->skipped);
-    if (used + strlen(line) + 2 < sizeof st->skipped)
+    /* Whole lines only; when the next does not fit, one last line says that
+     * the rest is in the log (room for it is always kept). */
+    static const char more[] = "(more: every skipped item is logged at level INFO)\n";
+    size_t used = strlen(st->skipped), room = sizeof st->skipped - sizeof more;
+    if (used + strlen(line) + 1 < room)
         snprintf(st->skipped + used, sizeof st->skipped - used, "%s\n", line);
+    else if (!strstr(st->skipped, more))
+        snprintf(st->skipped + used, sizeof st->skipped - used, "%s", more);
 }
 
 /* The RSM of light `l`, or a noted skip: *lit = 0 when the light has no
