@@ -22,13 +22,13 @@ const char cli_usage[] =
     "  --fit NAME            two | fis | kmeans | lattice   (VSGL fit)\n"
     "  --vsgls N             VSGLs per light (fis, kmeans; 1..65536)\n"
     "  --sharpness NAME      toksvig | banerjee\n"
-    "  --diffuse NAME        sg | pulled | accurate   (receiver cosine)\n"
+    "  --diffuse NAME        sg | pulled-out | accurate   (receiver cosine)\n"
     "  --glossy NAME         asg | sg | asg2   (one ASG, one SG, GGX core + tail as two ASGs)\n"
     "  --visibility NAME     none | ray\n"
     "  --leak NAME           auto | off | on   (emitter-hemisphere light-leak correction)\n"
     "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
     "  --shade-stride N      1..8              (shade one pixel in N x N, interpolate the rest)\n"
-    "  --method NAME         vsgl | brute   (brute: every RSM texel, the reference)\n"
+    "  --method NAME         vsgl | brute-force   (brute-force: every RSM texel, the reference)\n"
     "  --threads N           worker threads (0 = all cores)\n"
     "  --max-memory SIZE     refuse a render estimated to need more (e.g. 8G, 512M;\n"
     "                        default: the memory available on this machine)\n"
@@ -108,8 +108,11 @@ static const char *const fit_names[] = {"two", "fis", "kmeans", "lattice", NULL}
 static const int fit_values[] = {VSGL_FIT_TWO, VSGL_FIT_FIS, VSGL_FIT_KMEANS, VSGL_FIT_LATTICE};
 static const char *const sharp_names[] = {"toksvig", "banerjee", NULL};
 static const int sharp_values[] = {VSGL_SHARPNESS_TOKSVIG, VSGL_SHARPNESS_BANERJEE};
-static const char *const diffuse_names[] = {"sg", "pulled", "accurate", NULL};
-static const int diffuse_values[] = {VSGL_COSINE_SG, VSGL_COSINE_PULLED_OUT, VSGL_COSINE_ACCURATE};
+/* The add-on's enum names in lower case with '-' (PULLED_OUT -> pulled-out);
+ * the older short spellings stay accepted after them. */
+static const char *const diffuse_names[] = {"sg", "pulled-out", "accurate", "pulled", NULL};
+static const int diffuse_values[] = {VSGL_COSINE_SG, VSGL_COSINE_PULLED_OUT, VSGL_COSINE_ACCURATE,
+                                     VSGL_COSINE_PULLED_OUT};
 static const char *const glossy_names[] = {"asg", "sg", "asg2", NULL};
 static const int glossy_values[] = {VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG, VSGL_GLOSSY_ASG2};
 static const char *const vis_names[] = {"none", "ray", NULL};
@@ -118,8 +121,8 @@ static const char *const leak_names[] = {"auto", "off", "on", NULL};
 static const int leak_values[] = {VSGL_LEAK_AUTO, VSGL_LEAK_OFF, VSGL_LEAK_ON};
 static const char *const merge_names[] = {"auto", "off", NULL};
 static const int merge_values[] = {VSGL_MERGE_AUTO, VSGL_MERGE_OFF};
-static const char *const method_names[] = {"vsgl", "brute", NULL};
-static const int method_values[] = {VSGL_METHOD_VSGL, VSGL_METHOD_BRUTE_FORCE};
+static const char *const method_names[] = {"vsgl", "brute-force", "brute", NULL};
+static const int method_values[] = {VSGL_METHOD_VSGL, VSGL_METHOD_BRUTE_FORCE, VSGL_METHOD_BRUTE_FORCE};
 
 static const char *const comp_names[] = {"zip", "zips", "piz", "none", "rle", "pxr24", "b44", "b44a", NULL};
 static const int comp_values[] = {VSGL_EXR_ZIP, VSGL_EXR_ZIPS, VSGL_EXR_PIZ, VSGL_EXR_NONE, VSGL_EXR_RLE, VSGL_EXR_PXR24,

@@ -267,6 +267,15 @@ if want render_compression && have oiiotool; then
     fi
   done
 fi
+# The add-on's enum names (PULLED_OUT, BRUTE_FORCE) in lower case, and the
+# short spellings of earlier releases.
+for spelling in "--diffuse pulled-out --method brute-force" "--diffuse pulled --method brute"; do
+  # shellcheck disable=SC2086
+  if expect_ok "args_names $spelling" "$VSGL" render "$SCENE" -o "$T/names.exr" $spelling --dry-run; then
+    if grep -q "method=brute-force" "$T/out" && grep -q "diffuse=pulled-out" "$T/out"; then ok "args_names $spelling"
+    else bad "args_names $spelling" "$(head -3 "$T/out" | tr '\n' '|')"; fi
+  fi
+done
 expect_fail args_bad_compression 2 "'lzma' is not one of zip|zips|piz|none|rle|pxr24|b44|b44a" "$VSGL" render "$SCENE" \
   --compression lzma
 
