@@ -8,7 +8,6 @@ Nothing here skips: a missing symbol or an unloadable library fails
 """
 
 import os
-import sys
 
 import numpy as np
 import pytest
@@ -16,11 +15,8 @@ import pytest
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
 ADDON = os.path.join(REPO, "addon", "vsgl_indirect")
-for p in (ADDON, HERE):
-    if p not in sys.path:
-        sys.path.insert(0, p)
 
-import libvsgl  # noqa: E402
+import libvsgl  # noqa: E402  (addon/vsgl_indirect is on setup.cfg's pythonpath)
 
 
 @pytest.fixture(scope="session")

@@ -2,17 +2,11 @@
 lights, camera, paths. Independent facts: Fresnel formula,
 Blender's rules. No bpy: the add-on package imports Blender only when it
 registers, so this runs in the fast suite with Debian's Python."""
-import os
-import sys
 
 import numpy as np
 import pytest
 
-_REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-if os.path.join(_REPO, "addon") not in sys.path:
-    sys.path.insert(0, os.path.join(_REPO, "addon"))
-
-from vsgl_indirect import convert, materials  # noqa: E402
+from vsgl_indirect import convert, materials
 
 
 def desc(kind, inputs, version, linked=()):

@@ -8,9 +8,8 @@ import pytest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", "..", ".."))
-for p in (os.path.join(REPO, "addon"), HERE):
-    if p not in sys.path:
-        sys.path.insert(0, p)
+# addon/ and this folder are on setup.cfg's pythonpath (pytest finds it
+# from the repository root, in Blender as in the pip module)
 
 import bpy  # noqa: E402
 import vsgl_indirect  # noqa: E402
