@@ -22,6 +22,7 @@ import time
 
 REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 sys.path.insert(0, os.path.join(REPO, "addon"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
 
@@ -41,31 +42,10 @@ from vsgl_indirect import export, live, viewport  # noqa: E402
 
 
 def build(triangles):
+    from live_room import build_room, material
     bpy.ops.wm.read_factory_settings(use_empty=True)
     s = bpy.context.scene
-
-    def mat(name, rgb, rough=0.5, metal=0.0):
-        m = bpy.data.materials.new(name)
-        m.use_nodes = True
-        b = m.node_tree.nodes["Principled BSDF"]
-        b.inputs["Base Color"].default_value = rgb + (1,)
-        b.inputs["Roughness"].default_value = rough
-        b.inputs["Metallic"].default_value = metal
-        return m
-
-    def quad(name, verts, m):
-        me = bpy.data.meshes.new(name)
-        me.from_pydata(verts, [], [(0, 1, 2, 3)])
-        me.materials.append(m)
-        ob = bpy.data.objects.new(name, me)
-        s.collection.objects.link(ob)
-        return ob
-
-    white = mat("White", (0.8, 0.8, 0.8))
-    quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], mat("Floor", (0.7, 0.7, 0.7), 0.25, 1.0))
-    quad("Back", [(-3, 3, 0), (3, 3, 0), (3, 3, 3), (-3, 3, 3)], white)
-    quad("Left", [(-3, -3, 0), (-3, 3, 0), (-3, 3, 3), (-3, -3, 3)], mat("Red", (0.8, 0.05, 0.05)))
-    quad("Right", [(3, 3, 0), (3, -3, 0), (3, -3, 3), (3, 3, 3)], mat("Green", (0.05, 0.6, 0.1)))
+    light, cam = build_room(s)
     # a grid bent into a wave: ~triangles triangles
     n = max(2, int(math.sqrt(triangles / 2)))
     verts = [(-1.5 + 3.0 * i / n, -1.0 + 2.0 * j / n, 0.6 + 0.2 * math.sin(6.0 * i / n) * math.cos(5.0 * j / n))
@@ -74,20 +54,9 @@ def build(triangles):
              for j in range(n) for i in range(n)]
     me = bpy.data.meshes.new("Wave")
     me.from_pydata(verts, [], faces)
-    me.materials.append(mat("Gold", (0.9, 0.6, 0.2), 0.3, 1.0))
+    me.materials.append(material("Gold", (0.9, 0.6, 0.2), 0.3, 1.0))
     wave = bpy.data.objects.new("Wave", me)
     s.collection.objects.link(wave)
-    ld = bpy.data.lights.new("Spot", "SPOT")
-    ld.energy, ld.spot_size = 800.0, 1.0
-    light = bpy.data.objects.new("Spot", ld)
-    light.location = (-1.5, 0.0, 2.8)
-    light.rotation_euler = (0.0, math.radians(-60), 0.0)
-    s.collection.objects.link(light)
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    cam.location, cam.rotation_euler = (0, -7.5, 1.6), (math.radians(85), 0, 0)
-    cam.data.lens = 24
-    s.collection.objects.link(cam)
-    s.camera = cam
     return light, cam, wave
 
 
