@@ -192,7 +192,7 @@ int main(int argc, char **argv)
         hits = 0;
         count = g.count;
         for (size_t e = 0; e < g.count; ++e)
-            hits += g.material[e] != VSGL_GBUFFER_MISS;
+            hits += g.material[e] != VSGL__GBUFFER_MISS;
         vsgl__gbuffer_free(&g);
         vsgl_scene_destroy(s);
     }

@@ -4,7 +4,7 @@
 #include "harness.h"
 #include "scene_fixture.h"
 #include "shade/shade.h"
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
 
 #define KERNEL_ATTR static __attribute__((unused))
 #define KERNEL_NAME test_kernel_copy

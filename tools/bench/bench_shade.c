@@ -8,7 +8,7 @@
 #include "fit/vsgl_set.h"
 #include "shade/shade.h"
 #include "core/context.h"
-#include "shade/render_internal.h"
+#include "render/render_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
