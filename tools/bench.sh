@@ -4,7 +4,8 @@
 # stages are timed directly) and runs them. BENCH_QUICK=1 shrinks sizes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-objs=$(ls build/obj/csrc/src/*/*.o)
+# the objects of the current sources (a build dir may still hold those of moved files)
+objs=$(ls csrc/src/*/*.c | sed 's|^|build/obj/|; s|\.c$|.o|')
 flags="-O2 -march=native -Itests/c -Icsrc/include -Icsrc/src"
 libs="-lembree3 -lOpenEXRCore-3_1 -lpthread -lm"
 mkdir -p build/bench
