@@ -20,7 +20,10 @@ libvsgl. Checks:
   and the same wall with a flat grey of equal luminance must differ from
   the textured one by more than the tolerance (the texture matters).
 - emission: an emissive panel (no lamps) lighting a room: the library's
-  mean coloured indirect diffuse within 10 % of Cycles one-bounce.
+  mean coloured indirect diffuse within 10 % of Cycles one-bounce;
+- emission_units: the panel's lights' RSM flux in a closed box against the
+  emitted power 2 pi A S C (0.5 %), and the irradiance their RSM implies on
+  the floor against Cycles' DiffDir (2 %).
 
 Cycles renders are cached under --out (key: this file, the case, Blender's
 version). Writes report.md and summary.txt ("N passed, N failed").
@@ -376,6 +379,92 @@ def check_emission(out_dir, report):
     return ok
 
 
+EMIT_S, EMIT_C = 8.0, (1.0, 0.9, 0.7)
+
+
+def build_emission_units(closed=False):
+    """An emissive 1.2 x 0.8 m panel 1.5 m above a white floor (closed: inside
+    a 6 m box, for the power balance), seen from above."""
+    sc = reset()
+    white = lambert("white", (0.8, 0.8, 0.8))
+
+    def emit(nodes, links, bsdf):
+        e = nodes.new("ShaderNodeEmission")
+        e.inputs["Strength"].default_value = EMIT_S
+        e.inputs["Color"].default_value = EMIT_C + (1.0,)
+        links.new(e.outputs["Emission"], nodes["Material Output"].inputs["Surface"])
+    panel = material("panel", emit)
+    quad("Floor", (-4, -4, 0), (4, -4, 0), (4, 4, 0), (-4, 4, 0), white)
+    if closed:
+        quad("Top", (-4, -4, 3), (-4, 4, 3), (4, 4, 3), (4, -4, 3), white)
+        quad("W1", (-4, 4, 0), (4, 4, 0), (4, 4, 3), (-4, 4, 3), white)
+        quad("W2", (-4, -4, 0), (-4, 4, 0), (-4, 4, 3), (-4, -4, 3), white)
+        quad("W3", (4, -4, 0), (4, -4, 3), (4, 4, 3), (4, 4, 0), white)
+        quad("W4", (4, -4, 0), (-4, -4, 0), (-4, -4, 3), (4, -4, 3), white)
+    quad("Panel", (-0.6, -0.4, 1.5), (-0.6, 0.4, 1.5), (0.6, 0.4, 1.5), (0.6, -0.4, 1.5), panel)
+    cam = bpy.data.cameras.new("Top")
+    cam.type = "ORTHO"
+    cam.ortho_scale = 4.0
+    ob = bpy.data.objects.new("Top", cam)
+    ob.location = (0, 0, 1.2)      # under the panel: it sees the floor only
+    sc.collection.objects.link(ob)
+    sc.camera = ob
+    sc.render.resolution_x = sc.render.resolution_y = 96
+    sc.render.resolution_percentage = 100
+    return sc
+
+
+def check_emission_units(out_dir, report):
+    """The emissive panel's lights: RSM flux against the emitted power (closed
+    box: both sides' light lands somewhere), and the irradiance the RSM
+    implies on the floor against Cycles' DiffDir (cos^2 kernel of half-width
+    0.3 m at 9 points, as cycles_ref.py's light-unit suite)."""
+    ok = True
+    sc = build_emission_units(closed=True)
+    sd = export.collect(bpy.context.evaluated_depsgraph_get(), sc)
+    ctx = libvsgl.Context()
+    scene = libvsgl.Scene(ctx, **engine.scene_arrays(sd, libvsgl))
+    total = sum(libvsgl.reference_rsm(ctx, scene, i, 256)["flux"].astype(np.float64).sum(0)
+                for i in range(len(sd.lights)))
+    scene.close()
+    want = 2 * math.pi * 1.2 * 0.8 * EMIT_S * np.array(EMIT_C)
+    rel = np.abs(total / want - 1)
+    good = bool((rel < 0.005).all()) and len(sd.lights) == 2
+    ok &= good
+    line = "%s emission units: %d lights, RSM flux %s W vs emitted 2 pi A S C = %s W (rel %s %%)" % (
+        "PASS" if good else "FAIL", len(sd.lights), np.round(total, 3), np.round(want, 3), np.round(100 * rel, 3))
+    print(line)
+    report.append(line)
+    cyc, _ = cycles("emission_units", build_emission_units, ["DiffDir"], 256, 1.0, out_dir)
+    E_cyc = math.pi * cyc["DiffDir"][..., 0] / EMIT_C[0]
+    sc = build_emission_units()
+    sd = export.collect(bpy.context.evaluated_depsgraph_get(), sc)
+    scene = libvsgl.Scene(ctx, **engine.scene_arrays(sd, libvsgl))
+    rs = [libvsgl.reference_rsm(ctx, scene, i, 512) for i in range(len(sd.lights))]
+    scene.close()
+    P = np.concatenate([r["positions"] for r in rs])
+    F = np.concatenate([r["flux"][:, 0] for r in rs]) / EMIT_C[0]
+    h, w = E_cyc.shape
+    xs = (np.arange(w) + 0.5) / w * 4.0 - 2.0
+    ys = 2.0 - (np.arange(h) + 0.5) / h * 4.0
+    X, Y = np.meshgrid(xs, ys)
+    pix = (4.0 / w) * (4.0 / h)
+    worst = 0.0
+    for gx in (-1.0, 0.0, 1.0):
+        for gy in (-1.0, 0.0, 1.0):
+            ec = float(np.sum(E_cyc * cycles_ref.kernel(X - gx, Y - gy, 0.3)) * pix)
+            sel = (np.abs(P[:, 0] - gx) < 0.3) & (np.abs(P[:, 1] - gy) < 0.3) & (np.abs(P[:, 2]) < 1e-3)
+            er = float(np.sum(F[sel] * cycles_ref.kernel(P[sel, 0] - gx, P[sel, 1] - gy, 0.3)))
+            worst = max(worst, abs(er / ec - 1))
+    good = worst < 0.02
+    ok &= good
+    line = "%s emission irradiance: RSM-implied E vs Cycles DiffDir under the panel, worst of 9 points %.2f %% " \
+           "(tol 2 %%)" % ("PASS" if good else "FAIL", 100 * worst)
+    print(line)
+    report.append(line)
+    return ok
+
+
 # ---------------------------------------------------------------------------
 # rendering
 # ---------------------------------------------------------------------------
@@ -525,7 +614,8 @@ def main():
     out_dir = os.path.abspath(A["--out"])
     os.makedirs(out_dir, exist_ok=True)
     report = ["# Textures vs Cycles (%s)" % bpy.app.version_string, ""]
-    checks = [("diffcol", check_diffcol), ("bleed", check_bleed), ("emission", check_emission)]
+    checks = [("diffcol", check_diffcol), ("bleed", check_bleed), ("emission", check_emission),
+              ("emission_units", check_emission_units)]
     extra = globals().get("EXTRA_CHECKS", [])
     p = f = 0
     for name, fn in checks + extra:
