@@ -41,7 +41,7 @@ class _Session:
         self.last_submit = 0.0                 # when the newest render was started
         self.submits = 0                       # renders started
         self.lib_scene = None                  # libvsgl.Scene reused while geometry stands still
-        self.lib_arrays = None                 # (arrays, materials) it was built from
+        self.lib_arrays = None                 # _scene_signature(sd) of what it was built from
         self.scene_builds = 0
         self.lib_cache = None                  # libvsgl.RenderCache: G-buffer / VSGLs of the last render
         self.updates = 0                       # depsgraph updates seen
@@ -163,7 +163,8 @@ def _render(session, sd, preset, threads, job, exposure, t_export):
     t0 = time.perf_counter()
     arrays = engine.scene_arrays(sd, lib)
     view = dict(camera=arrays.pop("camera"), lights=arrays.pop("lights"))
-    if session.lib_scene is None or not _same_geometry(session.lib_arrays, arrays, sd.materials):
+    signature = _scene_signature(sd)
+    if session.lib_scene is None or not _equal(session.lib_arrays, signature):
         if session.lib_scene is not None:
             session.lib_scene.close()
             session.lib_scene = None
@@ -171,7 +172,7 @@ def _render(session, sd, preset, threads, job, exposure, t_export):
             session.lib_scene = lib.Scene(session.ctx, **arrays, **view)
         except lib.VsglError as e:
             raise RuntimeError("the scene was refused: %s" % (e.message or e))
-        session.lib_arrays = (arrays, list(sd.materials))
+        session.lib_arrays = signature
         session.scene_builds += 1
     else:
         session.lib_scene.set_view(view["camera"], view["lights"])
@@ -192,21 +193,27 @@ def _render(session, sd, preset, threads, job, exposure, t_export):
                 triangles=sd.triangle_count, vsgls=int(stats.get("vsgl_count", 0)) if isinstance(stats, dict) else 0)
 
 
-def _same_geometry(prev, arrays, materials):
-    """Did geometry and materials stay as they were? (Then only the camera
-    and lights change: vsgl_scene_set_view keeps the BVH.)"""
-    if prev is None:
-        return False
-    old, old_materials = prev
-    if old_materials != list(materials) or old.keys() != arrays.keys():
-        return False
-    for k, a in arrays.items():
-        b = old[k]
-        if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-            if not (isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and a.shape == b.shape
-                    and np.array_equal(a, b)):
-                return False
-    return True
+def _scene_signature(sd):
+    """Everything of ``sd`` a library scene is built from but camera and
+    lights: while it stays equal, vsgl_scene_set_view keeps the BVH."""
+    return (sd.positions, sd.indices, sd.corner_normals, sd.corner_uvs,
+            getattr(sd, "corner_tangents", None), sd.material_indices, list(sd.materials),
+            getattr(sd, "material_textures", None), list(getattr(sd, "textures", ()) or ()),
+            getattr(sd, "corner_colors", None))
+
+
+def _equal(a, b):
+    """Deep equality of arrays, sequences, dicts and plain values."""
+    if a is b:
+        return True
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return (isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and a.shape == b.shape
+                and a.dtype == b.dtype and np.array_equal(a, b))
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return len(a) == len(b) and all(_equal(x, y) for x, y in zip(a, b))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_equal(a[k], b[k]) for k in a)
+    return type(a) is type(b) and a == b
 
 
 def _tick():

@@ -226,3 +226,26 @@ def test_live_keeps_the_library_scene_while_geometry_stands_still(scene):
         assert s.scene_builds == 2
     finally:
         s.close()
+
+
+def test_scene_signature_sees_textures_and_materials():
+    """The live preview rebuilds its library scene when anything but camera
+    and lights changed: a texture's pixels or flags, a material, geometry."""
+    sd = export.SceneData()
+    sd.positions = np.zeros((3, 3), np.float32)
+    sd.indices = np.array([[0, 1, 2]], np.uint32)
+    sd.materials = [dict(base_color=(0.5, 0.5, 0.5))]
+    sd.textures = [(np.zeros((2, 2, 4), np.float32), 1)]
+    a = viewport._scene_signature(sd)
+    assert viewport._equal(a, viewport._scene_signature(sd))
+    sd.lights = [dict(power=5.0)]                       # lights are not part of it
+    assert viewport._equal(a, viewport._scene_signature(sd))
+    pix = sd.textures[0][0].copy()
+    pix[1, 1, 0] = 0.25
+    sd.textures = [(pix, 1)]
+    assert not viewport._equal(a, viewport._scene_signature(sd))
+    sd.textures = [(np.zeros((2, 2, 4), np.float32), 0)]
+    assert not viewport._equal(a, viewport._scene_signature(sd))
+    sd.textures = [(np.zeros((2, 2, 4), np.float32), 1)]
+    sd.materials = [dict(base_color=(0.5, 0.5, 0.6))]
+    assert not viewport._equal(a, viewport._scene_signature(sd))
