@@ -359,7 +359,7 @@ def _socket_value(s):
 # texture node chains (bpy glue; the evaluation is textures.py)
 # --------------------------------------------------------------------------
 
-_image_pixels_cache = {}
+_image_pixels_cache = {}   # one export's images (cleared by collect)
 
 
 def _image_pixels(img):
@@ -710,6 +710,7 @@ def collect(depsgraph, scene=None, require_lights=True, camera=True, mesh_cache=
         return mat_index[key]
 
     mesh_cache = {} if mesh_cache is None else mesh_cache
+    _image_pixels_cache.clear()   # images are read once per export (painted pixels change)
     chunks = []
     warned_objects = set()
     _world_warnings(sd, scene)
