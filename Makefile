@@ -142,7 +142,8 @@ $(BUILD)/obj/tests/c/kernel_isa%.o: OPT += -O3 $(KERNEL_MATH)
 # saved as $(BUILD)/fuzz/crash-* and make the target fail.
 .PHONY: fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_LIB_SRC := csrc/src/io/bundle.c csrc/src/io/atomic.c csrc/src/core/context.c csrc/src/core/result.c
+FUZZ_LIB_SRC := csrc/src/io/bundle.c csrc/src/io/atomic.c csrc/src/core/context.c csrc/src/core/result.c \
+  csrc/src/core/versioned.c
 FUZZ_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
 $(BUILD)/fuzz/fuzz_bundle: tests/fuzz/fuzz_bundle.c $(FUZZ_LIB_SRC) $(HEADERS)
 	@mkdir -p $(dir $@)

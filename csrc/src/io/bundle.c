@@ -563,7 +563,16 @@ static vsgl_result read_records(vsgl_context *ctx, int kind, layout l, const uns
     return VSGL_OK;
 }
 
-static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size, vsgl_bundle *out)
+/* Where each known section's elements are, how many, of what size. */
+typedef struct section_table {
+    const unsigned char *where[S_COUNT];
+    uint64_t counts[S_COUNT];
+    uint32_t esizes[S_COUNT];
+} section_table;
+
+/* Magic, version, header size and CRC, file size, section count. */
+static vsgl_result parse_header(vsgl_context *ctx, const unsigned char *b, size_t size, crc_table *crc,
+                                uint32_t *header_size_out, uint32_t *section_count_out, vsgl_bundle *out)
 {
     if (size < 16)
         return BAD("bundle truncated: %zu bytes, the header alone is %u", size, HEADER_SIZE);
@@ -578,9 +587,7 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
     uint32_t header_size = get_u32(b + 16);
     if (header_size < HEADER_SIZE || header_size % 8u || header_size > size)
         return BAD("bundle header: size %u invalid or beyond the %zu bytes present", header_size, size);
-    crc_table crc;
-    crc_init(&crc);
-    if (crc32_of(&crc, b, header_size - 4) != get_u32(b + header_size - 4) && !IGNORE_CRC)
+    if (crc32_of(crc, b, header_size - 4) != get_u32(b + header_size - 4) && !IGNORE_CRC)
         return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle header is corrupt (CRC32 mismatch)");
     uint32_t section_count = get_u32(b + 20);
     uint64_t file_size = get_u64(b + 24);
@@ -593,9 +600,15 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
     out->version_major = major;
     out->version_minor = minor;
 
-    const unsigned char *where[S_COUNT] = {0};
-    uint64_t counts[S_COUNT] = {0};
-    uint32_t esizes[S_COUNT] = {0};
+    *header_size_out = header_size;
+    *section_count_out = section_count;
+    return VSGL_OK;
+}
+
+/* Every section: bounds, CRC, padding, kind, element size; known ones into t. */
+static vsgl_result parse_sections(vsgl_context *ctx, const unsigned char *b, size_t size, const crc_table *crc,
+                                  uint32_t header_size, uint32_t section_count, section_table *t)
+{
     uint64_t at = header_size;
     for (uint32_t i = 0; i < section_count; ++i) {
         if (size - at < SECTION_HEADER_SIZE)
@@ -616,7 +629,7 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
         if (padded(bytes) > avail)
             return BAD("bundle section %s: padding after %llu bytes exceeds the file", tag, ULL(bytes));
         const unsigned char *p = h + SECTION_HEADER_SIZE;
-        if (crc32_more(&crc, crc32_of(&crc, h, 20), p, (size_t)bytes) != get_u32(h + 20) && !IGNORE_CRC)
+        if (crc32_more(crc, crc32_of(crc, h, 20), p, (size_t)bytes) != get_u32(h + 20) && !IGNORE_CRC)
             return BAD("bundle section %s is corrupt (CRC32 mismatch over %llu bytes)", tag, ULL(bytes));
         for (uint64_t z = bytes; z < padded(bytes); ++z)
             if (p[z])
@@ -629,7 +642,7 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
         if (kind < 0)
             continue; /* unknown section of a newer minor version: skipped */
         const section_kind *k = &kinds[kind];
-        if (where[kind])
+        if (t->where[kind])
             return BAD("bundle section %s (%s) appears twice", k->tag, k->what);
         uint32_t min_size = k->min_size ? k->min_size : k->element_size;
         if (k->is_record ? esize < min_size : esize != k->element_size)
@@ -637,108 +650,127 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
                               esize, k->is_record ? "at least " : "", k->is_record ? min_size : k->element_size);
         if (count > UINT32_MAX)
             return BAD("bundle section %s: %llu elements (at most %u)", k->tag, ULL(count), UINT32_MAX);
-        where[kind] = p;
-        counts[kind] = count;
-        esizes[kind] = esize;
+        t->where[kind] = p;
+        t->counts[kind] = count;
+        t->esizes[kind] = esize;
     }
     if (at != size)
         return BAD("bundle: %llu bytes after the last section", ULL(size - at));
 
-    /* Counts that must agree. */
-    if (!where[S_CAM] || counts[S_CAM] != 1)
-        return BAD("bundle has %s camera (want exactly 1, got %llu)", where[S_CAM] ? "a bad" : "no", ULL(counts[S_CAM]));
-    if (where[S_RSET] && counts[S_RSET] != 1)
-        return BAD("bundle section RSET (render settings): %llu elements, want 1", ULL(counts[S_RSET]));
-    if (where[S_FRME] && counts[S_FRME] != 1)
-        return BAD("bundle section FRME (frame): %llu elements, want 1", ULL(counts[S_FRME]));
-    if (where[S_OUTP] && counts[S_OUTP] > MAX_OUTPUT_PATH)
-        return BAD("bundle section OUTP (output path): %llu bytes, at most %u", ULL(counts[S_OUTP]), MAX_OUTPUT_PATH);
-    uint64_t nt = counts[S_IDX];
+    return VSGL_OK;
+}
+
+/* Counts that must agree between sections. */
+static vsgl_result check_counts(vsgl_context *ctx, const section_table *t)
+{
+    if (!t->where[S_CAM] || t->counts[S_CAM] != 1)
+        return BAD("bundle has %s camera (want exactly 1, got %llu)", t->where[S_CAM] ? "a bad" : "no", ULL(t->counts[S_CAM]));
+    if (t->where[S_RSET] && t->counts[S_RSET] != 1)
+        return BAD("bundle section RSET (render settings): %llu elements, want 1", ULL(t->counts[S_RSET]));
+    if (t->where[S_FRME] && t->counts[S_FRME] != 1)
+        return BAD("bundle section FRME (frame): %llu elements, want 1", ULL(t->counts[S_FRME]));
+    if (t->where[S_OUTP] && t->counts[S_OUTP] > MAX_OUTPUT_PATH)
+        return BAD("bundle section OUTP (output path): %llu bytes, at most %u", ULL(t->counts[S_OUTP]), MAX_OUTPUT_PATH);
+    uint64_t nt = t->counts[S_IDX];
     static const int per_triangle[] = {S_NRM, S_UV, S_TAN, S_MIDX, S_CCOL};
     for (size_t i = 0; i < 5; ++i) {
         int kk = per_triangle[i];
-        if (where[kk] && counts[kk] != nt)
+        if (t->where[kk] && t->counts[kk] != nt)
             return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section %s (%s): %llu elements, want %llu (one per triangle)",
-                              kinds[kk].tag, kinds[kk].what, (unsigned long long)counts[kk], (unsigned long long)nt);
+                              kinds[kk].tag, kinds[kk].what, (unsigned long long)t->counts[kk], (unsigned long long)nt);
     }
 
-    /* Copy out. */
+    return VSGL_OK;
+}
+
+/* Geometry arrays, materials, lights and the camera. */
+static vsgl_result read_scene(vsgl_context *ctx, const section_table *t, vsgl_bundle *out)
+{
+    uint64_t nt = t->counts[S_IDX];
     vsgl_result r;
     void *a = NULL;
     /* Arrays of zero elements stay NULL. */
-    if (where[S_POS] && counts[S_POS] && (r = read_words(ctx, S_POS, where[S_POS], counts[S_POS], &a)))
+    if (t->where[S_POS] && t->counts[S_POS] && (r = read_words(ctx, S_POS, t->where[S_POS], t->counts[S_POS], &a)))
         return r;
     out->positions = a;
     a = NULL;
-    if (where[S_IDX] && nt && (r = read_words(ctx, S_IDX, where[S_IDX], nt, &a)))
+    if (t->where[S_IDX] && nt && (r = read_words(ctx, S_IDX, t->where[S_IDX], nt, &a)))
         return r;
     out->indices = a;
     a = NULL;
-    if (where[S_NRM] && nt && (r = read_words(ctx, S_NRM, where[S_NRM], nt, &a)))
+    if (t->where[S_NRM] && nt && (r = read_words(ctx, S_NRM, t->where[S_NRM], nt, &a)))
         return r;
     out->corner_normals = a;
     a = NULL;
-    if (where[S_UV] && nt && (r = read_words(ctx, S_UV, where[S_UV], nt, &a)))
+    if (t->where[S_UV] && nt && (r = read_words(ctx, S_UV, t->where[S_UV], nt, &a)))
         return r;
     out->corner_uvs = a;
     a = NULL;
-    if (where[S_TAN] && nt && (r = read_words(ctx, S_TAN, where[S_TAN], nt, &a)))
+    if (t->where[S_TAN] && nt && (r = read_words(ctx, S_TAN, t->where[S_TAN], nt, &a)))
         return r;
     out->corner_tangents = a;
     a = NULL;
-    if (where[S_MIDX] && nt && (r = read_words(ctx, S_MIDX, where[S_MIDX], nt, &a)))
+    if (t->where[S_MIDX] && nt && (r = read_words(ctx, S_MIDX, t->where[S_MIDX], nt, &a)))
         return r;
     out->material_indices = a;
 
-    uint64_t nm = counts[S_MATL], nl = counts[S_LGHT];
+    uint64_t nm = t->counts[S_MATL], nl = t->counts[S_LGHT];
     out->materials = calloc(nm ? (size_t)nm : 1, sizeof(vsgl_material));
     out->lights = calloc(nl ? (size_t)nl : 1, sizeof(vsgl_light));
     if (!out->materials || !out->lights)
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory for %llu materials and %llu lights",
                           (unsigned long long)nm, (unsigned long long)nl);
-    if ((r = read_records(ctx, S_MATL, (layout)LAYOUT(material_fields), where[S_MATL], nm, esizes[S_MATL], out->materials, sizeof(vsgl_material))))
+    if ((r = read_records(ctx, S_MATL, (layout)LAYOUT(material_fields), t->where[S_MATL], nm, t->esizes[S_MATL], out->materials, sizeof(vsgl_material))))
         return r;
-    if ((r = read_records(ctx, S_LGHT, (layout)LAYOUT(light_fields), where[S_LGHT], nl, esizes[S_LGHT], out->lights, sizeof(vsgl_light))))
+    if ((r = read_records(ctx, S_LGHT, (layout)LAYOUT(light_fields), t->where[S_LGHT], nl, t->esizes[S_LGHT], out->lights, sizeof(vsgl_light))))
         return r;
-    if ((r = read_records(ctx, S_CAM, (layout)LAYOUT(camera_fields), where[S_CAM], 1, esizes[S_CAM], &out->camera, sizeof(vsgl_camera))))
+    if ((r = read_records(ctx, S_CAM, (layout)LAYOUT(camera_fields), t->where[S_CAM], 1, t->esizes[S_CAM], &out->camera, sizeof(vsgl_camera))))
         return r;
-    /* format 1.2: textures */
+    return VSGL_OK;
+}
+
+/* Format 1.2: corner colours, material texture slots, texture headers and pixels. */
+static vsgl_result read_textures(vsgl_context *ctx, const section_table *t, vsgl_bundle *out)
+{
+    uint64_t nt = t->counts[S_IDX], nm = t->counts[S_MATL];
+    vsgl_result r;
+    void *a;
     a = NULL;
-    if (where[S_CCOL] && nt && (r = read_words(ctx, S_CCOL, where[S_CCOL], nt, &a)))
+    if (t->where[S_CCOL] && nt && (r = read_words(ctx, S_CCOL, t->where[S_CCOL], nt, &a)))
         return r;
     out->corner_colors = a;
-    if (where[S_MTEX]) {
-        if (counts[S_MTEX] != nm)
+    if (t->where[S_MTEX]) {
+        if (t->counts[S_MTEX] != nm)
             return BAD("bundle section MTEX (material textures): %llu elements, want %llu (one per material)",
-                       ULL(counts[S_MTEX]), ULL(nm));
+                       ULL(t->counts[S_MTEX]), ULL(nm));
         out->material_textures = calloc(nm ? (size_t)nm : 1, sizeof(vsgl_material_textures));
         if (!out->material_textures)
             return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory for material textures");
-        if ((r = read_records(ctx, S_MTEX, (layout)LAYOUT(mtex_fields), where[S_MTEX], nm, esizes[S_MTEX],
+        if ((r = read_records(ctx, S_MTEX, (layout)LAYOUT(mtex_fields), t->where[S_MTEX], nm, t->esizes[S_MTEX],
                               out->material_textures, sizeof(vsgl_material_textures))))
             return r;
     }
-    uint64_t ntex = where[S_TEXH] ? counts[S_TEXH] : 0;
+    uint64_t ntex = t->where[S_TEXH] ? t->counts[S_TEXH] : 0;
     if (ntex) {
         out->textures = calloc((size_t)ntex, sizeof(vsgl_texture));
         if (!out->textures)
             return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory for %llu textures", ULL(ntex));
-        if ((r = read_records(ctx, S_TEXH, (layout)LAYOUT(texh_fields), where[S_TEXH], ntex, esizes[S_TEXH], out->textures,
+        if ((r = read_records(ctx, S_TEXH, (layout)LAYOUT(texh_fields), t->where[S_TEXH], ntex, t->esizes[S_TEXH], out->textures,
                               sizeof(vsgl_texture))))
             return r;
         uint64_t want = 0;
         for (uint64_t i = 0; i < ntex; ++i) {
-            const vsgl_texture *t = &out->textures[i];
-            if (t->width < 1 || t->height < 1 || t->width > MAX_TEXTURE_SIDE || t->height > MAX_TEXTURE_SIDE)
-                return BAD("bundle section TEXH (texture headers): texture %llu is %ux%u (sides 1..%u)", ULL(i), t->width,
-                           t->height, MAX_TEXTURE_SIDE);
-            want += (uint64_t)t->width * t->height * 4;
+            const vsgl_texture *tx = &out->textures[i];
+            if (tx->width < 1 || tx->height < 1 || tx->width > MAX_TEXTURE_SIDE || tx->height > MAX_TEXTURE_SIDE)
+                return BAD("bundle section TEXH (texture headers): texture %llu is %ux%u (sides 1..%u)", ULL(i), tx->width,
+                           tx->height, MAX_TEXTURE_SIDE);
+            want += (uint64_t)tx->width * tx->height * 4;
         }
-        if (!where[S_TEXP] || counts[S_TEXP] != want)
-            return BAD("bundle section TEXP (texture pixels): %llu floats, the headers need %llu", ULL(counts[S_TEXP]),
+        if (!t->where[S_TEXP] || t->counts[S_TEXP] != want)
+            return BAD("bundle section TEXP (texture pixels): %llu floats, the headers need %llu", ULL(t->counts[S_TEXP]),
                        ULL(want));
         a = NULL;
-        if ((r = read_words(ctx, S_TEXP, where[S_TEXP], want, &a)))
+        if ((r = read_words(ctx, S_TEXP, t->where[S_TEXP], want, &a)))
             return r;
         out->texture_pixels = a;
         uint64_t off = 0;
@@ -746,35 +778,49 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
             out->textures[i].pixels = out->texture_pixels + off;
             off += (uint64_t)out->textures[i].width * out->textures[i].height * 4;
         }
-    } else if (where[S_TEXP] && counts[S_TEXP]) {
+    } else if (t->where[S_TEXP] && t->counts[S_TEXP]) {
         return BAD("bundle section TEXP (texture pixels) without TEXH (texture headers)");
     }
-    if (where[S_RSET]) {
-        if ((r = read_records(ctx, S_RSET, (layout)LAYOUT(settings_fields), where[S_RSET], 1, esizes[S_RSET], &out->settings,
+    return VSGL_OK;
+}
+
+/* Render settings, output path and frame. */
+static vsgl_result read_extras(vsgl_context *ctx, const section_table *t, vsgl_bundle *out)
+{
+    vsgl_result r;
+    if (t->where[S_RSET]) {
+        if ((r = read_records(ctx, S_RSET, (layout)LAYOUT(settings_fields), t->where[S_RSET], 1, t->esizes[S_RSET], &out->settings,
                               sizeof(vsgl_render_settings))))
             return r;
         out->has_settings = 1;
     }
     out->settings.size = sizeof out->settings;
-    size_t plen = where[S_OUTP] ? (size_t)counts[S_OUTP] : 0;
+    size_t plen = t->where[S_OUTP] ? (size_t)t->counts[S_OUTP] : 0;
     out->output_path = malloc(plen + 1);
     if (!out->output_path)
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "bundle: out of memory");
     if (plen) {
-        if (memchr(where[S_OUTP], 0, plen))
+        if (memchr(t->where[S_OUTP], 0, plen))
             return vsgl__fail(ctx, VSGL_ERROR_BAD_FORMAT, "bundle section OUTP (output path): contains a NUL byte");
-        memcpy(out->output_path, where[S_OUTP], plen);
+        memcpy(out->output_path, t->where[S_OUTP], plen);
     }
     out->output_path[plen] = '\0';
-    if (where[S_FRME]) {
+    if (t->where[S_FRME]) {
         out->has_frame = 1;
-        uint32_t f = get_u32(where[S_FRME]);
+        uint32_t f = get_u32(t->where[S_FRME]);
         memcpy(&out->frame, &f, 4);
     }
 
+    return VSGL_OK;
+}
+
+static void fill_desc(const section_table *t, vsgl_bundle *out)
+{
+    uint64_t nt = t->counts[S_IDX], nm = t->counts[S_MATL], nl = t->counts[S_LGHT];
+    uint64_t ntex = t->where[S_TEXH] ? t->counts[S_TEXH] : 0;
     vsgl_scene_desc *d = &out->desc;
     d->size = sizeof *d;
-    d->vertex_count = (uint32_t)counts[S_POS];
+    d->vertex_count = (uint32_t)t->counts[S_POS];
     d->positions = out->positions;
     d->triangle_count = (uint32_t)nt;
     d->indices = out->indices;
@@ -791,7 +837,29 @@ static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size,
     d->textures = ntex ? out->textures : NULL;
     d->material_textures = out->material_textures;
     d->corner_colors = out->corner_colors;
-    return VSGL_OK;
+}
+
+static vsgl_result parse(vsgl_context *ctx, const unsigned char *b, size_t size, vsgl_bundle *out)
+{
+    crc_table crc;
+    crc_init(&crc);
+    uint32_t header_size = 0, section_count = 0;
+    section_table t;
+    memset(&t, 0, sizeof t);
+    vsgl_result r = parse_header(ctx, b, size, &crc, &header_size, &section_count, out);
+    if (r == VSGL_OK)
+        r = parse_sections(ctx, b, size, &crc, header_size, section_count, &t);
+    if (r == VSGL_OK)
+        r = check_counts(ctx, &t);
+    if (r == VSGL_OK)
+        r = read_scene(ctx, &t, out);
+    if (r == VSGL_OK)
+        r = read_textures(ctx, &t, out);
+    if (r == VSGL_OK)
+        r = read_extras(ctx, &t, out);
+    if (r == VSGL_OK)
+        fill_desc(&t, out);
+    return r;
 }
 
 vsgl_result vsgl_bundle_read_memory(vsgl_context *ctx, const void *data, size_t size, vsgl_bundle **out)
