@@ -91,14 +91,19 @@ static int zero_normal_corner(const float *n9)
     return -1;
 }
 
-static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene *s)
+/* Pass 1: which triangles survive (non-zero area, no zero-length corner
+ * normal); the first few dropped ones are named in warnings. NULL with the
+ * error set when out of memory (and for no triangles: *kept = 0). */
+static unsigned char *select_triangles(vsgl_context *ctx, const vsgl_scene_desc *d, uint32_t *kept_out,
+                                       uint32_t *dropped_out, vsgl_result *r)
 {
-    uint32_t tc = d->triangle_count;
-    /* pass 1: which triangles survive */
-    uint32_t kept = 0, dropped = 0;
+    uint32_t tc = d->triangle_count, kept = 0, dropped = 0;
+    *r = VSGL_OK;
     unsigned char *keep = tc ? malloc(tc) : NULL;
-    if (tc && !keep)
-        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u triangles", (unsigned)tc);
+    if (tc && !keep) {
+        *r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u triangles", (unsigned)tc);
+        return NULL;
+    }
     for (uint32_t t = 0; t < tc; ++t) {
         const uint32_t *ix = d->indices + (size_t)t * 3;
         float n[3];
@@ -111,149 +116,179 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
             keep[t] = 0;
         if (keep[t]) {
             ++kept;
-        } else {
-            if (dropped < VSGL__MAX_DROP_WARNINGS) {
-                if (zero_corner >= 0) {
-                    const float *cn = d->corner_normals + (size_t)t * 9 + zero_corner * 3;
-                    vsgl__log(ctx, VSGL_LOG_WARNING, "triangle %u: corner %d normal (%g, %g, %g) has zero length, dropped",
-                              (unsigned)t, zero_corner, (double)cn[0], (double)cn[1], (double)cn[2]);
-                } else {
-                    vsgl__log(ctx, VSGL_LOG_WARNING, "triangle %u: zero area (vertices %u, %u, %u), dropped",
-                              (unsigned)t, (unsigned)ix[0], (unsigned)ix[1], (unsigned)ix[2]);
-                }
-            }
-            ++dropped;
+            continue;
         }
+        if (dropped < VSGL__MAX_DROP_WARNINGS) {
+            if (zero_corner >= 0) {
+                const float *cn = d->corner_normals + (size_t)t * 9 + zero_corner * 3;
+                vsgl__log(ctx, VSGL_LOG_WARNING, "triangle %u: corner %d normal (%g, %g, %g) has zero length, dropped",
+                          (unsigned)t, zero_corner, (double)cn[0], (double)cn[1], (double)cn[2]);
+            } else {
+                vsgl__log(ctx, VSGL_LOG_WARNING, "triangle %u: zero area (vertices %u, %u, %u), dropped",
+                          (unsigned)t, (unsigned)ix[0], (unsigned)ix[1], (unsigned)ix[2]);
+            }
+        }
+        ++dropped;
     }
     if (dropped > VSGL__MAX_DROP_WARNINGS)
         vsgl__log(ctx, VSGL_LOG_WARNING, "scene: %u degenerate triangles (zero area or zero-length normal) dropped in all",
                   (unsigned)dropped);
-    s->triangle_count = kept;
-    s->dropped_triangles = dropped;
+    *kept_out = kept;
+    *dropped_out = dropped;
+    return keep;
+}
 
-    size_t k = kept;
-    s->corner_normals = malloc((k ? k : 1) * 9 * sizeof(float));
-    s->face_normals = malloc((k ? k : 1) * 3 * sizeof(float));
-    s->tri_material = malloc((k ? k : 1) * sizeof(uint32_t));
-    s->source_triangle = malloc((k ? k : 1) * sizeof(uint32_t));
+/* The per-triangle arrays of the kept triangles. */
+static vsgl_result alloc_triangle_arrays(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene *s, uint32_t kept)
+{
+    size_t k = kept ? kept : 1;
+    s->corner_normals = malloc(k * 9 * sizeof(float));
+    s->face_normals = malloc(k * 3 * sizeof(float));
+    s->tri_material = malloc(k * sizeof(uint32_t));
+    s->source_triangle = malloc(k * sizeof(uint32_t));
     if (d->corner_uvs)
-        s->corner_uvs = malloc((k ? k : 1) * 6 * sizeof(float));
+        s->corner_uvs = malloc(k * 6 * sizeof(float));
     if (d->corner_tangents)
-        s->corner_tangents = malloc((k ? k : 1) * 12 * sizeof(float));
+        s->corner_tangents = malloc(k * 12 * sizeof(float));
     if (s->textured && d->corner_colors)
-        s->corner_colors = malloc((k ? k : 1) * 9 * sizeof(float));
+        s->corner_colors = malloc(k * 9 * sizeof(float));
     if (s->textured)
-        s->uv_density = calloc(k ? k : 1, sizeof(float));
-    if ((s->textured && d->corner_colors && !s->corner_colors) || (s->textured && !s->uv_density)) {
-        free(keep);
-        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u triangles", (unsigned)kept);
-    }
+        s->uv_density = calloc(k, sizeof(float));
     if (!s->corner_normals || !s->face_normals || !s->tri_material || !s->source_triangle ||
-        (d->corner_uvs && !s->corner_uvs) || (d->corner_tangents && !s->corner_tangents)) {
-        free(keep);
+        (d->corner_uvs && !s->corner_uvs) || (d->corner_tangents && !s->corner_tangents) ||
+        (s->textured && d->corner_colors && !s->corner_colors) || (s->textured && !s->uv_density))
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for %u triangles", (unsigned)kept);
-    }
+    return VSGL_OK;
+}
 
-    /* Embree device and geometry: its buffers hold the positions and indices */
+/* The scene's Embree device (its own: no global state) and empty scene. */
+static vsgl_result new_embree_scene(vsgl_context *ctx, vsgl_scene *s)
+{
     char config[96];
     uint32_t threads = vsgl_context_thread_count(ctx);
     if (threads > VSGL__EMBREE_MAX_THREADS)
         threads = VSGL__EMBREE_MAX_THREADS;
     snprintf(config, sizeof config, "threads=%u,set_affinity=0,verbose=0", (unsigned)threads);
     s->device = rtcNewDevice(config);
-    if (!s->device) {
-        free(keep);
+    if (!s->device)
         return vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "scene: rtcNewDevice(\"%s\") failed (Embree error %d)", config,
                           (int)rtcGetDeviceError(NULL));
-    }
     rtcSetDeviceErrorFunction(s->device, embree_error, s);
     s->rtc = rtcNewScene(s->device);
     vsgl_result r = embree_check(ctx, s, "rtcNewScene");
-    if (r != VSGL_OK) {
-        free(keep);
+    if (r != VSGL_OK)
         return r;
-    }
     rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_MEDIUM);
+    return VSGL_OK;
+}
 
-    if (kept > 0) {
-        RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        float *vb = g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                3 * sizeof(float), d->vertex_count) : NULL;
-        uint32_t *ib = g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                   3 * sizeof(uint32_t), kept) : NULL;
-        if (!g || !vb || !ib) {
-            if (g)
-                rtcReleaseGeometry(g);
-            free(keep);
-            r = embree_check(ctx, s, "creating the triangle geometry");
-            return r != VSGL_OK ? r : vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "scene: Embree returned no buffer");
-        }
-        memcpy(vb, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
-        s->positions = vb;
-        s->indices = ib;
-        v3 lo = v3_make(INFINITY, INFINITY, INFINITY), hi = v3_make(-INFINITY, -INFINITY, -INFINITY);
-        uint32_t o = 0;
-        for (uint32_t t = 0; t < tc; ++t) {
-            if (!keep[t])
-                continue;
-            const uint32_t *ix = d->indices + (size_t)t * 3;
-            memcpy(ib + (size_t)o * 3, ix, 3 * sizeof(uint32_t));
-            for (int c = 0; c < 3; ++c) {
-                const float *p = d->positions + (size_t)ix[c] * 3;
-                lo = v3_make(fminf(lo.x, p[0]), fminf(lo.y, p[1]), fminf(lo.z, p[2]));
-                hi = v3_make(fmaxf(hi.x, p[0]), fmaxf(hi.y, p[1]), fmaxf(hi.z, p[2]));
-            }
-            float *fn = s->face_normals + (size_t)o * 3;
-            face_normal(d->positions + (size_t)ix[0] * 3, d->positions + (size_t)ix[1] * 3,
-                        d->positions + (size_t)ix[2] * 3, fn);
-            float *cn = s->corner_normals + (size_t)o * 9;
-            for (int c = 0; c < 3; ++c) {
-                v3 n = d->corner_normals
-                           ? v3_make(d->corner_normals[(size_t)t * 9 + c * 3], d->corner_normals[(size_t)t * 9 + c * 3 + 1],
-                                     d->corner_normals[(size_t)t * 9 + c * 3 + 2])
-                           : v3_make(fn[0], fn[1], fn[2]);
-                /* normalise in double: validated lengths may be tiny or large */
-                double l = sqrt((double)n.x * n.x + (double)n.y * n.y + (double)n.z * n.z);
-                cn[c * 3 + 0] = (float)(n.x / l);
-                cn[c * 3 + 1] = (float)(n.y / l);
-                cn[c * 3 + 2] = (float)(n.z / l);
-            }
-            if (s->corner_uvs)
-                memcpy(s->corner_uvs + (size_t)o * 6, d->corner_uvs + (size_t)t * 6, 6 * sizeof(float));
-            if (s->corner_tangents)
-                memcpy(s->corner_tangents + (size_t)o * 12, d->corner_tangents + (size_t)t * 12, 12 * sizeof(float));
-            if (s->corner_colors)
-                memcpy(s->corner_colors + (size_t)o * 9, d->corner_colors + (size_t)t * 9, 9 * sizeof(float));
-            if (s->uv_density && d->corner_uvs) {
-                /* texture-space area per world area, for the lookups' footprints */
-                const float *uv = d->corner_uvs + (size_t)t * 6;
-                double a_uv = 0.5 * fabs(((double)uv[2] - uv[0]) * ((double)uv[5] - uv[1]) -
-                                         ((double)uv[4] - uv[0]) * ((double)uv[3] - uv[1]));
-                const float *p0 = d->positions + (size_t)ix[0] * 3, *p1 = d->positions + (size_t)ix[1] * 3,
-                            *p2 = d->positions + (size_t)ix[2] * 3;
-                double e1[3], e2[3];
-                for (int q = 0; q < 3; ++q) {
-                    e1[q] = (double)p1[q] - p0[q];
-                    e2[q] = (double)p2[q] - p0[q];
-                }
-                double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
-                       cz = e1[0] * e2[1] - e1[1] * e2[0];
-                double a_w = 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
-                double dens = a_w > 0.0 ? a_uv / a_w : 0.0;
-                s->uv_density[o] = dens < 3e38 ? (float)dens : 3e38f;
-            }
-            s->tri_material[o] = d->material_indices ? d->material_indices[t] : 0u;
-            s->source_triangle[o] = t;
-            ++o;
-        }
-        s->lo = lo;
-        s->hi = hi;
-        rtcCommitGeometry(g);
-        rtcAttachGeometry(s->rtc, g);
-        rtcReleaseGeometry(g);
+/* Texture-space area per world area of triangle t, for the lookups' footprints. */
+static float uv_density(const vsgl_scene_desc *d, uint32_t t)
+{
+    const uint32_t *ix = d->indices + (size_t)t * 3;
+    const float *uv = d->corner_uvs + (size_t)t * 6;
+    double a_uv = 0.5 * fabs(((double)uv[2] - uv[0]) * ((double)uv[5] - uv[1]) -
+                             ((double)uv[4] - uv[0]) * ((double)uv[3] - uv[1]));
+    const float *p0 = d->positions + (size_t)ix[0] * 3, *p1 = d->positions + (size_t)ix[1] * 3,
+                *p2 = d->positions + (size_t)ix[2] * 3;
+    double e1[3], e2[3];
+    for (int q = 0; q < 3; ++q) {
+        e1[q] = (double)p1[q] - p0[q];
+        e2[q] = (double)p2[q] - p0[q];
     }
+    double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2], cz = e1[0] * e2[1] - e1[1] * e2[0];
+    double a_w = 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
+    double dens = a_w > 0.0 ? a_uv / a_w : 0.0;
+    return dens < 3e38 ? (float)dens : 3e38f;
+}
+
+/* Caller's triangle t becomes the scene's triangle o: indices into the
+ * Embree buffer `ib`, normals (unit, in double), per-corner data, bounds. */
+static void copy_triangle(const vsgl_scene_desc *d, vsgl_scene *s, uint32_t *ib, uint32_t t, uint32_t o, v3 *lo,
+                          v3 *hi)
+{
+    const uint32_t *ix = d->indices + (size_t)t * 3;
+    memcpy(ib + (size_t)o * 3, ix, 3 * sizeof(uint32_t));
+    for (int c = 0; c < 3; ++c) {
+        const float *p = d->positions + (size_t)ix[c] * 3;
+        *lo = v3_make(fminf(lo->x, p[0]), fminf(lo->y, p[1]), fminf(lo->z, p[2]));
+        *hi = v3_make(fmaxf(hi->x, p[0]), fmaxf(hi->y, p[1]), fmaxf(hi->z, p[2]));
+    }
+    float *fn = s->face_normals + (size_t)o * 3;
+    face_normal(d->positions + (size_t)ix[0] * 3, d->positions + (size_t)ix[1] * 3, d->positions + (size_t)ix[2] * 3, fn);
+    float *cn = s->corner_normals + (size_t)o * 9;
+    for (int c = 0; c < 3; ++c) {
+        v3 n = d->corner_normals
+                   ? v3_make(d->corner_normals[(size_t)t * 9 + c * 3], d->corner_normals[(size_t)t * 9 + c * 3 + 1],
+                             d->corner_normals[(size_t)t * 9 + c * 3 + 2])
+                   : v3_make(fn[0], fn[1], fn[2]);
+        /* normalise in double: validated lengths may be tiny or large */
+        double l = sqrt((double)n.x * n.x + (double)n.y * n.y + (double)n.z * n.z);
+        cn[c * 3 + 0] = (float)(n.x / l);
+        cn[c * 3 + 1] = (float)(n.y / l);
+        cn[c * 3 + 2] = (float)(n.z / l);
+    }
+    if (s->corner_uvs)
+        memcpy(s->corner_uvs + (size_t)o * 6, d->corner_uvs + (size_t)t * 6, 6 * sizeof(float));
+    if (s->corner_tangents)
+        memcpy(s->corner_tangents + (size_t)o * 12, d->corner_tangents + (size_t)t * 12, 12 * sizeof(float));
+    if (s->corner_colors)
+        memcpy(s->corner_colors + (size_t)o * 9, d->corner_colors + (size_t)t * 9, 9 * sizeof(float));
+    if (s->uv_density && d->corner_uvs)
+        s->uv_density[o] = uv_density(d, t);
+    s->tri_material[o] = d->material_indices ? d->material_indices[t] : 0u;
+    s->source_triangle[o] = t;
+}
+
+/* The kept triangles into the Embree geometry and the scene's arrays. */
+static vsgl_result add_geometry(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene *s, const unsigned char *keep,
+                                uint32_t kept)
+{
+    RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *vb = g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                            d->vertex_count) : NULL;
+    uint32_t *ib = g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
+                                               kept) : NULL;
+    if (!g || !vb || !ib) {
+        if (g)
+            rtcReleaseGeometry(g);
+        vsgl_result r = embree_check(ctx, s, "creating the triangle geometry");
+        return r != VSGL_OK ? r : vsgl__fail(ctx, VSGL_ERROR_INTERNAL, "scene: Embree returned no buffer");
+    }
+    memcpy(vb, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
+    s->positions = vb;
+    s->indices = ib;
+    v3 lo = v3_make(INFINITY, INFINITY, INFINITY), hi = v3_make(-INFINITY, -INFINITY, -INFINITY);
+    uint32_t o = 0;
+    for (uint32_t t = 0; t < d->triangle_count; ++t)
+        if (keep[t])
+            copy_triangle(d, s, ib, t, o++, &lo, &hi);
+    s->lo = lo;
+    s->hi = hi;
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(s->rtc, g);
+    rtcReleaseGeometry(g);
+    return VSGL_OK;
+}
+
+static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene *s)
+{
+    uint32_t kept = 0, dropped = 0;
+    vsgl_result r;
+    unsigned char *keep = select_triangles(ctx, d, &kept, &dropped, &r);
+    if (r != VSGL_OK)
+        return r;
+    s->triangle_count = kept;
+    s->dropped_triangles = dropped;
+    r = alloc_triangle_arrays(ctx, d, s, kept);
+    if (r == VSGL_OK)
+        r = new_embree_scene(ctx, s);
+    if (r == VSGL_OK && kept > 0)
+        r = add_geometry(ctx, d, s, keep, kept);
     free(keep);
+    if (r != VSGL_OK)
+        return r;
     s->vertex_count = d->vertex_count;
     rtcCommitScene(s->rtc);
     return embree_check(ctx, s, "building the BVH");
