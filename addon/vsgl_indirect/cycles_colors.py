@@ -12,7 +12,6 @@ Builds two Multiply nodes per view layer and returns their outputs for the
 Add nodes of compositor.ensure() (which calls :func:`sources` when
 ``Options.use_cycles_colors`` is set, :func:`remove` otherwise).
 """
-import bpy
 
 from . import compat
 

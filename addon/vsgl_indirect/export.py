@@ -836,9 +836,9 @@ def _visibility_warnings(sd, obj, warned):
         return
     warned.add(obj.name)
     what = "light" if obj.type == "LIGHT" else "object"
+    light_only = ("visible_camera", "visible_transmission", "visible_volume_scatter", "visible_shadow")
     off = [label for prop, label in _RAY_VISIBILITY if not getattr(obj, prop, True)
-           and not (what == "light" and prop in ("visible_camera", "visible_transmission",
-                                                  "visible_volume_scatter", "visible_shadow"))]
+           and not (what == "light" and prop in light_only)]
     if off:
         sd.warnings.append("%s '%s': ray visibility (%s off) is not modelled; it is seen, lights, is lit and "
                            "casts shadows as if every ray type were on" % (what, obj.name, ", ".join(off)))
@@ -1066,8 +1066,8 @@ def _add_emissive_lights(sd, material_emission, version):
                              skipped=blocked)
     for g, side, gap in blocked[:10]:
         sd.warnings.append("material '%s': the %s side of an emissive face is %.3g m from a surface it faces; "
-                           "its light stays in the gap and is skipped" % (sd.material_names[g],
-                                                                           "front" if side > 0 else "back", gap))
+                           "its light stays in the gap and is skipped"
+                           % (sd.material_names[g], "front" if side > 0 else "back", gap))
     if not lights:
         return
     brightest = max([l["power"] * max(l["color"]) for l in sd.lights + lights] or [0.0])

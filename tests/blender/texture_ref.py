@@ -29,7 +29,6 @@ Cycles renders are cached under --out (key: this file, the case, Blender's
 version). Writes report.md and summary.txt ("N passed, N failed").
 """
 import hashlib
-import json
 import math
 import os
 import sys
@@ -52,8 +51,8 @@ TOL_EMISSION = 0.10
 
 def args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    a = {"--lib": os.path.join(ROOT, "build", "libvsgl.so"), "--out": os.path.join(ROOT, "build", "blender", "textures"),
-         "--only": ""}
+    a = {"--lib": os.path.join(ROOT, "build", "libvsgl.so"),
+         "--out": os.path.join(ROOT, "build", "blender", "textures"), "--only": ""}
     for i in range(0, len(argv) - 1, 2):
         a[argv[i]] = argv[i + 1]
     return a
@@ -61,7 +60,6 @@ def args():
 
 A = args()
 os.environ.setdefault("VSGL_LIBRARY", os.path.abspath(A["--lib"]))
-import vsgl_indirect  # noqa: E402
 from vsgl_indirect import engine, export, libvsgl  # noqa: E402
 import cycles_ref  # noqa: E402  (its Cycles pass renderer and EXR readers)
 
@@ -286,8 +284,8 @@ def build_diffcol():
         links.new(ramp.outputs["Color"], bsdf.inputs["Roughness"])
 
     mats = [material(n, f) for n, f in (("plain", plain), ("closest_clip", closest_clip),
-                                         ("mapped_mix", mapped_mix), ("multiply", multiply_invert_hsv),
-                                         ("vcol", vertex_colour))]
+                                        ("mapped_mix", mapped_mix), ("multiply", multiply_invert_hsv),
+                                        ("vcol", vertex_colour))]
     # five panels facing the camera (-y), in a row; the clip one's UVs reach past [0, 1]
     for i, m in enumerate(mats):
         x0 = -2.5 + i * 1.0
@@ -576,7 +574,6 @@ def floor_mask(h, w):
 
 def check_bleed(out_dir, report):
     passes = ["DiffInd", "DiffCol"]
-    results = []
     cyc, _ = cycles("bleed", lambda: build_bleed(True), passes, 1024, 1.0, out_dir)
     ref = cyc["DiffInd"] * cyc["DiffCol"]
     m = floor_mask(*ref.shape[:2])
