@@ -6,6 +6,7 @@
 #include "scene_fixture.h"
 #include "fit/grid.h"
 #include "shade/shade.h"
+#include "vsgl/debug.h"
 
 #include <stdlib.h>
 
@@ -284,4 +285,55 @@ VT_TEST(shade_clipped_lattice_lights_like_the_exact_plane)
     vsgl__vsgl_set_free(&set);
     free_plane_rsm(&h);
     lroom_close(&rm);
+}
+
+/* An area light 5 mm under the ceiling, facing it: its power lands on a
+ * few RSM texels, and the spacing from the participation area alone made
+ * 500 x the requested clusters, some of one texel (variance 0), whose
+ * d^2 / variance overflowed to inf and gave NaN pixels. Now: at most 16
+ * cells per requested VSGL (two lobes each) and finite, non-negative light. */
+VT_TEST(render_light_millimetres_from_a_wall_stays_finite_and_bounded)
+{
+    enum { W = 32, H = 24 };
+    static float comb[W * H * 3];
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.35f, 100.0f);
+    fx.materials[3].roughness = 0.35f;   /* a glossy-ish ceiling */
+    vsgl_light *L = &fx.lights[0];
+    memset(L, 0, sizeof *L);
+    L->type = VSGL_LIGHT_AREA;
+    L->color[0] = L->color[1] = L->color[2] = 1.0f;
+    L->power = 100.0f;
+    L->size_x = L->size_y = 0.6f;
+    L->spread = 3.14159f;
+    fx_translation(L->world_from_light, 0.0f, 0.0f, 1.995f);
+    L->world_from_light[5] = -1.0f;      /* flip: the light's -Z (its emission) points up at the ceiling */
+    L->world_from_light[10] = -1.0f;
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    const int presets[3] = {VSGL_PRESET_PREVIEW, VSGL_PRESET_BALANCED, VSGL_PRESET_QUALITY};
+    for (int p = 0; p < 3; ++p) {
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(presets[p], &s);
+        size_t count = 0;
+        VT_CHECK(vsgl_debug_vsgls(ctx, scene, &s, &count, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_CHECK(count <= (size_t)(2 * 16 * s.vsgl_count), "preset %d: %zu VSGLs for %u requested", presets[p], count,
+                 s.vsgl_count);
+        vsgl_render_output o;
+        memset(&o, 0, sizeof o);
+        o.width = W;
+        o.height = H;
+        o.combined = comb;
+        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "preset %d: %s", presets[p], vsgl_context_last_error(ctx));
+        double sum = 0;
+        for (size_t i = 0; i < sizeof comb / sizeof comb[0]; ++i) {
+            VT_CHECK(isfinite(comb[i]) && comb[i] >= 0.0f, "pixel value %g", (double)comb[i]);
+            sum += comb[i];
+        }
+        VT_CHECK(sum > 0.0, "preset %d: no indirect light at all", presets[p]);
+    }
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
 }

@@ -40,6 +40,10 @@
 /* Extra positional variance of a VSGL seen through a glossy lobe, in
  * units of h^2 (vsgl_vsgl.widen). */
 #define VSGL__LATTICE_OVERLAP (1.0 / 6.0)
+/* At most this many clusters per requested VSGL: past it the spacing grows
+ * (bright and tiny lit spots, e.g. a light a few mm from a wall, made
+ * 500 x the request; usual scenes stay at 1.6-6.5 x and never reach it). */
+#define VSGL__LATTICE_MAX_PER_VSGL 16.0
 
 /* Open-addressing map from a packed lattice key to a cluster's sums. */
 typedef struct cell_map {
@@ -151,27 +155,21 @@ static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, uint32_t 
     double texel = sqrt(swa / sw);
     if (h < 1.5 * texel)
         h = 1.5 * texel;
+
     /* keys hold 20-bit coordinates */
     double hmin = (extent > 0.0 ? extent : 1.0) / 200000.0;
     return h > hmin ? h : hmin;
 }
 
-vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
-                              const vsgl_render_settings *s, vsgl_vsgl_set *out)
+/* Every lit texel's moments into the tents of its lattice cells, spacing h. */
+static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl_grid *gp, const double anchor[3],
+                              double h, cell_map *out)
 {
-    uint32_t n_clusters = s->vsgl_count ? s->vsgl_count : 64;
-    vsgl_grid g;
-    vsgl_result r = vsgl__grid_build(ctx, scene, rsm, s->sharpness_estimator, 0, &g);
-    if (r != VSGL_OK)
-        return r;
-    v3 lo, hi;
-    vsgl__scene_bounds(scene, &lo, &hi);
-    double extent = v3_length(v3_sub(hi, lo));
-    double h = lattice_spacing(rsm, &g, n_clusters, extent);
-    double inv_h = 1.0 / h;
-    const double anchor[3] = {lo.x, lo.y, lo.z};
+    const vsgl_grid g = *gp;
     cell_map map;
     memset(&map, 0, sizeof map);
+    double inv_h = 1.0 / h;
+    vsgl_result r = VSGL_OK;
     size_t per_face = (size_t)rsm->res * rsm->res;
     /* Sequential in texel order: the sums and the VSGLs' order are the same
      * for any thread count. */
@@ -210,6 +208,35 @@ vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const 
                         dst[f] += w * m[f];
                 }
         }
+    }
+    if (r != VSGL_OK)
+        map_free(&map);
+    *out = map;
+    return r;
+}
+
+vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
+                              const vsgl_render_settings *s, vsgl_vsgl_set *out)
+{
+    uint32_t n_clusters = s->vsgl_count ? s->vsgl_count : 64;
+    vsgl_grid g;
+    vsgl_result r = vsgl__grid_build(ctx, scene, rsm, s->sharpness_estimator, 0, &g);
+    if (r != VSGL_OK)
+        return r;
+    v3 lo, hi;
+    vsgl__scene_bounds(scene, &lo, &hi);
+    double extent = v3_length(v3_sub(hi, lo));
+    double h = lattice_spacing(rsm, &g, n_clusters, extent);
+    const double anchor[3] = {lo.x, lo.y, lo.z};
+    cell_map map;
+    memset(&map, 0, sizeof map);
+    for (int attempt = 0;; ++attempt) {
+        r = bin_texels(ctx, rsm, &g, anchor, h, &map);
+        double cap = VSGL__LATTICE_MAX_PER_VSGL * (double)n_clusters;
+        if (r != VSGL_OK || (double)map.count <= cap || attempt == 3)
+            break;
+        h *= 1.05 * sqrt((double)map.count / cap);
+        map_free(&map);
     }
     double total = g.total[0] + g.total[VSGL__GRID_FIELDS];
     double widen = VSGL__LATTICE_OVERLAP * h * h;

@@ -582,7 +582,10 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
             o->mx = v->mean.x; o->my = v->mean.y; o->mz = v->mean.z;
             o->var = v->variance;
             o->var2 = 2.0f * v->variance;
-            o->ivar = v->variance > 0.0f ? 1.0f / v->variance : FLT_MAX;
+            /* a single-texel cluster has variance 0: 1e30, not FLT_MAX, so that
+             * d^2 / var stays finite in the kernel (FLT_MAX x d^2 > 1 m^2 overflowed
+             * to inf and inf / inf gave NaN pixels beside a light 5 mm from a wall) */
+            o->ivar = 1.0f / fmaxf(v->variance, VSGL__TINY);
             o->valid = v->variance > 0.0f ? 1.0f : 0.0f;
             o->ax = -v->axis.x; o->ay = -v->axis.y; o->az = -v->axis.z;
             o->lv = v->sharpness;
