@@ -1155,7 +1155,40 @@ def _progress_trampoline(ctx_ref):
     return PROGRESS_FN(progress)
 
 
-class Context:
+class _Owned:
+    """A library object the Python side owns: ``handle`` (ValueError once
+    closed), ``close()`` calls ``_destroy`` once; usable with ``with``;
+    ``__del__`` closes too."""
+
+    _handle = None
+    _what = "object"       # for the closed-handle message
+    _destroy = ""          # the library function that frees the handle
+
+    @property
+    def handle(self):
+        if self._handle is None:
+            raise ValueError("the vsgl %s is closed" % self._what)
+        return self._handle
+
+    def close(self):
+        h, self._handle = self._handle, None
+        if h is not None:
+            getattr(self._lib, self._destroy)(h)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+class Context(_Owned):
     """A vsgl_context: thread count, callbacks, last error.
 
     ``log(level, message)`` receives the library's log lines (levels are
@@ -1166,7 +1199,7 @@ class Context:
     or call close(); ``__del__`` also destroys it.
     """
 
-    _handle = None
+    _what, _destroy = "context", "vsgl_context_destroy"
 
     def __init__(self, thread_count=0, log=None, log_level=None, progress=None,
                  desc_size=None, max_memory=0):
@@ -1199,12 +1232,6 @@ class Context:
         self._handle = handle
 
     @property
-    def handle(self):
-        if self._handle is None:
-            raise ValueError("the vsgl context is closed")
-        return self._handle
-
-    @property
     def last_error(self):
         """Message of the last failed call on this context ("" if none)."""
         if self._handle is None:
@@ -1223,23 +1250,6 @@ class Context:
         if rc != 0:
             cls = VsglCancelledError if rc == Result.ERROR_CANCELLED else VsglError
             raise cls(rc, self.last_error, function)
-
-    def close(self):
-        h, self._handle = self._handle, None
-        if h is not None:
-            self._lib.vsgl_context_destroy(h)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:
-            pass
 
 
 # --------------------------------------------------------------------------
@@ -1372,7 +1382,7 @@ def _build_scene_desc(positions, indices, corner_normals=None, corner_uvs=None,
     return desc, keep
 
 
-class Scene:
+class Scene(_Owned):
     """A validated vsgl_scene built from numpy arrays (zero-copy: read during
     construction only).
 
@@ -1386,7 +1396,7 @@ class Scene:
     bad arrays and VsglError (with the library's message) for bad content.
     """
 
-    _handle = None
+    _what, _destroy = "scene", "vsgl_scene_destroy"
 
     def __init__(self, ctx, positions, indices, corner_normals=None, corner_uvs=None,
                  corner_tangents=None, material_indices=None, materials=(), lights=(),
@@ -1404,12 +1414,6 @@ class Scene:
         ctx.check(rc, "vsgl_scene_create")
         self._handle = handle
         self.width, self.height = int(camera.width), int(camera.height)
-
-    @property
-    def handle(self):
-        if self._handle is None:
-            raise ValueError("the vsgl scene is closed")
-        return self._handle
 
     def set_view(self, camera, lights=()):
         """Replace the camera and lights, keeping geometry, materials and the
@@ -1431,23 +1435,6 @@ class Scene:
         d = info.as_dict()
         d["bounds_min"], d["bounds_max"] = tuple(d["bounds_min"]), tuple(d["bounds_max"])
         return d
-
-    def close(self):
-        h, self._handle = self._handle, None
-        if h is not None:
-            self._lib.vsgl_scene_destroy(h)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:
-            pass
 
 
 # --------------------------------------------------------------------------
@@ -1494,41 +1481,18 @@ def render_estimate(ctx, scene, settings=None, planes=PLANES):
     return est.as_dict()
 
 
-class RenderCache:
+class RenderCache(_Owned):
     """A vsgl_render_cache: the G-buffer and VSGLs of the last render passed
     to ``render(..., cache=)``, reused while their inputs stand still. Close
     it (or use ``with``) before its context."""
 
-    _handle = None
+    _what, _destroy = "render cache", "vsgl_render_cache_destroy"
 
     def __init__(self, ctx):
         self._ctx, self._lib = ctx, ctx._lib
         h = ctypes.c_void_p()
         ctx.check(self._lib.vsgl_render_cache_create(ctx.handle, ctypes.byref(h)), "vsgl_render_cache_create")
         self._handle = h
-
-    @property
-    def handle(self):
-        if self._handle is None:
-            raise ValueError("the render cache is closed")
-        return self._handle
-
-    def close(self):
-        h, self._handle = self._handle, None
-        if h is not None:
-            self._lib.vsgl_render_cache_destroy(h)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:
-            pass
 
 
 def render(ctx, scene, settings=None, planes=PLANES, cache=None):
