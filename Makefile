@@ -27,7 +27,7 @@ TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/obj/%.o)
 ASAN_LIB_OBJ  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 ASAN_TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/asan/%.o)
 
-.PHONY: all help deps test test-c test-python test-blender asan demo bench lint clean headers-cxx check-exports
+.PHONY: all help deps test test-c test-python test-blender asan demo bench lint abi clean headers-cxx check-exports
 
 all: $(BUILD)/libvsgl.so check-exports headers-cxx $(if $(CLI_SRC),$(BUILD)/vsgl)
 
@@ -39,6 +39,7 @@ help:
 	@echo "make bench      speed/memory benchmarks, reported as ratios"
 	@echo "make screenshots  the add-on's panels in Blender's UI under Xvfb -> docs/img/"
 	@echo "make lint       flake8 (setup.cfg) and cppcheck over the sources"
+	@echo "make abi        regenerate the binding's ABI mirror (addon/vsgl_indirect/_libvsgl_abi.py) from the headers"
 
 deps:
 	@tools/deps.sh build
@@ -117,6 +118,11 @@ lint:
 	/usr/bin/python3 -m flake8 addon tests tools
 	cppcheck --quiet --error-exitcode=1 --std=c11 --enable=warning,portability,performance --inline-suppr \
 	  -D__GNUC__ -I csrc/include -I csrc/src csrc/src csrc/cli
+
+# The binding's ABI mirror (enums, constants, structs, prototypes) from the
+# public headers; tests/python/test_layout.py fails when it is not current.
+abi:
+	$(PYTHON) tools/gen_abi.py
 
 clean:
 	rm -rf $(BUILD)

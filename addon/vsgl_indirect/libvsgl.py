@@ -1,8 +1,11 @@
-"""ctypes binding of libvsgl, the only module of the add-on that uses ctypes.
+"""ctypes binding of libvsgl, the only module of the add-on that calls the
+library (with _libvsgl_abi.py, its ABI mirror generated from the headers by
+tools/gen_abi.py: constants, enums, structs, prototypes; this module
+re-exports all of it and adds the Pythonic layer).
 
-Pure Python + numpy; no ``bpy`` import and no relative imports, so the
-tests can import it directly (``sys.path.insert(0, 'addon/vsgl_indirect')``)
-and the add-on as ``from . import libvsgl``.
+Pure Python + numpy; no ``bpy`` import, so the tests can import it as a
+top-level module (setup.cfg puts ``addon/vsgl_indirect`` on the path) and
+the add-on as ``from . import libvsgl``.
 
 Library lookup, first match wins:
 
@@ -21,7 +24,6 @@ naming what is wrong. See docs/python.md.
 """
 
 import ctypes
-import enum
 import logging
 import math
 import os
@@ -40,9 +42,6 @@ __all__ = [
 ]
 
 _logger = logging.getLogger("vsgl_indirect.libvsgl")
-
-#: (major, minor) of the C API this binding was written for.
-BINDING_VERSION = (0, 2)
 
 # --------------------------------------------------------------------------
 # Errors
@@ -75,504 +74,48 @@ class VsglCancelledError(VsglError):
 
 
 # --------------------------------------------------------------------------
-# Constants (values of the C #defines)
+# The C ABI: constants, enums, structs, callbacks and prototypes are generated
+# from the headers into _libvsgl_abi.py (tools/gen_abi.py, `make abi`) and
+# re-exported here; what follows them is written by hand.
 # --------------------------------------------------------------------------
 
-
-class Result(enum.IntEnum):
-    OK = 0
-    ERROR_INVALID_ARGUMENT = 1
-    ERROR_OUT_OF_MEMORY = 2
-    ERROR_IO = 3
-    ERROR_BAD_FORMAT = 4
-    ERROR_VERSION_MISMATCH = 5
-    ERROR_UNSUPPORTED = 6
-    ERROR_CANCELLED = 7
-    ERROR_INTERNAL = 8
-
-
-class LogLevel(enum.IntEnum):
-    ERROR = 0
-    WARNING = 1
-    INFO = 2
-    DEBUG = 3
-
-
-class CosineMode(enum.IntEnum):
-    ACCURATE = 0
-    SG = 1
-    PULLED_OUT = 2
-
-
-class SharpnessEstimator(enum.IntEnum):
-    TOKSVIG = 0
-    BANERJEE = 1
-
-
-class NDF(enum.IntEnum):
-    GGX = 0
-    BECKMANN = 1
-
-
-class LightType(enum.IntEnum):
-    POINT = 0
-    SPOT = 1
-    SUN = 2
-    AREA = 3
-
-
-class AreaShape(enum.IntEnum):
-    SQUARE = 0
-    RECTANGLE = 1
-    DISK = 2
-    ELLIPSE = 3
-
-
-class CameraType(enum.IntEnum):
-    PERSPECTIVE = 0
-    ORTHOGRAPHIC = 1
-
-
-class SensorFit(enum.IntEnum):
-    AUTO = 0
-    HORIZONTAL = 1
-    VERTICAL = 2
-
-
-class Method(enum.IntEnum):
-    VSGL = 0
-    BRUTE_FORCE = 1
-
-
-class FitMode(enum.IntEnum):
-    TWO = 0
-    FIS = 1
-    KMEANS = 2
-    LATTICE = 3
-
-
-class GlossyMode(enum.IntEnum):
-    ASG = 0
-    SG = 1
-    ASG2 = 2
-
-
-class Visibility(enum.IntEnum):
-    NONE = 0
-    RAY = 1
-
-
-class LeakCorrection(enum.IntEnum):
-    AUTO = 0
-    OFF = 1
-    ON = 2
-
-
-class SampleMerging(enum.IntEnum):
-    AUTO = 0
-    OFF = 1
-
-
-class Preset(enum.IntEnum):
-    PREVIEW = 0
-    BALANCED = 1
-    QUALITY = 2
-
-
-class ExrPixelType(enum.IntEnum):
-    FLOAT = 0
-    HALF = 1
-
-
-class ExrCompression(enum.IntEnum):
-    ZIP = 0
-    NONE = 1
-    ZIPS = 2
-    PIZ = 3
-    RLE = 4
-    PXR24 = 5
-    B44 = 6
-    B44A = 7
-
-
-MATERIAL_UNSUPPORTED = 1
-MATERIAL_FLAG_BLENDER_4 = 2   # vsgl_material.flags: Cycles 4.x+ GGX shadowing
-MATERIAL_FLAG_MULTISCATTER = 4  # vsgl_material.flags: Cycles 4.x+ "Multiscatter GGX"
-MATERIAL_FLAGS_KNOWN = 7
-LIGHT_FLAG_BLENDER_4 = 1   # vsgl_light.flags: Blender 4.0+ spot semantics
-LIGHT_FLAGS_KNOWN = 1
-SHARPNESS_MAX = 2199023255552.0  # 2^41
-ALPHA_MIN = 4.656612873077393e-10  # 2^-31
-EXR_MAX_CHANNELS = 4
-# Valid ranges of the numeric render settings (render.h; the add-on's
-# property limits and the CLI use the same).
-AA_SAMPLES_MAX = 16
-RSM_RESOLUTION_MIN = 2
-RSM_RESOLUTION_MAX = 8192
-VSGL_COUNT_MAX = 65536
-FIS_ITERATIONS_MAX = 32
-SHADE_STRIDE_MAX = 8
-#: vsgl_render_stats.reused bits (render.h)
-REUSED_GBUFFER = 1
-REUSED_FIT = 2
-BUNDLE_VERSION = (1, 2)
-
-
-def _enum(value, cls, what):
-    """Accept an IntEnum member, an int or a (case-insensitive) member name."""
-    if isinstance(value, str):
-        try:
-            return int(cls[value.upper()])
-        except KeyError:
-            raise ValueError("%s: unknown %s %r (one of %s)" % (
-                what, cls.__name__, value, ", ".join(m.name for m in cls))) from None
-    return int(value)
-
-
-# --------------------------------------------------------------------------
-# Structures: field order and types exactly as csrc/include/vsgl/*.h
-# --------------------------------------------------------------------------
-
-_f32, _u32, _i32 = ctypes.c_float, ctypes.c_uint32, ctypes.c_int32
-_PF32 = ctypes.POINTER(ctypes.c_float)
-_PU32 = ctypes.POINTER(ctypes.c_uint32)
-
-LOG_FN = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int32, ctypes.c_char_p)
-PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int32, ctypes.c_void_p, ctypes.c_char_p, ctypes.c_float)
-
-_MATRIX_FIELDS = {"world_from_light", "world_from_camera"}
-
-
-class _Struct(ctypes.Structure):
-    """Keyword constructor that accepts numpy arrays, enum names and
-    Blender-style 4x4 / 3x4 matrices for the 12-float matrix fields."""
-
-    _enums = {}
-
-    def __init__(self, **fields):
-        super().__init__()
-        names = [f[0] for f in self._fields_]
-        if "size" in names:
-            self.size = ctypes.sizeof(self)
-        for key, value in fields.items():
-            if key not in names:
-                raise TypeError("%s has no field %r (fields: %s)" % (
-                    type(self).__name__, key, ", ".join(names)))
-            setattr(self, key, self._convert(key, value))
-
-    def _convert(self, key, value):
-        ftype = dict(self._fields_)[key]
-        if key in self._enums:
-            return _enum(value, self._enums[key], key)
-        if issubclass(ftype, ctypes.Array) and not isinstance(value, (bytes, str)):
-            arr = np.asarray(value, dtype=np.float64)
-            if key in _MATRIX_FIELDS and arr.shape in ((4, 4), (3, 4)):
-                arr = arr[:3, :]
-            arr = arr.reshape(-1)
-            if arr.size != ftype._length_:
-                raise ValueError("%s.%s needs %d values, got shape %s" % (
-                    type(self).__name__, key, ftype._length_, np.shape(value)))
-            return ftype(*arr.tolist())
-        return value
-
-    def as_dict(self):
-        out = {}
-        for name, ftype in self._fields_:
-            v = getattr(self, name)
-            if isinstance(v, bytes):
-                v = v.decode("utf-8", "replace")
-            elif isinstance(v, ctypes.Array):
-                v = list(v)
-            out[name] = v
-        return out
-
-    def __repr__(self):
-        return "%s(%s)" % (type(self).__name__, ", ".join(
-            "%s=%r" % kv for kv in self.as_dict().items()))
-
-
-class vsgl_vec3(ctypes.Structure):
-    _fields_ = [("x", _f32), ("y", _f32), ("z", _f32)]
-
-
-class vsgl_context_desc(_Struct):
-    _fields_ = [
-        ("size", _u32),
-        ("thread_count", _u32),
-        ("log_level", _i32),
-        ("log", LOG_FN),
-        ("log_user", ctypes.c_void_p),
-        ("progress", PROGRESS_FN),
-        ("progress_user", ctypes.c_void_p),
-        ("max_memory", ctypes.c_uint64),
-    ]
-
-
-class vsgl_sg(ctypes.Structure):
-    _fields_ = [("axis", vsgl_vec3), ("sharpness", _f32), ("log_amplitude", _f32)]
-
-
-class vsgl_asg(ctypes.Structure):
-    _fields_ = [
-        ("x", vsgl_vec3), ("y", vsgl_vec3), ("z", vsgl_vec3),
-        ("lambda_", _f32), ("mu", _f32), ("log_amplitude", _f32),
-    ]
-
-
-class vsgl_material(_Struct):
-    _fields_ = [
-        ("base_color", _f32 * 3),
-        ("metallic", _f32),
-        ("roughness", _f32),
-        ("specular_f0", _f32),
-        ("anisotropy", _f32),
-        ("anisotropic_rotation", _f32),
-        ("flags", _u32),
-        ("reserved", _u32),
-    ]
-
-
-class vsgl_light(_Struct):
-    _fields_ = [
-        ("type", _i32),
-        ("area_shape", _i32),
-        ("color", _f32 * 3),
-        ("power", _f32),
-        ("world_from_light", _f32 * 12),
-        ("radius", _f32),
-        ("spot_size", _f32),
-        ("spot_blend", _f32),
-        ("sun_angle", _f32),
-        ("size_x", _f32),
-        ("size_y", _f32),
-        ("spread", _f32),
-        ("flags", _u32),
-    ]
-    _enums = {"type": LightType, "area_shape": AreaShape}
-
-
-class vsgl_camera(_Struct):
-    _fields_ = [
-        ("type", _i32),
-        ("sensor_fit", _i32),
-        ("world_from_camera", _f32 * 12),
-        ("lens_mm", _f32),
-        ("sensor_width_mm", _f32),
-        ("sensor_height_mm", _f32),
-        ("ortho_scale", _f32),
-        ("shift_x", _f32),
-        ("shift_y", _f32),
-        ("clip_start", _f32),
-        ("clip_end", _f32),
-        ("width", _u32),
-        ("height", _u32),
-        ("pixel_aspect_x", _f32),
-        ("pixel_aspect_y", _f32),
-    ]
-    _enums = {"type": CameraType, "sensor_fit": SensorFit}
-
-
-class vsgl_texture(_Struct):
-    _fields_ = [
-        ("width", _u32),
-        ("height", _u32),
-        ("pixels", _PF32),
-        ("flags", _u32),
-        ("reserved", _u32),
-    ]
-
-
-TEXTURE_FLAG_SRGB = 1
-FILTER_LINEAR, FILTER_CLOSEST = 0, 1
-WRAP_REPEAT, WRAP_EXTEND, WRAP_CLIP = 0, 1, 2
-MATERIAL_TEXTURES_VERTEX_COLOR = 1
-
-
-class vsgl_texture_slot(_Struct):
-    _fields_ = [
-        ("texture", _u32),
-        ("filter", _i32),
-        ("wrap", _i32),
-        ("channel", _i32),
-        ("uv_transform", _f32 * 6),
-    ]
-
-
-class vsgl_material_textures(_Struct):
-    _fields_ = [
-        ("base_color", vsgl_texture_slot),
-        ("roughness", vsgl_texture_slot),
-        ("metallic", vsgl_texture_slot),
-        ("flags", _u32),
-        ("reserved", _u32),
-    ]
-
-
-class vsgl_scene_desc(_Struct):
-    _fields_ = [
-        ("size", _u32),
-        ("vertex_count", _u32),
-        ("positions", _PF32),
-        ("triangle_count", _u32),
-        ("indices", _PU32),
-        ("corner_normals", _PF32),
-        ("corner_uvs", _PF32),
-        ("corner_tangents", _PF32),
-        ("material_indices", _PU32),
-        ("material_count", _u32),
-        ("materials", ctypes.POINTER(vsgl_material)),
-        ("light_count", _u32),
-        ("lights", ctypes.POINTER(vsgl_light)),
-        ("camera", ctypes.POINTER(vsgl_camera)),
-        ("texture_count", _u32),
-        ("textures", ctypes.POINTER(vsgl_texture)),
-        ("material_textures", ctypes.POINTER(vsgl_material_textures)),
-        ("corner_colors", _PF32),
-    ]
-
-
-class vsgl_scene_info(_Struct):
-    _fields_ = [
-        ("triangle_count", _u32),
-        ("dropped_triangles", _u32),
-        ("light_count", _u32),
-        ("material_count", _u32),
-        ("bounds_min", _f32 * 3),
-        ("bounds_max", _f32 * 3),
-    ]
-
-
-class vsgl_render_settings(_Struct):
-    _fields_ = [
-        ("size", _u32),
-        ("method", _i32),
-        ("aa_samples", _u32),
-        ("rsm_resolution", _u32),
-        ("fit_mode", _i32),
-        ("vsgl_count", _u32),
-        ("fis_iterations", _u32),
-        ("sharpness_estimator", _i32),
-        ("diffuse_mode", _i32),
-        ("glossy_mode", _i32),
-        ("visibility", _i32),
-        ("seed", _u32),
-        ("leak_correction", _i32),
-        ("sample_merging", _i32),
-        ("shade_stride", _u32),
-    ]
-    _enums = {"method": Method, "fit_mode": FitMode, "sharpness_estimator": SharpnessEstimator,
-              "diffuse_mode": CosineMode, "glossy_mode": GlossyMode, "visibility": Visibility,
-              "leak_correction": LeakCorrection, "sample_merging": SampleMerging}
-
+# Every name of it is re-exported (*); the ones this module uses are named.
+if __package__:  # the add-on package
+    from ._libvsgl_abi import *  # noqa: F401,F403
+    from ._libvsgl_abi import (
+        _enum, BINDING_VERSION, EXR_MAX_CHANNELS, PROTOTYPES, CosineMode, ExrCompression, ExrPixelType,
+        LogLevel, NDF, Preset, Result, SharpnessEstimator, Visibility, vsgl_asg, vsgl_bundle_info,
+        vsgl_bundle_options, vsgl_camera, vsgl_context_desc, vsgl_debug_vsgl, vsgl_exr_metadata,
+        vsgl_exr_options, vsgl_exr_pass, vsgl_light, vsgl_log_fn, vsgl_material, vsgl_material_textures,
+        vsgl_memory_estimate, vsgl_progress_fn, vsgl_reference_stats, vsgl_render_output,
+        vsgl_render_settings, vsgl_render_stats, vsgl_scene_desc, vsgl_scene_info, vsgl_sg,
+        vsgl_texture, vsgl_texture_slot, vsgl_vec3)
+else:  # a top-level module (the tests, tools/; see the module docstring)
+    from _libvsgl_abi import *  # noqa: F401,F403
+    from _libvsgl_abi import (
+        _enum, BINDING_VERSION, EXR_MAX_CHANNELS, PROTOTYPES, CosineMode, ExrCompression, ExrPixelType,
+        LogLevel, NDF, Preset, Result, SharpnessEstimator, Visibility, vsgl_asg, vsgl_bundle_info,
+        vsgl_bundle_options, vsgl_camera, vsgl_context_desc, vsgl_debug_vsgl, vsgl_exr_metadata,
+        vsgl_exr_options, vsgl_exr_pass, vsgl_light, vsgl_log_fn, vsgl_material, vsgl_material_textures,
+        vsgl_memory_estimate, vsgl_progress_fn, vsgl_reference_stats, vsgl_render_output,
+        vsgl_render_settings, vsgl_render_stats, vsgl_scene_desc, vsgl_scene_info, vsgl_sg,
+        vsgl_texture, vsgl_texture_slot, vsgl_vec3)
 
 #: The planes of vsgl_render_output, in field order (each H x W x 3 except alpha: H x W).
-PLANES = ("diffuse_light", "glossy_light", "diffuse_color", "glossy_color",
-          "diffuse", "glossy", "combined", "alpha")
+PLANES = tuple(name for name, ftype in vsgl_render_output._fields_
+               if ftype is ctypes.POINTER(ctypes.c_float))
 #: Cycles/EXR pass names of the planes (vsgl_exr_write_render).
 PLANE_PASS_NAMES = {"diffuse_light": "DiffInd", "glossy_light": "GlossInd",
                     "diffuse_color": "DiffCol", "glossy_color": "GlossCol",
                     "diffuse": "Diff", "glossy": "Gloss", "combined": "Combined",
                     "alpha": "Combined.A"}
 
+LOG_FN = vsgl_log_fn
+PROGRESS_FN = vsgl_progress_fn
 
-class vsgl_render_output(_Struct):
-    _fields_ = [("width", _u32), ("height", _u32)] + [(p, _PF32) for p in PLANES]
-
-
-class vsgl_memory_estimate(_Struct):
-    _fields_ = [(n, ctypes.c_uint64) for n in
-                ("output", "gbuffer", "planes", "rsm", "fit", "shade", "total", "limit")]
-
-
-class vsgl_render_stats(_Struct):
-    _fields_ = [
-        ("seconds_total", ctypes.c_double),
-        ("seconds_scene_prep", ctypes.c_double),
-        ("seconds_gbuffer", ctypes.c_double),
-        ("seconds_rsm", ctypes.c_double),
-        ("seconds_fit", ctypes.c_double),
-        ("seconds_shade", ctypes.c_double),
-        ("lights_used", _u32),
-        ("lights_skipped", _u32),
-        ("vsgl_count", _u32),
-        ("shading_pairs", ctypes.c_uint64),
-        ("skipped", ctypes.c_char * 1024),
-        ("reused", _u32),
-    ]
-
-
-# io.h
-class vsgl_exr_pass(_Struct):
-    _fields_ = [
-        ("name", ctypes.c_char_p),
-        ("channels", ctypes.c_char_p),
-        ("data", _PF32 * EXR_MAX_CHANNELS),
-        ("stride", _u32 * EXR_MAX_CHANNELS),
-    ]
-
-
-class vsgl_exr_metadata(_Struct):
-    _fields_ = [("key", ctypes.c_char_p), ("value", ctypes.c_char_p)]
-
-
-class vsgl_exr_options(_Struct):
-    _fields_ = [
-        ("size", _u32),
-        ("layer", ctypes.c_char_p),
-        ("pixel_type", _i32),
-        ("compression", _i32),
-        ("metadata_count", _u32),
-        ("metadata", ctypes.POINTER(vsgl_exr_metadata)),
-    ]
-    _enums = {"pixel_type": ExrPixelType, "compression": ExrCompression}
-
-
-class vsgl_bundle_options(_Struct):
-    _fields_ = [
-        ("size", _u32),
-        ("output_path", ctypes.c_char_p),
-        ("has_frame", _i32),
-        ("frame", _i32),
-    ]
-
-
-class vsgl_bundle_info(_Struct):
-    _fields_ = [
-        ("version_major", _u32),
-        ("version_minor", _u32),
-        ("output_path", ctypes.c_char_p),
-        ("has_frame", _i32),
-        ("frame", _i32),
-        ("has_settings", _u32),
-    ]
-
-
-# debug.h
-class vsgl_debug_vsgl(_Struct):
-    _fields_ = [
-        ("mean", ctypes.c_float * 3),
-        ("variance", ctypes.c_float),
-        ("axis", ctypes.c_float * 3),
-        ("sharpness", ctypes.c_float),
-        ("power", ctypes.c_float * 3),
-        ("normal", ctypes.c_float * 3),
-        ("coherence", ctypes.c_float),
-        ("light", ctypes.c_uint32),
-        ("lobe", ctypes.c_uint32),
-    ]
-
-
-# reference.h
-class vsgl_reference_stats(_Struct):
-    _fields_ = [
-        ("seconds_gbuffer", ctypes.c_double),
-        ("seconds_rsm", ctypes.c_double),
-        ("seconds_gather", ctypes.c_double),
-        ("rsm_bytes", ctypes.c_uint64),
-        ("vpl_count", ctypes.c_uint64),
-        ("total_flux", ctypes.c_double * 3),
-    ]
-
+_P = ctypes.POINTER
+_PF32 = _P(ctypes.c_float)
+_PU32 = _P(ctypes.c_uint32)
 
 # Friendlier names for the structs users fill in.
 Material = vsgl_material
@@ -581,121 +124,6 @@ Camera = vsgl_camera
 TextureSlot = vsgl_texture_slot
 MaterialTextures = vsgl_material_textures
 RenderSettings = vsgl_render_settings
-
-#: Every mirrored struct, by its C name (the layout test checks each).
-STRUCTS = {cls.__name__: cls for cls in (
-    vsgl_vec3, vsgl_context_desc, vsgl_sg, vsgl_asg, vsgl_material, vsgl_light,
-    vsgl_texture, vsgl_texture_slot, vsgl_material_textures,
-    vsgl_camera, vsgl_scene_desc, vsgl_scene_info, vsgl_render_settings,
-    vsgl_render_output, vsgl_memory_estimate, vsgl_render_stats, vsgl_exr_pass, vsgl_exr_metadata,
-    vsgl_exr_options, vsgl_bundle_options, vsgl_bundle_info, vsgl_debug_vsgl, vsgl_reference_stats)}
-#: Python field names that differ from the C ones.
-FIELD_C_NAMES = {"lambda_": "lambda"}
-
-
-def header_of(name):
-    """The public header declaring a struct or function of the binding."""
-    if name.startswith(("vsgl_exr", "vsgl_bundle", "vsgl_check_output")):
-        return "io.h"
-    if name.startswith("vsgl_debug"):
-        return "debug.h"
-    if name.startswith("vsgl_reference"):
-        return "reference.h"
-    return "vsgl.h"
-
-
-# --------------------------------------------------------------------------
-# Prototypes: (name, restype, argtypes), as in the headers
-# --------------------------------------------------------------------------
-
-_P = ctypes.POINTER
-_VP = ctypes.c_void_p
-_PVP = _P(ctypes.c_void_p)
-_PV3, _PSG, _PASG = _P(vsgl_vec3), _P(vsgl_sg), _P(vsgl_asg)
-
-PROTOTYPES = (
-    # base.h
-    ("vsgl_result_string", ctypes.c_char_p, [_i32]),
-    ("vsgl_version", _i32, []),
-    ("vsgl_version_string", ctypes.c_char_p, []),
-    ("vsgl_context_create", _i32, [_P(vsgl_context_desc), _PVP]),
-    ("vsgl_context_destroy", None, [_VP]),
-    ("vsgl_context_last_error", ctypes.c_char_p, [_VP]),
-    ("vsgl_context_thread_count", _u32, [_VP]),
-    # sg.h
-    ("vsgl_sg_eval", _f32, [_PSG, _PV3]),
-    ("vsgl_sg_integral", _f32, [_f32]),
-    ("vsgl_sg_lobe_integral", _f32, [_PSG]),
-    ("vsgl_sg_product", None, [_PSG, _PSG, _PSG]),
-    ("vsgl_sg_product_integral", _f32, [_PSG, _PSG]),
-    ("vsgl_sg_product_integral_iwasaki", _f32, [_PSG, _PSG]),
-    ("vsgl_sg_cosine_sharpness", _f32, []),
-    ("vsgl_sg_cosine_integral", _f32, [_PSG, _PV3, _i32]),
-    ("vsgl_sharpness_from_mean_length", _f32, [_f32, _i32]),
-    ("vsgl_mean_length_from_sharpness", _f32, [_f32, _i32]),
-    # asg.h
-    ("vsgl_asg_eval", _f32, [_PASG, _PV3]),
-    ("vsgl_asg_bessel_f", _f32, [_f32]),
-    ("vsgl_asg_integral", _f32, [_PASG]),
-    ("vsgl_asg_integral_approx", _f32, [_PASG]),
-    ("vsgl_asg_product", None, [_PASG, _PASG, _PASG]),
-    ("vsgl_asg_convolve_sg", None, [_PASG, _PSG, _PASG]),
-    ("vsgl_asg_sg_product_integral", _f32, [_PASG, _PSG]),
-    ("vsgl_sg_to_asg", None, [_PSG, _PASG]),
-    # lobes.h
-    ("vsgl_lambert_to_sg", None, [_PV3, _PSG]),
-    ("vsgl_ndf_sharpness", _f32, [_f32]),
-    ("vsgl_ndf_to_sg", None, [_PV3, _f32, _i32, _PSG]),
-    ("vsgl_ndf_aniso_to_asg", None, [_PV3, _PV3, _f32, _f32, _PASG]),
-    ("vsgl_warp_ndf_sg", None, [_PSG, _PV3, _PSG]),
-    ("vsgl_warp_ndf_asg", None, [_PASG, _PV3, _PASG]),
-    ("vsgl_specular_factor", _f32, [_PV3, _PV3, _PV3, _f32, _f32]),
-    ("vsgl_ward_to_asg", None, [_PV3, _PV3, _f32, _f32, _PASG]),
-    ("vsgl_ashikhmin_shirley_to_asg", None, [_PV3, _PV3, _f32, _f32, _PASG]),
-    # scene.h
-    ("vsgl_scene_create", _i32, [_VP, _P(vsgl_scene_desc), _PVP]),
-    ("vsgl_scene_destroy", None, [_VP]),
-    ("vsgl_scene_get_info", _i32, [_VP, _P(vsgl_scene_info)]),
-    ("vsgl_scene_set_view", _i32, [_VP, _VP, _P(vsgl_camera), _P(vsgl_light), _u32]),
-    # render.h
-    ("vsgl_render_settings_preset", None, [_i32, _P(vsgl_render_settings)]),
-    ("vsgl_render_estimate", _i32, [_VP, _VP, _P(vsgl_render_settings), _u32,
-                                    _P(vsgl_memory_estimate)]),
-    ("vsgl_render", _i32, [_VP, _VP, _P(vsgl_render_settings), _P(vsgl_render_output),
-                           _P(vsgl_render_stats)]),
-    ("vsgl_render_cache_create", _i32, [_VP, _PVP]),
-    ("vsgl_render_cache_destroy", None, [_VP]),
-    ("vsgl_render_cached", _i32, [_VP, _VP, _P(vsgl_render_settings), _VP, _P(vsgl_render_output),
-                                  _P(vsgl_render_stats)]),
-    # io.h
-    ("vsgl_check_output_path", _i32, [_VP, ctypes.c_char_p]),
-    ("vsgl_exr_write", _i32, [_VP, ctypes.c_char_p, _u32, _u32, _P(vsgl_exr_pass), _u32,
-                              _P(vsgl_exr_options)]),
-    ("vsgl_exr_write_render", _i32, [_VP, ctypes.c_char_p, _P(vsgl_render_output),
-                                     _P(vsgl_exr_options)]),
-    ("vsgl_bundle_write_memory", _i32, [_VP, _P(vsgl_scene_desc), _P(vsgl_render_settings),
-                                        _P(vsgl_bundle_options), _VP, ctypes.c_size_t,
-                                        _P(ctypes.c_size_t)]),
-    ("vsgl_bundle_write", _i32, [_VP, ctypes.c_char_p, _P(vsgl_scene_desc),
-                                 _P(vsgl_render_settings), _P(vsgl_bundle_options)]),
-    ("vsgl_bundle_read", _i32, [_VP, ctypes.c_char_p, _PVP]),
-    ("vsgl_bundle_read_memory", _i32, [_VP, _VP, ctypes.c_size_t, _PVP]),
-    ("vsgl_bundle_destroy", None, [_VP]),
-    ("vsgl_bundle_scene", _P(vsgl_scene_desc), [_VP]),
-    ("vsgl_bundle_settings", _P(vsgl_render_settings), [_VP]),
-    ("vsgl_bundle_get_info", _i32, [_VP, _P(vsgl_bundle_info)]),
-    # debug.h
-    ("vsgl_debug_gbuffer", _i32, [_VP, _VP, _u32, _PF32, _PF32, _PU32]),
-    ("vsgl_debug_gbuffer_frames", _i32, [_VP, _VP, _u32, _PF32, _PF32]),
-    ("vsgl_debug_vsgls", _i32, [_VP, _VP, _P(vsgl_render_settings), _P(ctypes.c_size_t), _P(vsgl_debug_vsgl)]),
-    # reference.h
-    ("vsgl_reference_rsm", _i32, [_VP, _VP, _u32, _u32, _P(ctypes.c_size_t), _PF32, _PF32,
-                                  _PF32, _PF32, _PU32]),
-    ("vsgl_reference_brdf", _i32, [_P(vsgl_material), _u32, _PF32, _PF32, _PF32, _PF32, _PF32,
-                                   _PF32]),
-    ("vsgl_reference_render", _i32, [_VP, _VP, _u32, _u32, _i32, _PF32, _PF32, _PF32, _PF32,
-                                     _P(vsgl_reference_stats)]),
-)
 
 # --------------------------------------------------------------------------
 # Loading
