@@ -1,0 +1,74 @@
+/* Eq. 10 for one Lambertian rectangle of uniform radiance seen by a GGX
+ * receiver: the MRP pipeline (peak, disk, overlap, ASG light, convolution
+ * with the warped NDF) put together. docs/mrp.md measures it against
+ * quadrature of the exact BRDF over the rectangle (tests/c/test_mrp_glossy.c). */
+#include "mrp/mrp.h"
+#include "mrp/geom.h"
+#include "math/constants.h"
+
+vsgl__mrp_options vsgl__mrp_options_default(void)
+{
+    vsgl__mrp_options o = {VSGL__MRP_NORM_EXACT, 1, 1, 0, 1, 0.7};
+    return o;
+}
+
+vsgl__mrp_options vsgl__mrp_options_paper(void)
+{
+    vsgl__mrp_options o = {VSGL__MRP_NORM_PAPER, 0, 0, 0, 0, 0.7};
+    return o;
+}
+
+/* y clamped onto the rectangle (in its plane). */
+static d3 clamp_to_rect(const vsgl__mrp_rect *rc, d3 y)
+{
+    d3 d = d3_sub(y, rc->center);
+    double cu = d3_dot(d, rc->u), cv = d3_dot(d, rc->v);
+    cu = cu < -rc->half_u ? -rc->half_u : (cu > rc->half_u ? rc->half_u : cu);
+    cv = cv < -rc->half_v ? -rc->half_v : (cv > rc->half_v ? rc->half_v : cv);
+    return d3_add(rc->center, d3_add(d3_scale(rc->u, cu), d3_scale(rc->v, cv)));
+}
+
+double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha,
+                                const vsgl__mrp_options *opt, d3 *axis)
+{
+    *axis = n;
+    double h = d3_dot(d3_sub(x, rc->center), rc->normal);
+    if (!(h > 0.0) || !(rc->half_u > 0.0) || !(rc->half_v > 0.0))
+        return 0.0;
+    vsgl_sg g;
+    vsgl__mrp_receiver_sg(n, o, alpha, &g);                /* Eq. 8 */
+    d3 z = d3_of_v3(g.axis), y;
+    if (g.log_amplitude == -INFINITY || !vsgl__mrp_peak(rc, x, d3_scale(z, -1.0), &y))
+        return 0.0;                                        /* Eq. 12 */
+    y = clamp_to_rect(rc, y);
+    d3 xy = d3_sub(y, x);
+    double d = d3_length(xy);
+    if (!(d > 0.0) || !(d < INFINITY))
+        return 0.0;
+    double cs = h / d;                                     /* cos(sigma) = n_r . yx */
+    double nu = 0.5 * g.sharpness;
+    double rd = opt->rd_scale * d * sqrt(3.0 / (nu > 1e-30 ? nu : 1e-30));
+    double A = opt->overlap ? vsgl__mrp_overlap_exact(rc, y, rd) : vsgl__mrp_overlap_bbox(rc, y, rd);
+    if (!(A > 0.0))
+        return 0.0;
+    double l = rd / d, omega;
+    if (opt->solid_angle) /* the equal-area cap of the projected disk (semi-axes l, l cos sigma) */
+        omega = 2.0 * VSGL__PI_D * (1.0 - 1.0 / sqrt(1.0 + l * l * cs));
+    else                  /* Eq. 26 with k = 0 (uniform radiance) */
+        omega = vsgl__mrp_disk_integral(0.0, vsgl__mrp_cap_t(l, cs));
+    double C = A * omega;                                  /* Eq. 14/27, per unit L */
+    d3 p = opt->centred ? vsgl__mrp_overlap_center(rc, y, rd) : y;
+    *axis = d3_normalize(d3_sub(p, x));
+    vsgl_asg light;
+    if (!vsgl__mrp_asg_light(x, p, rc->normal, rd, C, opt->norm, &light))
+        return 0.0;                                        /* Eq. 28-35 */
+    double v;
+    if (opt->sg_only) {                                    /* Eq. 37 */
+        vsgl_sg ls;
+        vsgl__mrp_asg_to_sg(&light, 1, &ls);
+        v = vsgl__mrp_convolve_sg(&ls, &g);
+    } else {
+        v = vsgl__mrp_convolve(&light, &g);                /* Eq. 11 */
+    }
+    return v > 0.0 && v < INFINITY ? v : 0.0;
+}
