@@ -8,14 +8,36 @@
 
 vsgl__mrp_options vsgl__mrp_options_default(void)
 {
-    vsgl__mrp_options o = {VSGL__MRP_NORM_EXACT, 1, 1, 0, 1, 0.7};
+    vsgl__mrp_options o = {VSGL__MRP_NORM_EXACT, 1, 1, 0, 1, 1.0};
     return o;
 }
 
 vsgl__mrp_options vsgl__mrp_options_paper(void)
 {
-    vsgl__mrp_options o = {VSGL__MRP_NORM_PAPER, 0, 0, 0, 0, 0.7};
+    vsgl__mrp_options o = {VSGL__MRP_NORM_PAPER, 0, 0, 0, 0, 1.0};
     return o;
+}
+
+/* The sampling disk's radius (the paper leaves r_d to the user). For a disk
+ * inside the rectangle, small against its distance d, Eq. 32 gives
+ * bandwidths lambda ~ E / l^2 and mu ~ E / (l cs)^2 (E = 2.996,
+ * l = r_d / d), its solid angle is ~ pi l^2 cs, so the energy-keeping ASG
+ * convolved with the receiver's SG (Eq. 11, nu = its sharpness / 2) is
+ * E pi / sqrt((lambda + nu)(mu + nu)) per unit radiance at the axis, where
+ * the exact value for a uniform plane is pi / nu. They agree when
+ * lambda = a nu with (a + 1)(a / cs^2 + 1) = E^2:
+ *   a = (sqrt((1 + cs^2)^2 + 4 (E^2 - 1) cs^2) - (1 + cs^2)) / 2,
+ * i.e. r_d = d sqrt(E / (a nu)) (a = 1.996 head-on: r_d = 1.23 d / sqrt(nu)).
+ * @p scale multiplies it (1 = the rule; docs/mrp.md measures 0.7-1.4). */
+static double disk_radius(double d, double cs, double nu, double scale)
+{
+    const double E = 2.996;
+    double c2 = cs * cs, b = 1.0 + c2;
+    double a = 0.5 * (sqrt(b * b + 4.0 * (E * E - 1.0) * c2) - b);
+    a = a > 1e-12 ? a : 1e-12;
+    nu = nu > 1e-30 ? nu : 1e-30;
+    double r = scale * d * sqrt(E / (a * nu));
+    return r < 1e30 ? r : 1e30;
 }
 
 /* y clamped onto the rectangle (in its plane). */
@@ -47,7 +69,7 @@ double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, doub
         return 0.0;
     double cs = h / d;                                     /* cos(sigma) = n_r . yx */
     double nu = 0.5 * g.sharpness;
-    double rd = opt->rd_scale * d * sqrt(3.0 / (nu > 1e-30 ? nu : 1e-30));
+    double rd = disk_radius(d, cs, nu, opt->rd_scale);
     double A = opt->overlap ? vsgl__mrp_overlap_exact(rc, y, rd) : vsgl__mrp_overlap_bbox(rc, y, rd);
     if (!(A > 0.0))
         return 0.0;

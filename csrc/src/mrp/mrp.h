@@ -147,7 +147,7 @@ typedef struct vsgl__mrp_options {
     int centred;     /* 1: the lobe's axis through the centre of J, not y */
     int sg_only;     /* 1: Eq. 37 (geometric-mean SG, Iwasaki product) */
     int solid_angle; /* 0: Eq. 26's cap of aperture atan(l cos sigma) (paper), 1: the disk's own solid angle */
-    double rd_scale; /* r_d = rd_scale * d * sqrt(3 / nu), nu = the receiver SG's sharpness / 2 */
+    double rd_scale; /* r_d = rd_scale x the rule of glossy.c (disk_radius); 1 = the rule */
 } vsgl__mrp_options;
 
 /* The options docs/mrp.md recommends (the best measured). */
