@@ -301,121 +301,158 @@ static vsgl_result check_records(vsgl_context *ctx, int kind, layout l, const vo
     return VSGL_OK;
 }
 
-vsgl_result vsgl_bundle_write_memory(vsgl_context *ctx, const vsgl_scene_desc *scene,
-                                     const vsgl_render_settings *settings, const vsgl_bundle_options *opt,
-                                     void *buffer, size_t capacity, size_t *size)
+/* The writer's inputs: pointers that go with their counts, the output
+ * path's length. */
+static vsgl_result check_write_inputs(vsgl_context *ctx, const vsgl_scene_desc *d, const vsgl_bundle_options *o,
+                                      size_t *path_len)
 {
-    vsgl__clear_error(ctx);
-    if (!scene || !size)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: scene and size must not be NULL");
-    *size = 0;
-    vsgl_scene_desc d;
-    vsgl_render_settings s;
-    vsgl_bundle_options o;
-    vsgl_result rv = vsgl__copy_versioned(ctx, &d, sizeof d, scene, "vsgl_scene_desc");
-    if (rv == VSGL_OK)
-        rv = vsgl__copy_versioned(ctx, &s, sizeof s, settings, "vsgl_render_settings");
-    if (rv == VSGL_OK)
-        rv = vsgl__copy_versioned(ctx, &o, sizeof o, opt, "vsgl_bundle_options");
-    if (rv != VSGL_OK)
-        return rv;
-    if (settings)
-        s.size = sizeof s;
-    if (!d.camera)
+    if (!d->camera)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: scene has no camera");
-    if (d.vertex_count && !d.positions)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u vertices but positions is NULL", d.vertex_count);
-    if (d.triangle_count && !d.indices)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u triangles but indices is NULL", d.triangle_count);
-    if (d.material_count && !d.materials)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u materials but materials is NULL", d.material_count);
-    if (d.light_count && !d.lights)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u lights but lights is NULL", d.light_count);
-    size_t path_len = o.output_path ? strlen(o.output_path) : 0;
-    if (path_len > MAX_OUTPUT_PATH)
+    if (d->vertex_count && !d->positions)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u vertices but positions is NULL", d->vertex_count);
+    if (d->triangle_count && !d->indices)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u triangles but indices is NULL", d->triangle_count);
+    if (d->material_count && !d->materials)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u materials but materials is NULL", d->material_count);
+    if (d->light_count && !d->lights)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u lights but lights is NULL", d->light_count);
+    if (d->texture_count && !d->textures)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u textures but textures is NULL", d->texture_count);
+    *path_len = o->output_path ? strlen(o->output_path) : 0;
+    if (*path_len > MAX_OUTPUT_PATH)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: output path longer than %u bytes", MAX_OUTPUT_PATH);
+    return VSGL_OK;
+}
 
+/* Every float the bundle stores is finite (arrays and records), and every
+ * texture has a size and pixels; *texel_floats = the textures' floats. */
+static vsgl_result check_write_values(vsgl_context *ctx, const vsgl_scene_desc *d, uint64_t *texel_floats)
+{
     vsgl_result r;
-    if ((r = check_floats(ctx, S_POS, d.positions, d.vertex_count)))
+    uint32_t nt = d->triangle_count;
+    if ((r = check_floats(ctx, S_POS, d->positions, d->vertex_count)))
         return r;
-    uint32_t nt = d.triangle_count;
-    if (d.corner_normals && (r = check_floats(ctx, S_NRM, d.corner_normals, nt)))
+    if (d->corner_normals && (r = check_floats(ctx, S_NRM, d->corner_normals, nt)))
         return r;
-    if (d.corner_uvs && (r = check_floats(ctx, S_UV, d.corner_uvs, nt)))
+    if (d->corner_uvs && (r = check_floats(ctx, S_UV, d->corner_uvs, nt)))
         return r;
-    if (d.corner_tangents && (r = check_floats(ctx, S_TAN, d.corner_tangents, nt)))
+    if (d->corner_tangents && (r = check_floats(ctx, S_TAN, d->corner_tangents, nt)))
         return r;
-    if ((r = check_records(ctx, S_MATL, (layout)LAYOUT(material_fields), d.materials, sizeof(vsgl_material), d.material_count)))
+    if ((r = check_records(ctx, S_MATL, (layout)LAYOUT(material_fields), d->materials, sizeof(vsgl_material),
+                           d->material_count)))
         return r;
-    if ((r = check_records(ctx, S_LGHT, (layout)LAYOUT(light_fields), d.lights, sizeof(vsgl_light), d.light_count)))
+    if ((r = check_records(ctx, S_LGHT, (layout)LAYOUT(light_fields), d->lights, sizeof(vsgl_light), d->light_count)))
         return r;
-    if ((r = check_records(ctx, S_CAM, (layout)LAYOUT(camera_fields), d.camera, sizeof(vsgl_camera), 1)))
+    if ((r = check_records(ctx, S_CAM, (layout)LAYOUT(camera_fields), d->camera, sizeof(vsgl_camera), 1)))
         return r;
-    if (d.corner_colors && (r = check_floats(ctx, S_CCOL, d.corner_colors, nt)))
+    if (d->corner_colors && (r = check_floats(ctx, S_CCOL, d->corner_colors, nt)))
         return r;
-    if (d.material_textures &&
-        (r = check_records(ctx, S_MTEX, (layout)LAYOUT(mtex_fields), d.material_textures, sizeof(vsgl_material_textures),
-                           d.material_count)))
+    if (d->material_textures &&
+        (r = check_records(ctx, S_MTEX, (layout)LAYOUT(mtex_fields), d->material_textures,
+                           sizeof(vsgl_material_textures), d->material_count)))
         return r;
-    if (d.texture_count && !d.textures)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %u textures but textures is NULL", d.texture_count);
-    uint64_t texel_floats = 0;
-    for (uint32_t i = 0; i < d.texture_count; ++i) {
-        const vsgl_texture *t = &d.textures[i];
+    *texel_floats = 0;
+    for (uint32_t i = 0; i < d->texture_count; ++i) {
+        const vsgl_texture *t = &d->textures[i];
         if (!t->pixels || t->width < 1 || t->height < 1 || t->width > MAX_TEXTURE_SIDE || t->height > MAX_TEXTURE_SIDE)
             return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: texture %u is %ux%u with pixels %s", i, t->width,
                               t->height, t->pixels ? "given" : "NULL");
         uint64_t nf = (uint64_t)t->width * t->height * 4;
         if ((r = check_floats(ctx, S_TEXP, t->pixels, nf)))
             return r;
-        texel_floats += nf;
+        *texel_floats += nf;
     }
+    return VSGL_OK;
+}
 
-    int32_t frame = o.frame;
-    out_section sec[S_COUNT];
+/* The sections to write, in file order; returns their number. `settings`
+ * and `frame` point at the writer's copies (NULL settings: none stored). */
+static int list_sections(const vsgl_scene_desc *d, const vsgl_bundle_options *o, const vsgl_render_settings *settings,
+                         const int32_t *frame, size_t path_len, uint64_t texel_floats, out_section sec[S_COUNT])
+{
+    uint32_t nt = d->triangle_count;
     int ns = 0;
-    sec[ns++] = (out_section){S_POS, d.vertex_count, d.positions};
-    sec[ns++] = (out_section){S_IDX, nt, d.indices};
-    if (d.corner_normals && nt)
-        sec[ns++] = (out_section){S_NRM, nt, d.corner_normals};
-    if (d.corner_uvs && nt)
-        sec[ns++] = (out_section){S_UV, nt, d.corner_uvs};
-    if (d.corner_tangents && nt)
-        sec[ns++] = (out_section){S_TAN, nt, d.corner_tangents};
-    if (d.material_indices && nt)
-        sec[ns++] = (out_section){S_MIDX, nt, d.material_indices};
-    sec[ns++] = (out_section){S_MATL, d.material_count, d.materials};
-    sec[ns++] = (out_section){S_LGHT, d.light_count, d.lights};
-    sec[ns++] = (out_section){S_CAM, 1, d.camera};
+    sec[ns++] = (out_section){S_POS, d->vertex_count, d->positions};
+    sec[ns++] = (out_section){S_IDX, nt, d->indices};
+    if (d->corner_normals && nt)
+        sec[ns++] = (out_section){S_NRM, nt, d->corner_normals};
+    if (d->corner_uvs && nt)
+        sec[ns++] = (out_section){S_UV, nt, d->corner_uvs};
+    if (d->corner_tangents && nt)
+        sec[ns++] = (out_section){S_TAN, nt, d->corner_tangents};
+    if (d->material_indices && nt)
+        sec[ns++] = (out_section){S_MIDX, nt, d->material_indices};
+    sec[ns++] = (out_section){S_MATL, d->material_count, d->materials};
+    sec[ns++] = (out_section){S_LGHT, d->light_count, d->lights};
+    sec[ns++] = (out_section){S_CAM, 1, d->camera};
     if (settings)
-        sec[ns++] = (out_section){S_RSET, 1, &s};
-    if (o.output_path)
-        sec[ns++] = (out_section){S_OUTP, path_len, o.output_path};
-    if (o.has_frame)
-        sec[ns++] = (out_section){S_FRME, 1, &frame};
-    if (d.corner_colors && nt)
-        sec[ns++] = (out_section){S_CCOL, nt, d.corner_colors};
-    if (d.material_textures && d.material_count)
-        sec[ns++] = (out_section){S_MTEX, d.material_count, d.material_textures};
-    if (d.texture_count) {
-        sec[ns++] = (out_section){S_TEXH, d.texture_count, d.textures};
-        sec[ns++] = (out_section){S_TEXP, texel_floats, d.textures}; /* the textures' pixels, in order */
+        sec[ns++] = (out_section){S_RSET, 1, settings};
+    if (o->output_path)
+        sec[ns++] = (out_section){S_OUTP, path_len, o->output_path};
+    if (o->has_frame)
+        sec[ns++] = (out_section){S_FRME, 1, frame};
+    if (d->corner_colors && nt)
+        sec[ns++] = (out_section){S_CCOL, nt, d->corner_colors};
+    if (d->material_textures && d->material_count)
+        sec[ns++] = (out_section){S_MTEX, d->material_count, d->material_textures};
+    if (d->texture_count) {
+        sec[ns++] = (out_section){S_TEXH, d->texture_count, d->textures};
+        sec[ns++] = (out_section){S_TEXP, texel_floats, d->textures}; /* the textures' pixels, in order */
     }
+    return ns;
+}
 
-    uint64_t total = HEADER_SIZE;
-    for (int i = 0; i < ns; ++i)
-        total += SECTION_HEADER_SIZE + padded(sec[i].count * kinds[sec[i].kind].element_size);
-    if (total > (uint64_t)SIZE_MAX)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %llu bytes do not fit in memory", (unsigned long long)total);
-    *size = (size_t)total;
-    if (!buffer)
-        return VSGL_OK;
-    if (capacity < total)
-        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: buffer of %zu bytes, need %llu", capacity, (unsigned long long)total);
+/* The field layout and in-memory size of a record section's element
+ * (layout NULL for arrays). */
+static layout record_layout(int kind, size_t *rec_size)
+{
+    switch (kind) {
+    case S_MATL: *rec_size = sizeof(vsgl_material); return (layout)LAYOUT(material_fields);
+    case S_LGHT: *rec_size = sizeof(vsgl_light); return (layout)LAYOUT(light_fields);
+    case S_CAM: *rec_size = sizeof(vsgl_camera); return (layout)LAYOUT(camera_fields);
+    case S_RSET: *rec_size = sizeof(vsgl_render_settings); return (layout)LAYOUT(settings_fields);
+    case S_MTEX: *rec_size = sizeof(vsgl_material_textures); return (layout)LAYOUT(mtex_fields);
+    case S_TEXH: *rec_size = sizeof(vsgl_texture); return (layout)LAYOUT(texh_fields);
+    default: *rec_size = 0; return (layout){NULL, 0};
+    }
+}
 
+/* Little-endian 32-bit words from memory. */
+static unsigned char *put_words(unsigned char *p, const void *src, uint64_t words)
+{
+    for (uint64_t w = 0; w < words; ++w) {
+        uint32_t v;
+        memcpy(&v, (const unsigned char *)src + 4 * w, 4);
+        put_u32(p, v);
+        p += 4;
+    }
+    return p;
+}
+
+/* A section's payload at `p` (`bytes` long), encoded as the format says. */
+static void encode_payload(const vsgl_scene_desc *d, const out_section *sec, uint64_t bytes, unsigned char *p)
+{
+    size_t rec_size;
+    layout l = record_layout(sec->kind, &rec_size);
+    if (sec->kind == S_TEXP) {
+        for (uint32_t t = 0; t < d->texture_count; ++t)
+            p = put_words(p, d->textures[t].pixels, (uint64_t)d->textures[t].width * d->textures[t].height * 4);
+    } else if (l.fields) {
+        for (uint64_t e = 0; e < sec->count; ++e)
+            encode_record(l, (const unsigned char *)sec->data + e * rec_size, p + e * kinds[sec->kind].element_size);
+    } else if (sec->kind == S_OUTP) {
+        memcpy(p, sec->data, (size_t)bytes);
+    } else { /* arrays of 32-bit words */
+        put_words(p, sec->data, bytes / 4);
+    }
+}
+
+/* The file header and every section with its header and CRC, into `b`
+ * (`total` bytes). */
+static void encode_bundle(const vsgl_scene_desc *d, const out_section *sec, int ns, uint64_t total, unsigned char *b)
+{
     crc_table crc;
     crc_init(&crc);
-    unsigned char *b = buffer;
     memset(b, 0, (size_t)total);
     memcpy(b, magic, 8);
     put_u32(b + 8, VSGL_BUNDLE_VERSION_MAJOR);
@@ -433,46 +470,53 @@ vsgl_result vsgl_bundle_write_memory(vsgl_context *ctx, const vsgl_scene_desc *s
         memcpy(h, k->tag, 4);
         put_u32(h + 4, k->element_size);
         put_u64(h + 8, sec[i].count);
-        layout l = {NULL, 0};
-        size_t rec_size = 0;
-        switch (sec[i].kind) {
-        case S_MATL: l = (layout)LAYOUT(material_fields); rec_size = sizeof(vsgl_material); break;
-        case S_LGHT: l = (layout)LAYOUT(light_fields); rec_size = sizeof(vsgl_light); break;
-        case S_CAM: l = (layout)LAYOUT(camera_fields); rec_size = sizeof(vsgl_camera); break;
-        case S_RSET: l = (layout)LAYOUT(settings_fields); rec_size = sizeof(vsgl_render_settings); break;
-        case S_MTEX: l = (layout)LAYOUT(mtex_fields); rec_size = sizeof(vsgl_material_textures); break;
-        case S_TEXH: l = (layout)LAYOUT(texh_fields); rec_size = sizeof(vsgl_texture); break;
-        default: break;
-        }
-        if (sec[i].kind == S_TEXP) {
-            unsigned char *q = p;
-            for (uint32_t t = 0; t < d.texture_count; ++t) {
-                const float *src = d.textures[t].pixels;
-                size_t nf = (size_t)d.textures[t].width * d.textures[t].height * 4;
-                for (size_t w = 0; w < nf; ++w) {
-                    uint32_t v;
-                    memcpy(&v, src + w, 4);
-                    put_u32(q, v);
-                    q += 4;
-                }
-            }
-        } else if (l.fields) {
-            for (uint64_t e = 0; e < sec[i].count; ++e)
-                encode_record(l, (const unsigned char *)sec[i].data + e * rec_size, p + e * k->element_size);
-        } else if (sec[i].kind == S_OUTP) {
-            memcpy(p, sec[i].data, (size_t)bytes);
-        } else { /* arrays of 32-bit words */
-            const unsigned char *src = sec[i].data;
-            for (uint64_t w = 0; w < bytes / 4; ++w) {
-                uint32_t v;
-                memcpy(&v, src + 4 * w, 4);
-                put_u32(p + 4 * w, v);
-            }
-        }
+        encode_payload(d, &sec[i], bytes, p);
         put_u32(h + 16, 0); /* reserved */
         put_u32(h + 20, crc32_more(&crc, crc32_of(&crc, h, 20), p, (size_t)bytes));
         at += SECTION_HEADER_SIZE + padded(bytes);
     }
+}
+
+vsgl_result vsgl_bundle_write_memory(vsgl_context *ctx, const vsgl_scene_desc *scene,
+                                     const vsgl_render_settings *settings, const vsgl_bundle_options *opt,
+                                     void *buffer, size_t capacity, size_t *size)
+{
+    vsgl__clear_error(ctx);
+    if (!scene || !size)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: scene and size must not be NULL");
+    *size = 0;
+    vsgl_scene_desc d;
+    vsgl_render_settings s;
+    vsgl_bundle_options o;
+    size_t path_len = 0;
+    uint64_t texel_floats = 0;
+    vsgl_result r = vsgl__copy_versioned(ctx, &d, sizeof d, scene, "vsgl_scene_desc");
+    if (r == VSGL_OK)
+        r = vsgl__copy_versioned(ctx, &s, sizeof s, settings, "vsgl_render_settings");
+    if (r == VSGL_OK)
+        r = vsgl__copy_versioned(ctx, &o, sizeof o, opt, "vsgl_bundle_options");
+    if (r == VSGL_OK)
+        r = check_write_inputs(ctx, &d, &o, &path_len);
+    if (r == VSGL_OK)
+        r = check_write_values(ctx, &d, &texel_floats);
+    if (r != VSGL_OK)
+        return r;
+    s.size = sizeof s;
+
+    out_section sec[S_COUNT];
+    int32_t frame = o.frame;
+    int ns = list_sections(&d, &o, settings ? &s : NULL, &frame, path_len, texel_floats, sec);
+    uint64_t total = HEADER_SIZE;
+    for (int i = 0; i < ns; ++i)
+        total += SECTION_HEADER_SIZE + padded(sec[i].count * kinds[sec[i].kind].element_size);
+    if (total > (uint64_t)SIZE_MAX)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: %llu bytes do not fit in memory", (unsigned long long)total);
+    *size = (size_t)total;
+    if (!buffer)
+        return VSGL_OK;
+    if (capacity < total)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "bundle: buffer of %zu bytes, need %llu", capacity, (unsigned long long)total);
+    encode_bundle(&d, sec, ns, total, buffer);
     return VSGL_OK;
 }
 
