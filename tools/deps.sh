@@ -8,7 +8,7 @@ build_pkgs="gcc make pkg-config libembree-dev libopenexr-dev"
 python_pkgs="python3 python3-numpy python3-pytest"
 case "${1:-build}" in
   build) pkgs="$build_pkgs" ;;
-  test)  pkgs="$build_pkgs $python_pkgs blender openimageio-tools" ;;
+  test)  pkgs="$build_pkgs $python_pkgs blender openimageio-tools python3-openimageio" ;;
   asan)  pkgs="$build_pkgs clang libclang-rt-14-dev" ;;
   demo)  pkgs="$build_pkgs $python_pkgs blender" ;;
   bench) pkgs="$build_pkgs $python_pkgs" ;;

@@ -371,7 +371,7 @@ PASS_LONG_NAMES = {"DiffDir": "Diffuse Direct", "DiffInd": "Diffuse Indirect", "
 
 
 def read_passes_exr(path, passes):
-    """Passes (rows top first, HxWx3) from an uncompressed multilayer EXR,
+    """Passes (rows top first, HxWx3) from a multilayer EXR (OpenImageIO),
     with the independent reader of gbuffer_ref.py."""
     import importlib.util
     spec = importlib.util.spec_from_file_location("gbuffer_ref_reader", os.path.join(HERE, "gbuffer_ref.py"))

@@ -25,7 +25,6 @@ Blender's version. Writes report.md and summary.txt (last line
 import ctypes
 import hashlib
 import os
-import struct
 import sys
 
 import bpy
@@ -176,89 +175,17 @@ def configure(sc, cam, cam_opts, res):
     bpy.context.view_layer.update()
 
 
-# ---- EXR reader (scanline, uncompressed; single-part as Blender 3.4 writes,
-# multi-part as Blender 5 writes: one part per pass) ------------------------
-
-def _exr_header(data, pos):
-    h = {"channels": []}
-    while data[pos] != 0:
-        e = data.index(b"\0", pos)
-        name = data[pos:e].decode()
-        pos = e + 1
-        e = data.index(b"\0", pos)
-        pos = e + 1
-        size = struct.unpack_from("<i", data, pos)[0]
-        pos += 4
-        val = data[pos:pos + size]
-        pos += size
-        if name == "channels":
-            p = 0
-            while val[p] != 0:
-                e = val.index(b"\0", p)
-                h["channels"].append((val[p:e].decode(), struct.unpack_from("<i", val, e + 1)[0]))
-                p = e + 1 + 16
-        elif name == "dataWindow":
-            h["window"] = struct.unpack_from("<4i", val, 0)
-        elif name == "compression":
-            h["compression"] = val[0]
-        elif name == "name":
-            h["name"] = val.rstrip(b"\0").decode()
-        elif name == "chunkCount":
-            h["chunks"] = struct.unpack_from("<i", val, 0)[0]
-        elif name == "type":
-            h["type"] = val.rstrip(b"\0").decode()
-    return h, pos + 1
-
+# ---- EXR reading: tests/blender/addon/exr_read.py (OpenImageIO; single-part
+# as Blender 3.4 writes, multi-part as Blender 5 writes: one part per pass) ----
 
 def read_exr(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    if struct.unpack_from("<i", data, 0)[0] != 20000630:
-        raise RuntimeError("%s: not an EXR file" % path)
-    flags = struct.unpack_from("<i", data, 4)[0]
-    multipart = bool(flags & 0x1000)
-    if flags & 0x200 or flags & 0x800:
-        raise RuntimeError("%s: tiled or deep EXR not supported" % path)
-    parts, pos = [], 8
-    while True:
-        h, pos = _exr_header(data, pos)
-        parts.append(h)
-        if not multipart:
-            break
-        if data[pos] == 0:
-            pos += 1
-            break
-    for h in parts:
-        if h.get("compression") != 0 or h.get("type", "scanlineimage") != "scanlineimage":
-            raise RuntimeError("%s: part %s: compression %s / type %s, expected uncompressed scanlines"
-                               % (path, h.get("name"), h.get("compression"), h.get("type")))
-        h["height"] = h["window"][3] - h["window"][1] + 1
-        h["width"] = h["window"][2] - h["window"][0] + 1
-        n = h.get("chunks", h["height"])
-        h["offsets"] = struct.unpack_from("<%dQ" % n, data, pos)
-        pos += 8 * n
-    out = {}
-    for pi, h in enumerate(parts):
-        w = h["width"]
-        full = {c: ((h["name"] + "." + c) if multipart and "name" in h and "." not in c else c)
-                for c, _ in h["channels"]}
-        img = {c: np.zeros((h["height"], w), np.float32) for c, _ in h["channels"]}
-        for off in h["offsets"]:
-            if multipart:
-                part = struct.unpack_from("<i", data, off)[0]
-                if part != pi:
-                    raise RuntimeError("%s: chunk of part %d in part %d's table" % (path, part, pi))
-                off += 4
-            y = struct.unpack_from("<i", data, off)[0]
-            p = off + 8
-            row = y - h["window"][1]
-            for c, ptype in h["channels"]:
-                dt, nb = (np.float16, 2) if ptype == 1 else ((np.float32, 4) if ptype == 2 else (np.uint32, 4))
-                img[c][row] = np.frombuffer(data, dt, w, p).astype(np.float32)
-                p += w * nb
-        for c in img:
-            out[full[c]] = img[c]
-    return out  # row 0 = top of the image
+    """Every channel by its full name, (H, W) float32, row 0 = top of the image."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(
+        "vsgl_exr_read", os.path.join(os.path.dirname(os.path.abspath(__file__)), "addon", "exr_read.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.read_exr(path)[0]
 
 
 def cycles_passes(exr):

@@ -31,7 +31,7 @@ else
   echo "run_addon.sh: no '$BLENDER' binary; install Debian's blender (tools/deps.sh test)"; fail=$((fail + 1)); status=1
 fi
 
-if "$BPY_PYTHON" -c 'import bpy, numpy, pytest' >/dev/null 2>&1 || tools/install_bpy.sh; then
+if "$BPY_PYTHON" -c 'import bpy, numpy, pytest, OpenImageIO' >/dev/null 2>&1 || tools/install_bpy.sh; then
   echo "== add-on tests in bpy $("$BPY_PYTHON" -c 'import bpy; print(bpy.app.version_string)' 2>/dev/null | tail -1)"
   "$BPY_PYTHON" -m pytest -q -rs -p no:cacheprovider tests/blender/addon "$@" 2>&1 | tee "$log"
   tally "pip bpy" "${PIPESTATUS[0]}"

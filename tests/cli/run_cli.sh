@@ -25,6 +25,11 @@ if [ ! -x "$VSGL" ]; then
   echo "0 passed, 1 failed"; exit 1
 fi
 have() { command -v "$1" >/dev/null 2>&1; }
+# OpenImageIO's oiiotool reads the EXRs back (the independent reader): required.
+if ! have oiiotool; then
+  echo "run_cli.sh: oiiotool is missing: install openimageio-tools (tools/deps.sh test)"
+  echo "0 passed, 1 failed"; exit 1
+fi
 
 ok()  { pass=$((pass + 1)); printf 'PASS %s\n' "$1"; }
 bad() { fail=$((fail + 1)); printf 'FAIL %s\n' "$1"; shift; printf '    %s\n' "$@"; }
@@ -222,24 +227,20 @@ if want render_float && expect_ok render_float "$VSGL" render "$SCENE" -o "$T/ou
   [ -s "$T/out.exr" ] || errs="$errs [no file]"
   grep -q $'\r' "$T/err" && errs="$errs [carriage return on a non-terminal]"
   grep -Eq '^vsgl: (gbuffer|rsm|fit|shade) \([0-9]+%\)$' "$T/err" || errs="$errs [no plain progress lines: $(head -2 "$T/err" | tr '\n' '|')]"
-  if have oiiotool; then
-    info=$(oiiotool --info -v "$T/out.exr" 2>&1)
-    grep -q "64 x   48, 22 channel, float openexr" <<<"$info" || errs="$errs [header: $(head -2 <<<"$info" | tr '\n' '|')]"
-    for p in $PASSES; do
-      grep -q "VSGL\.$p\.R" <<<"$info" || errs="$errs [no VSGL.$p.R]"
-    done
-    grep -q "VSGL.Combined.A" <<<"$info" || errs="$errs [no VSGL.Combined.A]"
-    grep -q 'vsgl.settings: "method=vsgl aa=1 rsm=128 fit=lattice vsgls=32' <<<"$info" || errs="$errs [settings metadata]"
-    stats=$(oiiotool --stats "$T/out.exr" 2>&1)
-    nan=$(grep "NanCount" <<<"$stats" | tr -s ' ' '\n' | grep -Ec '^[1-9]')
-    inf=$(grep "InfCount" <<<"$stats" | tr -s ' ' '\n' | grep -Ec '^[1-9]')
-    [ "$nan" -eq 0 ] && [ "$inf" -eq 0 ] || errs="$errs [non-finite: $nan NaN, $inf Inf channels]"
-    # Some indirect light reaches the floor: the maximum of DiffInd is positive.
-    mx=$(grep "Stats Max" <<<"$stats" | awk '{print $8}')   # 4th channel listed = DiffInd.R after Combined RGBA
-    awk -v m="$mx" 'BEGIN { exit !(m > 0) }' || errs="$errs [DiffInd.R max $mx not > 0]"
-  else
-    echo "    SKIP part of render_float: oiiotool not installed"
-  fi
+  info=$(oiiotool --info -v "$T/out.exr" 2>&1)
+  grep -q "64 x   48, 22 channel, float openexr" <<<"$info" || errs="$errs [header: $(head -2 <<<"$info" | tr '\n' '|')]"
+  for p in $PASSES; do
+    grep -q "VSGL\.$p\.R" <<<"$info" || errs="$errs [no VSGL.$p.R]"
+  done
+  grep -q "VSGL.Combined.A" <<<"$info" || errs="$errs [no VSGL.Combined.A]"
+  grep -q 'vsgl.settings: "method=vsgl aa=1 rsm=128 fit=lattice vsgls=32' <<<"$info" || errs="$errs [settings metadata]"
+  stats=$(oiiotool --stats "$T/out.exr" 2>&1)
+  nan=$(grep "NanCount" <<<"$stats" | tr -s ' ' '\n' | grep -Ec '^[1-9]')
+  inf=$(grep "InfCount" <<<"$stats" | tr -s ' ' '\n' | grep -Ec '^[1-9]')
+  [ "$nan" -eq 0 ] && [ "$inf" -eq 0 ] || errs="$errs [non-finite: $nan NaN, $inf Inf channels]"
+  # Some indirect light reaches the floor: the maximum of DiffInd is positive.
+  mx=$(grep "Stats Max" <<<"$stats" | awk '{print $8}')   # 4th channel listed = DiffInd.R after Combined RGBA
+  awk -v m="$mx" 'BEGIN { exit !(m > 0) }' || errs="$errs [DiffInd.R max $mx not > 0]"
   if [ -z "$errs" ]; then ok render_float; else bad render_float "$errs"; fi
 fi
 
@@ -249,15 +250,13 @@ if want render_half_verbose && expect_ok render_half_verbose "$VSGL" render "$SC
   for l in "vsgl: settings: method=vsgl" "vsgl: render " "gbuffer " "rsm " "fit " "shade " "vsgl: lights used 1, skipped 0" "(64x48, half, zip)"; do
     grep -qF "$l" "$T/err" || errs="$errs [stderr lacks '$l']"
   done
-  if have oiiotool; then
-    oiiotool --info "$T/from_bundle.exr" 2>&1 | grep -q "22 channel, half openexr" || errs="$errs [not half: $(oiiotool --info "$T/from_bundle.exr" 2>&1)]"
-  fi
+  oiiotool --info "$T/from_bundle.exr" 2>&1 | grep -q "22 channel, half openexr" || errs="$errs [not half: $(oiiotool --info "$T/from_bundle.exr" 2>&1)]"
   if [ -z "$errs" ]; then ok render_half_verbose; else bad render_half_verbose "$errs"; fi
 fi
 
 # Compression choices, read back by oiiotool; -v names the compression
 # (it indexed a 4-name table and crashed on rle).
-if want render_compression && have oiiotool; then
+if want render_compression; then
   for c in none zips zip piz rle pxr24 b44 b44a; do
     if expect_ok render_compression "$VSGL" render "$SCENE" -o "$T/c-$c.exr" --compression "$c" --preset preview -v; then
       if ! oiiotool --info -v "$T/c-$c.exr" 2>&1 | grep -q "compression: \"$c\""; then
@@ -299,7 +298,7 @@ if want render_failure_keeps_file && [ -s "$T/out.exr" ]; then
 fi
 
 # Same pixels with 1 and 2 threads (the library promises determinism).
-if want render_deterministic && have oiiotool; then
+if want render_deterministic; then
   if expect_ok render_deterministic "$VSGL" render "$SCENE" -o "$T/t1.exr" --threads 1 --fit fis --vsgls 16 &&
      expect_ok render_deterministic "$VSGL" render "$SCENE" -o "$T/t2.exr" --threads 2 --fit fis --vsgls 16; then
     h1=$(oiiotool --hash "$T/t1.exr" 2>&1 | grep -o 'SHA-1: [0-9A-F]*'); h2=$(oiiotool --hash "$T/t2.exr" 2>&1 | grep -o 'SHA-1: [0-9A-F]*')

@@ -1,37 +1,17 @@
 """Files (vsgl/io.h): multilayer EXR and scene bundles through the binding."""
 
-import struct
-
 import numpy as np
 import pytest
 
 import libvsgl as L
 from conftest import require
+from exr_read import read_exr
 from scenes import floor_and_wall
 
-EXR_MAGIC = struct.pack("<I", 20000630)
 
-
-def _exr_channels(path):
-    """Channel names from an EXR header (parsed here, no OpenEXR needed)."""
-    data = open(path, "rb").read()
-    assert data[:4] == EXR_MAGIC, "not an OpenEXR file"
-    pos = 8
-    while data[pos] != 0:
-        end = data.index(b"\0", pos)
-        name = data[pos:end].decode()
-        tend = data.index(b"\0", end + 1)
-        size, = struct.unpack_from("<i", data, tend + 1)
-        value = data[tend + 5:tend + 5 + size]
-        pos = tend + 5 + size
-        if name == "channels":
-            out, p = [], 0
-            while value[p] != 0:
-                e = value.index(b"\0", p)
-                out.append(value[p:e].decode())
-                p = e + 1 + 16
-            return out
-    raise AssertionError("no channels attribute")
+def _exr(path):
+    """Channels and attributes as OpenImageIO reads them (an independent reader)."""
+    return read_exr(str(path))
 
 
 def test_exr_write_passes(lib, ctx, tmp_path):
@@ -42,10 +22,13 @@ def test_exr_write_passes(lib, ctx, tmp_path):
     path = tmp_path / "out.exr"
     L.exr_write(ctx, str(path), {"DiffInd": rgb, "Mask": a, "Combined": (np.dstack([rgb, a]), "RGBA")},
                 metadata={"vsgl.test": "yes"})
-    chans = _exr_channels(path)
+    chans, attrs = _exr(path)
     for c in ("VSGL.DiffInd.R", "VSGL.DiffInd.G", "VSGL.DiffInd.B", "VSGL.Mask.V",
               "VSGL.Combined.A"):
-        assert c in chans, chans
+        assert c in chans, sorted(chans)
+    got = np.dstack([chans["VSGL.DiffInd." + c] for c in "RGB"])
+    assert np.array_equal(got, rgb), "float pixels read back differ"     # float: exact
+    assert np.array_equal(chans["VSGL.Mask.V"], a) and attrs.get("vsgl.test") == "yes", attrs
     with pytest.raises(ValueError):
         L.exr_write(ctx, str(path), {"A": rgb, "B": rgb[:2]})  # size mismatch
     with pytest.raises(TypeError):
@@ -78,10 +61,12 @@ def test_exr_write_render(lib, ctx, tmp_path):
     images, _ = L.render(ctx, scene, L.render_settings_preset("preview"))
     path = tmp_path / "render.exr"
     L.exr_write_render(ctx, str(path), images)
-    chans = _exr_channels(path)
+    chans, _ = _exr(path)
     for p in ("DiffInd", "GlossInd", "DiffCol", "GlossCol", "Diff", "Gloss"):
-        assert "VSGL.%s.R" % p in chans, chans
-    assert "VSGL.Combined.A" in chans
+        got = np.dstack([chans["VSGL.%s.%s" % (p, c)] for c in "RGB"])
+        want = images[{v: k for k, v in L.PLANE_PASS_NAMES.items()}[p]]
+        assert np.allclose(got, want, rtol=1e-3, atol=1e-6), p      # half or float
+    assert np.allclose(chans["VSGL.Combined.A"], images["alpha"])
 
 
 def test_check_output_path(lib, ctx, tmp_path):
