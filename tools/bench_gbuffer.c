@@ -179,7 +179,7 @@ int main(int argc, char **argv)
             return 1;
         }
         vsgl_gbuffer g;
-        res = vsgl__gbuffer_build(ctx, s, aa, &g);
+        res = vsgl__gbuffer_build(ctx, s, aa, 0, &g);
         double t2 = now(), c2 = cpu_now();
         cb[r] = c1 - c0;
         cg[r] = c2 - c1;

@@ -447,6 +447,7 @@ class vsgl_render_settings(_Struct):
         ("leak_correction", c_int32),
         ("sample_merging", c_int32),
         ("shade_stride", c_uint32),
+        ("edge_samples", c_uint32),
     ]
     _enums = {
         "method": Method, "fit_mode": FitMode, "sharpness_estimator": SharpnessEstimator,

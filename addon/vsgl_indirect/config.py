@@ -15,6 +15,7 @@ KNOBS = {
     "method": (("VSGL", "BRUTE_FORCE"), "VSGL"),
     "aa_samples": (None, 2),
     "shade_stride": (None, 2),
+    "edge_samples": (None, 8),
     "sample_merging": (("AUTO", "OFF"), "AUTO"),
     "visibility": (("NONE", "RAY"), "RAY"),
     "seed": (None, 0),
@@ -35,12 +36,12 @@ _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", 
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
                diffuse_mode="PULLED_OUT")
 PRESET_VALUES = {
-    "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="NONE",
-                    shade_stride=2),
+    "PREVIEW": dict(_COMMON, aa_samples=2, rsm_resolution=128, vsgl_count=32, visibility="NONE",
+                    shade_stride=2, edge_samples=8),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=128, visibility="RAY",
-                     shade_stride=2),
+                     shade_stride=2, edge_samples=8),
     "QUALITY": dict(_COMMON, aa_samples=2, rsm_resolution=512, vsgl_count=256, visibility="RAY",
-                    shade_stride=2),
+                    shade_stride=2, edge_samples=8),
 }
 assert all(PRESET_VALUES["BALANCED"][k] == v[1] for k, v in KNOBS.items())
 
@@ -85,7 +86,7 @@ def inactive_knobs(obj):
     elif obj.fit_mode == "KMEANS":
         out |= {"fis_iterations"}
     if obj.aa_samples <= 1:
-        out.add("sample_merging")
+        out |= {"sample_merging", "edge_samples"}   # one slot per pixel: nothing to refine into
     return out
 
 
@@ -98,6 +99,7 @@ class Options:
     method: str = "VSGL"
     aa_samples: int = 2
     shade_stride: int = 2
+    edge_samples: int = 8
     rsm_resolution: int = 256
     fit_mode: str = "LATTICE"
     vsgl_count: int = 128

@@ -28,6 +28,7 @@ const char cli_usage[] =
     "  --leak NAME           auto | off | on   (emitter-hemisphere light-leak correction)\n"
     "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
     "  --shade-stride N      1..8              (shade one pixel in N x N, interpolate the rest)\n"
+    "  --edge-samples N      0..16             (N x N rays in pixels a geometric edge crosses; 0 = off)\n"
     "  --method NAME         vsgl | brute-force   (brute-force: every RSM texel, the reference)\n"
     "  --threads N           worker threads (0 = all cores)\n"
     "  --max-memory SIZE     refuse a render estimated to need more (e.g. 8G, 512M;\n"
@@ -154,6 +155,7 @@ static const num_opt num_opts[] = {
     {"--rsm", 1, offsetof(cli_options, rsm)},
     {"--vsgls", 1, offsetof(cli_options, vsgls)},
     {"--shade-stride", 1, offsetof(cli_options, stride)},
+    {"--edge-samples", 0, offsetof(cli_options, edge)},
     {"--threads", 0, offsetof(cli_options, threads)},
     {"--seed", 0, offsetof(cli_options, seed)},
 };
@@ -325,6 +327,7 @@ void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_r
     if (o->rsm.set) s->rsm_resolution = o->rsm.value;
     if (o->vsgls.set) s->vsgl_count = o->vsgls.value;
     if (o->stride.set) s->shade_stride = o->stride.value;
+    if (o->edge.set) s->edge_samples = o->edge.value;
     if (o->seed.set) s->seed = o->seed.value;
     if (o->fit >= 0) s->fit_mode = o->fit;
     if (o->sharpness >= 0) s->sharpness_estimator = o->sharpness;
@@ -346,10 +349,10 @@ static const char *name_of(const char *const *names, const int *values, int v)
 
 void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size)
 {
-    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s",
+    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u",
              name_of(method_names, method_values, s->method), s->aa_samples, s->rsm_resolution,
              name_of(fit_names, fit_values, s->fit_mode), s->vsgl_count, s->fis_iterations,
              name_of(sharp_names, sharp_values, s->sharpness_estimator), name_of(diffuse_names, diffuse_values, s->diffuse_mode),
              name_of(glossy_names, glossy_values, s->glossy_mode), name_of(vis_names, vis_values, s->visibility), s->seed,
-             name_of(leak_names, leak_values, s->leak_correction), name_of(merge_names, merge_values, s->sample_merging));
+             name_of(leak_names, leak_values, s->leak_correction), name_of(merge_names, merge_values, s->sample_merging), s->shade_stride, s->edge_samples);
 }

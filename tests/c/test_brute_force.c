@@ -105,7 +105,7 @@ static int do_run(fx_scene *s, uint32_t threads, uint32_t res, int vis, run *out
     vsgl_rsm r;
     memset(out, 0, sizeof *out);
     if (ok)
-        ok = vsgl__gbuffer_build(ctx, sc, 1, &out->g) == VSGL_OK;
+        ok = vsgl__gbuffer_build(ctx, sc, 1, 0, &out->g) == VSGL_OK;
     if (ok)
         ok = vsgl__rsm_build(ctx, sc, 0, res, &r) == VSGL_OK;
     if (ok) {

@@ -6,6 +6,8 @@
 #include "core/context.h"
 #include "gbuffer/gbuffer.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -78,7 +80,7 @@ VT_TEST(gbuffer_perspective_plane_matches_analytic_points)
     VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
     for (uint32_t aa = 1; s && aa <= 3; ++aa) {
         vsgl_gbuffer g;
-        vsgl_result r = vsgl__gbuffer_build(ctx, s, aa, &g);
+        vsgl_result r = vsgl__gbuffer_build(ctx, s, aa, 0, &g);
         VT_CHECK(r == VSGL_OK && g.count == 64u * 48u * aa * aa && g.spp == aa * aa && g.width == 64 && g.height == 48,
                  "aa %u: r %d count %zu", aa, r, g.count);
         if (r != VSGL_OK)
@@ -124,7 +126,7 @@ VT_TEST(gbuffer_misses_backfaces_and_clipping)
     vsgl_scene *s = NULL;
     VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
     vsgl_gbuffer g;
-    if (s && vsgl__gbuffer_build(ctx, s, 1, &g) == VSGL_OK) {
+    if (s && vsgl__gbuffer_build(ctx, s, 1, 0, &g) == VSGL_OK) {
         size_t hits = 0, want_hits = 0;
         for (uint32_t row = 0; row < 48; ++row)
             for (uint32_t col = 0; col < 64; ++col) {
@@ -158,7 +160,7 @@ VT_TEST(gbuffer_misses_backfaces_and_clipping)
             p.cam.clip_end = ranges[k][1];
             s = NULL;
             VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
-            if (s && vsgl__gbuffer_build(ctx, s, 1, &g) == VSGL_OK) {
+            if (s && vsgl__gbuffer_build(ctx, s, 1, 0, &g) == VSGL_OK) {
                 size_t hits = 0;
                 for (size_t e = 0; e < g.count; ++e)
                     hits += g.material[e] != VSGL__GBUFFER_MISS;
@@ -185,7 +187,7 @@ VT_TEST(gbuffer_orthographic_positions)
     vsgl_scene *s = NULL;
     VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
     vsgl_gbuffer g;
-    if (s && vsgl__gbuffer_build(ctx, s, 2, &g) == VSGL_OK) {
+    if (s && vsgl__gbuffer_build(ctx, s, 2, 0, &g) == VSGL_OK) {
         double maxerr = 0;
         for (uint32_t row = 0; row < 48; ++row)
             for (uint32_t col = 0; col < 64; ++col)
@@ -234,7 +236,7 @@ VT_TEST(gbuffer_is_deterministic_across_thread_counts)
         vsgl_scene *s = NULL;
         VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
         vsgl_gbuffer g;
-        if (s && vsgl__gbuffer_build(ctx, s, 2, &g) == VSGL_OK) {
+        if (s && vsgl__gbuffer_build(ctx, s, 2, 0, &g) == VSGL_OK) {
             if (k == 0) {
                 ref = g;
             } else {
@@ -254,6 +256,97 @@ VT_TEST(gbuffer_is_deterministic_across_thread_counts)
         hits += ref.material[e] != VSGL__GBUFFER_MISS;
     VT_CHECK(hits > ref.count / 10 && hits < ref.count, "soup covers %zu of %zu samples", hits, ref.count);
     vsgl__gbuffer_free(&ref);
+}
+
+/* Edge refinement (gbuffer/edges.c): a plane whose slanted edge crosses the
+ * image. The coverage of every pixel (the weights of its hit samples) is
+ * compared with the exact fraction of the pixel inside the edge, from 200 x
+ * 200 points mapped through the camera analytically (no ray tracing): 2 x 2
+ * samples quantise it to quarters (error up to 0.5), 16 x 16 edge rays to
+ * 1/256 of the pixel. Weights sum to 1, pixels away from the edge are the
+ * unrefined buffer's, and the result does not depend on the thread count. */
+static double exact_coverage(uint32_t col, uint32_t row, double x0, double k, double z0)
+{
+    const int n = 200;
+    double hx = 18.0 / 50.0, hy = hx * 48.0 / 64.0;
+    int in = 0;
+    for (int b = 0; b < n; ++b)
+        for (int a = 0; a < n; ++a) {
+            double px = col + (a + 0.5) / n, py = row + (b + 0.5) / n;
+            double x = (2.0 * px / 64.0 - 1.0) * hx * -z0, y = (1.0 - 2.0 * py / 48.0) * hy * -z0;
+            in += x < x0 + k * y;
+        }
+    return (double)in / (n * n);
+}
+
+VT_TEST(gbuffer_edge_refinement_resolves_coverage)
+{
+    const float z0 = -5.0f, x0 = 0.3f, k = 0.37f, h = 100.0f;
+    plane_scene p;
+    plane_init(&p, z0, h, 0);
+    float v[12] = {-h, -h, z0, x0 - k * h, -h, z0, x0 + k * h, h, z0, -h, h, z0};
+    memcpy(p.pos, v, sizeof v);
+    vsgl_gbuffer ref[2];
+    memset(ref, 0, sizeof ref);
+    uint32_t threads[2] = {1, 2};
+    double worst[2] = {0, 0}, mean_err[2] = {0, 0};
+    size_t edge_px = 0, changed_non_edge = 0, bad_weights = 0;
+    for (int t = 0; t < 2; ++t) {
+        vsgl_context *ctx = make_ctx(threads[t]);
+        vsgl_scene *s = NULL;
+        VT_REQUIRE(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+        vsgl_gbuffer plain, fine;
+        VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 2, 0, &plain) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+        VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 2, 16, &fine) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+        VT_CHECK(plain.weight == NULL && fine.weight != NULL, "weights only when refining");
+        if (t == 0) {
+            edge_px = fine.edge_pixels;
+            for (uint32_t row = 0; row < 48; ++row)
+                for (uint32_t col = 0; col < 64; ++col) {
+                    size_t base = ((size_t)row * 64 + col) * 4;
+                    double want = exact_coverage(col, row, x0, k, z0), cov[2] = {0, 0}, wsum = 0;
+                    for (int q = 0; q < 4; ++q) {
+                        cov[0] += plain.material[base + q] != VSGL__GBUFFER_MISS ? 0.25 : 0.0;
+                        cov[1] += fine.material[base + q] != VSGL__GBUFFER_MISS ? fine.weight[base + q] : 0.0;
+                        wsum += fine.weight[base + q];
+                    }
+                    bad_weights += fabs(wsum - 1.0) > 1e-5;
+                    for (int m = 0; m < 2; ++m) {
+                        double e = fabs(cov[m] - want);
+                        worst[m] = e > worst[m] ? e : worst[m];
+                        mean_err[m] += e / (64.0 * 48.0);
+                    }
+                    if (want == 0.0 || want == 1.0) {
+                        /* far from the edge: the unrefined samples, unweighted */
+                        int near = exact_coverage(col > 0 ? col - 1 : col, row, x0, k, z0) != want ||
+                                   exact_coverage(col < 63 ? col + 1 : col, row, x0, k, z0) != want;
+                        if (!near)
+                            for (int q = 0; q < 4; ++q)
+                                changed_non_edge += fine.material[base + q] != plain.material[base + q] ||
+                                                    fine.pos[0][base + q] != plain.pos[0][base + q] ||
+                                                    fine.weight[base + q] != 0.25f;
+                    }
+                }
+        }
+        ref[t] = fine;
+        vsgl__gbuffer_free(&plain);
+        vsgl_scene_destroy(s);
+        vsgl_context_destroy(ctx);
+    }
+    printf("    edge pixels %zu; coverage error worst/mean: 2x2 %.3f / %.4f, 16x16 edge rays %.3f / %.4f\n", edge_px,
+           worst[0], mean_err[0], worst[1], mean_err[1]);
+    VT_CHECK(edge_px >= 48 && edge_px <= 4 * 48, "%zu edge pixels for one edge across 48 rows", edge_px);
+    VT_CHECK(worst[0] > 0.1, "the unrefined buffer's coverage error %.3f: the test scene has no edge", worst[0]);
+    VT_CHECK(worst[1] < 0.035, "refined coverage off by %.3f (16 x 16 rays: < 1/32)", worst[1]);
+    VT_CHECK(bad_weights == 0, "%zu pixels whose weights do not sum to 1", bad_weights);
+    VT_CHECK(changed_non_edge == 0, "%zu samples away from the edge changed", changed_non_edge);
+    int same = memcmp(ref[0].material, ref[1].material, ref[0].count * 4) == 0 &&
+               memcmp(ref[0].weight, ref[1].weight, ref[0].count * 4) == 0;
+    for (int c = 0; c < 3; ++c)
+        same &= memcmp(ref[0].pos[c], ref[1].pos[c], ref[0].count * 4) == 0;
+    VT_CHECK(same, "1 and 2 threads refine differently");
+    vsgl__gbuffer_free(&ref[0]);
+    vsgl__gbuffer_free(&ref[1]);
 }
 
 typedef struct progress_log { int calls, cancel_at; float last; int decreasing; } progress_log;
@@ -283,7 +376,7 @@ VT_TEST(gbuffer_progress_cancel_and_debug_copy)
     VT_CHECK(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
     if (!s) { vsgl_context_destroy(ctx); return; }
     vsgl_gbuffer g;
-    VT_CHECK(vsgl__gbuffer_build(ctx, s, 1, &g) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    VT_CHECK(vsgl__gbuffer_build(ctx, s, 1, 0, &g) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
     VT_CHECK(log.calls >= 2 && log.last == 1.0f && !log.decreasing, "calls %d last %g decreasing %d", log.calls, log.last,
              log.decreasing);
     /* debug copy equals the internal buffer */
@@ -312,7 +405,7 @@ VT_TEST(gbuffer_progress_cancel_and_debug_copy)
     memset(&log, 0, sizeof log);
     log.cancel_at = 3;
     memset(&g, 0xAB, sizeof g);
-    vsgl_result r = vsgl__gbuffer_build(ctx, s, 1, &g);
+    vsgl_result r = vsgl__gbuffer_build(ctx, s, 1, 0, &g);
     VT_CHECK(r == VSGL_ERROR_CANCELLED && g.pos[0] == NULL && g.material == NULL && g.count == 0, "r %d", r);
     VT_CHECK(strncmp(vsgl_context_last_error(ctx), "gbuffer: cancelled at row ", 26) == 0, "'%s'", vsgl_context_last_error(ctx));
     memset(&log, 0, sizeof log);
@@ -321,7 +414,7 @@ VT_TEST(gbuffer_progress_cancel_and_debug_copy)
     r = vsgl_debug_gbuffer(ctx, s, 1, pos, NULL, NULL);
     VT_CHECK(r == VSGL_ERROR_CANCELLED && pos[0] == 42.0f, "debug cancel r %d, output touched %g", r, pos[0]);
     /* aa out of range */
-    r = vsgl__gbuffer_build(ctx, s, 17, &g);
+    r = vsgl__gbuffer_build(ctx, s, 17, 0, &g);
     VT_CHECK(r == VSGL_ERROR_INVALID_ARGUMENT && strcmp(vsgl_context_last_error(ctx), "gbuffer: aa_samples is 17 (must be in [1, 16])") == 0,
              "r %d '%s'", r, vsgl_context_last_error(ctx));
     free(pos); free(nrm); free(mat);

@@ -87,7 +87,7 @@ static int setup(bundle *b, float roughness, uint32_t vsgls, int32_t fit, int32_
     in.fit_mode = fit;
     vsgl_rsm rsm;
     if (vsgl_context_create(NULL, &b->ctx) || vsgl_scene_create(b->ctx, fx_desc(&b->fx), &b->scene) ||
-        vsgl__settings_resolve(b->ctx, &in, &b->s) || vsgl__gbuffer_build(b->ctx, b->scene, 1, &b->g) ||
+        vsgl__settings_resolve(b->ctx, &in, &b->s) || vsgl__gbuffer_build(b->ctx, b->scene, 1, 0, &b->g) ||
         vsgl__rsm_build(b->ctx, b->scene, 0, 32, &rsm))
         return 0;
     int ok = (fit == VSGL_FIT_LATTICE ? vsgl__fit_lattice : vsgl__fit_fis)(b->ctx, b->scene, &rsm, &b->s, &b->set) == VSGL_OK;

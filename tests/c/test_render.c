@@ -260,8 +260,9 @@ VT_TEST(render_refuses_what_exceeds_the_memory_limit_up_front)
     VT_CHECK(r == VSGL_ERROR_OUT_OF_MEMORY, "estimate result %d '%s'", r, msg);
     VT_CHECK(strstr(msg, "render: 48x36 with aa 2 and RSM 256 needs about ") == msg, "'%s'", msg);
     VT_CHECK(strstr(msg, "more than the memory limit of 1.0 MiB (max_memory)") != NULL, "'%s'", msg);
-    /* the parts: 48x36 pixels x 22 output floats; 4 samples x 52 bytes; 52 bytes of planes */
-    VT_CHECK(e.output == (uint64_t)W * H * 22 * 4 && e.gbuffer == (uint64_t)W * H * 4 * 52 &&
+    /* the parts: 48x36 pixels x 22 output floats; 4 samples x 52 bytes, + 4 for the edge
+     * refinement's weight, + a byte of edge mask per pixel; 52 bytes of planes */
+    VT_CHECK(e.output == (uint64_t)W * H * 22 * 4 && e.gbuffer == (uint64_t)W * H * (4 * (52 + 4) + 1) &&
                  e.planes == (uint64_t)W * H * 52 && e.limit == (1u << 20),
              "output %llu gbuffer %llu planes %llu limit %llu", (unsigned long long)e.output,
              (unsigned long long)e.gbuffer, (unsigned long long)e.planes, (unsigned long long)e.limit);
@@ -564,6 +565,7 @@ VT_TEST(render_blender4_diffuse_colour_dimmed_by_specular_layer)
         vsgl_render_settings s;
         vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
         s.rsm_resolution = 32;
+        s.aa_samples = 1; /* one surface per pixel: a floor pixel is one whose DiffCol is the floor's */
         if (methods[mi] == 1)
             s.glossy_mode = VSGL_GLOSSY_SG; /* shades through the reference path */
         if (methods[mi] == 2)

@@ -195,7 +195,7 @@ VT_TEST(texture_gbuffer_colour_is_the_texels_each_pixel_covers)
         vsgl_scene *sc = NULL;
         VT_CHECK(vsgl_scene_create(ctx, plane_desc(&s), &sc) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
         vsgl_gbuffer g;
-        VT_CHECK(vsgl__gbuffer_build(ctx, sc, 1, &g) == VSGL_OK, "gbuffer");
+        VT_CHECK(vsgl__gbuffer_build(ctx, sc, 1, 0, &g) == VSGL_OK, "gbuffer");
         VT_CHECK(g.surf[0] != NULL, "textured scene keeps per-sample inputs");
         double worst = 0;
         for (uint32_t row = 0; row < H; ++row)

@@ -99,6 +99,12 @@ typedef struct vsgl_render_settings {
     uint32_t shade_stride;       /**< shade one pixel in S x S and interpolate the light between them where
                                       neighbours share a surface (joint bilateral on the G-buffer; edges
                                       are shaded), 1..VSGL_SHADE_STRIDE_MAX; default 1 (every pixel) */
+    uint32_t edge_samples;       /**< samples per axis traced in a pixel where a geometric edge crosses it
+                                      (E x E rays, E in 0..VSGL_AA_SAMPLES_MAX): the pixel still shades at
+                                      most aa x aa samples, one per surface it sees, each weighted by the
+                                      fraction of the E x E rays that saw it, so silhouettes move smoothly
+                                      with the camera instead of in steps of 1/aa^2. Needs aa_samples >= 2;
+                                      0, or E <= aa_samples, is off (the default) */
 } vsgl_render_settings;
 
 /** @brief Fill @p out with a preset (VSGL_PRESET_*); unknown presets give BALANCED. */

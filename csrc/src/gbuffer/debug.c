@@ -10,7 +10,7 @@ vsgl_result vsgl_debug_gbuffer(vsgl_context *ctx, const vsgl_scene *scene, uint3
     if (!scene)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "debug_gbuffer: scene is NULL");
     vsgl_gbuffer g;
-    vsgl_result r = vsgl__gbuffer_build(ctx, scene, aa, &g);
+    vsgl_result r = vsgl__gbuffer_build(ctx, scene, aa, 0, &g);
     if (r != VSGL_OK)
         return r;
     for (size_t i = 0; i < g.count; ++i) {
@@ -34,7 +34,7 @@ vsgl_result vsgl_debug_gbuffer_frames(vsgl_context *ctx, const vsgl_scene *scene
     if (!scene)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "debug_gbuffer_frames: scene is NULL");
     vsgl_gbuffer g;
-    vsgl_result r = vsgl__gbuffer_build(ctx, scene, aa, &g);
+    vsgl_result r = vsgl__gbuffer_build(ctx, scene, aa, 0, &g);
     if (r != VSGL_OK)
         return r;
     for (size_t i = 0; i < g.count; ++i)

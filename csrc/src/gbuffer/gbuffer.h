@@ -24,7 +24,19 @@ typedef struct vsgl_gbuffer {
     float *surf[VSGL__SURF_N];      /* textured scenes only (else NULL): the material inputs at the
                                       sample (scene_internal.h VSGL_SURF_*), textures filtered over the
                                       sample's 1/spp share of its pixel; 0 for misses */
+    float *weight;                 /* NULL: every sample weighs 1/spp. Else (edge refinement) each
+                                      sample's share of its pixel, summing to 1 per pixel: an edge
+                                      pixel's slots hold one sample per surface it sees, weighted by
+                                      the fraction of edge_aa x edge_aa rays that saw it (0 for unused
+                                      slots, which are misses) */
+    size_t edge_pixels;            /* pixels refined */
 } vsgl_gbuffer;
+
+/* Sample i's share of its pixel. */
+static inline float vsgl__gbuffer_weight(const vsgl_gbuffer *g, size_t i)
+{
+    return g->weight ? g->weight[i] : 1.0f / (float)g->spp;
+}
 
 /* Material of sample i with its own inputs (textured scenes), else its
  * material's constants. The sample must be a hit. */
@@ -32,10 +44,15 @@ void vsgl__gbuffer_material(const vsgl_gbuffer *g, const vsgl_material *material
 
 /* Trace the camera's primary rays (aa x aa per pixel, aa in 1..16, 0 means 1;
  * sample s = j*aa + i at raster (col + (i+0.5)/aa, row + (j+0.5)/aa)) in
- * parallel. Reports progress as stage "gbuffer"; on cancellation returns
+ * parallel. With edge_aa > aa > 1, pixels whose samples (or whose
+ * neighbours' nearest samples) lie on different surfaces are traced again
+ * with edge_aa x edge_aa rays, and their aa x aa slots hold one sample per
+ * surface seen, weighted by coverage (edges.c): edges move smoothly as the
+ * camera moves instead of in steps of 1/spp. Reports progress as stage "gbuffer"; on cancellation returns
  * VSGL_ERROR_CANCELLED with *out zeroed. Bit-identical for any thread count.
  * Free with vsgl__gbuffer_free (also safe on a zeroed struct). */
-vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t aa, vsgl_gbuffer *out);
+vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t aa, uint32_t edge_aa,
+                                vsgl_gbuffer *out);
 void vsgl__gbuffer_free(vsgl_gbuffer *g);
 
 #endif

@@ -114,7 +114,9 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
     uint64_t samples = mul(pixels, spp);
     uint64_t threads = vsgl_context_thread_count(ctx);
     e->output = output_bytes;
-    e->gbuffer = mul(samples, GBUFFER_BYTES_PER_SAMPLE);
+    /* edge refinement: a weight per sample, an edge mask per pixel */
+    int refined = s->edge_samples > s->aa_samples && s->aa_samples > 1;
+    e->gbuffer = add(mul(samples, GBUFFER_BYTES_PER_SAMPLE + (refined ? 4u : 0u)), refined ? pixels : 0);
     e->planes = mul(pixels, PLANE_BYTES_PER_PIXEL);
 
     uint32_t light_count = 0;

@@ -154,10 +154,11 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
                 planes->glossy[i] *= planes->glossy_color[i];
             }
             for (size_t p = 0; p < pixels; ++p) {
-                size_t hits = 0;
+                float hits = 0.0f;
                 for (size_t k = 0; k < g->spp; ++k)
-                    hits += g->material[p * g->spp + k] != VSGL__GBUFFER_MISS;
-                planes->coverage[p] = (float)hits / (float)g->spp;
+                    if (g->material[p * g->spp + k] != VSGL__GBUFFER_MISS)
+                        hits += vsgl__gbuffer_weight(g, p * g->spp + k);
+                planes->coverage[p] = hits;
             }
             for (uint32_t k = 0; k < used; ++k)
                 st->shading_pairs += (uint64_t)g->count * rsms[k].count;
@@ -263,11 +264,11 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     vsgl__progress_window(ctx, 0.0f, 0.1f);
     const vsgl_gbuffer *gb = &g; /* the cache's, or this render's own */
     int built_g = 0, built_set = 0;
-    if (vsgl__cache_gbuffer_hit(cache, scene, s.aa_samples)) {
+    if (vsgl__cache_gbuffer_hit(cache, scene, s.aa_samples, s.edge_samples)) {
         gb = &cache->g;
         st.reused |= VSGL_REUSED_GBUFFER;
     } else {
-        r = vsgl__gbuffer_build(ctx, scene, s.aa_samples, &g);
+        r = vsgl__gbuffer_build(ctx, scene, s.aa_samples, s.edge_samples, &g);
         built_g = 1;
     }
     st.seconds_gbuffer = now_seconds() - t0;
@@ -319,7 +320,7 @@ done:
         vsgl__cache_clear(cache);
     } else if (cache) {
         if (built_g)
-            vsgl__cache_keep_gbuffer(cache, scene, s.aa_samples, &g);
+            vsgl__cache_keep_gbuffer(cache, scene, s.aa_samples, s.edge_samples, &g);
         if (built_set)
             vsgl__cache_keep_fit(cache, scene, &s, &set, &st);
     }

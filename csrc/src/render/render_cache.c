@@ -39,13 +39,14 @@ static int same_scene(const vsgl_scene *a, uint64_t a_id, const vsgl_scene *b)
     return a == b && a_id == vsgl__scene_identity(b);
 }
 
-int vsgl__cache_gbuffer_hit(const vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa)
+int vsgl__cache_gbuffer_hit(const vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, uint32_t edge_aa)
 {
-    return c && c->has_g && same_scene(c->g_scene, c->g_identity, scene) && c->g_aa == aa &&
+    return c && c->has_g && same_scene(c->g_scene, c->g_identity, scene) && c->g_aa == aa && c->g_edge_aa == edge_aa &&
            memcmp(&c->g_camera, vsgl__scene_camera(scene), sizeof c->g_camera) == 0;
 }
 
-void vsgl__cache_keep_gbuffer(vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, vsgl_gbuffer *g)
+void vsgl__cache_keep_gbuffer(vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, uint32_t edge_aa,
+                              vsgl_gbuffer *g)
 {
     vsgl__gbuffer_free(&c->g);
     c->g = *g;
@@ -54,6 +55,7 @@ void vsgl__cache_keep_gbuffer(vsgl_render_cache *c, const vsgl_scene *scene, uin
     c->g_identity = vsgl__scene_identity(scene);
     c->g_camera = *vsgl__scene_camera(scene);
     c->g_aa = aa;
+    c->g_edge_aa = edge_aa;
     c->has_g = 1;
 }
 

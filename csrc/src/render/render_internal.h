@@ -25,11 +25,11 @@ vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const v
 
 /* What a vsgl_render_cache holds (render_cache.c). */
 struct vsgl_render_cache {
-    int has_g;                   /* the G-buffer of g_scene seen by g_camera with g_aa */
+    int has_g;                   /* the G-buffer of g_scene seen by g_camera with g_aa, g_edge_aa */
     const vsgl_scene *g_scene;
     uint64_t g_identity;
     vsgl_camera g_camera;
-    uint32_t g_aa;
+    uint32_t g_aa, g_edge_aa;
     vsgl_gbuffer g;
     int has_f;                   /* the VSGLs of f_scene's f_lights with f_settings, and the fit's stats */
     const vsgl_scene *f_scene;
@@ -43,9 +43,10 @@ struct vsgl_render_cache {
 };
 
 void vsgl__cache_clear(vsgl_render_cache *c);
-int vsgl__cache_gbuffer_hit(const vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa);
+int vsgl__cache_gbuffer_hit(const vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, uint32_t edge_aa);
 /* Takes `g` (zeroed afterwards). */
-void vsgl__cache_keep_gbuffer(vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, vsgl_gbuffer *g);
+void vsgl__cache_keep_gbuffer(vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, uint32_t edge_aa,
+                              vsgl_gbuffer *g);
 int vsgl__cache_fit_hit(const vsgl_render_cache *c, const vsgl_scene *scene, const vsgl_render_settings *s);
 /* Takes `set` (zeroed afterwards) with the fit's stats from `st`. */
 vsgl_result vsgl__cache_keep_fit(vsgl_render_cache *c, const vsgl_scene *scene, const vsgl_render_settings *s,

@@ -27,10 +27,18 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
      * structured error 1400x -> 73x the reference's noise at 320 x 240);
      * balanced with both takes 1.1-1.5x what it took without either. */
     out->fit_mode = VSGL_FIT_LATTICE;
+    /* Every preset resolves edges with 8 x 8 rays (coverage only, gbuffer/
+     * edges.c): as the camera moves 1/1000 of the scene a frame, the frame-to-
+     * frame change of the bundled rooms at 80 x 60 falls from 0.012-0.11 to
+     * 0.006-0.07 (the rest is the true change and silhouette shading,
+     * docs/quality.md), for 5-35 % more time at that size, less at larger
+     * sizes where fewer pixels are edges. The preview takes 2 x 2 samples for
+     * it: at a stride of 2 it shades about what it shaded at 1 x 1. */
+    out->edge_samples = 8;
     out->diffuse_mode = VSGL_COSINE_PULLED_OUT;
     switch (preset) {
     case VSGL_PRESET_PREVIEW: /* within +-21 % of Cycles per pass on the bundled scenes */
-        out->aa_samples = 1;
+        out->aa_samples = 2;
         out->rsm_resolution = 128;
         out->vsgl_count = 32;
         /* a quarter of the shading pairs; structured error and FLIP within
@@ -98,6 +106,9 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     if (s->shade_stride > VSGL_SHADE_STRIDE_MAX)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: shade_stride is %u (valid 1..%d)",
                           s->shade_stride, VSGL_SHADE_STRIDE_MAX);
+    if (s->edge_samples > VSGL_AA_SAMPLES_MAX)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: edge_samples is %u (valid 0..%d)",
+                          s->edge_samples, VSGL_AA_SAMPLES_MAX);
     if (s->fis_iterations > VSGL_FIS_ITERATIONS_MAX)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: fis_iterations is %u (valid 1..%d)",
                           s->fis_iterations, VSGL_FIS_ITERATIONS_MAX);

@@ -207,11 +207,10 @@ void vsgl__brute_force_resolve(const vsgl_gbuffer *g, const float *sample_light,
             double lc = 0, col = 0;
             for (size_t s = 0; s < spp; ++s) {
                 size_t i = 3 * (p * spp + s) + (size_t)c;
-                lc += (double)sample_light[i] * sample_color[i];
-                col += sample_color[i];
+                double w = vsgl__gbuffer_weight(g, p * spp + s);
+                lc += w * sample_light[i] * sample_color[i];
+                col += w * sample_color[i];
             }
-            lc /= (double)spp;
-            col /= (double)spp;
             if (pixel_color)
                 pixel_color[3 * p + (size_t)c] = (float)col;
             if (pixel_light)

@@ -90,7 +90,7 @@ vsgl_result vsgl_reference_render(vsgl_context *ctx, const vsgl_scene *scene, ui
     memset(&st, 0, sizeof st);
     double t0 = now_s();
     vsgl_gbuffer g;
-    vsgl_result rc = vsgl__gbuffer_build(ctx, scene, aa, &g);
+    vsgl_result rc = vsgl__gbuffer_build(ctx, scene, aa, 0, &g);
     if (rc != VSGL_OK)
         return rc;
     st.seconds_gbuffer = now_s() - t0;

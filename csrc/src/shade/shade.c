@@ -215,7 +215,6 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
     const vsgl_gbuffer *g = j->g;
     const vsgl_pixel_planes *pl = j->planes;
     const size_t spp = g->spp;
-    const float inv_spp = 1.0f / (float)spp;
     uint64_t pairs = 0;
     for (size_t px = j->base + b; px < j->base + e; ++px) {
         float acc_d[3] = {0, 0, 0}, acc_g[3] = {0, 0, 0}, col_d[3] = {0, 0, 0}, col_g[3] = {0, 0, 0};
@@ -224,7 +223,8 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
             size_t i = px * spp + sidx;
             if (g->material[i] == VSGL__GBUFFER_MISS)
                 continue;
-            covered += 1.0f;
+            const float w = vsgl__gbuffer_weight(g, i);
+            covered += w;
             receiver r;
             setup_receiver(j, i, &r);
             float gcol[3] = {0, 0, 0};
@@ -233,8 +233,8 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
             /* Blender 4.x+: the dielectric layer dims the diffuse base seen from o */
             float wd = vsgl__scene_diffuse_weight(j->scene, g->material[i], v3_dot(r.n, r.o));
             for (int c = 0; c < 3; ++c) {
-                col_d[c] += r.bp.diffuse[c] * wd;
-                col_g[c] += gcol[c];
+                col_d[c] += w * r.bp.diffuse[c] * wd;
+                col_g[c] += w * gcol[c];
             }
             int has_diffuse = r.bp.diffuse[0] + r.bp.diffuse[1] + r.bp.diffuse[2] > 0.0f;
             float ld[3] = {0, 0, 0}, ls[3] = {0, 0, 0};
@@ -269,17 +269,17 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 }
             }
             for (int c = 0; c < 3; ++c) {
-                acc_d[c] += r.bp.diffuse[c] * wd * ld[c];
-                acc_g[c] += ls[c];
+                acc_d[c] += w * r.bp.diffuse[c] * wd * ld[c];
+                acc_g[c] += w * ls[c];
             }
         }
         for (int c = 0; c < 3; ++c) {
-            pl->diffuse[px * 3 + c] = acc_d[c] * inv_spp;
-            pl->glossy[px * 3 + c] = acc_g[c] * inv_spp;
-            pl->diffuse_color[px * 3 + c] = col_d[c] * inv_spp;
-            pl->glossy_color[px * 3 + c] = col_g[c] * inv_spp;
+            pl->diffuse[px * 3 + c] = acc_d[c];
+            pl->glossy[px * 3 + c] = acc_g[c];
+            pl->diffuse_color[px * 3 + c] = col_d[c];
+            pl->glossy_color[px * 3 + c] = col_g[c];
         }
-        pl->coverage[px] = covered * inv_spp;
+        pl->coverage[px] = covered;
     }
     j->pairs[chunk] = pairs;
     return 0;
@@ -454,23 +454,23 @@ void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls)
         if (bp.glossy && v3_dot(n, o) > 0.0f)
             vsgl__glossy_color(&bp, n, o, gcol);
         const float *L = Ls[k];
-        float wd = vsgl__scene_diffuse_weight(j->scene, g->material[si], v3_dot(n, o));
+        const float w = vsgl__gbuffer_weight(g, si);
+        float wd = w * vsgl__scene_diffuse_weight(j->scene, g->material[si], v3_dot(n, o));
         for (int c = 0; c < 3; ++c) {
             acc[c] += bp.diffuse[c] * wd * L[c];
-            acc[3 + c] += L[3 + c];
+            acc[3 + c] += w * L[3 + c];
             acc[6 + c] += bp.diffuse[c] * wd;
-            acc[9 + c] += gcol[c];
+            acc[9 + c] += w * gcol[c];
         }
-        covered += 1.0f;
+        covered += w;
     }
-    const float inv_spp = 1.0f / (float)spp;
     for (int c = 0; c < 3; ++c) {
-        pl->diffuse[px * 3 + c] = acc[c] * inv_spp;
-        pl->glossy[px * 3 + c] = acc[3 + c] * inv_spp;
-        pl->diffuse_color[px * 3 + c] = acc[6 + c] * inv_spp;
-        pl->glossy_color[px * 3 + c] = acc[9 + c] * inv_spp;
+        pl->diffuse[px * 3 + c] = acc[c];
+        pl->glossy[px * 3 + c] = acc[3 + c];
+        pl->diffuse_color[px * 3 + c] = acc[6 + c];
+        pl->glossy_color[px * 3 + c] = acc[9 + c];
     }
-    pl->coverage[px] = covered * inv_spp;
+    pl->coverage[px] = covered;
 }
 
 /* Rows of pixels through the vectorised kernel, VSGL__KERNEL_BLOCK shaded

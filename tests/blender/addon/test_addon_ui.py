@@ -361,7 +361,8 @@ def test_property_limits_are_the_library_ranges():
             "aa_samples": (1, libvsgl.AA_SAMPLES_MAX),
             "vsgl_count": (1, libvsgl.VSGL_COUNT_MAX),
             "fis_iterations": (1, libvsgl.FIS_ITERATIONS_MAX),
-            "shade_stride": (1, libvsgl.SHADE_STRIDE_MAX)}
+            "shade_stride": (1, libvsgl.SHADE_STRIDE_MAX),
+            "edge_samples": (0, libvsgl.AA_SAMPLES_MAX)}
     for name, (lo, hi) in want.items():
         assert (props[name].hard_min, props[name].hard_max) == (lo, hi), name
     assert (libvsgl.RSM_RESOLUTION_MIN, libvsgl.RSM_RESOLUTION_MAX) == (2, 8192)

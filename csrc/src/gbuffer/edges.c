@@ -1,0 +1,219 @@
+/* Edge refinement of the camera G-buffer (vsgl_render_settings.edge_samples).
+ *
+ * With aa x aa samples on a fixed grid, a geometric edge that crosses a
+ * pixel covers 0, 1/spp, 2/spp ... of it: as the camera moves, the edge
+ * pixel jumps in steps of 1/spp, which an animation shows as crawling
+ * silhouettes (docs/quality.md, "camera flicker"). Shading more samples
+ * would cost spp-fold in the shade stage. Instead, as MSAA separates
+ * coverage from shading:
+ *  1. mark: a pixel is an edge when two of its samples, or one of its
+ *     samples and the nearest sample of a 4-neighbour, lie on different
+ *     surfaces (hit vs miss, another material, normals more than ~25
+ *     degrees apart, or off each other's tangent plane);
+ *  2. refine: an edge pixel is traced again with edge_aa x edge_aa rays,
+ *     the rays are grouped by surface (at most spp groups; a further
+ *     surface joins its most similar group), and slot q of the pixel holds
+ *     the ray nearest the centre of group q, weighted by the group's share
+ *     of the rays. Unused slots are misses of weight 0.
+ * The shade stage still shades at most spp samples per pixel; only the
+ * coverage is resolved finer. Every pixel is decided from its own and its
+ * neighbours' first-pass samples, and refined in place: the result does
+ * not depend on the thread count. */
+#include "gbuffer/trace.h"
+#include "scene/camera.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Normals further apart than this (cosine) are different surfaces. */
+#define EDGE_NORMAL_COS 0.9f
+/* Off the tangent plane by more than this fraction of the distance (plus the job's plane_tol). */
+#define EDGE_PLANE_REL 0.05f
+
+static v3 at3(float *const a[3], size_t i)
+{
+    return v3_make(a[0][i], a[1][i], a[2][i]);
+}
+
+/* Do samples a and b lie on one surface? Two misses do. */
+static int same_surface(const vsgl_gbuffer *g, size_t a, size_t b, float plane_tol)
+{
+    if (g->material[a] != g->material[b])
+        return 0;
+    if (g->material[a] == VSGL__GBUFFER_MISS)
+        return 1;
+    v3 na = at3(g->nrm, a), nb = at3(g->nrm, b);
+    if (!(v3_dot(na, nb) > EDGE_NORMAL_COS))
+        return 0;
+    v3 d = v3_sub(at3(g->pos, b), at3(g->pos, a));
+    float tol = EDGE_PLANE_REL * v3_length(d) + plane_tol;
+    return fabsf(v3_dot(d, na)) <= tol && fabsf(v3_dot(d, nb)) <= tol;
+}
+
+/* Sample (i, j) of pixel (x, y) on the aa x aa grid. */
+static size_t sample_at(const vsgl_gbuffer *g, uint32_t aa, uint32_t x, uint32_t y, uint32_t i, uint32_t j)
+{
+    return ((size_t)y * g->width + x) * g->spp + (size_t)j * aa + i;
+}
+
+static int is_edge(const gb_job *job, uint32_t x, uint32_t y)
+{
+    const vsgl_gbuffer *g = job->g;
+    const uint32_t aa = job->aa, W = g->width, H = g->height;
+    size_t p0 = ((size_t)y * W + x) * g->spp;
+    for (size_t k = 1; k < g->spp; ++k)
+        if (!same_surface(g, p0, p0 + k, job->plane_tol))
+            return 1;
+    /* the samples next to each border against the neighbour's across it */
+    for (uint32_t t = 0; t < aa; ++t) {
+        if (x > 0 && !same_surface(g, sample_at(g, aa, x, y, 0, t), sample_at(g, aa, x - 1, y, aa - 1, t), job->plane_tol))
+            return 1;
+        if (x + 1 < W && !same_surface(g, sample_at(g, aa, x, y, aa - 1, t), sample_at(g, aa, x + 1, y, 0, t), job->plane_tol))
+            return 1;
+        if (y > 0 && !same_surface(g, sample_at(g, aa, x, y, t, 0), sample_at(g, aa, x, y - 1, t, aa - 1), job->plane_tol))
+            return 1;
+        if (y + 1 < H && !same_surface(g, sample_at(g, aa, x, y, t, aa - 1), sample_at(g, aa, x, y + 1, t, 0), job->plane_tol))
+            return 1;
+    }
+    return 0;
+}
+
+int32_t vsgl__gbuffer_mark_edges(void *user, size_t chunk, size_t begin, size_t end)
+{
+    (void)chunk;
+    gb_job *job = user;
+    const uint32_t W = job->g->width;
+    for (size_t r = begin; r < end; ++r) {
+        uint32_t y = job->row0 + (uint32_t)r;
+        for (uint32_t x = 0; x < W; ++x)
+            job->edge[(size_t)y * W + x] = (unsigned char)is_edge(job, x, y);
+    }
+    return 0;
+}
+
+/* Copy sample `from` of `src` into slot `to` of `dst`. */
+static void copy_sample(vsgl_gbuffer *dst, size_t to, const vsgl_gbuffer *src, size_t from)
+{
+    for (int k = 0; k < 3; ++k) {
+        dst->pos[k][to] = src->pos[k][from];
+        dst->nrm[k][to] = src->nrm[k][from];
+        dst->view[k][to] = src->view[k][from];
+        dst->tan[k][to] = src->tan[k][from];
+    }
+    dst->material[to] = src->material[from];
+    if (dst->surf[0])
+        for (int q = 0; q < VSGL__SURF_N; ++q)
+            dst->surf[q][to] = src->surf[q][from];
+}
+
+/* The group a further surface joins when every slot is taken: the one
+ * with the same material (hit or miss) and the closest normal. */
+static uint32_t nearest_group(const vsgl_gbuffer *sub, const size_t *founder, uint32_t groups, size_t s)
+{
+    uint32_t best = 0;
+    float best_score = -1e30f;
+    for (uint32_t q = 0; q < groups; ++q) {
+        size_t f = founder[q];
+        float score = sub->material[f] == sub->material[s] ? 2.0f : 0.0f;
+        if (sub->material[f] != VSGL__GBUFFER_MISS && sub->material[s] != VSGL__GBUFFER_MISS)
+            score += v3_dot(at3(sub->nrm, f), at3(sub->nrm, s));
+        if (score > best_score) {
+            best_score = score;
+            best = q;
+        }
+    }
+    return best;
+}
+
+/* Refine pixel (x, y): trace E x E rays into `sub` and rewrite its slots. */
+static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint32_t y)
+{
+    vsgl_gbuffer *g = job->g;
+    const uint32_t E = job->edge_aa, n = E * E, spp = g->spp;
+    const float inv = 1.0f / (float)E;
+    float rx[VSGL__GBUFFER_BATCH], ry[VSGL__GBUFFER_BATCH];
+    size_t dst[VSGL__GBUFFER_BATCH];
+    for (uint32_t b = 0; b < n; b += VSGL__GBUFFER_BATCH) {
+        uint32_t m = n - b < VSGL__GBUFFER_BATCH ? n - b : VSGL__GBUFFER_BATCH;
+        for (uint32_t k = 0; k < m; ++k) {
+            uint32_t s = b + k;
+            rx[k] = (float)x + ((float)(s % E) + 0.5f) * inv;
+            ry[k] = (float)y + ((float)(s / E) + 0.5f) * inv;
+            dst[k] = s;
+        }
+        /* the texture footprint of a first-pass sample: what a slot stands for */
+        vsgl__gbuffer_trace(job, sub, m, rx, ry, dst, 1.0f / (float)job->aa);
+    }
+    size_t founder[VSGL__GBUFFER_MAX_SPP];
+    uint32_t count[VSGL__GBUFFER_MAX_SPP];
+    float cx[VSGL__GBUFFER_MAX_SPP], cy[VSGL__GBUFFER_MAX_SPP];
+    uint8_t group[VSGL__GBUFFER_MAX_SPP];
+    uint32_t groups = 0;
+    for (uint32_t s = 0; s < n; ++s) {
+        uint32_t q = groups;
+        for (uint32_t t = 0; t < groups && q == groups; ++t)
+            if (same_surface(sub, founder[t], s, job->plane_tol))
+                q = t;
+        if (q == groups) {
+            if (groups < spp) {
+                founder[groups] = s;
+                count[groups] = 0;
+                cx[groups] = cy[groups] = 0.0f;
+                ++groups;
+            } else {
+                q = nearest_group(sub, founder, groups, s);
+            }
+        }
+        group[s] = (uint8_t)q;
+        count[q] += 1;
+        cx[q] += (float)(s % E);
+        cy[q] += (float)(s / E);
+    }
+    size_t base = ((size_t)y * g->width + x) * spp;
+    for (uint32_t q = 0; q < groups; ++q) {
+        /* the member nearest the group's centre (ties: the first) */
+        float mx = cx[q] / (float)count[q], my = cy[q] / (float)count[q], best = 1e30f;
+        uint32_t rep = (uint32_t)founder[q];
+        for (uint32_t s = 0; s < n; ++s) {
+            if (group[s] != q)
+                continue;
+            float dx = (float)(s % E) - mx, dy = (float)(s / E) - my, d2 = dx * dx + dy * dy;
+            if (d2 < best) {
+                best = d2;
+                rep = s;
+            }
+        }
+        copy_sample(g, base + q, sub, rep);
+        g->weight[base + q] = (float)count[q] / (float)n;
+    }
+    for (uint32_t q = groups; q < spp; ++q) {
+        /* an unused slot: a miss that weighs nothing (its view ray stays valid) */
+        g->material[base + q] = VSGL__GBUFFER_MISS;
+        for (int k = 0; k < 3; ++k)
+            g->pos[k][base + q] = g->nrm[k][base + q] = g->tan[k][base + q] = 0.0f;
+        if (g->surf[0])
+            for (int t = 0; t < VSGL__SURF_N; ++t)
+                g->surf[t][base + q] = 0.0f;
+        g->weight[base + q] = 0.0f;
+    }
+}
+
+int32_t vsgl__gbuffer_refine_edges(void *user, size_t chunk, size_t begin, size_t end)
+{
+    (void)chunk;
+    gb_job *job = user;
+    const uint32_t W = job->g->width;
+    vsgl_gbuffer sub;
+    memset(&sub, 0, sizeof sub);
+    if (!vsgl__gbuffer_alloc(&sub, (size_t)job->edge_aa * job->edge_aa, job->g->surf[0] != NULL, 0))
+        return VSGL_ERROR_OUT_OF_MEMORY;
+    for (size_t r = begin; r < end; ++r) {
+        uint32_t y = job->row0 + (uint32_t)r;
+        for (uint32_t x = 0; x < W; ++x)
+            if (job->edge[(size_t)y * W + x])
+                refine_pixel(job, &sub, x, y);
+    }
+    vsgl__gbuffer_free(&sub);
+    return 0;
+}

@@ -1,0 +1,37 @@
+/* Internal to csrc/src/gbuffer: tracing camera samples into a G-buffer,
+ * shared by the regular grid (gbuffer.c) and the edge refinement (edges.c). */
+#ifndef VSGL_GBUFFER_TRACE_H
+#define VSGL_GBUFFER_TRACE_H
+
+#include "gbuffer/gbuffer.h"
+#include "scene/camera.h"
+
+/* Rays traced per Embree stream call: the most vsgl__gbuffer_trace takes. */
+#define VSGL__GBUFFER_BATCH 64
+
+typedef struct gb_job {
+    const vsgl_scene *scene;
+    vsgl_camera_model cam;
+    uint32_t aa;
+    uint32_t edge_aa; /* samples per axis in an edge pixel; <= aa: no refinement */
+    float plane_tol;  /* metres off a sample's tangent plane that count as another surface */
+    vsgl_gbuffer *g;
+    uint32_t row0;    /* first row of the current step */
+    unsigned char *edge; /* width x height: 1 where the pixel is refined */
+} gb_job;
+
+/* Trace m <= VSGL__GBUFFER_BATCH camera rays at raster positions (rx[k],
+ * ry[k]) and store what each sees at index dst[k] of g; `foot` is a
+ * sample's side in pixels (the texture filter's footprint). */
+void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const float *rx, const float *ry,
+                         const size_t *dst, float foot);
+
+/* Allocate g's per-sample arrays for n samples (surf too when textured,
+ * weight when weighted); 0 when out of memory (then g is freed). */
+int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted);
+
+/* Edge pixels (edges.c): mark then refine, rows [begin, end) of the job. */
+int32_t vsgl__gbuffer_mark_edges(void *job, size_t chunk, size_t begin, size_t end);
+int32_t vsgl__gbuffer_refine_edges(void *job, size_t chunk, size_t begin, size_t end);
+
+#endif
