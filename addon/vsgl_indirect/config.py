@@ -21,7 +21,7 @@ KNOBS = {
     "seed": (None, 0),
     "rsm_resolution": (None, 256),
     "fit_mode": (("TWO", "FIS", "KMEANS", "LATTICE"), "LATTICE"),
-    "vsgl_count": (None, 128),
+    "vsgl_count": (None, 192),
     "fis_iterations": (None, 8),
     "sharpness_estimator": (("TOKSVIG", "BANERJEE"), "TOKSVIG"),
     "leak_correction": (("AUTO", "OFF", "ON"), "AUTO"),
@@ -38,7 +38,7 @@ _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", 
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=2, rsm_resolution=128, vsgl_count=32, visibility="NONE",
                     shade_stride=2, edge_samples=8),
-    "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=128, visibility="RAY",
+    "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
                      shade_stride=2, edge_samples=8),
     "QUALITY": dict(_COMMON, aa_samples=2, rsm_resolution=512, vsgl_count=256, visibility="RAY",
                     shade_stride=2, edge_samples=8),
@@ -102,7 +102,7 @@ class Options:
     edge_samples: int = 8
     rsm_resolution: int = 256
     fit_mode: str = "LATTICE"
-    vsgl_count: int = 128
+    vsgl_count: int = 192
     fis_iterations: int = 8
     sharpness_estimator: str = "TOKSVIG"
     diffuse_mode: str = "PULLED_OUT"

@@ -53,10 +53,13 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
         out->visibility = VSGL_VISIBILITY_RAY;
         out->shade_stride = 2;
         break;
-    default: /* BALANCED */
+    default: /* BALANCED: lattice 192, not 128: at 128 the coarser clusters' emitter clip
+                takes 5-6 % of the light of three bundled rooms (metal floor + red wall
+                Diff 0.943, sphere Gloss 0.942, sun room Gloss 0.947 of Cycles); at 192
+                every pass of the six is within 5 % (0.951-1.032) */
         out->aa_samples = 2;
         out->rsm_resolution = 256;
-        out->vsgl_count = 128;
+        out->vsgl_count = 192;
         out->visibility = VSGL_VISIBILITY_RAY;
         out->shade_stride = 2;
         break;
