@@ -41,7 +41,7 @@ int main(int argc, char **argv)
         s.rsm_resolution = rsm;
         s.method = VSGL_METHOD_BRUTE_FORCE;
         acc_planes ref, got;
-        vsgl_render_stats st;
+        vsgl_render_stats st = {.size = sizeof st};
         double t0 = now();
         if (!acc_render(k, W, H, &s, &ref, &st))
             return 1;

@@ -79,7 +79,7 @@ class _Struct(ctypes.Structure):
 # Constants (#define VSGL_*)
 # --------------------------------------------------------------------------
 
-BINDING_VERSION = (0, 2)
+BINDING_VERSION = (0, 3)
 BUNDLE_VERSION = (1, 2)
 
 
@@ -421,6 +421,7 @@ class vsgl_scene_desc(_Struct):
 
 class vsgl_scene_info(_Struct):
     _fields_ = [
+        ("size", c_uint32),
         ("triangle_count", c_uint32),
         ("dropped_triangles", c_uint32),
         ("light_count", c_uint32),
@@ -457,6 +458,7 @@ class vsgl_render_settings(_Struct):
 
 class vsgl_render_output(_Struct):
     _fields_ = [
+        ("size", c_uint32),
         ("width", c_uint32),
         ("height", c_uint32),
         ("diffuse_light", POINTER(c_float)),
@@ -472,6 +474,7 @@ class vsgl_render_output(_Struct):
 
 class vsgl_render_stats(_Struct):
     _fields_ = [
+        ("size", c_uint32),
         ("seconds_total", c_double),
         ("seconds_scene_prep", c_double),
         ("seconds_gbuffer", c_double),
@@ -539,6 +542,7 @@ class vsgl_bundle_options(_Struct):
 
 class vsgl_bundle_info(_Struct):
     _fields_ = [
+        ("size", c_uint32),
         ("version_major", c_uint32),
         ("version_minor", c_uint32),
         ("output_path", c_char_p),

@@ -861,6 +861,7 @@ class Scene(_Owned):
         rc = self._lib.vsgl_scene_get_info(self.handle, ctypes.byref(info))
         self._ctx.check(rc, "vsgl_scene_get_info")
         d = info.as_dict()
+        del d["size"]
         d["bounds_min"], d["bounds_max"] = tuple(d["bounds_min"]), tuple(d["bounds_max"])
         return d
 
@@ -888,6 +889,7 @@ def _settings(settings):
 
 def _stats_dict(stats):
     d = stats.as_dict()
+    del d["size"]
     d["skipped"] = stats.skipped.decode("utf-8", "replace")
     return d
 
@@ -1133,6 +1135,7 @@ def _read_bundle(ctx, handle):
         info = vsgl_bundle_info()
         ctx.check(lib.vsgl_bundle_get_info(handle, ctypes.byref(info)), "vsgl_bundle_get_info")
         info = info.as_dict()
+        del info["size"]
         return scene, settings, info
     finally:
         lib.vsgl_bundle_destroy(handle)

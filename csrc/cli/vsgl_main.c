@@ -106,7 +106,7 @@ static int cmd_info(vsgl_context *ctx, const cli_options *o)
     if (r)
         return fail(ctx, r, o->scene_path);
     const vsgl_scene_desc *d = vsgl_bundle_scene(b);
-    vsgl_bundle_info bi;
+    vsgl_bundle_info bi = {.size = sizeof bi};
     vsgl_bundle_get_info(b, &bi);
     printf("bundle: %s (format %u.%u)\n", o->scene_path, bi.version_major, bi.version_minor);
     printf("vertices: %u\ntriangles: %u\nmaterials: %u\nlights: %u\n", d->vertex_count, d->triangle_count,
@@ -156,7 +156,7 @@ static int cmd_info(vsgl_context *ctx, const cli_options *o)
         vsgl_bundle_destroy(b);
         return fail(ctx, r, "scene");
     }
-    vsgl_scene_info si;
+    vsgl_scene_info si = {.size = sizeof si};
     if (vsgl_scene_get_info(scene, &si) == VSGL_OK)
         printf("valid: yes (%u triangles kept, %u degenerate dropped)\n", si.triangle_count, si.dropped_triangles);
     vsgl_scene_destroy(scene);
@@ -184,7 +184,7 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
     vsgl_result r = vsgl_bundle_read(ctx, o->scene_path, &b);
     if (r)
         return fail(ctx, r, o->scene_path);
-    vsgl_bundle_info bi;
+    vsgl_bundle_info bi = {.size = sizeof bi};
     vsgl_bundle_get_info(b, &bi);
     const char *out_path = o->output_path ? o->output_path : (*bi.output_path ? bi.output_path : NULL);
     if (!out_path) {
@@ -249,10 +249,9 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
         status = 1;
         goto done;
     }
-    vsgl_render_output out = {cam->width, cam->height, pl.p[0], pl.p[1], pl.p[2], pl.p[3],
+    vsgl_render_output out = {sizeof out, cam->width, cam->height, pl.p[0], pl.p[1], pl.p[2], pl.p[3],
                               pl.p[4], pl.p[5], pl.p[6], pl.alpha};
-    vsgl_render_stats stats;
-    memset(&stats, 0, sizeof stats);
+    vsgl_render_stats stats = {.size = sizeof stats};
     r = vsgl_render(ctx, scene, &s, &out, &stats);
     progress_end(progress);
     if (r) {

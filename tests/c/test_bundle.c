@@ -183,7 +183,7 @@ VT_TEST(bundle_roundtrip_memory_is_bit_exact)
         check_same_scene(vsgl_bundle_scene(bd), &s.desc);
         const vsgl_render_settings *st = vsgl_bundle_settings(bd);
         VT_CHECK(memcmp(st, &s.settings, sizeof *st) == 0, "settings seed %u aa %u", st->seed, st->aa_samples);
-        vsgl_bundle_info info;
+        vsgl_bundle_info info = {.size = sizeof info};
         VT_CHECK(vsgl_bundle_get_info(bd, &info) == VSGL_OK, "info");
         VT_CHECK(info.version_major == 1 && info.version_minor == 2 && info.has_frame && info.frame == -42 && info.has_settings &&
                      strcmp(info.output_path, "/tmp/out dir/frame_0042.exr") == 0,
@@ -228,7 +228,7 @@ VT_TEST(bundle_minimal_scene_without_optional_arrays)
         vsgl_render_settings zero;
         memset(&zero, 0, sizeof zero);
         zero.size = sizeof zero;
-        vsgl_bundle_info info;
+        vsgl_bundle_info info = {.size = sizeof info};
         vsgl_bundle_get_info(bd, &info);
         VT_CHECK(!info.has_settings && !info.has_frame && info.output_path && !*info.output_path &&
                      memcmp(vsgl_bundle_settings(bd), &zero, sizeof zero) == 0,
@@ -396,7 +396,7 @@ VT_TEST(bundle_bad_headers_give_clear_errors)
         fix_crcs(u, n);
         vsgl_bundle *bd = NULL;
         VT_CHECK(vsgl_bundle_read_memory(ctx, u, n + extra, &bd) == VSGL_OK, "minor 7 with unknown section: %s", vsgl_context_last_error(ctx));
-        vsgl_bundle_info info;
+        vsgl_bundle_info info = {.size = sizeof info};
         if (bd && vsgl_bundle_get_info(bd, &info) == VSGL_OK)
             VT_CHECK(info.version_minor == 7, "minor %u", info.version_minor);
         vsgl_bundle_destroy(bd);

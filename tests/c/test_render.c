@@ -85,7 +85,7 @@ VT_TEST(render_every_mode_is_finite_and_bleeds_colour)
                 s.fit_mode = fits[f];
                 s.diffuse_mode = diffuse[d];
                 s.glossy_mode = gm;
-                vsgl_render_stats st;
+                vsgl_render_stats st = {.size = sizeof st};
                 char err[256] = "";
                 memset(&p, 0xff, sizeof p); /* NaN pattern: every pixel must be written */
                 vsgl_result r = render_room(0, &s, &p, &st, err, sizeof err);
@@ -184,11 +184,64 @@ VT_TEST(render_skips_dark_lights_and_says_why)
     vsgl_render_settings s;
     vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
     vsgl_render_output o = bind(&p);
-    vsgl_render_stats st;
+    vsgl_render_stats st = {.size = sizeof st};
     VT_CHECK(vsgl_render(ctx, scene, &s, &o, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     VT_CHECK(st.lights_used == 1 && st.lights_skipped == 2, "used %u skipped %u", st.lights_used, st.lights_skipped);
     VT_CHECK(strstr(st.skipped, "light 1: zero power") != NULL, "skipped: %s", st.skipped);
     VT_CHECK(strstr(st.skipped, "light 2: lights no geometry") != NULL, "skipped: %s", st.skipped);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
+/* The output structs are size-prefixed too (core/versioned.c): an older,
+ * shorter stats or output struct gets only its fields, the size is kept,
+ * and a size this library does not know is refused before anything runs. */
+VT_TEST(render_output_structs_follow_the_versioned_rule)
+{
+    static planes p;
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.3f, 100.0f);
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene: %s", vsgl_context_last_error(ctx));
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    /* an older stats struct ending before `skipped`: the tail is not written */
+    vsgl_render_stats st;
+    memset(&st, 0x5a, sizeof st);
+    st.size = (uint32_t)offsetof(vsgl_render_stats, skipped);
+    vsgl_render_output o = bind(&p);
+    VT_CHECK(vsgl_render(ctx, scene, &s, &o, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(st.size == offsetof(vsgl_render_stats, skipped), "size changed to %u", st.size);
+    VT_CHECK(st.lights_used == 1 && st.seconds_total > 0.0, "known fields not written");
+    VT_CHECK((unsigned char)st.skipped[0] == 0x5a && (st.reused & 0xff) == 0x5a, "wrote past the caller's size");
+    /* an older output struct ending before `alpha`: alpha is not requested */
+    memset(p.alpha, 0x7f, sizeof p.alpha);
+    o = bind(&p);
+    o.size = (uint32_t)offsetof(vsgl_render_output, alpha);
+    VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(p.alpha[0] == p.alpha[W * H - 1] && p.alpha[0] != 1.0f, "alpha written beyond the caller's size");
+    /* unknown sizes: refused, named, the planes untouched */
+    memset(p.dl, 0x7f, sizeof p.dl);
+    o = bind(&p);
+    vsgl_render_stats newer = {.size = sizeof newer + 8};
+    VT_CHECK(vsgl_render(ctx, scene, &s, &o, &newer) == VSGL_ERROR_INVALID_ARGUMENT, "newer stats accepted");
+    VT_CHECK(strstr(vsgl_context_last_error(ctx), "vsgl_render_stats.size") != NULL, "%s",
+             vsgl_context_last_error(ctx));
+    o.size = 6;
+    VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_ERROR_INVALID_ARGUMENT, "output size 6 accepted");
+    VT_CHECK(strstr(vsgl_context_last_error(ctx), "vsgl_render_output.size") != NULL, "%s",
+             vsgl_context_last_error(ctx));
+    VT_CHECK(p.dl[0] == p.dl[W * H * 3 - 1], "output touched");
+    /* the infos */
+    vsgl_scene_info info;
+    memset(&info, 0x5a, sizeof info);
+    info.size = (uint32_t)offsetof(vsgl_scene_info, bounds_min);
+    VT_CHECK(vsgl_scene_get_info(scene, &info) == VSGL_OK && info.light_count == 1, "older scene info");
+    VT_CHECK(((unsigned char *)info.bounds_min)[0] == 0x5a, "scene info written past its size");
+    info.size = sizeof info + 4;
+    VT_CHECK(vsgl_scene_get_info(scene, &info) == VSGL_ERROR_INVALID_ARGUMENT, "newer scene info accepted");
     vsgl_scene_destroy(scene);
     vsgl_context_destroy(ctx);
 }
@@ -217,7 +270,7 @@ VT_TEST(render_skipped_list_says_when_it_is_full)
     vsgl_render_settings s;
     vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
     vsgl_render_output o = bind(&p);
-    vsgl_render_stats st;
+    vsgl_render_stats st = {.size = sizeof st};
     VT_CHECK(vsgl_render(ctx, scene, &s, &o, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     VT_CHECK(st.lights_skipped == N - 1, "skipped %u", st.lights_skipped);
     size_t len = strlen(st.skipped);
@@ -397,7 +450,7 @@ VT_TEST(render_sample_merging_cuts_pairs_at_small_error)
     s.aa_samples = 3;
     s.rsm_resolution = 32;
     s.vsgl_count = 32;
-    vsgl_render_stats st_on, st_off;
+    vsgl_render_stats st_on = {.size = sizeof st_on}, st_off = {.size = sizeof st_off};
     char err[256] = "";
     VT_CHECK(render_room(0, &s, &on, &st_on, err, sizeof err) == VSGL_OK, "%s", err);
     s.sample_merging = VSGL_MERGE_OFF;
@@ -462,7 +515,7 @@ VT_TEST(render_shade_stride_cuts_pairs_at_small_error)
     s.visibility = VSGL_VISIBILITY_NONE;
     s.rsm_resolution = 64;
     s.aa_samples = 1;
-    vsgl_render_stats st_full, st_sparse;
+    vsgl_render_stats st_full = {.size = sizeof st_full}, st_sparse = {.size = sizeof st_sparse};
     float *dc_full, *dc_sparse, *dc1;
     float *full = render_room_size(SW, SH, 0, &s, &st_full, &dc_full);
     const uint32_t strides[2] = {2, 4};

@@ -116,7 +116,7 @@ VT_TEST(scene_valid_fixture_builds)
     vsgl_result r = vsgl_scene_create(ctx, &f.desc, &s);
     VT_CHECK(r == VSGL_OK && s, "result %d '%s'", r, vsgl_context_last_error(ctx));
     if (s) {
-        vsgl_scene_info info;
+        vsgl_scene_info info = {.size = sizeof info};
         VT_CHECK(vsgl_scene_get_info(s, &info) == VSGL_OK, "info");
         VT_CHECK(info.triangle_count == 4 && info.dropped_triangles == 0 && info.light_count == 2 && info.material_count == 2,
                  "tris %u dropped %u lights %u mats %u", info.triangle_count, info.dropped_triangles, info.light_count,
@@ -373,7 +373,7 @@ VT_TEST(scene_drops_degenerate_triangles_with_a_warning)
     vsgl_result r = vsgl_scene_create(ctx, &f.desc, &s);
     VT_CHECK(r == VSGL_OK, "result %d '%s'", r, vsgl_context_last_error(ctx));
     if (s) {
-        vsgl_scene_info info;
+        vsgl_scene_info info = {.size = sizeof info};
         vsgl_scene_get_info(s, &info);
         VT_CHECK(info.triangle_count == 2 && info.dropped_triangles == 2, "kept %u dropped %u", info.triangle_count,
                  info.dropped_triangles);
@@ -400,7 +400,7 @@ VT_TEST(scene_drops_degenerate_triangles_with_a_warning)
     r = vsgl_scene_create(ctx, &f.desc, &s);
     VT_CHECK(r == VSGL_OK, "all degenerate: %d '%s'", r, vsgl_context_last_error(ctx));
     if (s) {
-        vsgl_scene_info info;
+        vsgl_scene_info info = {.size = sizeof info};
         vsgl_scene_get_info(s, &info);
         VT_CHECK(info.triangle_count == 0 && info.dropped_triangles == 4 && info.bounds_min[0] == 0 && info.bounds_max[2] == 0,
                  "kept %u dropped %u", info.triangle_count, info.dropped_triangles);
@@ -433,7 +433,7 @@ VT_TEST(scene_drops_triangles_with_zero_normals)
     vsgl_result r = vsgl_scene_create(ctx, &f.desc, &s);
     VT_CHECK(r == VSGL_OK, "result %d '%s'", r, vsgl_context_last_error(ctx));
     if (s) {
-        vsgl_scene_info info;
+        vsgl_scene_info info = {.size = sizeof info};
         vsgl_scene_get_info(s, &info);
         VT_CHECK(info.triangle_count == 3 && info.dropped_triangles == 1, "kept %u dropped %u", info.triangle_count,
                  info.dropped_triangles);
@@ -449,7 +449,7 @@ VT_TEST(scene_drops_triangles_with_zero_normals)
     r = vsgl_scene_create(ctx, &f.desc, &s);
     VT_CHECK(r == VSGL_OK, "all zero: %d '%s'", r, vsgl_context_last_error(ctx));
     if (s) {
-        vsgl_scene_info info;
+        vsgl_scene_info info = {.size = sizeof info};
         vsgl_scene_get_info(s, &info);
         VT_CHECK(info.triangle_count == 0 && info.dropped_triangles == 4, "kept %u dropped %u", info.triangle_count,
                  info.dropped_triangles);

@@ -54,7 +54,7 @@ VT_TEST(scene_set_view_renders_as_a_new_scene)
     VT_CHECK(render(ctx, reused, &a) == VSGL_OK && render(ctx, fresh, &b) == VSGL_OK, "render");
     VT_CHECK(memcmp(&a, &b, sizeof a) == 0, "set_view differs from a scene built with the same view");
     VT_CHECK(memcmp(&a, &before, sizeof a) != 0, "the new view changed nothing (test cannot fail)");
-    vsgl_scene_info info;
+    vsgl_scene_info info = {.size = sizeof info};
     VT_CHECK(vsgl_scene_get_info(reused, &info) == VSGL_OK && info.light_count == 2, "light count %u",
              info.light_count);
 
@@ -101,7 +101,7 @@ VT_TEST(render_cache_reuses_what_stood_still_bit_identically)
     vsgl_context *ctx = NULL;
     vsgl_scene *scene = NULL;
     vsgl_render_cache *cache = NULL;
-    vsgl_render_stats st;
+    vsgl_render_stats st = {.size = sizeof st};
     VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
     VT_REQUIRE(vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
     VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));

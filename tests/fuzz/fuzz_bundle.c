@@ -50,7 +50,7 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
         return 0;
     }
     const vsgl_scene_desc *d = vsgl_bundle_scene(b);
-    vsgl_bundle_info info;
+    vsgl_bundle_info info = {.size = sizeof info};
     if (!d || !d->camera || vsgl_bundle_get_info(b, &info) != VSGL_OK || !info.output_path)
         abort();
     /* Round trip through the writer. */

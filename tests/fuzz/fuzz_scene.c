@@ -51,7 +51,7 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
         need_message(ctx);
         goto done;
     }
-    vsgl_scene_info info;
+    vsgl_scene_info info = {.size = sizeof info};
     if (vsgl_scene_get_info(scene, &info) != VSGL_OK || info.triangle_count + info.dropped_triangles != d->triangle_count)
         abort();
     vsgl_render_settings s = *vsgl_bundle_settings(b);

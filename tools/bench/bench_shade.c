@@ -142,7 +142,7 @@ int main(int argc, char **argv)
     o.width = W;
     o.height = H;
     o.combined = buf;
-    vsgl_render_stats st;
+    vsgl_render_stats st = {.size = sizeof st};
     double tp[16];
     for (int r = 0; r < reps; ++r) {
         double t0 = now();

@@ -17,6 +17,11 @@
  *   it; use one context per thread that calls the library concurrently.
  * - Buffers are caller-owned: the library never keeps a pointer to caller
  *   memory past the call that received it unless a function says so.
+ * - A struct whose first field is `uint32_t size` is versioned, in or out:
+ *   the caller sets it to sizeof(the struct) or 0 (= this version's). The
+ *   library reads an older, shorter struct as far as it reaches (the rest
+ *   takes its default) and writes an output struct only that far; a size
+ *   it does not know is ::VSGL_ERROR_INVALID_ARGUMENT.
  */
 #ifndef VSGL_BASE_H
 #define VSGL_BASE_H
@@ -42,7 +47,7 @@ extern "C" {
 
 /** Library version. The add-on refuses a library whose major.minor differ. */
 #define VSGL_VERSION_MAJOR 0
-#define VSGL_VERSION_MINOR 2
+#define VSGL_VERSION_MINOR 3
 #define VSGL_VERSION_PATCH 0
 /** Version packed as major*10000 + minor*100 + patch. */
 #define VSGL_VERSION (VSGL_VERSION_MAJOR * 10000 + VSGL_VERSION_MINOR * 100 + VSGL_VERSION_PATCH)

@@ -172,6 +172,7 @@ typedef struct vsgl_bundle_options {
 
 /** What a bundle holds besides the scene and settings. */
 typedef struct vsgl_bundle_info {
+    uint32_t size;           /**< sizeof(vsgl_bundle_info) or 0, set by the caller; read, not written */
     uint32_t version_major, version_minor; /**< of the file */
     const char *output_path; /**< "" if none; owned by the bundle */
     int32_t has_frame;
@@ -241,7 +242,12 @@ VSGL_API const vsgl_scene_desc *vsgl_bundle_scene(const vsgl_bundle *bundle);
 /** @brief The render settings stored in @p bundle (owned by it). Never NULL for a non-NULL bundle. */
 VSGL_API const vsgl_render_settings *vsgl_bundle_settings(const vsgl_bundle *bundle);
 
-/** @brief Fill @p info (strings owned by the bundle). Both pointers must be non-NULL. */
+/**
+ * @brief Fill @p info (strings owned by the bundle). Both pointers must be
+ * non-NULL; set @p info->size to sizeof(vsgl_bundle_info) or 0 first.
+ * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (also for a size this
+ *         library does not know).
+ */
 VSGL_API vsgl_result vsgl_bundle_get_info(const vsgl_bundle *bundle, vsgl_bundle_info *info);
 
 #ifdef __cplusplus

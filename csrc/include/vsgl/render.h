@@ -117,6 +117,7 @@ VSGL_API void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *
  * contribution is DiffInd*DiffCol + GlossInd*GlossCol = @p combined.
  */
 typedef struct vsgl_render_output {
+    uint32_t size;               /**< sizeof(vsgl_render_output) or 0 */
     uint32_t width, height;      /**< must equal the camera's */
     float *diffuse_light;        /**< DiffInd */
     float *glossy_light;         /**< GlossInd */
@@ -128,8 +129,14 @@ typedef struct vsgl_render_output {
     float *alpha;                /**< width*height floats: pixel coverage */
 } vsgl_render_output;
 
-/** What a render did, for logs and the add-on's panel. */
+/**
+ * What a render did, for logs and the add-on's panel. Set @p size to
+ * sizeof(vsgl_render_stats) or 0 (or zero the struct) before the call: the
+ * render fills that many bytes (an older caller's shorter struct gets the
+ * fields it knows) and leaves @p size as it was.
+ */
 typedef struct vsgl_render_stats {
+    uint32_t size;               /**< sizeof(vsgl_render_stats) or 0; read, not written */
     double seconds_total;
     double seconds_scene_prep;   /**< settings, memory estimate, output checks: everything before the G-buffer */
     double seconds_gbuffer;
@@ -187,7 +194,7 @@ VSGL_API vsgl_result vsgl_render_estimate(vsgl_context *ctx, const vsgl_scene *s
  * @brief Render the indirect AOV planes.
  * @param[in,out] out planes to fill; every non-NULL plane is written
  *        completely on success and left untouched on failure.
- * @param[out] stats may be NULL.
+ * @param[out] stats may be NULL; its size must be set (sizeof or 0).
  * A scene without lights, or whose every light is skipped, renders black
  * planes and logs a warning saying why.
  * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (settings or output

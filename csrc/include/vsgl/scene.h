@@ -297,6 +297,7 @@ VSGL_API vsgl_result vsgl_scene_set_view(vsgl_context *ctx, vsgl_scene *scene, c
 
 /** Counts after validation (degenerate triangles dropped). */
 typedef struct vsgl_scene_info {
+    uint32_t size;               /**< sizeof(vsgl_scene_info) or 0, set by the caller; read, not written */
     uint32_t triangle_count;
     uint32_t dropped_triangles;
     uint32_t light_count;
@@ -304,7 +305,12 @@ typedef struct vsgl_scene_info {
     float bounds_min[3], bounds_max[3];
 } vsgl_scene_info;
 
-/** @brief Fill @p info. Both pointers must be non-NULL. */
+/**
+ * @brief Fill @p info. Both pointers must be non-NULL; set @p info->size to
+ * sizeof(vsgl_scene_info) or 0 first.
+ * @return ::VSGL_OK, ::VSGL_ERROR_INVALID_ARGUMENT (also for a size this
+ *         library does not know).
+ */
 VSGL_API vsgl_result vsgl_scene_get_info(const vsgl_scene *scene, vsgl_scene_info *info);
 
 #ifdef __cplusplus

@@ -991,12 +991,13 @@ vsgl_result vsgl_bundle_get_info(const vsgl_bundle *b, vsgl_bundle_info *info)
 {
     if (!b || !info)
         return VSGL_ERROR_INVALID_ARGUMENT;
-    memset(info, 0, sizeof *info);
-    info->version_major = b->version_major;
-    info->version_minor = b->version_minor;
-    info->output_path = b->output_path;
-    info->has_frame = b->has_frame;
-    info->frame = b->frame;
-    info->has_settings = b->has_settings;
-    return VSGL_OK;
+    vsgl_bundle_info i;
+    memset(&i, 0, sizeof i);
+    i.version_major = b->version_major;
+    i.version_minor = b->version_minor;
+    i.output_path = b->output_path;
+    i.has_frame = b->has_frame;
+    i.frame = b->frame;
+    i.has_settings = b->has_settings;
+    return vsgl__return_versioned(NULL, info, &i, sizeof i, "vsgl_bundle_info");
 }

@@ -426,12 +426,17 @@ vsgl_result vsgl_exr_write(vsgl_context *ctx, const char *path, uint32_t width, 
     return vsgl__atomic_commit(ctx, &sink.file);
 }
 
-vsgl_result vsgl_exr_write_render(vsgl_context *ctx, const char *path, const vsgl_render_output *out,
+vsgl_result vsgl_exr_write_render(vsgl_context *ctx, const char *path, const vsgl_render_output *caller_out,
                                   const vsgl_exr_options *opt)
 {
     vsgl__clear_error(ctx);
-    if (!out)
+    if (!caller_out)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "render output is NULL");
+    vsgl_render_output o;
+    const vsgl_render_output *out = &o;
+    vsgl_result rv = vsgl__copy_versioned(ctx, &o, sizeof o, caller_out, "vsgl_render_output");
+    if (rv != VSGL_OK)
+        return rv;
     vsgl_exr_pass passes[7];
     memset(passes, 0, sizeof passes);
     uint32_t n = 0;

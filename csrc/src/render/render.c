@@ -5,6 +5,7 @@
 #include "shade/shade.h"
 #include "shade/brute_force.h"
 #include "core/context.h"
+#include "core/versioned.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -180,7 +181,7 @@ static float divide_or_zero(float num, float den)
 }
 
 static vsgl_result write_outputs(vsgl_context *ctx, const vsgl_pixel_planes *p, size_t pixels,
-                                 vsgl_render_output *out)
+                                 const vsgl_render_output *out)
 {
     /* Refuse to hand out a non-finite value: that would be a bug. */
     for (size_t i = 0; i < pixels * 3; ++i)
@@ -226,15 +227,22 @@ vsgl_result vsgl_render(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_r
 }
 
 vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *settings,
-                               vsgl_render_cache *cache, vsgl_render_output *out, vsgl_render_stats *stats)
+                               vsgl_render_cache *cache, vsgl_render_output *caller_out, vsgl_render_stats *stats)
 {
     double t_start = now_seconds();
     vsgl__clear_error(ctx);
-    if (!ctx || !scene || !out)
+    if (!ctx || !scene || !caller_out)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "render: %s is NULL",
                           !ctx ? "context" : (!scene ? "scene" : "output"));
+    vsgl_render_output o; /* the caller's, an older one's missing planes NULL */
+    const vsgl_render_output *out = &o;
     vsgl_render_settings s;
-    vsgl_result r = vsgl__settings_resolve(ctx, settings, &s);
+    size_t stats_bytes = 0;
+    vsgl_result r = vsgl__copy_versioned(ctx, &o, sizeof o, caller_out, "vsgl_render_output");
+    if (r == VSGL_OK && stats)
+        r = vsgl__versioned_size(ctx, stats, sizeof *stats, &stats_bytes, "vsgl_render_stats");
+    if (r == VSGL_OK)
+        r = vsgl__settings_resolve(ctx, settings, &s);
     if (r == VSGL_OK)
         r = check_output(ctx, scene, out);
     if (r == VSGL_OK) { /* refuse what cannot fit before allocating (render/memory.c) */
@@ -327,7 +335,7 @@ done:
     vsgl__vsgl_set_free(&set);
     vsgl__gbuffer_free(&g);
     st.seconds_total = now_seconds() - t_start;
-    if (stats)
-        *stats = st;
+    if (stats) /* its size was checked up front */
+        (void)vsgl__return_versioned(ctx, stats, &st, sizeof st, "vsgl_render_stats");
     return r;
 }

@@ -2,6 +2,7 @@
  * BVH (one RTCDevice per scene, no global state). */
 #include "scene/scene_data.h"
 #include "core/parallel.h"
+#include "core/versioned.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -406,18 +407,19 @@ vsgl_result vsgl_scene_get_info(const vsgl_scene *scene, vsgl_scene_info *info)
 {
     if (!scene || !info)
         return VSGL_ERROR_INVALID_ARGUMENT;
-    memset(info, 0, sizeof *info);
-    info->triangle_count = scene->triangle_count;
-    info->dropped_triangles = scene->dropped_triangles;
-    info->light_count = scene->light_count;
-    info->material_count = scene->material_count;
-    info->bounds_min[0] = scene->lo.x;
-    info->bounds_min[1] = scene->lo.y;
-    info->bounds_min[2] = scene->lo.z;
-    info->bounds_max[0] = scene->hi.x;
-    info->bounds_max[1] = scene->hi.y;
-    info->bounds_max[2] = scene->hi.z;
-    return VSGL_OK;
+    vsgl_scene_info i;
+    memset(&i, 0, sizeof i);
+    i.triangle_count = scene->triangle_count;
+    i.dropped_triangles = scene->dropped_triangles;
+    i.light_count = scene->light_count;
+    i.material_count = scene->material_count;
+    i.bounds_min[0] = scene->lo.x;
+    i.bounds_min[1] = scene->lo.y;
+    i.bounds_min[2] = scene->lo.z;
+    i.bounds_max[0] = scene->hi.x;
+    i.bounds_max[1] = scene->hi.y;
+    i.bounds_max[2] = scene->hi.z;
+    return vsgl__return_versioned(NULL, info, &i, sizeof i, "vsgl_scene_info");
 }
 
 const vsgl_material *vsgl__scene_materials(const vsgl_scene *scene, uint32_t *count)
