@@ -81,9 +81,10 @@ class VsglCancelledError(VsglError):
 
 # Every name of it is re-exported (*); the ones this module uses are named.
 if __package__:  # the add-on package
+    from ._libvsgl_struct import _enum
     from ._libvsgl_abi import *  # noqa: F401,F403
     from ._libvsgl_abi import (
-        _enum, BINDING_VERSION, EXR_MAX_CHANNELS, PROTOTYPES, CosineMode, ExrCompression, ExrPixelType,
+        BINDING_VERSION, EXR_MAX_CHANNELS, PROTOTYPES, CosineMode, ExrCompression, ExrPixelType,
         LogLevel, NDF, Preset, Result, SharpnessEstimator, Visibility, vsgl_asg, vsgl_bundle_info,
         vsgl_bundle_options, vsgl_camera, vsgl_context_desc, vsgl_debug_vsgl, vsgl_exr_metadata,
         vsgl_exr_options, vsgl_exr_pass, vsgl_light, vsgl_log_fn, vsgl_material, vsgl_material_textures,
@@ -91,9 +92,10 @@ if __package__:  # the add-on package
         vsgl_render_settings, vsgl_render_stats, vsgl_scene_desc, vsgl_scene_info, vsgl_sg,
         vsgl_texture, vsgl_texture_slot, vsgl_vec3)
 else:  # a top-level module (the tests, tools/; see the module docstring)
+    from _libvsgl_struct import _enum
     from _libvsgl_abi import *  # noqa: F401,F403
     from _libvsgl_abi import (
-        _enum, BINDING_VERSION, EXR_MAX_CHANNELS, PROTOTYPES, CosineMode, ExrCompression, ExrPixelType,
+        BINDING_VERSION, EXR_MAX_CHANNELS, PROTOTYPES, CosineMode, ExrCompression, ExrPixelType,
         LogLevel, NDF, Preset, Result, SharpnessEstimator, Visibility, vsgl_asg, vsgl_bundle_info,
         vsgl_bundle_options, vsgl_camera, vsgl_context_desc, vsgl_debug_vsgl, vsgl_exr_metadata,
         vsgl_exr_options, vsgl_exr_pass, vsgl_light, vsgl_log_fn, vsgl_material, vsgl_material_textures,

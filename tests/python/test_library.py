@@ -80,7 +80,7 @@ def test_env_override_is_used(lib, tmp_path):
 def test_library_beside_module_is_preferred(lib, tmp_path):
     # the layout of an installed add-on: libvsgl.py with lib/libvsgl.so
     # (a libvsgl.so right beside libvsgl.py would shadow the module on import)
-    for f in ("libvsgl.py", "_libvsgl_abi.py"):  # the binding and its generated ABI mirror
+    for f in ("libvsgl.py", "_libvsgl_abi.py", "_libvsgl_struct.py"):  # the binding, its ABI mirror
         shutil.copy(os.path.join(ADDON, f), tmp_path / f)
     (tmp_path / "lib").mkdir()
     shutil.copy(lib.path, tmp_path / "lib" / "libvsgl.so")
@@ -94,7 +94,7 @@ def test_library_beside_module_is_preferred(lib, tmp_path):
 
 
 def test_missing_library_message_says_make(tmp_path):
-    for f in ("libvsgl.py", "_libvsgl_abi.py"):  # the binding and its generated ABI mirror
+    for f in ("libvsgl.py", "_libvsgl_abi.py", "_libvsgl_struct.py"):  # the binding, its ABI mirror
         shutil.copy(os.path.join(ADDON, f), tmp_path / f)
     r = _run("""
         import sys; sys.path.insert(0, %r)
@@ -198,4 +198,4 @@ def test_binding_does_not_import_bpy_or_use_star_imports():
     assert "import bpy" not in src and "from ctypes import *" not in src
     # one relative import, of the generated ABI, taken only inside the add-on package
     relative = re.findall(r"^\s*from \.(\w*) import", src, re.M)
-    assert set(relative) <= {"_libvsgl_abi"}, "relative imports: the tests import the module directly"
+    assert set(relative) <= {"_libvsgl_abi", "_libvsgl_struct"}, "relative imports: the tests import it directly"
