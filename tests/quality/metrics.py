@@ -136,6 +136,17 @@ def flicker(frames):
                 ratio=med2 / med if med > 0 else float("nan"), l1=float(np.median(l1)) if l1 else float("nan"))
 
 
+def excess_flicker(frames, truth):
+    """Median over consecutive pairs of the RMS of (f[t+1] - f[t]) - (g[t+1]
+    - g[t]) relative to the RMS of f[t]: how much a sequence changes beyond
+    the change of `truth` (the same motion rendered densely)."""
+    f = [np.asarray(x, np.float64) for x in frames]
+    g = [np.asarray(x, np.float64) for x in truth]
+    if len(f) != len(g) or len(f) < 2:
+        raise ValueError("excess_flicker: %d frames against %d truth frames" % (len(f), len(g)))
+    return float(np.median([_rel((f[t + 1] - f[t]) - (g[t + 1] - g[t]), f[t]) for t in range(len(f) - 1)]))
+
+
 def all_metrics(img, ref_seeds, k=4):
     """Every still metric of one configuration's passes against the
     reference seeds (each a dict of coloured passes). Returns

@@ -4,6 +4,7 @@ import os
 import sys
 
 import numpy as np
+import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import metrics as M  # noqa: E402
@@ -116,3 +117,16 @@ def test_flip_of_identical_images_is_zero():
 
 
 TESTS = [v for k, v in sorted(globals().items()) if k.startswith("test_")]
+
+
+def test_excess_flicker_removes_the_motions_own_change():
+    x = _img(5)
+    truth = [(1 + 0.03 * t) * x for t in range(8)]              # the true change: 3 % a frame
+    same = [g.copy() for g in truth]
+    assert M.flicker(same)["median"] > 0.02                      # plain flicker sees the motion
+    assert M.excess_flicker(same, truth) < 1e-12                 # nothing beyond it
+    jitter = [g * (1 + 0.01 * (-1) ** t) for t, g in enumerate(truth)]
+    e = M.excess_flicker(jitter, truth)
+    assert 0.015 < e < 0.025                                     # +-1 % alternating: ~2 % a frame
+    with pytest.raises(ValueError):
+        M.excess_flicker(same, truth[:-1])
