@@ -442,7 +442,8 @@ def markdown(results, args, img_rel):
                 f = e["flicker"][kind]
                 ex = ""
                 if f["Diff"].get("excess") is not None:
-                    ex = "; above the motion %s / %s" % (_f(f["Diff"]["excess"], "%.4f"), _f(f["Gloss"]["excess"], "%.4f"))
+                    ex = "; above the motion %s / %s" % (_f(f["Diff"]["excess"], "%.4f"),
+                                                         _f(f["Gloss"]["excess"], "%.4f"))
                 return "%s / %s (%s / %s; L1 %s / %s%s)" % (
                     _f(f["Diff"]["median"], "%.4f"), _f(f["Gloss"]["median"], "%.4f"),
                     _f(f["Diff"]["ratio"], "%.1f"), _f(f["Gloss"]["ratio"], "%.1f"),
