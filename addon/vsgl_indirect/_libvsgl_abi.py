@@ -124,6 +124,7 @@ class GlossyMode(enum.IntEnum):
     ASG = 0
     SG = 1
     ASG2 = 2
+    MRP = 3
 
 
 class Visibility(enum.IntEnum):

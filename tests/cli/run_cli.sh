@@ -275,6 +275,11 @@ for spelling in "--diffuse pulled-out --method brute-force" "--diffuse pulled --
     else bad "args_names $spelling" "$(head -3 "$T/out" | tr '\n' '|')"; fi
   fi
 done
+# --glossy mrp: the rectangle-proxy glossy mode (docs/mrp.md)
+if want args_glossy_mrp && expect_ok "args_glossy_mrp" "$VSGL" render "$SCENE" -o "$T/mrp.exr" --glossy mrp --dry-run; then
+  if grep -q "glossy=mrp" "$T/out"; then ok "args_glossy_mrp"
+  else bad "args_glossy_mrp" "$(head -3 "$T/out" | tr '\n' '|')"; fi
+fi
 expect_fail args_bad_compression 2 "'lzma' is not one of zip|zips|piz|none|rle|pxr24|b44|b44a" "$VSGL" render "$SCENE" \
   --compression lzma
 

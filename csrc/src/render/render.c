@@ -1,6 +1,7 @@
 /* vsgl_render: G-buffer -> per-light RSM -> VSGL fit -> shading -> planes.
  * Lights that contribute nothing are skipped and reported; outputs are
  * written only when everything succeeded. */
+#include "mrp/proxies.h"
 #include "render/render_internal.h"
 #include "shade/shade.h"
 #include "shade/brute_force.h"
@@ -307,6 +308,9 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
             t0 = now_seconds();
             vsgl__progress_window(ctx, 0.4f, 0.6f);
             r = vsgl__shade(ctx, scene, gb, vs, &s, &planes, VSGL__SHADE_KERNEL, &st.shading_pairs);
+            if (r == VSGL_OK && s.glossy_mode == VSGL_GLOSSY_MRP) /* the glossy plane from rectangle proxies */
+                r = vsgl__mrp_glossy_pass(ctx, scene, s.rsm_resolution, VSGL__MRP_MIN_AREA, VSGL__MRP_CELLS, gb,
+                                          &planes, NULL);
             st.seconds_shade = now_seconds() - t0;
         }
     }

@@ -1,0 +1,72 @@
+/* Internal: rectangle proxies (RPs) built from a scene's planar faces, their
+ * outgoing radiance from this frame's RSMs, and the MRP glossy shading of
+ * the G-buffer from them (docs/mrp.md §4). Owner: csrc/src/mrp. */
+#ifndef VSGL_MRP_PROXIES_H
+#define VSGL_MRP_PROXIES_H
+
+#include "mrp/mrp.h"
+#include "rsm/rsm.h"
+#include "gbuffer/gbuffer.h"
+#include "shade/shade.h"
+
+/* One proxy: a rectangle fitted to a group of coplanar triangles, split
+ * into cells_u x cells_v cells, each a Lambertian rectangle of uniform
+ * radiance on either side (side 0 = along rect.normal, 1 = against it). */
+typedef struct vsgl__mrp_proxy {
+    vsgl__mrp_rect rect;
+    double coverage;     /* the group's triangle area / the rectangle's */
+    uint32_t nu, nv;     /* cells along u and v (>= 1): square-ish cells, `cells` along the longer side */
+    float *power;        /* [2][cells_v][cells_u][3]: sum of RSM flux x diffuse albedo (W), then radiance */
+    float side_total[2]; /* sum over cells of the luminance-ish sum of channels, per side */
+} vsgl__mrp_proxy;
+
+typedef struct vsgl__mrp_proxy_set {
+    vsgl__mrp_proxy *items;
+    size_t count;
+    float *storage;      /* all proxies' power arrays */
+    double plane_tol;    /* how far from the plane a texel may lie (m) */
+} vsgl__mrp_proxy_set;
+
+/* Group the scene's triangles by plane (normal within ~0.06 degrees,
+ * offset within 1e-4 of the scene's diagonal), fit each group a rectangle
+ * (axes along its largest triangle's longest edge; the bounds of its
+ * vertices) and keep those of area >= @p min_area (m^2) whose triangles
+ * cover >= 70 % of it, at most 256, largest first. @p cells: cells along a
+ * proxy's longer side (1..64). */
+vsgl_result vsgl__mrp_proxies_build(vsgl_context *ctx, const vsgl_scene *scene, double min_area, uint32_t cells,
+                                    vsgl__mrp_proxy_set *out);
+
+/* Add the light an RSM puts on the proxies: each lit texel on a proxy (its
+ * position within plane_tol of the plane and inside the rectangle, its
+ * normal within ~18 degrees of the plane's) adds flux x diffuse albedo to
+ * its cell on the side its normal faces. Each texel counts once (first proxy). */
+void vsgl__mrp_proxies_add_rsm(vsgl__mrp_proxy_set *set, const vsgl_scene *scene, const vsgl_rsm *rsm);
+
+/* Turn the accumulated power into radiance: P / (pi * cell area). */
+void vsgl__mrp_proxies_finish(vsgl__mrp_proxy_set *set);
+
+void vsgl__mrp_proxies_free(vsgl__mrp_proxy_set *set);
+
+/* The glossy plane from the proxies: for every hit sample with a glossy
+ * lobe, the sum over proxies and lit cells of the MRP term
+ * (vsgl__mrp_glossy_uniform, default options) x the smooth factor x the
+ * cell's radiance; planes->glossy (per pixel, sample-weighted as the VSGL
+ * shading) is overwritten. */
+vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
+                                   const vsgl__mrp_proxy_set *set, const vsgl_pixel_planes *planes);
+
+/* Defaults of the proxy pass (not settings yet): proxies of at least
+ * VSGL__MRP_MIN_AREA m^2, VSGL__MRP_CELLS cells along their longer side. */
+#define VSGL__MRP_MIN_AREA 0.25
+#define VSGL__MRP_CELLS 32
+
+/* The whole glossy_mode = VSGL_GLOSSY_MRP pass: proxies from the scene, one
+ * RSM per light at @p rsm_resolution (built again: the fit frees its own),
+ * proxies of at least @p min_area m^2 with @p cells cells on their longer side,
+ * radiance, then vsgl__mrp_shade_glossy into planes->glossy. Writes the
+ * proxy count to *proxies (may be NULL). */
+vsgl_result vsgl__mrp_glossy_pass(vsgl_context *ctx, const vsgl_scene *scene, uint32_t rsm_resolution,
+                                  double min_area, uint32_t cells, const vsgl_gbuffer *g,
+                                  const vsgl_pixel_planes *planes, size_t *proxies);
+
+#endif

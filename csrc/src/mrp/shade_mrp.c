@@ -1,0 +1,123 @@
+/* The glossy plane from the rectangle proxies (proxies.h): every glossy
+ * camera sample sums the MRP term of the lit cells its lobe can reach. */
+#include "mrp/proxies.h"
+#include "mrp/geom.h"
+#include "core/context.h"
+#include "core/parallel.h"
+#include "scene/material.h"
+
+typedef struct mrp_job {
+    const vsgl_scene *scene;
+    const vsgl_gbuffer *g;
+    const vsgl__mrp_proxy_set *set;
+    const vsgl_pixel_planes *planes;
+    const vsgl_material *materials;
+    vsgl__mrp_options opt;
+} mrp_job;
+
+/* Glossy radiance (RGB, smooth factor included) at sample i. */
+static void sample_glossy(const mrp_job *j, size_t i, float out[3])
+{
+    out[0] = out[1] = out[2] = 0.0f;
+    const vsgl_gbuffer *g = j->g;
+    vsgl_material m;
+    vsgl__gbuffer_material(g, j->materials, i, &m);
+    vsgl_brdf_params bp;
+    vsgl__material_params(&m, &bp);
+    if (!bp.glossy)
+        return;
+    d3 x = d3_make(g->pos[0][i], g->pos[1][i], g->pos[2][i]);
+    d3 n = d3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
+    d3 o = d3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
+    double alpha = sqrt((double)bp.alpha_x * bp.alpha_y);
+    vsgl_sg lobe;
+    vsgl__mrp_receiver_sg(n, o, alpha, &lobe);
+    d3 z = d3_of_v3(lobe.axis);
+    double nu = 0.5 * lobe.sharpness, spread = 3.0 / sqrt(nu > 1e-6 ? nu : 1e-6); /* e^{-9} of the peak */
+    v3 nf = d3_to_v3(n), of = d3_to_v3(o);
+    float ms[3];
+    for (int c = 0; c < 3; ++c)
+        ms[c] = vsgl__ms_scale(&bp, c, v3_dot(nf, of));
+    double acc[3] = {0, 0, 0};
+    for (size_t k = 0; k < j->set->count; ++k) {
+        const vsgl__mrp_proxy *p = &j->set->items[k];
+        for (int side = 0; side < 2; ++side) {
+            if (!(p->side_total[side] > 0.0f))
+                continue;
+            vsgl__mrp_rect plane = p->rect;
+            if (side) {
+                plane.normal = d3_scale(plane.normal, -1.0);
+                plane.v = d3_scale(plane.v, -1.0); /* keep v = n x u */
+            }
+            d3 y;
+            if (!vsgl__mrp_peak(&plane, x, d3_scale(z, -1.0), &y))
+                continue; /* behind the plane, or the lobe's axis leaves it */
+            /* cells farther from the peak than the lobe's reach are skipped */
+            double d = d3_length(d3_sub(y, x)), cs = d3_dot(d3_sub(x, y), plane.normal) / (d > 0.0 ? d : 1.0);
+            double reach = d * spread / (cs > 0.05 ? cs : 0.05);
+            d3 dy = d3_sub(y, plane.center);
+            double yu = d3_dot(dy, plane.u), yv = d3_dot(dy, plane.v);
+            double cu = plane.half_u / p->nu, cv = plane.half_v / p->nv;
+            const float *rad = p->power + (size_t)side * p->nu * p->nv * 3;
+            for (uint32_t iv = 0; iv < p->nv; ++iv) {
+                double mv = -plane.half_v + (2.0 * iv + 1.0) * cv;
+                if (fabs(yv - mv) - cv > reach)
+                    continue;
+                for (uint32_t iu = 0; iu < p->nu; ++iu) {
+                    const float *L = rad + ((size_t)iv * p->nu + iu) * 3;
+                    if (!(L[0] + L[1] + L[2] > 0.0f))
+                        continue;
+                    double mu = -plane.half_u + (2.0 * iu + 1.0) * cu;
+                    if (fabs(yu - mu) - cu > reach)
+                        continue;
+                    vsgl__mrp_rect cell = plane;
+                    cell.center = d3_add(plane.center, d3_add(d3_scale(plane.u, mu), d3_scale(plane.v, mv)));
+                    cell.half_u = cu;
+                    cell.half_v = cv;
+                    d3 axis;
+                    double v = vsgl__mrp_glossy_uniform(&cell, x, n, o, alpha, &j->opt, &axis);
+                    if (!(v > 0.0))
+                        continue;
+                    float sf[3];
+                    vsgl__specular_factor(&bp, nf, of, d3_to_v3(axis), (float)alpha, sf);
+                    for (int c = 0; c < 3; ++c)
+                        acc[c] += v * sf[c] * ms[c] * L[c];
+                }
+            }
+        }
+    }
+    for (int c = 0; c < 3; ++c)
+        out[c] = acc[c] > 0.0 && acc[c] < 3e38 ? (float)acc[c] : 0.0f;
+}
+
+static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
+{
+    (void)chunk;
+    const mrp_job *j = user;
+    const vsgl_gbuffer *g = j->g;
+    for (size_t px = b; px < e; ++px) {
+        float acc[3] = {0, 0, 0};
+        for (size_t s = 0; s < g->spp; ++s) {
+            size_t i = px * g->spp + s;
+            if (g->material[i] == VSGL__GBUFFER_MISS)
+                continue;
+            float w = vsgl__gbuffer_weight(g, i), l[3]; /* the sample's share of its pixel */
+            sample_glossy(j, i, l);
+            for (int c = 0; c < 3; ++c)
+                acc[c] += w * l[c];
+        }
+        for (int c = 0; c < 3; ++c)
+            j->planes->glossy[px * 3 + c] = acc[c];
+    }
+    return 0;
+}
+
+vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
+                                   const vsgl__mrp_proxy_set *set, const vsgl_pixel_planes *planes)
+{
+    uint32_t mcount = 0;
+    mrp_job j = {scene, g, set, planes, vsgl__scene_materials(scene, &mcount), vsgl__mrp_options_default()};
+    size_t pixels = (size_t)g->width * g->height;
+    int32_t r = vsgl__parallel_for(vsgl_context_thread_count(ctx), pixels, 64, mrp_chunk, &j);
+    return r == 0 ? VSGL_OK : vsgl__fail(ctx, (vsgl_result)r, "mrp: glossy shading failed");
+}
