@@ -991,13 +991,14 @@ vsgl_result vsgl_bundle_get_info(const vsgl_bundle *b, vsgl_bundle_info *info)
 {
     if (!b || !info)
         return VSGL_ERROR_INVALID_ARGUMENT;
-    vsgl_bundle_info i;
-    memset(&i, 0, sizeof i);
-    i.version_major = b->version_major;
-    i.version_minor = b->version_minor;
-    i.output_path = b->output_path;
-    i.has_frame = b->has_frame;
-    i.frame = b->frame;
-    i.has_settings = b->has_settings;
+    const vsgl_bundle_info i = {
+        .size = sizeof i,
+        .version_major = b->version_major,
+        .version_minor = b->version_minor,
+        .output_path = b->output_path,
+        .has_frame = b->has_frame,
+        .frame = b->frame,
+        .has_settings = b->has_settings,
+    };
     return vsgl__return_versioned(NULL, info, &i, sizeof i, "vsgl_bundle_info");
 }

@@ -407,18 +407,15 @@ vsgl_result vsgl_scene_get_info(const vsgl_scene *scene, vsgl_scene_info *info)
 {
     if (!scene || !info)
         return VSGL_ERROR_INVALID_ARGUMENT;
-    vsgl_scene_info i;
-    memset(&i, 0, sizeof i);
-    i.triangle_count = scene->triangle_count;
-    i.dropped_triangles = scene->dropped_triangles;
-    i.light_count = scene->light_count;
-    i.material_count = scene->material_count;
-    i.bounds_min[0] = scene->lo.x;
-    i.bounds_min[1] = scene->lo.y;
-    i.bounds_min[2] = scene->lo.z;
-    i.bounds_max[0] = scene->hi.x;
-    i.bounds_max[1] = scene->hi.y;
-    i.bounds_max[2] = scene->hi.z;
+    const vsgl_scene_info i = {
+        .size = sizeof i,
+        .triangle_count = scene->triangle_count,
+        .dropped_triangles = scene->dropped_triangles,
+        .light_count = scene->light_count,
+        .material_count = scene->material_count,
+        .bounds_min = {scene->lo.x, scene->lo.y, scene->lo.z},
+        .bounds_max = {scene->hi.x, scene->hi.y, scene->hi.z},
+    };
     return vsgl__return_versioned(NULL, info, &i, sizeof i, "vsgl_scene_info");
 }
 
