@@ -231,3 +231,44 @@ VT_TEST(mrp_render_spot_metal_floor_against_brute_force)
     free(buf);
     vsgl_context_destroy(ctx);
 }
+
+static int32_t cancel_in_mrp(void *user, const char *stage, float fraction)
+{
+    (void)fraction;
+    int *seen = user;
+    if (strcmp(stage, "mrp") == 0) {
+        ++*seen;
+        return 1;
+    }
+    return 0;
+}
+
+VT_TEST(mrp_render_cancels_in_the_mrp_pass)
+{
+    fx_scene fx;
+    metal_floor_room(&fx, 32, 24, 0.2f);
+    int seen = 0;
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.size = sizeof cd;
+    cd.progress = cancel_in_mrp;
+    cd.progress_user = &seen;
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_context_create(&cd, &ctx) == VSGL_OK, "context");
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    s.glossy_mode = VSGL_GLOSSY_MRP;
+    float *glossy = calloc(32 * 24 * 3, sizeof(float));
+    vsgl_render_output out;
+    memset(&out, 0, sizeof out);
+    out.width = 32;
+    out.height = 24;
+    out.glossy = glossy;
+    VT_CHECK(vsgl_render(ctx, scene, &s, &out, NULL) == VSGL_ERROR_CANCELLED, "cancelled");
+    VT_CHECK(seen == 1, "the mrp stage reported %d times before stopping", seen);
+    free(glossy);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}

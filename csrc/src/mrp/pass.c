@@ -24,10 +24,14 @@ vsgl_result vsgl__mrp_glossy_pass(vsgl_context *ctx, const vsgl_scene *scene, ui
             break;
         vsgl__mrp_proxies_add_rsm(&set, scene, &rsm);
         vsgl__rsm_free(&rsm);
+        if (vsgl__progress(ctx, "mrp", 0.5f * (float)(l + 1) / (float)light_count))
+            r = vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "mrp: cancelled");
     }
     if (r == VSGL_OK) {
         vsgl__mrp_proxies_finish(&set);
         r = vsgl__mrp_shade_glossy(ctx, scene, g, &set, planes);
+        if (r == VSGL_OK && vsgl__progress(ctx, "mrp", 1.0f))
+            r = vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "mrp: cancelled");
     }
     vsgl__mrp_proxies_free(&set);
     return r;

@@ -64,7 +64,9 @@ vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, c
  * RSM per light at @p rsm_resolution (built again: the fit frees its own),
  * proxies of at least @p min_area m^2 with @p cells cells on their longer side,
  * radiance, then vsgl__mrp_shade_glossy into planes->glossy. Writes the
- * proxy count to *proxies (may be NULL). */
+ * proxy count to *proxies (may be NULL). Reports progress as stage "mrp"
+ * (after each light's RSM and after shading); a cancel there returns
+ * VSGL_ERROR_CANCELLED. */
 vsgl_result vsgl__mrp_glossy_pass(vsgl_context *ctx, const vsgl_scene *scene, uint32_t rsm_resolution,
                                   double min_area, uint32_t cells, const vsgl_gbuffer *g,
                                   const vsgl_pixel_planes *planes, size_t *proxies);
