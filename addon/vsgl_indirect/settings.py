@@ -156,10 +156,10 @@ ITEMS = {
          "0.0013, but a sun room's cabinet loses 6-10 % of its glossy light at grazing views; "
          "more shading time"),
         ("MRP", "Rectangle Proxies",
-         "The glossy light of the large planar faces (walls, floors, 0.25 m^2 and up) as lit "
-         "rectangles reflected in closed form (the MRP paper, docs/mrp.md): a metal floor's "
-         "reflection of a spot-lit wall 3.7x lower relMSE than k-means 256; light from curved or "
-         "small surfaces is not in the glossy pass"),
+         "Experimental: the glossy light of the large planar faces (walls, floors, 0.25 m^2 and "
+         "up) as lit rectangles reflected in closed form (the MRP paper, docs/mrp.md); against "
+         "Cycles still behind ASG on the metal-floor scenes (cell steps at grazing views, slower); "
+         "light from curved or small surfaces is not in the glossy pass"),
     ],
     "visibility": [
         ("NONE", "None",

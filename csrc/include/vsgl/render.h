@@ -36,10 +36,11 @@ extern "C" {
                                reflection of a lit wall: glossy structured error 3.6x lower) but the
                                tail loses 6-10 % of the glossy light at grazing views (docs/quality.md);
                                the glossy stage at twice the cost */
-#define VSGL_GLOSSY_MRP  3 /**< glossy light from rectangle proxies (the MRP paper, docs/mrp.md): the scene's
-                               large planar faces (>= 0.25 m^2), lit by this frame's RSMs, reflected by
-                               each receiver's SG lobe in closed form; light from anything else (curved
-                               or small surfaces) is not in the glossy pass. Diffuse as the other modes */
+#define VSGL_GLOSSY_MRP  3 /**< experimental: glossy light from rectangle proxies (the MRP paper,
+                               docs/mrp.md): the scene's large planar faces (>= 0.25 m^2), lit by this
+                               frame's RSMs, reflected by each receiver's warped ASG lobe in closed form;
+                               light from anything else (curved or small surfaces) is not in the glossy
+                               pass; against Cycles still behind ASG on metal floors. Diffuse as ASG */
 
 #define VSGL_VISIBILITY_NONE 0
 #define VSGL_VISIBILITY_RAY  1  /**< one ray from the shading point to each VSGL centre / VPL */

@@ -5,16 +5,17 @@
 #include "mrp/mrp.h"
 #include "mrp/geom.h"
 #include "math/constants.h"
+#include "vsgl/lobes.h"
 
 vsgl__mrp_options vsgl__mrp_options_default(void)
 {
-    vsgl__mrp_options o = {VSGL__MRP_NORM_EXACT, 1, 1, 0, 1, 1.0};
+    vsgl__mrp_options o = {VSGL__MRP_NORM_EXACT, 1, 1, 0, 1, 1.0, 1};
     return o;
 }
 
 vsgl__mrp_options vsgl__mrp_options_paper(void)
 {
-    vsgl__mrp_options o = {VSGL__MRP_NORM_PAPER, 0, 0, 0, 0, 1.0};
+    vsgl__mrp_options o = {VSGL__MRP_NORM_PAPER, 0, 0, 0, 0, 1.0, 0};
     return o;
 }
 
@@ -69,6 +70,17 @@ double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, doub
         return 0.0;
     double cs = h / d;                                     /* cos(sigma) = n_r . yx */
     double nu = 0.5 * g.sharpness;
+    vsgl_asg ra;
+    if (opt->receiver_asg) { /* the warped ASG; the rule below takes its geometric-mean bandwidth */
+        vsgl_vec3 nf = d3_to_v3(n), of = d3_to_v3(o), t;
+        d3 t0, t1;
+        d3_basis(n, &t0, &t1);
+        t = d3_to_v3(t0);
+        vsgl_asg ndf;
+        vsgl_ndf_aniso_to_asg(&nf, &t, (float)alpha, (float)alpha, &ndf);
+        vsgl_warp_ndf_asg(&ndf, &of, &ra);
+        nu = sqrt((double)ra.lambda * ra.mu);
+    }
     double rd = disk_radius(d, cs, nu, opt->rd_scale);
     double A = opt->overlap ? vsgl__mrp_overlap_exact(rc, y, rd) : vsgl__mrp_overlap_bbox(rc, y, rd);
     if (!(A > 0.0))
@@ -89,6 +101,10 @@ double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, doub
         vsgl_sg ls;
         vsgl__mrp_asg_to_sg(&light, 1, &ls);
         v = vsgl__mrp_convolve_sg(&ls, &g);
+    } else if (opt->receiver_asg) {                        /* ASG x ASG (Xu Eq. 13), integrated */
+        vsgl_asg prod;
+        vsgl_asg_product(&light, &ra, &prod);
+        v = vsgl_asg_integral(&prod);
     } else {
         v = vsgl__mrp_convolve(&light, &g);                /* Eq. 11 */
     }

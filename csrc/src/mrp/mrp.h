@@ -148,6 +148,8 @@ typedef struct vsgl__mrp_options {
     int sg_only;     /* 1: Eq. 37 (geometric-mean SG, Iwasaki product) */
     int solid_angle; /* 0: Eq. 26's cap of aperture atan(l cos sigma) (paper), 1: the disk's own solid angle */
     double rd_scale; /* r_d = rd_scale x the rule of glossy.c (disk_radius); 1 = the rule */
+    int receiver_asg; /* 1: the receiver's NDF as the library's warped ASG (vsgl_warp_ndf_asg: stretched
+                         at grazing views) and the ASG x ASG product integral, not Eq. 8's isotropic SG */
 } vsgl__mrp_options;
 
 /* The options docs/mrp.md recommends (the best measured). */
