@@ -47,7 +47,7 @@ if want install_bpy_fresh; then
   make_stub
   out=$(PIP_PYTHON=python3 BPY_PYTHON="$T/bin/stubpy" tools/install_bpy.sh 2>&1); rc=$?
   log=$(cat "$T/bin/pip.log" 2>/dev/null)
-  if [ $rc -eq 0 ] && [ -e "$T/bin/installed" ] && [[ "$log" == "PIP_PYTHON=<unset> args: install "*" bpy numpy pytest" ]]; then
+  if [ $rc -eq 0 ] && [ -e "$T/bin/installed" ] && [[ "$log" == "PIP_PYTHON=<unset> args: install "*" bpy numpy pytest OpenImageIO<3.1" ]]; then
     ok install_bpy_fresh
   else
     bad install_bpy_fresh "exit $rc; pip calls: ${log:-none}" "output: $(tr '\n' '|' <<<"$out")"
