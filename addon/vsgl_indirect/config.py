@@ -36,7 +36,7 @@ _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", 
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
                diffuse_mode="PULLED_OUT")
 PRESET_VALUES = {
-    "PREVIEW": dict(_COMMON, aa_samples=2, rsm_resolution=128, vsgl_count=32, visibility="NONE",
+    "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="NONE",
                     shade_stride=2, edge_samples=8),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
                      shade_stride=2, edge_samples=8),
@@ -86,7 +86,7 @@ def inactive_knobs(obj):
     elif obj.fit_mode == "KMEANS":
         out |= {"fis_iterations"}
     if obj.aa_samples <= 1:
-        out |= {"sample_merging", "edge_samples"}   # one slot per pixel: nothing to refine into
+        out.add("sample_merging")
     return out
 
 

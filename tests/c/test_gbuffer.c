@@ -347,6 +347,36 @@ VT_TEST(gbuffer_edge_refinement_resolves_coverage)
     VT_CHECK(same, "1 and 2 threads refine differently");
     vsgl__gbuffer_free(&ref[0]);
     vsgl__gbuffer_free(&ref[1]);
+
+    /* one sample per pixel: a second slot per pixel, empty (a miss of weight
+     * 0) except where an edge puts the second surface in it */
+    vsgl_context *ctx = make_ctx(2);
+    vsgl_scene *s = NULL;
+    VT_REQUIRE(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    vsgl_gbuffer one;
+    VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 1, 16, &one) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    VT_CHECK(one.spp == 2 && one.weight != NULL, "spp %u", one.spp);
+    double worst1 = 0.0;
+    size_t filled = 0, bad_empty = 0;
+    for (uint32_t row = 0; one.spp == 2 && row < 48; ++row)
+        for (uint32_t col = 0; col < 64; ++col) {
+            size_t base = ((size_t)row * 64 + col) * 2;
+            double cov = 0.0;
+            for (int q = 0; q < 2; ++q)
+                cov += one.material[base + q] != VSGL__GBUFFER_MISS ? one.weight[base + q] : 0.0;
+            double e = fabs(cov - exact_coverage(col, row, x0, k, z0));
+            worst1 = e > worst1 ? e : worst1;
+            if (one.weight[base + 1] > 0.0f)
+                ++filled;
+            else
+                bad_empty += one.material[base + 1] != VSGL__GBUFFER_MISS || one.weight[base] != 1.0f;
+        }
+    printf("    one sample per pixel: %zu second slots filled, coverage error worst %.3f\n", filled, worst1);
+    VT_CHECK(worst1 < 0.035, "coverage off by %.3f at one sample per pixel", worst1);
+    VT_CHECK(filled >= 40 && bad_empty == 0, "%zu filled, %zu bad empty slots", filled, bad_empty);
+    vsgl__gbuffer_free(&one);
+    vsgl_scene_destroy(s);
+    vsgl_context_destroy(ctx);
 }
 
 typedef struct progress_log { int calls, cancel_at; float last; int decreasing; } progress_log;

@@ -619,6 +619,7 @@ VT_TEST(render_blender4_diffuse_colour_dimmed_by_specular_layer)
         vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
         s.rsm_resolution = 32;
         s.aa_samples = 1; /* one surface per pixel: a floor pixel is one whose DiffCol is the floor's */
+        s.edge_samples = 0;
         if (methods[mi] == 1)
             s.glossy_mode = VSGL_GLOSSY_SG; /* shades through the reference path */
         if (methods[mi] == 2)

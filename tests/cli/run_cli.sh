@@ -233,7 +233,7 @@ if want render_float && expect_ok render_float "$VSGL" render "$SCENE" -o "$T/ou
     grep -q "VSGL\.$p\.R" <<<"$info" || errs="$errs [no VSGL.$p.R]"
   done
   grep -q "VSGL.Combined.A" <<<"$info" || errs="$errs [no VSGL.Combined.A]"
-  grep -q 'vsgl.settings: "method=vsgl aa=2 rsm=128 fit=lattice vsgls=32' <<<"$info" || errs="$errs [settings metadata]"
+  grep -q 'vsgl.settings: "method=vsgl aa=1 rsm=128 fit=lattice vsgls=32' <<<"$info" || errs="$errs [settings metadata]"
   stats=$(oiiotool --stats "$T/out.exr" 2>&1)
   nan=$(grep "NanCount" <<<"$stats" | tr -s ' ' '\n' | grep -Ec '^[1-9]')
   inf=$(grep "InfCount" <<<"$stats" | tr -s ' ' '\n' | grep -Ec '^[1-9]')

@@ -115,6 +115,7 @@ def rendered(lib):
         scene = L.Scene(ctx, **floor_and_wall())
         s = L.render_settings_preset("preview")
         s.aa_samples = 1  # one sample per pixel: the identities below hold per pixel exactly
+        s.edge_samples = 0
         a = L.render(ctx, scene, s)
         b = L.render(ctx, scene, s)
     return a, b

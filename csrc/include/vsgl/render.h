@@ -108,8 +108,9 @@ typedef struct vsgl_render_settings {
                                       (E x E rays, E in 0..VSGL_AA_SAMPLES_MAX): the pixel still shades at
                                       most aa x aa samples, one per surface it sees, each weighted by the
                                       fraction of the E x E rays that saw it, so silhouettes move smoothly
-                                      with the camera instead of in steps of 1/aa^2. Needs aa_samples >= 2;
-                                      0, or E <= aa_samples, is off (the default) */
+                                      with the camera instead of in steps of 1/aa^2 (with aa_samples 1 a
+                                      pixel gets a second slot for a second surface); 0, or E <=
+                                      aa_samples, is off (the default) */
 } vsgl_render_settings;
 
 /** @brief Fill @p out with a preset (VSGL_PRESET_*); unknown presets give BALANCED. */

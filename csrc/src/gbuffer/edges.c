@@ -62,7 +62,7 @@ static int is_edge(const gb_job *job, uint32_t x, uint32_t y)
     const vsgl_gbuffer *g = job->g;
     const uint32_t aa = job->aa, W = g->width, H = g->height;
     size_t p0 = ((size_t)y * W + x) * g->spp;
-    for (size_t k = 1; k < g->spp; ++k)
+    for (size_t k = 1; k < (size_t)aa * aa; ++k)
         if (!same_surface(g, p0, p0 + k, job->plane_tol))
             return 1;
     /* the samples next to each border against the neighbour's across it */
@@ -187,16 +187,8 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint3
         copy_sample(g, base + q, sub, rep);
         g->weight[base + q] = (float)count[q] / (float)n;
     }
-    for (uint32_t q = groups; q < spp; ++q) {
-        /* an unused slot: a miss that weighs nothing (its view ray stays valid) */
-        g->material[base + q] = VSGL__GBUFFER_MISS;
-        for (int k = 0; k < 3; ++k)
-            g->pos[k][base + q] = g->nrm[k][base + q] = g->tan[k][base + q] = 0.0f;
-        if (g->surf[0])
-            for (int t = 0; t < VSGL__SURF_N; ++t)
-                g->surf[t][base + q] = 0.0f;
-        g->weight[base + q] = 0.0f;
-    }
+    for (uint32_t q = groups; q < spp; ++q)
+        vsgl__gbuffer_clear_slot(g, base + q, base);
 }
 
 int32_t vsgl__gbuffer_refine_edges(void *user, size_t chunk, size_t begin, size_t end)

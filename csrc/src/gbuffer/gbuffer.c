@@ -84,25 +84,29 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
     (void)chunk;
     const gb_job *j = user;
     vsgl_gbuffer *g = j->g;
-    const uint32_t aa = j->aa, spp = aa * aa, width = g->width;
+    const uint32_t aa = j->aa, grid = aa * aa, spp = g->spp, width = g->width;
     const float inv = 1.0f / (float)aa;
     float rx[VSGL__GBUFFER_BATCH], ry[VSGL__GBUFFER_BATCH];
     size_t dst[VSGL__GBUFFER_BATCH];
     for (size_t r = begin; r < end; ++r) {
         uint32_t row = j->row0 + (uint32_t)r;
         size_t base = (size_t)row * width * spp;
-        size_t n = (size_t)width * spp;
+        size_t n = (size_t)width * grid;
         for (size_t b = 0; b < n; b += VSGL__GBUFFER_BATCH) {
             uint32_t m = (uint32_t)(n - b < VSGL__GBUFFER_BATCH ? n - b : VSGL__GBUFFER_BATCH);
             for (uint32_t k = 0; k < m; ++k) {
                 size_t idx = b + k;
-                uint32_t col = (uint32_t)(idx / spp), s = (uint32_t)(idx % spp);
+                uint32_t col = (uint32_t)(idx / grid), s = (uint32_t)(idx % grid);
                 rx[k] = (float)col + ((float)(s % aa) + 0.5f) * inv;
                 ry[k] = (float)row + ((float)(s / aa) + 0.5f) * inv;
-                dst[k] = base + idx;
+                dst[k] = base + (size_t)col * spp + s;
             }
             vsgl__gbuffer_trace(j, g, m, rx, ry, dst, inv);
         }
+        /* slots beyond the grid (one sample per pixel, refined): empty until an edge fills them */
+        for (uint32_t col = 0; spp > grid && col < width; ++col)
+            for (uint32_t s = grid; s < spp; ++s)
+                vsgl__gbuffer_clear_slot(g, base + (size_t)col * spp + s, base + (size_t)col * spp);
     }
     return 0;
 }
@@ -184,8 +188,9 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
     if (edge_aa > VSGL__GBUFFER_MAX_AA)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "gbuffer: edge_samples is %u (must be in [0, %d])",
                           (unsigned)edge_aa, VSGL__GBUFFER_MAX_AA);
-    /* one sample per pixel has no slot for a second surface: nothing to refine into */
-    int refine = edge_aa > aa && aa > 1;
+    /* one sample per pixel gets a second, empty slot for a second surface */
+    int refine = edge_aa > aa;
+    uint32_t spp = refine && aa == 1 ? 2u : aa * aa;
     const vsgl_camera *cam = vsgl__scene_camera(scene);
     gb_job job;
     memset(&job, 0, sizeof job);
@@ -197,19 +202,19 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
     v3 lo, hi;
     vsgl__scene_bounds(scene, &lo, &hi);
     job.plane_tol = 1e-3f * v3_length(v3_sub(hi, lo));
-    if (!vsgl__gbuffer_alloc(out, (size_t)cam->width * cam->height * aa * aa, vsgl__scene_textured(scene), refine))
+    if (!vsgl__gbuffer_alloc(out, (size_t)cam->width * cam->height * spp, vsgl__scene_textured(scene), refine))
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "gbuffer: out of memory for %ux%u pixels x %u samples",
-                          (unsigned)cam->width, (unsigned)cam->height, (unsigned)(aa * aa));
+                          (unsigned)cam->width, (unsigned)cam->height, (unsigned)spp);
     out->width = cam->width;
     out->height = cam->height;
-    out->spp = aa * aa;
+    out->spp = spp;
     out->count = (size_t)cam->width * cam->height * out->spp;
     vsgl_result r = for_rows(ctx, &job, trace_rows, 0.0f, refine ? 0.6f : 1.0f, "tracing");
     if (r != VSGL_OK)
         return r;
     if (refine) {
         for (size_t i = 0; i < out->count; ++i)
-            out->weight[i] = 1.0f / (float)out->spp;
+            out->weight[i] = i % spp < aa * aa ? 1.0f / (float)(aa * aa) : 0.0f;
         job.edge = calloc((size_t)out->width * out->height + 1, 1);
         if (!job.edge) {
             vsgl__gbuffer_free(out);

@@ -11,7 +11,8 @@
 /* Structure of arrays; sample index = (row * width + col) * spp + s,
  * row 0 = top of the image, samples on a stratified aa x aa grid. */
 typedef struct vsgl_gbuffer {
-    uint32_t width, height, spp;   /* spp = aa * aa */
+    uint32_t width, height, spp;   /* slots per pixel: aa * aa, or 2 at aa = 1 with edge refinement
+                                      (the second an empty miss of weight 0 unless an edge fills it) */
     size_t count;                  /* width * height * spp */
     float *pos[3];                 /* world position */
     float *nrm[3];                 /* unit shading normal on the camera's side of the surface: flipped
@@ -44,7 +45,7 @@ void vsgl__gbuffer_material(const vsgl_gbuffer *g, const vsgl_material *material
 
 /* Trace the camera's primary rays (aa x aa per pixel, aa in 1..16, 0 means 1;
  * sample s = j*aa + i at raster (col + (i+0.5)/aa, row + (j+0.5)/aa)) in
- * parallel. With edge_aa > aa > 1, pixels whose samples (or whose
+ * parallel. With edge_aa > aa, pixels whose samples (or whose
  * neighbours' nearest samples) lie on different surfaces are traced again
  * with edge_aa x edge_aa rays, and their aa x aa slots hold one sample per
  * surface seen, weighted by coverage (edges.c): edges move smoothly as the

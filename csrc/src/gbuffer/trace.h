@@ -30,6 +30,21 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
  * weight when weighted); 0 when out of memory (then g is freed). */
 int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted);
 
+/* Empty slot i (a miss that weighs nothing); its view is slot `like`'s. */
+static inline void vsgl__gbuffer_clear_slot(vsgl_gbuffer *g, size_t i, size_t like)
+{
+    g->material[i] = VSGL__GBUFFER_MISS;
+    for (int k = 0; k < 3; ++k) {
+        g->pos[k][i] = g->nrm[k][i] = g->tan[k][i] = 0.0f;
+        g->view[k][i] = g->view[k][like];
+    }
+    if (g->surf[0])
+        for (int t = 0; t < VSGL__SURF_N; ++t)
+            g->surf[t][i] = 0.0f;
+    if (g->weight)
+        g->weight[i] = 0.0f;
+}
+
 /* Edge pixels (edges.c): mark then refine, rows [begin, end) of the job. */
 int32_t vsgl__gbuffer_mark_edges(void *job, size_t chunk, size_t begin, size_t end);
 int32_t vsgl__gbuffer_refine_edges(void *job, size_t chunk, size_t begin, size_t end);
