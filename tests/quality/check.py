@@ -14,9 +14,11 @@ Checks that hold today and can fail; prints PASS/FAIL lines and ends with
   (issue 9 measured this on its rooms: the RSM holds the light);
 
 then measures the presets (still and both animations, VSGL_QUALITY_FRAMES
-frames, default 12) and checks what they hold (MAX_FLICKER_LIGHT, MAX_BIAS,
-QUALITY_OVER_BALANCED below; every one fails with the session-1 presets:
-flicker 0.12-0.74, bias up to 3.4x), with issue 9's own acceptance criteria as
+frames, default 12) and checks what they hold (MAX_FLICKER_LIGHT,
+MAX_FLICKER_CAMERA, MAX_BIAS, QUALITY_OVER_BALANCED below; every one fails with
+the session-1 presets: flicker 0.12-0.74, bias up to 3.4x; the camera checks
+and the 5 % bias of balanced and quality fail with the session-3 presets),
+with issue 9's own acceptance criteria as
 INFO lines. Writes build/quality/check_test.md and .json.
 """
 import argparse
@@ -45,7 +47,12 @@ TOL_BRUTE = 0.06
 # pass, and quality's structured error (combined pass) against balanced's, where a tie within the
 # references' noise is allowed (the spot room: both at its noise floor).
 MAX_FLICKER_LIGHT = 0.015
-MAX_BIAS = dict(preview=0.30, balanced=0.17, quality=0.17)
+# The camera animation, where a moving view's own change stays below 0.01 a frame at 80x60 (the
+# sphere's rim and the sun rooms' sunlit patch change more than that by themselves: INFO there):
+# 0.012-0.028 per frame before edge pixels were refined (crawling silhouettes), 0.006-0.010 after.
+MAX_FLICKER_CAMERA = 0.012
+CAMERA_SCENES = ("spot_metal_floor", "metal_floor_red_wall", "box_point_area_glossy_green")
+MAX_BIAS = dict(preview=0.30, balanced=0.05, quality=0.05)
 QUALITY_OVER_BALANCED = 1.15
 TOL_Z = 4.0
 MAX_NOISE_S4 = 0.002
@@ -207,6 +214,11 @@ def main(argv=None):
                       "%s %s: the light animation's flicker Diff %.4f, Gloss %.4f (<= %g; second/first %.2f / %.2f)"
                       % (label, n, fl["Diff"]["median"], fl["Gloss"]["median"], MAX_FLICKER_LIGHT,
                          fl["Diff"]["ratio"], fl["Gloss"]["ratio"]))
+            fc = e["flicker"]["camera"]
+            if n in CAMERA_SCENES:
+                cnt.check(all(fc[p]["median"] <= MAX_FLICKER_CAMERA for p in ("Diff", "Gloss")),
+                          "%s %s: the camera animation's flicker Diff %.4f, Gloss %.4f (<= %g)"
+                          % (label, n, fc["Diff"]["median"], fc["Gloss"]["median"], MAX_FLICKER_CAMERA))
             s = e["still"]
             cnt.check(all(abs(s[p]["bias"] - 1) <= MAX_BIAS[label] for p in ("Diff", "Gloss")),
                       "%s %s: bias Diff %.3f, Gloss %.3f (within %d %%)" % (label, n, s["Diff"]["bias"],
