@@ -68,6 +68,26 @@ static inline void fx_look_at(float m[12], const float eye[3], const float at[3]
     }
 }
 
+/* A perspective camera (36 x 24 mm sensor, auto fit) at `eye` looking at
+ * `at`, `lens_mm`, width x height pixels. */
+static inline void fx_camera(fx_scene *s, const float eye[3], const float at[3], float lens_mm, uint32_t width,
+                             uint32_t height)
+{
+    vsgl_camera *c = &s->camera;
+    c->type = VSGL_CAMERA_PERSPECTIVE;
+    c->sensor_fit = VSGL_SENSOR_FIT_AUTO;
+    fx_look_at(c->world_from_camera, eye, at);
+    c->lens_mm = lens_mm;
+    c->sensor_width_mm = 36.0f;
+    c->sensor_height_mm = 24.0f;
+    c->ortho_scale = 1.0f;
+    c->clip_start = 0.01f;
+    c->clip_end = 100.0f;
+    c->width = width;
+    c->height = height;
+    c->pixel_aspect_x = c->pixel_aspect_y = 1.0f;
+}
+
 /* Room [-1,1] x [-1,1] x [0,2]: glossy grey floor (material 0), red left
  * wall x=-1 (1), green right wall x=+1 (2), white back wall y=+1 and
  * ceiling (3). A spot light at the ceiling aimed at the floor, power P. */
@@ -104,20 +124,8 @@ static inline void fx_room(fx_scene *s, uint32_t width, uint32_t height, float f
     L->spot_size = 1.2f;
     L->spot_blend = 0.2f;
     s->light_count = 1;
-    vsgl_camera *c = &s->camera;
-    c->type = VSGL_CAMERA_PERSPECTIVE;
-    c->sensor_fit = VSGL_SENSOR_FIT_AUTO;
     const float ceye[3] = {0.0f, -3.5f, 1.0f}, cat[3] = {0.0f, 0.0f, 0.8f};
-    fx_look_at(c->world_from_camera, ceye, cat);
-    c->lens_mm = 35.0f;
-    c->sensor_width_mm = 36.0f;
-    c->sensor_height_mm = 24.0f;
-    c->ortho_scale = 1.0f;
-    c->clip_start = 0.01f;
-    c->clip_end = 100.0f;
-    c->width = width;
-    c->height = height;
-    c->pixel_aspect_x = c->pixel_aspect_y = 1.0f;
+    fx_camera(s, ceye, cat, 35.0f, width, height);
 }
 
 /* Point the descriptor at the arrays (call after edits, before create). */

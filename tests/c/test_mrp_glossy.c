@@ -5,6 +5,7 @@
  * Smith; the same material the MRP smooth factor is evaluated with).
  * VSGL_TEST_TABLES=1 prints the tables of docs/mrp.md. */
 #include "harness.h"
+#include "sphere_quad.h"
 #include "mrp/mrp.h"
 #include "mrp/geom.h"
 #include "scene/material.h"
@@ -17,24 +18,7 @@ static int tables(void) { return getenv("VSGL_TEST_TABLES") != NULL; }
 static double gl_x[GL_N], gl_w[GL_N];
 static void gl_init(void)
 {
-    for (int i = 0; i < GL_N; ++i) { /* Newton on P_n */
-        double z = cos(3.14159265358979323846 * (i + 0.75) / (GL_N + 0.5)), pp = 1.0;
-        for (int it = 0; it < 100; ++it) {
-            double p1 = 1.0, p2 = 0.0;
-            for (int j = 1; j <= GL_N; ++j) {
-                double p3 = p2;
-                p2 = p1;
-                p1 = ((2.0 * j - 1.0) * z * p2 - (j - 1.0) * p3) / j;
-            }
-            pp = GL_N * (z * p1 - p2) / (z * z - 1.0);
-            double dz = p1 / pp;
-            z -= dz;
-            if (fabs(dz) < 1e-16)
-                break;
-        }
-        gl_x[i] = z;
-        gl_w[i] = 2.0 / ((1.0 - z * z) * pp * pp);
-    }
+    sq_gauss_legendre(GL_N, gl_x, gl_w);
 }
 
 /* Panel edges on [-a, a] graded around c: c +- w 2^k, k = -4.., and the ends. */

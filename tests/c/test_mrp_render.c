@@ -58,20 +58,8 @@ static void metal_floor_room(fx_scene *s, uint32_t w, uint32_t h, float roughnes
     L->spot_size = 40.0f * 3.14159265f / 180.0f;
     L->spot_blend = 0.3f;
     s->light_count = 1;
-    vsgl_camera *c = &s->camera;
-    c->type = VSGL_CAMERA_PERSPECTIVE;
-    c->sensor_fit = VSGL_SENSOR_FIT_AUTO;
     const float ceye[3] = {0.0f, -2.8f, 1.2f}, cat[3] = {0.0f, 3.0f, 0.6f};
-    fx_look_at(c->world_from_camera, ceye, cat);
-    c->lens_mm = 28.0f;
-    c->sensor_width_mm = 36.0f;
-    c->sensor_height_mm = 24.0f;
-    c->ortho_scale = 1.0f;
-    c->clip_start = 0.01f;
-    c->clip_end = 100.0f;
-    c->width = w;
-    c->height = h;
-    c->pixel_aspect_x = c->pixel_aspect_y = 1.0f;
+    fx_camera(s, ceye, cat, 28.0f, w, h);
 }
 
 VT_TEST(mrp_proxies_from_a_room)
