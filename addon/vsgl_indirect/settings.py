@@ -84,25 +84,25 @@ _PATH_OPTIONS = ({"options": {"PATH_SUPPORTS_BLEND_RELATIVE"}}
 # Labels and tooltips of the enum items: (identifier, label, description).
 ITEMS = {
     # Times: tools/curve.sh's gather room at 80x60 (docs/accuracy.md), rerun
-    # with the current presets on a loaded 2-core machine, where Cycles took
-    # 1.75 s for 256 spp (relMSE 0.0133); compare them with each other.
+    # with the current presets on a 2-core machine, where Cycles took
+    # 0.70 s for 256 spp (relMSE 0.0133); compare them with each other.
     "preset": [
         ("PREVIEW", "Preview",
          "Fastest: lattice 32 VSGLs per light, RSM 128, 1 sample (8 x 8 rays at edges), one "
          "pixel in 2 x 2 shaded, "
          "no indirect shadows. Within 21 % of Cycles per pass on the bundled scenes; the gather "
-         "room in 0.024 s at relMSE 0.090 (light leaks past occluders)"),
+         "room in 0.04 s at relMSE 0.079 (light leaks past occluders)"),
         ("BALANCED", "Balanced",
          "Lattice 192 VSGLs per light, RSM 256, 2 x 2 AA (8 x 8 rays at edges), one pixel in 2 x 2 "
          "shaded, visibility "
-         "rays: the gather room in 0.23 s at relMSE 0.0078, below Cycles at 256 spp (0.0133 in "
-         "1.75 s); within 5 % of Cycles where nothing blocks the light. About 1 s per 1080p "
+         "rays: the gather room in 0.17 s at relMSE 0.0058, below Cycles at 256 spp (0.0133 in "
+         "0.70 s); within 5 % of Cycles per pass on every bundled scene. About 1 s per 1080p "
          "frame on 2 cores"),
         ("QUALITY", "Quality",
          "Lattice 256 VSGLs per light, RSM 512, 2 x 2 AA (8 x 8 rays at edges), one pixel in 2 x 2 "
          "shaded, visibility "
-         "rays: within 4 % of Cycles per pass on every bundled scene; the gather room in 0.91 s "
-         "at relMSE 0.0070, about 4x Balanced's time"),
+         "rays: within 5 % of Cycles per pass on every bundled scene; the gather room in 0.35 s "
+         "at relMSE 0.0056, about 2x Balanced's time"),
     ],
     "method": [
         ("VSGL", "VSGL",

@@ -813,33 +813,45 @@ def suite_gather(lib, ctx, out_dir, report):
 # room, against the same two-seed reference. A report, not a test.
 CURVE_SPP = [int(v) for v in os.environ.get("VSGL_CURVE_SPP", "1,4,16,64,256").split(",")]
 CURVE_SETTINGS = [
-    # (label, preset, overrides)
-    ("preview preset (lattice 32, RSM 128)", "PREVIEW", {}),
-    ("balanced preset (lattice 128, RSM 256, aa 2)", "BALANCED", {}),
-    ("quality preset (lattice 256, RSM 512, aa 2, visibility)", "QUALITY", {}),
-    ("lattice 512, RSM 512, aa 2, visibility", "BALANCED", dict(vsgl_count=512, rsm_resolution=512, visibility=1)),
-    ("lattice 32, RSM 256, aa 1, visibility", "BALANCED", dict(vsgl_count=32, aa_samples=1, visibility=1)),
-    ("lattice 64, RSM 256, aa 1, visibility", "BALANCED", dict(vsgl_count=64, aa_samples=1, visibility=1)),
-    ("lattice 128, RSM 256, aa 1, visibility", "BALANCED", dict(vsgl_count=128, aa_samples=1, visibility=1)),
-    ("lattice 128, RSM 256, aa 2, visibility", "BALANCED", dict(vsgl_count=128, visibility=1)),
-    ("FIS 16, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=16, rsm_resolution=128, aa_samples=1)),
-    ("FIS 64, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=64, rsm_resolution=128, aa_samples=1)),
-    ("FIS 256, RSM 128, aa 1", "BALANCED", dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1)),
-    ("FIS 256, RSM 128, aa 1, visibility", "BALANCED",
-     dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1, visibility=1)),
-    ("k-means 256, RSM 128, aa 1, visibility", "BALANCED",
-     dict(fit_mode=2, vsgl_count=256, rsm_resolution=128, aa_samples=1, visibility=1)),
-    ("FIS 1024, RSM 256, aa 1, visibility", "BALANCED",
-     dict(fit_mode=1, vsgl_count=1024, rsm_resolution=256, aa_samples=1, visibility=1)),
-    ("k-means 64, RSM 256, aa 1, visibility", "BALANCED",
-     dict(fit_mode=2, vsgl_count=64, rsm_resolution=256, aa_samples=1, visibility=1)),
-    ("k-means 128, RSM 256, aa 1, visibility", "BALANCED",
-     dict(fit_mode=2, vsgl_count=128, rsm_resolution=256, aa_samples=1, visibility=1)),
-    ("k-means 128, RSM 256, aa 2, visibility", "BALANCED",
-     dict(fit_mode=2, vsgl_count=128, rsm_resolution=256, aa_samples=2, visibility=1)),
-    ("brute force, RSM 128, aa 1, visibility", "BALANCED",
-     dict(method=1, rsm_resolution=128, aa_samples=1, visibility=1)),
+    # (preset, overrides); the label is made from the settings the render used (curve_label)
+    ("PREVIEW", {}),
+    ("BALANCED", {}),
+    ("QUALITY", {}),
+    ("BALANCED", dict(vsgl_count=512, rsm_resolution=512)),
+    ("BALANCED", dict(vsgl_count=32, aa_samples=1)),
+    ("BALANCED", dict(vsgl_count=64, aa_samples=1)),
+    ("BALANCED", dict(vsgl_count=128, aa_samples=1)),
+    ("BALANCED", dict(vsgl_count=128)),
+    ("BALANCED", dict(fit_mode=1, vsgl_count=16, rsm_resolution=128, aa_samples=1, visibility=0)),
+    ("BALANCED", dict(fit_mode=1, vsgl_count=64, rsm_resolution=128, aa_samples=1, visibility=0)),
+    ("BALANCED", dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1, visibility=0)),
+    ("BALANCED", dict(fit_mode=1, vsgl_count=256, rsm_resolution=128, aa_samples=1)),
+    ("BALANCED", dict(fit_mode=2, vsgl_count=256, rsm_resolution=128, aa_samples=1)),
+    ("BALANCED", dict(fit_mode=1, vsgl_count=1024, rsm_resolution=256, aa_samples=1)),
+    ("BALANCED", dict(fit_mode=2, vsgl_count=64, rsm_resolution=256, aa_samples=1)),
+    ("BALANCED", dict(fit_mode=2, vsgl_count=128, rsm_resolution=256, aa_samples=1)),
+    ("BALANCED", dict(fit_mode=2, vsgl_count=128, rsm_resolution=256, aa_samples=2)),
+    ("BALANCED", dict(method=1, rsm_resolution=128, aa_samples=1)),
 ]
+
+
+def curve_label(preset, over, s):
+    """What a curve row rendered with, from the settings themselves."""
+    if s.method == 1:
+        bits = ["brute force", "RSM %d" % s.rsm_resolution]
+    else:
+        fit = {0: "two VSGLs", 1: "FIS %d" % s.vsgl_count, 2: "k-means %d" % s.vsgl_count,
+               3: "lattice %d" % s.vsgl_count}.get(s.fit_mode, "fit %d" % s.fit_mode)
+        bits = [fit, "RSM %d" % s.rsm_resolution]
+    bits.append("aa %d" % s.aa_samples)
+    if s.edge_samples > s.aa_samples:
+        bits.append("edge %d" % s.edge_samples)
+    if s.shade_stride > 1 and s.method != 1:
+        bits.append("stride %d" % s.shade_stride)
+    if s.visibility:
+        bits.append("visibility")
+    head = "%s preset" % preset.lower() if not over else ""
+    return (head + " (" + ", ".join(bits) + ")") if head else ", ".join(bits)
 
 
 def suite_curve(lib, ctx, out_dir, report):
@@ -862,11 +874,12 @@ def suite_curve(lib, ctx, out_dir, report):
         print("curve: Cycles %4d spp: %.2f s, relMSE %.4f" % (spp, t, rows[-1][2]))
     scene = library_scene(lib, ctx, ob, lights, co, mats)
     try:
-        for label, preset, over in CURVE_SETTINGS:
+        for preset, over in CURVE_SETTINGS:
             s = libvsgl.vsgl_render_settings()
             lib.vsgl_render_settings_preset(int(libvsgl.Preset[preset]), ctypes.byref(s))
             for k, v in over.items():
                 setattr(s, k, v)
+            label = curve_label(preset, over, s)
             planes = {k: np.zeros((H, W, 3), np.float32) for k in ("diffuse", "glossy")}
             o = libvsgl.vsgl_render_output()
             o.width, o.height = W, H
