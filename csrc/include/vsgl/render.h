@@ -169,7 +169,9 @@ typedef struct vsgl_render_stats {
  */
 typedef struct vsgl_memory_estimate {
     uint64_t output;         /**< the caller's output planes (width x height x output floats per pixel) */
-    uint64_t gbuffer;        /**< camera samples: width x height x aa^2 x 52 */
+    uint64_t gbuffer;        /**< camera samples: width x height x aa^2 x 52; with edge refinement
+                                  (edge_samples > aa_samples) x 56, + 1 per pixel, and at aa 1 two
+                                  slots per pixel */
     uint64_t planes;         /**< the library's own accumulation planes: 52 per pixel */
     uint64_t rsm;            /**< reflective shadow maps alive at once (one; every light's with brute force), 68 per texel */
     uint64_t fit;            /**< moment grids and cluster labels of the largest light's fit */
@@ -236,7 +238,7 @@ VSGL_API void vsgl_render_cache_destroy(vsgl_render_cache *cache);
  * A render that fails once started (e.g. cancelled) leaves the cache
  * empty; one refused up front (bad settings or sizes) leaves it as it was.
  * The cache holds
- * memory (the G-buffer: width x height x aa^2 x 52 bytes) until the next
+ * memory (the G-buffer: vsgl_memory_estimate.gbuffer) until the next
  * render through it or its destruction; one cache must not be used by two
  * calls at once. @p cache NULL is ::vsgl_render.
  */
