@@ -6,27 +6,18 @@ Combined, DiffInd, DiffCol, GlossInd and GlossCol.
 
     blender -b out/demo/demo.blend --python tools/demo_reference.py -- SPP
 """
+import os
 import sys
 
 import bpy
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "blender"))
+from cycles_ref import one_bounce  # noqa: E402  (the test references' one-bounce settings)
+
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 spp = int(argv[0]) if argv else 32
 sc = bpy.context.scene
-c = sc.cycles
-c.samples = spp
-c.max_bounces = 1
-c.diffuse_bounces = 1
-c.glossy_bounces = 1
-c.transmission_bounces = 0
-c.volume_bounces = 0
-c.transparent_max_bounces = 0
-c.sample_clamp_direct = 0.0
-c.sample_clamp_indirect = 0.0
-c.blur_glossy = 0.0
-c.light_sampling_threshold = 0.0
-c.use_denoising = False
-c.seed = 0
+one_bounce(sc.cycles, spp, 0)
 vl = sc.view_layers[0]
 for flag in ("use_pass_diffuse_indirect", "use_pass_diffuse_color", "use_pass_glossy_indirect",
              "use_pass_glossy_color"):

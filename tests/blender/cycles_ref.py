@@ -291,17 +291,12 @@ def build_blender(case):
     return ob, lights, co, mats
 
 
-def render_cycles(case, passes, path_prefix, samples, seed=1):
-    sc = bpy.context.scene
-    sc.render.engine = "CYCLES"
-    cy = sc.cycles
-    cy.device = "CPU"
+def one_bounce(cy, samples, seed):
+    """Cycles settings `cy` for an unbiased one-bounce render: one diffuse or
+    glossy bounce, no transmission, volume or transparency, no clamps, no
+    glossy blur, every light sampled, no denoising. Shared by the test
+    references here and the demo's (tools/demo_reference.py)."""
     cy.samples = samples
-    # one sample position per pixel: its centre (+-0.005 px), as the
-    # library's G-buffer with aa = 1 (edges then compare pixel for pixel)
-    cy.pixel_filter_type = "BOX"
-    cy.filter_width = 0.01
-    cy.use_adaptive_sampling = False
     cy.use_denoising = False
     cy.seed = seed
     cy.max_bounces = 1
@@ -316,6 +311,19 @@ def render_cycles(case, passes, path_prefix, samples, seed=1):
     cy.light_sampling_threshold = 0.0
     cy.caustics_reflective = True
     cy.caustics_refractive = True
+
+
+def render_cycles(case, passes, path_prefix, samples, seed=1):
+    sc = bpy.context.scene
+    sc.render.engine = "CYCLES"
+    cy = sc.cycles
+    cy.device = "CPU"
+    one_bounce(cy, samples, seed)
+    # one sample position per pixel: its centre (+-0.005 px), as the
+    # library's G-buffer with aa = 1 (edges then compare pixel for pixel)
+    cy.pixel_filter_type = "BOX"
+    cy.filter_width = 0.01
+    cy.use_adaptive_sampling = False
     sc.render.threads_mode = "AUTO"
     w = bpy.data.worlds.new("black")
     w.use_nodes = True
