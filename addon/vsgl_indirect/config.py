@@ -26,7 +26,7 @@ KNOBS = {
     "sharpness_estimator": (("TOKSVIG", "BANERJEE"), "TOKSVIG"),
     "leak_correction": (("AUTO", "OFF", "ON"), "AUTO"),
     "diffuse_mode": (("SG", "PULLED_OUT", "ACCURATE"), "PULLED_OUT"),
-    "glossy_mode": (("ASG", "SG", "ASG2", "MRP"), "ASG"),
+    "glossy_mode": (("ASG", "SG", "ASG2", "MRP"), "ASG2"),
 }
 
 # The presets' knob values: vsgl_render_settings_preset (csrc/src/shade/
@@ -39,9 +39,9 @@ PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="NONE",
                     shade_stride=2, edge_samples=8),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
-                     shade_stride=2, edge_samples=8),
+                     shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
     "QUALITY": dict(_COMMON, aa_samples=2, rsm_resolution=512, vsgl_count=256, visibility="RAY",
-                    shade_stride=2, edge_samples=8),
+                    shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
 }
 assert all(PRESET_VALUES["BALANCED"][k] == v[1] for k, v in KNOBS.items())
 

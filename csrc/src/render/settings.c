@@ -53,6 +53,7 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
         out->vsgl_count = 256;
         out->visibility = VSGL_VISIBILITY_RAY;
         out->shade_stride = 2;
+        out->glossy_mode = VSGL_GLOSSY_ASG2;
         break;
     default: /* BALANCED: lattice 192, not 128: at 128 the coarser clusters' emitter clip
                 takes 5-6 % of the light of three bundled rooms (metal floor + red wall
@@ -63,6 +64,7 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
         out->vsgl_count = 192;
         out->visibility = VSGL_VISIBILITY_RAY;
         out->shade_stride = 2;
+        out->glossy_mode = VSGL_GLOSSY_ASG2;
         break;
     }
 }

@@ -607,7 +607,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
                    eps, 0, per_chunk, kl, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
-                   0, 0, 0, NULL, NULL, NULL};
+                   0, 0, 0, NULL, NULL, NULL, {0.0f, 0.0f}};
     vsgl_result r = VSGL_OK;
     /* One pixel in S x S (sparse.c): the anchors now, the rest row by row below. */
     int sparse = s->shade_stride > 1 && path != VSGL__SHADE_REFERENCE && g->width && g->height;

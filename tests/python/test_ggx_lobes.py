@@ -1,0 +1,50 @@
+"""The two-lobe GGX fit of VSGL_GLOSSY_ASG2 (csrc/src/shade/kernel.h
+VSGL__GGX_*): the constants in the header keep GGX's integral, are the
+minimum of the objective tools/fit_ggx_lobes.py states (checked here by
+perturbing each free parameter, with the objective evaluated by quadrature),
+and stay within 18 % of GGX up to three alphas."""
+import os
+import re
+import sys
+
+import numpy as np
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+import fit_ggx_lobes as F  # noqa: E402
+
+
+def header_constants():
+    text = open(os.path.join(ROOT, "csrc", "src", "shade", "kernel.h")).read()
+    get = lambda name: float(re.search(r"#define VSGL__GGX_%s ([0-9.e+-]+)f" % name, text).group(1))  # noqa: E731
+    return get("CORE_K"), get("CORE_C"), get("TAIL_K"), get("TAIL_C")
+
+
+def test_two_lobes_keep_ggx_integral():
+    k1, c1, k2, c2 = header_constants()
+    # int c exp(-k x^2) 2 pi x dx = pi c / k; GGX's 1/(1+x^2)^2 integrates to pi
+    assert abs(c1 / k1 + c2 / k2 - 1.0) < 1e-3
+    x = np.linspace(0.0, 400.0, 800001)
+    quad = lambda f: float(np.sum(((f * x)[1:] + (f * x)[:-1]) * 0.5 * np.diff(x)))  # noqa: E731
+    assert abs(quad(F.model(k1, c1, k2, c2, x)) / quad(F.ggx(x)) - 1.0) < 2e-3
+
+
+def test_header_constants_minimise_the_stated_objective():
+    k1, c1, k2, c2 = header_constants()
+    base = F.objective(k1, c1, k2, c2)
+    share = c1 / k1
+    for dk1, dk2, ds in [(1.03, 1, 0), (0.97, 1, 0), (1, 1.03, 0), (1, 0.97, 0), (1, 1, 0.02), (1, 1, -0.02)]:
+        a1, a2, s = k1 * dk1, k2 * dk2, share + ds
+        assert F.objective(a1, s * a1, a2, (1 - s) * a2) > base, (dk1, dk2, ds)
+    # and it beats the one lobe of Wang et al. (k = 1, c = 1) by far
+    assert base < 0.05 * F.objective(1.0, 1.0, 1.0, 0.0)
+
+
+def test_two_lobes_follow_ggx_within_three_alphas():
+    k1, c1, k2, c2 = header_constants()
+    x = np.linspace(0.0, 3.0, 301)
+    ratio = F.model(k1, c1, k2, c2, x) / F.ggx(x)
+    assert np.all(np.abs(ratio - 1.0) < 0.18), float(np.max(np.abs(ratio - 1.0)))
+    # one lobe is 47 % too bright at one alpha and half as bright at two
+    one = np.exp(-x * x) / F.ggx(x)
+    assert np.max(np.abs(one - 1.0)) > 0.45
