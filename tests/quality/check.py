@@ -15,7 +15,7 @@ Checks that hold today and can fail; prints PASS/FAIL lines and ends with
 
 then measures the presets (still and both animations, VSGL_QUALITY_FRAMES
 frames, default 12) and checks what they hold (MAX_FLICKER_LIGHT,
-MAX_FLICKER_CAMERA, MAX_BIAS, QUALITY_OVER_BALANCED below; every one fails with
+MAX_FLICKER_CAMERA, MAX_BIAS, MAX_STRUCT_GLOSS, QUALITY_OVER_BALANCED below; every one fails with
 the session-1 presets: flicker 0.12-0.74, bias up to 3.4x; the camera checks
 and the 5 % bias of balanced and quality fail with the session-3 presets),
 with issue 9's own acceptance criteria as
@@ -54,6 +54,11 @@ MAX_FLICKER_CAMERA = 0.012
 CAMERA_SCENES = ("spot_metal_floor", "metal_floor_red_wall", "box_point_area_glossy_green")
 MAX_BIAS = dict(preview=0.30, balanced=0.05, quality=0.05)
 QUALITY_OVER_BALANCED = 1.15
+# Blotches in the glossy pass: balanced's and quality's structured Gloss error on every room (the
+# spot room's metal floor broke the reflected ellipse into lobes: 0.0054 in session 4, 0.0019 in the
+# red-wall room, with one Gaussian for GGX and the sparse shading's bilinear blur; 0.0004-0.0011
+# with GGX as two lobes and the sparse shading's contrast bound).
+MAX_STRUCT_GLOSS = 0.0015
 TOL_Z = 4.0
 MAX_NOISE_S4 = 0.002
 
@@ -220,6 +225,10 @@ def main(argv=None):
                           "%s %s: the camera animation's flicker Diff %.4f, Gloss %.4f (<= %g)"
                           % (label, n, fc["Diff"]["median"], fc["Gloss"]["median"], MAX_FLICKER_CAMERA))
             s = e["still"]
+            if label != "preview":
+                cnt.check(s["Gloss"]["structured"] <= MAX_STRUCT_GLOSS,
+                          "%s %s: glossy structured error %.5f (<= %g: no blotches in the reflections)"
+                          % (label, n, s["Gloss"]["structured"], MAX_STRUCT_GLOSS))
             cnt.check(all(abs(s[p]["bias"] - 1) <= MAX_BIAS[label] for p in ("Diff", "Gloss")),
                       "%s %s: bias Diff %.3f, Gloss %.3f (within %d %%)" % (label, n, s["Diff"]["bias"],
                                                                             s["Gloss"]["bias"], 100 * MAX_BIAS[label]))
