@@ -28,7 +28,7 @@ typedef struct shade_job {
     size_t *anchor_sample;   /* per anchor: its shaded sample, SIZE_MAX if its pixel missed */
     float *anchor_light;     /* per anchor: 6 floats */
     uint64_t *anchor_pairs;  /* per anchor row */
-    float contrast_floor[2]; /* diffuse, glossy: anchors differing by less are interpolated (sparse.c) */
+    float contrast_floor[2]; /* diffuse, glossy: the interpolation test's floor, a fraction of the frame's mean (sparse.c) */
 } shade_job;
 
 /* Receiver lobe of one sample, set up once and used for every VSGL. */

@@ -11,16 +11,19 @@
  *     surface (same material, normals within ~6 degrees, off the sample's
  *     tangent plane by at most ~5 % of their distance): a joint bilateral
  *     filter on the G-buffer. A sample is shaded itself where no anchor
- *     shares its surface (an edge, a thin object) or where the anchors'
- *     diffuse or glossy light differs by more than 10 % of their sum (plus
- *     2 % of the frame's mean): the edge of a glossy floor's reflection of a
- *     lit wall, which bilinear weights blurred and shifted (the spot room's
- *     glossy structured error 3.6x, its diffuse 2x what these samples give,
- *     docs/quality.md) (vsgl__shade_chunk_sparse).
+ *     shares its surface (an edge, a thin object) or where bilinear
+ *     interpolation would be off by more than 4 % of its light, judged from
+ *     the anchors' second differences around the cell (SPARSE_TOL below):
+ *     the edge of a glossy floor's reflection of a lit wall, which bilinear
+ *     weights blurred (the spot room's glossy structured error 3.6x, its
+ *     diffuse 2x what these samples give, docs/quality.md)
+ *     (vsgl__shade_chunk_sparse).
  * The light of a sample, not its colour, is interpolated: DiffCol and
  * GlossCol stay per pixel. The shading work falls by about S^2 except at
- * edges and contrasts (3.8x fewer pairs at S = 2 in the spot room at
- * 320 x 240); tests/c/test_render.c and tests/quality measure the error. */
+ * edges and where the light bends (at S = 2 and 2 x 2 samples, 320 x 240:
+ * 6.1x fewer pairs than shading every sample in the spot room, 6.5x in the
+ * sphere room; 8x and 10x with bilinear weights everywhere);
+ * tests/c/test_render.c and tests/quality measure the error. */
 #include "shade/shade_job.h"
 #include "core/context.h"
 #include "core/parallel.h"
@@ -41,19 +44,19 @@
  * samples in every pixel). Flat surfaces have one normal. */
 #define SPARSE_NORMAL_COS 0.995f
 #define SPARSE_PLANE_REL 0.05f
-/* Interpolate only between anchors whose light (diffuse, glossy) differs by
- * at most this fraction of their sum, plus a fraction of the frame's mean
- * (5 % and 2.5 % change no bundled room's error by more than a few per cent
- * and shade more samples; 20 % leaves the spot room's diffuse error 1.45x). */
-#ifndef SPARSE_CONTRAST_D
-#define SPARSE_CONTRAST_D 0.1f
-#endif
-#ifndef SPARSE_CONTRAST_G
-#define SPARSE_CONTRAST_G 0.1f
-#endif
-#ifndef SPARSE_FLOOR
-#define SPARSE_FLOOR 0.02f
-#endif
+/* Interpolate only where bilinear interpolation is accurate: its error at
+ * (tx, ty) in a cell is about (tx (1 - tx) d2x + ty (1 - ty) d2y) / 2, d2
+ * the anchors' second differences along x and y (from the anchors around
+ * the cell on the sample's surface). A sample is shaded itself where that
+ * exceeds SPARSE_TOL of its interpolated light plus SPARSE_FLOOR of the
+ * frame's mean, per lobe: a step between anchors of more than ~30 %, or a
+ * falloff steeper than ~1.8x per anchor (2 % shaded 1.35x the samples of
+ * the sphere room for no gain in its error). Where no second difference can be
+ * taken (fewer than three anchors in a row on the surface), anchors that
+ * differ by more than SPARSE_CONTRAST of their sum. */
+#define SPARSE_TOL 0.04f
+#define SPARSE_CONTRAST 0.1f
+#define SPARSE_FLOOR 0.002f
 
 static size_t anchor_pixel(const shade_job *j, uint32_t ax, uint32_t ay)
 {
@@ -148,6 +151,46 @@ static float same_surface_weight(const shade_job *j, size_t s, size_t a)
     return wn * wp;
 }
 
+/* Anchor (cx, cy) if it exists and stands on sample si's surface, else SIZE_MAX. */
+static size_t usable_anchor(const shade_job *j, size_t si, int64_t cx, int64_t cy)
+{
+    if (cx < 0 || cy < 0 || cx >= (int64_t)j->aw || cy >= (int64_t)j->ah)
+        return SIZE_MAX;
+    size_t a = (size_t)cy * j->aw + (size_t)cx, as = j->anchor_sample[a];
+    if (as == SIZE_MAX || (as != si && !(same_surface_weight(j, si, as) > 0.0f)))
+        return SIZE_MAX;
+    return a;
+}
+
+/* The largest |v0 - 2 v1 + v2| of lobe l over runs of three usable anchors
+ * along (sx, sy) that include the cell's anchors (x0, y0) and (x0 + sx,
+ * y0 + sy), for the two rows (or columns) of the cell; -1 if there is none. */
+static void second_differences(const shade_job *j, size_t si, int64_t ax, int64_t ay, int along_x, float d2[2])
+{
+    d2[0] = d2[1] = -1.0f;
+    for (int r = 0; r < 2; ++r)
+        for (int start = -1; start <= 0; ++start) {
+            size_t a[3];
+            int ok = 1;
+            for (int q = 0; q < 3 && ok; ++q) {
+                int64_t cx = along_x ? ax + start + q : ax + r, cy = along_x ? ay + r : ay + start + q;
+                a[q] = usable_anchor(j, si, cx, cy);
+                ok = a[q] != SIZE_MAX;
+            }
+            if (!ok)
+                continue;
+            for (int l = 0; l < 2; ++l) {
+                float v[3];
+                for (int q = 0; q < 3; ++q) {
+                    const float *A = j->anchor_light + a[q] * 6 + 3 * l;
+                    v[q] = A[0] + A[1] + A[2];
+                }
+                float d = fabsf(v[0] - 2.0f * v[1] + v[2]);
+                d2[l] = d > d2[l] ? d : d2[l];
+            }
+        }
+}
+
 int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
 {
     shade_job *j = user;
@@ -205,12 +248,25 @@ int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
                     hi[l] = v > hi[l] ? v : hi[l];
                 }
             }
-        /* anchors that disagree by more than the contrast bound (a reflection's
-         * edge, a shadow's): the sample is shaded itself */
+        /* where bilinear interpolation would be off by more than SPARSE_TOL
+         * (a reflection's edge, a shadow's), the sample is shaded itself */
         int smooth = 1;
-        const float contrast[2] = {SPARSE_CONTRAST_D, SPARSE_CONTRAST_G};
-        for (int l = 0; l < 2; ++l)
-            smooth &= !(hi[l] - lo[l] > contrast[l] * (hi[l] + lo[l]) + j->contrast_floor[l]);
+        if (wsum > 0.05f) {
+            float dx2[2], dy2[2];
+            second_differences(j, si, ax, ay, 1, dx2);
+            second_differences(j, si, ax, ay, 0, dy2);
+            for (int l = 0; l < 2; ++l) {
+                float m = (L[3 * l] + L[3 * l + 1] + L[3 * l + 2]) / wsum;
+                float bound = SPARSE_TOL * m + j->contrast_floor[l];
+                if (dx2[l] < 0.0f && dy2[l] < 0.0f) {
+                    smooth &= !(hi[l] - lo[l] > SPARSE_CONTRAST * (hi[l] + lo[l]) + j->contrast_floor[l]);
+                    continue;
+                }
+                float e = 0.5f * ((dx2[l] > 0.0f ? tx * (1.0f - tx) * dx2[l] : 0.0f) +
+                                  (dy2[l] > 0.0f ? ty * (1.0f - ty) * dy2[l] : 0.0f));
+                smooth &= !(e > bound);
+            }
+        }
         if (wsum > 0.05f && smooth) {
             for (int c = 0; c < 6; ++c)
                 interp[i * 6 + c] = L[c] / wsum;
