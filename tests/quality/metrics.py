@@ -27,6 +27,8 @@ GlossInd*GlossCol, Combined = Diff + Gloss (`coloured`).
   > 1 means jitter. Also the L1 form, median of sum|f[t+1] - f[t]| / sum|f[t]|,
   which a few hot pixels cannot dominate.
 """
+import math
+
 import numpy as np
 
 EPS = 0.01  # relMSE's regulariser (docs/references.md §6)
@@ -55,6 +57,43 @@ def relmse(a, ref):
     a = np.asarray(a, np.float64)
     b = np.asarray(ref, np.float64)
     return float(np.mean((a - b) ** 2 / (b * b + EPS)))
+
+
+def rel_rmse(a, ref):
+    """Relative RMSE sqrt(sum((a - ref)^2) / sum(ref^2)) (bright pixels dominate; relMSE weights them down)."""
+    return _rel(np.asarray(a, np.float64) - np.asarray(ref, np.float64), ref)
+
+
+def pareto_front(times, errors):
+    """Indices of the points no other point beats in both time and error
+    (lower is better in both; a point equal in both to another is kept
+    once, the first), sorted by time."""
+    t, e = np.asarray(times, np.float64), np.asarray(errors, np.float64)
+    keep = []
+    for i in np.lexsort((e, t)):
+        if not (np.isfinite(t[i]) and np.isfinite(e[i])):
+            continue
+        if not keep or e[i] < e[keep[-1]]:
+            keep.append(int(i))
+    return keep
+
+
+def time_at_error(times, errors, target):
+    """The time a method whose runs (times, errors) form a curve (ordered
+    by cost, e.g. by spp) needs to reach `target` error: log-log
+    interpolation between the last run above the target and the first at
+    or below it. Returns (time, how) with how = "reached" (interpolated),
+    "first" (the cheapest run already reaches it: its time, an upper
+    bound) or "never" (no run reaches it: the dearest run's time, a lower
+    bound)."""
+    t, e = np.asarray(times, np.float64), np.asarray(errors, np.float64)
+    for i in range(len(t)):
+        if e[i] <= target:
+            if i == 0:
+                return float(t[0]), "first"
+            f = (math.log(e[i - 1]) - math.log(target)) / (math.log(e[i - 1]) - math.log(e[i]))
+            return float(math.exp(math.log(t[i - 1]) + f * (math.log(t[i]) - math.log(t[i - 1])))), "reached"
+    return float(t[-1]), "never"
 
 
 def downsample(img, k=4):

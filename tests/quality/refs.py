@@ -38,10 +38,10 @@ CODE = {
 }
 
 
-def code_digest():
-    """sha1 of the source text of the functions in CODE (parsed, not imported)."""
+def code_digest(code=None):
+    """sha1 of the source text of the functions in `code` (default CODE; parsed, not imported)."""
     h = hashlib.sha1()
-    for rel, funcs in sorted(CODE.items()):
+    for rel, funcs in sorted((code or CODE).items()):
         src = open(os.path.join(ROOT, rel)).read()
         tree = ast.parse(src)
         found = {n.name: ast.get_source_segment(src, n) for n in tree.body if isinstance(n, ast.FunctionDef)}
@@ -116,17 +116,17 @@ def path(refdir, name, size, seed, version, code=None):
     return os.path.join(refdir, "%s_%dx%d_%dspp_s%d_%s.npz" % (name, w, h, spp, seed, k))
 
 
-def load(p):
+def load(p, names=PASSES):
     """(passes dict, metadata dict) of a reference file."""
     with np.load(p) as z:
-        passes = {k: z[k] for k in PASSES}
+        passes = {k: z[k] for k in names}
         meta = json.loads(str(z["meta"]))
     return passes, meta
 
 
-def save(p, passes, meta):
+def save(p, passes, meta, names=PASSES):
     tmp = p + ".part.npz"
-    np.savez(tmp, meta=np.array(json.dumps(meta)), **{k: np.asarray(passes[k], np.float32) for k in PASSES})
+    np.savez(tmp, meta=np.array(json.dumps(meta)), **{k: np.asarray(passes[k], np.float32) for k in names})
     os.replace(tmp, p)  # a cache entry is never partial
 
 

@@ -292,14 +292,69 @@ def _sun_opening_thick():
     return s
 
 
+def _brushed_metal_floor():
+    # the spot room of spot_metal_floor with a brushed (anisotropic) metal
+    # floor: a Principled metal, roughness 0.3, anisotropy 0.8, Cycles'
+    # default tangent (radial about Z in generated coordinates, which
+    # library_arrays gives the library as corner tangents)
+    s = _spot_metal_floor()
+    s["name"] = "brushed_metal_floor"
+    s["feature"] = ("the spot room with a brushed-metal floor (Principled metal, roughness 0.3, anisotropy 0.8, "
+                    "Cycles' default radial tangent): the lit back wall's reflection is stretched")
+    s["materials"]["metal_floor"] = dict(kind="metal", color=(0.9, 0.9, 0.9), roughness=0.3, anisotropy=0.8)
+    s.pop("convex")  # the brute force then casts shadow rays; the room is still empty
+    return s
+
+
+def heightfield(x0, x1, y0, y1, n, height, mat):
+    """A bumpy floor of 2 n^2 flat-shaded triangles over [x0, x1] x [y0, y1]:
+    z = height * (bumps of a few wavelengths), >= 0."""
+    xs, ys = np.linspace(x0, x1, n + 1), np.linspace(y0, y1, n + 1)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    Z = height * 0.25 * (2 + np.sin(7.1 * X + 1.3 * np.sin(3.3 * Y)) + np.cos(6.3 * Y - 0.7 * np.sin(4.1 * X)))
+    P = np.round(np.stack([X, Y, Z], -1), 6) + 0.0
+    a, b, c, d = P[:-1, :-1], P[1:, :-1], P[1:, 1:], P[:-1, 1:]  # counter-clockwise from above
+    tris = np.concatenate([np.stack([a, b, c], -2).reshape(-1, 3, 3), np.stack([a, c, d], -2).reshape(-1, 3, 3)])
+    return dict(tris=tris.tolist(), normals=None, mat=mat)
+
+
+def _dense_floor():
+    # 5 x 5 x 3 m room with a bumpy floor of 500k flat triangles (a 500 x 500
+    # grid, bumps up to 10 cm) lit by a spot; one glossy wall reflects it
+    mats = dict(floor=None, ceiling="ceiling", left="wall", right="glossy_wall", back="back_wall", front="wall")
+    geo = [q for q in box_room(-2.5, 2.5, -2.5, 2.5, 0, 3.0, mats) if q["mat"] is not None]
+    geo.append(heightfield(-2.5, 2.5, -2.5, 2.5, 500, 0.1, "bumpy_floor"))
+    spot_loc, spot_target = (-1.0, -1.2, 2.7), (0.6, 0.8, 0.0)
+    cam_loc, cam_target = (0.2137, -2.3, 1.6), (0.3, 1.5, 0.5)
+    return dict(
+        name="dense_floor",
+        feature="a room whose floor is a bumpy heightfield of 500k flat triangles, lit by a spot; a glossy wall "
+                "(GGX, roughness 0.3) reflects the lit floor (scene size: export, BVH and G-buffer cost)",
+        materials=dict(bumpy_floor=dict(kind="lambert_spec", color=(0.6, 0.55, 0.45), roughness=0.35),
+                       glossy_wall=dict(kind="glossy", color=(0.8, 0.8, 0.85), roughness=0.3),
+                       back_wall=WHITE, wall=WHITE, ceiling=WHITE),
+        geometry=geo,
+        lights=[dict(type="SPOT", energy=2500.0, loc=spot_loc, rot=look_rot(spot_loc, spot_target),
+                     spot_size=50.0, spot_blend=0.3)],
+        camera=dict(type="PERSP", lens=18.0, loc=cam_loc, rot=look_rot(cam_loc, cam_target)),
+        extent=5.0,
+        light_motion=dict(light=0, loc=(1.0, 0.0, 0.0)),
+        camera_motion=dict(loc=(1.0, 0.0, 0.0)),
+    )
+
+
 _BUILDERS = [_spot_metal_floor, _metal_floor_red_wall, _box_point_area_glossy_green, _glossy_sphere_floor,
              _sun_opening, _sun_opening_thick]
 NAMES = [b.__name__[1:] for b in _BUILDERS]
+# scenes of the trade measurement only (tools/trade.py, issue 11): not in the
+# quality suite (NAMES), which `make test` runs
+_TRADE_BUILDERS = [_brushed_metal_floor, _dense_floor]
+TRADE_NAMES = [b.__name__[1:] for b in _TRADE_BUILDERS]
 
 
 def scene(name):
     """The scene dict (camera without a resolution)."""
-    for b in _BUILDERS:
+    for b in _BUILDERS + _TRADE_BUILDERS:
         if b.__name__[1:] == name:
             s = b()
             assert s["name"] == name, (s["name"], name)
@@ -468,6 +523,19 @@ def library_arrays(s, L):
     for g in s["geometry"]:
         polys = [g["quad"]] if "quad" in g else g["tris"]
         nrms = g.get("normals") if "tris" in g else None
+        if "tris" in g and len(polys) > 1000:  # the same, vectorised (dense_floor's 500k triangles)
+            P = np.asarray(polys, np.float64)
+            base = len(V)
+            V += [tuple(p) for p in P.reshape(-1, 3).tolist()]
+            I += [(base + 3 * t, base + 3 * t + 1, base + 3 * t + 2) for t in range(len(P))]
+            Mi += [mi[g["mat"]]] * len(P)
+            if nrms is not None:
+                N += list(np.asarray(nrms, np.float64))
+            else:
+                fn = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
+                fn /= np.linalg.norm(fn, axis=1, keepdims=True)
+                N += list(np.repeat(fn[:, None, :], 3, axis=1))
+            continue
         for k, poly in enumerate(polys):
             base = len(V)
             V += [tuple(map(float, p)) for p in poly]
@@ -481,10 +549,27 @@ def library_arrays(s, L):
                     N.append([nrms[k][0], nrms[k][j], nrms[k][j + 1]])
                 else:
                     N.append([fn, fn, fn])
-    return dict(positions=np.ascontiguousarray(V, np.float32),
-                indices=np.ascontiguousarray(I, np.uint32),
-                corner_normals=np.ascontiguousarray(N, np.float32),
-                material_indices=np.ascontiguousarray(Mi, np.uint32),
-                materials=[library_material(L, s["materials"][n]) for n in order],
-                lights=[library_light(L, ls) for ls in s["lights"]],
-                camera=library_camera(L, s["camera"]))
+    out = dict(positions=np.ascontiguousarray(V, np.float32),
+               indices=np.ascontiguousarray(I, np.uint32),
+               corner_normals=np.ascontiguousarray(N, np.float32),
+               material_indices=np.ascontiguousarray(Mi, np.uint32),
+               materials=[library_material(L, s["materials"][n]) for n in order],
+               lights=[library_light(L, ls) for ls in s["lights"]],
+               camera=library_camera(L, s["camera"]))
+    if any(m.get("anisotropy", 0.0) for m in s["materials"].values()):
+        out["corner_tangents"] = radial_tangents(out["positions"], out["indices"])
+    return out
+
+
+def radial_tangents(positions, indices):
+    """Corner tangents (T, 3, 4: xyz, bitangent sign 1) of Cycles' default
+    anisotropy tangent for one mesh object at the origin (build_blender's):
+    radial about Z in generated coordinates, (-g.y, g.x, 0) with g =
+    (p - bounding-box centre) / (bounding-box size), as the add-on's
+    export.default_tangents_local."""
+    p = np.asarray(positions, np.float64)
+    lo, hi = p.min(0), p.max(0)
+    size = np.where(hi - lo == 0, 2.0, hi - lo)
+    g = (p - (lo + hi) / 2) / size
+    t = np.stack([-g[:, 1], g[:, 0], np.zeros(len(g)), np.ones(len(g))], -1)
+    return np.ascontiguousarray(t[np.asarray(indices, np.int64)], np.float32)

@@ -130,3 +130,42 @@ def test_excess_flicker_removes_the_motions_own_change():
     assert 0.015 < e < 0.025                                     # +-1 % alternating: ~2 % a frame
     with pytest.raises(ValueError):
         M.excess_flicker(same, truth[:-1])
+
+
+def test_rel_rmse_by_hand():
+    b = np.full((4, 4, 3), 2.0)
+    assert abs(M.rel_rmse(b * 1.1, b) - 0.1) < 1e-12
+
+
+def test_pareto_front_against_the_definition():
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        n = int(rng.integers(1, 30))
+        t = rng.choice([0.5, 1.0, 2.0, 3.0], n) if rng.random() < 0.3 else rng.uniform(0, 1, n)
+        e = rng.uniform(0, 1, n)
+        # independent: i is on the front iff no j is <= in both and < in one (duplicates kept once)
+        want = set()
+        for i in range(n):
+            dominated = any((t[j] <= t[i] and e[j] <= e[i] and (t[j] < t[i] or e[j] < e[i])) for j in range(n))
+            dup_before = any(t[j] == t[i] and e[j] == e[i] for j in range(n) if j != i and j in want)
+            if not dominated and not dup_before:
+                want.add(i)
+        got = M.pareto_front(t, e)
+        assert set(got) == want, (t, e)
+        assert list(np.asarray(t)[got]) == sorted(np.asarray(t)[got])
+
+
+def test_pareto_front_ties():
+    # equal error at a higher time is dominated; equal time at a higher error too
+    assert M.pareto_front([1.0, 2.0, 3.0], [0.5, 0.5, 0.2]) == [0, 2]
+    assert M.pareto_front([1.0, 1.0, 3.0], [0.6, 0.5, 0.2]) == [1, 2]
+    assert M.pareto_front([2.0, float("nan"), 1.0], [0.1, 0.0, 0.3]) == [2, 0]
+
+
+def test_time_at_error_on_a_power_law():
+    t = np.array([1.0, 4.0, 16.0, 64.0])
+    e = 0.3 / t  # error inversely proportional to time: exact in log-log
+    got, how = M.time_at_error(t, e, 0.3 / 10.0)
+    assert how == "reached" and abs(got - 10.0) < 1e-9
+    assert M.time_at_error(t, e, 1.0) == (1.0, "first")
+    assert M.time_at_error(t, e, 1e-4) == (64.0, "never")
