@@ -32,3 +32,10 @@ else
 fi
 echo "== EXR writing: every compression, float and half"
 tools/bench_exr.sh
+echo "== the trade: error against whole-frame time, library vs Cycles and Cycles + OIDN (issue 11)"
+if "$py" -c 'import numpy, matplotlib, flip_evaluator, bpy' >/dev/null 2>&1; then
+  # Cycles references and sweeps are rendered (niced) when missing, then cached
+  if [ "${BENCH_QUICK:-0}" = 1 ]; then "$py" tools/trade.py --quick; else "$py" tools/trade.py --docs; fi
+else
+  echo "trade: skipped: $py lacks numpy, matplotlib, flip-evaluator or bpy (OIDN)"
+fi
