@@ -68,6 +68,7 @@ BRUTE = ["brute RSM 64:preset=brute,rsm_resolution=64", "brute RSM 128:preset=br
 DENSE = 100000
 SWEEP_SEED = 7
 TIME_SPP = [1, 4]  # Cycles at --time-size (times only)
+FLICKER_SIZE = (160, 120)  # the light animation of the presets (tests/quality/scenes.py: extent/1000 per frame)
 SWEEP_DIR = os.path.join(ROOT, "build", "trade", "cycles")
 EXR_PASSES = {p: n for p, n in L.PLANE_PASS_NAMES.items() if p not in ("combined", "alpha")}
 
@@ -207,6 +208,19 @@ def measure_scene(name, args, ctx, version, exr_dir):
         res["points"].append(dict(kind=kind, label=cfg.label, describe=cfg.describe(), seconds=sum(parts.values()),
                                   parts=parts, vsgls=vsgls, **score(img, ref)))
         images[cfg.label] = img["Combined"]
+    if args.flicker_frames and not dense:
+        small = scenes.case(name, FLICKER_SIZE)
+        for p in res["points"]:
+            if p["kind"] != "preset":
+                continue
+            cfg, seq = parse(p["label"]), []
+            for f in range(args.flicker_frames):
+                fc = scenes.animate(small, "light", f)
+                with L.Scene(ctx, **scenes.library_arrays(fc, L)) as sc:
+                    im, _ = L.render(ctx, sc, cfg.settings(), planes=("diffuse", "glossy"))
+                seq.append(im["diffuse"].astype(np.float64) + im["glossy"])
+            fl = M.flicker(seq)
+            p["flicker"] = dict(rms=fl["median"], l1=fl["l1"], ratio=fl["ratio"])
     if args.time_size and not dense:
         res["time_at"] = time_at_size(name, args, ctx, version, export, exr_dir)
     for p in res["points"]:
@@ -351,8 +365,8 @@ def plot(results, path):
 
 
 def error_images(name, images, path):
-    """Reference, balanced, quality, Cycles 1 and 4 spp + OIDN, with their FLIP maps below."""
-    tiles = [k for k in ("ref", "balanced", "quality", "1 spp + OIDN", "4 spp + OIDN", "1 spp") if k in images]
+    """Reference, the presets, Cycles 1 and 4 spp + OIDN, with their FLIP maps below."""
+    tiles = [k for k in ("ref", "preview", "balanced", "quality", "1 spp + OIDN", "4 spp + OIDN") if k in images]
     ref = images["ref"]
     ex = imgutil.exposure_for(ref)
     top, bottom = [], []
@@ -402,15 +416,21 @@ def markdown(results, meta, img_rel, png_rel):
               "(> 1x: the preset is faster; 0.5x: it takes twice as long). Cycles' equal-error time is a log-log "
               "interpolation of its sweep at the preset's error; '<=' when Cycles' cheapest point (1 spp) is "
               "already as accurate, '>=' when no sweep point is.", "",
-              "| scene | preset | time (s) | relMSE | FLIP | at equal FLIP vs Cycles + OIDN | at equal relMSE vs "
-              "Cycles + OIDN | at equal FLIP vs Cycles |", "|---|---|---|---|---|---|---|---|"]
+              "Flicker: the preset's light animation (%d frames at %dx%d, the light moving by 1/1000 of the "
+              "scene per frame; tests/quality/metrics.py flicker): median relative RMS and L1 change of the "
+              "combined pass between consecutive frames, a smooth truth changing by ~0.3 %% per frame." % (
+                  meta["flicker_frames"], FLICKER_SIZE[0], FLICKER_SIZE[1]), "",
+              "| scene | preset | time (s) | relMSE | FLIP | flicker RMS / L1 | at equal FLIP vs Cycles + OIDN | "
+              "at equal relMSE vs Cycles + OIDN | at equal FLIP vs Cycles |", "|---|---|---|---|---|---|---|---|---|"]
     for name, res in results.items():
         for label in PRESETS:
             p = point(res, label)
             if p is None:
                 continue
-            lines.append("| %s | %s | %.2f | %s | %s | %s | %s | %s |" % (
+            fl = p.get("flicker")
+            lines.append("| %s | %s | %.2f | %s | %s | %s | %s | %s | %s |" % (
                 name, label, p["seconds"], fmt(p["Combined"]["relmse"]), fmt(p["flip"]),
+                "%.4f / %.4f" % (fl["rms"], fl["l1"]) if fl else "-",
                 ratio_text(res, label, "oidn", "flip"), ratio_text(res, label, "oidn", "relmse"),
                 ratio_text(res, label, "cycles", "flip")))
     lines += ["", "## Acceptance (issue 11)", "",
@@ -503,6 +523,8 @@ def main():
     ap.add_argument("--time-size", default="960x540",
                     help="also time (no error) balanced, quality and Cycles 1/4 spp (+ OIDN) at this size "
                          "(default 960x540; 'none' skips it)")
+    ap.add_argument("--flicker-frames", type=int, default=None,
+                    help="frames of the presets' light animation at 160x120 (default 6; --quick 0)")
     ap.add_argument("--oidn-quality", default="high", choices=sorted(oidn.QUALITY))
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
@@ -513,6 +535,8 @@ def main():
     args.spp = [int(s) for s in args.spp.split(",")] if args.spp else (QUICK_SPP if args.quick else SPP)
     args.configs = args.configs.split(";") if args.configs else (PRESETS if args.quick else PRESETS + KNOBS + BRUTE)
     args.repeat = args.repeat or 2
+    if args.flicker_frames is None:
+        args.flicker_frames = 0 if args.quick else 6
     if args.docs:
         out, md_path, png_path = (os.path.join(ROOT, "docs", "img", "trade"), os.path.join(ROOT, "docs", "trade.md"),
                                   os.path.join(ROOT, "docs", "trade.png"))
@@ -542,6 +566,7 @@ def main():
     meta = dict(command=cmd, date=datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"),
                 library=L.version_string(), commit=commit, blender=version, size=list(args.size),
                 ref_spp=args.ref_spp, oidn_quality=args.oidn_quality, repeat=args.repeat, time_size=args.time_size,
+                flicker_frames=args.flicker_frames,
                 seconds=time.time() - t0)
     plot(results, png_path)
     img_rel = os.path.relpath(out, os.path.dirname(md_path))
