@@ -56,7 +56,7 @@ import scenes  # noqa: E402
 SCENES = ["spot_metal_floor", "sun_opening", "box_point_area_glossy_green", "glossy_sphere_floor",
           "brushed_metal_floor", "dense_floor"]
 QUICK_SCENES = ["spot_metal_floor", "box_point_area_glossy_green"]
-SPP = [1, 2, 4, 8, 16, 64, 256]
+SPP = [1, 2, 4, 8, 16, 64, 256, 1024]
 QUICK_SPP = [1, 4, 16]
 PRESETS = ["preview", "balanced", "quality"]
 KNOBS = ["lattice 64:vsgl_count=64", "lattice 512:vsgl_count=512", "RSM 128:rsm_resolution=128",
