@@ -72,6 +72,11 @@ def export_seconds(repeat=3):
     return best
 
 
+def clear(tmp):
+    for f in os.listdir(tmp):
+        os.remove(os.path.join(tmp, f))
+
+
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:]
     a = dict(zip(argv[0::2], argv[1::2]))
@@ -94,12 +99,13 @@ def main():
         print("%s: built in %.1f s, add-on export %.3f s" % (name, build, exp), flush=True)
         tmp = os.path.join(out, "tmp_%d" % os.getpid())
         render_sweep(c, 1, seed, tmp)  # warm-up, not kept: the session's first render loads the kernels
+        clear(tmp)  # (render_sweep reads an existing multilayer file as Blender 5's own)
         for spp in todo:
             passes, secs = render_sweep(c, spp, seed, tmp)
+            clear(tmp)
             if spp <= 16:  # cheap: the faster of two renders (the machine is shared); the first one's image
                 secs = min(secs, render_sweep(c, spp, seed, tmp)[1])
-            for f in os.listdir(tmp):
-                os.remove(os.path.join(tmp, f))
+                clear(tmp)
             meta = dict(scene=name, width=w, height=h, spp=spp, seed=seed, blender=version, render_seconds=secs,
                         export_seconds=exp, threads=bpy.context.scene.render.threads)
             refs.save(refs.path(out, name, (w, h, spp), seed, version, code), passes, meta, NAMES)
