@@ -607,7 +607,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
                    eps, 0, per_chunk, kl, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
-                   0, 0, 0, NULL, NULL, NULL, {0.0f, 0.0f}};
+                   0, 0, 0, NULL, NULL, NULL, NULL, {0.0f, 0.0f}};
     vsgl_result r = VSGL_OK;
     /* One pixel in S x S (sparse.c): the anchors now, the rest row by row below. */
     int sparse = s->shade_stride > 1 && path != VSGL__SHADE_REFERENCE && g->width && g->height;
@@ -619,8 +619,9 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
         size_t na = (size_t)j.aw * j.ah;
         j.anchor_sample = malloc(na * sizeof *j.anchor_sample);
         j.anchor_light = malloc(na * 6 * sizeof *j.anchor_light);
+        j.anchor_d2 = malloc(na * 4 * sizeof *j.anchor_d2);
         j.anchor_pairs = calloc(j.ah, sizeof *j.anchor_pairs);
-        if (!j.anchor_sample || !j.anchor_light || !j.anchor_pairs)
+        if (!j.anchor_sample || !j.anchor_light || !j.anchor_d2 || !j.anchor_pairs)
             r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory for the sparse anchors");
         else
             r = vsgl__shade_anchors(ctx, &j);
@@ -650,6 +651,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
     free(kl);
     free(j.anchor_sample);
     free(j.anchor_light);
+    free(j.anchor_d2);
     free(j.anchor_pairs);
     if (pairs)
         *pairs = total;

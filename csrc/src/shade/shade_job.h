@@ -27,6 +27,8 @@ typedef struct shade_job {
     uint32_t stride, aw, ah;
     size_t *anchor_sample;   /* per anchor: its shaded sample, SIZE_MAX if its pixel missed */
     float *anchor_light;     /* per anchor: 6 floats */
+    float *anchor_d2;        /* per anchor: |second difference| of its light (diffuse x, y, glossy x, y)
+                                through it and its two neighbours on its surface, -1 where there is none */
     uint64_t *anchor_pairs;  /* per anchor row */
     float contrast_floor[2]; /* diffuse, glossy: the interpolation test's floor, a fraction of the frame's mean (sparse.c) */
 } shade_job;

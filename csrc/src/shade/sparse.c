@@ -111,26 +111,6 @@ static int32_t anchor_rows(void *user, size_t chunk, size_t b, size_t e)
     return rc;
 }
 
-vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
-{
-    if (vsgl__parallel_for(vsgl_context_thread_count(ctx), j->ah, 1, anchor_rows, j) != 0)
-        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory for the sparse anchors");
-    /* the contrast test's floor: a fraction of the frame's mean light per lobe */
-    double sum[2] = {0.0, 0.0};
-    size_t n = 0;
-    for (size_t a = 0; a < (size_t)j->aw * j->ah; ++a) {
-        if (j->anchor_sample[a] == SIZE_MAX)
-            continue;
-        const float *A = j->anchor_light + a * 6;
-        sum[0] += (double)A[0] + A[1] + A[2];
-        sum[1] += (double)A[3] + A[4] + A[5];
-        ++n;
-    }
-    for (int l = 0; l < 2; ++l)
-        j->contrast_floor[l] = n ? (float)(SPARSE_FLOOR * sum[l] / (double)n) : 0.0f;
-    return VSGL_OK;
-}
-
 /* How much anchor sample a stands on sample s's surface, in [0, 1]. */
 static float same_surface_weight(const shade_job *j, size_t s, size_t a)
 {
@@ -151,44 +131,47 @@ static float same_surface_weight(const shade_job *j, size_t s, size_t a)
     return wn * wp;
 }
 
-/* Anchor (cx, cy) if it exists and stands on sample si's surface, else SIZE_MAX. */
-static size_t usable_anchor(const shade_job *j, size_t si, int64_t cx, int64_t cy)
+vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
 {
-    if (cx < 0 || cy < 0 || cx >= (int64_t)j->aw || cy >= (int64_t)j->ah)
-        return SIZE_MAX;
-    size_t a = (size_t)cy * j->aw + (size_t)cx, as = j->anchor_sample[a];
-    if (as == SIZE_MAX || (as != si && !(same_surface_weight(j, si, as) > 0.0f)))
-        return SIZE_MAX;
-    return a;
-}
-
-/* The largest |v0 - 2 v1 + v2| of lobe l over runs of three usable anchors
- * along (sx, sy) that include the cell's anchors (x0, y0) and (x0 + sx,
- * y0 + sy), for the two rows (or columns) of the cell; -1 if there is none. */
-static void second_differences(const shade_job *j, size_t si, int64_t ax, int64_t ay, int along_x, float d2[2])
-{
-    d2[0] = d2[1] = -1.0f;
-    for (int r = 0; r < 2; ++r)
-        for (int start = -1; start <= 0; ++start) {
-            size_t a[3];
-            int ok = 1;
-            for (int q = 0; q < 3 && ok; ++q) {
-                int64_t cx = along_x ? ax + start + q : ax + r, cy = along_x ? ay + r : ay + start + q;
-                a[q] = usable_anchor(j, si, cx, cy);
-                ok = a[q] != SIZE_MAX;
-            }
-            if (!ok)
+    if (vsgl__parallel_for(vsgl_context_thread_count(ctx), j->ah, 1, anchor_rows, j) != 0)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory for the sparse anchors");
+    /* each anchor's second differences along x and y through its neighbours on its surface */
+    for (uint32_t ay = 0; ay < j->ah; ++ay)
+        for (uint32_t ax = 0; ax < j->aw; ++ax) {
+            size_t a = (size_t)ay * j->aw + ax, as = j->anchor_sample[a];
+            float *D = j->anchor_d2 + a * 4;
+            D[0] = D[1] = D[2] = D[3] = -1.0f;
+            if (as == SIZE_MAX)
                 continue;
-            for (int l = 0; l < 2; ++l) {
-                float v[3];
-                for (int q = 0; q < 3; ++q) {
-                    const float *A = j->anchor_light + a[q] * 6 + 3 * l;
-                    v[q] = A[0] + A[1] + A[2];
+            for (int axis = 0; axis < 2; ++axis) {
+                if (axis == 0 ? (ax == 0 || ax + 1 >= j->aw) : (ay == 0 || ay + 1 >= j->ah))
+                    continue;
+                size_t step = axis == 0 ? 1 : j->aw, m = a - step, p = a + step;
+                size_t ms = j->anchor_sample[m], ps = j->anchor_sample[p];
+                if (ms == SIZE_MAX || ps == SIZE_MAX || !(same_surface_weight(j, as, ms) > 0.0f) ||
+                    !(same_surface_weight(j, as, ps) > 0.0f))
+                    continue;
+                for (int l = 0; l < 2; ++l) {
+                    const float *A = j->anchor_light + a * 6 + 3 * l, *M = j->anchor_light + m * 6 + 3 * l,
+                                *P = j->anchor_light + p * 6 + 3 * l;
+                    D[2 * l + axis] = fabsf((M[0] + M[1] + M[2]) - 2.0f * (A[0] + A[1] + A[2]) + (P[0] + P[1] + P[2]));
                 }
-                float d = fabsf(v[0] - 2.0f * v[1] + v[2]);
-                d2[l] = d > d2[l] ? d : d2[l];
             }
         }
+    /* the interpolation test's floor: a fraction of the frame's mean light per lobe */
+    double sum[2] = {0.0, 0.0};
+    size_t n = 0;
+    for (size_t a = 0; a < (size_t)j->aw * j->ah; ++a) {
+        if (j->anchor_sample[a] == SIZE_MAX)
+            continue;
+        const float *A = j->anchor_light + a * 6;
+        sum[0] += (double)A[0] + A[1] + A[2];
+        sum[1] += (double)A[3] + A[4] + A[5];
+        ++n;
+    }
+    for (int l = 0; l < 2; ++l)
+        j->contrast_floor[l] = n ? (float)(SPARSE_FLOOR * sum[l] / (double)n) : 0.0f;
+    return VSGL_OK;
 }
 
 int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
@@ -225,7 +208,7 @@ int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
         uint32_t ax = (uint32_t)fx, ay = (uint32_t)fy;
         float tx = fx - (float)ax, ty = fy - (float)ay;
         float wsum = 0.0f, L[6] = {0, 0, 0, 0, 0, 0};
-        float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {0.0f, 0.0f};
+        float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {0.0f, 0.0f}, dx2[2] = {-1.0f, -1.0f}, dy2[2] = {-1.0f, -1.0f};
         for (int dy = 0; dy < 2; ++dy)
             for (int dx = 0; dx < 2; ++dx) {
                 uint32_t cx = ax + (uint32_t)dx, cy = ay + (uint32_t)dy;
@@ -242,19 +225,19 @@ int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
                 const float *A = j->anchor_light + a * 6;
                 for (int c = 0; c < 6; ++c)
                     L[c] += w * A[c];
+                const float *D = j->anchor_d2 + a * 4;
                 for (int l = 0; l < 2; ++l) {
                     float v = A[3 * l] + A[3 * l + 1] + A[3 * l + 2];
                     lo[l] = v < lo[l] ? v : lo[l];
                     hi[l] = v > hi[l] ? v : hi[l];
+                    dx2[l] = D[2 * l] > dx2[l] ? D[2 * l] : dx2[l];
+                    dy2[l] = D[2 * l + 1] > dy2[l] ? D[2 * l + 1] : dy2[l];
                 }
             }
         /* where bilinear interpolation would be off by more than SPARSE_TOL
          * (a reflection's edge, a shadow's), the sample is shaded itself */
         int smooth = 1;
         if (wsum > 0.05f) {
-            float dx2[2], dy2[2];
-            second_differences(j, si, ax, ay, 1, dx2);
-            second_differences(j, si, ax, ay, 0, dy2);
             for (int l = 0; l < 2; ++l) {
                 float m = (L[3 * l] + L[3 * l + 1] + L[3 * l + 2]) / wsum;
                 float bound = SPARSE_TOL * m + j->contrast_floor[l];
