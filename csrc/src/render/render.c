@@ -192,17 +192,24 @@ static vsgl_result write_outputs(vsgl_context *ctx, const vsgl_pixel_planes *p, 
                               "render: pixel %zu channel %zu is not finite and non-negative "
                               "(diffuse %g, glossy %g): please report this scene",
                               i / 3, i % 3, (double)p->diffuse[i], (double)p->glossy[i]);
-    for (size_t i = 0; i < pixels * 3; ++i) {
-        float dl = divide_or_zero(p->diffuse[i], p->diffuse_color[i]);
-        float gl = divide_or_zero(p->glossy[i], p->glossy_color[i]);
-        if (out->diffuse_light) out->diffuse_light[i] = dl;
-        if (out->glossy_light) out->glossy_light[i] = gl;
-        if (out->diffuse_color) out->diffuse_color[i] = p->diffuse_color[i];
-        if (out->glossy_color) out->glossy_color[i] = p->glossy_color[i];
-        if (out->diffuse) out->diffuse[i] = p->diffuse[i];
-        if (out->glossy) out->glossy[i] = p->glossy[i];
-        if (out->combined) out->combined[i] = p->diffuse[i] + p->glossy[i];
-    }
+    /* plane by plane, only those asked for (the live viewport asks for one) */
+    if (out->diffuse_light)
+        for (size_t i = 0; i < pixels * 3; ++i)
+            out->diffuse_light[i] = divide_or_zero(p->diffuse[i], p->diffuse_color[i]);
+    if (out->glossy_light)
+        for (size_t i = 0; i < pixels * 3; ++i)
+            out->glossy_light[i] = divide_or_zero(p->glossy[i], p->glossy_color[i]);
+    if (out->diffuse_color)
+        memcpy(out->diffuse_color, p->diffuse_color, pixels * 3 * sizeof(float));
+    if (out->glossy_color)
+        memcpy(out->glossy_color, p->glossy_color, pixels * 3 * sizeof(float));
+    if (out->diffuse)
+        memcpy(out->diffuse, p->diffuse, pixels * 3 * sizeof(float));
+    if (out->glossy)
+        memcpy(out->glossy, p->glossy, pixels * 3 * sizeof(float));
+    if (out->combined)
+        for (size_t i = 0; i < pixels * 3; ++i)
+            out->combined[i] = p->diffuse[i] + p->glossy[i];
     if (out->alpha)
         memcpy(out->alpha, p->coverage, pixels * sizeof(float));
     return VSGL_OK;
@@ -273,6 +280,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     vsgl__progress_window(ctx, 0.0f, 0.1f);
     const vsgl_gbuffer *gb = &g; /* the cache's, or this render's own */
     int built_g = 0, built_set = 0;
+    vsgl_shade_plan *plan = NULL; /* the shading plan recorded for a G-buffer this render builds */
     if (vsgl__cache_gbuffer_hit(cache, scene, s.aa_samples, s.edge_samples)) {
         gb = &cache->g;
         st.reused |= VSGL_REUSED_GBUFFER;
@@ -307,7 +315,9 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
         if (r == VSGL_OK) {
             t0 = now_seconds();
             vsgl__progress_window(ctx, 0.4f, 0.6f);
-            r = vsgl__shade(ctx, scene, gb, vs, &s, &planes, VSGL__SHADE_KERNEL, &st.shading_pairs);
+            /* through a cache: a light edit replays the shading plan of the G-buffer */
+            r = vsgl__shade_planned(ctx, scene, gb, vs, &s, &planes, VSGL__SHADE_KERNEL, &st.shading_pairs,
+                                    !cache ? NULL : built_g ? &plan : &cache->plan);
             if (r == VSGL_OK && s.glossy_mode == VSGL_GLOSSY_MRP) /* the glossy plane from rectangle proxies */
                 r = vsgl__mrp_glossy_pass(ctx, scene, s.rsm_resolution, VSGL__MRP_MIN_AREA, VSGL__MRP_CELLS, gb,
                                           &planes, NULL);
@@ -331,11 +341,14 @@ done:
     if (cache && r != VSGL_OK) {
         vsgl__cache_clear(cache);
     } else if (cache) {
-        if (built_g)
-            vsgl__cache_keep_gbuffer(cache, scene, s.aa_samples, s.edge_samples, &g);
+        if (built_g) {
+            vsgl__cache_keep_gbuffer(cache, scene, s.aa_samples, s.edge_samples, &g, plan);
+            plan = NULL;
+        }
         if (built_set)
             vsgl__cache_keep_fit(cache, scene, &s, &set, &st);
     }
+    vsgl__shade_plan_free(plan);
     vsgl__vsgl_set_free(&set);
     vsgl__gbuffer_free(&g);
     st.seconds_total = now_seconds() - t_start;

@@ -23,6 +23,7 @@ void vsgl__cache_clear(vsgl_render_cache *c)
     if (!c)
         return;
     vsgl__gbuffer_free(&c->g);
+    vsgl__shade_plan_free(c->plan);
     vsgl__vsgl_set_free(&c->set);
     free(c->f_lights);
     memset(c, 0, sizeof *c);
@@ -46,10 +47,13 @@ int vsgl__cache_gbuffer_hit(const vsgl_render_cache *c, const vsgl_scene *scene,
 }
 
 void vsgl__cache_keep_gbuffer(vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, uint32_t edge_aa,
-                              vsgl_gbuffer *g)
+                              vsgl_gbuffer *g, vsgl_shade_plan *plan)
 {
+    if (c->plan != plan)
+        vsgl__shade_plan_free(c->plan);
     vsgl__gbuffer_free(&c->g);
     c->g = *g;
+    c->plan = plan; /* recorded from g, or NULL */
     memset(g, 0, sizeof *g);
     c->g_scene = scene;
     c->g_identity = vsgl__scene_identity(scene);

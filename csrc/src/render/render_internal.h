@@ -5,6 +5,7 @@
 #include "vsgl/render.h"
 #include "fit/vsgl_set.h"
 #include "gbuffer/gbuffer.h"
+#include "shade/shade.h"
 
 /* Copy `in` (NULL = defaults) into `s`, fill defaults for zero fields and
  * validate; the error names the field. */
@@ -31,6 +32,7 @@ struct vsgl_render_cache {
     vsgl_camera g_camera;
     uint32_t g_aa, g_edge_aa;
     vsgl_gbuffer g;
+    vsgl_shade_plan *plan;       /* NULL, or the shading plan of g (shade/shade_job.h) */
     int has_f;                   /* the VSGLs of f_scene's f_lights with f_settings, and the fit's stats */
     const vsgl_scene *f_scene;
     uint64_t f_identity;
@@ -44,9 +46,9 @@ struct vsgl_render_cache {
 
 void vsgl__cache_clear(vsgl_render_cache *c);
 int vsgl__cache_gbuffer_hit(const vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, uint32_t edge_aa);
-/* Takes `g` (zeroed afterwards). */
+/* Takes `g` (zeroed afterwards) and `plan` (its shading plan, or NULL). */
 void vsgl__cache_keep_gbuffer(vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, uint32_t edge_aa,
-                              vsgl_gbuffer *g);
+                              vsgl_gbuffer *g, vsgl_shade_plan *plan);
 int vsgl__cache_fit_hit(const vsgl_render_cache *c, const vsgl_scene *scene, const vsgl_render_settings *s);
 /* Takes `set` (zeroed afterwards) with the fit's stats from `st`. */
 vsgl_result vsgl__cache_keep_fit(vsgl_render_cache *c, const vsgl_scene *scene, const vsgl_render_settings *s,

@@ -99,15 +99,27 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
     return expf(lobe->log_amplitude - 0.5f * q) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
 }
 
+/* The BRDF parameters of G-buffer sample i: its material's, from the
+ * job's table where no sample has inputs of its own (untextured scenes),
+ * the same function of the same inputs either way. */
+static void sample_params(const shade_job *j, size_t i, vsgl_brdf_params *bp)
+{
+    if (j->params) {
+        *bp = j->params[j->g->material[i]];
+        return;
+    }
+    vsgl_material m;
+    vsgl__gbuffer_material(j->g, j->materials, i, &m);
+    vsgl__material_params(&m, bp);
+}
+
 static void setup_receiver(const shade_job *j, size_t i, receiver *r)
 {
     const vsgl_gbuffer *g = j->g;
     r->x = v3_make(g->pos[0][i], g->pos[1][i], g->pos[2][i]);
     r->n = v3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
     r->o = v3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
-    vsgl_material m;
-    vsgl__gbuffer_material(g, j->materials, i, &m);
-    vsgl__material_params(&m, &r->bp);
+    sample_params(j, i, &r->bp);
     r->alpha = sqrtf(r->bp.alpha_x * r->bp.alpha_y);
     r->glossy = r->bp.glossy && v3_dot(r->n, r->o) > 0.0f;
     if (!r->glossy)
@@ -368,21 +380,96 @@ static int same_surface(const vsgl_gbuffer *g, const vsgl_material *materials, s
     return fabsf(v3_dot(d, na)) <= plane_tol;
 }
 
+/* A kernel lane's receiver fields (vsgl_kernel_block without the
+ * accumulators), as a shading plan keeps them (shade_job.h). */
+static void lane_get(const vsgl_kernel_block *b, size_t k, vsgl__plan_lane *o)
+{
+    float *v = o->v;
+    *v++ = b->x[k]; *v++ = b->y[k]; *v++ = b->z[k];
+    *v++ = b->nx[k]; *v++ = b->ny[k]; *v++ = b->nz[k];
+    *v++ = b->ox[k]; *v++ = b->oy[k]; *v++ = b->oz[k];
+    *v++ = b->diffuse[k];
+    *v++ = b->Xx[k]; *v++ = b->Xy[k]; *v++ = b->Xz[k];
+    *v++ = b->Yx[k]; *v++ = b->Yy[k]; *v++ = b->Yz[k];
+    *v++ = b->Zx[k]; *v++ = b->Zy[k]; *v++ = b->Zz[k];
+    *v++ = b->lam[k]; *v++ = b->mu[k]; *v++ = b->camp[k];
+    *v++ = b->f0r[k]; *v++ = b->f0g[k]; *v = b->f0b[k];
+}
+
+static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o)
+{
+    const float *v = o->v;
+    b->x[k] = *v++; b->y[k] = *v++; b->z[k] = *v++;
+    b->nx[k] = *v++; b->ny[k] = *v++; b->nz[k] = *v++;
+    b->ox[k] = *v++; b->oy[k] = *v++; b->oz[k] = *v++;
+    b->diffuse[k] = *v++;
+    b->Xx[k] = *v++; b->Xy[k] = *v++; b->Xz[k] = *v++;
+    b->Yx[k] = *v++; b->Yy[k] = *v++; b->Yz[k] = *v++;
+    b->Zx[k] = *v++; b->Zy[k] = *v++; b->Zz[k] = *v++;
+    b->lam[k] = *v++; b->mu[k] = *v++; b->camp[k] = *v++;
+    b->f0r[k] = *v++; b->f0g[k] = *v++; b->f0b[k] = *v;
+}
+
+/* Shade a filled block of n receivers (lanes [0, n) of blk, rec[k].x and
+ * .n for visibility rays) and write 6 floats per receiver to light. */
+static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const receiver *rec, size_t n, float *light)
+{
+    float vis[2 * VSGL__KERNEL_BLOCK]; /* visibility of two VSGLs */
+    uint64_t pairs = 0;
+    int32_t lobes = 0;
+    for (size_t k = 0; k < n; ++k)
+        lobes |= (blk->diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk->camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0);
+    if ((lobes & VSGL__KERNEL_GLOSSY) && j->s->glossy_mode == VSGL_GLOSSY_ASG2)
+        lobes |= VSGL__KERNEL_GGX_TAIL;
+    for (size_t k = n; k < VSGL__KERNEL_BLOCK; ++k) {
+        /* padding lanes: shaded, never read; at lane 0's position so that
+         * they do not change the block's choice of short forms */
+        clear_lane(blk, k, blk->x[0], blk->y[0], blk->z[0]);
+        vis[k] = vis[VSGL__KERNEL_BLOCK + k] = 0.0f;
+    }
+    memset(blk->ld, 0, sizeof blk->ld);
+    memset(blk->ls, 0, sizeof blk->ls);
+    if (lobes) {
+        void (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t) =
+            j->path == VSGL__SHADE_KERNEL_SCALAR ? vsgl__kernel_shade_scalar : vsgl__kernel_shade;
+        const size_t count = j->set->count;
+        if (j->s->visibility == VSGL_VISIBILITY_RAY) {
+            /* two VSGLs per kernel call, the pairs it interleaves */
+            for (size_t v = 0; v < count; v += 2) {
+                size_t m = count - v < 2 ? count - v : 2;
+                for (size_t q = 0; q < m; ++q)
+                    visibility_rays(j, ray_target(&j->set->items[j->korder[v + q]]), rec, n,
+                                    vis + q * VSGL__KERNEL_BLOCK);
+                kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
+            }
+        } else {
+            kernel(blk, j->klights, count, NULL, j->s->diffuse_mode, lobes);
+        }
+        pairs += (uint64_t)n * j->set->count;
+    }
+    for (size_t k = 0; k < n; ++k)
+        for (int c = 0; c < 3; ++c) {
+            light[k * 6 + c] = blk->ld[c][k];
+            light[k * 6 + 3 + c] = blk->ls[c][k];
+        }
+    return pairs;
+}
+
 /* Shade G-buffer samples list[0..n) through the kernel, VSGL__KERNEL_BLOCK at
  * a time, each at its own position or, where centroid (4 floats per entry:
  * a position sum and a count) has a count above 1, at the centroid of a
  * merged group; writes 6 floats per entry (diffuse light RGB, glossy RGB).
- * Every listed sample must be a hit. Returns the number of pairs. */
+ * Every listed sample must be a hit. lanes: NULL, or n entries that
+ * receive each receiver's kernel lane (a shading plan's record). Returns
+ * the number of pairs. */
 uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshaded, const float *centroid,
-                          float *light)
+                          float *light, vsgl__plan_lane *lanes)
 {
     vsgl_kernel_block blk;
     receiver rec[VSGL__KERNEL_BLOCK];
-    float vis[2 * VSGL__KERNEL_BLOCK]; /* visibility of two VSGLs */
     uint64_t pairs = 0;
     for (size_t s0 = 0; s0 < nshaded; s0 += VSGL__KERNEL_BLOCK) {
         size_t n = nshaded - s0 < VSGL__KERNEL_BLOCK ? nshaded - s0 : VSGL__KERNEL_BLOCK;
-        int32_t lobes = 0;
         for (size_t k = 0; k < n; ++k) {
             fill_lane(j, shaded[s0 + k], &blk, k, &rec[k]); /* every shaded sample is a hit */
             const float *cg = centroid ? centroid + (s0 + k) * 4 : NULL;
@@ -393,47 +480,46 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
                 blk.y[k] = rec[k].x.y;
                 blk.z[k] = rec[k].x.z;
             }
-            lobes |= (blk.diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk.camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0);
+            if (lanes)
+                lane_get(&blk, k, &lanes[s0 + k]);
         }
-        if ((lobes & VSGL__KERNEL_GLOSSY) && j->s->glossy_mode == VSGL_GLOSSY_ASG2)
-            lobes |= VSGL__KERNEL_GGX_TAIL;
-        for (size_t k = n; k < VSGL__KERNEL_BLOCK; ++k) {
-            /* padding lanes: shaded, never read; at lane 0's position so that
-             * they do not change the block's choice of short forms */
-            clear_lane(&blk, k, blk.x[0], blk.y[0], blk.z[0]);
-            vis[k] = vis[VSGL__KERNEL_BLOCK + k] = 0.0f;
+        pairs += run_block(j, &blk, rec, n, light + s0 * 6);
+    }
+    return pairs;
+}
+
+/* The kernel lane of G-buffer sample i (a hit), as vsgl__shade_list fills it. */
+void vsgl__sample_lane(const shade_job *j, size_t i, vsgl__plan_lane *lane)
+{
+    vsgl_kernel_block blk;
+    receiver r;
+    fill_lane(j, i, &blk, 0, &r);
+    lane_get(&blk, 0, lane);
+}
+
+/* The same from recorded lanes (a shading plan's replay): bit-identical
+ * to vsgl__shade_list on the samples they were recorded from. */
+uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lanes, size_t n_total, float *light)
+{
+    vsgl_kernel_block blk;
+    receiver rec[VSGL__KERNEL_BLOCK];
+    uint64_t pairs = 0;
+    for (size_t s0 = 0; s0 < n_total; s0 += VSGL__KERNEL_BLOCK) {
+        size_t n = n_total - s0 < VSGL__KERNEL_BLOCK ? n_total - s0 : VSGL__KERNEL_BLOCK;
+        for (size_t k = 0; k < n; ++k) {
+            lane_put(&blk, k, lanes[s0 + k]);
+            rec[k].x = v3_make(blk.x[k], blk.y[k], blk.z[k]);
+            rec[k].n = v3_make(blk.nx[k], blk.ny[k], blk.nz[k]);
         }
-        memset(blk.ld, 0, sizeof blk.ld);
-        memset(blk.ls, 0, sizeof blk.ls);
-        if (lobes) {
-            void (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t) =
-                j->path == VSGL__SHADE_KERNEL_SCALAR ? vsgl__kernel_shade_scalar : vsgl__kernel_shade;
-            const size_t count = j->set->count;
-            if (j->s->visibility == VSGL_VISIBILITY_RAY) {
-                /* two VSGLs per kernel call, the pairs it interleaves */
-                for (size_t v = 0; v < count; v += 2) {
-                    size_t m = count - v < 2 ? count - v : 2;
-                    for (size_t q = 0; q < m; ++q)
-                        visibility_rays(j, ray_target(&j->set->items[v + q]), rec, n, vis + q * VSGL__KERNEL_BLOCK);
-                    kernel(&blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
-                }
-            } else {
-                kernel(&blk, j->klights, count, NULL, j->s->diffuse_mode, lobes);
-            }
-            pairs += (uint64_t)n * j->set->count;
-        }
-        for (size_t k = 0; k < n; ++k)
-            for (int c = 0; c < 3; ++c) {
-                light[(s0 + k) * 6 + c] = blk.ld[c][k];
-                light[(s0 + k) * 6 + 3 + c] = blk.ls[c][k];
-            }
+        pairs += run_block(j, &blk, rec, n, light + s0 * 6);
     }
     return pairs;
 }
 
 /* Pixel px of the planes from its samples' light (Ls[k]: 6 floats, NULL
- * for a miss) and their own colours. */
-void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls)
+ * for a miss) and their own colours; cd (NULL or 4 floats per sample)
+ * receives each hit sample's diffuse colour x weight and its weight. */
+void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls, float *cd)
 {
     const vsgl_gbuffer *g = j->g;
     const vsgl_pixel_planes *pl = j->planes;
@@ -444,10 +530,8 @@ void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls)
         size_t si = px * spp + k;
         if (!Ls[k])
             continue;
-        vsgl_material m;
-        vsgl__gbuffer_material(g, j->materials, si, &m);
         vsgl_brdf_params bp;
-        vsgl__material_params(&m, &bp);
+        sample_params(j, si, &bp);
         v3 n = v3_make(g->nrm[0][si], g->nrm[1][si], g->nrm[2][si]);
         v3 o = v3_make(g->view[0][si], g->view[1][si], g->view[2][si]);
         float gcol[3] = {0, 0, 0};
@@ -456,6 +540,11 @@ void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls)
         const float *L = Ls[k];
         const float w = vsgl__gbuffer_weight(g, si);
         float wd = w * vsgl__scene_diffuse_weight(j->scene, g->material[si], v3_dot(n, o));
+        if (cd) {
+            for (int c = 0; c < 3; ++c)
+                cd[k * 4 + c] = bp.diffuse[c] * wd;
+            cd[k * 4 + 3] = w;
+        }
         for (int c = 0; c < 3; ++c) {
             acc[c] += bp.diffuse[c] * wd * L[c];
             acc[3 + c] += w * L[3 + c];
@@ -524,7 +613,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
         cg[2] += g->pos[2][si];
         cg[3] += 1.0f;
     }
-    pairs += vsgl__shade_list(j, shaded, nshaded, centroid, light);
+    pairs += vsgl__shade_list(j, shaded, nshaded, centroid, light, NULL);
     /* every covered sample: its own colours, the light of its slot */
     const float *Ls[VSGL__GBUFFER_MAX_SPP];
     for (size_t px = j->base + b0; px < j->base + e0; ++px) {
@@ -532,7 +621,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             size_t i = (px - j->base - b0) * spp + k;
             Ls[k] = slot[i] == UINT32_MAX ? NULL : light + (size_t)slot[i] * 6;
         }
-        vsgl__write_pixel(j, px, Ls);
+        vsgl__write_pixel(j, px, Ls, NULL);
     }
     free(shaded);
     free(slot);
@@ -548,6 +637,14 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
 vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
                         const vsgl_vsgl_set *set, const vsgl_render_settings *s,
                         const vsgl_pixel_planes *planes, int path, uint64_t *pairs)
+{
+    return vsgl__shade_planned(ctx, scene, g, set, s, planes, path, pairs, NULL);
+}
+
+vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
+                                const vsgl_vsgl_set *set, const vsgl_render_settings *s,
+                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs,
+                                vsgl_shade_plan **plan)
 {
     size_t pixels = (size_t)g->width * g->height;
     size_t chunk = g->width ? g->width : 1; /* one row per chunk */
@@ -570,6 +667,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
     int leak = s->leak_correction == VSGL_LEAK_ON ||
                s->leak_correction == VSGL_LEAK_AUTO;
     vsgl_kernel_light *kl = NULL;
+    size_t *korder = NULL;
     if (path != VSGL__SHADE_REFERENCE) {
         kl = malloc((set->count + 1) * sizeof *kl);
         if (!kl) {
@@ -603,11 +701,42 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
             o->u1x = u1.x; o->u1y = u1.y; o->u1z = u1.z;
             o->u2x = u2.x; o->u2y = u2.y; o->u2z = u2.z;
         }
+        /* The kernel shades VSGLs two at a time, and a pair that mixes a
+         * planar cluster with another computes both glossy models for both
+         * (the lattice emits them alternating: every pair was mixed). In
+         * the order planar 0, between, 1, each kept in the fit's order, at
+         * most two pairs mix. korder[k]: the VSGL of kernel light k. */
+        korder = malloc((set->count + 1) * sizeof *korder);
+        vsgl_kernel_light *sorted = malloc((set->count + 1) * sizeof *sorted);
+        if (!korder || !sorted) {
+            free(korder);
+            free(sorted);
+            free(kl);
+            free(per_chunk);
+            return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
+        }
+        size_t n = 0;
+        for (int cls = 0; cls < 3; ++cls)
+            for (size_t k = 0; k < set->count; ++k) {
+                float q = kl[k].planar;
+                if ((q == 0.0f ? 0 : q == 1.0f ? 2 : 1) == cls) {
+                    korder[n] = k;
+                    sorted[n++] = kl[k];
+                }
+            }
+        free(kl);
+        kl = sorted;
     }
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
-                   eps, 0, per_chunk, kl, path, leak,
+                   eps, 0, per_chunk, kl, korder, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
-                   0, 0, 0, NULL, NULL, NULL, NULL, {0.0f, 0.0f}};
+                   0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL};
+    /* untextured: each material's BRDF parameters once, not once per sample */
+    vsgl_brdf_params *params = g->surf[0] ? NULL : malloc(((size_t)material_count + 1) * sizeof *params);
+    if (params)
+        for (uint32_t k = 0; k < material_count; ++k)
+            vsgl__material_params(&j.materials[k], &params[k]);
+    j.params = params;
     vsgl_result r = VSGL_OK;
     /* One pixel in S x S (sparse.c): the anchors now, the rest row by row below. */
     int sparse = s->shade_stride > 1 && path != VSGL__SHADE_REFERENCE && g->width && g->height;
@@ -620,24 +749,39 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
         j.anchor_sample = malloc(na * sizeof *j.anchor_sample);
         j.anchor_light = malloc(na * 6 * sizeof *j.anchor_light);
         j.anchor_d2 = malloc(na * 4 * sizeof *j.anchor_d2);
-        j.anchor_pairs = calloc(j.ah, sizeof *j.anchor_pairs);
-        if (!j.anchor_sample || !j.anchor_light || !j.anchor_d2 || !j.anchor_pairs)
+        j.anchor_pairs = calloc(na + 1, sizeof *j.anchor_pairs); /* per chunk of anchors: fewer than na */
+        j.alist = malloc((na + 1) * sizeof *j.alist);
+        if (plan) { /* replay a plan of this G-buffer, or record one */
+            if (*plan && vsgl__shade_plan_matches(*plan, g, s, j.aw, j.ah)) {
+                j.plan = *plan;
+                j.replay = 1;
+            } else {
+                j.plan = vsgl__shade_plan_new(g, s, j.aw, j.ah);
+            }
+        }
+        if (!j.anchor_sample || !j.anchor_light || !j.anchor_d2 || !j.anchor_pairs || !j.alist)
             r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory for the sparse anchors");
         else
             r = vsgl__shade_anchors(ctx, &j);
-        for (uint32_t a = 0; r == VSGL_OK && a < j.ah; ++a)
+        for (size_t a = 0; r == VSGL_OK && a < na; ++a)
             anchor_total += j.anchor_pairs[a];
     }
-    /* Rows in batches so progress can be reported and cancellation honoured. */
-    size_t rows_per_batch = g->height / 20 + 1;
+    /* Rows in batches so progress can be reported and cancellation honoured:
+     * 20 of them, but none under 2^17 pixels (each batch ends in a wait for
+     * its slowest row: a live viewport's 960 x 540 has 4, not 20) */
+    size_t rows_per_batch = g->height / 20 + 1, min_rows = ((size_t)1 << 17) / (chunk ? chunk : 1) + 1;
+    if (rows_per_batch < min_rows)
+        rows_per_batch = min_rows;
     for (size_t row = 0; row < g->height && r == VSGL_OK; row += rows_per_batch) {
         size_t end = row + rows_per_batch < g->height ? row + rows_per_batch : g->height;
         j.base = row * chunk;
         j.pairs = per_chunk + row;
-        if (vsgl__parallel_for(vsgl_context_thread_count(ctx), (end - row) * chunk, chunk,
-                               path == VSGL__SHADE_REFERENCE ? shade_chunk
-                               : sparse                     ? vsgl__shade_chunk_sparse
-                                                            : shade_chunk_kernel, &j) != 0) {
+        if (sparse) {
+            r = vsgl__shade_sparse_batch(ctx, &j, row, end);
+            if (r != VSGL_OK)
+                break;
+        } else if (vsgl__parallel_for(vsgl_context_thread_count(ctx), (end - row) * chunk, chunk,
+                                      path == VSGL__SHADE_REFERENCE ? shade_chunk : shade_chunk_kernel, &j) != 0) {
             r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
             break;
         }
@@ -649,10 +793,21 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
         total += per_chunk[c];
     free(per_chunk);
     free(kl);
+    free(korder);
     free(j.anchor_sample);
     free(j.anchor_light);
     free(j.anchor_d2);
     free(j.anchor_pairs);
+    free(j.alist);
+    free(params);
+    if (j.plan && !j.replay) {
+        if (r == VSGL_OK && vsgl__shade_plan_complete(j.plan)) {
+            vsgl__shade_plan_free(*plan);
+            *plan = j.plan;
+        } else {
+            vsgl__shade_plan_free(j.plan);
+        }
+    }
     if (pairs)
         *pairs = total;
     return r;

@@ -77,4 +77,19 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
                         const vsgl_vsgl_set *set, const vsgl_render_settings *s,
                         const vsgl_pixel_planes *planes, int path, uint64_t *pairs);
 
+/* What shading a G-buffer needs that no light changes (shade_job.h). */
+typedef struct vsgl_shade_plan vsgl_shade_plan;
+void vsgl__shade_plan_free(vsgl_shade_plan *plan);
+
+/* vsgl__shade through a shading plan kept by the caller with the G-buffer
+ * (`*plan` NULL or a plan of this very G-buffer: the caller frees it when
+ * the G-buffer changes). With shade_stride > 1 it replays a plan made
+ * with the same stride and glossy mode, else records one into `*plan`
+ * (replacing the old one; left as it was if memory is short). The planes
+ * are bit-identical to vsgl__shade's either way. */
+vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
+                                const vsgl_vsgl_set *set, const vsgl_render_settings *s,
+                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs,
+                                vsgl_shade_plan **plan);
+
 #endif

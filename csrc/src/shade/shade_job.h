@@ -8,6 +8,38 @@
 #include "shade/kernel.h"
 #include "scene/material.h"
 
+/* A kernel lane's receiver fields (25 floats, shade.c: lane_get/lane_put). */
+typedef struct vsgl__plan_lane {
+    float v[25];
+} vsgl__plan_lane;
+
+/* A shading plan (shade_stride > 1): what shading a G-buffer needs that no
+ * light changes, recorded by one render and replayed by the next ones
+ * through a vsgl_render_cache while the G-buffer stands still (a light
+ * edit in the live viewport): every anchor's kernel lane, every sample's
+ * interpolation weights and colour factors, every pixel's colours and
+ * coverage. The interpolation test (which samples are shaded themselves
+ * because their anchors' light bends) reads the light and runs in every
+ * render; such samples take the lanes the record made, or make them from
+ * the G-buffer. A replay
+ * does the same arithmetic in the same order as a render without a plan:
+ * bit-identical planes. */
+struct vsgl_shade_plan {
+    uint32_t stride, glossy_mode, width, height, aw, ah;
+    size_t spp, count;
+    size_t *anchor_sample;          /* aw x ah, as shade_job */
+    vsgl__plan_lane *anchor_lane;   /* aw x ah: the lane of each shaded anchor */
+    float *w4;                      /* 4 per sample: the weights of the anchors around it (0: not used) */
+    int32_t *direct;                /* per sample: -2 miss, -3 shaded itself (no anchor shares its surface),
+                                       -1 interpolated where the interpolation test passes (sparse.c) */
+    float *cd;                      /* 4 per sample: diffuse colour x weight (RGB), the sample's weight */
+    float *colour;                  /* 7 per pixel: DiffCol, GlossCol, coverage */
+    unsigned char *row_ok;          /* per row, and for the anchors (at height): recorded */
+    int32_t *dlane_of;              /* per sample: its lane in dlanes, or -1 (it was not shaded itself) */
+    vsgl__plan_lane *dlanes;        /* the lanes of the samples the record shaded themselves */
+    size_t ndlanes, dlanes_cap;
+};
+
 typedef struct shade_job {
     const vsgl_scene *scene;
     const vsgl_gbuffer *g;
@@ -18,7 +50,8 @@ typedef struct shade_job {
     float eps;            /* ray offset, metres */
     size_t base;          /* first pixel of the current batch */
     uint64_t *pairs;      /* per chunk of the current batch */
-    const vsgl_kernel_light *klights; /* the VSGLs, kernel layout */
+    const vsgl_kernel_light *klights; /* the VSGLs, kernel layout, in kernel order */
+    const size_t *korder;             /* per kernel light: its index in set->items */
     int path;             /* VSGL_SHADE_* */
     int leak;             /* apply the emitter-hemisphere correction */
     int merge;            /* share light between samples of one surface in a pixel */
@@ -29,8 +62,12 @@ typedef struct shade_job {
     float *anchor_light;     /* per anchor: 6 floats */
     float *anchor_d2;        /* per anchor: |second difference| of its light (diffuse x, y, glossy x, y)
                                 through it and its two neighbours on its surface, -1 where there is none */
-    uint64_t *anchor_pairs;  /* per anchor row */
+    size_t *alist;           /* the anchors with a hit sample, in raster order */
+    uint64_t *anchor_pairs;  /* per chunk of alist */
     float contrast_floor[2]; /* diffuse, glossy: the interpolation test's floor, a fraction of the frame's mean (sparse.c) */
+    vsgl_shade_plan *plan;   /* NULL, or the plan being recorded (replay 0) or replayed (replay 1) */
+    int replay;
+    const vsgl_brdf_params *params; /* NULL, or per material (no sample has inputs of its own) */
 } shade_job;
 
 /* Receiver lobe of one sample, set up once and used for every VSGL. */
@@ -44,12 +81,28 @@ typedef struct receiver {
     vsgl_sg sg;          /* warped NDF (SG mode) */
 } receiver;
 
-uint64_t vsgl__shade_list(const shade_job *j, const size_t *list, size_t n, const float *centroid, float *light);
-void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls);
+uint64_t vsgl__shade_list(const shade_job *j, const size_t *list, size_t n, const float *centroid, float *light,
+                          vsgl__plan_lane *lanes);
+void vsgl__sample_lane(const shade_job *j, size_t i, vsgl__plan_lane *lane);
+uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lanes, size_t n, float *light);
+/* cd: NULL, or 4 floats per sample of the pixel that receive its colour factors (a plan's record) */
+void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls, float *cd);
+
+/* Shading plans (sparse.c): a new empty plan to record (NULL if memory is
+ * short), whether one fits this G-buffer and settings, whether a record
+ * filled every row. */
+vsgl_shade_plan *vsgl__shade_plan_new(const vsgl_gbuffer *g, const vsgl_render_settings *s, uint32_t aw,
+                                      uint32_t ah);
+int vsgl__shade_plan_matches(const vsgl_shade_plan *p, const vsgl_gbuffer *g, const vsgl_render_settings *s,
+                             uint32_t aw, uint32_t ah);
+int vsgl__shade_plan_complete(const vsgl_shade_plan *p);
 
 /* Shade with shade_stride > 1 (sparse.c): the anchors first, then rows of
  * pixels [b, e) of the current batch, as vsgl__parallel_for's callback. */
 vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j);
-int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b, size_t e);
+/* Rows [row, end) with shade_stride > 1 (j->base = row * width, j->pairs
+ * the batch's per-row pair counts): interpolate, shade what cannot be
+ * interpolated in full kernel blocks, resolve the pixels. */
+vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row, size_t end);
 
 #endif

@@ -17,7 +17,7 @@
  *     the edge of a glossy floor's reflection of a lit wall, which bilinear
  *     weights blurred (the spot room's glossy structured error 3.6x, its
  *     diffuse 2x what these samples give, docs/quality.md)
- *     (vsgl__shade_chunk_sparse).
+ *     (vsgl__shade_sparse_batch).
  * The light of a sample, not its colour, is interpolated: DiffCol and
  * GlossCol stay per pixel. The shading work falls by about S^2 except at
  * edges and where the light bends (at S = 2 and 2 x 2 samples, 320 x 240:
@@ -67,74 +67,143 @@ static size_t anchor_pixel(const shade_job *j, uint32_t ax, uint32_t ay)
     return (size_t)y * g->width + x;
 }
 
-/* Anchor rows [b, e): shade each anchor's first hit sample. */
-static int32_t anchor_rows(void *user, size_t chunk, size_t b, size_t e)
+void vsgl__shade_plan_free(vsgl_shade_plan *p)
+{
+    if (!p)
+        return;
+    free(p->row_ok);
+    free(p->dlane_of);
+    free(p->dlanes);
+    free(p->anchor_sample);
+    free(p->anchor_lane);
+    free(p->w4);
+    free(p->direct);
+    free(p->cd);
+    free(p->colour);
+    free(p);
+}
+
+vsgl_shade_plan *vsgl__shade_plan_new(const vsgl_gbuffer *g, const vsgl_render_settings *s, uint32_t aw, uint32_t ah)
+{
+    vsgl_shade_plan *p = calloc(1, sizeof *p);
+    if (!p)
+        return NULL;
+    size_t na = (size_t)aw * ah, pixels = (size_t)g->width * g->height;
+    p->stride = s->shade_stride;
+    p->glossy_mode = (uint32_t)s->glossy_mode;
+    p->width = g->width;
+    p->height = g->height;
+    p->aw = aw;
+    p->ah = ah;
+    p->spp = g->spp;
+    p->count = g->count;
+    p->anchor_sample = malloc((na + 1) * sizeof *p->anchor_sample);
+    p->anchor_lane = malloc((na + 1) * sizeof *p->anchor_lane);
+    p->w4 = malloc((g->count + 1) * 4 * sizeof *p->w4);
+    p->direct = malloc((g->count + 1) * sizeof *p->direct);
+    p->cd = malloc((g->count + 1) * 4 * sizeof *p->cd);
+    p->colour = malloc((pixels + 1) * 7 * sizeof *p->colour);
+    p->row_ok = calloc((size_t)g->height + 2, 1);
+    p->dlane_of = malloc((g->count + 1) * sizeof *p->dlane_of);
+    if (!p->anchor_sample || !p->anchor_lane || !p->w4 || !p->direct || !p->cd || !p->colour || !p->row_ok ||
+        !p->dlane_of) {
+        vsgl__shade_plan_free(p);
+        return NULL;
+    }
+    return p;
+}
+
+int vsgl__shade_plan_matches(const vsgl_shade_plan *p, const vsgl_gbuffer *g, const vsgl_render_settings *s,
+                             uint32_t aw, uint32_t ah)
+{
+    return p && p->stride == s->shade_stride && p->glossy_mode == (uint32_t)s->glossy_mode &&
+           p->width == g->width && p->height == g->height && p->spp == g->spp && p->count == g->count &&
+           p->aw == aw && p->ah == ah;
+}
+
+int vsgl__shade_plan_complete(const vsgl_shade_plan *p)
+{
+    for (size_t y = 0; y <= (size_t)p->height; ++y)
+        if (!p->row_ok[y])
+            return 0;
+    return 1;
+}
+
+static float same_surface_weight(const shade_job *j, size_t s, size_t a);
+
+/* Anchors shaded per parallel chunk: four kernel blocks. */
+#define ANCHOR_CHUNK (4 * VSGL__KERNEL_BLOCK)
+
+/* Hit anchors [b, e) of j->alist, packed into full kernel blocks (their
+ * order is the raster order of the anchors, whatever the rows). */
+static int32_t anchor_blocks(void *user, size_t chunk, size_t b, size_t e)
 {
     shade_job *j = user;
-    (void)chunk;
 #if defined(__x86_64__) || defined(__i386__)
     unsigned int saved_csr = _mm_getcsr();
     _mm_setcsr(saved_csr | 0x8040u); /* FTZ | DAZ, as the full-resolution path */
 #endif
-    const vsgl_gbuffer *g = j->g;
-    size_t n_max = (e - b) * j->aw;
-    size_t *list = malloc((n_max + 1) * sizeof *list);
-    size_t *where = malloc((n_max + 1) * sizeof *where);
-    float *light = malloc((n_max + 1) * 6 * sizeof *light);
+    vsgl_shade_plan *plan = j->plan;
+    size_t n = e - b;
+    size_t *list = malloc((n + 1) * sizeof *list);
+    const vsgl__plan_lane **from = malloc((n + 1) * sizeof *from);
+    float *light = malloc((n + 1) * 6 * sizeof *light);
+    vsgl__plan_lane *lanes = plan && !j->replay ? malloc((n + 1) * sizeof *lanes) : NULL;
     int32_t rc = 0;
-    if (!list || !where || !light) {
+    if (!list || !from || !light || (plan && !j->replay && !lanes)) {
         rc = VSGL_ERROR_OUT_OF_MEMORY;
     } else {
-        size_t n = 0;
-        for (size_t ay = b; ay < e; ++ay)
-            for (uint32_t ax = 0; ax < j->aw; ++ax) {
-                size_t a = ay * j->aw + ax, px = anchor_pixel(j, ax, (uint32_t)ay);
-                j->anchor_sample[a] = SIZE_MAX;
-                for (size_t k = 0; k < g->spp; ++k)
-                    if (g->material[px * g->spp + k] != VSGL__GBUFFER_MISS) {
-                        j->anchor_sample[a] = px * g->spp + k;
-                        list[n] = px * g->spp + k;
-                        where[n++] = a;
-                        break;
-                    }
-            }
-        j->anchor_pairs[b] = vsgl__shade_list(j, list, n, NULL, light);
-        for (size_t k = 0; k < n; ++k)
-            memcpy(j->anchor_light + where[k] * 6, light + k * 6, 6 * sizeof *light);
+        for (size_t k = 0; k < n; ++k) {
+            size_t a = j->alist[b + k];
+            list[k] = j->anchor_sample[a];
+            from[k] = j->replay ? &plan->anchor_lane[a] : NULL;
+        }
+        j->anchor_pairs[chunk] = j->replay ? vsgl__shade_lanes(j, from, n, light)
+                                           : vsgl__shade_list(j, list, n, NULL, light, lanes);
+        for (size_t k = 0; k < n; ++k) {
+            size_t a = j->alist[b + k];
+            memcpy(j->anchor_light + a * 6, light + k * 6, 6 * sizeof *light);
+            if (lanes) /* the plan's record: each anchor's lane */
+                plan->anchor_lane[a] = lanes[k];
+        }
     }
     free(list);
-    free(where);
+    free(from);
     free(light);
+    free(lanes);
 #if defined(__x86_64__) || defined(__i386__)
     _mm_setcsr(saved_csr);
 #endif
     return rc;
 }
 
-/* How much anchor sample a stands on sample s's surface, in [0, 1]. */
-static float same_surface_weight(const shade_job *j, size_t s, size_t a)
-{
-    const vsgl_gbuffer *g = j->g;
-    if (g->material[a] != g->material[s])
-        return 0.0f;
-    v3 ns = v3_make(g->nrm[0][s], g->nrm[1][s], g->nrm[2][s]);
-    v3 na = v3_make(g->nrm[0][a], g->nrm[1][a], g->nrm[2][a]);
-    float c = v3_dot(ns, na);
-    if (!(c > SPARSE_NORMAL_COS))
-        return 0.0f;
-    float wn = (c - SPARSE_NORMAL_COS) * (1.0f / (1.0f - SPARSE_NORMAL_COS));
-    v3 d = v3_make(g->pos[0][a] - g->pos[0][s], g->pos[1][a] - g->pos[1][s], g->pos[2][a] - g->pos[2][s]);
-    float off = fabsf(v3_dot(d, ns)), tol = SPARSE_PLANE_REL * v3_length(d) + j->plane_tol;
-    float wp = 1.0f - off / tol;
-    if (!(wp > 0.0f))
-        return 0.0f;
-    return wn * wp;
-}
-
 vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
 {
-    if (vsgl__parallel_for(vsgl_context_thread_count(ctx), j->ah, 1, anchor_rows, j) != 0)
+    const vsgl_gbuffer *g = j->g;
+    vsgl_shade_plan *plan = j->plan;
+    size_t na = (size_t)j->aw * j->ah, nh = 0;
+    /* each anchor's first hit sample (or the plan's), and the list of hit anchors */
+    for (size_t a = 0; a < na; ++a) {
+        if (j->replay) {
+            j->anchor_sample[a] = plan->anchor_sample[a];
+        } else {
+            size_t px = anchor_pixel(j, (uint32_t)(a % j->aw), (uint32_t)(a / j->aw));
+            j->anchor_sample[a] = SIZE_MAX;
+            for (size_t k = 0; k < g->spp; ++k)
+                if (g->material[px * g->spp + k] != VSGL__GBUFFER_MISS) {
+                    j->anchor_sample[a] = px * g->spp + k;
+                    break;
+                }
+        }
+        if (j->anchor_sample[a] != SIZE_MAX)
+            j->alist[nh++] = a;
+    }
+    if (vsgl__parallel_for(vsgl_context_thread_count(ctx), nh, ANCHOR_CHUNK, anchor_blocks, j) != 0)
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory for the sparse anchors");
+    if (plan && !j->replay) {
+        memcpy(plan->anchor_sample, j->anchor_sample, na * sizeof *plan->anchor_sample);
+        plan->row_ok[plan->height] = 1;
+    }
     /* each anchor's second differences along x and y through its neighbours on its surface */
     for (uint32_t ay = 0; ay < j->ah; ++ay)
         for (uint32_t ax = 0; ax < j->aw; ++ax) {
@@ -174,54 +243,116 @@ vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
     return VSGL_OK;
 }
 
-int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
+/* How much anchor sample a stands on sample s's surface, in [0, 1]. */
+static float same_surface_weight(const shade_job *j, size_t s, size_t a)
 {
-    shade_job *j = user;
+    const vsgl_gbuffer *g = j->g;
+    if (g->material[a] != g->material[s])
+        return 0.0f;
+    v3 ns = v3_make(g->nrm[0][s], g->nrm[1][s], g->nrm[2][s]);
+    v3 na = v3_make(g->nrm[0][a], g->nrm[1][a], g->nrm[2][a]);
+    float c = v3_dot(ns, na);
+    if (!(c > SPARSE_NORMAL_COS))
+        return 0.0f;
+    float wn = (c - SPARSE_NORMAL_COS) * (1.0f / (1.0f - SPARSE_NORMAL_COS));
+    v3 d = v3_make(g->pos[0][a] - g->pos[0][s], g->pos[1][a] - g->pos[1][s], g->pos[2][a] - g->pos[2][s]);
+    float off = fabsf(v3_dot(d, ns)), tol = SPARSE_PLANE_REL * v3_length(d) + j->plane_tol;
+    float wp = 1.0f - off / tol;
+    if (!(wp > 0.0f))
+        return 0.0f;
+    return wn * wp;
+}
+
+/* The anchor cell around sample si: its raster position against the
+ * anchors' (each shaded at its pixel's first sample); sample k of pixel
+ * (x, y) lies at (x + (k % aa + 0.5) / aa, ...). */
+static inline void sample_cell(const shade_job *j, size_t si, size_t spp, uint32_t aa, float inv_aa, uint32_t *ax,
+                               uint32_t *ay, float *tx, float *ty)
+{
+    const size_t W = j->g->width, px = si / spp, k = si % spp;
+    const float inv_s = 1.0f / (float)j->stride;
+    float ox = k < aa * aa ? (float)(k % aa) * inv_aa : 0.0f, oy = k < aa * aa ? (float)(k / aa) * inv_aa : 0.0f;
+    float fx = ((float)(px % W) + ox) * inv_s, fy = ((float)(px / W) + oy) * inv_s;
+    *ax = (uint32_t)fx;
+    *ay = (uint32_t)fy;
+    *tx = fx - (float)*ax;
+    *ty = fy - (float)*ay;
+}
+
+/* Plan codes per sample (vsgl_shade_plan.direct): */
+#define PLAN_MISS (-2)
+#define PLAN_ALONE (-3)  /* no anchor shares its surface: always shaded itself */
+#define PLAN_NEAR (-1)   /* interpolated where the interpolation test passes (per render: it reads the light) */
+
+/* The rows of one batch (vsgl__shade_sparse_batch): their samples' interpolated light,
+ * which are shaded themselves, and those samples' light, packed in full kernel blocks. */
+typedef struct sparse_batch {
+    shade_job *j;
+    size_t first, ns;        /* the batch's first sample, its sample count */
+    float *interp;           /* 6 per sample */
+    size_t *direct_of;       /* per sample: SIZE_MAX (interpolated or a miss), else its index in dlist */
+    size_t *dlist;           /* the samples shaded themselves, in sample order */
+    float *dlight;           /* 6 per entry of dlist */
+    uint64_t *dpairs;        /* per chunk of dlist */
+    vsgl__plan_lane *lanes;  /* per entry of dlist: its lane (recorded, or for a replay read or made) */
+} sparse_batch;
+
+#define SPARSE_MARK (SIZE_MAX - 1) /* direct_of of a sample to shade, before it has its index */
+
+/* Rows [b0, e0) of the batch (one row per chunk): each sample's
+ * interpolated light, or a mark to shade it itself. Records the plan's
+ * weights and codes; a replay reads them instead of the G-buffer. */
+static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
+{
+    sparse_batch *bt = user;
+    shade_job *j = bt->j;
+    (void)chunk;
     const vsgl_gbuffer *g = j->g;
     const size_t spp = g->spp, W = g->width;
     const size_t first = (j->base + b0) * spp, ns = (e0 - b0) * spp;
-    const float inv_s = 1.0f / (float)j->stride;
-    /* sample k of pixel (x, y) lies at (x + (k % aa + 0.5) / aa, ...): its
-     * offset from the first sample's, where the anchors were shaded */
     const uint32_t aa = g->weight && spp == 2 ? 1u : (uint32_t)(sqrtf((float)spp) + 0.5f);
     const float inv_aa = 1.0f / (float)aa;
-    float *interp = malloc((ns + 1) * 6 * sizeof *interp);
-    size_t *direct = malloc((ns + 1) * sizeof *direct);
-    size_t *direct_of = malloc((ns + 1) * sizeof *direct_of); /* per sample: index in direct, or SIZE_MAX */
-    float *dlight = malloc((ns + 1) * 6 * sizeof *dlight);
-    int32_t rc = 0;
-    if (!interp || !direct || !direct_of || !dlight) {
-        rc = VSGL_ERROR_OUT_OF_MEMORY;
-        goto done;
-    }
-    size_t nd = 0;
+    vsgl_shade_plan *plan = j->plan;
+    const int replay = j->replay, record = plan && !replay && b0 % W == 0 && e0 - b0 == W;
     for (size_t i = 0; i < ns; ++i) {
-        size_t si = first + i, px = si / spp;
-        direct_of[i] = SIZE_MAX;
-        if (g->material[si] == VSGL__GBUFFER_MISS)
+        size_t si = first + i, bi = si - bt->first;
+        bt->direct_of[bi] = SIZE_MAX;
+        if (record) {
+            plan->direct[si] = PLAN_MISS;
+            plan->w4[si * 4] = plan->w4[si * 4 + 1] = plan->w4[si * 4 + 2] = plan->w4[si * 4 + 3] = 0.0f;
+        }
+        if (replay ? plan->direct[si] == PLAN_MISS : g->material[si] == VSGL__GBUFFER_MISS)
             continue;
-        /* the anchor cell around the sample: its raster position against
-         * the anchors' (each shaded at its pixel's first sample) */
-        size_t k = si % spp;
-        float ox = k < aa * aa ? (float)(k % aa) * inv_aa : 0.0f, oy = k < aa * aa ? (float)(k / aa) * inv_aa : 0.0f;
-        float fx = ((float)(px % W) + ox) * inv_s, fy = ((float)(px / W) + oy) * inv_s;
-        uint32_t ax = (uint32_t)fx, ay = (uint32_t)fy;
-        float tx = fx - (float)ax, ty = fy - (float)ay;
+        if (replay && plan->direct[si] == PLAN_ALONE) {
+            bt->direct_of[bi] = SPARSE_MARK;
+            continue;
+        }
+        uint32_t ax, ay;
+        float tx, ty;
+        sample_cell(j, si, spp, aa, inv_aa, &ax, &ay, &tx, &ty);
         float wsum = 0.0f, L[6] = {0, 0, 0, 0, 0, 0};
         float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {0.0f, 0.0f}, dx2[2] = {-1.0f, -1.0f}, dy2[2] = {-1.0f, -1.0f};
         for (int dy = 0; dy < 2; ++dy)
             for (int dx = 0; dx < 2; ++dx) {
                 uint32_t cx = ax + (uint32_t)dx, cy = ay + (uint32_t)dy;
-                if (cx >= j->aw || cy >= j->ah)
-                    continue;
-                size_t a = (size_t)cy * j->aw + cx, as = j->anchor_sample[a];
-                float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
-                if (as == SIZE_MAX || !(wb > 0.0f))
-                    continue;
-                float w = wb * (as == si ? 1.0f : same_surface_weight(j, si, as));
+                float w;
+                size_t a = (size_t)cy * j->aw + cx;
+                if (replay) { /* the recorded weight (0: the anchor did not count) */
+                    w = plan->w4[si * 4 + (size_t)(dy * 2 + dx)];
+                } else {
+                    if (cx >= j->aw || cy >= j->ah)
+                        continue;
+                    size_t as = j->anchor_sample[a];
+                    float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
+                    if (as == SIZE_MAX || !(wb > 0.0f))
+                        continue;
+                    w = wb * (as == si ? 1.0f : same_surface_weight(j, si, as));
+                }
                 if (!(w > 0.0f))
                     continue;
                 wsum += w;
+                if (record)
+                    plan->w4[si * 4 + (size_t)(dy * 2 + dx)] = w;
                 const float *A = j->anchor_light + a * 6;
                 for (int c = 0; c < 6; ++c)
                     L[c] += w * A[c];
@@ -234,6 +365,8 @@ int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
                     dy2[l] = D[2 * l + 1] > dy2[l] ? D[2 * l + 1] : dy2[l];
                 }
             }
+        if (record)
+            plan->direct[si] = wsum > 0.05f ? PLAN_NEAR : PLAN_ALONE;
         /* where bilinear interpolation would be off by more than SPARSE_TOL
          * (a reflection's edge, a shadow's), the sample is shaded itself */
         int smooth = 1;
@@ -252,35 +385,177 @@ int32_t vsgl__shade_chunk_sparse(void *user, size_t chunk, size_t b0, size_t e0)
         }
         if (wsum > 0.05f && smooth) {
             for (int c = 0; c < 6; ++c)
-                interp[i * 6 + c] = L[c] / wsum;
+                bt->interp[bi * 6 + c] = L[c] / wsum;
         } else {
-            direct_of[i] = nd;
-            direct[nd++] = si;
+            bt->direct_of[bi] = SPARSE_MARK;
         }
     }
+    return 0;
+}
+
+/* Entries [b, e) of the batch's list of samples shaded themselves. A
+ * record keeps their lanes; a replay takes a sample's recorded lane when
+ * the record shaded it too (most do: a light edit moves few contrasts),
+ * else makes it from the G-buffer. */
+static int32_t sparse_direct(void *user, size_t chunk, size_t b, size_t e)
+{
+    sparse_batch *bt = user;
+    shade_job *j = bt->j;
+    const vsgl_shade_plan *plan = j->plan;
+    int32_t rc = 0;
 #if defined(__x86_64__) || defined(__i386__)
     unsigned int saved_csr = _mm_getcsr();
     _mm_setcsr(saved_csr | 0x8040u);
 #endif
-    j->pairs[chunk] = vsgl__shade_list(j, direct, nd, NULL, dlight);
+    if (j->replay) {
+        const vsgl__plan_lane **from = malloc((e - b + 1) * sizeof *from);
+        if (!from) {
+            rc = VSGL_ERROR_OUT_OF_MEMORY;
+        } else {
+            for (size_t k = b; k < e; ++k) {
+                int32_t d = plan->dlane_of[bt->dlist[k]];
+                if (d >= 0) {
+                    from[k - b] = &plan->dlanes[d];
+                } else {
+                    vsgl__sample_lane(j, bt->dlist[k], &bt->lanes[k]);
+                    from[k - b] = &bt->lanes[k];
+                }
+            }
+            bt->dpairs[chunk] = vsgl__shade_lanes(j, from, e - b, bt->dlight + b * 6);
+            free(from);
+        }
+    } else {
+        bt->dpairs[chunk] = vsgl__shade_list(j, bt->dlist + b, e - b, NULL, bt->dlight + b * 6,
+                                             bt->lanes ? bt->lanes + b : NULL);
+    }
 #if defined(__x86_64__) || defined(__i386__)
     _mm_setcsr(saved_csr);
 #endif
+    return rc;
+}
+
+/* Rows [b0, e0) of the batch: every pixel from its samples' light and
+ * colours (a replay: the recorded colours and factors, the same sums). */
+static int32_t sparse_resolve(void *user, size_t chunk, size_t b0, size_t e0)
+{
+    sparse_batch *bt = user;
+    shade_job *j = bt->j;
+    (void)chunk;
+    const vsgl_gbuffer *g = j->g;
+    const vsgl_pixel_planes *pl = j->planes;
+    const size_t spp = g->spp, W = g->width;
+    vsgl_shade_plan *plan = j->plan;
+    const int replay = j->replay, record = plan && !replay && b0 % W == 0 && e0 - b0 == W;
     const float *Ls[VSGL__GBUFFER_MAX_SPP];
     for (size_t px = j->base + b0; px < j->base + e0; ++px) {
         for (size_t k = 0; k < spp; ++k) {
-            size_t i = (px - j->base - b0) * spp + k;
-            if (g->material[first + i] == VSGL__GBUFFER_MISS)
+            size_t si = px * spp + k, bi = si - bt->first;
+            if (replay ? plan->direct[si] == PLAN_MISS : g->material[si] == VSGL__GBUFFER_MISS)
                 Ls[k] = NULL;
             else
-                Ls[k] = direct_of[i] != SIZE_MAX ? dlight + direct_of[i] * 6 : interp + i * 6;
+                Ls[k] = bt->direct_of[bi] != SIZE_MAX ? bt->dlight + bt->direct_of[bi] * 6 : bt->interp + bi * 6;
         }
-        vsgl__write_pixel(j, px, Ls);
+        if (!replay) {
+            vsgl__write_pixel(j, px, Ls, record ? plan->cd + px * spp * 4 : NULL);
+            if (record) {
+                float *col = plan->colour + px * 7;
+                for (int c = 0; c < 3; ++c) {
+                    col[c] = pl->diffuse_color[px * 3 + c];
+                    col[3 + c] = pl->glossy_color[px * 3 + c];
+                }
+                col[6] = pl->coverage[px];
+            }
+            continue;
+        }
+        float acc[6] = {0, 0, 0, 0, 0, 0};
+        for (size_t k = 0; k < spp; ++k) {
+            if (!Ls[k])
+                continue;
+            const float *L = Ls[k], *cd = plan->cd + (px * spp + k) * 4;
+            for (int c = 0; c < 3; ++c) {
+                acc[c] += cd[c] * L[c];
+                acc[3 + c] += cd[3] * L[3 + c];
+            }
+        }
+        const float *col = plan->colour + px * 7;
+        for (int c = 0; c < 3; ++c) {
+            pl->diffuse[px * 3 + c] = acc[c];
+            pl->glossy[px * 3 + c] = acc[3 + c];
+            pl->diffuse_color[px * 3 + c] = col[c];
+            pl->glossy_color[px * 3 + c] = col[3 + c];
+        }
+        pl->coverage[px] = col[6];
     }
+    if (record)
+        for (size_t y = (j->base + b0) / W; y < (j->base + e0) / W; ++y)
+            plan->row_ok[y] = 1;
+    return 0;
+}
+
+vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row, size_t end)
+{
+    const vsgl_gbuffer *g = j->g;
+    const size_t W = g->width, spp = g->spp;
+    const uint32_t threads = vsgl_context_thread_count(ctx);
+    sparse_batch bt;
+    memset(&bt, 0, sizeof bt);
+    bt.j = j;
+    bt.first = row * W * spp;
+    bt.ns = (end - row) * W * spp;
+    bt.interp = malloc((bt.ns + 1) * 6 * sizeof *bt.interp);
+    bt.direct_of = malloc((bt.ns + 1) * sizeof *bt.direct_of);
+    bt.dlist = malloc((bt.ns + 1) * sizeof *bt.dlist);
+    vsgl_result r = VSGL_OK;
+    if (!bt.interp || !bt.direct_of || !bt.dlist ||
+        vsgl__parallel_for(threads, (end - row) * W, W, sparse_classify, &bt) != 0) {
+        r = VSGL_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    /* the samples to shade, in sample order, in full blocks whatever their rows */
+    size_t nd = 0;
+    for (size_t i = 0; i < bt.ns; ++i)
+        if (bt.direct_of[i] == SPARSE_MARK) {
+            bt.direct_of[i] = nd;
+            bt.dlist[nd++] = bt.first + i;
+        }
+    bt.dlight = malloc((nd + 1) * 6 * sizeof *bt.dlight);
+    bt.dpairs = calloc(nd / ANCHOR_CHUNK + 2, sizeof *bt.dpairs);
+    vsgl_shade_plan *plan = j->plan;
+    if (plan) /* a record keeps the lanes, a replay makes those it has not */
+        bt.lanes = malloc((nd + 1) * sizeof *bt.lanes);
+    if (!bt.dlight || !bt.dpairs || (plan && !bt.lanes) ||
+        vsgl__parallel_for(threads, nd, ANCHOR_CHUNK, sparse_direct, &bt) != 0 ||
+        vsgl__parallel_for(threads, (end - row) * W, W, sparse_resolve, &bt) != 0) {
+        r = VSGL_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    if (plan && !j->replay) { /* the record: these samples' lanes, for the next renders */
+        for (size_t i = bt.first; i < bt.first + bt.ns; ++i)
+            plan->dlane_of[i] = -1;
+        if (plan->ndlanes + nd > plan->dlanes_cap) {
+            size_t cap = 2 * (plan->ndlanes + nd) + 64;
+            vsgl__plan_lane *grown = realloc(plan->dlanes, cap * sizeof *grown);
+            if (grown) {
+                plan->dlanes = grown;
+                plan->dlanes_cap = cap;
+            } else {
+                plan->row_ok[plan->height] = 0; /* no memory for them: the plan is not kept */
+                nd = 0;
+            }
+        }
+        for (size_t k = 0; k < nd && plan->ndlanes < (size_t)INT32_MAX; ++k) {
+            plan->dlane_of[bt.dlist[k]] = (int32_t)plan->ndlanes;
+            plan->dlanes[plan->ndlanes++] = bt.lanes[k];
+        }
+    }
+    for (size_t c = 0; c < nd / ANCHOR_CHUNK + 2; ++c)
+        j->pairs[0] += bt.dpairs[c];
 done:
-    free(interp);
-    free(direct);
-    free(direct_of);
-    free(dlight);
-    return rc;
+    free(bt.interp);
+    free(bt.direct_of);
+    free(bt.dlist);
+    free(bt.dlight);
+    free(bt.dpairs);
+    free(bt.lanes);
+    return r == VSGL_OK ? VSGL_OK : vsgl__fail(ctx, r, "shade: out of memory");
 }
