@@ -1,7 +1,7 @@
 """Live viewport preview timings, headless (make bench): what an edit costs
 from Blender's data to a displayable image, without Blender's drawing.
 
-    python3 tools/bench_live.py [--triangles N] [--size 960x540] [--repeat 5]
+    python3 tools/bench_live.py [--triangles N] [--size 960x540] [--repeat 5] [--quality LIVE,PREVIEW]
 
 Runs in the pip bpy module (or `blender -b --python tools/bench_live.py --`).
 Builds a room with a subdivided object of about N triangles (default 100k),
@@ -9,7 +9,12 @@ then times, each the median of --repeat edits:
   * light moved:  export (mesh cache warm) + library (scene reused) + encode
   * camera moved: the same with another view
   * geometry edit: export of the changed object + a new library scene + render
-for the viewport at full size and at the panel's default 1/2, preview preset.
+for the viewport at full size and at the panel's default 1/2, for each
+panel quality asked for (LIVE, the panel's default: the preview preset
+without edge rays, shading 1 pixel in 3 x 3 or, from 0.4 MP, 4 x 4;
+PREVIEW: the preset as F12 renders it). Then the error of each quality's image against PREVIEW's
+(Combined, the last view: relMSE and mean FLIP as tests/quality/metrics.py
+computes them).
 Targets (issue 12): library time <= 50 ms at 960x540; <= 200 ms with the
 export for a 100k-triangle scene. Prints measured/target ratios.
 """
@@ -33,6 +38,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("--triangles", type=int, default=100_000)
 ap.add_argument("--size", default="960x540")
 ap.add_argument("--repeat", type=int, default=5)
+ap.add_argument("--quality", default="LIVE,PREVIEW", help="panel qualities to time, comma-separated")
 args = ap.parse_args(argv)
 W, H = (int(v) for v in args.size.lower().split("x"))
 
@@ -60,52 +66,99 @@ def build(triangles):
     return light, cam, wave
 
 
-def edit_cost(session, cache, w, h, scene, cam, edit):
-    """Apply ``edit``, then export + library + encode as the live preview does."""
-    edit()
-    t0 = time.perf_counter()
+def view_data(cache, w, h, scene, cam):
+    """The scene data of the live preview's render of the camera's view at w x h."""
     dg = bpy.context.evaluated_depsgraph_get()
     sd = export.collect(dg, scene, require_lights=False, camera=False, mesh_cache=cache)
     dg_cam = cam.evaluated_get(dg)
     P = dg_cam.calc_matrix_camera(dg, x=w, y=h, scale_x=1.0, scale_y=1.0)
     sd.camera = live.view_camera(dg_cam.matrix_world.inverted(), P, w, h, cam.data.clip_start, cam.data.clip_end)
     sd.width, sd.height = w, h
+    return sd
+
+
+def edit_cost(session, cache, w, h, scene, cam, edit, quality):
+    """Apply ``edit``, then export + library + encode as the live preview does."""
+    edit()
+    t0 = time.perf_counter()
+    sd = view_data(cache, w, h, scene, cam)
     t_export = time.perf_counter() - t0
-    out = viewport._render(session, sd, "PREVIEW", 0, live.Job(1, None), 0.0, t_export)
+    out = viewport._render(session, sd, quality, 0, live.Job(1, None), 0.0, t_export)
     return dict(out["timings"], triangles=sd.triangle_count)
+
+
+def combined(w, h, scene, cam, quality):
+    """The linear Combined pass the live preview renders at ``quality``."""
+    from vsgl_indirect import engine
+    lib = engine._binding()
+    arrays = engine.scene_arrays(view_data({}, w, h, scene, cam), lib)
+    ctx = lib.Context(log_level=lib.LogLevel.ERROR)
+    try:
+        sc = lib.Scene(ctx, **arrays)
+        try:
+            images, _ = lib.render(ctx, sc, live.render_settings(lib, quality, w * h), ("combined",))
+        finally:
+            sc.close()
+    finally:
+        ctx.close()
+    return images["combined"]
 
 
 def main():
     light, cam, wave = build(args.triangles)
     scene = bpy.context.scene
+    qualities = [q.strip().upper() for q in args.quality.split(",") if q.strip()]
     rows = []
-    for div in (1, 2):
-        w, h = live.internal_size(W, H, div)
-        session = viewport._Session(0)
-        cache = {}
-        try:
-            edit_cost(session, cache, w, h, scene, cam, lambda: None)       # warm: first export, first scene
-            for name, edit in (
-                    ("light moved", lambda: setattr(light.location, "x", light.location.x + 0.01)),
-                    ("camera moved", lambda: setattr(cam.location, "x", cam.location.x + 0.01)),
-                    ("geometry edit", lambda: (cache.clear(), setattr(wave.location, "z", wave.location.z + 0.001)))):
-                ts = [edit_cost(session, cache, w, h, scene, cam, edit) for _ in range(args.repeat)]
-                med = {k: statistics.median(t[k] for t in ts)
-                       for k in ("export", "scene", "render", "encode", "gbuffer", "rsm", "fit", "shade")}
-                rows.append((w, h, div, name, med, ts[0]["triangles"]))
-        finally:
-            session.close()
-    print("live preview, preview preset, %d triangles, median of %d edits (s); machine: %d cores, load %s"
-          % (rows[0][5], args.repeat, os.cpu_count(), " ".join("%.1f" % v for v in os.getloadavg())))
-    print("%-10s %-14s %8s %8s %8s %8s %8s  %-26s %s" % ("size", "edit", "export", "scene", "render", "encode",
-                                                         "total", "library/50 ms, all/200 ms",
-                                                         "render = gbuffer + rsm + fit + shade"))
-    for w, h, div, name, m, _ in rows:
+    for quality in qualities:
+        for div in (1, 2):
+            w, h = live.internal_size(W, H, div)
+            session = viewport._Session(0)
+            cache = {}
+            try:
+                edit_cost(session, cache, w, h, scene, cam, lambda: None, quality)  # warm: first export, scene
+                for name, edit in (
+                        ("light moved", lambda: setattr(light.location, "x", light.location.x + 0.01)),
+                        ("camera moved", lambda: setattr(cam.location, "x", cam.location.x + 0.01)),
+                        ("geometry edit",
+                         lambda: (cache.clear(), setattr(wave.location, "z", wave.location.z + 0.001)))):
+                    ts = [edit_cost(session, cache, w, h, scene, cam, edit, quality) for _ in range(args.repeat)]
+                    med = {k: statistics.median(t[k] for t in ts)
+                           for k in ("export", "scene", "render", "encode", "gbuffer", "rsm", "fit", "shade")}
+                    rows.append((quality, w, h, div, name, med, ts[0]["triangles"]))
+            finally:
+                session.close()
+    print("live preview, %d triangles, median of %d edits (s); machine: %d cores, load %s"
+          % (rows[0][6], args.repeat, os.cpu_count(), " ".join("%.1f" % v for v in os.getloadavg())))
+    print("%-8s %-10s %-14s %8s %8s %8s %8s %8s  %-26s %s" % ("quality", "size", "edit", "export", "scene", "render",
+                                                              "encode", "total", "library/50 ms, all/200 ms",
+                                                              "render = gbuffer + rsm + fit + shade"))
+    targets = []
+    for quality, w, h, div, name, m, _ in rows:
         lib = m["scene"] + m["render"]
         total = m["export"] + lib + m["encode"]
-        print("%-10s %-14s %8.3f %8.3f %8.3f %8.3f %8.3f  %-26s %.3f + %.3f + %.3f + %.3f"
-              % ("%dx%d" % (w, h), name, m["export"], m["scene"], m["render"], m["encode"], total,
-                 "%.1fx, %.1fx" % (lib / 0.050, total / 0.200), m["gbuffer"], m["rsm"], m["fit"], m["shade"]))
+        print("%-8s %-10s %-14s %8.3f %8.3f %8.3f %8.3f %8.3f  %-26s %.3f + %.3f + %.3f + %.3f"
+              % (quality, "%dx%d" % (w, h), name, m["export"], m["scene"], m["render"], m["encode"], total,
+                 "%.2fx, %.2fx" % (lib / 0.050, total / 0.200), m["gbuffer"], m["rsm"], m["fit"], m["shade"]))
+        if div == 1 and name != "geometry edit":
+            targets.append("%s %s %s: library %.3f s / 0.050 s = %.2f, with export %.3f s / 0.200 s = %.2f"
+                           % (quality, "%dx%d" % (w, h), name, lib, lib / 0.050, total, total / 0.200))
+    print("issue 12 targets, measured/target (<= 1 meets it):")
+    for t in targets:
+        print("  " + t)
+    if any(q != "PREVIEW" for q in qualities):
+        sys.path.insert(0, os.path.join(REPO, "tests", "quality"))
+        import metrics
+        print("error against the preview preset's image (Combined, last view): relMSE, mean FLIP"
+              + ("" if metrics.FLIP_ERROR is None else " (FLIP unavailable: %s)" % metrics.FLIP_ERROR))
+        for div in (1, 2):
+            w, h = live.internal_size(W, H, div)
+            ref = combined(w, h, scene, cam, "PREVIEW")
+            for quality in qualities:
+                if quality != "PREVIEW":
+                    a = combined(w, h, scene, cam, quality)
+                    f = metrics.flip(a, ref)
+                    print("  %-8s %dx%d: relMSE %.2e, FLIP %s"
+                          % (quality, w, h, metrics.relmse(a, ref), "n/a" if f is None else "%.4f" % f))
 
 
 main()

@@ -17,6 +17,31 @@ DEBOUNCE_S = 0.04
 #: Viewport resolution divisors offered in the panel.
 SCALES = (1, 2, 3, 4)
 
+#: The panel's "Live" quality: the preview preset without edge rays,
+#: shading one pixel in 3 x 3, or in 4 x 4 from LIVE_STRIDE4_PIXELS pixels
+#: on (not 2 x 2). With the contrast test (samples whose anchors' light
+#: disagrees are shaded themselves) a coarser lattice marks more samples:
+#: on the live room at 480 x 270 stride 4 shaded more pairs than stride 3,
+#: at 960 x 540 fewer. Its Combined pass is within relMSE 1e-4 / mean FLIP
+#: 0.02-0.045 of the preview preset's there (docs/performance.md, "Live
+#: viewport"); F12 keeps the scene's preset.
+LIVE_OVERRIDES = {"shade_stride": 3, "edge_samples": 0}
+LIVE_STRIDE4_PIXELS = 400_000
+
+
+def render_settings(lib, quality, pixels=0):
+    """Library settings of a live render of ``pixels`` pixels at the
+    panel's ``quality``: "LIVE" is the preview preset with LIVE_OVERRIDES
+    (stride 4 from LIVE_STRIDE4_PIXELS on), any other the preset of that
+    name unchanged. ``lib``: the binding (libvsgl)."""
+    s = lib.render_settings_preset(getattr(lib.Preset, "PREVIEW" if quality == "LIVE" else quality))
+    if quality == "LIVE":
+        for k, v in LIVE_OVERRIDES.items():
+            setattr(s, k, v)
+        if pixels >= LIVE_STRIDE4_PIXELS:
+            s.shade_stride = 4
+    return s
+
 
 def _rows(m):
     """4x4 nested sequence / mathutils.Matrix / ndarray -> float64 ndarray."""
@@ -70,10 +95,13 @@ def display_rgba(rgb, exposure=0.0, alpha=1.0):
     x = np.asarray(rgb, np.float32)
     # a table of the transfer function, looked up at 1/16384 steps (1/4 of an
     # 8-bit display step where the curve is steepest); NaN and negative -> 0
-    idx = np.nan_to_num(x * np.float32(2.0 ** exposure * (_LUT_N - 1)), nan=0.0, posinf=_LUT_N - 1, neginf=0.0)
-    np.clip(idx, 0, _LUT_N - 1, out=idx)
+    # (fmax/fmin take the number over a NaN), +inf -> the last entry
+    idx = np.multiply(x, np.float32(2.0 ** exposure * (_LUT_N - 1)))
+    np.fmax(idx, np.float32(0.0), out=idx)
+    np.fmin(idx, np.float32(_LUT_N - 1), out=idx)
+    idx += np.float32(0.5)
     out = np.empty(x.shape[:2] + (4,), np.float32)
-    out[::-1, :, :3] = _srgb_lut()[(idx + np.float32(0.5)).astype(np.int32)]
+    out[::-1, :, :3] = _srgb_lut()[idx.astype(np.int32)]
     out[..., 3] = alpha
     return out
 
