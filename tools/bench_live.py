@@ -11,8 +11,8 @@ then times, each the median of --repeat edits:
   * geometry edit: export of the changed object + a new library scene + render
 for the viewport at full size and at the panel's default 1/2, for each
 panel quality asked for (LIVE, the panel's default: the preview preset
-without edge rays, shading 1 pixel in 3 x 3 or, from 0.4 MP, 4 x 4;
-PREVIEW: the preset as F12 renders it). Then the error of each quality's image against PREVIEW's
+without edge rays, shading 1 pixel in 4 x 4; PREVIEW: the preset as F12
+renders it). Then the error of each quality's image against PREVIEW's
 (Combined, the last view: relMSE and mean FLIP as tests/quality/metrics.py
 computes them).
 Targets (issue 12): library time <= 50 ms at 960x540; <= 200 ms with the

@@ -18,28 +18,22 @@ DEBOUNCE_S = 0.04
 SCALES = (1, 2, 3, 4)
 
 #: The panel's "Live" quality: the preview preset without edge rays,
-#: shading one pixel in 3 x 3, or in 4 x 4 from LIVE_STRIDE4_PIXELS pixels
-#: on (not 2 x 2). With the contrast test (samples whose anchors' light
-#: disagrees are shaded themselves) a coarser lattice marks more samples:
-#: on the live room at 480 x 270 stride 4 shaded more pairs than stride 3,
-#: at 960 x 540 fewer. Its Combined pass is within relMSE 1e-4 / mean FLIP
-#: 0.02-0.045 of the preview preset's there (docs/performance.md, "Live
-#: viewport"); F12 keeps the scene's preset.
-LIVE_OVERRIDES = {"shade_stride": 3, "edge_samples": 0}
-LIVE_STRIDE4_PIXELS = 400_000
+#: shading one pixel in 4 x 4 (not 2 x 2). On the live room its Combined
+#: pass is within relMSE ~1e-4 / mean FLIP 0.02-0.04 of the preview
+#: preset's (docs/performance.md, "Live viewport"); F12 keeps the scene's
+#: preset.
+LIVE_OVERRIDES = {"shade_stride": 4, "edge_samples": 0}
 
 
 def render_settings(lib, quality, pixels=0):
-    """Library settings of a live render of ``pixels`` pixels at the
-    panel's ``quality``: "LIVE" is the preview preset with LIVE_OVERRIDES
-    (stride 4 from LIVE_STRIDE4_PIXELS on), any other the preset of that
-    name unchanged. ``lib``: the binding (libvsgl)."""
+    """Library settings of a live render (of ``pixels`` pixels: unused, kept
+    for a size-dependent choice) at the panel's ``quality``: "LIVE" is the
+    preview preset with LIVE_OVERRIDES, any other the preset of that name
+    unchanged. ``lib``: the binding (libvsgl)."""
     s = lib.render_settings_preset(getattr(lib.Preset, "PREVIEW" if quality == "LIVE" else quality))
     if quality == "LIVE":
         for k, v in LIVE_OVERRIDES.items():
             setattr(s, k, v)
-        if pixels >= LIVE_STRIDE4_PIXELS:
-            s.shade_stride = 4
     return s
 
 

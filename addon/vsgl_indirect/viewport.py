@@ -352,8 +352,7 @@ class VSGLLiveProps(bpy.types.PropertyGroup):
     quality: bpy.props.EnumProperty(
         name="Quality",
         items=(("LIVE", "Live", "Preview's lattice and RSM, 1 sample without edge rays, shading 1 pixel "
-                "in 3 x 3 (4 x 4 from 0.4 megapixels): a camera move in half of Preview's time, a light "
-                "edit in 2/3, within a few per cent of Preview's image"),
+                "in 4 x 4: about half of Preview's time, within a few per cent of Preview's image"),
                ("PREVIEW", "Preview", "Lattice 32, RSM 128, 1 sample (8 x 8 rays at edges), "
                 "shading 1 pixel in 2 x 2: about 0.1-0.4 s at 960 x 540 on 2 cores, bias within about 20 %"),
                ("BALANCED", "Balanced", "Lattice 192, RSM 256, 2 x 2 samples (8 x 8 rays at edges), "

@@ -174,17 +174,16 @@ def test_live_render_equals_the_f12_path(scene):
 
 
 def test_live_quality_is_the_preview_preset_sparser():
-    """The panel's Live quality: the preview preset with LIVE_OVERRIDES
-    (stride 4 from LIVE_STRIDE4_PIXELS on) and nothing else changed; the
-    presets pass through unchanged."""
+    """The panel's Live quality: the preview preset with LIVE_OVERRIDES and
+    nothing else changed; the presets pass through unchanged."""
     lib = engine._binding()
     prev = lib.render_settings_preset(lib.Preset.PREVIEW)
-    small, big = live.render_settings(lib, "LIVE", 480 * 270), live.render_settings(lib, "LIVE", 960 * 540)
-    assert live.LIVE_OVERRIDES == {"shade_stride": 3, "edge_samples": 0}
-    assert (small.shade_stride, small.edge_samples, big.shade_stride, big.edge_samples) == (3, 0, 4, 0)
-    for name, _ in small._fields_:
+    lv = live.render_settings(lib, "LIVE", 960 * 540)
+    assert live.LIVE_OVERRIDES == {"shade_stride": 4, "edge_samples": 0}
+    assert (lv.shade_stride, lv.edge_samples) == (4, 0)
+    for name, _ in lv._fields_:
         if name not in live.LIVE_OVERRIDES:
-            assert getattr(small, name) == getattr(prev, name) == getattr(big, name), name
+            assert getattr(lv, name) == getattr(prev, name), name
     for q in ("PREVIEW", "BALANCED"):
         a, b = live.render_settings(lib, q, 960 * 540), lib.render_settings_preset(getattr(lib.Preset, q))
         assert all(getattr(a, n) == getattr(b, n) for n, _ in a._fields_), q
