@@ -549,6 +549,9 @@ def main():
     if version is None:
         raise SystemExit("no Blender ($BLENDER=%s): the Cycles references and sweeps need Debian's Blender 3.4"
                          % refs.blender_binary())
+    # the commit measured: the checkout when the run starts (build/libvsgl.so as `make` left it)
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                            cwd=ROOT).stdout.strip()
     ctx = L.Context()
     exr_dir = tempfile.mkdtemp(prefix="vsgl_trade_")
     results = {}
@@ -561,8 +564,6 @@ def main():
     finally:
         shutil.rmtree(exr_dir, ignore_errors=True)
     cmd = "python3 tools/trade.py" + (" --quick" if args.quick else "") + (" --docs" if args.docs else "")
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                            cwd=ROOT).stdout.strip()
     meta = dict(command=cmd, date=datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"),
                 library=L.version_string(), commit=commit, blender=version, size=list(args.size),
                 ref_spp=args.ref_spp, oidn_quality=args.oidn_quality, repeat=args.repeat, time_size=args.time_size,
