@@ -91,18 +91,18 @@ ITEMS = {
          "Fastest: lattice 32 VSGLs per light, RSM 128, 1 sample (8 x 8 rays at edges), one "
          "pixel in 2 x 2 shaded, "
          "no indirect shadows. Within 21 % of Cycles per pass on the bundled scenes; the gather "
-         "room in 0.04 s at relMSE 0.079 (light leaks past occluders)"),
+         "room in 0.03 s at relMSE 0.078 (light leaks past occluders)"),
         ("BALANCED", "Balanced",
          "Lattice 192 VSGLs per light, RSM 256, 2 x 2 AA (8 x 8 rays at edges), one pixel in 2 x 2 "
          "shaded, visibility "
-         "rays: the gather room in 0.17 s at relMSE 0.0058, below Cycles at 256 spp (0.0133 in "
-         "0.70 s); within 5 % of Cycles per pass on every bundled scene. 8-28 s per 1080p "
+         "rays, GGX as two lobes: the gather room in 0.24 s at relMSE 0.0050, below Cycles at 256 "
+         "spp (0.0133 in 0.59 s); within 5 % of Cycles per pass on every bundled scene. 8-28 s per 1080p "
          "frame of the bundled rooms (one or two lights) on 2 cores, Preview 0.9-1.3 s"),
         ("QUALITY", "Quality",
          "Lattice 256 VSGLs per light, RSM 512, 2 x 2 AA (8 x 8 rays at edges), one pixel in 2 x 2 "
          "shaded, visibility "
-         "rays: within 5 % of Cycles per pass on every bundled scene; the gather room in 0.35 s "
-         "at relMSE 0.0056, about 2x Balanced's time"),
+         "rays: within 5 % of Cycles per pass on every bundled scene; the gather room in 0.39 s "
+         "at relMSE 0.0047, about 1.6x Balanced's time"),
     ],
     "method": [
         ("VSGL", "VSGL",
