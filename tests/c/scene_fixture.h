@@ -128,6 +128,18 @@ static inline void fx_room(fx_scene *s, uint32_t width, uint32_t height, float f
     fx_camera(s, ceye, cat, 35.0f, width, height);
 }
 
+/* A context with `threads` threads (0: all cores) and nothing else set;
+ * NULL if it cannot be created. */
+static inline vsgl_context *fx_context(uint32_t threads)
+{
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.size = sizeof cd;
+    cd.thread_count = threads;
+    vsgl_context *ctx = NULL;
+    return vsgl_context_create(&cd, &ctx) == VSGL_OK ? ctx : NULL;
+}
+
 /* Point the descriptor at the arrays (call after edits, before create). */
 static inline const vsgl_scene_desc *fx_desc(fx_scene *s)
 {

@@ -94,14 +94,10 @@ typedef struct run {
 
 static int do_run(fx_scene *s, uint32_t threads, uint32_t res, int vis, run *out)
 {
-    vsgl_context_desc d;
-    memset(&d, 0, sizeof d);
-    d.thread_count = threads;
-    vsgl_context *ctx = NULL;
-    vsgl_context_create(&d, &ctx);
+    vsgl_context *ctx = fx_context(threads);
     vsgl_scene *sc = NULL;
-    int ok = vsgl_scene_create(ctx, fx_desc(s), &sc) == VSGL_OK;
-    VT_CHECK(ok, "scene: %s", vsgl_context_last_error(ctx));
+    int ok = ctx && vsgl_scene_create(ctx, fx_desc(s), &sc) == VSGL_OK;
+    VT_CHECK(ok, "scene: %s", ctx ? vsgl_context_last_error(ctx) : "no context");
     vsgl_rsm r;
     memset(out, 0, sizeof *out);
     if (ok)

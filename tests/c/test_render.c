@@ -34,20 +34,16 @@ static vsgl_result render_room_flags(uint32_t threads, const vsgl_render_setting
     fx_room(&fx, W, H, 0.25f, 200.0f);
     for (uint32_t k = 0; k < 4; ++k)
         fx.materials[k].flags |= material_flags;
-    vsgl_context_desc cd;
-    memset(&cd, 0, sizeof cd);
-    cd.size = sizeof cd;
-    cd.thread_count = threads;
-    vsgl_context *ctx = NULL;
+    vsgl_context *ctx = fx_context(threads);
     vsgl_scene *scene = NULL;
-    vsgl_result r = vsgl_context_create(&cd, &ctx);
+    vsgl_result r = ctx ? VSGL_OK : VSGL_ERROR_OUT_OF_MEMORY;
     if (r == VSGL_OK)
         r = vsgl_scene_create(ctx, fx_desc(&fx), &scene);
     vsgl_render_output o = bind(p);
     if (r == VSGL_OK)
         r = vsgl_render(ctx, scene, s, &o, st);
     if (r != VSGL_OK && err)
-        snprintf(err, errlen, "%s", vsgl_context_last_error(ctx));
+        snprintf(err, errlen, "%s", ctx ? vsgl_context_last_error(ctx) : "no context");
     vsgl_scene_destroy(scene);
     vsgl_context_destroy(ctx);
     return r;
@@ -480,11 +476,7 @@ static float *render_room_size(uint32_t w, uint32_t h, uint32_t threads, const v
 {
     fx_scene fx;
     fx_room(&fx, w, h, 0.25f, 200.0f);
-    vsgl_context_desc cd;
-    memset(&cd, 0, sizeof cd);
-    cd.size = sizeof cd;
-    cd.thread_count = threads;
-    vsgl_context *ctx = NULL;
+    vsgl_context *ctx = fx_context(threads);
     vsgl_scene *scene = NULL;
     float *comb = calloc((size_t)w * h * 3, sizeof *comb), *col = calloc((size_t)w * h * 3, sizeof *col);
     vsgl_render_output o;
@@ -493,7 +485,7 @@ static float *render_room_size(uint32_t w, uint32_t h, uint32_t threads, const v
     o.height = h;
     o.combined = comb;
     o.diffuse_color = col;
-    int ok = vsgl_context_create(&cd, &ctx) == VSGL_OK && vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK &&
+    int ok = ctx && vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK &&
              vsgl_render(ctx, scene, s, &o, st) == VSGL_OK;
     VT_CHECK(ok, "render %ux%u: %s", w, h, ctx ? vsgl_context_last_error(ctx) : "no context");
     vsgl_scene_destroy(scene);

@@ -329,13 +329,10 @@ VT_TEST(rsm_is_deterministic_across_thread_counts)
     s.lights[0].size_x = 0.5f;
     vsgl_rsm r[2];
     for (int t = 0; t < 2; ++t) {
-        vsgl_context_desc d;
-        memset(&d, 0, sizeof d);
-        d.thread_count = t ? 3 : 1;
-        vsgl_context *ctx = NULL;
-        vsgl_context_create(&d, &ctx);
-        vsgl_scene *sc = make(ctx, &s);
-        VT_CHECK(sc && vsgl__rsm_build(ctx, sc, 0, 64, &r[t]) == VSGL_OK, "threads %u", d.thread_count);
+        const uint32_t threads = t ? 3 : 1;
+        vsgl_context *ctx = fx_context(threads);
+        vsgl_scene *sc = ctx ? make(ctx, &s) : NULL;
+        VT_CHECK(sc && vsgl__rsm_build(ctx, sc, 0, 64, &r[t]) == VSGL_OK, "threads %u", threads);
         vsgl_scene_destroy(sc);
         vsgl_context_destroy(ctx);
     }

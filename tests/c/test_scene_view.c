@@ -205,14 +205,10 @@ VT_TEST(render_cache_shading_plan_replays_bit_identically)
     for (uint32_t threads = 1; threads <= 3; threads += 2) {
         fx_scene fx;
         fx_room(&fx, W, H, 0.25f, 200.0f);
-        vsgl_context_desc cd;
-        memset(&cd, 0, sizeof cd);
-        cd.size = sizeof cd;
-        cd.thread_count = threads;
-        vsgl_context *ctx = NULL;
+        vsgl_context *ctx = fx_context(threads);
         vsgl_scene *scene = NULL;
         vsgl_render_cache *cache = NULL;
-        VT_REQUIRE(vsgl_context_create(&cd, &ctx) == VSGL_OK, "context");
+        VT_REQUIRE(ctx != NULL, "context");
         VT_REQUIRE(vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
         VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
         for (int c = 0; c < 4; ++c) {

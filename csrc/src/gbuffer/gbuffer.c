@@ -208,6 +208,7 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
     out->width = cam->width;
     out->height = cam->height;
     out->spp = spp;
+    out->aa = aa;
     out->count = (size_t)cam->width * cam->height * out->spp;
     vsgl_result r = for_rows(ctx, &job, trace_rows, 0.0f, refine ? 0.6f : 1.0f, "tracing");
     if (r != VSGL_OK)

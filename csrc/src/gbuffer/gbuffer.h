@@ -13,6 +13,8 @@
 typedef struct vsgl_gbuffer {
     uint32_t width, height, spp;   /* slots per pixel: aa * aa, or 2 at aa = 1 with edge refinement
                                       (the second an empty miss of weight 0 unless an edge fills it) */
+    uint32_t aa;                   /* the stratified grid's side: slot s < aa * aa of pixel (col, row) was
+                                      traced at (col + (s % aa + 0.5) / aa, row + (s / aa + 0.5) / aa) */
     size_t count;                  /* width * height * spp */
     float *pos[3];                 /* world position */
     float *nrm[3];                 /* unit shading normal on the camera's side of the surface: flipped

@@ -310,7 +310,7 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
     const vsgl_gbuffer *g = j->g;
     const size_t spp = g->spp, W = g->width;
     const size_t first = (j->base + b0) * spp, ns = (e0 - b0) * spp;
-    const uint32_t aa = g->weight && spp == 2 ? 1u : (uint32_t)(sqrtf((float)spp) + 0.5f);
+    const uint32_t aa = g->aa;
     const float inv_aa = 1.0f / (float)aa;
     vsgl_shade_plan *plan = j->plan;
     const int replay = j->replay, record = plan && !replay && b0 % W == 0 && e0 - b0 == W;
@@ -378,8 +378,8 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
                     smooth &= !(hi[l] - lo[l] > SPARSE_CONTRAST * (hi[l] + lo[l]) + j->contrast_floor[l]);
                     continue;
                 }
-                float e = 0.5f * ((dx2[l] > 0.0f ? tx * (1.0f - tx) * dx2[l] : 0.0f) +
-                                  (dy2[l] > 0.0f ? ty * (1.0f - ty) * dy2[l] : 0.0f));
+                /* (a missing second difference, -1, counts as 0) */
+                float e = 0.5f * (tx * (1.0f - tx) * fmaxf(dx2[l], 0.0f) + ty * (1.0f - ty) * fmaxf(dy2[l], 0.0f));
                 smooth &= !(e > bound);
             }
         }
