@@ -429,6 +429,7 @@ class vsgl_render_stats(_Struct):
         ("shading_pairs", c_uint64),
         ("skipped", c_char * 1024),
         ("reused", c_uint32),
+        ("budget", c_char * 512),
     ]
 
 

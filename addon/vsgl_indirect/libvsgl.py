@@ -893,6 +893,7 @@ def _stats_dict(stats):
     d = stats.as_dict()
     del d["size"]
     d["skipped"] = stats.skipped.decode("utf-8", "replace")
+    d["budget"] = stats.budget.decode("utf-8", "replace")
     return d
 
 

@@ -62,7 +62,7 @@ def export_prefix(scene, options=None):
 
 def begin(scene_name, frame):
     LAST_RUN[scene_name] = {"status": "running", "frame": frame, "messages": [],
-                            "timings": {}, "skipped": "", "summary": "", "path": "", "error": "",
+                            "timings": {}, "skipped": "", "budget": "", "summary": "", "path": "", "error": "",
                             "memory": ""}
 
 
@@ -80,7 +80,7 @@ def finish(scene_name, result, t_export):
     for k in ("scene_prep", "gbuffer", "rsm", "fit", "shade", "total"):
         if "seconds_" + k in st:
             timings["lib " + k] = st["seconds_" + k]
-    info.update(status="done", timings=timings, skipped=st.get("skipped", ""),
+    info.update(status="done", timings=timings, skipped=st.get("skipped", ""), budget=st.get("budget", ""),
                 summary=result.summary, path=result.path, memory=engine.memory_summary(st),
                 lights={k: st[k] for k in ("lights_used", "lights_skipped", "vsgl_count") if k in st})
     for w in result.warnings:
@@ -88,6 +88,9 @@ def finish(scene_name, result, t_export):
     for line in (st.get("skipped") or "").splitlines():
         if line.strip():
             report(scene_name, "INFO", "skipped: " + line.strip())
+    for line in (st.get("budget") or "").splitlines():
+        if line.strip():
+            report(scene_name, "INFO", "budget: " + line.strip())
     mem = info.get("memory")
     report(scene_name, "INFO", "wrote %s (%s; export %.3fs, render %.3fs, write %.3fs%s)"
            % (result.path, result.summary, t_export, result.timings.get("render", 0),

@@ -259,6 +259,12 @@ class VSGL_PT_last_run(_Sub, bpy.types.Panel):
             box.label(text="Skipped by the library", icon="INFO")
             for line in skipped:
                 wrapped(box, context, line, select=bool(named_elements(line)))
+        budget = [l.strip() for l in (info.get("budget") or "").splitlines() if l.strip()]
+        if budget:
+            box = layout.box()
+            box.label(text="Budget per light", icon="LIGHT")
+            for line in budget:
+                wrapped(box, context, line)
         if messages:
             box = layout.box()
             box.label(text="Warnings and errors (%d)" % len(messages), icon="ERROR")

@@ -298,6 +298,14 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
                 stats.seconds_shade);
         fprintf(stderr, "vsgl: lights used %u, skipped %u; VSGLs %u; shading pairs %llu\n", stats.lights_used,
                 stats.lights_skipped, stats.vsgl_count, (unsigned long long)stats.shading_pairs);
+        /* several lights: what each got of the VSGL and RSM budget, and why */
+        for (const char *line = stats.budget; *line;) {
+            const char *nl = strchr(line, '\n');
+            size_t n = nl ? (size_t)(nl - line) : strlen(line);
+            if (n)
+                fprintf(stderr, "vsgl: budget: %.*s\n", (int)n, line);
+            line += n + (nl ? 1 : 0);
+        }
         fprintf(stderr, "vsgl: write %.3f s; wall %.3f s; wrote %s (%ux%u, %s, %s)\n", t_written - t_rendered,
                 t_written - t_start, out_path, cam->width, cam->height, o->half ? "half" : "float",
                 cli_compression_name(o->compression));

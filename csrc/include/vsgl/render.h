@@ -158,6 +158,13 @@ typedef struct vsgl_render_stats {
     char skipped[1024];          /**< what was skipped and why, one item per line; when they do not all
                                       fit, the last line says so (the log has every item) */
     uint32_t reused;             /**< stages taken from a vsgl_render_cache: VSGL_REUSED_* bits */
+    char budget[512];            /**< with two or more lights that light something: what each light got
+                                      and why, one line per light ("light 1: 23 % of the reflected
+                                      power: 118 VSGLs, RSM 215 (uniform 192, 256)"); the VSGLs and RSM
+                                      texels follow each light's reflected power, measured on a 32^2
+                                      probe RSM, with a floor of a quarter of the uniform share; the
+                                      totals stay the settings'. Empty with one light (the settings
+                                      apply as they are) */
 } vsgl_render_stats;
 
 #define VSGL_REUSED_GBUFFER 1u /**< the G-buffer (same scene, camera, AA) */

@@ -131,7 +131,7 @@ static void map_free(cell_map *m)
 }
 
 /* The lattice spacing for about n clusters over the light's lit area. */
-static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, uint32_t n, double extent)
+static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, double n, double extent)
 {
     double sw = 0.0, sw2a = 0.0, swa = 0.0;
     size_t per_face = (size_t)rsm->res * rsm->res;
@@ -150,7 +150,7 @@ static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, uint32_t 
     if (!(sw > 0.0) || !(sw2a > 0.0))
         return extent > 0.0 ? extent : 1.0;
     double area = sw * sw / sw2a;
-    double h = sqrt(area / (double)(n ? n : 1));
+    double h = sqrt(area / (n >= 1.0 ? n : 1.0));
     /* a cluster should hold a few texels: h >= 1.5 x the typical texel size */
     double texel = sqrt(swa / sw);
     if (h < 1.5 * texel)
@@ -218,7 +218,14 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl
 vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
                               const vsgl_render_settings *s, vsgl_vsgl_set *out)
 {
-    uint32_t n_clusters = s->vsgl_count ? s->vsgl_count : 64;
+    return vsgl__fit_lattice_n(ctx, scene, rsm, s, s->vsgl_count ? (double)s->vsgl_count : 64.0, out);
+}
+
+vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
+                                const vsgl_render_settings *s, double n_clusters, vsgl_vsgl_set *out)
+{
+    if (!(n_clusters >= 1.0))
+        n_clusters = 1.0;
     vsgl_grid g;
     vsgl_result r = vsgl__grid_build(ctx, scene, rsm, s->sharpness_estimator, 0, &g);
     if (r != VSGL_OK)
@@ -232,7 +239,7 @@ vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const 
     memset(&map, 0, sizeof map);
     for (int attempt = 0;; ++attempt) {
         r = bin_texels(ctx, rsm, &g, anchor, h, &map);
-        double cap = VSGL__LATTICE_MAX_PER_VSGL * (double)n_clusters;
+        double cap = VSGL__LATTICE_MAX_PER_VSGL * n_clusters;
         if (r != VSGL_OK || (double)map.count <= cap || attempt == 3)
             break;
         h *= 1.05 * sqrt((double)map.count / cap);

@@ -66,6 +66,10 @@ vsgl_result vsgl__fit_fis(vsgl_context *ctx, const vsgl_scene *scene, const vsgl
                           const vsgl_render_settings *s, vsgl_vsgl_set *out);
 vsgl_result vsgl__fit_lattice(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
                               const vsgl_render_settings *s, vsgl_vsgl_set *out);
+/* The lattice with about `n_clusters` VSGLs (real: the spacing follows it
+ * continuously; the per-light budget passes its share). */
+vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
+                                const vsgl_render_settings *s, double n_clusters, vsgl_vsgl_set *out);
 vsgl_result vsgl__fit_kmeans(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm,
                              const vsgl_render_settings *s, vsgl_vsgl_set *out);
 

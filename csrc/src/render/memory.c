@@ -7,6 +7,7 @@
  * tests/cli/run_cli.sh compares the estimate with the peak RSS of real
  * renders. */
 #include "render/render_internal.h"
+#include "render/budget.h"
 #include "shade/kernel.h"
 #include "fit/grid.h"
 #include "fit/vsgl_set.h"
@@ -124,7 +125,14 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
 
     uint32_t light_count = 0;
     const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
-    uint64_t res = s->rsm_resolution, side = 1;
+    /* with two or more lights the budget may give one light more than the
+     * settings (render/budget.h): count its caps */
+    uint32_t powered = 0;
+    for (uint32_t l = 0; l < light_count; ++l)
+        powered += lights[l].power * (lights[l].color[0] + lights[l].color[1] + lights[l].color[2]) > 0.0f;
+    int shared = powered >= 2 && s->fit_mode != VSGL_FIT_TWO && s->method != VSGL_METHOD_BRUTE_FORCE;
+    uint64_t res = shared ? vsgl__budget_rsm_max(s->rsm_resolution) : s->rsm_resolution, side = 1;
+    uint64_t per_light_vsgls = shared ? vsgl__budget_vsgl_max(s->vsgl_count) : s->vsgl_count;
     while (side < res)
         side *= 2;
     uint64_t lit = 0, rsm_max = 0, rsm_sum = 0, texels_sum = 0, fit_max = 0;
@@ -149,13 +157,13 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
             } else if (s->fit_mode == VSGL_FIT_LATTICE) {
                 /* fit/lattice.c: a hash map of lattice cells, each with its sums; a texel's
                  * tent weights reach 4 cells, and there are a few cells per cluster */
-                uint64_t lattice_cells = mul(s->vsgl_count, 16u);
+                uint64_t lattice_cells = mul(per_light_vsgls, 16u);
                 if (lattice_cells > mul(texels, 4u))
                     lattice_cells = mul(texels, 4u);
                 fit = add(grid, mul(lattice_cells, VSGL__GRID_STRIDE * sizeof(double) + 2u * 12u));
             } else {
                 fit = add(grid, add(mul(texels, sizeof(uint32_t)), /* labels, centres, sums */
-                                    mul(s->vsgl_count, 64u + VSGL__GRID_STRIDE * sizeof(double))));
+                                    mul(per_light_vsgls, 64u + VSGL__GRID_STRIDE * sizeof(double))));
             }
         }
         fit_max = fit > fit_max ? fit : fit_max;

@@ -2,6 +2,7 @@
  * Lights that contribute nothing are skipped and reported; outputs are
  * written only when everything succeeded. */
 #include "mrp/proxies.h"
+#include "render/budget.h"
 #include "render/render_internal.h"
 #include "shade/shade.h"
 #include "shade/brute_force.h"
@@ -72,32 +73,116 @@ static vsgl_result light_rsm(vsgl_context *ctx, const vsgl_scene *scene, uint32_
     return VSGL_OK;
 }
 
+/* Appends one line to the stats' budget text (whole lines only). */
+static void note_budget(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...) VSGL_PRINTF(3, 4);
+static void note_budget(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...)
+{
+    char line[192];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    vsgl__log(ctx, VSGL_LOG_INFO, "budget: %s", line);
+    size_t used = strlen(st->budget);
+    if (used + strlen(line) + 1 < sizeof st->budget)
+        snprintf(st->budget + used, sizeof st->budget - used, "%s\n", line);
+}
+
+/* The per-light budget (budget.h): each powered light's reflected power on
+ * a probe RSM, then the shares. 0 lights or 1 powered light: `shares` is
+ * left NULL and every light takes the settings as they are. */
+static vsgl_result light_budget(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
+                                vsgl_light_share **shares_out, vsgl_render_stats *st)
+{
+    uint32_t light_count = 0;
+    const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
+    *shares_out = NULL;
+    if (s->fit_mode == VSGL_FIT_TWO) /* two VSGLs per light whatever the budget */
+        return VSGL_OK;
+    uint32_t powered = 0;
+    for (uint32_t l = 0; l < light_count; ++l)
+        powered += lights[l].power * (lights[l].color[0] + lights[l].color[1] + lights[l].color[2]) > 0.0f;
+    if (powered < 2)
+        return VSGL_OK;
+    vsgl_light_share *sh = calloc(light_count, sizeof *sh);
+    if (!sh)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "render: out of memory for the light budget");
+    double t0 = now_seconds();
+    uint32_t receivers = 0;
+    vsgl__progress_window(ctx, 0.1f, 0.0f);
+    vsgl_result r = vsgl__budget_weights(ctx, scene, s, sh, &receivers);
+    if (r != VSGL_OK) {
+        free(sh);
+        return r;
+    }
+    vsgl__light_budget(sh, light_count, s->vsgl_count, s->rsm_resolution);
+    double t_probe = now_seconds() - t0;
+    st->seconds_rsm += t_probe;
+    uint32_t contributing = 0;
+    for (uint32_t l = 0; l < light_count; ++l)
+        contributing += sh[l].fraction > 0.0;
+    if (contributing < 2) { /* one light reflects anything: it takes the settings as they are */
+        free(sh);
+        return VSGL_OK;
+    }
+    for (uint32_t l = 0; l < light_count; ++l) {
+        if (!(lights[l].power * (lights[l].color[0] + lights[l].color[1] + lights[l].color[2]) > 0.0f))
+            continue;
+        if (sh[l].fraction > 0.0)
+            note_budget(ctx, st, "light %u: %.0f %% of the light on what the camera sees: %u VSGLs, RSM %u "
+                        "(uniform %u, %u)", l,
+                        100.0 * sh[l].fraction, sh[l].vsgl_count, sh[l].rsm_resolution, s->vsgl_count,
+                        s->rsm_resolution);
+        else
+            note_budget(ctx, st, "light %u: sends nothing the camera sees on a %u^2 probe: floor %u VSGLs, RSM %u",
+                        l, s->rsm_resolution < VSGL__BUDGET_PROBE ? s->rsm_resolution : VSGL__BUDGET_PROBE,
+                        sh[l].vsgl_count, sh[l].rsm_resolution);
+    }
+    vsgl__log(ctx, VSGL_LOG_INFO, "budget: %u lights shared %u VSGLs and %u^2 RSM texels each by the light they "
+              "send onto what the camera sees (%u probe receivers; probe %.4f s)", contributing, s->vsgl_count,
+              s->rsm_resolution, receivers, t_probe);
+    *shares_out = sh;
+    return VSGL_OK;
+}
+
 vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                              vsgl_vsgl_set *set, vsgl_render_stats *st)
 {
     uint32_t light_count = 0;
     (void)vsgl__scene_lights(scene, &light_count);
+    vsgl_light_share *shares = NULL;
+    vsgl_result r = light_budget(ctx, scene, s, &shares, st);
+    if (r != VSGL_OK)
+        return r;
     for (uint32_t l = 0; l < light_count; ++l) {
+        vsgl_render_settings ls = *s; /* this light's budget */
+        if (shares) {
+            ls.vsgl_count = shares[l].vsgl_count;
+            ls.rsm_resolution = shares[l].rsm_resolution;
+        }
         vsgl_rsm rsm;
         int lit;
-        vsgl_result r = light_rsm(ctx, scene, l, s->rsm_resolution, 0.1f + 0.3f * (float)l / (float)light_count,
-                                  0.3f / (float)light_count, &rsm, &lit, st);
+        r = light_rsm(ctx, scene, l, ls.rsm_resolution, 0.1f + 0.3f * (float)l / (float)light_count,
+                      0.3f / (float)light_count, &rsm, &lit, st);
         if (r != VSGL_OK)
-            return r;
+            break;
         if (!lit)
             continue;
         double t0 = now_seconds();
         size_t before = set->count;
         switch (s->fit_mode) {
-        case VSGL_FIT_FIS: r = vsgl__fit_fis(ctx, scene, &rsm, s, set); break;
-        case VSGL_FIT_KMEANS: r = vsgl__fit_kmeans(ctx, scene, &rsm, s, set); break;
-        case VSGL_FIT_LATTICE: r = vsgl__fit_lattice(ctx, scene, &rsm, s, set); break;
-        default: r = vsgl__fit_two(ctx, scene, &rsm, s, set); break;
+        case VSGL_FIT_FIS: r = vsgl__fit_fis(ctx, scene, &rsm, &ls, set); break;
+        case VSGL_FIT_KMEANS: r = vsgl__fit_kmeans(ctx, scene, &rsm, &ls, set); break;
+        case VSGL_FIT_LATTICE:
+            r = shares ? vsgl__fit_lattice_n(ctx, scene, &rsm, &ls, shares[l].vsgls, set)
+                       : vsgl__fit_lattice(ctx, scene, &rsm, &ls, set);
+            break;
+        default: r = vsgl__fit_two(ctx, scene, &rsm, &ls, set); break;
         }
         st->seconds_fit += now_seconds() - t0;
         vsgl__rsm_free(&rsm);
         if (r != VSGL_OK)
-            return r;
+            break;
         size_t spec = 0;
         for (size_t k = before; k < set->count; ++k)
             spec += set->items[k].lobe == VSGL__LOBE_SPECULAR;
@@ -109,10 +194,13 @@ vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const v
         } else {
             ++st->lights_used;
         }
-        if (vsgl__progress(ctx, "fit", 1.0f))
-            return vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "fit: cancelled");
+        if (vsgl__progress(ctx, "fit", 1.0f)) {
+            r = vsgl__fail(ctx, VSGL_ERROR_CANCELLED, "fit: cancelled");
+            break;
+        }
     }
-    return VSGL_OK;
+    free(shares);
+    return r;
 }
 
 
@@ -307,6 +395,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
             st.lights_used = cache->f_lights_used;
             st.lights_skipped = cache->f_lights_skipped;
             memcpy(st.skipped, cache->f_skipped, sizeof st.skipped);
+            memcpy(st.budget, cache->f_budget, sizeof st.budget);
         } else {
             r = vsgl__fit_lights(ctx, scene, &s, &set, &st);
             built_set = 1;

@@ -70,7 +70,10 @@ int vsgl__cache_fit_hit(const vsgl_render_cache *c, const vsgl_scene *scene, con
         return 0;
     uint32_t n = 0;
     const vsgl_light *lights = vsgl__scene_lights(scene, &n);
-    return n == c->f_light_count && (n == 0 || memcmp(lights, c->f_lights, (size_t)n * sizeof *lights) == 0);
+    if (n != c->f_light_count || (n && memcmp(lights, c->f_lights, (size_t)n * sizeof *lights) != 0))
+        return 0;
+    /* a budget shared among lights follows what the camera sees (render/budget.h) */
+    return !c->f_budget[0] || memcmp(vsgl__scene_camera(scene), &c->f_camera, sizeof c->f_camera) == 0;
 }
 
 vsgl_result vsgl__cache_keep_fit(vsgl_render_cache *c, const vsgl_scene *scene, const vsgl_render_settings *s,
@@ -99,6 +102,8 @@ vsgl_result vsgl__cache_keep_fit(vsgl_render_cache *c, const vsgl_scene *scene, 
     c->f_lights_used = st->lights_used;
     c->f_lights_skipped = st->lights_skipped;
     memcpy(c->f_skipped, st->skipped, sizeof c->f_skipped);
+    memcpy(c->f_budget, st->budget, sizeof c->f_budget);
+    c->f_camera = *vsgl__scene_camera(scene);
     c->has_f = 1;
     return VSGL_OK;
 }

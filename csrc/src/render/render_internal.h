@@ -42,6 +42,9 @@ struct vsgl_render_cache {
     vsgl_vsgl_set set;
     uint32_t f_lights_used, f_lights_skipped;
     char f_skipped[sizeof(((vsgl_render_stats *)0)->skipped)];
+    char f_budget[sizeof(((vsgl_render_stats *)0)->budget)]; /* non-empty: the lights shared a budget
+                                                                 measured from f_camera's view */
+    vsgl_camera f_camera;
 };
 
 void vsgl__cache_clear(vsgl_render_cache *c);

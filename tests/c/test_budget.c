@@ -1,0 +1,258 @@
+/* The per-light budget (render/budget.h): the rule on its own, against
+ * shares worked out by hand; a render's lights against single-light fits
+ * with those shares; one light untouched; the cache keyed by the camera. */
+#include "harness.h"
+#include "scene_fixture.h"
+#include "render/budget.h"
+#include "vsgl/debug.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+VT_TEST(budget_rule_matches_shares_worked_by_hand)
+{
+    /* weights 9 : 1, the square root: shares 3/4 and 1/4 of the 0.75 x 2 x 64
+     * left above the floors of 16: 16 + 72 = 88 and 16 + 24 = 40; texels
+     * 2 x 64^2 in proportion to VSGLs: sides 64 sqrt(88/64) = 75.05, 64
+     * sqrt(40/64) = 50.6 */
+    vsgl_light_share l[2] = {{.weight = 9.0, .faces = 1}, {.weight = 1.0, .faces = 1}};
+    vsgl__light_budget(l, 2, 64, 64);
+    VT_CHECK(fabs(l[0].vsgls - 88.0) < 1e-9 && fabs(l[1].vsgls - 40.0) < 1e-9, "vsgls %g %g", l[0].vsgls, l[1].vsgls);
+    VT_CHECK(l[0].vsgl_count == 88 && l[1].vsgl_count == 40, "counts %u %u", l[0].vsgl_count, l[1].vsgl_count);
+    VT_CHECK(l[0].rsm_resolution == 75 && l[1].rsm_resolution == 51, "rsm %u %u", l[0].rsm_resolution,
+             l[1].rsm_resolution);
+    VT_CHECK(fabs(l[0].fraction - 0.75) < 1e-12, "fraction %g", l[0].fraction);
+
+    /* one light that counts: exactly the settings; the dark one the floor */
+    vsgl_light_share one[3] = {{.weight = 0.0, .faces = 6}, {.weight = 5.0, .faces = 6}, {.weight = NAN, .faces = 1}};
+    vsgl__light_budget(one, 3, 192, 256);
+    VT_CHECK(one[1].vsgl_count == 192 && one[1].vsgls == 192.0 && one[1].rsm_resolution == 256, "one: %u %g %u",
+             one[1].vsgl_count, one[1].vsgls, one[1].rsm_resolution);
+    VT_CHECK(one[0].vsgl_count == 48 && one[2].vsgl_count == 48 && one[0].rsm_resolution == 128 &&
+             one[2].fraction == 0.0, "dark: %u %u %u %g", one[0].vsgl_count, one[2].vsgl_count,
+             one[0].rsm_resolution, one[2].fraction);
+
+    /* equal lights: the settings each (cube maps and single faces alike) */
+    vsgl_light_share eq[2] = {{.weight = 2.0, .faces = 6}, {.weight = 2.0, .faces = 6}};
+    vsgl__light_budget(eq, 2, 100, 128);
+    VT_CHECK(eq[0].vsgl_count == 100 && eq[1].vsgl_count == 100 && eq[0].rsm_resolution == 128 &&
+             eq[1].rsm_resolution == 128, "equal: %u %u %u %u", eq[0].vsgl_count, eq[1].vsgl_count,
+             eq[0].rsm_resolution, eq[1].rsm_resolution);
+
+    /* many lights, one far brighter: the cap (4 x 32), the rest to the
+     * others, the integers summing to 10 x 32, every light >= the floor of 8,
+     * every output finite */
+    vsgl_light_share many[10];
+    for (int i = 0; i < 10; ++i)
+        many[i] = (vsgl_light_share){.weight = i == 3 ? 1e12 : 1.0 + i, .faces = i % 2 ? 6u : 1u};
+    vsgl__light_budget(many, 10, 32, 100);
+    uint32_t sum = 0;
+    double rsum = 0.0;
+    int ok = 1;
+    for (int i = 0; i < 10; ++i) {
+        sum += many[i].vsgl_count;
+        rsum += many[i].vsgls;
+        ok &= many[i].vsgl_count >= 8 && isfinite(many[i].vsgls) && many[i].rsm_resolution >= 25 &&
+              many[i].rsm_resolution <= 150;
+    }
+    VT_CHECK(many[3].vsgl_count == 128 && sum == 320 && fabs(rsum - 320.0) < 1e-6 && ok, "cap %u sum %u %g ok %d",
+             many[3].vsgl_count, sum, rsum, ok);
+    VT_CHECK(vsgl__budget_rsm_max(256) == 384 && vsgl__budget_vsgl_max(192) == 768, "caps %u %u",
+             vsgl__budget_rsm_max(256), vsgl__budget_vsgl_max(192));
+}
+
+enum { BW = 40, BH = 30 };
+
+/* The fixture room with a second spot: a copy of the first at 1/9 of its
+ * power (the same geometry, so the probe weighs them exactly 9 : 1 up to
+ * float rounding of the flux). */
+static void two_spots(fx_scene *fx)
+{
+    fx_room(fx, BW, BH, 0.3f, 180.0f);
+    fx->lights[1] = fx->lights[0];
+    fx->lights[1].power = 20.0f;
+    fx->light_count = 2;
+}
+
+static size_t fit(vsgl_context *ctx, fx_scene *fx, const vsgl_render_settings *s, vsgl_debug_vsgl *out, size_t cap)
+{
+    vsgl_scene *scene = NULL;
+    size_t n = cap;
+    if (vsgl_scene_create(ctx, fx_desc(fx), &scene) != VSGL_OK || vsgl_debug_vsgls(ctx, scene, s, &n, out) != VSGL_OK)
+        n = 0;
+    vsgl_scene_destroy(scene);
+    return n;
+}
+
+/* The VSGLs of light `light` among a[0..na) equal b[0..nb) to within tol. */
+static int same_vsgls(const vsgl_debug_vsgl *a, size_t na, uint32_t light, const vsgl_debug_vsgl *b, size_t nb,
+                      double tol, char *why, size_t whylen)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < na; ++i) {
+        if (a[i].light != light)
+            continue;
+        if (k >= nb) {
+            snprintf(why, whylen, "more VSGLs than %zu", nb);
+            return 0;
+        }
+        for (int c = 0; c < 3; ++c)
+            if (fabs(a[i].mean[c] - b[k].mean[c]) > tol || fabs(a[i].power[c] - b[k].power[c]) >
+                tol * (fabs(b[k].power[c]) + 1e-6)) {
+                snprintf(why, whylen, "VSGL %zu: mean %g vs %g, power %g vs %g", k, a[i].mean[c], b[k].mean[c],
+                         a[i].power[c], b[k].power[c]);
+                return 0;
+            }
+        ++k;
+    }
+    snprintf(why, whylen, "%zu of %zu", k, nb);
+    return k == nb;
+}
+
+VT_TEST(budget_render_fits_each_light_with_its_share)
+{
+    enum { CAP = 4096 };
+    vsgl_debug_vsgl *both = calloc(CAP, sizeof *both), *solo = calloc(CAP, sizeof *solo);
+    vsgl_context *ctx = fx_context(2);
+    VT_REQUIRE(both && solo && ctx, "alloc");
+    fx_scene fx;
+    two_spots(&fx);
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.vsgl_count = 64;
+    s.rsm_resolution = 64;
+    size_t nb = fit(ctx, &fx, &s, both, CAP);
+    VT_REQUIRE(nb > 0, "two lights: %s", vsgl_context_last_error(ctx));
+
+    /* light 0 alone with 88 VSGLs and RSM 75; light 1 alone with 40 and 51 */
+    char why[160];
+    fx_scene one;
+    two_spots(&one);
+    one.light_count = 1;
+    vsgl_render_settings s0 = s;
+    s0.vsgl_count = 88;
+    s0.rsm_resolution = 75;
+    size_t n0 = fit(ctx, &one, &s0, solo, CAP);
+    VT_CHECK(n0 > 0 && same_vsgls(both, nb, 0, solo, n0, 1e-3, why, sizeof why), "light 0 vs 88/75 alone: %s", why);
+    one.lights[0] = fx.lights[1];
+    vsgl_render_settings s1 = s;
+    s1.vsgl_count = 40;
+    s1.rsm_resolution = 51;
+    size_t n1 = fit(ctx, &one, &s1, solo, CAP);
+    VT_CHECK(n1 > 0 && same_vsgls(both, nb, 1, solo, n1, 1e-3, why, sizeof why), "light 1 vs 40/51 alone: %s", why);
+
+    /* the uniform budget would not pass: light 0 alone at the settings' 64 / 64 */
+    one.lights[0] = fx.lights[0];
+    size_t nu = fit(ctx, &one, &s, solo, CAP);
+    VT_CHECK(nu > 0 && !same_vsgls(both, nb, 0, solo, nu, 1e-3, why, sizeof why), "uniform matched: %s", why);
+    vsgl_context_destroy(ctx);
+    free(both);
+    free(solo);
+}
+
+typedef struct bplanes {
+    float comb[BW * BH * 3], gl[BW * BH * 3];
+} bplanes;
+
+static vsgl_result render(vsgl_context *ctx, fx_scene *fx, vsgl_render_cache *cache, bplanes *p,
+                          vsgl_render_stats *st)
+{
+    vsgl_scene *scene = NULL;
+    vsgl_result r = vsgl_scene_create(ctx, fx_desc(fx), &scene);
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = BW;
+    o.height = BH;
+    o.combined = p->comb;
+    o.glossy_light = p->gl;
+    if (r == VSGL_OK)
+        r = vsgl_render_cached(ctx, scene, &s, cache, &o, st);
+    vsgl_scene_destroy(scene);
+    return r;
+}
+
+VT_TEST(budget_leaves_one_light_alone_and_reports_two)
+{
+    static bplanes a, b;
+    vsgl_context *ctx = fx_context(2);
+    VT_REQUIRE(ctx, "context");
+    fx_scene fx;
+    fx_room(&fx, BW, BH, 0.3f, 150.0f);
+    vsgl_render_stats st = {.size = sizeof st};
+    VT_CHECK(render(ctx, &fx, NULL, &a, &st) == VSGL_OK && st.budget[0] == 0, "one light: budget '%s'", st.budget);
+    /* a second light into the void and a third of zero power change nothing */
+    fx.lights[1] = fx.lights[0];
+    fx_translation(fx.lights[1].world_from_light, 0, 0, 50);
+    fx.lights[1].world_from_light[10] = -1.0f;
+    fx.lights[1].world_from_light[5] = -1.0f;
+    fx.lights[2] = fx.lights[0];
+    fx.lights[2].power = 0.0f;
+    fx.light_count = 3;
+    VT_CHECK(render(ctx, &fx, NULL, &b, &st) == VSGL_OK && st.budget[0] == 0, "dead lights: budget '%s'", st.budget);
+    VT_CHECK(memcmp(&a, &b, sizeof a) == 0, "a light that lights nothing changed the render");
+
+    two_spots(&fx);
+    VT_CHECK(render(ctx, &fx, NULL, &a, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    unsigned v0 = 0, v1 = 0, r0 = 0, r1 = 0;
+    const char *l1 = strstr(st.budget, "light 1:");
+    VT_CHECK(sscanf(st.budget, "light 0: 75 %% of the light on what the camera sees: %u VSGLs, RSM %u", &v0, &r0) == 2 &&
+             l1 && sscanf(l1, "light 1: 25 %% of the light on what the camera sees: %u VSGLs, RSM %u", &v1, &r1) == 2,
+             "budget text: %s", st.budget);
+    /* preview: 32 VSGLs, RSM 128: floors 8, then 36 and 12 */
+    VT_CHECK(v0 == 44 && v1 == 20 && r0 == 150 && r1 == 101, "%u %u %u %u", v0, v1, r0, r1);
+    vsgl_context_destroy(ctx);
+}
+
+static vsgl_result render_view(vsgl_context *ctx, const vsgl_scene *scene, vsgl_render_cache *cache, bplanes *p,
+                               vsgl_render_stats *st)
+{
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = BW;
+    o.height = BH;
+    o.combined = p->comb;
+    o.glossy_light = p->gl;
+    return vsgl_render_cached(ctx, scene, &s, cache, &o, st);
+}
+
+VT_TEST(budget_cache_follows_the_camera)
+{
+    static bplanes cached, plain;
+    vsgl_context *ctx = fx_context(2);
+    vsgl_render_cache *cache = NULL;
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(ctx && vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
+    fx_scene fx;
+    two_spots(&fx);
+    fx.lights[1].power = 60.0f;
+    const float at[3] = {0.5f, 0.5f, 0.3f};
+    fx_look_at(fx.lights[1].world_from_light, (const float[3]){0.6f, -0.6f, 1.9f}, at);
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    vsgl_render_stats st = {.size = sizeof st};
+    VT_CHECK(render_view(ctx, scene, cache, &cached, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    char before[sizeof st.budget];
+    memcpy(before, st.budget, sizeof before);
+    /* the camera turns to the other light's side: the budget follows it, so
+     * the fit is not reused */
+    const float eye[3] = {0.9f, -0.9f, 1.0f}, look[3] = {-1.0f, 0.3f, 0.6f};
+    fx_look_at(fx.camera.world_from_camera, eye, look);
+    VT_CHECK(vsgl_scene_set_view(ctx, scene, &fx.camera, fx.lights, fx.light_count) == VSGL_OK, "set_view");
+    VT_CHECK(render_view(ctx, scene, cache, &cached, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(st.reused == 0 && strcmp(before, st.budget) != 0, "camera moved: reused %u, budget %s -> %s", st.reused,
+             before, st.budget);
+    VT_CHECK(render_view(ctx, scene, NULL, &plain, NULL) == VSGL_OK, "uncached");
+    VT_CHECK(memcmp(&cached, &plain, sizeof cached) == 0, "camera moved: the cached render differs");
+    /* nothing moved: both reused, bit-identical, the budget reported again */
+    VT_CHECK(render_view(ctx, scene, cache, &cached, &st) == VSGL_OK, "again");
+    VT_CHECK(st.reused == (VSGL_REUSED_GBUFFER | VSGL_REUSED_FIT) && st.budget[0], "unchanged: reused %u '%s'",
+             st.reused, st.budget);
+    VT_CHECK(memcmp(&cached, &plain, sizeof cached) == 0, "unchanged: the cached render differs");
+    vsgl_scene_destroy(scene);
+    vsgl_render_cache_destroy(cache);
+    vsgl_context_destroy(ctx);
+}
