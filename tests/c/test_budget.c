@@ -256,3 +256,54 @@ VT_TEST(budget_cache_follows_the_camera)
     vsgl_render_cache_destroy(cache);
     vsgl_context_destroy(ctx);
 }
+
+/* Negligible specular VSGLs (render.c, VSGL__SPECULAR_NEGLIGIBLE): every
+ * specular VSGL kept carries at least 1 % of its light's mean VSGL power
+ * (the mean over what the fit made, dropped ones included), the count
+ * dropped and the power they carried are said, and that power is tiny. */
+VT_TEST(budget_negligible_specular_vsgls_are_dropped_and_said)
+{
+    enum { CAP = 8192 };
+    vsgl_debug_vsgl *v = calloc(CAP, sizeof *v);
+    vsgl_context *ctx = fx_context(2);
+    VT_REQUIRE(v && ctx, "alloc");
+    fx_scene fx;
+    fx_room(&fx, BW, BH, 0.3f, 150.0f);
+    fx.materials[3].specular_f0 = 0.04f; /* the white walls and the ceiling glossy too: many specular VSGLs */
+    fx.materials[3].roughness = 0.4f;
+    vsgl_render_settings s; /* render_view's */
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    size_t n = CAP;
+    VT_REQUIRE(vsgl_debug_vsgls(ctx, scene, &s, &n, v) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    static bplanes p;
+    vsgl_render_stats st = {.size = sizeof st};
+    VT_REQUIRE(render_view(ctx, scene, NULL, &p, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    unsigned dropped = 0, spec_all = 0;
+    double pct = -1.0, saved = -1.0;
+    const char *line = strstr(st.skipped, "light 0: ");
+    while (line && sscanf(line, "light 0: %u of its %u specular VSGLs under 1 %% of its mean VSGL power (%lf %% of "
+                          "its light): %lf %%", &dropped, &spec_all, &pct, &saved) != 4)
+        line = strstr(line + 1, "light 0: ");
+    VT_CHECK(line && dropped > 0 && pct >= 0.0 && pct < 0.1, "skipped: %s", st.skipped);
+    double total = 0.0, min_spec = 1e30;
+    size_t spec = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double pw = (double)v[i].power[0] + v[i].power[1] + v[i].power[2];
+        total += pw;
+        if (v[i].lobe == 1) {
+            ++spec;
+            min_spec = pw < min_spec ? pw : min_spec;
+        }
+    }
+    VT_CHECK(spec + dropped == spec_all, "kept %zu + dropped %u != %u", spec, dropped, spec_all);
+    /* the light's mean before the drop: (kept power + dropped power) / (kept + dropped count) */
+    double mean_all = total * (1.0 + pct / 100.0) / (double)(n + dropped);
+    VT_CHECK(min_spec >= 0.01 * mean_all * (1.0 - 1e-4), "a kept specular VSGL of %g < 1 %% of %g", min_spec,
+             mean_all);
+    VT_CHECK(fabs(saved - 100.0 * dropped / (double)(n + dropped)) < 0.06, "saved %g %% of %zu", saved, n + dropped);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+    free(v);
+}
