@@ -26,11 +26,15 @@ Debian's Blender 3.4 ($BLENDER), run under `nice -n 19`:
 The library's whole-frame time: the add-on's export of the scene in Blender
 (measured by trade_cycles.py), scene creation (BVH), vsgl_render of every
 plane, and the multilayer EXR write (float, ZIP, as the add-on writes it):
-the fastest of --repeat runs. Metrics (tests/quality/metrics.py) on the
+the presets the fastest of --repeat runs, the knobs one run. The brute force
+is cached under build/trade/brute/ (like the sweeps, with its time as
+measured when it was computed) by a hash of the scene, its parameters and
+the sources its path runs through (BRUTE_CODE). Metrics (tests/quality/metrics.py) on the
 coloured passes against the mean of the two reference seeds.
 """
 import argparse
 import datetime
+import hashlib
 import json
 import os
 import shutil
@@ -70,6 +74,13 @@ SWEEP_SEED = 7
 TIME_SPP = [1, 4]  # Cycles at --time-size (times only)
 FLICKER_SIZE = (160, 120)  # the light animation of the presets (tests/quality/scenes.py: extent/1000 per frame)
 SWEEP_DIR = os.path.join(ROOT, "build", "trade", "cycles")
+# brute-force points, cached like the Cycles sweeps (with their time as measured when computed): the
+# gather is deterministic and was most of a full run (box room: 219 s at RSM 64, ~4x that at RSM 128);
+# the key covers the scene, the parameters and every source file the brute-force path runs through
+BRUTE_DIR = os.path.join(ROOT, "build", "trade", "brute")
+BRUTE_CODE = ["csrc/include", "csrc/src/core", "csrc/src/math", "csrc/src/scene", "csrc/src/gbuffer",
+              "csrc/src/rsm", "csrc/src/shade/brute_force.c", "csrc/src/shade/brute_force.h",
+              "csrc/src/shade/reference.c"]
 EXR_PASSES = {p: n for p, n in L.PLANE_PASS_NAMES.items() if p not in ("combined", "alpha")}
 
 
@@ -125,6 +136,55 @@ def references(names, size, ref_spp):
 def parse(spec):
     label, _, rest = spec.partition(":")
     return evaluate.parse_config(rest, label) if rest else evaluate.parse_config(label)
+
+
+def _digest_value(h, v):
+    if isinstance(v, np.ndarray):
+        h.update(str(v.dtype).encode() + str(v.shape).encode())
+        h.update(np.ascontiguousarray(v).tobytes())
+    elif isinstance(v, (list, tuple)):
+        h.update(b"[%d" % len(v))
+        for x in v:
+            _digest_value(h, x)
+    elif hasattr(v, "_fields_"):  # a ctypes structure: its bytes
+        h.update(bytes(v))
+    else:
+        h.update(repr(v).encode())
+
+
+def brute_key(arrays, params):
+    """sha1 of the brute-force path's sources (BRUTE_CODE), the scene arrays and the parameters."""
+    h = hashlib.sha1()
+    for rel in BRUTE_CODE:
+        path = os.path.join(ROOT, rel)
+        files = [path] if os.path.isfile(path) else sorted(
+            os.path.join(d, f) for d, _, fs in os.walk(path) for f in fs if f.endswith((".c", ".h")))
+        for f in files:
+            h.update(os.path.relpath(f, ROOT).encode())
+            with open(f, "rb") as fh:
+                h.update(fh.read())
+    for k in sorted(arrays):
+        h.update(k.encode())
+        _digest_value(h, arrays[k])
+    h.update(json.dumps(params, sort_keys=True, default=str).encode())
+    return h.hexdigest()[:16]
+
+
+def run_brute_cached(ctx, arrays, case, cfg, exr_dir, name):
+    """run_library for a brute-force configuration through BRUTE_DIR: (passes, seconds, VPLs, cached?)."""
+    w, h = case["camera"]["res"]
+    path = os.path.join(BRUTE_DIR, "%s_%dx%d_%s.npz" % (name, w, h, brute_key(arrays, cfg.brute_params(case))))
+    if os.path.exists(path):
+        with np.load(path) as z:
+            meta = json.loads(str(z["meta"]))
+            return {k: z[k] for k in z.files if k != "meta"}, meta["seconds"], meta["vsgls"], True
+    img, secs, vsgls = run_library(ctx, arrays, case, cfg, exr_dir)
+    os.makedirs(BRUTE_DIR, exist_ok=True)
+    tmp = path + ".tmp.npz"
+    np.savez(tmp, meta=json.dumps(dict(seconds=secs, vsgls=vsgls, library=L.version_string(),
+                                       date=datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"))), **img)
+    os.replace(tmp, path)
+    return img, secs, vsgls, False
 
 
 def run_library(ctx, arrays, case, cfg, exr_dir):
@@ -203,11 +263,18 @@ def measure_scene(name, args, ctx, version, exr_dir):
         if dense and cfg.label not in PRESETS:
             res["skipped"].append(cfg.label)  # ~20-40 s a frame here: the presets only
             continue
-        img, secs, vsgls = run_library(ctx, arrays, case, cfg, exr_dir)
-        for _ in range(repeat - 1 if not cfg.brute else 0):
+        kind = "brute" if cfg.brute else ("preset" if cfg.label in PRESETS else "knob")
+        if cfg.brute:
+            img, secs, vsgls, cached = run_brute_cached(ctx, arrays, case, cfg, exr_dir, name)
+            if cached:
+                res.setdefault("brute_cached", []).append(cfg.label)
+        else:
+            img, secs, vsgls = run_library(ctx, arrays, case, cfg, exr_dir)
+        # the presets' times are the headline ratios: the fastest of --repeat runs; a knob's point
+        # on the front is one run (a second was a sixth of a full run's library time)
+        for _ in range(repeat - 1 if kind == "preset" else 0):
             secs = min(secs, run_library(ctx, arrays, case, cfg, exr_dir)[1], key=lambda s: sum(s.values()))
         parts = dict(export=export, **secs)
-        kind = "brute" if cfg.brute else ("preset" if cfg.label in PRESETS else "knob")
         res["points"].append(dict(kind=kind, label=cfg.label, describe=cfg.describe(), seconds=sum(parts.values()),
                                   parts=parts, vsgls=vsgls, **score(img, ref)))
         images[cfg.label] = img["Combined"]
@@ -402,8 +469,10 @@ def markdown(results, meta, img_rel, png_rel):
              "DiffCol + GlossCol, normal guide the Normal pass), its time render + denoise (device, commit, "
              "execute). **Library**: whole frame as the add-on runs it: export in Blender (the add-on's "
              "`export.collect`, measured in Blender 3.4) + scene creation (BVH) + `vsgl_render` of every plane + "
-             "the multilayer EXR write (float, ZIP); the fastest of %d runs. **Brute force**: every RSM texel a "
-             "VPL with the exact BRDF (the RSM's own limit), one run." % (
+             "the multilayer EXR write (float, ZIP); the presets the fastest of %d runs, the knobs one run. "
+             "**Brute force**: every RSM texel a VPL with the exact BRDF (the RSM's own limit), one run, cached "
+             "under build/trade/brute/ by a hash of the scene, its parameters and the sources the brute-force "
+             "path runs through, its time as measured when it was computed (like the Cycles sweeps)." % (
                  meta["size"][0], meta["size"][1], meta["blender"], meta["ref_spp"], 2 * meta["ref_spp"],
                  SWEEP_SEED, "2.3", meta["oidn_quality"], meta["repeat"]), "",
              "**Metrics** (tests/quality/metrics.py) of the combined pass against the references' mean: "
@@ -484,11 +553,14 @@ def markdown(results, meta, img_rel, png_rel):
         ref = res["reference"]
         lines += ["", "## %s" % name, "", res["feature"] + ".", "",
                   "%d triangles. Reference: %d spp x 2 seeds, %s s each; its own relMSE noise %.5f, FLIP "
-                  "between the seeds %s. Add-on export: %.3f s. Library: the fastest of %d run(s)%s." % (
+                  "between the seeds %s. Add-on export: %.3f s. Library: presets the fastest of %d run(s), knobs "
+                  "one%s%s." % (
                       res["triangles"], ref["spp"], " / ".join("%.0f" % s for s in ref["seconds"]), ref["noise"],
                       fmt(ref["flip_seeds"]), res["export_seconds"], res["library_repeat"],
                       ("; not run (minutes per frame here): " + ", ".join(res["skipped"]))
-                      if res["skipped"] else ""), "",
+                      if res["skipped"] else "",
+                      ("; from the brute-force cache: " + ", ".join(res["brute_cached"]))
+                      if res.get("brute_cached") else ""), "",
                   "| method | time (s) | parts (s) | VSGLs | relMSE | rel. RMSE | FLIP | bias C | bias D / G | "
                   "Pareto (FLIP) |", "|---|---|---|---|---|---|---|---|---|---|"]
         pts = res["points"]
