@@ -134,8 +134,8 @@ def ensure_frame(names, size, anim, frame, refdir=DEFAULT_DIR, seeds=scenes.SEED
         return ensure(names, size, refdir, seeds, log, quiet)
     version = blender_version(refdir)
     code = code_digest()
-    need = sorted({n for n in names for s in seeds
-                   if version is None or not os.path.exists(path_frame(refdir, n, size, s, version, anim, frame, code))})
+    need = sorted({n for n in names for s in seeds if version is None
+                   or not os.path.exists(path_frame(refdir, n, size, s, version, anim, frame, code))})
     if need:
         if version is None:
             raise RuntimeError("references missing and no Blender found ($BLENDER=%s)" % blender_binary())

@@ -144,8 +144,8 @@ def test_motion_change_removes_independent_noise():
     assert abs(got - want) < 0.1 * want
     assert naive > 1.5 * want  # one seed's difference is noise-dominated here
     # no motion: nothing measurable above the noise
-    still = M.motion_change((seeds[0][0], seeds[1][0]), (seeds[0][0] + rng.normal(0, 0.02, f0.shape),
-                                                           seeds[1][0] + rng.normal(0, 0.02, f0.shape)), steps)
+    again = [seeds[k][0] + rng.normal(0, 0.02, f0.shape) for k in range(2)]
+    still = M.motion_change((seeds[0][0], seeds[1][0]), (again[0], again[1]), steps)
     assert still < 0.2 * want
 
 
