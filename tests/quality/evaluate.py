@@ -394,6 +394,12 @@ def quick_line(name, label, e, ref):
                 ("  WARN: " + e["warnings"][0][:80]) if e["warnings"] else ""))
 
 
+def own(motion, kind):
+    """Summary cell suffix: the motion's own change in Cycles, when measured."""
+    m = (motion or {}).get(kind)
+    return "" if not m else " (Cycles' own: %s / %s)" % (_f(m["Diff"], "%.4f"), _f(m["Gloss"], "%.4f"))
+
+
 def camera_cell(e):
     """Summary cell: camera flicker Diff / Gloss, and above the motion's own change when measured."""
     f = e["flicker"].get("camera")
@@ -496,7 +502,7 @@ def markdown(results, args, img_rel):
                     name, label, e["seconds"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]),
                     _f(s["Diff"]["structured"], "%.5f"), _ratio(s["Diff"]["structured"], nz["Diff"]["s4"]),
                     _f(s["Gloss"]["structured"], "%.5f"), _ratio(s["Gloss"]["structured"], nz["Gloss"]["s4"]),
-                    _f(e["flip"], "%.4f"), fl("light").split(" (")[0], camera_cell(e)))
+                    _f(e["flip"], "%.4f"), fl("light").split(" (")[0] + own(mo, "light"), camera_cell(e) + own(mo, "camera")))
         body.append("")
         body.append("Configurations: " + "; ".join("**%s** = %s" % (l, e["describe"]) for l, e in r["configs"].items())
                     + ".")
