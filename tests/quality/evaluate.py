@@ -502,7 +502,8 @@ def markdown(results, args, img_rel):
                     name, label, e["seconds"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]),
                     _f(s["Diff"]["structured"], "%.5f"), _ratio(s["Diff"]["structured"], nz["Diff"]["s4"]),
                     _f(s["Gloss"]["structured"], "%.5f"), _ratio(s["Gloss"]["structured"], nz["Gloss"]["s4"]),
-                    _f(e["flip"], "%.4f"), fl("light").split(" (")[0] + own(mo, "light"), camera_cell(e) + own(mo, "camera")))
+                    _f(e["flip"], "%.4f"), fl("light").split(" (")[0] + own(mo, "light"),
+                    camera_cell(e) + own(mo, "camera")))
         body.append("")
         body.append("Configurations: " + "; ".join("**%s** = %s" % (l, e["describe"]) for l, e in r["configs"].items())
                     + ".")
