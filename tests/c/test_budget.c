@@ -310,3 +310,45 @@ VT_TEST(budget_negligible_specular_vsgls_are_dropped_and_said)
     vsgl_context_destroy(ctx);
     free(v);
 }
+
+/* Visibility rays in a convex shell (scene/convex.c): the open box of the
+ * fixture has every surface on its convex hull, so rays are skipped (said,
+ * and the render equals one without rays bit for bit); a wall standing in
+ * the room makes rays count again (the render differs from one without). */
+VT_TEST(budget_visibility_rays_skipped_only_in_a_convex_shell)
+{
+    static bplanes ray, none;
+    vsgl_context *ctx = fx_context(2);
+    VT_REQUIRE(ctx, "context");
+    for (int occluder = 0; occluder < 2; ++occluder) {
+        fx_scene fx;
+        fx_room(&fx, BW, BH, 0.3f, 150.0f);
+        if (occluder) {
+            const float wall[4][3] = {{0.2f, -1.0f, 0.0f}, {0.2f, 1.0f, 0.0f}, {0.2f, 1.0f, 1.6f}, {0.2f, -1.0f, 1.6f}};
+            fx_quad(&fx, wall, 3);
+        }
+        vsgl_scene *scene = NULL;
+        VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        vsgl_render_stats st = {.size = sizeof st};
+        for (int k = 0; k < 2; ++k) {
+            vsgl_render_settings s;
+            vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+            s.visibility = k ? VSGL_VISIBILITY_NONE : VSGL_VISIBILITY_RAY;
+            vsgl_render_output o;
+            memset(&o, 0, sizeof o);
+            o.width = BW;
+            o.height = BH;
+            o.combined = k ? none.comb : ray.comb;
+            o.glossy_light = k ? none.gl : ray.gl;
+            VT_CHECK(vsgl_render(ctx, scene, &s, &o, k ? NULL : &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        }
+        int said = strstr(st.skipped, "visibility rays: every surface lies on the scene's convex hull") != NULL;
+        int same = memcmp(&ray, &none, sizeof ray) == 0;
+        if (occluder)
+            VT_CHECK(!said && !same, "with a wall: said %d, same as without rays %d", said, same);
+        else
+            VT_CHECK(said && same, "open box: said %d, same as without rays %d (%s)", said, same, st.skipped);
+        vsgl_scene_destroy(scene);
+    }
+    vsgl_context_destroy(ctx);
+}

@@ -410,6 +410,12 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
 
     vsgl_render_stats st;
     memset(&st, 0, sizeof st);
+    /* a convex shell (an empty closed room): visibility rays cannot find anything */
+    int rays_skipped = 0;
+    if (s.method == VSGL_METHOD_VSGL && s.visibility == VSGL_VISIBILITY_RAY && vsgl__scene_convex_shell(scene)) {
+        s.visibility = VSGL_VISIBILITY_NONE;
+        rays_skipped = 1;
+    }
     vsgl_gbuffer g;
     memset(&g, 0, sizeof g);
     vsgl_vsgl_set set;
@@ -492,6 +498,10 @@ done:
         if (built_set)
             vsgl__cache_keep_fit(cache, scene, &s, &set, &st);
     }
+    if (r == VSGL_OK && rays_skipped) /* after the cache kept the fit's notes: said on every render */
+        note_skip(ctx, &st, "visibility rays: every surface lies on the scene's convex hull (an empty closed "
+                  "room), so nothing can block light between two surfaces: %llu rays saved",
+                  (unsigned long long)st.shading_pairs);
     vsgl__shade_plan_free(plan);
     vsgl__vsgl_set_free(&set);
     vsgl__gbuffer_free(&g);
