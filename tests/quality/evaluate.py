@@ -363,13 +363,13 @@ def quick_line(name, label, e, ref):
             _f(fl[kind]["Diff"]["median"], "%.4f"), _f(fl[kind]["Gloss"]["median"], "%.4f"),
             _f(fl[kind]["Diff"]["ratio"], "%.1f"), _f(fl[kind]["Gloss"]["ratio"], "%.1f"),
             _f(fl[kind]["Diff"]["l1"], "%.4f"), _f(fl[kind]["Gloss"]["l1"], "%.4f"))
-    return ("%-28s %-16s %6.3fs  bias D %s G %s C %s  relMSE C %s  struct D %s (%sx) G %s (%sx)  FLIP %s  "
+    return ("%-28s %-16s %6.3fs  bias D %s G %s C %s  relMSE C %s G %s  struct D %s (%sx) G %s (%sx)  FLIP %s G %s  "
             "flicker light %s camera %s%s" % (
                 name, label, e["seconds"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]), _f(s["Combined"]["bias"]),
-                _f(s["Combined"]["relmse"], "%.4f"),
+                _f(s["Combined"]["relmse"], "%.4f"), _f(s["Gloss"]["relmse"], "%.4f"),
                 _f(s["Diff"]["structured"], "%.5f"), _ratio(s["Diff"]["structured"], nz["Diff"]["s4"]),
                 _f(s["Gloss"]["structured"], "%.5f"), _ratio(s["Gloss"]["structured"], nz["Gloss"]["s4"]),
-                _f(e["flip"], "%.4f"), flk("light"), flk("camera"),
+                _f(e["flip"], "%.4f"), _f(s["Gloss"].get("flip"), "%.4f"), flk("light"), flk("camera"),
                 ("  WARN: " + e["warnings"][0][:80]) if e["warnings"] else ""))
 
 

@@ -189,11 +189,13 @@ def excess_flicker(frames, truth):
 def all_metrics(img, ref_seeds, k=4):
     """Every still metric of one configuration's passes against the
     reference seeds (each a dict of coloured passes). Returns
-    {pass: dict(bias, relmse, structured)} plus 'flip' (combined)."""
+    {pass: dict(bias, relmse, structured)} plus 'flip' (combined); the
+    glossy pass also has its own 'flip' (issue 14's acceptance is on it)."""
     ref = {p: 0.5 * (ref_seeds[0][p] + ref_seeds[1][p]) for p in ("Diff", "Gloss", "Combined")}
     out = {}
     for p in ("Diff", "Gloss", "Combined"):
         out[p] = dict(bias=bias(img[p], ref[p]), relmse=relmse(img[p], ref[p]),
                       structured=structured(img[p], ref[p], k))
     out["flip"] = flip(img["Combined"], ref["Combined"])
+    out["Gloss"]["flip"] = flip(img["Gloss"], ref["Gloss"])
     return out

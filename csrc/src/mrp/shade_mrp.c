@@ -5,6 +5,7 @@
 #include "core/context.h"
 #include "core/parallel.h"
 #include "scene/material.h"
+#include "shade/kernel.h"
 
 typedef struct mrp_job {
     const vsgl_scene *scene;
@@ -33,7 +34,9 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
     vsgl_sg lobe;
     vsgl__mrp_receiver_sg(n, o, alpha, &lobe);
     d3 z = d3_of_v3(lobe.axis);
-    double nu = 0.5 * lobe.sharpness, spread = 3.0 / sqrt(nu > 1e-6 ? nu : 1e-6); /* e^{-9} of the peak */
+    /* e^{-9} of the peak of the widest lobe (GGX's tail when there are two) */
+    double nu = 0.5 * lobe.sharpness * (j->opt.lobes == 2 ? VSGL__GGX_TAIL_K : 1.0);
+    double spread = 3.0 / sqrt(nu > 1e-6 ? nu : 1e-6);
     v3 nf = d3_to_v3(n), of = d3_to_v3(o);
     float ms[3];
     for (int c = 0; c < 3; ++c)
@@ -74,14 +77,17 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
                     cell.center = d3_add(plane.center, d3_add(d3_scale(plane.u, mu), d3_scale(plane.v, mv)));
                     cell.half_u = cu;
                     cell.half_v = cv;
-                    d3 axis;
-                    double v = vsgl__mrp_glossy_uniform(&cell, x, n, o, alpha, &j->opt, &axis);
-                    if (!(v > 0.0))
-                        continue;
-                    float sf[3];
-                    vsgl__specular_factor(&bp, nf, of, d3_to_v3(axis), (float)alpha, sf);
-                    for (int c = 0; c < 3; ++c)
-                        acc[c] += v * sf[c] * ms[c] * L[c];
+                    d3 axis[2];
+                    double v[2];
+                    int parts = vsgl__mrp_glossy_parts(&cell, x, n, o, alpha, &j->opt, v, axis);
+                    for (int q = 0; q < parts; ++q) {
+                        if (!(v[q] > 0.0))
+                            continue;
+                        float sf[3];
+                        vsgl__specular_factor(&bp, nf, of, d3_to_v3(axis[q]), (float)alpha, sf);
+                        for (int c = 0; c < 3; ++c)
+                            acc[c] += v[q] * sf[c] * ms[c] * L[c];
+                    }
                 }
             }
         }

@@ -328,7 +328,9 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     b->nx[k] = r->n.x; b->ny[k] = r->n.y; b->nz[k] = r->n.z;
     b->ox[k] = r->o.x; b->oy[k] = r->o.y; b->oz[k] = r->o.z;
     b->diffuse[k] = r->bp.diffuse[0] + r->bp.diffuse[1] + r->bp.diffuse[2] > 0.0f ? 1.0f : 0.0f;
-    if (r->glossy) {
+    /* VSGL_GLOSSY_MRP replaces the glossy plane (mrp/pass.c): the kernel
+     * skips the glossy lobe of lanes with camp 0 */
+    if (r->glossy && j->s->glossy_mode != VSGL_GLOSSY_MRP) {
         b->Xx[k] = r->asg.x.x; b->Xy[k] = r->asg.x.y; b->Xz[k] = r->asg.x.z;
         b->Yx[k] = r->asg.y.x; b->Yy[k] = r->asg.y.y; b->Yz[k] = r->asg.y.z;
         b->Zx[k] = r->asg.z.x; b->Zy[k] = r->asg.z.y; b->Zz[k] = r->asg.z.z;
@@ -342,7 +344,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
         b->lam[k] = b->mu[k] = b->camp[k] = 0.0f;
     }
     float m[3] = {0.0f, 0.0f, 0.0f};
-    if (r->glossy) {
+    if (r->glossy && j->s->glossy_mode != VSGL_GLOSSY_MRP) {
         vsgl__specular_factor(&r->bp, r->n, r->o, r->asg.z, r->alpha, m);
         for (int c = 0; c < 3; ++c)
             m[c] *= r->ms[c];
