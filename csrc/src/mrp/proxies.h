@@ -58,7 +58,9 @@ vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, c
 /* Defaults of the proxy pass (not settings yet): proxies of at least
  * VSGL__MRP_MIN_AREA m^2, VSGL__MRP_CELLS cells along their longer side. */
 #define VSGL__MRP_MIN_AREA 0.25
+#ifndef VSGL__MRP_CELLS
 #define VSGL__MRP_CELLS 32
+#endif
 
 /* The whole glossy_mode = VSGL_GLOSSY_MRP pass: proxies from the scene, one
  * RSM per light at @p rsm_resolution (built again: the fit frees its own),

@@ -6,6 +6,7 @@
 #include "core/parallel.h"
 #include "scene/material.h"
 #include "shade/kernel.h"
+#include "vsgl/lobes.h"
 
 typedef struct mrp_job {
     const vsgl_scene *scene;
@@ -34,8 +35,16 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
     vsgl_sg lobe;
     vsgl__mrp_receiver_sg(n, o, alpha, &lobe);
     d3 z = d3_of_v3(lobe.axis);
-    /* e^{-9} of the peak of the widest lobe (GGX's tail when there are two) */
-    double nu = 0.5 * lobe.sharpness * (j->opt.lobes == 2 ? VSGL__GGX_TAIL_K : 1.0);
+    /* e^{-9} of the peak of the widest lobe (GGX's tail when there are two)
+     * along the warped ASG's wider axis (a grazing view stretches it in the
+     * plane of incidence: Eq. 8's isotropic SG is up to 1/sqrt(2 |o.n|) narrower) */
+    vsgl_asg ndf, wa;
+    d3 t0, t1;
+    d3_basis(n, &t0, &t1);
+    v3 tf0 = d3_to_v3(t0), nf0 = d3_to_v3(n), of0 = d3_to_v3(o);
+    vsgl_ndf_aniso_to_asg(&nf0, &tf0, (float)alpha, (float)alpha, &ndf);
+    vsgl_warp_ndf_asg(&ndf, &of0, &wa);
+    double nu = fmin((double)wa.lambda, (double)wa.mu) * (j->opt.lobes == 2 ? VSGL__GGX_TAIL_K : 1.0);
     double spread = 3.0 / sqrt(nu > 1e-6 ? nu : 1e-6);
     v3 nf = d3_to_v3(n), of = d3_to_v3(o);
     float ms[3];
@@ -59,7 +68,10 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
             double d = d3_length(d3_sub(y, x)), cs = d3_dot(d3_sub(x, y), plane.normal) / (d > 0.0 ? d : 1.0);
             double reach = d * spread / (cs > 0.05 ? cs : 0.05);
             d3 dy = d3_sub(y, plane.center);
-            double yu = d3_dot(dy, plane.u), yv = d3_dot(dy, plane.v);
+            /* cell (iu, iv) is where proxies.c put it: along the proxy's own v
+             * (the back side's flipped plane.v would mirror its radiance) */
+            const d3 pv0 = p->rect.v;
+            double yu = d3_dot(dy, plane.u), yv = d3_dot(dy, pv0);
             double cu = plane.half_u / p->nu, cv = plane.half_v / p->nv;
             const float *rad = p->power + (size_t)side * p->nu * p->nv * 3;
             for (uint32_t iv = 0; iv < p->nv; ++iv) {
@@ -74,9 +86,34 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
                     if (fabs(yu - mu) - cu > reach)
                         continue;
                     vsgl__mrp_rect cell = plane;
-                    cell.center = d3_add(plane.center, d3_add(d3_scale(plane.u, mu), d3_scale(plane.v, mv)));
+                    cell.center = d3_add(plane.center, d3_add(d3_scale(plane.u, mu), d3_scale(pv0, mv)));
                     cell.half_u = cu;
                     cell.half_v = cv;
+#ifdef VSGL__MRP_EXACT_CELLS
+                    { /* diagnostic build (tools/mrp_quality.sh): the exact BRDF integrated over the cell
+                       * (N x N midpoints, -DVSGL__MRP_EXACT_CELLS=N) instead of the MRP term, to tell
+                       * the term's error from the cells' radiance */
+                        const int Q = VSGL__MRP_EXACT_CELLS;
+                        for (int a = 0; a < Q; ++a)
+                            for (int b = 0; b < Q; ++b) {
+                                double pu = mu + cu * (2.0 * (a + 0.5) / Q - 1.0), pv = mv + cv * (2.0 * (b + 0.5) / Q - 1.0);
+                                d3 pp = d3_add(plane.center, d3_add(d3_scale(plane.u, pu), d3_scale(pv0, pv)));
+                                d3 wi = d3_sub(pp, x);
+                                double r2 = d3_dot(wi, wi);
+                                wi = d3_scale(wi, 1.0 / sqrt(r2));
+                                double cr = -d3_dot(wi, plane.normal);
+                                if (!(cr > 0.0))
+                                    continue;
+                                float dif[3], gl[3];
+                                v3 tf = v3_make(g->tan[0][i], g->tan[1][i], g->tan[2][i]);
+                                vsgl__brdf_eval(&bp, nf, tf, d3_to_v3(wi), of, dif, gl);
+                                double w = 4.0 * cu * cv / (Q * Q) * cr / r2;
+                                for (int c = 0; c < 3; ++c)
+                                    acc[c] += w * gl[c] * ms[c] * L[c];
+                            }
+                        continue;
+                    }
+#endif
                     d3 axis[2];
                     double v[2];
                     int parts = vsgl__mrp_glossy_parts(&cell, x, n, o, alpha, &j->opt, v, axis);
