@@ -2,9 +2,9 @@
 # docs/mrp.md §4's tables and images (tools/mrp_quality.py): the MRP glossy
 # mode against balanced, k-means 256 and the brute force over Cycles, on the
 # quality harness's metal-floor and sun scenes, stills and animations; and
-# the MRP variants of the previous defaults (one GGX lobe; the light spanning
-# the whole disk), built into build/mrp_variants/ with other compile-time
-# defaults (csrc/src/mrp/glossy.c) and loaded through $VSGL_LIBRARY.
+# MRP variants built into build/mrp_variants/ with other compile-time
+# defaults (csrc/src/mrp/glossy.c, shade_mrp.c) and loaded through
+# $VSGL_LIBRARY.
 # Cycles references come from the harness's cache (build/quality/refs);
 # about 15 min on 2 shared cores.
 set -euo pipefail
@@ -14,12 +14,16 @@ OUT=build/mrp_quality
 mkdir -p "$OUT"
 make -s build/libvsgl.so
 "$PY" tools/mrp_quality.py run "$OUT/main.npz" "$@"
-for v in "1 0:one lobe" "2 0:no shrink"; do
-    flags=${v%%:*}; label=${v#*:}
-    lobes=${flags% *}; shrink=${flags#* }
-    dir=build/mrp_variants/l${lobes}s${shrink}
-    make -s BUILD="$dir" OPT="-O2 -g -DVSGL__MRP_LOBES=$lobes -DVSGL__MRP_SHRINK=$shrink" "$dir/libvsgl.so"
-    VSGL_LIBRARY="$PWD/$dir/libvsgl.so" "$PY" tools/mrp_quality.py run "$OUT/l${lobes}s${shrink}.npz" \
-        --configs "mrp:glossy_mode=3" --suffix " ($label)" "$@"
+# variants: one GGX lobe (the old default); the light shrunk to a cell; the
+# exact BRDF integrated over each cell instead of the MRP term (diagnostic:
+# what the cells' radiance allows); stills only
+for v in "one:-DVSGL__MRP_LOBES=1:one lobe" "shrink:-DVSGL__MRP_SHRINK=1.0:shrink 1" \
+         "exact:-DVSGL__MRP_EXACT_CELLS=4:exact cells"; do
+    tag=${v%%:*}; rest=${v#*:}; flags=${rest%%:*}; label=${rest#*:}
+    dir=build/mrp_variants/$tag
+    rm -rf "$dir"
+    make -s BUILD="$dir" OPT="-O2 -g $flags" "$dir/libvsgl.so"
+    VSGL_LIBRARY="$PWD/$dir/libvsgl.so" "$PY" tools/mrp_quality.py run "$OUT/$tag.npz" \
+        --configs "mrp:glossy_mode=3" --suffix " ($label)" "$@" --anim none
 done
-"$PY" tools/mrp_quality.py docs "$OUT/main.npz" "$OUT/l1s0.npz" "$OUT/l2s0.npz"
+"$PY" tools/mrp_quality.py docs "$OUT/main.npz" "$OUT/one.npz" "$OUT/shrink.npz" "$OUT/exact.npz"

@@ -10,14 +10,14 @@
 
 #include <string.h>
 
-/* The receiver's lobe count and the shrunken light of the default options
+/* The receiver's lobe count and the light's shrink of the default options
  * (docs/mrp.md §4 compares the variants: tools/mrp_quality.sh builds the
- * library with -DVSGL__MRP_LOBES=1 / -DVSGL__MRP_SHRINK=0 to measure them). */
+ * library with -DVSGL__MRP_LOBES=1 / -DVSGL__MRP_SHRINK=1 to measure them). */
 #ifndef VSGL__MRP_LOBES
 #define VSGL__MRP_LOBES 2
 #endif
 #ifndef VSGL__MRP_SHRINK
-#define VSGL__MRP_SHRINK 1
+#define VSGL__MRP_SHRINK 0.0
 #endif
 
 vsgl__mrp_options vsgl__mrp_options_default(void)
@@ -95,7 +95,7 @@ static double glossy_lobe(const vsgl__mrp_rect *rc, d3 x, double h, const vsgl_s
     *axis = d3_normalize(d3_sub(p, x));
     vsgl_asg light;
     /* the light's extent: the disk, or the disk of the overlap's area (a cell smaller than the disk) */
-    double rl = opt->shrink && A < 1.0 ? rd * sqrt(A) : rd;
+    double rl = opt->shrink > 0.0 && A < 1.0 ? fmin(rd, opt->shrink * rd * sqrt(A)) : rd;
     if (!vsgl__mrp_asg_light(x, p, rc->normal, rl, C, opt->norm, &light))
         return 0.0;                                        /* Eq. 28-35 */
     double v;
@@ -114,7 +114,7 @@ static double glossy_lobe(const vsgl__mrp_rect *rc, d3 x, double h, const vsgl_s
 }
 
 int vsgl__mrp_glossy_parts(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha, const vsgl__mrp_options *opt,
-                           double value[2], d3 axis[2])
+                           unsigned skip, double value[2], d3 axis[2])
 {
     const int parts = opt->lobes == 2 ? 2 : 1;
     for (int q = 0; q < 2; ++q) {
@@ -138,6 +138,8 @@ int vsgl__mrp_glossy_parts(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double al
         vsgl_warp_ndf_asg(&ndf, &of, &ra);
     }
     for (int q = 0; q < parts; ++q) {
+        if (skip & (1u << q))
+            continue;
         vsgl_sg gq = g;
         vsgl_asg aq = ra;
         if (parts == 2) { /* GGX's core (q 0) or tail (q 1): bandwidths x K, amplitude x C */
@@ -158,7 +160,7 @@ double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, doub
 {
     double v[2];
     d3 ax[2];
-    int parts = vsgl__mrp_glossy_parts(rc, x, n, o, alpha, opt, v, ax);
+    int parts = vsgl__mrp_glossy_parts(rc, x, n, o, alpha, opt, 0u, v, ax);
     *axis = ax[0];
     return parts == 2 ? v[0] + v[1] : v[0];
 }

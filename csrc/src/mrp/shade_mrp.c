@@ -8,6 +8,8 @@
 #include "shade/kernel.h"
 #include "vsgl/lobes.h"
 
+#include <string.h>
+
 typedef struct mrp_job {
     const vsgl_scene *scene;
     const vsgl_gbuffer *g;
@@ -17,8 +19,9 @@ typedef struct mrp_job {
     vsgl__mrp_options opt;
 } mrp_job;
 
-/* Glossy radiance (RGB, smooth factor included) at sample i. */
-static void sample_glossy(const mrp_job *j, size_t i, float out[3])
+/* Glossy radiance (RGB, smooth factor included) at position x, normal n,
+ * view o with the material of sample i. */
+static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float out[3])
 {
     out[0] = out[1] = out[2] = 0.0f;
     const vsgl_gbuffer *g = j->g;
@@ -26,11 +29,8 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
     vsgl__gbuffer_material(g, j->materials, i, &m);
     vsgl_brdf_params bp;
     vsgl__material_params(&m, &bp);
-    if (!bp.glossy)
+    if (!bp.glossy || !(d3_dot(n, o) > 0.0))
         return;
-    d3 x = d3_make(g->pos[0][i], g->pos[1][i], g->pos[2][i]);
-    d3 n = d3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
-    d3 o = d3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
     double alpha = sqrt((double)bp.alpha_x * bp.alpha_y);
     vsgl_sg lobe;
     vsgl__mrp_receiver_sg(n, o, alpha, &lobe);
@@ -46,6 +46,8 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
     vsgl_warp_ndf_asg(&ndf, &of0, &wa);
     double nu = fmin((double)wa.lambda, (double)wa.mu) * (j->opt.lobes == 2 ? VSGL__GGX_TAIL_K : 1.0);
     double spread = 3.0 / sqrt(nu > 1e-6 ? nu : 1e-6);
+    /* the core's reach, where there are two lobes: cells beyond it skip the core */
+    const double core_frac = j->opt.lobes == 2 ? sqrt((double)VSGL__GGX_TAIL_K / VSGL__GGX_CORE_K) : 1.0;
     v3 nf = d3_to_v3(n), of = d3_to_v3(o);
     float ms[3];
     for (int c = 0; c < 3; ++c)
@@ -76,15 +78,18 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
             const float *rad = p->power + (size_t)side * p->nu * p->nv * 3;
             for (uint32_t iv = 0; iv < p->nv; ++iv) {
                 double mv = -plane.half_v + (2.0 * iv + 1.0) * cv;
-                if (fabs(yv - mv) - cv > reach)
+                double dv = fabs(yv - mv) - cv;
+                if (dv > reach)
                     continue;
                 for (uint32_t iu = 0; iu < p->nu; ++iu) {
                     const float *L = rad + ((size_t)iv * p->nu + iu) * 3;
                     if (!(L[0] + L[1] + L[2] > 0.0f))
                         continue;
                     double mu = -plane.half_u + (2.0 * iu + 1.0) * cu;
-                    if (fabs(yu - mu) - cu > reach)
+                    double du = fabs(yu - mu) - cu;
+                    if (du > reach)
                         continue;
+                    unsigned skip = du > reach * core_frac || dv > reach * core_frac ? 1u : 0u;
                     vsgl__mrp_rect cell = plane;
                     cell.center = d3_add(plane.center, d3_add(d3_scale(plane.u, mu), d3_scale(pv0, mv)));
                     cell.half_u = cu;
@@ -116,7 +121,7 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
 #endif
                     d3 axis[2];
                     double v[2];
-                    int parts = vsgl__mrp_glossy_parts(&cell, x, n, o, alpha, &j->opt, v, axis);
+                    int parts = vsgl__mrp_glossy_parts(&cell, x, n, o, alpha, &j->opt, skip, v, axis);
                     for (int q = 0; q < parts; ++q) {
                         if (!(v[q] > 0.0))
                             continue;
@@ -133,21 +138,50 @@ static void sample_glossy(const mrp_job *j, size_t i, float out[3])
         out[c] = acc[c] > 0.0 && acc[c] < 3e38 ? (float)acc[c] : 0.0f;
 }
 
+/* The samples of a pixel on one flat surface (same material, normals within
+ * ~0.5 degree) are shaded once, at their weighted mean position and view:
+ * the glossy light of a flat mirror-like floor changes little within a
+ * pixel (the VSGL pass shades one anchor per 2 x 2 pixels and interpolates),
+ * and the mode's cost is per shading point. */
+#define MRP_GROUP_COS 0.99996
+
 static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
 {
     (void)chunk;
     const mrp_job *j = user;
     const vsgl_gbuffer *g = j->g;
+    size_t spp = g->spp;
+    unsigned char done[256];
     for (size_t px = b; px < e; ++px) {
         float acc[3] = {0, 0, 0};
-        for (size_t s = 0; s < g->spp; ++s) {
-            size_t i = px * g->spp + s;
-            if (g->material[i] == VSGL__GBUFFER_MISS)
+        memset(done, 0, sizeof done);
+        for (size_t s = 0; s < spp; ++s) {
+            size_t i = px * spp + s;
+            if (g->material[i] == VSGL__GBUFFER_MISS || (s < 256 && done[s]))
                 continue;
-            float w = vsgl__gbuffer_weight(g, i), l[3]; /* the sample's share of its pixel */
-            sample_glossy(j, i, l);
+            d3 n0 = d3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
+            d3 xs = d3_make(0, 0, 0), os = d3_make(0, 0, 0);
+            double ws = 0.0;
+            for (size_t t = s; t < spp; ++t) { /* s and the later samples of its group */
+                size_t k = px * spp + t;
+                if (t >= 256 && t != s)
+                    break;
+                if (t != s && (done[t] || g->material[k] != g->material[i] ||
+                               d3_dot(n0, d3_make(g->nrm[0][k], g->nrm[1][k], g->nrm[2][k])) < MRP_GROUP_COS))
+                    continue;
+                double w = vsgl__gbuffer_weight(g, k); /* the sample's share of its pixel */
+                xs = d3_add(xs, d3_scale(d3_make(g->pos[0][k], g->pos[1][k], g->pos[2][k]), w));
+                os = d3_add(os, d3_scale(d3_make(g->view[0][k], g->view[1][k], g->view[2][k]), w));
+                ws += w;
+                if (t < 256)
+                    done[t] = 1;
+            }
+            if (!(ws > 0.0))
+                continue;
+            float l[3];
+            sample_glossy(j, i, d3_scale(xs, 1.0 / ws), n0, d3_normalize(os), l);
             for (int c = 0; c < 3; ++c)
-                acc[c] += w * l[c];
+                acc[c] += (float)ws * l[c];
         }
         for (int c = 0; c < 3; ++c)
             j->planes->glossy[px * 3 + c] = acc[c];
