@@ -5,8 +5,8 @@ defaults, loaded through $VSGL_LIBRARY) can be measured in their own
 processes and shown side by side:
 
     # measure (the quality harness's scenes, cached Cycles references, test size)
-    python3 tools/mrp_quality.py run build/mrp_quality/main.npz \\
-        --configs "balanced,km256:fit_mode=kmeans,vsgl_count=256,mrp:glossy_mode=3,brute"
+    # (default --configs: balanced, km256, mrp, hybrid, hybrid-km256, brute)
+    python3 tools/mrp_quality.py run build/mrp_quality/main.npz
     # a variant library: only its MRP configuration, labelled with a suffix
     VSGL_LIBRARY=/tmp/mrp1/libvsgl.so python3 tools/mrp_quality.py run build/mrp_quality/lobe1.npz \\
         --configs "mrp:glossy_mode=3" --suffix " (1 lobe)"
@@ -182,7 +182,8 @@ def main(argv=None):
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run")
     r.add_argument("out")
-    r.add_argument("--configs", default="balanced,km256:fit_mode=kmeans,vsgl_count=256,mrp:glossy_mode=3,brute")
+    r.add_argument("--configs", default="balanced,km256:fit_mode=kmeans,vsgl_count=256,mrp:glossy_mode=3,"
+                   "hybrid:glossy_mode=4,hybrid-km256:glossy_mode=4,fit_mode=kmeans,vsgl_count=256,brute")
     r.add_argument("--scenes", default=SCENES)
     r.add_argument("--anim", default="light,camera")
     r.add_argument("--frames", type=int, default=12)

@@ -159,9 +159,13 @@ ITEMS = {
          "time"),
         ("MRP", "Rectangle Proxies",
          "Experimental: the glossy light of the large planar faces (walls, floors, 0.25 m^2 and "
-         "up) as lit rectangles reflected in closed form (the MRP paper, docs/mrp.md); against "
-         "Cycles still behind ASG on the metal-floor scenes (cell steps at grazing views, slower); "
-         "light from curved or small surfaces is not in the glossy pass"),
+         "up) as lit rectangles reflected in closed form (the MRP paper, docs/mrp.md): lower glossy "
+         "error than k-means 256 in the red-wall and sun rooms, but several times slower on metal "
+         "floors; light from curved or small surfaces is not in the glossy pass"),
+        ("HYBRID", "Hybrid",
+         "Experimental: Rectangle Proxies for sharp glossy surfaces (roughness up to 0.5) facing "
+         "lit walls, plus the light of clusters off the walls; Two ASGs everywhere else "
+         "(docs/mrp.md)"),
     ],
     "visibility": [
         ("NONE", "None",

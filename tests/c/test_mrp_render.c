@@ -269,6 +269,96 @@ VT_TEST(mrp_render_off_centre_patch_against_brute_force)
     vsgl_context_destroy(ctx);
 }
 
+/* vsgl__mrp_on_proxy: which clusters the hybrid leaves to MRP. */
+VT_TEST(mrp_hybrid_on_proxy_classification)
+{
+    vsgl_context *ctx = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    fx_scene fx;
+    metal_floor_room(&fx, 32, 24, 0.2f);
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+    vsgl__mrp_proxy_set set;
+    VT_REQUIRE(vsgl__mrp_proxies_build(ctx, scene, VSGL__MRP_MIN_AREA, 8, &set) == VSGL_OK, "proxies");
+    vsgl_vsgl v;
+    memset(&v, 0, sizeof v);
+    v.lobe = VSGL__LOBE_DIFFUSE;
+    v.mean = v3_make(0.5f, 3.0f, 1.2f); /* on the back wall, facing into the room */
+    v.normal = v3_make(0.0f, -1.0f, 0.0f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 1, "a cluster on the back wall");
+    v.normal = v3_make(0.0f, -0.99f, 0.14f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 1, "normal 8 degrees off");
+    v.normal = v3_make(0.0f, -0.7f, 0.714f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 0, "normal 45 degrees off (mixed surfaces)");
+    v.normal = v3_make(0.0f, -1.0f, 0.0f);
+    v.mean = v3_make(0.5f, 2.8f, 1.2f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 0, "20 cm in front of the wall (a corner cluster's mean)");
+    v.mean = v3_make(3.5f, 3.0f, 1.2f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 0, "in the wall's plane, outside its rectangle");
+    v.mean = v3_make(0.5f, 3.0f, 1.2f);
+    v.lobe = VSGL__LOBE_SPECULAR;
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 0, "a specular cluster (the cells carry diffuse light only)");
+    vsgl__mrp_proxies_free(&set);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
+/* VSGL_GLOSSY_HYBRID: a rough floor (roughness 0.8 > 0.5) keeps the two-lobe
+ * VSGL glossy light bit for bit; a sharp one takes MRP's light, with nothing
+ * counted twice (its sum against the brute force as MRP's). */
+VT_TEST(mrp_hybrid_rule_against_asg2_and_mrp)
+{
+    const uint32_t w = 48, h = 36;
+    const size_t n = (size_t)w * h * 3;
+    vsgl_context *ctx = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    float *buf = calloc(6 * n, sizeof(float));
+    VT_REQUIRE(buf, "memory");
+    float *a2 = buf, *hy = buf + n, *mr = buf + 2 * n, *ref = buf + 3 * n, *dif = buf + 4 * n, *dif_h = buf + 5 * n;
+    const float rough[2] = {0.8f, 0.2f};
+    for (int ri = 0; ri < 2; ++ri) {
+        fx_scene fx;
+        metal_floor_room(&fx, w, h, rough[ri]);
+        vsgl_scene *scene = NULL;
+        VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.aa_samples = 1;
+        s.rsm_resolution = 64;
+        s.glossy_mode = VSGL_GLOSSY_ASG2;
+        render_glossy(ctx, scene, &s, w, h, a2, dif);
+        vsgl_render_settings hs = s;
+        hs.glossy_mode = VSGL_GLOSSY_HYBRID;
+        render_glossy(ctx, scene, &hs, w, h, hy, dif_h);
+        int finite = 1;
+        for (size_t i = 0; i < n; ++i)
+            finite &= isfinite(hy[i]) && hy[i] >= 0.0f;
+        VT_CHECK(finite, "hybrid glossy plane finite, non-negative");
+        VT_CHECK(relmse(dif_h, dif, n) < 1e-12, "diffuse changed: %g", relmse(dif_h, dif, n));
+        if (ri == 0) {
+            VT_CHECK(relmse(hy, a2, n) == 0.0, "rough floor: hybrid differs from ASG2 (%g)", relmse(hy, a2, n));
+        } else {
+            vsgl_render_settings m = s, b = s;
+            m.glossy_mode = VSGL_GLOSSY_MRP;
+            b.method = VSGL_METHOD_BRUTE_FORCE;
+            render_glossy(ctx, scene, &m, w, h, mr, dif);
+            render_glossy(ctx, scene, &b, w, h, ref, dif);
+            double e_h = relmse(hy, ref, n), e_m = relmse(mr, ref, n), e_a = relmse(a2, ref, n);
+            double q_h = ratio(hy, ref, n), q_m = ratio(mr, ref, n);
+            if (tables())
+                printf("    hybrid, roughness 0.2: glossy relMSE against the brute force %.4f (sum %.3f), "
+                       "MRP %.4f (sum %.3f), ASG2 lattice %.4f\n", e_h, q_h, e_m, q_m, e_a);
+            /* every cluster of this room's lattice lies on a wall or is a specular floor cluster
+             * (whose light no floor pixel sees): the hybrid is MRP here */
+            VT_CHECK(fabs(q_h - q_m) < 0.02 && e_h < 1.1 * e_m + 1e-4, "hybrid %g (sum %g) vs MRP %g (sum %g)", e_h,
+                     q_h, e_m, q_m);
+        }
+        vsgl_scene_destroy(scene);
+    }
+    free(buf);
+    vsgl_context_destroy(ctx);
+}
+
 static int32_t cancel_in_mrp(void *user, const char *stage, float fraction)
 {
     (void)fraction;

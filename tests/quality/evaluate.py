@@ -142,7 +142,8 @@ class Config:
                3: "lattice %d" % s["vsgl_count"]}[s["fit_mode"]]
         bits = [fit, "RSM %d" % s["rsm_resolution"], "aa %d" % s["aa_samples"],
                 {0: "accurate cosine", 1: "SG cosine", 2: "pulled-out cosine"}[s["diffuse_mode"]],
-                {0: "ASG", 1: "SG", 2: "two-ASG (GGX core + tail)", 3: "rectangle-proxy (MRP)"}[s["glossy_mode"]]
+                {0: "ASG", 1: "SG", 2: "two-ASG (GGX core + tail)", 3: "rectangle-proxy (MRP)",
+                 4: "hybrid (MRP where it applies, else two-ASG)"}[s["glossy_mode"]]
                 + " glossy"]
         if s["visibility"]:
             bits.append("visibility rays")

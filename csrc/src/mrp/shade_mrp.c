@@ -17,7 +17,28 @@ typedef struct mrp_job {
     const vsgl_pixel_planes *planes;
     const vsgl_material *materials;
     vsgl__mrp_options opt;
+    const float *glossy_q; /* hybrid: the VSGL glossy of the clusters off the proxies, else NULL */
+    double max_alpha;      /* hybrid: the sharpest receivers that take MRP */
 } mrp_job;
+
+/* Hybrid rule, first half: 1 if every glossy sample of pixel px is sharp
+ * enough for MRP (alpha <= max_alpha); pixels without glossy samples too. */
+static int pixel_sharp(const mrp_job *j, size_t px)
+{
+    const vsgl_gbuffer *g = j->g;
+    for (size_t s = 0; s < g->spp; ++s) {
+        size_t i = px * g->spp + s;
+        if (g->material[i] == VSGL__GBUFFER_MISS)
+            continue;
+        vsgl_material m;
+        vsgl__gbuffer_material(g, j->materials, i, &m);
+        vsgl_brdf_params bp;
+        vsgl__material_params(&m, &bp);
+        if (bp.glossy && !(sqrt((double)bp.alpha_x * bp.alpha_y) <= j->max_alpha))
+            return 0;
+    }
+    return 1;
+}
 
 /* Glossy radiance (RGB, smooth factor included) at position x, normal n,
  * view o with the material of sample i. */
@@ -154,6 +175,8 @@ static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
     unsigned char done[256];
     for (size_t px = b; px < e; ++px) {
         float acc[3] = {0, 0, 0};
+        if (j->glossy_q && !pixel_sharp(j, px))
+            continue; /* hybrid: a rough receiver keeps the VSGL glossy light */
         memset(done, 0, sizeof done);
         for (size_t s = 0; s < spp; ++s) {
             size_t i = px * spp + s;
@@ -183,6 +206,12 @@ static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
             for (int c = 0; c < 3; ++c)
                 acc[c] += (float)ws * l[c];
         }
+        if (j->glossy_q) { /* hybrid: MRP where it finds lit proxies, with the VSGLs off them */
+            if (!(acc[0] + acc[1] + acc[2] > 0.0f))
+                continue;
+            for (int c = 0; c < 3; ++c)
+                acc[c] += j->glossy_q[px * 3 + c];
+        }
         for (int c = 0; c < 3; ++c)
             j->planes->glossy[px * 3 + c] = acc[c];
     }
@@ -190,10 +219,12 @@ static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
 }
 
 vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
-                                   const vsgl__mrp_proxy_set *set, const vsgl_pixel_planes *planes)
+                                   const vsgl__mrp_proxy_set *set, const vsgl_pixel_planes *planes,
+                                   const float *glossy_q, double max_alpha)
 {
     uint32_t mcount = 0;
-    mrp_job j = {scene, g, set, planes, vsgl__scene_materials(scene, &mcount), vsgl__mrp_options_default()};
+    mrp_job j = {scene, g, set, planes, vsgl__scene_materials(scene, &mcount), vsgl__mrp_options_default(),
+                 glossy_q, max_alpha};
     size_t pixels = (size_t)g->width * g->height;
     int32_t r = vsgl__parallel_for(vsgl_context_thread_count(ctx), pixels, 64, mrp_chunk, &j);
     return r == 0 ? VSGL_OK : vsgl__fail(ctx, (vsgl_result)r, "mrp: glossy shading failed");

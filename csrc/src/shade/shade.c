@@ -170,6 +170,12 @@ static void visibility_rays(const shade_job *j, v3 target, const receiver *rec, 
         vis[k] = blocked[k] ? 0.0f : 1.0f;
 }
 
+/* GGX as two lobes, core and tail (kernel.h): ASG2 and the hybrid's VSGL term. */
+static int two_lobes(int32_t mode)
+{
+    return mode == VSGL_GLOSSY_ASG2 || mode == VSGL_GLOSSY_HYBRID;
+}
+
 /* Part q (0 core, 1 tail) of a GGX lobe's ASG (kernel.h, VSGL__KERNEL_GGX_TAIL). */
 static vsgl_asg ggx_part(const vsgl_asg *a, int q)
 {
@@ -191,7 +197,7 @@ static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_s
         return vsgl_sg_product_integral(&r->sg, in);
     }
     *axis = r->asg.z;
-    if (j->s->glossy_mode != VSGL_GLOSSY_ASG2)
+    if (!two_lobes(j->s->glossy_mode))
         return vsgl_asg_sg_product_integral(&r->asg, in);
     vsgl_asg a = ggx_part(&r->asg, part);
     return vsgl_asg_sg_product_integral(&a, in);
@@ -203,7 +209,7 @@ static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_s
  * kernel does. */
 static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl *v, const vsgl_sg *in, v3 *axis)
 {
-    int parts = j->s->glossy_mode == VSGL_GLOSSY_ASG2 ? 2 : 1;
+    int parts = two_lobes(j->s->glossy_mode) ? 2 : 1;
     float sum = 0.0f;
     for (int q = 0; q < parts; ++q) {
         float gi = glossy_integral(j, r, in, axis, q);
@@ -421,7 +427,7 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
     int32_t lobes = 0;
     for (size_t k = 0; k < n; ++k)
         lobes |= (blk->diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk->camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0);
-    if ((lobes & VSGL__KERNEL_GLOSSY) && j->s->glossy_mode == VSGL_GLOSSY_ASG2)
+    if ((lobes & VSGL__KERNEL_GLOSSY) && two_lobes(j->s->glossy_mode))
         lobes |= VSGL__KERNEL_GGX_TAIL;
     for (size_t k = n; k < VSGL__KERNEL_BLOCK; ++k) {
         /* padding lanes: shaded, never read; at lane 0's position so that
