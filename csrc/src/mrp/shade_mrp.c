@@ -10,6 +10,12 @@
 
 #include <string.h>
 
+/* 1: cells are culled against the warped lobe's ASG (anisotropic); 0: only
+ * the isotropic box around the peak (tools/mrp_quality.sh measures both). */
+#ifndef VSGL__MRP_CULL
+#define VSGL__MRP_CULL 1
+#endif
+
 typedef struct mrp_job {
     const vsgl_scene *scene;
     const vsgl_gbuffer *g;
@@ -69,6 +75,12 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
     double spread = 3.0 / sqrt(nu > 1e-6 ? nu : 1e-6);
     /* the core's reach, where there are two lobes: cells beyond it skip the core */
     const double core_frac = j->opt.lobes == 2 ? sqrt((double)VSGL__GGX_TAIL_K / VSGL__GGX_CORE_K) : 1.0;
+    /* per cell, the anisotropic test against the warped lobe (the box test
+     * above is isotropic: at grazing views the lobe is narrow across the
+     * plane of incidence); bandwidth scales of the widest lobe and the core */
+    const int cull = VSGL__MRP_CULL;
+    const double k_wide = j->opt.lobes == 2 ? VSGL__GGX_TAIL_K : 1.0, k_core = j->opt.lobes == 2 ? VSGL__GGX_CORE_K : 1.0;
+    const d3 wx = d3_of_v3(wa.x), wy = d3_of_v3(wa.y), wz = d3_of_v3(wa.z);
     v3 nf = d3_to_v3(n), of = d3_to_v3(o);
     float ms[3];
     for (int c = 0; c < 3; ++c)
@@ -115,6 +127,20 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
                     cell.center = d3_add(plane.center, d3_add(d3_scale(plane.u, mu), d3_scale(pv0, mv)));
                     cell.half_u = cu;
                     cell.half_v = cv;
+                    if (cull) { /* the lobe itself at the cell: its ASG exponent past e^{-9}, the cell's
+                                 * angular radius taken off both offsets (conservative) */
+                        d3 dc = d3_sub(cell.center, x);
+                        double dist = d3_length(dc), ang = sqrt(cu * cu + cv * cv) / (dist > 0.0 ? dist : 1e-30);
+                        d3 vd = d3_scale(dc, 1.0 / (dist > 0.0 ? dist : 1e-30));
+                        if (d3_dot(vd, wz) < -ang)
+                            continue;
+                        double ax = fmax(0.0, fabs(d3_dot(vd, wx)) - ang), ay = fmax(0.0, fabs(d3_dot(vd, wy)) - ang);
+                        double ex = (double)wa.lambda * ax * ax + (double)wa.mu * ay * ay;
+                        if (ex * k_wide > 9.0)
+                            continue;
+                        if (ex * k_core > 9.0)
+                            skip |= 1u;
+                    }
 #ifdef VSGL__MRP_EXACT_CELLS
                     { /* diagnostic build (tools/mrp_quality.sh): the exact BRDF integrated over the cell
                        * (N x N midpoints, -DVSGL__MRP_EXACT_CELLS=N) instead of the MRP term, to tell
