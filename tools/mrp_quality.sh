@@ -15,10 +15,10 @@ mkdir -p "$OUT"
 make -s build/libvsgl.so
 "$PY" tools/mrp_quality.py run "$OUT/main.npz" "$@"
 # variants: one GGX lobe (the old default); the light shrunk to a cell; the
-# exact BRDF integrated over each cell instead of the MRP term (diagnostic:
+# isotropic cell cull only (before the lobe's ASG test); the exact BRDF integrated over each cell instead of the MRP term (diagnostic:
 # what the cells' radiance allows); stills only
 for v in "one:-DVSGL__MRP_LOBES=1:one lobe" "shrink:-DVSGL__MRP_SHRINK=1.0:shrink 1" \
-         "exact:-DVSGL__MRP_EXACT_CELLS=4:exact cells"; do
+         "nocull:-DVSGL__MRP_CULL=0:box cull only" "exact:-DVSGL__MRP_EXACT_CELLS=4:exact cells"; do
     tag=${v%%:*}; rest=${v#*:}; flags=${rest%%:*}; label=${rest#*:}
     dir=build/mrp_variants/$tag
     rm -rf "$dir"
@@ -26,4 +26,4 @@ for v in "one:-DVSGL__MRP_LOBES=1:one lobe" "shrink:-DVSGL__MRP_SHRINK=1.0:shrin
     VSGL_LIBRARY="$PWD/$dir/libvsgl.so" "$PY" tools/mrp_quality.py run "$OUT/$tag.npz" \
         --configs "mrp:glossy_mode=3" --suffix " ($label)" "$@" --anim none
 done
-"$PY" tools/mrp_quality.py docs "$OUT/main.npz" "$OUT/one.npz" "$OUT/shrink.npz" "$OUT/exact.npz"
+"$PY" tools/mrp_quality.py docs "$OUT/main.npz" "$OUT/one.npz" "$OUT/shrink.npz" "$OUT/nocull.npz" "$OUT/exact.npz"
