@@ -6,7 +6,8 @@
 # defaults (csrc/src/mrp/glossy.c, shade_mrp.c) and loaded through
 # $VSGL_LIBRARY.
 # Cycles references come from the harness's cache (build/quality/refs);
-# about 15 min on 2 shared cores.
+# about 15 min on 2 shared cores. Then interleaved timing rounds of the
+# main configurations (the acceptance's "no more time").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=${PYTHON:-python3}
@@ -26,4 +27,5 @@ for v in "one:-DVSGL__MRP_LOBES=1:one lobe" "shrink:-DVSGL__MRP_SHRINK=1.0:shrin
     VSGL_LIBRARY="$PWD/$dir/libvsgl.so" "$PY" tools/mrp_quality.py run "$OUT/$tag.npz" \
         --configs "mrp:glossy_mode=3" --suffix " ($label)" "$@" --anim none
 done
-"$PY" tools/mrp_quality.py docs "$OUT/main.npz" "$OUT/one.npz" "$OUT/shrink.npz" "$OUT/nocull.npz" "$OUT/exact.npz"
+"$PY" tools/mrp_quality.py time "$OUT/time.json"
+"$PY" tools/mrp_quality.py docs --timing "$OUT/time.json" "$OUT/main.npz" "$OUT/one.npz" "$OUT/shrink.npz" "$OUT/nocull.npz" "$OUT/exact.npz"
