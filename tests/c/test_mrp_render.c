@@ -304,8 +304,9 @@ VT_TEST(mrp_hybrid_on_proxy_classification)
 }
 
 /* VSGL_GLOSSY_HYBRID: a rough floor (roughness 0.8 > 0.5) keeps the two-lobe
- * VSGL glossy light bit for bit; a sharp one takes MRP's light, with nothing
- * counted twice (its sum against the brute force as MRP's). */
+ * VSGL glossy light bit for bit; a sharp one takes the proxies' light from
+ * MRP or the on-proxy VSGLs, whichever is larger, never both (its sum against
+ * the brute force within 10 %). */
 VT_TEST(mrp_hybrid_rule_against_asg2_and_mrp)
 {
     const uint32_t w = 48, h = 36;
@@ -348,10 +349,12 @@ VT_TEST(mrp_hybrid_rule_against_asg2_and_mrp)
             if (tables())
                 printf("    hybrid, roughness 0.2: glossy relMSE against the brute force %.4f (sum %.3f), "
                        "MRP %.4f (sum %.3f), ASG2 lattice %.4f\n", e_h, q_h, e_m, q_m, e_a);
-            /* every cluster of this room's lattice lies on a wall or is a specular floor cluster
-             * (whose light no floor pixel sees): the hybrid is MRP here */
-            VT_CHECK(fabs(q_h - q_m) < 0.02 && e_h < 1.1 * e_m + 1e-4, "hybrid %g (sum %g) vs MRP %g (sum %g)", e_h,
-                     q_h, e_m, q_m);
+            /* every cluster of this room's lattice lies on a wall or is a specular floor cluster:
+             * in the floor's pixels the hybrid takes the larger of MRP's and the on-proxy VSGLs'
+             * light. Measured 0.0588 (sum 1.029) against MRP 0.0391 (0.943) and ASG2 0.0493 (1.03):
+             * the larger of two estimates is biased up; against Cycles it helps (docs/mrp.md §4) */
+            VT_CHECK(e_h < 1.25 * e_a && q_h > 0.9 && q_h < 1.1 && q_h >= q_m, "hybrid %g (sum %g) vs MRP %g (sum %g), "
+                     "ASG2 %g", e_h, q_h, e_m, q_m, e_a);
         }
         vsgl_scene_destroy(scene);
     }

@@ -15,6 +15,12 @@
 #ifndef VSGL__MRP_CULL
 #define VSGL__MRP_CULL 1
 #endif
+/* Hybrid: 1 takes, in a pixel MRP takes, the larger of MRP's and the
+ * on-proxy VSGLs' estimate of the proxies' light (no seam where MRP's
+ * reach ends: a dark band showed there); 0: MRP's alone (docs/mrp.md §4). */
+#ifndef VSGL__MRP_HYBRID_MAX
+#define VSGL__MRP_HYBRID_MAX 1
+#endif
 
 typedef struct mrp_job {
     const vsgl_scene *scene;
@@ -235,6 +241,19 @@ static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
         if (j->glossy_q) { /* hybrid: MRP where it finds lit proxies, with the VSGLs off them */
             if (!(acc[0] + acc[1] + acc[2] > 0.0f))
                 continue;
+#if VSGL__MRP_HYBRID_MAX
+            /* the proxies' light as the larger of MRP's and the on-proxy VSGLs' (all - off):
+             * MRP stops at e^{-9} of its tail lobe, the VSGLs keep a haze beyond it */
+            const float *ga = j->planes->glossy + px * 3, *gq = j->glossy_q + px * 3;
+            float pm = acc[0] + acc[1] + acc[2], pv = 0.0f, pvc[3];
+            for (int c = 0; c < 3; ++c) {
+                pvc[c] = ga[c] > gq[c] ? ga[c] - gq[c] : 0.0f;
+                pv += pvc[c];
+            }
+            if (pv > pm)
+                for (int c = 0; c < 3; ++c)
+                    acc[c] = pvc[c];
+#endif
             for (int c = 0; c < 3; ++c)
                 acc[c] += j->glossy_q[px * 3 + c];
         }
