@@ -5,7 +5,7 @@ defaults, loaded through $VSGL_LIBRARY) can be measured in their own
 processes and shown side by side:
 
     # measure (the quality harness's scenes, cached Cycles references, test size)
-    # (default --configs: balanced, km256, mrp, hybrid, hybrid-km256, hybrid-preview, brute)
+    # (default --configs: balanced, km256, mrp, hybrid, hybrid-km256, brute)
     python3 tools/mrp_quality.py run build/mrp_quality/main.npz
     # a variant library: only its MRP configuration, labelled with a suffix
     VSGL_LIBRARY=/tmp/mrp1/libvsgl.so python3 tools/mrp_quality.py run build/mrp_quality/lobe1.npz \\
@@ -35,10 +35,8 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "quality"))
 BEGIN, END = "<!-- mrp_quality: begin (tools/mrp_quality.py docs) -->", "<!-- mrp_quality: end -->"
 SCENES = "spot_metal_floor,metal_floor_red_wall,sun_opening"
 CONFIGS = ("balanced,km256:fit_mode=kmeans,vsgl_count=256,mrp:glossy_mode=3,hybrid:glossy_mode=4,"
-           "hybrid-km256:glossy_mode=4,fit_mode=kmeans,vsgl_count=256,"
-           "hybrid-preview:preset=preview,glossy_mode=4,brute")
-TIME_CONFIGS = ("km256:fit_mode=kmeans,vsgl_count=256,balanced,mrp:glossy_mode=3,hybrid:glossy_mode=4,"
-                "hybrid-preview:preset=preview,glossy_mode=4")
+           "hybrid-km256:glossy_mode=4,fit_mode=kmeans,vsgl_count=256,brute")
+TIME_CONFIGS = "km256:fit_mode=kmeans,vsgl_count=256,balanced,mrp:glossy_mode=3,hybrid:glossy_mode=4"
 
 
 def run(args):
@@ -216,8 +214,8 @@ def docs(args):
     md += ["The acceptance, per scene and configuration (k-means 256 as the reference; the time from the "
            "interleaved medians where measured):", "", verdict(res), ""]
     for name in res["scenes"]:
-        shown = lambda l: l not in ("balanced", "hybrid", "hybrid-km256") and "(" not in l  # noqa: E731
-        labels = [l for l in res["scenes"][name]["configs"] if shown(l) or l == "mrp (exact cells)"]
+        shown = lambda l: l not in ("balanced", "hybrid-km256") and "(" not in l  # noqa: E731
+        labels = [l for l in res["scenes"][name]["configs"] if shown(l) or l == "hybrid (MRP's light alone)"]
         fn = "mrp_quality_%s.png" % name
         image(res, arrs, name, labels, os.path.join(img_dir, fn))
         md += ["![%s, glossy pass (80 x 60): Cycles | %s; below, the signed error of each (red too bright, blue "

@@ -16,16 +16,22 @@ mkdir -p "$OUT"
 make -s build/libvsgl.so
 "$PY" tools/mrp_quality.py run "$OUT/main.npz" "$@"
 # variants: one GGX lobe (the old default); the light shrunk to a cell; the
-# isotropic cell cull only (before the lobe's ASG test); the exact BRDF integrated over each cell instead of the MRP term (diagnostic:
-# what the cells' radiance allows); stills only
-for v in "one:-DVSGL__MRP_LOBES=1:one lobe" "shrink:-DVSGL__MRP_SHRINK=1.0:shrink 1" \
-         "nocull:-DVSGL__MRP_CULL=0:box cull only" "exact:-DVSGL__MRP_EXACT_CELLS=4:exact cells"; do
-    tag=${v%%:*}; rest=${v#*:}; flags=${rest%%:*}; label=${rest#*:}
+# isotropic cell cull only (before the lobe's ASG test); the exact BRDF
+# integrated over each cell instead of the MRP term (diagnostic: what the
+# cells' radiance allows); the hybrid with MRP's light alone in its pixels
+# (before the larger-of-two rule). Stills only.
+for v in "one:-DVSGL__MRP_LOBES=1:one lobe:mrp:glossy_mode=3" \
+         "shrink:-DVSGL__MRP_SHRINK=1.0:shrink 1:mrp:glossy_mode=3" \
+         "nocull:-DVSGL__MRP_CULL=0:box cull only:mrp:glossy_mode=3" \
+         "exact:-DVSGL__MRP_EXACT_CELLS=4:exact cells:mrp:glossy_mode=3" \
+         "hybmrp:-DVSGL__MRP_HYBRID_MAX=0:MRP's light alone:hybrid:glossy_mode=4"; do
+    tag=${v%%:*}; rest=${v#*:}; flags=${rest%%:*}; rest=${rest#*:}; label=${rest%%:*}; cfg=${rest#*:}
     dir=build/mrp_variants/$tag
     rm -rf "$dir"
     make -s BUILD="$dir" OPT="-O2 -g $flags" "$dir/libvsgl.so"
     VSGL_LIBRARY="$PWD/$dir/libvsgl.so" "$PY" tools/mrp_quality.py run "$OUT/$tag.npz" \
-        --configs "mrp:glossy_mode=3" --suffix " ($label)" "$@" --anim none
+        --configs "$cfg" --suffix " ($label)" "$@" --anim none
 done
 "$PY" tools/mrp_quality.py time "$OUT/time.json"
-"$PY" tools/mrp_quality.py docs --timing "$OUT/time.json" "$OUT/main.npz" "$OUT/one.npz" "$OUT/shrink.npz" "$OUT/nocull.npz" "$OUT/exact.npz"
+"$PY" tools/mrp_quality.py docs --timing "$OUT/time.json" "$OUT/main.npz" "$OUT/one.npz" "$OUT/shrink.npz" "$OUT/nocull.npz" "$OUT/exact.npz" \
+    "$OUT/hybmrp.npz"
