@@ -258,6 +258,8 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
                motion=motion,
                camera_truth=None if truth is None else dict(
                    (p, M.flicker([x[p] for x in truth])["median"]) for p in PASSES),
+               camera_truth_jitter=None if truth is None else dict(
+                   (p, M.jitter([x[p] for x in truth])) for p in PASSES),
                reference=dict(spp=spp, seeds=[m["seed"] for _, m in R], blender=R[0][1]["blender"],
                               seconds=[round(m["render_seconds"], 2) for _, m in R],
                               mean={p: float(ref[p].mean()) for p in PASSES},
@@ -290,7 +292,8 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
             for p in PASSES:
                 fl = M.flicker([x[p] for x in seq])
                 entry["flicker"][kind][p] = dict(median=fl["median"], ratio=fl["ratio"],
-                                                 median_second=fl["median_second"], l1=fl["l1"])
+                                                 median_second=fl["median_second"], l1=fl["l1"],
+                                                 jitter=M.jitter([x[p] for x in seq]))
                 if kind == "camera" and truth is not None:
                     entry["flicker"][kind][p]["excess"] = M.excess_flicker([x[p] for x in seq],
                                                                            [x[p] for x in truth])
@@ -337,6 +340,12 @@ def acceptance(res):
             if k == "camera" and None not in ex:
                 a["camera flicker above the motion's own <= %.2f" % ACCEPT["flicker"]] = (
                     "PASS" if max(ex) <= ACCEPT["flicker"] else "FAIL (%.3f)" % max(ex))
+            tj = res.get("camera_truth_jitter") if k == "camera" else None
+            if tj:
+                jt = [(e["flicker"][k][p]["jitter"], max(ACCEPT["flicker"], tj[p])) for p in ("Diff", "Gloss")]
+                a["camera jitter <= max(%.2f, the dense render's)" % ACCEPT["flicker"]] = (
+                    "PASS" if all(j <= lim for j, lim in jt) else
+                    "FAIL (%s)" % ", ".join("%.3f > %.3f" % (j, lim) for j, lim in jt if j > lim))
         tol = ACCEPT["bias_preview"] if label == "preview" else ACCEPT["bias"]
         worst = max(abs(e["still"][p]["bias"] - 1) for p in ("Diff", "Gloss"))
         if worst <= tol:
@@ -444,7 +453,10 @@ def markdown(results, args, img_rel):
              "than 0.01 a frame by itself; **the motion's own change** (with --motion-truth) = the per-frame change "
              "of the same animation in Cycles, from its first and last frames with both seeds (the product of the "
              "two seeds' differences removes their noise; per frame = over the steps between them): the "
-             "acceptance then also reads flicker <= max(0.01, that).", ""]
+             "acceptance then also reads flicker <= max(0.01, that); **jitter** = the median relative RMS of "
+             "(f[t+1] - f[t]) - (f[n] - f[0]) / n, the change in excess of the sequence's own straight-line trend "
+             "(a smooth motion's is ~0; a reshuffling fit's, or an edge jumping across pixels, is not), checked "
+             "for the camera against the dense render's own (with --camera-truth).", ""]
     if results.get("flip_error"):
         lines += ["FLIP skipped: flip-evaluator does not import (%s)." % results["flip_error"], ""]
     summary = ["## Summary (presets)", "",
@@ -484,10 +496,11 @@ def markdown(results, args, img_rel):
                 if f["Diff"].get("excess") is not None:
                     ex = "; above the motion %s / %s" % (_f(f["Diff"]["excess"], "%.4f"),
                                                          _f(f["Gloss"]["excess"], "%.4f"))
-                return "%s / %s (%s / %s; L1 %s / %s%s)" % (
+                return "%s / %s (%s / %s; L1 %s / %s; jitter %s / %s%s)" % (
                     _f(f["Diff"]["median"], "%.4f"), _f(f["Gloss"]["median"], "%.4f"),
                     _f(f["Diff"]["ratio"], "%.1f"), _f(f["Gloss"]["ratio"], "%.1f"),
-                    _f(f["Diff"].get("l1"), "%.4f"), _f(f["Gloss"].get("l1"), "%.4f"), ex)
+                    _f(f["Diff"].get("l1"), "%.4f"), _f(f["Gloss"].get("l1"), "%.4f"),
+                    _f(f["Diff"].get("jitter"), "%.4f"), _f(f["Gloss"].get("jitter"), "%.4f"), ex)
             row = "| %s | %.3f | %d | %s | %s | %s | %s | %s | %s | %s (%sx) | %s (%sx) | %s (%sx) | %s | %s | %s |" % (
                 label, e["seconds"], e["vsgls"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]),
                 _f(s["Combined"]["bias"]),
