@@ -2,7 +2,7 @@
 
     blender -b --factory-startup --python-exit-code 1 --python tests/quality/render_refs.py -- \
         [--size test|bench|WxH[xSPP]] [--scenes a,b,...] [--seeds 1,2] [--out build/quality/refs] \
-        [--check-builder] [--force]
+        [--anim light|camera --frame N] [--check-builder] [--force]
 
 Builds each scene with tests/blender/cycles_ref.py's build_blender and renders
 it with its render_cycles (max_bounces 1, no clamps, blur_glossy 0, box filter
@@ -10,6 +10,9 @@ it with its render_cycles (max_bounces 1, no clamps, blur_glossy 0, box filter
 DiffInd, GlossInd, DiffCol, GlossCol, once per seed; stores each as an .npz
 under --out (refs.py names and keys them; existing ones are kept unless
 --force).
+
+--anim/--frame: render frame N of that animation (scenes.animate) instead
+of the still (evaluate.py --motion-truth: the motion's own change).
 
 --check-builder: compares the pure-Python builder (scenes.library_arrays)
 with the arrays cycles_ref.library_arrays reads back from the bpy-built scene
@@ -52,7 +55,7 @@ def render_passes(case, spp, seed, tmp):
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     args = {"--size": None, "--scenes": ",".join(scenes.NAMES), "--seeds": ",".join(map(str, scenes.SEEDS)),
-            "--out": refs.DEFAULT_DIR}
+            "--out": refs.DEFAULT_DIR, "--anim": "light", "--frame": "0"}
     flags = set()
     i = 0
     while i < len(argv):
@@ -127,11 +130,12 @@ def main():
         version = bpy.app.version_string
         code = refs.code_digest()
         w, h, spp = scenes.size_of(args["--size"])
+        anim, frame = args["--anim"], int(args["--frame"])
         for n in names:
-            c = scenes.case(n, (w, h))
+            c = scenes.animate(scenes.case(n, (w, h)), anim, frame)
             built = False
             for seed in [int(s) for s in args["--seeds"].split(",")]:
-                p = refs.path(out, n, (w, h, spp), seed, version, code)
+                p = refs.path_frame(out, n, (w, h, spp), seed, version, anim, frame, code)
                 if os.path.exists(p) and "--force" not in flags:
                     print("cached %s" % os.path.basename(p), flush=True)
                     continue
@@ -142,7 +146,7 @@ def main():
                 t0 = time.time()
                 passes, secs = render_passes(c, spp, seed, tmp)
                 shutil.rmtree(tmp, ignore_errors=True)
-                meta = dict(scene=n, width=w, height=h, spp=spp, seed=seed, blender=version,
+                meta = dict(scene=n, width=w, height=h, spp=spp, seed=seed, blender=version, anim=anim, frame=frame,
                             render_seconds=secs, wall_seconds=time.time() - t0,
                             threads=bpy.context.scene.render.threads)
                 refs.save(p, passes, meta)

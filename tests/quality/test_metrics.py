@@ -132,6 +132,32 @@ def test_excess_flicker_removes_the_motions_own_change():
         M.excess_flicker(same, truth[:-1])
 
 
+def test_motion_change_removes_independent_noise():
+    rng = np.random.default_rng(3)
+    f0 = _img(5, 40, 50)
+    d = 0.002 * _img(6, 40, 50)  # the true change per frame
+    steps = 11
+    seeds = [(f0 + rng.normal(0, 0.02, f0.shape), f0 + steps * d + rng.normal(0, 0.02, f0.shape)) for _ in range(2)]
+    want = M._rel(d, f0)
+    got = M.motion_change((seeds[0][0], seeds[1][0]), (seeds[0][1], seeds[1][1]), steps)
+    naive = M._rel((seeds[0][1] - seeds[0][0]) / steps, f0)
+    assert abs(got - want) < 0.1 * want
+    assert naive > 1.5 * want  # one seed's difference is noise-dominated here
+    # no motion: nothing measurable above the noise
+    again = [seeds[k][0] + rng.normal(0, 0.02, f0.shape) for k in range(2)]
+    still = M.motion_change((seeds[0][0], seeds[1][0]), (again[0], again[1]), steps)
+    assert still < 0.2 * want
+
+
+def test_jitter_of_a_ramp_is_zero_and_of_a_reshuffle_is_not():
+    base = _img(7)
+    ramp = [base * (1 + 0.01 * t) for t in range(8)]
+    assert M.jitter(ramp) < 1e-12 < M.flicker(ramp)["median"]
+    rng = np.random.default_rng(8)
+    shuffled = [x * (1 + 0.02 * rng.standard_normal(x.shape)) for x in ramp]
+    assert M.jitter(shuffled) > 0.02  # two independent 2 % perturbations per pair
+
+
 def test_rel_rmse_by_hand():
     b = np.full((4, 4, 3), 2.0)
     assert abs(M.rel_rmse(b * 1.1, b) - 0.1) < 1e-12
