@@ -1,5 +1,6 @@
-/* The glossy plane from the rectangle proxies (proxies.h): every glossy
- * camera sample sums the MRP term of the lit cells its lobe can reach. */
+/* The glossy plane from the rectangle proxies (proxies.h): every shading
+ * point (a pixel's samples on one flat surface) sums the MRP term of the lit
+ * cells its lobe can reach; the hybrid's per-pixel rule (docs/mrp.md §4). */
 #include "mrp/proxies.h"
 #include "mrp/geom.h"
 #include "core/context.h"
@@ -30,7 +31,7 @@ typedef struct mrp_job {
     const vsgl_material *materials;
     vsgl__mrp_options opt;
     const float *glossy_q; /* hybrid: the VSGL glossy of the clusters off the proxies, else NULL */
-    double max_alpha;      /* hybrid: the sharpest receivers that take MRP */
+    double max_alpha;      /* hybrid: the largest GGX alpha of a receiver that takes MRP */
 } mrp_job;
 
 /* Hybrid rule, first half: 1 if every glossy sample of pixel px is sharp
