@@ -125,6 +125,7 @@ class GlossyMode(enum.IntEnum):
     SG = 1
     ASG2 = 2
     MRP = 3
+    HYBRID = 4
 
 
 class Visibility(enum.IntEnum):

@@ -26,7 +26,7 @@ KNOBS = {
     "sharpness_estimator": (("TOKSVIG", "BANERJEE"), "TOKSVIG"),
     "leak_correction": (("AUTO", "OFF", "ON"), "AUTO"),
     "diffuse_mode": (("SG", "PULLED_OUT", "ACCURATE"), "PULLED_OUT"),
-    "glossy_mode": (("ASG", "SG", "ASG2", "MRP"), "ASG2"),
+    "glossy_mode": (("ASG", "SG", "ASG2", "MRP", "HYBRID"), "ASG2"),
 }
 
 # The presets' knob values: vsgl_render_settings_preset (csrc/src/shade/

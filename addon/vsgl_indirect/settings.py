@@ -91,7 +91,9 @@ ITEMS = {
          "Fastest: lattice 32 VSGLs per light, RSM 128, 1 sample (8 x 8 rays at edges), one "
          "pixel in 2 x 2 shaded, "
          "no indirect shadows. Within 21 % of Cycles per pass on the bundled scenes; the gather "
-         "room in 0.03 s at relMSE 0.078 (light leaks past occluders)"),
+         "room in 0.03 s at relMSE 0.078 (light leaks past occluders). For stills and light "
+         "edits: with 1 sample a moving camera makes glossy rims and sunlit edges shimmer "
+         "(use Balanced for camera animations)"),
         ("BALANCED", "Balanced",
          "Lattice 192 VSGLs per light, RSM 256, 2 x 2 AA (8 x 8 rays at edges), one pixel in 2 x 2 "
          "shaded, visibility "
@@ -159,9 +161,13 @@ ITEMS = {
          "time"),
         ("MRP", "Rectangle Proxies",
          "Experimental: the glossy light of the large planar faces (walls, floors, 0.25 m^2 and "
-         "up) as lit rectangles reflected in closed form (the MRP paper, docs/mrp.md); against "
-         "Cycles still behind ASG on the metal-floor scenes (cell steps at grazing views, slower); "
-         "light from curved or small surfaces is not in the glossy pass"),
+         "up) as lit rectangles reflected in closed form (the MRP paper, docs/mrp.md): lower glossy "
+         "error than k-means 256 in the red-wall and sun rooms, but several times slower on metal "
+         "floors; light from curved or small surfaces is not in the glossy pass"),
+        ("HYBRID", "Hybrid",
+         "Experimental: Rectangle Proxies for sharp glossy surfaces (roughness up to 0.5) facing "
+         "lit walls, plus the light of clusters off the walls; Two ASGs everywhere else "
+         "(docs/mrp.md)"),
     ],
     "visibility": [
         ("NONE", "None",

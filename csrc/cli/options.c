@@ -23,8 +23,8 @@ const char cli_usage[] =
     "  --vsgls N             VSGLs per light (fis, kmeans; 1..65536)\n"
     "  --sharpness NAME      toksvig | banerjee\n"
     "  --diffuse NAME        sg | pulled-out | accurate   (receiver cosine)\n"
-    "  --glossy NAME         asg | sg | asg2 | mrp   (one ASG, one SG, GGX core + tail as two ASGs,\n"
-    "                        rectangle proxies: the MRP paper)\n"
+    "  --glossy NAME         asg | sg | asg2 | mrp | hybrid   (one ASG, one SG, GGX core + tail as two\n"
+    "                        ASGs, rectangle proxies: the MRP paper, MRP per pixel where it applies)\n"
     "  --visibility NAME     none | ray\n"
     "  --leak NAME           auto | off | on   (emitter-hemisphere light-leak correction)\n"
     "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
@@ -115,8 +115,9 @@ static const int sharp_values[] = {VSGL_SHARPNESS_TOKSVIG, VSGL_SHARPNESS_BANERJ
 static const char *const diffuse_names[] = {"sg", "pulled-out", "accurate", "pulled", NULL};
 static const int diffuse_values[] = {VSGL_COSINE_SG, VSGL_COSINE_PULLED_OUT, VSGL_COSINE_ACCURATE,
                                      VSGL_COSINE_PULLED_OUT};
-static const char *const glossy_names[] = {"asg", "sg", "asg2", "mrp", NULL};
-static const int glossy_values[] = {VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG, VSGL_GLOSSY_ASG2, VSGL_GLOSSY_MRP};
+static const char *const glossy_names[] = {"asg", "sg", "asg2", "mrp", "hybrid", NULL};
+static const int glossy_values[] = {VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG, VSGL_GLOSSY_ASG2, VSGL_GLOSSY_MRP,
+                                    VSGL_GLOSSY_HYBRID};
 static const char *const vis_names[] = {"none", "ray", NULL};
 static const int vis_values[] = {VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY};
 static const char *const leak_names[] = {"auto", "off", "on", NULL};

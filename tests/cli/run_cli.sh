@@ -280,6 +280,12 @@ if want args_glossy_mrp && expect_ok "args_glossy_mrp" "$VSGL" render "$SCENE" -
   if grep -q "glossy=mrp" "$T/out"; then ok "args_glossy_mrp"
   else bad "args_glossy_mrp" "$(head -3 "$T/out" | tr '\n' '|')"; fi
 fi
+# --glossy hybrid: MRP per pixel where it applies (docs/mrp.md §4)
+if want args_glossy_hybrid && expect_ok "args_glossy_hybrid" "$VSGL" render "$SCENE" -o "$T/hyb.exr" --glossy hybrid \
+    --dry-run; then
+  if grep -q "glossy=hybrid" "$T/out"; then ok "args_glossy_hybrid"
+  else bad "args_glossy_hybrid" "$(head -3 "$T/out" | tr '\n' '|')"; fi
+fi
 expect_fail args_bad_compression 2 "'lzma' is not one of zip|zips|piz|none|rle|pxr24|b44|b44a" "$VSGL" render "$SCENE" \
   --compression lzma
 

@@ -289,3 +289,16 @@ def test_render_glossy_mode_mrp(lib, ctx):
     assert np.all(np.isfinite(mrp["glossy"])) and np.all(mrp["glossy"] >= 0)
     np.testing.assert_array_equal(mrp["diffuse"], asg["diffuse"])
     assert L.GlossyMode.MRP == 3
+
+
+def test_render_glossy_mode_hybrid(lib, ctx):
+    """glossy_mode HYBRID (MRP per pixel where it applies, docs/mrp.md §4)
+    through the binding: finite, non-negative, ASG2's diffuse pass."""
+    require(lib, *ALL)
+    scene = L.Scene(ctx, **floor_and_wall())
+    base = {"aa_samples": 1, "fit_mode": "two"}
+    asg2, _ = L.render(ctx, scene, dict(base, glossy_mode=L.GlossyMode.ASG2), planes=("diffuse", "glossy"))
+    hyb, _ = L.render(ctx, scene, dict(base, glossy_mode=L.GlossyMode.HYBRID), planes=("diffuse", "glossy"))
+    assert np.all(np.isfinite(hyb["glossy"])) and np.all(hyb["glossy"] >= 0)
+    np.testing.assert_array_equal(hyb["diffuse"], asg2["diffuse"])
+    assert L.GlossyMode.HYBRID == 4

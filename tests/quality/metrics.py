@@ -175,6 +175,20 @@ def flicker(frames):
                 ratio=med2 / med if med > 0 else float("nan"), l1=float(np.median(l1)) if l1 else float("nan"))
 
 
+def jitter(frames):
+    """Median over consecutive pairs of the RMS of (f[t+1] - f[t]) - (f[n] -
+    f[0]) / n relative to the RMS of f[t]: the change in excess of the
+    sequence's own straight-line trend. A smooth motion over a few frames
+    changes each pixel at a steady rate (jitter ~0); a fit that reshuffles,
+    or an edge or highlight that jumps across pixels, does not."""
+    f = [np.asarray(x, np.float64) for x in frames]
+    n = len(f) - 1
+    if n < 2:
+        return float("nan")
+    trend = (f[-1] - f[0]) / n
+    return float(np.median([_rel((f[t + 1] - f[t]) - trend, f[t]) for t in range(n)]))
+
+
 def excess_flicker(frames, truth):
     """Median over consecutive pairs of the RMS of (f[t+1] - f[t]) - (g[t+1]
     - g[t]) relative to the RMS of f[t]: how much a sequence changes beyond
@@ -205,11 +219,13 @@ def motion_change(first, last, steps):
 def all_metrics(img, ref_seeds, k=4):
     """Every still metric of one configuration's passes against the
     reference seeds (each a dict of coloured passes). Returns
-    {pass: dict(bias, relmse, structured)} plus 'flip' (combined)."""
+    {pass: dict(bias, relmse, structured)} plus 'flip' (combined); the
+    glossy pass also has its own 'flip' (issue 14's acceptance is on it)."""
     ref = {p: 0.5 * (ref_seeds[0][p] + ref_seeds[1][p]) for p in ("Diff", "Gloss", "Combined")}
     out = {}
     for p in ("Diff", "Gloss", "Combined"):
         out[p] = dict(bias=bias(img[p], ref[p]), relmse=relmse(img[p], ref[p]),
                       structured=structured(img[p], ref[p], k))
     out["flip"] = flip(img["Combined"], ref["Combined"])
+    out["Gloss"]["flip"] = flip(img["Gloss"], ref["Gloss"])
     return out

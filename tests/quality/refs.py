@@ -128,41 +128,6 @@ def path_frame(refdir, name, size, seed, version, anim, frame, code=None):
     return os.path.join(refdir, "%s_%s%02d_%dx%d_%dspp_s%d_%s.npz" % (name, anim, frame, w, h, spp, seed, k))
 
 
-def ensure_frame(names, size, anim, frame, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=False):
-    """ensure() for frame `frame` of animation `anim`: {name: [(passes, meta) per seed]}."""
-    if not frame:
-        return ensure(names, size, refdir, seeds, log, quiet)
-    version = blender_version(refdir)
-    code = code_digest()
-    need = sorted({n for n in names for s in seeds if version is None
-                   or not os.path.exists(path_frame(refdir, n, size, s, version, anim, frame, code))})
-    if need:
-        if version is None:
-            raise RuntimeError("references missing and no Blender found ($BLENDER=%s)" % blender_binary())
-        sz = size if isinstance(size, str) else "x".join(str(v) for v in scenes.size_of(size))
-        cmd = [blender_binary(), "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-               os.path.join(HERE, "render_refs.py"), "--", "--size", sz, "--scenes", ",".join(need),
-               "--seeds", ",".join(str(s) for s in seeds), "--out", refdir, "--anim", anim, "--frame", str(frame)]
-        if not quiet:
-            print("rendering Cycles frame %d of the %s animation (%d seeds) in Blender %s: %s"
-                  % (frame, anim, len(seeds), version, " ".join(need)), flush=True)
-        log = log or os.path.join(refdir, "render_refs.log")
-        os.makedirs(refdir, exist_ok=True)
-        with open(log, "a") as fh:
-            rc = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, env=blender_env()).returncode
-        if rc != 0:
-            raise RuntimeError("render_refs.py failed (exit %d); see %s" % (rc, log))
-    out = {}
-    for n in names:
-        out[n] = []
-        for s in seeds:
-            p = path_frame(refdir, n, size, s, version, anim, frame, code)
-            if not os.path.exists(p):
-                raise RuntimeError("reference %s was not written" % p)
-            out[n].append(load(p))
-    return out
-
-
 def load(p, names=PASSES):
     """(passes dict, metadata dict) of a reference file."""
     with np.load(p) as z:
@@ -187,18 +152,29 @@ def ensure(names, size, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=
     """Make sure every (scene, seed) reference exists; render the missing ones
     in Blender. Returns {name: [(passes, meta) per seed]}. Raises
     RuntimeError if Blender is missing or fails."""
+    return ensure_frame(names, size, "light", 0, refdir, seeds, log, quiet)
+
+
+def ensure_frame(names, size, anim, frame, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=False):
+    """ensure() for frame `frame` of animation `anim` (0: the still, the
+    same files as ensure()'s)."""
     version = blender_version(refdir)
-    need = missing(names, size, refdir, version, seeds) if version else [(n, s) for n in names for s in seeds]
+    code = code_digest()
+    need = sorted({n for n in names for s in seeds if version is None
+                   or not os.path.exists(path_frame(refdir, n, size, s, version, anim, frame, code))})
     if need:
         if version is None:
             raise RuntimeError("references missing and no Blender found ($BLENDER=%s)" % blender_binary())
-        todo = sorted({n for n, _ in need})
         sz = size if isinstance(size, str) else "x".join(str(v) for v in scenes.size_of(size))
         cmd = [blender_binary(), "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-               os.path.join(HERE, "render_refs.py"), "--", "--size", sz, "--scenes", ",".join(todo),
+               os.path.join(HERE, "render_refs.py"), "--", "--size", sz, "--scenes", ",".join(need),
                "--seeds", ",".join(str(s) for s in seeds), "--out", refdir]
+        what = "reference(s)"
+        if frame:
+            cmd += ["--anim", anim, "--frame", str(frame)]
+            what = "frame %d of the %s animation" % (frame, anim)
         if not quiet:
-            print("rendering %d Cycles reference(s) in Blender %s: %s" % (len(need), version, " ".join(todo)),
+            print("rendering Cycles %s (%d seeds) in Blender %s: %s" % (what, len(seeds), version, " ".join(need)),
                   flush=True)
         log = log or os.path.join(refdir, "render_refs.log")
         os.makedirs(refdir, exist_ok=True)
@@ -206,12 +182,11 @@ def ensure(names, size, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=
             rc = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, env=blender_env()).returncode
         if rc != 0:
             raise RuntimeError("render_refs.py failed (exit %d); see %s" % (rc, log))
-    code = code_digest()
     out = {}
     for n in names:
         out[n] = []
         for s in seeds:
-            p = path(refdir, n, size, s, version, code)
+            p = path_frame(refdir, n, size, s, version, anim, frame, code)
             if not os.path.exists(p):
                 raise RuntimeError("reference %s was not written" % p)
             out[n].append(load(p))

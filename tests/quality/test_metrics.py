@@ -149,6 +149,15 @@ def test_motion_change_removes_independent_noise():
     assert still < 0.2 * want
 
 
+def test_jitter_of_a_ramp_is_zero_and_of_a_reshuffle_is_not():
+    base = _img(7)
+    ramp = [base * (1 + 0.01 * t) for t in range(8)]
+    assert M.jitter(ramp) < 1e-12 < M.flicker(ramp)["median"]
+    rng = np.random.default_rng(8)
+    shuffled = [x * (1 + 0.02 * rng.standard_normal(x.shape)) for x in ramp]
+    assert M.jitter(shuffled) > 0.02  # two independent 2 % perturbations per pair
+
+
 def test_rel_rmse_by_hand():
     b = np.full((4, 4, 3), 2.0)
     assert abs(M.rel_rmse(b * 1.1, b) - 0.1) < 1e-12

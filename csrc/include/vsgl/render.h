@@ -42,7 +42,13 @@ extern "C" {
                                docs/mrp.md): the scene's large planar faces (>= 0.25 m^2), lit by this
                                frame's RSMs, reflected by each receiver's warped ASG lobe in closed form;
                                light from anything else (curved or small surfaces) is not in the glossy
-                               pass; against Cycles still behind ASG on metal floors. Diffuse as ASG */
+                               pass; several times slower than ASG2 (docs/mrp.md §4 says where it
+                               wins). Diffuse as ASG */
+#define VSGL_GLOSSY_HYBRID 4 /**< experimental: per pixel, where every glossy receiver is sharp
+                               (roughness <= 0.5) and reaches a lit rectangle proxy, the proxies' light
+                               as the larger of MRP's (above) and the on-proxy VSGLs' estimate, plus the
+                               VSGLs whose clusters lie on no proxy (nothing counts twice); the two-lobe
+                               VSGL term (ASG2) everywhere else (docs/mrp.md §4). Diffuse as ASG2 */
 
 #define VSGL_VISIBILITY_NONE 0
 #define VSGL_VISIBILITY_RAY  1  /**< one ray from the shading point to each VSGL centre / VPL */

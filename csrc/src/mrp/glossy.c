@@ -6,16 +6,34 @@
 #include "mrp/geom.h"
 #include "math/constants.h"
 #include "vsgl/lobes.h"
+#include "shade/kernel.h"
+
+#include <string.h>
+
+/* The receiver's lobe count, the disk rule's scale and the light's shrink
+ * of the default options (docs/mrp.md §4 compares the variants:
+ * tools/mrp_quality.sh builds the library with -DVSGL__MRP_LOBES=1 /
+ * -DVSGL__MRP_SHRINK=1 to measure them; r_d x 1.04 / 1.08 moved the quality
+ * scenes' glossy bias by +0.4-1.5 % and their relMSE by -5 % to +14 %). */
+#ifndef VSGL__MRP_LOBES
+#define VSGL__MRP_LOBES 2
+#endif
+#ifndef VSGL__MRP_RD_SCALE
+#define VSGL__MRP_RD_SCALE 1.0
+#endif
+#ifndef VSGL__MRP_SHRINK
+#define VSGL__MRP_SHRINK 0.0
+#endif
 
 vsgl__mrp_options vsgl__mrp_options_default(void)
 {
-    vsgl__mrp_options o = {VSGL__MRP_NORM_EXACT, 1, 1, 0, 1, 1.0, 1};
+    vsgl__mrp_options o = {VSGL__MRP_NORM_EXACT, 1, 1, 0, 1, VSGL__MRP_RD_SCALE, 1, VSGL__MRP_LOBES, VSGL__MRP_SHRINK};
     return o;
 }
 
 vsgl__mrp_options vsgl__mrp_options_paper(void)
 {
-    vsgl__mrp_options o = {VSGL__MRP_NORM_PAPER, 0, 0, 0, 0, 1.0, 0};
+    vsgl__mrp_options o = {VSGL__MRP_NORM_PAPER, 0, 0, 0, 0, 1.0, 0, 1, 0};
     return o;
 }
 
@@ -51,17 +69,14 @@ static d3 clamp_to_rect(const vsgl__mrp_rect *rc, d3 y)
     return d3_add(rc->center, d3_add(d3_scale(rc->u, cu), d3_scale(rc->v, cv)));
 }
 
-double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha,
-                                const vsgl__mrp_options *opt, d3 *axis)
+/* One Gaussian receiver lobe (g: Eq. 8's SG, ra: the warped ASG; the
+ * active one per opt->receiver_asg) against the rectangle: steps 2-6 of
+ * docs/mrp.md §3. h > 0 is x's height over the plane. */
+static double glossy_lobe(const vsgl__mrp_rect *rc, d3 x, double h, const vsgl_sg *g, const vsgl_asg *ra,
+                          const vsgl__mrp_options *opt, d3 *axis)
 {
-    *axis = n;
-    double h = d3_dot(d3_sub(x, rc->center), rc->normal);
-    if (!(h > 0.0) || !(rc->half_u > 0.0) || !(rc->half_v > 0.0))
-        return 0.0;
-    vsgl_sg g;
-    vsgl__mrp_receiver_sg(n, o, alpha, &g);                /* Eq. 8 */
-    d3 z = d3_of_v3(g.axis), y;
-    if (g.log_amplitude == -INFINITY || !vsgl__mrp_peak(rc, x, d3_scale(z, -1.0), &y))
+    d3 z = d3_of_v3(g->axis), y;
+    if (g->log_amplitude == -INFINITY || !vsgl__mrp_peak(rc, x, d3_scale(z, -1.0), &y))
         return 0.0;                                        /* Eq. 12 */
     y = clamp_to_rect(rc, y);
     d3 xy = d3_sub(y, x);
@@ -69,18 +84,8 @@ double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, doub
     if (!(d > 0.0) || !(d < INFINITY))
         return 0.0;
     double cs = h / d;                                     /* cos(sigma) = n_r . yx */
-    double nu = 0.5 * g.sharpness;
-    vsgl_asg ra;
-    if (opt->receiver_asg) { /* the warped ASG; the rule below takes its geometric-mean bandwidth */
-        vsgl_vec3 nf = d3_to_v3(n), of = d3_to_v3(o), t;
-        d3 t0, t1;
-        d3_basis(n, &t0, &t1);
-        t = d3_to_v3(t0);
-        vsgl_asg ndf;
-        vsgl_ndf_aniso_to_asg(&nf, &t, (float)alpha, (float)alpha, &ndf);
-        vsgl_warp_ndf_asg(&ndf, &of, &ra);
-        nu = sqrt((double)ra.lambda * ra.mu);
-    }
+    /* the rule below takes the receiver's (geometric-mean) bandwidth */
+    double nu = opt->receiver_asg ? sqrt((double)ra->lambda * ra->mu) : 0.5 * g->sharpness;
     double rd = disk_radius(d, cs, nu, opt->rd_scale);
     double A = opt->overlap ? vsgl__mrp_overlap_exact(rc, y, rd) : vsgl__mrp_overlap_bbox(rc, y, rd);
     if (!(A > 0.0))
@@ -94,19 +99,73 @@ double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, doub
     d3 p = opt->centred ? vsgl__mrp_overlap_center(rc, y, rd) : y;
     *axis = d3_normalize(d3_sub(p, x));
     vsgl_asg light;
-    if (!vsgl__mrp_asg_light(x, p, rc->normal, rd, C, opt->norm, &light))
+    /* the light's extent: the disk, or the disk of the overlap's area (a cell smaller than the disk) */
+    double rl = opt->shrink > 0.0 && A < 1.0 ? fmin(rd, opt->shrink * rd * sqrt(A)) : rd;
+    if (!vsgl__mrp_asg_light(x, p, rc->normal, rl, C, opt->norm, &light))
         return 0.0;                                        /* Eq. 28-35 */
     double v;
     if (opt->sg_only) {                                    /* Eq. 37 */
         vsgl_sg ls;
         vsgl__mrp_asg_to_sg(&light, 1, &ls);
-        v = vsgl__mrp_convolve_sg(&ls, &g);
+        v = vsgl__mrp_convolve_sg(&ls, g);
     } else if (opt->receiver_asg) {                        /* ASG x ASG (Xu Eq. 13), integrated */
         vsgl_asg prod;
-        vsgl_asg_product(&light, &ra, &prod);
+        vsgl_asg_product(&light, ra, &prod);
         v = vsgl_asg_integral(&prod);
     } else {
-        v = vsgl__mrp_convolve(&light, &g);                /* Eq. 11 */
+        v = vsgl__mrp_convolve(&light, g);                 /* Eq. 11 */
     }
     return v > 0.0 && v < INFINITY ? v : 0.0;
+}
+
+int vsgl__mrp_glossy_parts(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha, const vsgl__mrp_options *opt,
+                           unsigned skip, double value[2], d3 axis[2])
+{
+    const int parts = opt->lobes == 2 ? 2 : 1;
+    for (int q = 0; q < 2; ++q) {
+        value[q] = 0.0;
+        axis[q] = n;
+    }
+    double h = d3_dot(d3_sub(x, rc->center), rc->normal);
+    if (!(h > 0.0) || !(rc->half_u > 0.0) || !(rc->half_v > 0.0))
+        return parts;
+    vsgl_sg g;
+    vsgl__mrp_receiver_sg(n, o, alpha, &g);                /* Eq. 8 */
+    vsgl_asg ra;
+    memset(&ra, 0, sizeof ra);
+    if (opt->receiver_asg) { /* the library's warped ASG (stretched at grazing views) */
+        vsgl_vec3 nf = d3_to_v3(n), of = d3_to_v3(o), t;
+        d3 t0, t1;
+        d3_basis(n, &t0, &t1);
+        t = d3_to_v3(t0);
+        vsgl_asg ndf;
+        vsgl_ndf_aniso_to_asg(&nf, &t, (float)alpha, (float)alpha, &ndf);
+        vsgl_warp_ndf_asg(&ndf, &of, &ra);
+    }
+    for (int q = 0; q < parts; ++q) {
+        if (skip & (1u << q))
+            continue;
+        vsgl_sg gq = g;
+        vsgl_asg aq = ra;
+        if (parts == 2) { /* GGX's core (q 0) or tail (q 1): bandwidths x K, amplitude x C */
+            float k = q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K, c = q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C;
+            gq.sharpness *= k;
+            gq.log_amplitude += logf(c);
+            aq.lambda *= k;
+            aq.mu *= k;
+            aq.log_amplitude += logf(c);
+        }
+        value[q] = glossy_lobe(rc, x, h, &gq, &aq, opt, &axis[q]);
+    }
+    return parts;
+}
+
+double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha,
+                                const vsgl__mrp_options *opt, d3 *axis)
+{
+    double v[2];
+    d3 ax[2];
+    int parts = vsgl__mrp_glossy_parts(rc, x, n, o, alpha, opt, 0u, v, ax);
+    *axis = ax[0];
+    return parts == 2 ? v[0] + v[1] : v[0];
 }

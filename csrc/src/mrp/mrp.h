@@ -150,6 +150,13 @@ typedef struct vsgl__mrp_options {
     double rd_scale; /* r_d = rd_scale x the rule of glossy.c (disk_radius); 1 = the rule */
     int receiver_asg; /* 1: the receiver's NDF as the library's warped ASG (vsgl_warp_ndf_asg: stretched
                          at grazing views) and the ASG x ASG product integral, not Eq. 8's isotropic SG */
+    int lobes;        /* 1: the receiver's NDF as one Gaussian (Wang et al.: GGX's peak and integral, no tails);
+                         2: GGX as a core and a tail lobe (VSGL__GGX_{CORE,TAIL}_{K,C} of shade/kernel.h, as
+                         VSGL_GLOSSY_ASG2 does for VSGLs), each with its own disk (the rule scales with the
+                         lobe's width) */
+    double shrink;    /* > 0: when the rectangle covers less than the disk (a small cell of a proxy), the ASG
+                         light spans at most shrink x the radius of the disk of the overlap's area
+                         (r_d sqrt(A)), not the whole disk; 0: the whole disk */
 } vsgl__mrp_options;
 
 /* The options docs/mrp.md recommends (the best measured). */
@@ -168,5 +175,14 @@ vsgl__mrp_options vsgl__mrp_options_paper(void);
  * the plane's front. */
 double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha,
                                 const vsgl__mrp_options *opt, d3 *axis);
+
+/* The same per receiver lobe: value[q] and axis[q] for each of the
+ * opt->lobes parts (q 0 the core, 1 the tail; the unused one 0 with axis
+ * n), so the caller evaluates the smooth factor at each part's own axis;
+ * part q is not evaluated (left 0) when bit q of @p skip is set (a cell
+ * beyond the core's reach). Returns the number of parts (1 or 2).
+ * vsgl__mrp_glossy_uniform returns their sum with the core's axis. */
+int vsgl__mrp_glossy_parts(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha, const vsgl__mrp_options *opt,
+                           unsigned skip, double value[2], d3 axis[2]);
 
 #endif

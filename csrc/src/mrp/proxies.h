@@ -49,16 +49,35 @@ void vsgl__mrp_proxies_free(vsgl__mrp_proxy_set *set);
 
 /* The glossy plane from the proxies: for every hit sample with a glossy
  * lobe, the sum over proxies and lit cells of the MRP term
- * (vsgl__mrp_glossy_uniform, default options) x the smooth factor x the
+ * (vsgl__mrp_glossy_parts, default options) x the smooth factor x the
  * cell's radiance; planes->glossy (per pixel, sample-weighted as the VSGL
- * shading) is overwritten. */
+ * shading) is overwritten.
+ * Hybrid (@p glossy_q not NULL: the VSGL glossy plane of the clusters off
+ * every proxy): a pixel whose glossy samples all have alpha <= @p max_alpha
+ * and receive MRP light gets glossy_q + the larger of MRP's light and the
+ * on-proxy clusters' (planes->glossy - glossy_q); every other pixel keeps
+ * the VSGL glossy light already in planes->glossy (docs/mrp.md §4). */
 vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
-                                   const vsgl__mrp_proxy_set *set, const vsgl_pixel_planes *planes);
+                                   const vsgl__mrp_proxy_set *set, const vsgl_pixel_planes *planes,
+                                   const float *glossy_q, double max_alpha);
+
+/* The hybrid's rule: receivers up to this GGX alpha (roughness 0.5) take MRP. */
+#define VSGL__MRP_HYBRID_MAX_ALPHA 0.25
+/* A cluster lies on a proxy when its mean is within this many plane_tol of
+ * the proxy's plane and inside its rectangle, its mean normal within ~18
+ * degrees of the plane's. */
+#define VSGL__MRP_ON_PROXY_TOL 4.0
+
+/* 1 if VSGL v is a diffuse cluster lying on a proxy of @p set (whose light
+ * the proxy's cells carry), else 0. */
+int vsgl__mrp_on_proxy(const vsgl__mrp_proxy_set *set, const vsgl_vsgl *v);
 
 /* Defaults of the proxy pass (not settings yet): proxies of at least
  * VSGL__MRP_MIN_AREA m^2, VSGL__MRP_CELLS cells along their longer side. */
 #define VSGL__MRP_MIN_AREA 0.25
+#ifndef VSGL__MRP_CELLS
 #define VSGL__MRP_CELLS 32
+#endif
 
 /* The whole glossy_mode = VSGL_GLOSSY_MRP pass: proxies from the scene, one
  * RSM per light at @p rsm_resolution (built again: the fit frees its own),
@@ -70,5 +89,14 @@ vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, c
 vsgl_result vsgl__mrp_glossy_pass(vsgl_context *ctx, const vsgl_scene *scene, uint32_t rsm_resolution,
                                   double min_area, uint32_t cells, const vsgl_gbuffer *g,
                                   const vsgl_pixel_planes *planes, size_t *proxies);
+
+/* VSGL_GLOSSY_HYBRID: planes holds the VSGL pass of @p vsgls (two-lobe
+ * glossy). Builds the proxies, shades the VSGLs off every proxy again into
+ * a scratch plane (their glossy light; *excluded receives the number left
+ * out, may be NULL) and runs the MRP pass with the hybrid rule of
+ * vsgl__mrp_shade_glossy. */
+vsgl_result vsgl__mrp_hybrid_pass(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
+                                  const vsgl_gbuffer *g, const vsgl_vsgl_set *vsgls, const vsgl_pixel_planes *planes,
+                                  size_t *excluded);
 
 #endif

@@ -99,7 +99,7 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     CHECK_ENUM(fit_mode, VSGL_FIT_TWO, VSGL_FIT_LATTICE)
     CHECK_ENUM(sharpness_estimator, VSGL_SHARPNESS_TOKSVIG, VSGL_SHARPNESS_BANERJEE)
     CHECK_ENUM(diffuse_mode, VSGL_COSINE_ACCURATE, VSGL_COSINE_PULLED_OUT)
-    CHECK_ENUM(glossy_mode, VSGL_GLOSSY_ASG, VSGL_GLOSSY_MRP)
+    CHECK_ENUM(glossy_mode, VSGL_GLOSSY_ASG, VSGL_GLOSSY_HYBRID)
     CHECK_ENUM(visibility, VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY)
     CHECK_ENUM(leak_correction, VSGL_LEAK_AUTO, VSGL_LEAK_ON)
     CHECK_ENUM(sample_merging, VSGL_MERGE_AUTO, VSGL_MERGE_OFF)

@@ -170,6 +170,12 @@ static void visibility_rays(const shade_job *j, v3 target, const receiver *rec, 
         vis[k] = blocked[k] ? 0.0f : 1.0f;
 }
 
+/* GGX as two lobes, core and tail (kernel.h): ASG2 and the hybrid's VSGL term. */
+static int two_lobes(int32_t mode)
+{
+    return mode == VSGL_GLOSSY_ASG2 || mode == VSGL_GLOSSY_HYBRID;
+}
+
 /* Part q (0 core, 1 tail) of a GGX lobe's ASG (kernel.h, VSGL__KERNEL_GGX_TAIL). */
 static vsgl_asg ggx_part(const vsgl_asg *a, int q)
 {
@@ -191,7 +197,7 @@ static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_s
         return vsgl_sg_product_integral(&r->sg, in);
     }
     *axis = r->asg.z;
-    if (j->s->glossy_mode != VSGL_GLOSSY_ASG2)
+    if (!two_lobes(j->s->glossy_mode))
         return vsgl_asg_sg_product_integral(&r->asg, in);
     vsgl_asg a = ggx_part(&r->asg, part);
     return vsgl_asg_sg_product_integral(&a, in);
@@ -203,7 +209,7 @@ static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_s
  * kernel does. */
 static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl *v, const vsgl_sg *in, v3 *axis)
 {
-    int parts = j->s->glossy_mode == VSGL_GLOSSY_ASG2 ? 2 : 1;
+    int parts = two_lobes(j->s->glossy_mode) ? 2 : 1;
     float sum = 0.0f;
     for (int q = 0; q < parts; ++q) {
         float gi = glossy_integral(j, r, in, axis, q);
@@ -328,7 +334,9 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     b->nx[k] = r->n.x; b->ny[k] = r->n.y; b->nz[k] = r->n.z;
     b->ox[k] = r->o.x; b->oy[k] = r->o.y; b->oz[k] = r->o.z;
     b->diffuse[k] = r->bp.diffuse[0] + r->bp.diffuse[1] + r->bp.diffuse[2] > 0.0f ? 1.0f : 0.0f;
-    if (r->glossy) {
+    /* VSGL_GLOSSY_MRP replaces the glossy plane (mrp/pass.c): the kernel
+     * skips the glossy lobe of lanes with camp 0 */
+    if (r->glossy && j->s->glossy_mode != VSGL_GLOSSY_MRP) {
         b->Xx[k] = r->asg.x.x; b->Xy[k] = r->asg.x.y; b->Xz[k] = r->asg.x.z;
         b->Yx[k] = r->asg.y.x; b->Yy[k] = r->asg.y.y; b->Yz[k] = r->asg.y.z;
         b->Zx[k] = r->asg.z.x; b->Zy[k] = r->asg.z.y; b->Zz[k] = r->asg.z.z;
@@ -342,7 +350,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
         b->lam[k] = b->mu[k] = b->camp[k] = 0.0f;
     }
     float m[3] = {0.0f, 0.0f, 0.0f};
-    if (r->glossy) {
+    if (r->glossy && j->s->glossy_mode != VSGL_GLOSSY_MRP) {
         vsgl__specular_factor(&r->bp, r->n, r->o, r->asg.z, r->alpha, m);
         for (int c = 0; c < 3; ++c)
             m[c] *= r->ms[c];
@@ -419,7 +427,7 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
     int32_t lobes = 0;
     for (size_t k = 0; k < n; ++k)
         lobes |= (blk->diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk->camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0);
-    if ((lobes & VSGL__KERNEL_GLOSSY) && j->s->glossy_mode == VSGL_GLOSSY_ASG2)
+    if ((lobes & VSGL__KERNEL_GLOSSY) && two_lobes(j->s->glossy_mode))
         lobes |= VSGL__KERNEL_GGX_TAIL;
     for (size_t k = n; k < VSGL__KERNEL_BLOCK; ++k) {
         /* padding lanes: shaded, never read; at lane 0's position so that
