@@ -165,11 +165,13 @@ typedef struct vsgl_render_stats {
                                       fit, the last line says so (the log has every item) */
     uint32_t reused;             /**< stages taken from a vsgl_render_cache: VSGL_REUSED_* bits */
     char budget[512];            /**< with two or more lights that light something: what each light got
-                                      and why, one line per light ("light 1: 23 % of the reflected
-                                      power: 118 VSGLs, RSM 215 (uniform 192, 256)"); the VSGLs and RSM
-                                      texels follow each light's reflected power, measured on a 32^2
-                                      probe RSM, with a floor of a quarter of the uniform share; the
-                                      totals stay the settings'. Empty with one light (the settings
+                                      and why, one line per light ("light 1: 36 % of the light on what the
+                                      camera sees: 152 VSGLs, RSM 213 (uniform 192, 256)"). vsgl_count and
+                                      rsm_resolution are then a budget per light: each light's share
+                                      follows the square root of the light it sends onto what the camera
+                                      sees (a 16^2 probe RSM gathered at a 32-wide grid of camera rays),
+                                      with a floor of a quarter of the uniform share; the totals stay the
+                                      settings' (docs/pipeline.md). Empty with one light (the settings
                                       apply as they are) */
 } vsgl_render_stats;
 
