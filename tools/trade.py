@@ -65,7 +65,9 @@ QUICK_SPP = [1, 4, 16]
 PRESETS = ["preview", "balanced", "quality"]
 KNOBS = ["lattice 64:vsgl_count=64", "lattice 512:vsgl_count=512", "RSM 128:rsm_resolution=128",
          "RSM 512:rsm_resolution=512", "aa 1:aa_samples=1", "aa 4:aa_samples=4",
-         "quality aa 4:preset=quality,aa_samples=4"]
+         "quality aa 4:preset=quality,aa_samples=4",
+         # the glossy modes of issue 14 (docs/mrp.md) beside the k-means fit they are measured against
+         "k-means 256:fit_mode=kmeans,vsgl_count=256", "MRP:glossy_mode=3", "hybrid:glossy_mode=4"]
 BRUTE = ["brute RSM 64:preset=brute,rsm_resolution=64", "brute RSM 128:preset=brute,rsm_resolution=128"]
 # scenes with more triangles: one library run per point, no brute force (dense_floor: balanced
 # ~20 s, brute force RSM 64 ~280 s at 320x240 here)
