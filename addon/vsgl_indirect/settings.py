@@ -98,8 +98,9 @@ ITEMS = {
          "Lattice 192 VSGLs per light, RSM 256, 2 x 2 AA (8 x 8 rays at edges), one pixel in 2 x 2 "
          "shaded, visibility "
          "rays, GGX as two lobes: the gather room in 0.24 s at relMSE 0.0050, below Cycles at 256 "
-         "spp (0.0133 in 0.59 s); within 5 % of Cycles per pass on every bundled scene. 8-28 s per 1080p "
-         "frame of the bundled rooms (one or two lights) on 2 cores, Preview 0.9-1.3 s"),
+         "spp (0.0133 in 0.59 s); within 5 % of Cycles per pass on every bundled scene. Per 1080p "
+         "frame on 2 cores: 2.4-4 s in the bundled empty rooms (no rays: nothing can block), 12-33 s "
+         "where objects cast indirect shadows (sun room, sphere); Preview 0.9-1.5 s"),
         ("QUALITY", "Quality",
          "Lattice 256 VSGLs per light, RSM 512, 2 x 2 AA (8 x 8 rays at edges), one pixel in 2 x 2 "
          "shaded, visibility "
@@ -204,8 +205,8 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
         name="VSGL Indirect Light", default=False, **_UPDATE,
         description="Compute the one-bounce indirect-light AOV of every rendered frame (F12, -f, "
                     "-a) before the compositor runs. Costs the preset's time per frame and view "
-                    "layer (Balanced: 8-28 s at 1080p for the bundled rooms on 2 cores, Preview "
-                    "0.9-1.3 s) plus the EXR write")
+                    "layer (Balanced at 1080p on 2 cores: 2.4-4 s in the bundled empty rooms, 12-33 s "
+                    "with indirect shadows; Preview 0.9-1.5 s) plus the EXR write")
     add_to_render: BoolProperty(
         name="Add to Render", default=True, **_UPDATE,
         description="Add the AOV onto the render in the compositor (Render Layers + Strength x "
