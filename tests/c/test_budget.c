@@ -155,11 +155,9 @@ typedef struct bplanes {
     float comb[BW * BH * 3], gl[BW * BH * 3];
 } bplanes;
 
-static vsgl_result render(vsgl_context *ctx, fx_scene *fx, vsgl_render_cache *cache, bplanes *p,
-                          vsgl_render_stats *st)
+static vsgl_result render_view(vsgl_context *ctx, const vsgl_scene *scene, vsgl_render_cache *cache, bplanes *p,
+                               vsgl_render_stats *st)
 {
-    vsgl_scene *scene = NULL;
-    vsgl_result r = vsgl_scene_create(ctx, fx_desc(fx), &scene);
     vsgl_render_settings s;
     vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
     vsgl_render_output o;
@@ -168,8 +166,17 @@ static vsgl_result render(vsgl_context *ctx, fx_scene *fx, vsgl_render_cache *ca
     o.height = BH;
     o.combined = p->comb;
     o.glossy_light = p->gl;
+    return vsgl_render_cached(ctx, scene, &s, cache, &o, st);
+}
+
+/* render_view of a scene made from fx for this one render */
+static vsgl_result render(vsgl_context *ctx, fx_scene *fx, vsgl_render_cache *cache, bplanes *p,
+                          vsgl_render_stats *st)
+{
+    vsgl_scene *scene = NULL;
+    vsgl_result r = vsgl_scene_create(ctx, fx_desc(fx), &scene);
     if (r == VSGL_OK)
-        r = vsgl_render_cached(ctx, scene, &s, cache, &o, st);
+        r = render_view(ctx, scene, cache, p, st);
     vsgl_scene_destroy(scene);
     return r;
 }
@@ -204,20 +211,6 @@ VT_TEST(budget_leaves_one_light_alone_and_reports_two)
     /* preview: 32 VSGLs, RSM 128: floors 8, then 36 and 12 */
     VT_CHECK(v0 == 44 && v1 == 20 && r0 == 150 && r1 == 101, "%u %u %u %u", v0, v1, r0, r1);
     vsgl_context_destroy(ctx);
-}
-
-static vsgl_result render_view(vsgl_context *ctx, const vsgl_scene *scene, vsgl_render_cache *cache, bplanes *p,
-                               vsgl_render_stats *st)
-{
-    vsgl_render_settings s;
-    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
-    vsgl_render_output o;
-    memset(&o, 0, sizeof o);
-    o.width = BW;
-    o.height = BH;
-    o.combined = p->comb;
-    o.glossy_light = p->gl;
-    return vsgl_render_cached(ctx, scene, &s, cache, &o, st);
 }
 
 VT_TEST(budget_cache_follows_the_camera)

@@ -306,41 +306,43 @@ def _brushed_metal_floor():
     return s
 
 
+def _with_light(base, name, feature, light):
+    """Room `base` (a builder) with one more light, as scene `name` (the trade-only two-light rooms)."""
+    s = base()
+    s["name"], s["feature"] = name, feature
+    s["lights"] = s["lights"] + [light]
+    return s
+
+
 def _spot_fill_metal_floor():
     # the spot room with a dim fill light: a point light in the corner behind
     # the camera lights the whole room softly (a key and a fill, issue 11's
     # per-light budget: the two lights' light on screen differs in amount and
     # in extent)
-    s = _spot_metal_floor()
-    s["name"] = "spot_fill_metal_floor"
-    s["feature"] = ("the spot room with a 60 W point fill light in a corner under the ceiling: a key and a fill "
-                    "(issue 11: VSGLs and RSM texels per light)")
-    s["lights"] = s["lights"] + [dict(type="POINT", energy=60.0, loc=(-2.3, -2.4, 2.6), rot=(0.0, 0.0, 0.0))]
-    return s
+    return _with_light(_spot_metal_floor, "spot_fill_metal_floor",
+                       "the spot room with a 60 W point fill light in a corner under the ceiling: a key and a fill "
+                       "(issue 11: VSGLs and RSM texels per light)",
+                       dict(type="POINT", energy=60.0, loc=(-2.3, -2.4, 2.6), rot=(0.0, 0.0, 0.0)))
 
 
 def _sun_lamp_opening():
     # the sun room with a ceiling lamp (a small area light facing down): the
     # sun's RSM covers the whole scene, most of it the sunlit outside
-    s = _sun_opening()
-    s["name"] = "sun_lamp_opening"
-    s["feature"] = ("the sun room with a 0.4 m square 100 W ceiling lamp: a light that mostly lights the outside "
-                    "(the sun) beside one that lights only the inside (issue 11: VSGLs and RSM texels per light)")
-    s["lights"] = s["lights"] + [dict(type="AREA", energy=100.0, loc=(0.8, -0.9, 2.65), rot=(0.0, 0.0, 0.0),
-                                      shape="SQUARE", size=0.4)]
-    return s
+    return _with_light(_sun_opening, "sun_lamp_opening",
+                       "the sun room with a 0.4 m square 100 W ceiling lamp: a light that mostly lights the outside "
+                       "(the sun) beside one that lights only the inside (issue 11: VSGLs and RSM texels per light)",
+                       dict(type="AREA", energy=100.0, loc=(0.8, -0.9, 2.65), rot=(0.0, 0.0, 0.0), shape="SQUARE",
+                            size=0.4))
 
 
 def _red_wall_two_spots():
     # the red-wall room with a second, narrower and dimmer spot on the back wall
-    s = _metal_floor_red_wall()
-    s["name"] = "red_wall_two_spots"
     spot_loc, spot_target = (-1.5, -1.8, 2.6), (0.8, 2.5, 1.2)
-    s["feature"] = ("the red-wall room with a second spot (800 W, 30 degrees) on the white back wall "
-                    "(issue 11: VSGLs and RSM texels per light)")
-    s["lights"] = s["lights"] + [dict(type="SPOT", energy=800.0, loc=spot_loc, rot=look_rot(spot_loc, spot_target),
-                                      spot_size=30.0, spot_blend=0.2)]
-    return s
+    return _with_light(_metal_floor_red_wall, "red_wall_two_spots",
+                       "the red-wall room with a second spot (800 W, 30 degrees) on the white back wall "
+                       "(issue 11: VSGLs and RSM texels per light)",
+                       dict(type="SPOT", energy=800.0, loc=spot_loc, rot=look_rot(spot_loc, spot_target),
+                            spot_size=30.0, spot_blend=0.2))
 
 
 def heightfield(x0, x1, y0, y1, n, height, mat):

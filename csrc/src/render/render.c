@@ -23,23 +23,33 @@ static double now_seconds(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+/* Logs one formatted line (at most line_max - 1 characters) as "tag: line"
+ * and appends it to `text` (capacity cap), whole lines only. With `more`,
+ * room for it is always kept: when a line does not fit, `more` is appended
+ * once instead, saying the rest is in the log. */
+static void append_note(vsgl_context *ctx, const char *tag, char *text, size_t cap, size_t line_max, const char *more,
+                        const char *fmt, va_list ap) VSGL_PRINTF(7, 0);
+static void append_note(vsgl_context *ctx, const char *tag, char *text, size_t cap, size_t line_max, const char *more,
+                        const char *fmt, va_list ap)
+{
+    char line[256];
+    vsnprintf(line, line_max < sizeof line ? line_max : sizeof line, fmt, ap);
+    vsgl__log(ctx, VSGL_LOG_INFO, "%s: %s", tag, line);
+    size_t used = strlen(text), room = cap - (more ? strlen(more) + 1 : 0);
+    if (used + strlen(line) + 1 < room)
+        snprintf(text + used, cap - used, "%s\n", line);
+    else if (more && !strstr(text, more))
+        snprintf(text + used, cap - used, "%s", more);
+}
+
 static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...) VSGL_PRINTF(3, 4);
 static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...)
 {
-    char line[256];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(line, sizeof line, fmt, ap);
+    append_note(ctx, "skipped", st->skipped, sizeof st->skipped, 256,
+                "(more: every skipped item is logged at level INFO)\n", fmt, ap);
     va_end(ap);
-    vsgl__log(ctx, VSGL_LOG_INFO, "skipped: %s", line);
-    /* Whole lines only; when the next does not fit, one last line says that
-     * the rest is in the log (room for it is always kept). */
-    static const char more[] = "(more: every skipped item is logged at level INFO)\n";
-    size_t used = strlen(st->skipped), room = sizeof st->skipped - sizeof more;
-    if (used + strlen(line) + 1 < room)
-        snprintf(st->skipped + used, sizeof st->skipped - used, "%s\n", line);
-    else if (!strstr(st->skipped, more))
-        snprintf(st->skipped + used, sizeof st->skipped - used, "%s", more);
 }
 
 /* The RSM of light `l`, or a noted skip: *lit = 0 when the light has no
@@ -77,15 +87,10 @@ static vsgl_result light_rsm(vsgl_context *ctx, const vsgl_scene *scene, uint32_
 static void note_budget(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...) VSGL_PRINTF(3, 4);
 static void note_budget(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...)
 {
-    char line[192];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(line, sizeof line, fmt, ap);
+    append_note(ctx, "budget", st->budget, sizeof st->budget, 192, NULL, fmt, ap);
     va_end(ap);
-    vsgl__log(ctx, VSGL_LOG_INFO, "budget: %s", line);
-    size_t used = strlen(st->budget);
-    if (used + strlen(line) + 1 < sizeof st->budget)
-        snprintf(st->budget + used, sizeof st->budget - used, "%s\n", line);
 }
 
 /* The per-light budget (budget.h): each powered light's reflected power on
