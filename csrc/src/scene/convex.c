@@ -14,7 +14,7 @@
  * costs triangles x vertices in the worst case. */
 #define VSGL__CONVEX_MAX_TRIANGLES 2048u
 
-int vsgl__scene_convex_shell(const vsgl_scene *scene)
+int vsgl__scene_test_convex_shell(const vsgl_scene *scene)
 {
     uint32_t t_count = scene->triangle_count, v_count = scene->vertex_count;
     if (t_count == 0 || t_count > VSGL__CONVEX_MAX_TRIANGLES)
@@ -38,4 +38,9 @@ int vsgl__scene_convex_shell(const vsgl_scene *scene)
         }
     }
     return 1;
+}
+
+int vsgl__scene_convex_shell(const vsgl_scene *scene)
+{
+    return scene->convex_shell;
 }

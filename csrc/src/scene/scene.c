@@ -291,6 +291,7 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
     if (r != VSGL_OK)
         return r;
     s->vertex_count = d->vertex_count;
+    s->convex_shell = vsgl__scene_test_convex_shell(s); /* geometry never changes after this */
     rtcCommitScene(s->rtc);
     return embree_check(ctx, s, "building the BVH");
 }

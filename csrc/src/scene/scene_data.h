@@ -39,6 +39,7 @@ struct vsgl_scene {
     float *uv_density;           /* triangle_count: UV area / world area (0 without UVs); NULL if untextured */
     int textured;                /* some material reads a texture or corner colours */
     v3 lo, hi;                   /* bounds of the valid triangles (0,0,0 when empty) */
+    int convex_shell;            /* vsgl__scene_convex_shell, decided once when the scene is built */
     uint64_t identity;           /* creation time (CLOCK_MONOTONIC ns): with the address, tells this scene's
                                     geometry and materials from a destroyed one's at the same address;
                                     kept by vsgl_scene_set_view (render caches key on both) */

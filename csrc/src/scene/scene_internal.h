@@ -82,5 +82,7 @@ void vsgl__scene_bounds(const vsgl_scene *scene, v3 *lo, v3 *hi);
  * (scene/convex.c): no surface can block light between two others, so
  * visibility rays find nothing. 0 otherwise, and above 2048 triangles. */
 int vsgl__scene_convex_shell(const vsgl_scene *scene);
+/* The test itself (up to triangles x vertices): run once by the scene's build. */
+int vsgl__scene_test_convex_shell(const vsgl_scene *scene);
 
 #endif
