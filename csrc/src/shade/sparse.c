@@ -378,8 +378,10 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
                     smooth &= !(hi[l] - lo[l] > SPARSE_CONTRAST * (hi[l] + lo[l]) + j->contrast_floor[l]);
                     continue;
                 }
-                /* (a missing second difference, -1, counts as 0) */
-                float e = 0.5f * (tx * (1.0f - tx) * fmaxf(dx2[l], 0.0f) + ty * (1.0f - ty) * fmaxf(dy2[l], 0.0f));
+                /* (a missing second difference, -1, counts as 0; a compare, not
+                 * fmaxf, which without -ffinite-math-only is a libm call per sample) */
+                float ex = dx2[l] > 0.0f ? dx2[l] : 0.0f, ey = dy2[l] > 0.0f ? dy2[l] : 0.0f;
+                float e = 0.5f * (tx * (1.0f - tx) * ex + ty * (1.0f - ty) * ey);
                 smooth &= !(e > bound);
             }
         }
