@@ -141,6 +141,7 @@ class LeakCorrection(enum.IntEnum):
     AUTO = 0
     OFF = 1
     ON = 2
+    CLIP = 3
 
 
 class SampleMerging(enum.IntEnum):

@@ -24,7 +24,7 @@ KNOBS = {
     "vsgl_count": (None, 192),
     "fis_iterations": (None, 8),
     "sharpness_estimator": (("TOKSVIG", "BANERJEE"), "TOKSVIG"),
-    "leak_correction": (("AUTO", "OFF", "ON"), "AUTO"),
+    "leak_correction": (("AUTO", "OFF", "ON", "CLIP"), "AUTO"),
     "diffuse_mode": (("SG", "PULLED_OUT", "ACCURATE"), "PULLED_OUT"),
     "glossy_mode": (("ASG", "SG", "ASG2", "MRP", "HYBRID"), "ASG2"),
 }

@@ -180,11 +180,15 @@ ITEMS = {
          "one pixel in 2 x 2 pays most of it back (Balanced: 1.1-1.5x)"),
     ],
     "leak_correction": [
-        ("AUTO", "Auto (On)", "The emitter clip, on (the library's default)"),
+        ("AUTO", "Auto (On)", "The emitter clip and the near field, on (the library's default)"),
         ("OFF", "Off", "The papers' model: light also leaves behind a cluster's surface "
                        "(8.6x / 1.6x / 3.0x the lattice's diffuse error at N = 128)"),
         ("ON", "On", "The emitter clip: no light behind or within a cluster's own surface; within "
-                     "2 % of a lit plane's exact irradiance in the far field"),
+                     "2 % of a lit plane's exact irradiance in the far field. And the near field: "
+                     "beside a junction a lattice cluster is its cell's exact form factor (no dark "
+                     "seam along a wall's foot)"),
+        ("CLIP", "Clip Only", "The emitter clip without the near field (0.3's On): the box room's "
+                              "junctions 10-25 % dark"),
     ],
     "sample_merging": [
         ("AUTO", "Auto (On)",

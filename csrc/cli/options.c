@@ -26,7 +26,7 @@ const char cli_usage[] =
     "  --glossy NAME         asg | sg | asg2 | mrp | hybrid   (one ASG, one SG, GGX core + tail as two\n"
     "                        ASGs, rectangle proxies: the MRP paper, MRP per pixel where it applies)\n"
     "  --visibility NAME     none | ray\n"
-    "  --leak NAME           auto | off | on   (emitter-hemisphere light-leak correction)\n"
+    "  --leak NAME           auto | off | on | clip   (emitter clip and near field; clip: without the near field)\n"
     "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
     "  --shade-stride N      1..8              (shade one pixel in N x N, interpolate the rest)\n"
     "  --edge-samples N      0..16             (N x N rays in pixels a geometric edge crosses; 0 = off)\n"
@@ -120,8 +120,8 @@ static const int glossy_values[] = {VSGL_GLOSSY_ASG, VSGL_GLOSSY_SG, VSGL_GLOSSY
                                     VSGL_GLOSSY_HYBRID};
 static const char *const vis_names[] = {"none", "ray", NULL};
 static const int vis_values[] = {VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY};
-static const char *const leak_names[] = {"auto", "off", "on", NULL};
-static const int leak_values[] = {VSGL_LEAK_AUTO, VSGL_LEAK_OFF, VSGL_LEAK_ON};
+static const char *const leak_names[] = {"auto", "off", "on", "clip", NULL};
+static const int leak_values[] = {VSGL_LEAK_AUTO, VSGL_LEAK_OFF, VSGL_LEAK_ON, VSGL_LEAK_CLIP};
 static const char *const merge_names[] = {"auto", "off", NULL};
 static const int merge_values[] = {VSGL_MERGE_AUTO, VSGL_MERGE_OFF};
 static const char *const method_names[] = {"vsgl", "brute-force", "brute", NULL};

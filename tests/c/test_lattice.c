@@ -6,6 +6,7 @@
 #include "scene_fixture.h"
 #include "fit/grid.h"
 #include "shade/shade.h"
+#include "shade/near_field.h"
 #include "vsgl/debug.h"
 
 #include <stdlib.h>
@@ -137,16 +138,25 @@ VT_TEST(fit_lattice_conserves_power_and_keeps_orientations_apart)
 
 /* Light at receiver x (normal n) from a set, through the reference path's
  * formulas (the kernel is checked against them in test_kernel.c). */
+/* clip: 0 the papers' model, 1 the emitter clip, 2 the clip and the near
+ * field (shade/near_field.h), blended in as the shading does */
 static double diffuse_at(const vsgl_vsgl_set *set, v3 x, v3 n, int clip)
 {
     double e = 0.0;
     for (size_t k = 0; k < set->count; ++k) {
         const vsgl_vsgl *v = &set->items[k];
         vsgl_sg in;
-        if (!vsgl__vsgl_incident_sg(v, x, &in))
-            continue;
-        float f = vsgl__emitter_clip(v, x, n, clip);
-        e += (double)v->power[0] * f * vsgl_sg_cosine_integral(&in, &n, VSGL_COSINE_ACCURATE) / PI_D;
+        double far = 0.0;
+        if (vsgl__vsgl_incident_sg(v, x, &in)) {
+            float f = vsgl__emitter_clip(v, x, n, clip != 0);
+            far = f * vsgl_sg_cosine_integral(&in, &n, VSGL_COSINE_ACCURATE) / PI_D;
+        }
+        vsgl_near_cell c;
+        if (clip == 2 && vsgl__near_cell(v, (uint32_t)k, &c)) {
+            float w, q = vsgl__near_diffuse(&c, x, n, &w);
+            far += w * (q - far);
+        }
+        e += (double)v->power[0] * far;
     }
     return e;
 }
@@ -162,9 +172,9 @@ VT_TEST(fit_lattice_is_continuous_in_the_vpls_motion)
     vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
     s.vsgl_count = 64;
     enum { STEPS = 24, PROBES = 40 };
-    double light[STEPS][PROBES];
+    double light[STEPS][PROBES], near[STEPS][PROBES];
     int fits[2] = {VSGL_FIT_LATTICE, VSGL_FIT_KMEANS};
-    double worst_jerk[2] = {0, 0};
+    double worst_jerk[2] = {0, 0}, near_jerk = 0.0;
     for (int f = 0; f < 2; ++f) {
         for (int st = 0; st < STEPS; ++st) {
             plane_rsm h;
@@ -175,8 +185,12 @@ VT_TEST(fit_lattice_is_continuous_in_the_vpls_motion)
                 vsgl__fit_lattice(rm.ctx, rm.scene, &h.r, &s, &set);
             else
                 vsgl__fit_kmeans(rm.ctx, rm.scene, &h.r, &s, &set);
-            for (int p = 0; p < PROBES; ++p) /* a ceiling row 0.4 m above the floor, facing down */
+            for (int p = 0; p < PROBES; ++p) { /* a ceiling row 0.4 m above the floor, facing down */
                 light[st][p] = diffuse_at(&set, v3_make(-0.95f + 0.05f * (float)p, 0.1f, 0.4f), v3_make(0, 0, -1), 1);
+                /* and, in the near field, a row 3 cm above it, facing across it, over its moving edge */
+                near[st][p] = diffuse_at(&set, v3_make(-0.95f + 0.05f * (float)p, 0.1f, 0.03f),
+                                         v3_normalize(v3_make(-1, 0, -1)), 2);
+            }
             vsgl__vsgl_set_free(&set);
             free_plane_rsm(&h);
         }
@@ -185,11 +199,16 @@ VT_TEST(fit_lattice_is_continuous_in_the_vpls_motion)
             for (int p = 0; p < PROBES; ++p) {
                 double d2 = fabs(light[st + 1][p] - 2.0 * light[st][p] + light[st - 1][p]) / (light[st][p] + 1e-12);
                 worst_jerk[f] = d2 > worst_jerk[f] ? d2 : worst_jerk[f];
+                double n2 = fabs(near[st + 1][p] - 2.0 * near[st][p] + near[st - 1][p]) / (near[st][p] + 1e-12);
+                if (f == 0)
+                    near_jerk = n2 > near_jerk ? n2 : near_jerk;
             }
     }
     if (getenv("VSGL_TEST_VERBOSE"))
-        printf("    worst relative second difference: lattice %.3g, k-means %.3g\n", worst_jerk[0], worst_jerk[1]);
+        printf("    worst relative second difference: lattice %.3g (its near field %.3g), k-means %.3g\n", worst_jerk[0],
+               near_jerk, worst_jerk[1]);
     VT_CHECK(worst_jerk[0] < 2e-3, "lattice: the light jumps by %.3g between 0.5 mm steps", worst_jerk[0]);
+    VT_CHECK(near_jerk < 2e-3, "lattice near field: the light jumps by %.3g between 0.5 mm steps", near_jerk);
     /* the test can fail: importance-drawn k-means centres jump */
     VT_CHECK(worst_jerk[1] > 10.0 * worst_jerk[0], "k-means jerk %.3g not above the lattice's %.3g", worst_jerk[1], worst_jerk[0]);
     lroom_close(&rm);
@@ -263,13 +282,21 @@ VT_TEST(shade_clipped_lattice_lights_like_the_exact_plane)
         {1.0f, 0.0f, 1.0f, -1, 0, 0, 0.08, "wall at the edge, 1 m up"},
         {1.8f, 0.3f, 0.5f, -1, 0, 0, 0.08, "wall beyond the edge, 0.5 m up"},
         {-2.5f, 0.0f, 2.0f, 0.7071f, 0, -0.7071f, 0.08, "oblique, far"},
+        /* the near field: a wall standing on the square's edge, at its foot */
+        {1.0f, 0.2f, 0.02f, -1, 0, 0, 0.05, "wall at the edge, 2 cm up"},
+        {1.0f, -0.5f, 0.1f, -1, 0, 0, 0.05, "wall at the edge, 10 cm up"},
+        {1.0f, 0.0f, 0.3f, -1, 0, 0, 0.05, "wall at the edge, 30 cm up"},
+        {0.3f, 0.2f, 0.05f, 0, 0, -1, 0.05, "facing, 5 cm"},
+        {0.9f, 0.9f, 0.1f, -0.7071f, -0.7071f, 0, 0.05, "a corner's diagonal, 10 cm up"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         v3 x = v3_make(cases[i].x, cases[i].y, cases[i].z), n = v3_normalize(v3_make(cases[i].nx, cases[i].ny, cases[i].nz));
-        double want = polygon_irradiance(x, n, M) / PI_D, got = diffuse_at(&set, x, n, 1), paper = diffuse_at(&set, x, n, 0);
+        double want = polygon_irradiance(x, n, M) / PI_D, got = diffuse_at(&set, x, n, 2),
+               clipped = diffuse_at(&set, x, n, 1), paper = diffuse_at(&set, x, n, 0);
         if (getenv("VSGL_TEST_VERBOSE"))
-            printf("    %-32s exact %.5f clipped %.5f (%+.1f %%) papers' SG %.5f (%+.1f %%)\n", cases[i].what, want, got,
-                   100 * (got / want - 1), paper, 100 * (paper / want - 1));
+            printf("    %-32s exact %.5f near field %.5f (%+.1f %%) clip only %.5f (%+.1f %%) papers' SG %.5f (%+.1f %%)\n",
+                   cases[i].what, want, got, 100 * (got / want - 1), clipped, 100 * (clipped / want - 1), paper,
+                   100 * (paper / want - 1));
         VT_CHECK_REL(got, want, cases[i].tol, "%s", cases[i].what);
     }
     /* nothing where the plane cannot be seen: behind it, in it, facing its way */
@@ -277,7 +304,7 @@ VT_TEST(shade_clipped_lattice_lights_like_the_exact_plane)
                               {1.5f, 0.0f, 0.0f, 0, 0, 1}, {0.2f, -0.3f, 0.5f, 0, 0, 1}};
     for (int i = 0; i < 4; ++i) {
         v3 x = v3_make(zero[i][0], zero[i][1], zero[i][2]), n = v3_make(zero[i][3], zero[i][4], zero[i][5]);
-        double got = diffuse_at(&set, x, n, 1), paper = diffuse_at(&set, x, n, 0);
+        double got = diffuse_at(&set, x, n, 2), paper = diffuse_at(&set, x, n, 0);
         VT_CHECK(got <= 1e-6 * M, "case %d: %g where the plane is not seen (the papers' model: %g)", i, got, paper);
         if (i < 3) /* behind and in the plane the papers' SG lobe leaks: the check can fail */
             VT_CHECK(paper > 1e-6 * M, "case %d: the papers' model leaks here (%g)", i, paper);

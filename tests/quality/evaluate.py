@@ -156,7 +156,7 @@ class Config:
         if s["visibility"]:
             bits.append("visibility rays")
         if s["leak_correction"]:
-            bits.append("leak correction %s" % {1: "off", 2: "on"}[s["leak_correction"]])
+            bits.append("leak correction %s" % {1: "off", 2: "on", 3: "clip only"}[s["leak_correction"]])
         if s["method"]:
             bits.append("brute-force method")
         return ", ".join(bits)

@@ -61,10 +61,17 @@ extern "C" {
  * plane, nothing to receivers facing its way, the clamped cosine's falloff
  * far away, and a lattice cluster's glossy light comes from its plane seen
  * foreshortened. Weighted by how coherent the cluster's normals are (the
- * lattice's clusters: fully). docs/accuracy.md measures it. */
+ * lattice's clusters: fully). docs/accuracy.md measures it.
+ * The near field (ON): within a lattice cluster's own extent the SG model
+ * breaks (its Gaussian spills past the junction where its surface ends, a
+ * dark seam along every junction of a room); within one to two lattice
+ * spacings of a cell and one of its plane, the cluster is its cell of
+ * uniform radiosity, truncated to its VPLs' extent, and its diffuse light
+ * the cell's exact polygon form factor. docs/quality.md measures it. */
 #define VSGL_LEAK_AUTO 0  /**< on */
 #define VSGL_LEAK_OFF  1  /**< the papers' model */
-#define VSGL_LEAK_ON   2
+#define VSGL_LEAK_ON   2  /**< the clip and the lattice's near field */
+#define VSGL_LEAK_CLIP 3  /**< the clip alone: the far-field model everywhere (0.3's ON) */
 
 /* Sample merging: within a pixel, samples on the same surface (same
  * material, normals within 5 degrees, no step along the normal; sharp

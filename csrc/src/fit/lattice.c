@@ -51,6 +51,8 @@ typedef struct cell_map {
     uint32_t *slot;      /* index into sums, in first-touch order */
     size_t cap, count;
     double *sums;        /* count * VSGL__GRID_STRIDE */
+    double *ext;         /* count * 4: the VPLs' extent in u and v (lattice units) */
+    int32_t *cell;       /* count * 3: bin, i, j */
     size_t sums_cap;
 } cell_map;
 
@@ -112,12 +114,23 @@ static double *map_get(cell_map *m, uint64_t key)
         if (!s)
             return NULL;
         m->sums = s;
+        double *e = realloc(m->ext, cap * 4 * sizeof *e);
+        if (!e)
+            return NULL;
+        m->ext = e;
+        int32_t *c = realloc(m->cell, cap * 3 * sizeof *c);
+        if (!c)
+            return NULL;
+        m->cell = c;
         m->sums_cap = cap;
     }
     m->keys[p] = key;
     m->slot[p] = (uint32_t)m->count;
     double *s = m->sums + m->count * VSGL__GRID_STRIDE;
     memset(s, 0, VSGL__GRID_STRIDE * sizeof *s);
+    double *e = m->ext + m->count * 4;
+    e[0] = e[2] = INFINITY;
+    e[1] = e[3] = -INFINITY;
     ++m->count;
     return s;
 }
@@ -127,6 +140,8 @@ static void map_free(cell_map *m)
     free(m->keys);
     free(m->slot);
     free(m->sums);
+    free(m->ext);
+    free(m->cell);
     memset(m, 0, sizeof *m);
 }
 
@@ -206,6 +221,17 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl
                     }
                     for (int f = 0; f < VSGL__GRID_STRIDE; ++f)
                         dst[f] += w * m[f];
+                    size_t slot = (size_t)(dst - map.sums) / VSGL__GRID_STRIDE;
+                    int32_t *cc = map.cell + slot * 3;
+                    cc[0] = (int32_t)bin;
+                    cc[1] = (int32_t)fu + du;
+                    cc[2] = (int32_t)fv + dv;
+                    double *e = map.ext + slot * 4;
+                    double half = 0.5 * sqrt(rsm->area[t] > 0.0f ? (double)rsm->area[t] : 0.0) * inv_h;
+                    e[0] = fmin(e[0], q[u] - half);
+                    e[1] = fmax(e[1], q[u] + half);
+                    e[2] = fmin(e[2], q[v] - half);
+                    e[3] = fmax(e[3], q[v] + half);
                 }
         }
     }
@@ -257,6 +283,18 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
             vsgl__grid_moments(f, &mo);
             if (vsgl__moments_to_vsgl(&mo, g.origin, s->sharpness_estimator, rsm->light, lobe, &v)) {
                 v.widen = (float)widen;
+                const int32_t *cc = map.cell + c * 3;
+                const double *e = map.ext + c * 4;
+                int ax = cc[0] >> 1, au = (ax + 1) % 3, av = (ax + 2) % 3;
+                v.cell_h = (float)h;
+                v.cell_axis = (uint32_t)ax;
+                v.cell_side = (uint32_t)(cc[0] & 1);
+                v.cell_centre[0] = (float)(anchor[au] + cc[1] * h);
+                v.cell_centre[1] = (float)(anchor[av] + cc[2] * h);
+                v.cell_lo[0] = (float)(anchor[au] + fmax(e[0], cc[1] - 1.0) * h);
+                v.cell_hi[0] = (float)(anchor[au] + fmin(e[1], cc[1] + 1.0) * h);
+                v.cell_lo[1] = (float)(anchor[av] + fmax(e[2], cc[2] - 1.0) * h);
+                v.cell_hi[1] = (float)(anchor[av] + fmin(e[3], cc[2] + 1.0) * h);
                 r = vsgl__vsgl_set_push(out, &v);
                 if (r != VSGL_OK)
                     r = vsgl__fail(ctx, r, "fit: out of memory");

@@ -26,6 +26,14 @@ typedef struct vsgl_vsgl {
                          * lattice's overlap of neighbouring clusters (0 for the other fits) */
     uint32_t light;     /* scene light index */
     uint32_t lobe;      /* VSGL_LOBE_* */
+    /* The lattice cell (0 cell_h for the other fits): its VPLs lie on the
+     * plane x[axis] = mean[axis], facing +axis (side 0) or -axis (side 1),
+     * with tent weights around (centre[0], centre[1]) in the axes u = axis
+     * + 1, v = axis + 2 (mod 3), spacing cell_h, within [lo, hi] there
+     * (the VPLs' extent, padded by half a texel). */
+    float cell_h;
+    float cell_centre[2], cell_lo[2], cell_hi[2];
+    uint32_t cell_axis, cell_side;
 } vsgl_vsgl;
 
 typedef struct vsgl_vsgl_set {

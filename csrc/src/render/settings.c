@@ -101,7 +101,7 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     CHECK_ENUM(diffuse_mode, VSGL_COSINE_ACCURATE, VSGL_COSINE_PULLED_OUT)
     CHECK_ENUM(glossy_mode, VSGL_GLOSSY_ASG, VSGL_GLOSSY_HYBRID)
     CHECK_ENUM(visibility, VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY)
-    CHECK_ENUM(leak_correction, VSGL_LEAK_AUTO, VSGL_LEAK_ON)
+    CHECK_ENUM(leak_correction, VSGL_LEAK_AUTO, VSGL_LEAK_CLIP)
     CHECK_ENUM(sample_merging, VSGL_MERGE_AUTO, VSGL_MERGE_OFF)
 #undef CHECK_ENUM
     if (s->aa_samples > VSGL_AA_SAMPLES_MAX)

@@ -5,6 +5,7 @@
 #include "shade/shade.h"
 #include "math/constants.h"
 #include "shade/kernel.h"
+#include "shade/near_field.h"
 #include "shade/shade_job.h"
 #include "core/context.h"
 #include "core/parallel.h"
@@ -272,6 +273,11 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 }
                 if (has_diffuse) {
                     float e_d = vsgl_sg_cosine_integral(&in, &r.n, j->s->diffuse_mode) * VSGL__INV_PI;
+                    if (j->near->cell_of && j->near->cell_of[k] >= 0) {
+                        float wn, q = vsgl__near_diffuse(&j->near->cells[j->near->cell_of[k]], r.x, r.n, &wn);
+                        if (wn > 0.0f)
+                            e_d = (1.0f - wn) * e_d + wn * q;
+                    }
                     for (int c = 0; c < 3; ++c)
                         ld[c] += v->power[c] * e_d;
                 }
@@ -418,6 +424,49 @@ static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o)
     b->f0r[k] = *v++; b->f0g[k] = *v++; b->f0b[k] = *v;
 }
 
+/* The far-field diffuse light per watt of VSGL v at (x, n), as the kernel
+ * computes it: the incident SG, the emitter clip, the cosine integral. */
+static float far_diffuse(const shade_job *j, const vsgl_vsgl *v, v3 x, v3 n)
+{
+    vsgl_sg in;
+    if (!vsgl__vsgl_incident_sg(v, x, &in))
+        return 0.0f;
+    if (j->leak)
+        in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, x, n, 1), VSGL__TINY));
+    return vsgl_sg_cosine_integral(&in, &n, j->s->diffuse_mode) * VSGL__INV_PI;
+}
+
+/* The near field of the lattice clusters around receiver r (near_field.h):
+ * within it the kernel's far-field term gives way to the cell's form
+ * factor. ld: the kernel's diffuse light, corrected in place. */
+static void near_correct(const shade_job *j, const receiver *r, float *ld0, float *ld1, float *ld2)
+{
+    size_t n;
+    const uint32_t *c = vsgl__near_candidates(j->near, r->x, &n);
+    float d[3] = {0.0f, 0.0f, 0.0f};
+    for (size_t i = 0; i < n; ++i) {
+        const vsgl_near_cell *cell = &j->near->cells[c[i]];
+        float w;
+        float q = vsgl__near_diffuse(cell, r->x, r->n, &w);
+        if (!(w > 0.0f))
+            continue;
+        const vsgl_vsgl *v = &j->set->items[cell->vsgl];
+        float e = w * (q - far_diffuse(j, v, r->x, r->n));
+        if (e == 0.0f)
+            continue;
+        if (j->s->visibility == VSGL_VISIBILITY_RAY) {
+            float vis;
+            visibility_rays(j, ray_target(v), r, 1, &vis);
+            e *= vis;
+        }
+        for (int k = 0; k < 3; ++k)
+            d[k] += v->power[k] * e;
+    }
+    *ld0 = fmaxf(*ld0 + d[0], 0.0f);
+    *ld1 = fmaxf(*ld1 + d[1], 0.0f);
+    *ld2 = fmaxf(*ld2 + d[2], 0.0f);
+}
+
 /* Shade a filled block of n receivers (lanes [0, n) of blk, rec[k].x and
  * .n for visibility rays) and write 6 floats per receiver to light. */
 static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const receiver *rec, size_t n, float *light)
@@ -454,6 +503,10 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
             kernel(blk, j->klights, count, NULL, j->s->diffuse_mode, lobes);
         }
         pairs += (uint64_t)n * j->set->count;
+        if ((lobes & VSGL__KERNEL_DIFFUSE) && j->near->start)
+            for (size_t k = 0; k < n; ++k)
+                if (blk->diffuse[k] > 0.0f)
+                    near_correct(j, &rec[k], &blk->ld[0][k], &blk->ld[1][k], &blk->ld[2][k]);
     }
     for (size_t k = 0; k < n; ++k)
         for (int c = 0; c < 3; ++c) {
@@ -672,8 +725,8 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     /* The kernel models the ASG glossy lobe; the SG lobe uses the reference path. */
     if (s->glossy_mode == VSGL_GLOSSY_SG)
         path = VSGL__SHADE_REFERENCE;
-    int leak = s->leak_correction == VSGL_LEAK_ON ||
-               s->leak_correction == VSGL_LEAK_AUTO;
+    int leak = s->leak_correction == VSGL_LEAK_ON || s->leak_correction == VSGL_LEAK_AUTO ||
+               s->leak_correction == VSGL_LEAK_CLIP;
     vsgl_kernel_light *kl = NULL;
     size_t *korder = NULL;
     if (path != VSGL__SHADE_REFERENCE) {
@@ -738,13 +791,18 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
                    eps, 0, per_chunk, kl, korder, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
-                   0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL};
+                   0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL};
     /* untextured: each material's BRDF parameters once, not once per sample */
     vsgl_brdf_params *params = g->surf[0] ? NULL : malloc(((size_t)material_count + 1) * sizeof *params);
     if (params)
         for (uint32_t k = 0; k < material_count; ++k)
             vsgl__material_params(&j.materials[k], &params[k]);
     j.params = params;
+    vsgl_near_index near;
+    memset(&near, 0, sizeof near);
+    if (leak && s->leak_correction != VSGL_LEAK_CLIP)
+        vsgl__near_index_build(set, &near); /* short of memory: no near field */
+    j.near = &near;
     vsgl_result r = VSGL_OK;
     /* One pixel in S x S (sparse.c): the anchors now, the rest row by row below. */
     int sparse = s->shade_stride > 1 && path != VSGL__SHADE_REFERENCE && g->width && g->height;
@@ -808,6 +866,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     free(j.anchor_pairs);
     free(j.alist);
     free(params);
+    vsgl__near_index_free(&near);
     if (j.plan && !j.replay) {
         if (r == VSGL_OK && vsgl__shade_plan_complete(j.plan)) {
             vsgl__shade_plan_free(*plan);

@@ -6,6 +6,7 @@
 
 #include "shade/shade.h"
 #include "shade/kernel.h"
+#include "shade/near_field.h"
 #include "scene/material.h"
 
 /* A kernel lane's receiver fields (25 floats, shade.c: lane_get/lane_put). */
@@ -68,6 +69,7 @@ typedef struct shade_job {
     vsgl_shade_plan *plan;   /* NULL, or the plan being recorded (replay 0) or replayed (replay 1) */
     int replay;
     const vsgl_brdf_params *params; /* NULL, or per material (no sample has inputs of its own) */
+    const vsgl_near_index *near;    /* the lattice clusters' near fields (near_field.h) */
 } shade_job;
 
 /* Receiver lobe of one sample, set up once and used for every VSGL. */

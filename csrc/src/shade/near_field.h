@@ -1,0 +1,62 @@
+/* Internal: the near field of the lattice's clusters (fit/lattice.c).
+ *
+ * The far-field model (an SG of incident light per cluster) breaks within
+ * a cluster's own extent: a Gaussian's tails spill past the junction where
+ * its surface ends (a wall's foot), into space a receiver beside the
+ * junction cannot see, and the Gaussians of a surface's last lattice row
+ * sum to about half the surface's density at its edge. A floor beside a
+ * lit wall came out 10-25 % dark in a strip along the wall (a dark seam
+ * along every junction of a box). Near a cell, the cluster is instead its
+ * tent of uniform radiosity over the cell, truncated to its VPLs' extent,
+ * and its diffuse light the exact polygon form factor (Lambert) of the
+ * tent's steps. */
+#ifndef VSGL_SHADE_NEAR_FIELD_H
+#define VSGL_SHADE_NEAR_FIELD_H
+
+#include "fit/vsgl_set.h"
+#include "math/vec.h"
+
+/* A lattice cluster's cell, as the near-field model sees it. */
+typedef struct vsgl_near_cell {
+    v3 centre;            /* the lattice point on the cell's plane */
+    float h;              /* lattice spacing, m */
+    float za;             /* the plane: x[axis] = za */
+    float fit;            /* how far the model applies: coherence^2 x facing x uniformity, [0, 1] */
+    float inv_area;       /* 1 / (pi x the steps' total area) */
+    float rect[4][4];     /* the steps: u0 u1 v0 v1 (u = axis + 1, v = axis + 2 mod 3) */
+    uint32_t axis, side;  /* the plane faces +axis (side 0) or -axis (side 1) */
+    uint32_t nrect;       /* steps with any area */
+    uint32_t vsgl;        /* its VSGL in the set */
+} vsgl_near_cell;
+
+/* The cell of v; 0 if the model does not apply to v (not a diffuse lattice
+ * cluster, no power, a curved surface, or radiosity far from uniform). */
+int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c);
+
+/* The diffuse light per watt (irradiance / pi per W of the cluster's
+ * power) at x, normal n, and in *weight how much of the pair the model
+ * takes, in [0, 1]: the cell's fit, 1 within VSGL__NEAR_FULL spacings of
+ * its centre and 0 beyond VSGL__NEAR_NONE, smooth between. 0 and weight
+ * 0 behind or in the cell's plane (where the far-field term is ~0 too:
+ * the emitter clip). */
+float vsgl__near_diffuse(const vsgl_near_cell *c, v3 x, v3 n, float *weight);
+
+/* The cells whose near field reaches each cell of a uniform grid (CSR),
+ * so that a receiver tests only those. */
+typedef struct vsgl_near_index {
+    vsgl_near_cell *cells;
+    int32_t *cell_of;     /* per VSGL of the set: its cell, or -1 */
+    uint32_t *start;      /* grid cells + 1 offsets into items */
+    uint32_t *items;      /* indices into cells */
+    int32_t dims[3];      /* 0 0 0: no cluster has a near field */
+    v3 lo;
+    float inv;            /* 1 / the grid's cell size */
+} vsgl_near_index;
+
+/* 0 if memory is short (ix is then empty: the far field everywhere). */
+int vsgl__near_index_build(const vsgl_vsgl_set *set, vsgl_near_index *ix);
+void vsgl__near_index_free(vsgl_near_index *ix);
+/* The cells whose near field may reach x, in increasing order. */
+const uint32_t *vsgl__near_candidates(const vsgl_near_index *ix, v3 x, size_t *n);
+
+#endif

@@ -1,0 +1,255 @@
+/* The lattice's near field (shade/near_field.c): the cell's form factor
+ * against numerical quadrature of the same emitter, the index against a
+ * scan of every cell, and a room's junctions against the brute force. */
+#include "harness.h"
+#include "scene_fixture.h"
+#include "accuracy.h"
+#include "shade/near_field.h"
+
+#include <stdlib.h>
+
+/* A cell on the plane z = 0 facing +z, spacing 1, around (0, 0), its VPLs
+ * in [-1, 1] x [v0, 1] (v0 > -1: a junction cuts it at v = v0), the
+ * cluster's mean where the steps' centroid is (radiosity uniform). */
+static vsgl_vsgl cell_cluster(float v0)
+{
+    vsgl_vsgl v;
+    memset(&v, 0, sizeof v);
+    v.cell_h = 1.0f;
+    v.cell_axis = 2;
+    v.cell_side = 0;
+    v.cell_lo[0] = -1.0f;
+    v.cell_hi[0] = 1.0f;
+    v.cell_lo[1] = v0;
+    v.cell_hi[1] = 1.0f;
+    v.normal = v3_make(0.0f, 0.0f, 1.0f);
+    v.coherence = 1.0f;
+    v.power[0] = v.power[1] = v.power[2] = 1.0f;
+    v.lobe = VSGL__LOBE_DIFFUSE;
+    /* centroid of the steps in v (u is symmetric) */
+    static const float half[2] = {0.75f, 0.25f};
+    double sa = 0.0, sv = 0.0;
+    for (int iu = 0; iu < 2; ++iu)
+        for (int iv = 0; iv < 2; ++iv) {
+            double a0 = fmax(-half[iv], v0), a1 = half[iv];
+            if (a1 <= a0)
+                continue;
+            double ar = 2.0 * half[iu] * (a1 - a0);
+            sa += ar;
+            sv += ar * 0.5 * (a0 + a1);
+        }
+    v.mean = v3_make(0.0f, (float)(sv / sa), 0.0f);
+    return v;
+}
+
+/* The same light by midpoint quadrature: the steps' density (a quarter
+ * each) over their area, Lambertian, seen from x with normal n: E / (pi P). */
+static double quadrature(float v0, v3 x, v3 n, int grid)
+{
+    static const double half[2] = {0.75, 0.25};
+    double e = 0.0, area = 0.0;
+    for (int iu = 0; iu < 2; ++iu)
+        for (int iv = 0; iv < 2; ++iv) {
+            double u0 = -half[iu], u1 = half[iu], a0 = fmax(-half[iv], v0), a1 = half[iv];
+            if (a1 <= a0)
+                continue;
+            area += (u1 - u0) * (a1 - a0);
+            double du = (u1 - u0) / grid, dv = (a1 - a0) / grid;
+            for (int i = 0; i < grid; ++i)
+                for (int k = 0; k < grid; ++k) {
+                    double py = a0 + (k + 0.5) * dv, px = u0 + (i + 0.5) * du;
+                    double d[3] = {px - x.x, py - x.y, -x.z};
+                    double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    double cr = (d[0] * n.x + d[1] * n.y + d[2] * n.z) / sqrt(r2);
+                    double ce = x.z / sqrt(r2);
+                    if (cr > 0.0)
+                        e += cr * ce / (3.14159265358979323846 * r2) * du * dv;
+                }
+        }
+    /* exitance P / area: E / P = e / area; diffuse light per watt = E / (pi P) */
+    return e / area / 3.14159265358979323846;
+}
+
+VT_TEST(near_field_form_factor_matches_quadrature)
+{
+    srand(7);
+    const float cuts[3] = {-1.0f, -0.3f, 0.4f};
+    int tested = 0, clipped = 0;
+    double worst = 0.0;
+    for (int ci = 0; ci < 3; ++ci) {
+        vsgl_vsgl v = cell_cluster(cuts[ci]);
+        vsgl_near_cell c;
+        VT_REQUIRE(vsgl__near_cell(&v, 0, &c), "cut %g: no cell", cuts[ci]);
+        VT_CHECK_REL(c.fit, 1.0f, 1e-5, "cut %g: uniform radiosity, a plane: fit %g", cuts[ci], c.fit);
+        for (int t = 0; t < 40; ++t) {
+            float h = 0.1f + 0.8f * (float)rand() / RAND_MAX;
+            v3 x = v3_make(-1.5f + 3.0f * (float)rand() / RAND_MAX, -1.5f + 3.0f * (float)rand() / RAND_MAX, h);
+            /* normals all round, including ones whose tangent plane cuts the cell */
+            v3 n = v3_normalize(v3_make((float)rand() / RAND_MAX - 0.5f, (float)rand() / RAND_MAX - 0.5f,
+                                        (float)rand() / RAND_MAX - 0.7f));
+            float w;
+            double got = vsgl__near_diffuse(&c, x, n, &w), want = quadrature(cuts[ci], x, n, 240);
+            if (want < 1e-4)
+                continue;
+            ++tested;
+            int cut = 0;
+            for (int k = 0; k < 4; ++k) {
+                float px = k & 1 ? 0.75f : -0.75f, py = k & 2 ? 0.75f : fmaxf(-0.75f, cuts[ci]);
+                cut |= (px - x.x) * n.x + (py - x.y) * n.y - x.z * n.z > 0.0f ? 1 : 2;
+            }
+            clipped += cut == 3;
+            double rel = fabs(got - want) / want;
+            worst = rel > worst ? rel : worst;
+            VT_CHECK(rel < 0.01, "cut %g at (%g %g %g) n (%g %g %g): %g, quadrature %g", cuts[ci], x.x, x.y, x.z, n.x, n.y,
+                     n.z, got, want);
+        }
+    }
+    if (getenv("VSGL_TEST_VERBOSE"))
+        printf("    %d receivers (%d whose tangent plane cuts the cell): worst relative error %.2g\n", tested, clipped,
+               worst);
+    VT_CHECK(tested > 60 && clipped > 10, "%d receivers tested, %d clipped", tested, clipped);
+}
+
+VT_TEST(near_field_degenerate_receivers_and_cells)
+{
+    vsgl_vsgl v = cell_cluster(-1.0f);
+    vsgl_near_cell c;
+    VT_REQUIRE(vsgl__near_cell(&v, 0, &c), "no cell");
+    float w;
+    /* behind, in the plane (a thin wall's back face), on the cell's outline */
+    const v3 xs[4] = {v3_make(0.1f, 0.2f, -0.3f), v3_make(0.1f, 0.2f, 0.0f), v3_make(0.75f, 0.75f, 0.0f),
+                      v3_make(0.2f, 0.1f, 1e-7f)};
+    for (int k = 0; k < 4; ++k) {
+        float q = vsgl__near_diffuse(&c, xs[k], v3_make(0.0f, 0.0f, -1.0f), &w);
+        VT_CHECK(isfinite(q) && q >= 0.0f && q < 1e-3f, "receiver %d: %g", k, q);
+    }
+    /* beyond the near field: weight 0 */
+    vsgl__near_diffuse(&c, v3_make(5.0f, 0.0f, 0.2f), v3_make(-1.0f, 0.0f, 0.0f), &w);
+    VT_CHECK(w == 0.0f, "far receiver weight %g", w);
+    vsgl__near_diffuse(&c, v3_make(0.0f, 0.0f, 3.0f), v3_make(0.0f, 0.0f, -1.0f), &w);
+    VT_CHECK(w == 0.0f, "receiver 3 spacings above the plane: weight %g", w);
+    /* a curved surface's cluster (its normal off the axis), a radiosity off
+     * the steps' centroid (a shadow in the cell), a specular lobe, no
+     * power, another fit: no near field */
+    vsgl_vsgl bad[5];
+    for (int k = 0; k < 5; ++k)
+        bad[k] = v;
+    bad[0].normal = v3_normalize(v3_make(0.3f, 0.0f, 1.0f));
+    bad[1].mean = v3_make(0.4f, 0.0f, 0.0f);
+    bad[2].lobe = VSGL__LOBE_SPECULAR;
+    bad[3].power[0] = bad[3].power[1] = bad[3].power[2] = 0.0f;
+    bad[4].cell_h = 0.0f;
+    for (int k = 0; k < 5; ++k)
+        VT_CHECK(!vsgl__near_cell(&bad[k], 0, &c), "cluster %d has a near field (fit %g)", k, c.fit);
+}
+
+VT_TEST(near_field_index_lists_every_cell_that_reaches_a_point)
+{
+    /* a few hundred cells of two spacings on the six axis planes of a box */
+    vsgl_vsgl_set set;
+    memset(&set, 0, sizeof set);
+    srand(11);
+    for (int k = 0; k < 400; ++k) {
+        vsgl_vsgl v = cell_cluster(-1.0f);
+        uint32_t bin = (uint32_t)(rand() % 6);
+        float h = k % 2 ? 0.3f : 0.7f;
+        v.cell_h = h;
+        v.cell_axis = bin >> 1;
+        v.cell_side = bin & 1;
+        float cu = -2.0f + 4.0f * (float)rand() / RAND_MAX, cv = -2.0f + 4.0f * (float)rand() / RAND_MAX;
+        float za = (v.cell_side ? 2.0f : -2.0f);
+        v.cell_centre[0] = cu;
+        v.cell_centre[1] = cv;
+        v.cell_lo[0] = cu - h;
+        v.cell_hi[0] = cu + h;
+        v.cell_lo[1] = cv - h;
+        v.cell_hi[1] = cv + h;
+        float p[3], nn[3] = {0, 0, 0};
+        p[v.cell_axis] = za;
+        p[(v.cell_axis + 1) % 3] = cu;
+        p[(v.cell_axis + 2) % 3] = cv;
+        nn[v.cell_axis] = v.cell_side ? -1.0f : 1.0f;
+        v.mean = v3_make(p[0], p[1], p[2]);
+        v.normal = v3_make(nn[0], nn[1], nn[2]);
+        VT_REQUIRE(vsgl__vsgl_set_push(&set, &v) == VSGL_OK, "push");
+    }
+    vsgl_near_index ix;
+    VT_REQUIRE(vsgl__near_index_build(&set, &ix), "index");
+    int missing = 0, reached = 0;
+    for (int t = 0; t < 3000; ++t) {
+        v3 x = v3_make(-2.0f + 4.0f * (float)rand() / RAND_MAX, -2.0f + 4.0f * (float)rand() / RAND_MAX,
+                       -2.0f + 4.0f * (float)rand() / RAND_MAX);
+        v3 n = v3_normalize(v3_make((float)rand() / RAND_MAX - 0.5f, (float)rand() / RAND_MAX - 0.5f,
+                                    (float)rand() / RAND_MAX - 0.5f));
+        size_t nc;
+        const uint32_t *cand = vsgl__near_candidates(&ix, x, &nc);
+        for (size_t k = 0; k < set.count; ++k) {
+            if (ix.cell_of[k] < 0)
+                continue;
+            float w;
+            vsgl__near_diffuse(&ix.cells[ix.cell_of[k]], x, n, &w);
+            if (!(w > 0.0f))
+                continue;
+            ++reached;
+            int found = 0;
+            for (size_t i = 0; i < nc; ++i)
+                found |= cand[i] == (uint32_t)ix.cell_of[k];
+            missing += !found;
+        }
+        for (size_t i = 1; i < nc; ++i)
+            VT_CHECK(cand[i] > cand[i - 1], "candidates out of order");
+    }
+    VT_CHECK(missing == 0 && reached > 1000, "%d of %d reaching cells not listed", missing, reached);
+    vsgl__near_index_free(&ix);
+    vsgl__vsgl_set_free(&set);
+}
+
+/* A room lit by a spot (the fixture): with the near field the lattice's
+ * diffuse light beside the junctions moves to the brute force's over the
+ * same RSMs, where the far-field model alone is dark. */
+VT_TEST(near_field_junctions_against_brute_force)
+{
+    const uint32_t W = 64, H = 48;
+    fx_scene fx;
+    fx_room(&fx, W, H, 1.0f, 150.0f);
+    vsgl_context *ctx = fx_context(0);
+    VT_REQUIRE(ctx, "context");
+    vsgl_scene *scene;
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    size_t n = (size_t)W * H * 3;
+    float *img[3];
+    const int32_t leak[3] = {VSGL_LEAK_AUTO, VSGL_LEAK_AUTO, VSGL_LEAK_CLIP};
+    for (int k = 0; k < 3; ++k) {
+        img[k] = calloc(n, sizeof(float));
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.shade_stride = 1;
+        s.aa_samples = 1;
+        s.rsm_resolution = 64;
+        s.visibility = VSGL_VISIBILITY_NONE; /* a convex room */
+        s.method = k == 0 ? VSGL_METHOD_BRUTE_FORCE : VSGL_METHOD_VSGL;
+        s.leak_correction = leak[k];
+        vsgl_render_output o;
+        memset(&o, 0, sizeof o);
+        o.width = W;
+        o.height = H;
+        o.diffuse = img[k];
+        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "render %d: %s", k, vsgl_context_last_error(ctx));
+    }
+    double e_near = acc_relmse(img[1], img[0], n), e_far = acc_relmse(img[2], img[0], n);
+    double s0 = 0, s1 = 0, s2 = 0;
+    for (size_t i = 0; i < n; ++i) {
+        s0 += img[0][i];
+        s1 += img[1][i];
+        s2 += img[2][i];
+    }
+    if (getenv("VSGL_TEST_VERBOSE"))
+        printf("    diffuse relMSE against the brute force: %.4g with the near field, %.4g without; sums %.3f / %.3f\n",
+               e_near, e_far, s1 / s0, s2 / s0);
+    VT_CHECK(e_near < 0.7 * e_far, "relMSE %.4g with the near field, %.4g without", e_near, e_far);
+    VT_CHECK(fabs(s1 / s0 - 1.0) < fabs(s2 / s0 - 1.0), "sum ratio %.4f with, %.4f without", s1 / s0, s2 / s0);
+    for (int k = 0; k < 3; ++k)
+        free(img[k]);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
