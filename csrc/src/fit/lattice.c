@@ -50,7 +50,10 @@
  * clusters only, faded in over coherence 0.990-0.995: a curved surface's
  * cluster's sharpness is mostly the spread of its VPLs' mirror directions,
  * which the split would sharpen (the sphere room's diffuse error 0.00140 ->
- * 0.00164 split everywhere). */
+ * 0.00164 split everywhere). Not with one-lobe receivers (glossy mode ASG
+ * or SG; MRP and hybrid take ASG2's diffuse): the preview keeps one VSGL per cluster,
+ * and the live viewport its cost (the spot room's Live light edit had 212
+ * VSGLs, 317 with the split). */
 #define VSGL__LATTICE_SPLIT_LO 0.990f
 #define VSGL__LATTICE_SPLIT_HI 0.995f
 
@@ -317,7 +320,9 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
             vsgl__grid_moments(f, &mo);
             if (vsgl__moments_to_vsgl(&mo, g.origin, s->sharpness_estimator, rsm->light, lobe, &v)) {
                 v.widen = (float)widen;
-                if (lobe == VSGL__LOBE_SPECULAR && r == VSGL_OK) {
+                /* not with one-lobe receivers (ASG, SG: the preview) */
+                if (lobe == VSGL__LOBE_SPECULAR && r == VSGL_OK && s->glossy_mode != VSGL_GLOSSY_ASG &&
+                    s->glossy_mode != VSGL_GLOSSY_SG) {
                     r = split_specular(&v, out);
                     if (r != VSGL_OK) {
                         r = vsgl__fail(ctx, r, "fit: out of memory");
