@@ -8,6 +8,7 @@
 #include "shade/brute_force.h"
 #include "core/context.h"
 #include "core/versioned.h"
+#include "core/parallel.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -329,37 +330,72 @@ static float divide_or_zero(float num, float den)
     return den > 1e-8f ? num / den : 0.0f;
 }
 
+/* write_outputs in parallel: rows of pixels [b, e) checked (pass 0) or written (pass 1). */
+typedef struct output_job {
+    const vsgl_pixel_planes *p;
+    const vsgl_render_output *out;
+    int pass;
+} output_job;
+
+static int bad_value(const vsgl_pixel_planes *p, size_t i)
+{
+    return !isfinite(p->diffuse[i]) || !isfinite(p->glossy[i]) || !isfinite(p->diffuse_color[i]) ||
+           !isfinite(p->glossy_color[i]) || p->diffuse[i] < 0.0f || p->glossy[i] < 0.0f;
+}
+
+static int32_t output_chunk(void *user, size_t chunk, size_t b, size_t e)
+{
+    const output_job *oj = user;
+    const vsgl_pixel_planes *p = oj->p;
+    const vsgl_render_output *out = oj->out;
+    (void)chunk;
+    if (oj->pass == 0) {
+        int bad = 0;
+        for (size_t i = b * 3; i < e * 3; ++i)
+            bad |= bad_value(p, i);
+        return bad ? VSGL_ERROR_INTERNAL : 0;
+    }
+    /* plane by plane, only those asked for (the live viewport asks for one) */
+    if (out->diffuse_light)
+        for (size_t i = b * 3; i < e * 3; ++i)
+            out->diffuse_light[i] = divide_or_zero(p->diffuse[i], p->diffuse_color[i]);
+    if (out->glossy_light)
+        for (size_t i = b * 3; i < e * 3; ++i)
+            out->glossy_light[i] = divide_or_zero(p->glossy[i], p->glossy_color[i]);
+    if (out->diffuse_color)
+        memcpy(out->diffuse_color + b * 3, p->diffuse_color + b * 3, (e - b) * 3 * sizeof(float));
+    if (out->glossy_color)
+        memcpy(out->glossy_color + b * 3, p->glossy_color + b * 3, (e - b) * 3 * sizeof(float));
+    if (out->diffuse)
+        memcpy(out->diffuse + b * 3, p->diffuse + b * 3, (e - b) * 3 * sizeof(float));
+    if (out->glossy)
+        memcpy(out->glossy + b * 3, p->glossy + b * 3, (e - b) * 3 * sizeof(float));
+    if (out->combined)
+        for (size_t i = b * 3; i < e * 3; ++i)
+            out->combined[i] = p->diffuse[i] + p->glossy[i];
+    if (out->alpha)
+        memcpy(out->alpha + b, p->coverage + b, (e - b) * sizeof(float));
+    return 0;
+}
+
 static vsgl_result write_outputs(vsgl_context *ctx, const vsgl_pixel_planes *p, size_t pixels,
                                  const vsgl_render_output *out)
 {
-    /* Refuse to hand out a non-finite value: that would be a bug. */
-    for (size_t i = 0; i < pixels * 3; ++i)
-        if (!isfinite(p->diffuse[i]) || !isfinite(p->glossy[i]) || !isfinite(p->diffuse_color[i]) ||
-            !isfinite(p->glossy_color[i]) || p->diffuse[i] < 0.0f || p->glossy[i] < 0.0f)
-            return vsgl__fail(ctx, VSGL_ERROR_INTERNAL,
-                              "render: pixel %zu channel %zu is not finite and non-negative "
-                              "(diffuse %g, glossy %g): please report this scene",
-                              i / 3, i % 3, (double)p->diffuse[i], (double)p->glossy[i]);
-    /* plane by plane, only those asked for (the live viewport asks for one) */
-    if (out->diffuse_light)
+    /* Refuse to hand out a non-finite value: that would be a bug. Every
+     * value is checked before any output is written. */
+    const uint32_t threads = vsgl_context_thread_count(ctx);
+    const size_t chunk = 16384; /* pixels */
+    output_job oj = {p, out, 0};
+    if (vsgl__parallel_for(threads, pixels, chunk, output_chunk, &oj) != 0) {
         for (size_t i = 0; i < pixels * 3; ++i)
-            out->diffuse_light[i] = divide_or_zero(p->diffuse[i], p->diffuse_color[i]);
-    if (out->glossy_light)
-        for (size_t i = 0; i < pixels * 3; ++i)
-            out->glossy_light[i] = divide_or_zero(p->glossy[i], p->glossy_color[i]);
-    if (out->diffuse_color)
-        memcpy(out->diffuse_color, p->diffuse_color, pixels * 3 * sizeof(float));
-    if (out->glossy_color)
-        memcpy(out->glossy_color, p->glossy_color, pixels * 3 * sizeof(float));
-    if (out->diffuse)
-        memcpy(out->diffuse, p->diffuse, pixels * 3 * sizeof(float));
-    if (out->glossy)
-        memcpy(out->glossy, p->glossy, pixels * 3 * sizeof(float));
-    if (out->combined)
-        for (size_t i = 0; i < pixels * 3; ++i)
-            out->combined[i] = p->diffuse[i] + p->glossy[i];
-    if (out->alpha)
-        memcpy(out->alpha, p->coverage, pixels * sizeof(float));
+            if (bad_value(p, i))
+                return vsgl__fail(ctx, VSGL_ERROR_INTERNAL,
+                                  "render: pixel %zu channel %zu is not finite and non-negative "
+                                  "(diffuse %g, glossy %g): please report this scene",
+                                  i / 3, i % 3, (double)p->diffuse[i], (double)p->glossy[i]);
+    }
+    oj.pass = 1;
+    (void)vsgl__parallel_for(threads, pixels, chunk, output_chunk, &oj);
     return VSGL_OK;
 }
 
@@ -427,6 +463,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     memset(&set, 0, sizeof set);
     size_t pixels = (size_t)out->width * out->height;
     float *buf = NULL;
+    int own_buf = 1;
 
     double t0 = now_seconds();
     st.seconds_scene_prep = t0 - t_start;
@@ -445,7 +482,12 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     st.seconds_gbuffer = now_seconds() - t0;
     if (r != VSGL_OK)
         goto done;
-    buf = calloc(pixels * 13, sizeof(float));
+    /* through a cache, the VSGL method's planes are the cache's: every shading
+     * path writes every pixel of all five, so they need no zeroing */
+    if (cache && s.method == VSGL_METHOD_VSGL && (buf = vsgl__cache_planes(cache, pixels * 13)) != NULL)
+        own_buf = 0;
+    else
+        buf = calloc(pixels * 13, sizeof(float));
     if (!buf) {
         r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "render: out of memory for %zu pixels", pixels);
         goto done;
@@ -494,7 +536,8 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     }
 done:
     vsgl__progress_window(ctx, 0.0f, 1.0f);
-    free(buf);
+    if (own_buf)
+        free(buf);
     if (cache && r != VSGL_OK) {
         vsgl__cache_clear(cache);
     } else if (cache) {

@@ -26,7 +26,18 @@ void vsgl__cache_clear(vsgl_render_cache *c)
     vsgl__shade_plan_free(c->plan);
     vsgl__vsgl_set_free(&c->set);
     free(c->f_lights);
+    free(c->planes);
     memset(c, 0, sizeof *c);
+}
+
+float *vsgl__cache_planes(vsgl_render_cache *c, size_t floats)
+{
+    if (c->planes && c->planes_floats == floats)
+        return c->planes;
+    free(c->planes);
+    c->planes = calloc(floats + 1, sizeof *c->planes);
+    c->planes_floats = c->planes ? floats : 0;
+    return c->planes;
 }
 
 void vsgl_render_cache_destroy(vsgl_render_cache *cache)

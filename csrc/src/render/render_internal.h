@@ -45,6 +45,8 @@ struct vsgl_render_cache {
     char f_budget[sizeof(((vsgl_render_stats *)0)->budget)]; /* non-empty: the lights shared a budget
                                                                  measured from f_camera's view */
     vsgl_camera f_camera;
+    float *planes;               /* the last render's pixel planes, reused (render.c); planes_floats floats */
+    size_t planes_floats;
 };
 
 void vsgl__cache_clear(vsgl_render_cache *c);
@@ -52,6 +54,10 @@ int vsgl__cache_gbuffer_hit(const vsgl_render_cache *c, const vsgl_scene *scene,
 /* Takes `g` (zeroed afterwards) and `plan` (its shading plan, or NULL). */
 void vsgl__cache_keep_gbuffer(vsgl_render_cache *c, const vsgl_scene *scene, uint32_t aa, uint32_t edge_aa,
                               vsgl_gbuffer *g, vsgl_shade_plan *plan);
+/* `floats` floats of pixel planes owned by the cache (kept between renders:
+ * no allocation and no page faults per render), or NULL when memory is
+ * short. Zero when first allocated; afterwards they hold the last render's. */
+float *vsgl__cache_planes(vsgl_render_cache *c, size_t floats);
 int vsgl__cache_fit_hit(const vsgl_render_cache *c, const vsgl_scene *scene, const vsgl_render_settings *s);
 /* Takes `set` (zeroed afterwards) with the fit's stats from `st`. */
 vsgl_result vsgl__cache_keep_fit(vsgl_render_cache *c, const vsgl_scene *scene, const vsgl_render_settings *s,

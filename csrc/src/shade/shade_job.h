@@ -39,6 +39,16 @@ struct vsgl_shade_plan {
     int32_t *dlane_of;              /* per sample: its lane in dlanes, or -1 (it was not shaded itself) */
     vsgl__plan_lane *dlanes;        /* the lanes of the samples the record shaded themselves */
     size_t ndlanes, dlanes_cap;
+    /* what a replay reads instead of recomputing it (sparse.c): */
+    uint32_t *cell_x, *cell_y;      /* per (column, slot) and (row, slot): the anchor cell of a sample */
+    float *cell_tx, *cell_ty;       /* its position in that cell, as sample_cell computes it */
+    unsigned char *d2_ok;           /* per anchor: bit 0 (x), 1 (y): a second difference through its two
+                                       neighbours on its surface is taken */
+    /* a replay's working memory, kept between renders (no page faults per render) */
+    float *pack;                    /* per anchor: 12 floats: light (6), its sum per lobe (2), d2 (4) */
+    float *interp;                  /* 6 per sample of a batch */
+    uint32_t *direct_of, *marks;    /* per sample of a batch */
+    size_t scratch_ns;              /* the samples they hold */
 };
 
 typedef struct shade_job {

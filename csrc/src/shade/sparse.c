@@ -34,6 +34,9 @@
 #if defined(__x86_64__) || defined(__i386__)
 #  include <xmmintrin.h>
 #endif
+#if defined(__SSE2__)
+#  include <emmintrin.h>
+#endif
 
 /* A same-surface test's tolerances (see the file comment). */
 /* Normals within ~6 degrees: a curved surface at a grazing view (a sphere's
@@ -80,7 +83,30 @@ void vsgl__shade_plan_free(vsgl_shade_plan *p)
     free(p->direct);
     free(p->cd);
     free(p->colour);
+    free(p->cell_x);
+    free(p->cell_y);
+    free(p->cell_tx);
+    free(p->cell_ty);
+    free(p->d2_ok);
+    free(p->pack);
+    free(p->interp);
+    free(p->direct_of);
+    free(p->marks);
     free(p);
+}
+
+/* The anchor cell of slot k of column x (or row y): as sample_cell. */
+static void cell_table(uint32_t n, size_t spp, uint32_t aa, uint32_t stride, uint32_t *cell, float *t, int rows)
+{
+    const float inv_aa = 1.0f / (float)aa, inv_s = 1.0f / (float)stride;
+    for (uint32_t x = 0; x < n; ++x)
+        for (size_t k = 0; k < spp; ++k) {
+            float o = k < (size_t)aa * aa ? (float)(rows ? k / aa : k % aa) * inv_aa : 0.0f;
+            float f = ((float)x + o) * inv_s;
+            uint32_t c = (uint32_t)f;
+            cell[(size_t)x * spp + k] = c;
+            t[(size_t)x * spp + k] = f - (float)c;
+        }
 }
 
 vsgl_shade_plan *vsgl__shade_plan_new(const vsgl_gbuffer *g, const vsgl_render_settings *s, uint32_t aw, uint32_t ah)
@@ -105,11 +131,19 @@ vsgl_shade_plan *vsgl__shade_plan_new(const vsgl_gbuffer *g, const vsgl_render_s
     p->colour = malloc((pixels + 1) * 7 * sizeof *p->colour);
     p->row_ok = calloc((size_t)g->height + 2, 1);
     p->dlane_of = malloc((g->count + 1) * sizeof *p->dlane_of);
+    p->cell_x = malloc(((size_t)g->width * g->spp + 1) * sizeof *p->cell_x);
+    p->cell_tx = malloc(((size_t)g->width * g->spp + 1) * sizeof *p->cell_tx);
+    p->cell_y = malloc(((size_t)g->height * g->spp + 1) * sizeof *p->cell_y);
+    p->cell_ty = malloc(((size_t)g->height * g->spp + 1) * sizeof *p->cell_ty);
+    p->d2_ok = calloc(na + 1, 1);
+    p->pack = malloc((na + 1) * 12 * sizeof *p->pack);
     if (!p->anchor_sample || !p->anchor_lane || !p->w4 || !p->direct || !p->cd || !p->colour || !p->row_ok ||
-        !p->dlane_of) {
+        !p->dlane_of || !p->cell_x || !p->cell_tx || !p->cell_y || !p->cell_ty || !p->d2_ok || !p->pack) {
         vsgl__shade_plan_free(p);
         return NULL;
     }
+    cell_table(g->width, g->spp, g->aa, p->stride, p->cell_x, p->cell_tx, 0);
+    cell_table(g->height, g->spp, g->aa, p->stride, p->cell_y, p->cell_ty, 1);
     return p;
 }
 
@@ -177,6 +211,52 @@ static int32_t anchor_blocks(void *user, size_t chunk, size_t b, size_t e)
     return rc;
 }
 
+/* A replay's anchors: each anchor's light, its sum per lobe and its second
+ * differences, packed (plan->pack: 12 floats; a missed anchor's light 0),
+ * and the interpolation test's floor. The same values, in the same order
+ * of operations, as the record's (vsgl__shade_anchors below), but which
+ * neighbours share an anchor's surface is read from the record. */
+static void anchor_pack(shade_job *j)
+{
+    vsgl_shade_plan *plan = j->plan;
+    const size_t na = (size_t)j->aw * j->ah;
+    float *P = plan->pack;
+    double sum[2] = {0.0, 0.0};
+    size_t n = 0;
+    for (size_t a = 0; a < na; ++a) {
+        float *q = P + a * 12;
+        if (j->anchor_sample[a] == SIZE_MAX) {
+            for (int c = 0; c < 8; ++c)
+                q[c] = 0.0f;
+        } else {
+            const float *A = j->anchor_light + a * 6;
+            for (int c = 0; c < 6; ++c)
+                q[c] = A[c];
+            q[6] = A[0] + A[1] + A[2];
+            q[7] = A[3] + A[4] + A[5];
+            sum[0] += (double)A[0] + A[1] + A[2];
+            sum[1] += (double)A[3] + A[4] + A[5];
+            ++n;
+        }
+        q[8] = q[9] = q[10] = q[11] = -1.0f;
+    }
+    for (uint32_t ay = 0; ay < j->ah; ++ay)
+        for (uint32_t ax = 0; ax < j->aw; ++ax) {
+            size_t a = (size_t)ay * j->aw + ax;
+            unsigned bits = plan->d2_ok[a];
+            for (int axis = 0; axis < 2; ++axis) {
+                if (!(bits >> axis & 1u))
+                    continue;
+                size_t step = axis == 0 ? 1 : j->aw, m = a - step, p = a + step;
+                for (int l = 0; l < 2; ++l)
+                    P[a * 12 + 8 + 2 * l + axis] =
+                        fabsf(P[m * 12 + 6 + l] - 2.0f * P[a * 12 + 6 + l] + P[p * 12 + 6 + l]);
+            }
+        }
+    for (int l = 0; l < 2; ++l)
+        j->contrast_floor[l] = n ? (float)(SPARSE_FLOOR * sum[l] / (double)n) : 0.0f;
+}
+
 vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
 {
     const vsgl_gbuffer *g = j->g;
@@ -204,6 +284,11 @@ vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
         memcpy(plan->anchor_sample, j->anchor_sample, na * sizeof *plan->anchor_sample);
         plan->row_ok[plan->height] = 1;
     }
+    if (j->replay) { /* the same from the plan's record of which neighbours share a surface */
+        anchor_pack(j);
+        return VSGL_OK;
+    }
+    const int record = plan != NULL;
     /* each anchor's second differences along x and y through its neighbours on its surface */
     for (uint32_t ay = 0; ay < j->ah; ++ay)
         for (uint32_t ax = 0; ax < j->aw; ++ax) {
@@ -220,6 +305,8 @@ vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
                 if (ms == SIZE_MAX || ps == SIZE_MAX || !(same_surface_weight(j, as, ms) > 0.0f) ||
                     !(same_surface_weight(j, as, ps) > 0.0f))
                     continue;
+                if (record)
+                    plan->d2_ok[a] |= (unsigned char)(1u << axis);
                 for (int l = 0; l < 2; ++l) {
                     const float *A = j->anchor_light + a * 6 + 3 * l, *M = j->anchor_light + m * 6 + 3 * l,
                                 *P = j->anchor_light + p * 6 + 3 * l;
@@ -295,13 +382,14 @@ typedef struct sparse_batch {
     float *dlight;           /* 6 per entry of dlist */
     uint64_t *dpairs;        /* per chunk of dlist */
     vsgl__plan_lane *lanes;  /* per entry of dlist: its lane (recorded, or for a replay read or made) */
+    uint32_t *nmarks;        /* a replay: per row of the batch, its samples to shade (plan->marks) */
 } sparse_batch;
 
 #define SPARSE_MARK (SIZE_MAX - 1) /* direct_of of a sample to shade, before it has its index */
 
 /* Rows [b0, e0) of the batch (one row per chunk): each sample's
  * interpolated light, or a mark to shade it itself. Records the plan's
- * weights and codes; a replay reads them instead of the G-buffer. */
+ * weights and codes (a replay reads them: replay_rows). */
 static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
 {
     sparse_batch *bt = user;
@@ -313,7 +401,7 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
     const uint32_t aa = g->aa;
     const float inv_aa = 1.0f / (float)aa;
     vsgl_shade_plan *plan = j->plan;
-    const int replay = j->replay, record = plan && !replay && b0 % W == 0 && e0 - b0 == W;
+    const int record = plan && b0 % W == 0 && e0 - b0 == W;
     for (size_t i = 0; i < ns; ++i) {
         size_t si = first + i, bi = si - bt->first;
         bt->direct_of[bi] = SIZE_MAX;
@@ -321,12 +409,8 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
             plan->direct[si] = PLAN_MISS;
             plan->w4[si * 4] = plan->w4[si * 4 + 1] = plan->w4[si * 4 + 2] = plan->w4[si * 4 + 3] = 0.0f;
         }
-        if (replay ? plan->direct[si] == PLAN_MISS : g->material[si] == VSGL__GBUFFER_MISS)
+        if (g->material[si] == VSGL__GBUFFER_MISS)
             continue;
-        if (replay && plan->direct[si] == PLAN_ALONE) {
-            bt->direct_of[bi] = SPARSE_MARK;
-            continue;
-        }
         uint32_t ax, ay;
         float tx, ty;
         sample_cell(j, si, spp, aa, inv_aa, &ax, &ay, &tx, &ty);
@@ -335,19 +419,13 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
         for (int dy = 0; dy < 2; ++dy)
             for (int dx = 0; dx < 2; ++dx) {
                 uint32_t cx = ax + (uint32_t)dx, cy = ay + (uint32_t)dy;
-                float w;
-                size_t a = (size_t)cy * j->aw + cx;
-                if (replay) { /* the recorded weight (0: the anchor did not count) */
-                    w = plan->w4[si * 4 + (size_t)(dy * 2 + dx)];
-                } else {
-                    if (cx >= j->aw || cy >= j->ah)
-                        continue;
-                    size_t as = j->anchor_sample[a];
-                    float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
-                    if (as == SIZE_MAX || !(wb > 0.0f))
-                        continue;
-                    w = wb * (as == si ? 1.0f : same_surface_weight(j, si, as));
-                }
+                if (cx >= j->aw || cy >= j->ah)
+                    continue;
+                size_t a = (size_t)cy * j->aw + cx, as = j->anchor_sample[a];
+                float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
+                if (as == SIZE_MAX || !(wb > 0.0f))
+                    continue;
+                float w = wb * (as == si ? 1.0f : same_surface_weight(j, si, as));
                 if (!(w > 0.0f))
                     continue;
                 wsum += w;
@@ -437,7 +515,7 @@ static int32_t sparse_direct(void *user, size_t chunk, size_t b, size_t e)
 }
 
 /* Rows [b0, e0) of the batch: every pixel from its samples' light and
- * colours (a replay: the recorded colours and factors, the same sums). */
+ * colours (a record keeps the colours and factors: replay_pixel). */
 static int32_t sparse_resolve(void *user, size_t chunk, size_t b0, size_t e0)
 {
     sparse_batch *bt = user;
@@ -447,46 +525,25 @@ static int32_t sparse_resolve(void *user, size_t chunk, size_t b0, size_t e0)
     const vsgl_pixel_planes *pl = j->planes;
     const size_t spp = g->spp, W = g->width;
     vsgl_shade_plan *plan = j->plan;
-    const int replay = j->replay, record = plan && !replay && b0 % W == 0 && e0 - b0 == W;
+    const int record = plan && b0 % W == 0 && e0 - b0 == W;
     const float *Ls[VSGL__GBUFFER_MAX_SPP];
     for (size_t px = j->base + b0; px < j->base + e0; ++px) {
         for (size_t k = 0; k < spp; ++k) {
             size_t si = px * spp + k, bi = si - bt->first;
-            if (replay ? plan->direct[si] == PLAN_MISS : g->material[si] == VSGL__GBUFFER_MISS)
+            if (g->material[si] == VSGL__GBUFFER_MISS)
                 Ls[k] = NULL;
             else
                 Ls[k] = bt->direct_of[bi] != SIZE_MAX ? bt->dlight + bt->direct_of[bi] * 6 : bt->interp + bi * 6;
         }
-        if (!replay) {
-            vsgl__write_pixel(j, px, Ls, record ? plan->cd + px * spp * 4 : NULL);
-            if (record) {
-                float *col = plan->colour + px * 7;
-                for (int c = 0; c < 3; ++c) {
-                    col[c] = pl->diffuse_color[px * 3 + c];
-                    col[3 + c] = pl->glossy_color[px * 3 + c];
-                }
-                col[6] = pl->coverage[px];
-            }
-            continue;
-        }
-        float acc[6] = {0, 0, 0, 0, 0, 0};
-        for (size_t k = 0; k < spp; ++k) {
-            if (!Ls[k])
-                continue;
-            const float *L = Ls[k], *cd = plan->cd + (px * spp + k) * 4;
+        vsgl__write_pixel(j, px, Ls, record ? plan->cd + px * spp * 4 : NULL);
+        if (record) {
+            float *col = plan->colour + px * 7;
             for (int c = 0; c < 3; ++c) {
-                acc[c] += cd[c] * L[c];
-                acc[3 + c] += cd[3] * L[3 + c];
+                col[c] = pl->diffuse_color[px * 3 + c];
+                col[3 + c] = pl->glossy_color[px * 3 + c];
             }
+            col[6] = pl->coverage[px];
         }
-        const float *col = plan->colour + px * 7;
-        for (int c = 0; c < 3; ++c) {
-            pl->diffuse[px * 3 + c] = acc[c];
-            pl->glossy[px * 3 + c] = acc[3 + c];
-            pl->diffuse_color[px * 3 + c] = col[c];
-            pl->glossy_color[px * 3 + c] = col[3 + c];
-        }
-        pl->coverage[px] = col[6];
     }
     if (record)
         for (size_t y = (j->base + b0) / W; y < (j->base + e0) / W; ++y)
@@ -494,8 +551,267 @@ static int32_t sparse_resolve(void *user, size_t chunk, size_t b0, size_t e0)
     return 0;
 }
 
+/* A replay's sample: its light interpolated from the packed anchors of its
+ * cell (ax, ay) at (tx, ty) with the recorded weights w (4), into out (6);
+ * 0 where it is to be shaded itself. sparse_classify's arithmetic in its
+ * order: an anchor of weight 0 adds 0 x its light (finite, 0 for a miss)
+ * and leaves the bounds and second differences as they are. */
+static inline int replay_sample(const shade_job *j, const float *pack, const float *w, uint32_t ax, uint32_t ay,
+                                float tx, float ty, float *out)
+{
+    const size_t a0 = (size_t)ay * j->aw + ax;
+    const size_t sx = ax + 1 < j->aw ? 1 : 0, sy = ay + 1 < j->ah ? j->aw : 0; /* (off the lattice: weight 0) */
+    const float *q[4] = {pack + a0 * 12, pack + (a0 + sx) * 12, pack + (a0 + sy) * 12, pack + (a0 + sx + sy) * 12};
+#if defined(__SSE2__)
+    /* the same operations four lanes at a time: light RGB + glossy R, glossy GB
+     * + the sums per lobe (their bounds), the second differences */
+    float wsum = 0.0f, L[8], lo[4], hi[4], d2[4];
+    __m128 l0 = _mm_setzero_ps(), l1 = _mm_setzero_ps(), vlo = _mm_set1_ps(FLT_MAX), vhi = _mm_setzero_ps(),
+           vd2 = _mm_set1_ps(-1.0f);
+    for (int i = 0; i < 4; ++i) {
+        const int on = w[i] > 0.0f;
+        const float wi = on ? w[i] : 0.0f;
+        const __m128 m = _mm_castsi128_ps(_mm_set1_epi32(on ? -1 : 0)), W4 = _mm_set1_ps(wi);
+        const __m128 A0 = _mm_loadu_ps(q[i]), A1 = _mm_loadu_ps(q[i] + 4), A2 = _mm_loadu_ps(q[i] + 8);
+        wsum += wi;
+        l0 = _mm_add_ps(l0, _mm_mul_ps(W4, A0));
+        l1 = _mm_add_ps(l1, _mm_mul_ps(W4, A1));
+        vlo = _mm_min_ps(_mm_or_ps(_mm_and_ps(m, A1), _mm_andnot_ps(m, _mm_set1_ps(FLT_MAX))), vlo);
+        vhi = _mm_max_ps(_mm_and_ps(m, A1), vhi);
+        vd2 = _mm_max_ps(_mm_or_ps(_mm_and_ps(m, A2), _mm_andnot_ps(m, _mm_set1_ps(-1.0f))), vd2);
+    }
+    _mm_storeu_ps(L, l0);
+    _mm_storeu_ps(L + 4, l1);
+    _mm_storeu_ps(lo, vlo);
+    _mm_storeu_ps(hi, vhi);
+    _mm_storeu_ps(d2, vd2);
+    lo[0] = lo[2];
+    lo[1] = lo[3];
+    hi[0] = hi[2];
+    hi[1] = hi[3];
+#else
+    float wsum = 0.0f, L[6] = {0, 0, 0, 0, 0, 0};
+    float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {0.0f, 0.0f}, d2[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
+    for (int i = 0; i < 4; ++i) {
+        const int on = w[i] > 0.0f;
+        const float wi = on ? w[i] : 0.0f;
+        const float *A = q[i];
+        wsum += wi;
+        for (int c = 0; c < 6; ++c)
+            L[c] += wi * A[c];
+        for (int l = 0; l < 2; ++l) {
+            float vlo = on ? A[6 + l] : FLT_MAX, vhi = on ? A[6 + l] : 0.0f;
+            lo[l] = vlo < lo[l] ? vlo : lo[l];
+            hi[l] = vhi > hi[l] ? vhi : hi[l];
+        }
+        for (int c = 0; c < 4; ++c) {
+            float d = on ? A[8 + c] : -1.0f;
+            d2[c] = d > d2[c] ? d : d2[c];
+        }
+    }
+#endif
+    if (!(wsum > 0.05f))
+        return 0;
+    int smooth = 1;
+    for (int l = 0; l < 2; ++l) {
+        float m = (L[3 * l] + L[3 * l + 1] + L[3 * l + 2]) / wsum;
+        float bound = SPARSE_TOL * m + j->contrast_floor[l];
+        float dx2 = d2[2 * l], dy2 = d2[2 * l + 1];
+        if (dx2 < 0.0f && dy2 < 0.0f) {
+            smooth &= !(hi[l] - lo[l] > SPARSE_CONTRAST * (hi[l] + lo[l]) + j->contrast_floor[l]);
+            continue;
+        }
+        float ex = dx2 > 0.0f ? dx2 : 0.0f, ey = dy2 > 0.0f ? dy2 : 0.0f;
+        float e = 0.5f * (tx * (1.0f - tx) * ex + ty * (1.0f - ty) * ey);
+        smooth &= !(e > bound);
+    }
+    if (!smooth)
+        return 0;
+#if defined(__SSE2__)
+    const __m128 ws = _mm_set1_ps(wsum);
+    _mm_storeu_ps(out, _mm_div_ps(l0, ws));
+    _mm_storel_pi((__m64 *)(void *)(out + 4), _mm_div_ps(l1, ws));
+#else
+    for (int c = 0; c < 6; ++c)
+        out[c] = L[c] / wsum;
+#endif
+    return 1;
+}
+
+/* Pixel px of a replay from its samples' light: sparse_resolve's sums. */
+static void replay_pixel(const shade_job *j, size_t px, const float *const *Ls)
+{
+    const vsgl_shade_plan *plan = j->plan;
+    const vsgl_pixel_planes *pl = j->planes;
+    const size_t spp = plan->spp;
+    float acc[6] = {0, 0, 0, 0, 0, 0};
+    for (size_t k = 0; k < spp; ++k) {
+        if (!Ls[k])
+            continue;
+        const float *L = Ls[k], *cd = plan->cd + (px * spp + k) * 4;
+        for (int c = 0; c < 3; ++c) {
+            acc[c] += cd[c] * L[c];
+            acc[3 + c] += cd[3] * L[3 + c];
+        }
+    }
+    const float *col = plan->colour + px * 7;
+    for (int c = 0; c < 3; ++c) {
+        pl->diffuse[px * 3 + c] = acc[c];
+        pl->glossy[px * 3 + c] = acc[3 + c];
+        pl->diffuse_color[px * 3 + c] = col[c];
+        pl->glossy_color[px * 3 + c] = col[3 + c];
+    }
+    pl->coverage[px] = col[6];
+}
+
+/* A replay's rows [b0, e0) of the batch (one row per chunk): each sample
+ * interpolated or marked to be shaded itself (its index in the batch in
+ * plan->marks, row by row), and every pixel without such a sample written;
+ * the others wait for their samples' light (replay_fixup). */
+static int32_t replay_rows(void *user, size_t chunk, size_t b0, size_t e0)
+{
+    sparse_batch *bt = user;
+    const shade_job *j = bt->j;
+    const vsgl_shade_plan *plan = j->plan;
+    const size_t spp = plan->spp, W = plan->width;
+    const float *pack = plan->pack;
+    uint32_t *marks = plan->marks + b0 * spp, nm = 0;
+    const float *Ls[VSGL__GBUFFER_MAX_SPP];
+    float light[VSGL__GBUFFER_MAX_SPP * 6]; /* the pixel's interpolated light (plan->interp only if marked) */
+    size_t px = j->base + b0, x = px % W, y = px / W;
+    for (; px < j->base + e0; ++px) {
+        int marked = 0;
+        for (size_t k = 0; k < spp; ++k) {
+            const size_t si = px * spp + k, bi = si - bt->first;
+            const int32_t code = plan->direct[si];
+            if (code == PLAN_MISS) {
+                Ls[k] = NULL;
+                continue;
+            }
+            float *o = light + k * 6;
+            Ls[k] = o;
+            if (code == PLAN_ALONE ||
+                !replay_sample(j, pack, plan->w4 + si * 4, plan->cell_x[x * spp + k], plan->cell_y[y * spp + k],
+                               plan->cell_tx[x * spp + k], plan->cell_ty[y * spp + k], o)) {
+                marks[nm++] = (uint32_t)bi;
+                marked = 1;
+            }
+        }
+        if (marked) {
+            const size_t bi = px * spp - bt->first;
+            memcpy(plan->interp + bi * 6, light, spp * 6 * sizeof *light);
+            for (size_t k = 0; k < spp; ++k) /* its interpolated samples (the marked ones are numbered later) */
+                plan->direct_of[bi + k] = UINT32_MAX;
+        } else {
+            replay_pixel(j, px, Ls);
+        }
+        if (++x == W) {
+            x = 0;
+            ++y;
+        }
+    }
+    bt->nmarks[chunk] = nm;
+    return 0;
+}
+
+/* Entries [b, e) of a replay's samples shaded themselves: the pixel of each
+ * first entry of its pixel, from its samples' light. */
+static int32_t replay_fixup(void *user, size_t chunk, size_t b, size_t e)
+{
+    sparse_batch *bt = user;
+    const shade_job *j = bt->j;
+    const vsgl_shade_plan *plan = j->plan;
+    const size_t spp = plan->spp;
+    const float *Ls[VSGL__GBUFFER_MAX_SPP];
+    (void)chunk;
+    for (size_t k = b; k < e; ++k) {
+        size_t px = bt->dlist[k] / spp;
+        if (k > 0 && bt->dlist[k - 1] / spp == px)
+            continue;
+        for (size_t s = 0; s < spp; ++s) {
+            size_t si = px * spp + s, bi = si - bt->first;
+            uint32_t d = plan->direct_of[bi];
+            Ls[s] = plan->direct[si] == PLAN_MISS ? NULL
+                    : d != UINT32_MAX             ? bt->dlight + (size_t)d * 6
+                                                  : plan->interp + bi * 6;
+        }
+        replay_pixel(j, px, Ls);
+    }
+    return 0;
+}
+
+/* vsgl__shade_sparse_batch for a replay: interpolate and write what can be
+ * (replay_rows), shade the rest in full kernel blocks (sparse_direct), then
+ * write their pixels (replay_fixup). */
+static vsgl_result replay_batch(vsgl_context *ctx, shade_job *j, size_t row, size_t end)
+{
+    vsgl_shade_plan *plan = j->plan;
+    const size_t W = plan->width, spp = plan->spp, rows = end - row;
+    const uint32_t threads = vsgl_context_thread_count(ctx);
+    sparse_batch bt;
+    memset(&bt, 0, sizeof bt);
+    bt.j = j;
+    bt.first = row * W * spp;
+    bt.ns = rows * W * spp;
+    vsgl_result r = VSGL_OK;
+    if (plan->scratch_ns < bt.ns) {
+        free(plan->interp);
+        free(plan->direct_of);
+        free(plan->marks);
+        plan->interp = malloc((bt.ns + 1) * 6 * sizeof *plan->interp);
+        plan->direct_of = malloc((bt.ns + 1) * sizeof *plan->direct_of);
+        plan->marks = malloc((bt.ns + 1) * sizeof *plan->marks);
+        plan->scratch_ns = plan->interp && plan->direct_of && plan->marks ? bt.ns : 0;
+        if (!plan->scratch_ns) {
+            r = VSGL_ERROR_OUT_OF_MEMORY;
+            goto done;
+        }
+    }
+    bt.nmarks = malloc((rows + 1) * sizeof *bt.nmarks);
+    if (!bt.nmarks || vsgl__parallel_for(threads, rows * W, W, replay_rows, &bt) != 0) {
+        r = VSGL_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    size_t nd = 0;
+    for (size_t y = 0; y < rows; ++y)
+        nd += bt.nmarks[y];
+    bt.dlist = malloc((nd + 1) * sizeof *bt.dlist);
+    bt.dlight = malloc((nd + 1) * 6 * sizeof *bt.dlight);
+    bt.dpairs = calloc(nd / ANCHOR_CHUNK + 2, sizeof *bt.dpairs);
+    bt.lanes = malloc((nd + 1) * sizeof *bt.lanes);
+    if (!bt.dlist || !bt.dlight || !bt.dpairs || !bt.lanes) {
+        r = VSGL_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    /* the samples to shade, in sample order (rows in order, each row's in order) */
+    size_t k = 0;
+    for (size_t y = 0; y < rows; ++y) {
+        const uint32_t *m = plan->marks + y * W * spp;
+        for (uint32_t i = 0; i < bt.nmarks[y]; ++i, ++k) {
+            plan->direct_of[m[i]] = (uint32_t)k;
+            bt.dlist[k] = bt.first + m[i];
+        }
+    }
+    if (vsgl__parallel_for(threads, nd, ANCHOR_CHUNK, sparse_direct, &bt) != 0 ||
+        vsgl__parallel_for(threads, nd, 1024, replay_fixup, &bt) != 0) {
+        r = VSGL_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (size_t c = 0; c < nd / ANCHOR_CHUNK + 2; ++c)
+        j->pairs[0] += bt.dpairs[c];
+done:
+    free(bt.nmarks);
+    free(bt.dlist);
+    free(bt.dlight);
+    free(bt.dpairs);
+    free(bt.lanes);
+    return r == VSGL_OK ? VSGL_OK : vsgl__fail(ctx, r, "shade: out of memory");
+}
+
 vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row, size_t end)
 {
+    if (j->replay)
+        return replay_batch(ctx, j, row, end);
     const vsgl_gbuffer *g = j->g;
     const size_t W = g->width, spp = g->spp;
     const uint32_t threads = vsgl_context_thread_count(ctx);
@@ -523,7 +839,7 @@ vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row
     bt.dlight = malloc((nd + 1) * 6 * sizeof *bt.dlight);
     bt.dpairs = calloc(nd / ANCHOR_CHUNK + 2, sizeof *bt.dpairs);
     vsgl_shade_plan *plan = j->plan;
-    if (plan) /* a record keeps the lanes, a replay makes those it has not */
+    if (plan) /* a record keeps the lanes */
         bt.lanes = malloc((nd + 1) * sizeof *bt.lanes);
     if (!bt.dlight || !bt.dpairs || (plan && !bt.lanes) ||
         vsgl__parallel_for(threads, nd, ANCHOR_CHUNK, sparse_direct, &bt) != 0 ||
@@ -531,7 +847,7 @@ vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row
         r = VSGL_ERROR_OUT_OF_MEMORY;
         goto done;
     }
-    if (plan && !j->replay) { /* the record: these samples' lanes, for the next renders */
+    if (plan) { /* the record: these samples' lanes, for the next renders */
         for (size_t i = bt.first; i < bt.first + bt.ns; ++i)
             plan->dlane_of[i] = -1;
         if (plan->ndlanes + nd > plan->dlanes_cap) {
