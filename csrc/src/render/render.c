@@ -10,6 +10,7 @@
 #include "core/versioned.h"
 #include "core/parallel.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -349,11 +350,13 @@ static int32_t output_chunk(void *user, size_t chunk, size_t b, size_t e)
     const vsgl_pixel_planes *p = oj->p;
     const vsgl_render_output *out = oj->out;
     (void)chunk;
-    if (oj->pass == 0) {
-        int bad = 0;
+    if (oj->pass == 0) { /* bad_value as compares that vectorise (NaN compares false) */
+        int ok = 1;
         for (size_t i = b * 3; i < e * 3; ++i)
-            bad |= bad_value(p, i);
-        return bad ? VSGL_ERROR_INTERNAL : 0;
+            ok &= (p->diffuse[i] >= 0.0f) & (p->diffuse[i] <= FLT_MAX) & (p->glossy[i] >= 0.0f) &
+                  (p->glossy[i] <= FLT_MAX) & (fabsf(p->diffuse_color[i]) <= FLT_MAX) &
+                  (fabsf(p->glossy_color[i]) <= FLT_MAX);
+        return ok ? 0 : VSGL_ERROR_INTERNAL;
     }
     /* plane by plane, only those asked for (the live viewport asks for one) */
     if (out->diffuse_light)

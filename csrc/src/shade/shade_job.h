@@ -44,6 +44,7 @@ struct vsgl_shade_plan {
     float *cell_tx, *cell_ty;       /* its position in that cell, as sample_cell computes it */
     unsigned char *d2_ok;           /* per anchor: bit 0 (x), 1 (y): a second difference through its two
                                        neighbours on its surface is taken */
+    float *geo;                     /* per anchor: 8 floats: its sample's normal, position, material (bits) */
     /* a replay's working memory, kept between renders (no page faults per render) */
     float *pack;                    /* per anchor: 12 floats: light (6), its sum per lobe (2), d2 (4) */
     float *interp;                  /* 6 per sample of a batch */

@@ -88,6 +88,7 @@ void vsgl__shade_plan_free(vsgl_shade_plan *p)
     free(p->cell_tx);
     free(p->cell_ty);
     free(p->d2_ok);
+    free(p->geo);
     free(p->pack);
     free(p->interp);
     free(p->direct_of);
@@ -137,8 +138,9 @@ vsgl_shade_plan *vsgl__shade_plan_new(const vsgl_gbuffer *g, const vsgl_render_s
     p->cell_ty = malloc(((size_t)g->height * g->spp + 1) * sizeof *p->cell_ty);
     p->d2_ok = calloc(na + 1, 1);
     p->pack = malloc((na + 1) * 12 * sizeof *p->pack);
+    p->geo = malloc((na + 1) * 8 * sizeof *p->geo);
     if (!p->anchor_sample || !p->anchor_lane || !p->w4 || !p->direct || !p->cd || !p->colour || !p->row_ok ||
-        !p->dlane_of || !p->cell_x || !p->cell_tx || !p->cell_y || !p->cell_ty || !p->d2_ok || !p->pack) {
+        !p->dlane_of || !p->cell_x || !p->cell_tx || !p->cell_y || !p->cell_ty || !p->d2_ok || !p->pack || !p->geo) {
         vsgl__shade_plan_free(p);
         return NULL;
     }
@@ -240,6 +242,11 @@ static void anchor_pack(shade_job *j)
         }
         q[8] = q[9] = q[10] = q[11] = -1.0f;
     }
+    if (!j->replay) { /* a record: the second differences it computed (vsgl__shade_anchors) */
+        for (size_t a = 0; a < na; ++a)
+            memcpy(P + a * 12 + 8, j->anchor_d2 + a * 4, 4 * sizeof *P);
+        return;
+    }
     for (uint32_t ay = 0; ay < j->ah; ++ay)
         for (uint32_t ax = 0; ax < j->aw; ++ax) {
             size_t a = (size_t)ay * j->aw + ax;
@@ -327,6 +334,24 @@ vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
     }
     for (int l = 0; l < 2; ++l)
         j->contrast_floor[l] = n ? (float)(SPARSE_FLOOR * sum[l] / (double)n) : 0.0f;
+    if (record) { /* what record_rows reads: the anchors' light and surfaces, packed */
+        anchor_pack(j);
+        for (size_t a = 0; a < (size_t)j->aw * j->ah; ++a) {
+            size_t as = j->anchor_sample[a];
+            float *q = plan->geo + a * 8;
+            if (as == SIZE_MAX) {
+                memset(q, 0, 8 * sizeof *q);
+                continue;
+            }
+            for (int c = 0; c < 3; ++c) {
+                q[c] = g->nrm[c][as];
+                q[3 + c] = g->pos[c][as];
+            }
+            uint32_t m = g->material[as];
+            memcpy(&q[6], &m, sizeof m);
+            q[7] = 0.0f;
+        }
+    }
     return VSGL_OK;
 }
 
@@ -387,28 +412,23 @@ typedef struct sparse_batch {
 
 #define SPARSE_MARK (SIZE_MAX - 1) /* direct_of of a sample to shade, before it has its index */
 
-/* Rows [b0, e0) of the batch (one row per chunk): each sample's
- * interpolated light, or a mark to shade it itself. Records the plan's
- * weights and codes (a replay reads them: replay_rows). */
+/* Rows [b0, e0) of the batch (one row per chunk) of a render without a
+ * plan: each sample's interpolated light, or a mark to shade it itself.
+ * (A record does the same from packed anchors, record_rows, and keeps the
+ * weights and codes; a replay reads them, replay_rows.) */
 static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
 {
     sparse_batch *bt = user;
     shade_job *j = bt->j;
     (void)chunk;
     const vsgl_gbuffer *g = j->g;
-    const size_t spp = g->spp, W = g->width;
+    const size_t spp = g->spp;
     const size_t first = (j->base + b0) * spp, ns = (e0 - b0) * spp;
     const uint32_t aa = g->aa;
     const float inv_aa = 1.0f / (float)aa;
-    vsgl_shade_plan *plan = j->plan;
-    const int record = plan && b0 % W == 0 && e0 - b0 == W;
     for (size_t i = 0; i < ns; ++i) {
         size_t si = first + i, bi = si - bt->first;
         bt->direct_of[bi] = SIZE_MAX;
-        if (record) {
-            plan->direct[si] = PLAN_MISS;
-            plan->w4[si * 4] = plan->w4[si * 4 + 1] = plan->w4[si * 4 + 2] = plan->w4[si * 4 + 3] = 0.0f;
-        }
         if (g->material[si] == VSGL__GBUFFER_MISS)
             continue;
         uint32_t ax, ay;
@@ -429,8 +449,6 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
                 if (!(w > 0.0f))
                     continue;
                 wsum += w;
-                if (record)
-                    plan->w4[si * 4 + (size_t)(dy * 2 + dx)] = w;
                 const float *A = j->anchor_light + a * 6;
                 for (int c = 0; c < 6; ++c)
                     L[c] += w * A[c];
@@ -443,8 +461,6 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
                     dy2[l] = D[2 * l + 1] > dy2[l] ? D[2 * l + 1] : dy2[l];
                 }
             }
-        if (record)
-            plan->direct[si] = wsum > 0.05f ? PLAN_NEAR : PLAN_ALONE;
         /* where bilinear interpolation would be off by more than SPARSE_TOL
          * (a reflection's edge, a shadow's), the sample is shaded itself */
         int smooth = 1;
@@ -568,18 +584,24 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
     float wsum = 0.0f, L[8], lo[4], hi[4], d2[4];
     __m128 l0 = _mm_setzero_ps(), l1 = _mm_setzero_ps(), vlo = _mm_set1_ps(FLT_MAX), vhi = _mm_setzero_ps(),
            vd2 = _mm_set1_ps(-1.0f);
-    for (int i = 0; i < 4; ++i) {
-        const int on = w[i] > 0.0f;
-        const float wi = on ? w[i] : 0.0f;
-        const __m128 m = _mm_castsi128_ps(_mm_set1_epi32(on ? -1 : 0)), W4 = _mm_set1_ps(wi);
-        const __m128 A0 = _mm_loadu_ps(q[i]), A1 = _mm_loadu_ps(q[i] + 4), A2 = _mm_loadu_ps(q[i] + 8);
-        wsum += wi;
-        l0 = _mm_add_ps(l0, _mm_mul_ps(W4, A0));
-        l1 = _mm_add_ps(l1, _mm_mul_ps(W4, A1));
-        vlo = _mm_min_ps(_mm_or_ps(_mm_and_ps(m, A1), _mm_andnot_ps(m, _mm_set1_ps(FLT_MAX))), vlo);
-        vhi = _mm_max_ps(_mm_and_ps(m, A1), vhi);
-        vd2 = _mm_max_ps(_mm_or_ps(_mm_and_ps(m, A2), _mm_andnot_ps(m, _mm_set1_ps(-1.0f))), vd2);
-    }
+#  define REPLAY_ANCHOR(i)                                                                                      \
+    do {                                                                                                        \
+        const int on = w[i] > 0.0f;                                                                            \
+        const float wi = on ? w[i] : 0.0f;                                                                     \
+        const __m128 m = _mm_castsi128_ps(_mm_set1_epi32(-on)), W4 = _mm_set1_ps(wi);                          \
+        const __m128 A0 = _mm_loadu_ps(q[i]), A1 = _mm_loadu_ps(q[i] + 4), A2 = _mm_loadu_ps(q[i] + 8);         \
+        wsum += wi;                                                                                             \
+        l0 = _mm_add_ps(l0, _mm_mul_ps(W4, A0));                                                                \
+        l1 = _mm_add_ps(l1, _mm_mul_ps(W4, A1));                                                                \
+        vlo = _mm_min_ps(_mm_or_ps(_mm_and_ps(m, A1), _mm_andnot_ps(m, _mm_set1_ps(FLT_MAX))), vlo);           \
+        vhi = _mm_max_ps(_mm_and_ps(m, A1), vhi);                                                               \
+        vd2 = _mm_max_ps(_mm_or_ps(_mm_and_ps(m, A2), _mm_andnot_ps(m, _mm_set1_ps(-1.0f))), vd2);             \
+    } while (0)
+    REPLAY_ANCHOR(0);
+    REPLAY_ANCHOR(1);
+    REPLAY_ANCHOR(2);
+    REPLAY_ANCHOR(3);
+#  undef REPLAY_ANCHOR
     _mm_storeu_ps(L, l0);
     _mm_storeu_ps(L + 4, l1);
     _mm_storeu_ps(lo, vlo);
@@ -636,6 +658,82 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
         out[c] = L[c] / wsum;
 #endif
     return 1;
+}
+
+/* same_surface_weight of an anchor packed in q (plan->geo) for a sample of
+ * normal n, position x and material m: the same operations. */
+static inline float packed_surface_weight(const float *n, const float *x, uint32_t m, const float *q, float plane_tol)
+{
+    uint32_t qm;
+    memcpy(&qm, &q[6], sizeof qm);
+    if (qm != m)
+        return 0.0f;
+    float c = n[0] * q[0] + n[1] * q[1] + n[2] * q[2];
+    if (!(c > SPARSE_NORMAL_COS))
+        return 0.0f;
+    float wn = (c - SPARSE_NORMAL_COS) * (1.0f / (1.0f - SPARSE_NORMAL_COS));
+    float d0 = q[3] - x[0], d1 = q[4] - x[1], d2 = q[5] - x[2];
+    float off = fabsf(d0 * n[0] + d1 * n[1] + d2 * n[2]);
+    float tol = SPARSE_PLANE_REL * sqrtf(d0 * d0 + d1 * d1 + d2 * d2) + plane_tol;
+    float wp = 1.0f - off / tol;
+    if (!(wp > 0.0f))
+        return 0.0f;
+    return wn * wp;
+}
+
+/* Rows [b0, e0) of a record's batch (one row per chunk): sparse_classify
+ * from the packed anchors (their surfaces, plan->geo, and light,
+ * plan->pack) and the cell tables; records the weights and codes. */
+static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
+{
+    sparse_batch *bt = user;
+    const shade_job *j = bt->j;
+    vsgl_shade_plan *plan = j->plan;
+    const vsgl_gbuffer *g = j->g;
+    const size_t spp = plan->spp, W = plan->width;
+    const uint32_t aw = j->aw, ah = j->ah;
+    (void)chunk;
+    size_t px = j->base + b0, x = px % W, y = px / W;
+    for (; px < j->base + e0; ++px) {
+        for (size_t k = 0; k < spp; ++k) {
+            const size_t si = px * spp + k, bi = si - bt->first;
+            float *w = plan->w4 + si * 4;
+            bt->direct_of[bi] = SIZE_MAX;
+            plan->direct[si] = PLAN_MISS;
+            w[0] = w[1] = w[2] = w[3] = 0.0f;
+            const uint32_t m = g->material[si];
+            if (m == VSGL__GBUFFER_MISS)
+                continue;
+            const uint32_t ax = plan->cell_x[x * spp + k], ay = plan->cell_y[y * spp + k];
+            const float tx = plan->cell_tx[x * spp + k], ty = plan->cell_ty[y * spp + k];
+            const float n[3] = {g->nrm[0][si], g->nrm[1][si], g->nrm[2][si]};
+            const float xs[3] = {g->pos[0][si], g->pos[1][si], g->pos[2][si]};
+            float wsum = 0.0f;
+            for (uint32_t dy = 0; dy < 2; ++dy)
+                for (uint32_t dx = 0; dx < 2; ++dx) {
+                    uint32_t cx = ax + dx, cy = ay + dy;
+                    if (cx >= aw || cy >= ah)
+                        continue;
+                    size_t a = (size_t)cy * aw + cx, as = j->anchor_sample[a];
+                    float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
+                    if (as == SIZE_MAX || !(wb > 0.0f))
+                        continue;
+                    float wa = wb * (as == si ? 1.0f : packed_surface_weight(n, xs, m, plan->geo + a * 8, j->plane_tol));
+                    if (!(wa > 0.0f))
+                        continue;
+                    wsum += wa;
+                    w[dy * 2 + dx] = wa;
+                }
+            plan->direct[si] = wsum > 0.05f ? PLAN_NEAR : PLAN_ALONE;
+            if (!replay_sample(j, plan->pack, w, ax, ay, tx, ty, bt->interp + bi * 6))
+                bt->direct_of[bi] = SPARSE_MARK;
+        }
+        if (++x == W) {
+            x = 0;
+            ++y;
+        }
+    }
+    return 0;
 }
 
 /* Pixel px of a replay from its samples' light: sparse_resolve's sums. */
@@ -825,7 +923,7 @@ vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row
     bt.dlist = malloc((bt.ns + 1) * sizeof *bt.dlist);
     vsgl_result r = VSGL_OK;
     if (!bt.interp || !bt.direct_of || !bt.dlist ||
-        vsgl__parallel_for(threads, (end - row) * W, W, sparse_classify, &bt) != 0) {
+        vsgl__parallel_for(threads, (end - row) * W, W, j->plan ? record_rows : sparse_classify, &bt) != 0) {
         r = VSGL_ERROR_OUT_OF_MEMORY;
         goto done;
     }
