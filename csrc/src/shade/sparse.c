@@ -581,7 +581,7 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
 #if defined(__SSE2__)
     /* the same operations four lanes at a time: light RGB + glossy R, glossy GB
      * + the sums per lobe (their bounds), the second differences */
-    float wsum = 0.0f, L[8], lo[4], hi[4], d2[4];
+    float wsum = 0.0f;
     __m128 l0 = _mm_setzero_ps(), l1 = _mm_setzero_ps(), vlo = _mm_set1_ps(FLT_MAX), vhi = _mm_setzero_ps(),
            vd2 = _mm_set1_ps(-1.0f);
 #  define REPLAY_ANCHOR(i)                                                                                      \
@@ -602,15 +602,33 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
     REPLAY_ANCHOR(2);
     REPLAY_ANCHOR(3);
 #  undef REPLAY_ANCHOR
-    _mm_storeu_ps(L, l0);
-    _mm_storeu_ps(L + 4, l1);
-    _mm_storeu_ps(lo, vlo);
-    _mm_storeu_ps(hi, vhi);
-    _mm_storeu_ps(d2, vd2);
-    lo[0] = lo[2];
-    lo[1] = lo[3];
-    hi[0] = hi[2];
-    hi[1] = hi[3];
+    if (!(wsum > 0.05f))
+        return 0;
+    /* the interpolation test below, both lobes at once (lanes 0, 1) */
+    {
+        float L[8];
+        _mm_storeu_ps(L, l0);
+        _mm_storeu_ps(L + 4, l1);
+        const __m128 ws = _mm_set1_ps(wsum), zero = _mm_setzero_ps();
+        const __m128 fl = _mm_setr_ps(j->contrast_floor[0], j->contrast_floor[1], 0.0f, 0.0f);
+        const __m128 m = _mm_div_ps(_mm_setr_ps(L[0] + L[1] + L[2], L[3] + L[4] + L[5], 0.0f, 0.0f), ws);
+        const __m128 bound = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_TOL), m), fl);
+        const __m128 dx2 = _mm_shuffle_ps(vd2, vd2, _MM_SHUFFLE(3, 3, 2, 0));
+        const __m128 dy2 = _mm_shuffle_ps(vd2, vd2, _MM_SHUFFLE(3, 3, 3, 1));
+        const __m128 lo2 = _mm_movehl_ps(vlo, vlo), hi2 = _mm_movehl_ps(vhi, vhi);
+        const __m128 contrast = _mm_and_ps(_mm_cmplt_ps(dx2, zero), _mm_cmplt_ps(dy2, zero));
+        const __m128 cfail = _mm_cmpgt_ps(
+            _mm_sub_ps(hi2, lo2), _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_CONTRAST), _mm_add_ps(hi2, lo2)), fl));
+        const __m128 e = _mm_mul_ps(_mm_set1_ps(0.5f),
+                                    _mm_add_ps(_mm_mul_ps(_mm_set1_ps(tx * (1.0f - tx)), _mm_max_ps(dx2, zero)),
+                                               _mm_mul_ps(_mm_set1_ps(ty * (1.0f - ty)), _mm_max_ps(dy2, zero))));
+        const __m128 efail = _mm_cmpgt_ps(e, bound);
+        const __m128 fail = _mm_or_ps(_mm_and_ps(contrast, cfail), _mm_andnot_ps(contrast, efail));
+        if (_mm_movemask_ps(fail) & 3)
+            return 0;
+        _mm_storeu_ps(out, _mm_div_ps(l0, ws));
+        _mm_storel_pi((__m64 *)(void *)(out + 4), _mm_div_ps(l1, ws));
+    }
 #else
     float wsum = 0.0f, L[6] = {0, 0, 0, 0, 0, 0};
     float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {0.0f, 0.0f}, d2[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
@@ -631,7 +649,6 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
             d2[c] = d > d2[c] ? d : d2[c];
         }
     }
-#endif
     if (!(wsum > 0.05f))
         return 0;
     int smooth = 1;
@@ -649,11 +666,6 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
     }
     if (!smooth)
         return 0;
-#if defined(__SSE2__)
-    const __m128 ws = _mm_set1_ps(wsum);
-    _mm_storeu_ps(out, _mm_div_ps(l0, ws));
-    _mm_storel_pi((__m64 *)(void *)(out + 4), _mm_div_ps(l1, ws));
-#else
     for (int c = 0; c < 6; ++c)
         out[c] = L[c] / wsum;
 #endif
@@ -762,6 +774,27 @@ static void replay_pixel(const shade_job *j, size_t px, const float *const *Ls)
     pl->coverage[px] = col[6];
 }
 
+/* replay_pixel for one sample per pixel: its light L (6), or NULL for a miss. */
+static inline void replay_pixel1(const shade_job *j, size_t px, const float *L)
+{
+    const vsgl_shade_plan *plan = j->plan;
+    const vsgl_pixel_planes *pl = j->planes;
+    const float *cd = plan->cd + px * 4, *col = plan->colour + px * 7;
+    float *d = pl->diffuse + px * 3, *gl = pl->glossy + px * 3;
+    if (L) {
+        for (int c = 0; c < 3; ++c) {
+            d[c] = 0.0f + cd[c] * L[c];
+            gl[c] = 0.0f + cd[3] * L[3 + c];
+        }
+    } else {
+        for (int c = 0; c < 3; ++c)
+            d[c] = gl[c] = 0.0f;
+    }
+    memcpy(pl->diffuse_color + px * 3, col, 3 * sizeof *col);
+    memcpy(pl->glossy_color + px * 3, col + 3, 3 * sizeof *col);
+    pl->coverage[px] = col[6];
+}
+
 /* A replay's rows [b0, e0) of the batch (one row per chunk): each sample
  * interpolated or marked to be shaded itself (its index in the batch in
  * plan->marks, row by row), and every pixel without such a sample written;
@@ -777,6 +810,26 @@ static int32_t replay_rows(void *user, size_t chunk, size_t b0, size_t e0)
     const float *Ls[VSGL__GBUFFER_MAX_SPP];
     float light[VSGL__GBUFFER_MAX_SPP * 6]; /* the pixel's interpolated light (plan->interp only if marked) */
     size_t px = j->base + b0, x = px % W, y = px / W;
+    if (spp == 1) { /* the same, one sample per pixel (the live viewport's) */
+        for (; px < j->base + e0; ++px, ++x) {
+            if (x == W) {
+                x = 0;
+                ++y;
+            }
+            const int32_t code = plan->direct[px];
+            if (code == PLAN_MISS) {
+                replay_pixel1(j, px, NULL);
+            } else if (code == PLAN_ALONE || !replay_sample(j, pack, plan->w4 + px * 4, plan->cell_x[x],
+                                                             plan->cell_y[y], plan->cell_tx[x], plan->cell_ty[y],
+                                                             light)) {
+                marks[nm++] = (uint32_t)(px - bt->first);
+            } else {
+                replay_pixel1(j, px, light);
+            }
+        }
+        bt->nmarks[chunk] = nm;
+        return 0;
+    }
     for (; px < j->base + e0; ++px) {
         int marked = 0;
         for (size_t k = 0; k < spp; ++k) {
