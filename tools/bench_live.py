@@ -9,6 +9,8 @@ then times, each the median of --repeat edits:
   * light moved:  export (mesh cache warm) + library (scene reused) + encode
   * camera moved: the same with another view
   * geometry edit: export of the changed object + a new library scene + render
+and the CPU time of the library call and the encode (all threads: a
+figure less sensitive to other jobs on the machine than the wall times).
 for the viewport at full size and at the panel's default 1/2, for each
 panel quality asked for (LIVE, the panel's default: the preview preset
 without edge rays, shading 1 pixel in 4 x 4; PREVIEW: the preset as F12
@@ -83,8 +85,9 @@ def edit_cost(session, cache, w, h, scene, cam, edit, quality):
     t0 = time.perf_counter()
     sd = view_data(cache, w, h, scene, cam)
     t_export = time.perf_counter() - t0
+    c0 = time.process_time()
     out = viewport._render(session, sd, quality, 0, live.Job(1, None), 0.0, t_export)
-    return dict(out["timings"], triangles=sd.triangle_count)
+    return dict(out["timings"], cpu=time.process_time() - c0, triangles=sd.triangle_count)
 
 
 def combined(w, h, scene, cam, quality):
@@ -123,22 +126,23 @@ def main():
                          lambda: (cache.clear(), setattr(wave.location, "z", wave.location.z + 0.001)))):
                     ts = [edit_cost(session, cache, w, h, scene, cam, edit, quality) for _ in range(args.repeat)]
                     med = {k: statistics.median(t[k] for t in ts)
-                           for k in ("export", "scene", "render", "encode", "gbuffer", "rsm", "fit", "shade")}
+                           for k in ("export", "scene", "render", "encode", "gbuffer", "rsm", "fit", "shade", "cpu")}
                     rows.append((quality, w, h, div, name, med, ts[0]["triangles"]))
             finally:
                 session.close()
     print("live preview, %d triangles, median of %d edits (s); machine: %d cores, load %s"
           % (rows[0][6], args.repeat, os.cpu_count(), " ".join("%.1f" % v for v in os.getloadavg())))
-    print("%-8s %-10s %-14s %8s %8s %8s %8s %8s  %-26s %s" % ("quality", "size", "edit", "export", "scene", "render",
-                                                              "encode", "total", "library/50 ms, all/200 ms",
-                                                              "render = gbuffer + rsm + fit + shade"))
+    print("%-8s %-10s %-14s %8s %8s %8s %8s %8s  %-26s %-37s %s"
+          % ("quality", "size", "edit", "export", "scene", "render", "encode", "total", "library/50 ms, all/200 ms",
+             "render = gbuffer + rsm + fit + shade", "CPU-s"))
     targets = []
     for quality, w, h, div, name, m, _ in rows:
         lib = m["scene"] + m["render"]
         total = m["export"] + lib + m["encode"]
-        print("%-8s %-10s %-14s %8.3f %8.3f %8.3f %8.3f %8.3f  %-26s %.3f + %.3f + %.3f + %.3f"
+        print("%-8s %-10s %-14s %8.3f %8.3f %8.3f %8.3f %8.3f  %-26s %-37s %.3f"
               % (quality, "%dx%d" % (w, h), name, m["export"], m["scene"], m["render"], m["encode"], total,
-                 "%.2fx, %.2fx" % (lib / 0.050, total / 0.200), m["gbuffer"], m["rsm"], m["fit"], m["shade"]))
+                 "%.2fx, %.2fx" % (lib / 0.050, total / 0.200),
+                 "%.3f + %.3f + %.3f + %.3f" % (m["gbuffer"], m["rsm"], m["fit"], m["shade"]), m["cpu"]))
         if div == 1 and name != "geometry edit":
             targets.append("%s %s %s: library %.3f s / 0.050 s = %.2f, with export %.3f s / 0.200 s = %.2f"
                            % (quality, "%dx%d" % (w, h), name, lib, lib / 0.050, total, total / 0.200))
