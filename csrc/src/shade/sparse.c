@@ -795,6 +795,86 @@ static inline void replay_pixel1(const shade_job *j, size_t px, const float *L)
     pl->coverage[px] = col[6];
 }
 
+#if defined(__SSE2__)
+/* Four pixels px..px+3 of one row (one sample each, interpolated from the
+ * same cell (ax, ay), at tx[0..3], ty): replay_sample and replay_pixel1 with
+ * the four samples in the lanes, the same operations per lane. Writes the
+ * pixels whose samples pass the interpolation test; returns them as bits. */
+static unsigned replay_cell4(const shade_job *j, const float *pack, size_t px, uint32_t ax, uint32_t ay,
+                             const float *tx, float ty)
+{
+    const vsgl_shade_plan *plan = j->plan;
+    const size_t a0 = (size_t)ay * j->aw + ax;
+    const size_t sx = ax + 1 < j->aw ? 1 : 0, sy = ay + 1 < j->ah ? j->aw : 0;
+    const float *q[4] = {pack + a0 * 12, pack + (a0 + sx) * 12, pack + (a0 + sy) * 12, pack + (a0 + sx + sy) * 12};
+    const float *w4 = plan->w4 + px * 4;
+    __m128 r0 = _mm_loadu_ps(w4), r1 = _mm_loadu_ps(w4 + 4), r2 = _mm_loadu_ps(w4 + 8), r3 = _mm_loadu_ps(w4 + 12);
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3); /* ri: anchor i's weight for each of the four samples */
+    const __m128 zero = _mm_setzero_ps(), big = _mm_set1_ps(FLT_MAX), neg1 = _mm_set1_ps(-1.0f);
+    const __m128 wv[4] = {r0, r1, r2, r3};
+    __m128 wsum = zero, L[6], lo[2], hi[2], d2[4];
+    _Pragma("GCC unroll 8")
+    for (int c = 0; c < 6; ++c)
+        L[c] = zero;
+    _Pragma("GCC unroll 8")
+    for (int l = 0; l < 2; ++l) {
+        lo[l] = big;
+        hi[l] = zero;
+    }
+    _Pragma("GCC unroll 8")
+    for (int c = 0; c < 4; ++c)
+        d2[c] = neg1;
+    _Pragma("GCC unroll 8")
+    for (int i = 0; i < 4; ++i) {
+        const __m128 on = _mm_cmpgt_ps(wv[i], zero), wi = _mm_and_ps(on, wv[i]);
+        const float *A = q[i];
+        wsum = _mm_add_ps(wsum, wi);
+        _Pragma("GCC unroll 8")
+        for (int c = 0; c < 6; ++c)
+            L[c] = _mm_add_ps(L[c], _mm_mul_ps(wi, _mm_set1_ps(A[c])));
+        _Pragma("GCC unroll 8")
+        for (int l = 0; l < 2; ++l) {
+            const __m128 v = _mm_set1_ps(A[6 + l]);
+            lo[l] = _mm_min_ps(_mm_or_ps(_mm_and_ps(on, v), _mm_andnot_ps(on, big)), lo[l]);
+            hi[l] = _mm_max_ps(_mm_and_ps(on, v), hi[l]);
+        }
+        _Pragma("GCC unroll 8")
+        for (int c = 0; c < 4; ++c)
+            d2[c] = _mm_max_ps(_mm_or_ps(_mm_and_ps(on, _mm_set1_ps(A[8 + c])), _mm_andnot_ps(on, neg1)), d2[c]);
+    }
+    __m128 ok = _mm_cmpgt_ps(wsum, _mm_set1_ps(0.05f));
+    const __m128 vtx = _mm_loadu_ps(tx);
+    const __m128 ftx = _mm_mul_ps(vtx, _mm_sub_ps(_mm_set1_ps(1.0f), vtx)), fty = _mm_set1_ps(ty * (1.0f - ty));
+    _Pragma("GCC unroll 8")
+    for (int l = 0; l < 2; ++l) {
+        const __m128 fl = _mm_set1_ps(j->contrast_floor[l]);
+        const __m128 m = _mm_div_ps(_mm_add_ps(_mm_add_ps(L[3 * l], L[3 * l + 1]), L[3 * l + 2]), wsum);
+        const __m128 bound = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_TOL), m), fl);
+        const __m128 dx2 = d2[2 * l], dy2 = d2[2 * l + 1];
+        const __m128 contrast = _mm_and_ps(_mm_cmplt_ps(dx2, zero), _mm_cmplt_ps(dy2, zero));
+        const __m128 cfail = _mm_cmpgt_ps(_mm_sub_ps(hi[l], lo[l]),
+                                          _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_CONTRAST), _mm_add_ps(hi[l], lo[l])), fl));
+        const __m128 e = _mm_mul_ps(_mm_set1_ps(0.5f), _mm_add_ps(_mm_mul_ps(ftx, _mm_max_ps(dx2, zero)),
+                                                                    _mm_mul_ps(fty, _mm_max_ps(dy2, zero))));
+        const __m128 fail = _mm_or_ps(_mm_and_ps(contrast, cfail), _mm_andnot_ps(contrast, _mm_cmpgt_ps(e, bound)));
+        ok = _mm_andnot_ps(fail, ok);
+    }
+    const unsigned bits = (unsigned)_mm_movemask_ps(ok);
+    if (!bits)
+        return 0;
+    float out[6][4];
+    _Pragma("GCC unroll 8")
+    for (int c = 0; c < 6; ++c)
+        _mm_storeu_ps(out[c], _mm_div_ps(L[c], wsum));
+    for (unsigned k = 0; k < 4; ++k)
+        if (bits >> k & 1u) {
+            const float light[6] = {out[0][k], out[1][k], out[2][k], out[3][k], out[4][k], out[5][k]};
+            replay_pixel1(j, px + k, light);
+        }
+    return bits;
+}
+#endif
+
 /* A replay's rows [b0, e0) of the batch (one row per chunk): each sample
  * interpolated or marked to be shaded itself (its index in the batch in
  * plan->marks, row by row), and every pixel without such a sample written;
@@ -816,6 +896,21 @@ static int32_t replay_rows(void *user, size_t chunk, size_t b0, size_t e0)
                 x = 0;
                 ++y;
             }
+#if defined(__SSE2__)
+            /* four pixels of one row in one cell: their samples four lanes at a time */
+            if (x + 4 <= W && px + 4 <= j->base + e0 && plan->cell_x[x] == plan->cell_x[x + 3] &&
+                plan->direct[px] == PLAN_NEAR && plan->direct[px + 1] == PLAN_NEAR &&
+                plan->direct[px + 2] == PLAN_NEAR && plan->direct[px + 3] == PLAN_NEAR) {
+                unsigned ok = replay_cell4(j, pack, px, plan->cell_x[x], plan->cell_y[y], plan->cell_tx + x,
+                                           plan->cell_ty[y]);
+                for (unsigned k = 0; k < 4; ++k)
+                    if (!(ok >> k & 1u))
+                        marks[nm++] = (uint32_t)(px + k - bt->first);
+                px += 3;
+                x += 3;
+                continue;
+            }
+#endif
             const int32_t code = plan->direct[px];
             if (code == PLAN_MISS) {
                 replay_pixel1(j, px, NULL);
