@@ -267,9 +267,11 @@ VSGL_API void vsgl_render_cache_destroy(vsgl_render_cache *cache);
  * the same G-buffer, stride and glossy mode replays instead of
  * recomputing it (a light edit), bit-identically as well. The cache holds
  * memory (the G-buffer: vsgl_memory_estimate.gbuffer; the plan: about 40
- * bytes per sample, 28 per pixel, 108 per anchor and 100 per sample shaded
- * itself, not in the estimate) until the next render through it or its
- * destruction; one cache must not be used by two calls at once.
+ * bytes per sample, 28 per pixel, 190 per anchor and 100 per sample shaded
+ * itself, plus 32 per sample of a batch of rows once replayed; the pixel
+ * planes of the VSGL method, 52 bytes per pixel; none of it in the
+ * estimate) until the next render through it or its destruction; one
+ * cache must not be used by two calls at once.
  * @p cache NULL is ::vsgl_render.
  */
 VSGL_API vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene,
