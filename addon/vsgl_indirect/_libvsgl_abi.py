@@ -157,6 +157,7 @@ class Preset(enum.IntEnum):
     PREVIEW = 0
     BALANCED = 1
     QUALITY = 2
+    AUTO = 3
 
 
 class ExrPixelType(enum.IntEnum):
@@ -197,6 +198,8 @@ MATERIAL_TEXTURES_VERTEX_COLOR = 1
 MATERIAL_TEXTURES_FLAGS_KNOWN = 1
 LIGHT_FLAG_BLENDER_4 = 1
 LIGHT_FLAGS_KNOWN = 1
+AUTO_OFF = 0
+AUTO_BALANCED = 1
 AA_SAMPLES_MAX = 16
 RSM_RESOLUTION_MIN = 2
 RSM_RESOLUTION_MAX = 8192
@@ -393,6 +396,7 @@ class vsgl_render_settings(_Struct):
         ("sample_merging", c_int32),
         ("shade_stride", c_uint32),
         ("edge_samples", c_uint32),
+        ("auto_target", c_int32),
     ]
     _enums = {
         "method": Method, "fit_mode": FitMode, "sharpness_estimator": SharpnessEstimator,
@@ -641,11 +645,11 @@ __all__ = [
     "MATERIAL_FLAG_MULTISCATTER", "MATERIAL_FLAGS_KNOWN", "TEXTURE_FLAG_SRGB", "TEXTURE_FLAGS_KNOWN",
     "FILTER_LINEAR", "FILTER_CLOSEST", "WRAP_REPEAT", "WRAP_EXTEND", "WRAP_CLIP",
     "MATERIAL_TEXTURES_VERTEX_COLOR", "MATERIAL_TEXTURES_FLAGS_KNOWN", "LIGHT_FLAG_BLENDER_4",
-    "LIGHT_FLAGS_KNOWN", "AA_SAMPLES_MAX", "RSM_RESOLUTION_MIN", "RSM_RESOLUTION_MAX", "VSGL_COUNT_MAX",
-    "FIS_ITERATIONS_MAX", "SHADE_STRIDE_MAX", "REUSED_GBUFFER", "REUSED_FIT", "EXR_COMPRESSION_COUNT",
-    "EXR_MAX_CHANNELS", "vsgl_log_fn", "vsgl_progress_fn", "vsgl_vec3", "vsgl_context_desc", "vsgl_sg",
-    "vsgl_asg", "vsgl_material", "vsgl_texture", "vsgl_texture_slot", "vsgl_material_textures", "vsgl_light",
-    "vsgl_camera", "vsgl_scene_desc", "vsgl_scene_info", "vsgl_render_settings", "vsgl_render_output",
-    "vsgl_render_stats", "vsgl_memory_estimate", "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options",
-    "vsgl_bundle_options", "vsgl_bundle_info", "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS",
-    "FIELD_C_NAMES", "PROTOTYPES"]
+    "LIGHT_FLAGS_KNOWN", "AUTO_OFF", "AUTO_BALANCED", "AA_SAMPLES_MAX", "RSM_RESOLUTION_MIN",
+    "RSM_RESOLUTION_MAX", "VSGL_COUNT_MAX", "FIS_ITERATIONS_MAX", "SHADE_STRIDE_MAX", "REUSED_GBUFFER",
+    "REUSED_FIT", "EXR_COMPRESSION_COUNT", "EXR_MAX_CHANNELS", "vsgl_log_fn", "vsgl_progress_fn", "vsgl_vec3",
+    "vsgl_context_desc", "vsgl_sg", "vsgl_asg", "vsgl_material", "vsgl_texture", "vsgl_texture_slot",
+    "vsgl_material_textures", "vsgl_light", "vsgl_camera", "vsgl_scene_desc", "vsgl_scene_info",
+    "vsgl_render_settings", "vsgl_render_output", "vsgl_render_stats", "vsgl_memory_estimate",
+    "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options", "vsgl_bundle_options", "vsgl_bundle_info",
+    "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS", "FIELD_C_NAMES", "PROTOTYPES"]

@@ -85,6 +85,19 @@ extern "C" {
 #define VSGL_PRESET_PREVIEW  0
 #define VSGL_PRESET_BALANCED 1
 #define VSGL_PRESET_QUALITY  2
+#define VSGL_PRESET_AUTO     3 /**< balanced's knobs with auto_target BALANCED: chosen per scene at render time */
+
+/* The auto budget (vsgl_render_settings.auto_target): at render time the
+ * library chooses knobs for the scene by rules measured against Cycles on
+ * the bundled scenes (docs/trade.md, "The auto preset"), from what the
+ * per-light budget's probe sees (a 32-wide grid of camera rays, each
+ * light's 16^2 probe RSM): the glossy lobe model from the sharpest glossy
+ * material the camera sees, anti-aliasing from the image size, and each
+ * light's RSM side from its footprint (the probe texels whose light
+ * reaches what the camera sees). Never more than the knobs as set. The
+ * stats' `budget` text and the log say what it chose and why. */
+#define VSGL_AUTO_OFF      0 /**< the knobs as set (the default) */
+#define VSGL_AUTO_BALANCED 1 /**< the error of the balanced preset, at less cost where the scene allows */
 
 /* Valid ranges of the numeric settings (zero selects the default). One
  * source for the library, the CLI (--help, docs/cli.md) and the add-on's
@@ -126,6 +139,10 @@ typedef struct vsgl_render_settings {
                                       with the camera instead of in steps of 1/aa^2 (with aa_samples 1 a
                                       pixel gets a second slot for a second surface); 0, or E <=
                                       aa_samples, is off (the default) */
+    int32_t auto_target;         /**< VSGL_AUTO_*: OFF (the default) renders with the knobs as set;
+                                      BALANCED aims at the balanced preset's error at less cost:
+                                      aa_samples, rsm_resolution and glossy_mode are chosen for the
+                                      scene, at most as set; the other knobs are taken as set */
 } vsgl_render_settings;
 
 /** @brief Fill @p out with a preset (VSGL_PRESET_*); unknown presets give BALANCED. */
@@ -179,7 +196,8 @@ typedef struct vsgl_render_stats {
                                       sees (a 16^2 probe RSM gathered at a 32-wide grid of camera rays),
                                       with a floor of a quarter of the uniform share; the totals stay the
                                       settings' (docs/pipeline.md). Empty with one light (the settings
-                                      apply as they are) */
+                                      apply as they are) unless auto_target chose knobs: then its first
+                                      lines say what was chosen and why */
 } vsgl_render_stats;
 
 #define VSGL_REUSED_GBUFFER 1u /**< the G-buffer (same scene, camera, AA) */

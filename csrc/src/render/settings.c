@@ -61,6 +61,10 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
         out->shade_stride = 2;
         out->glossy_mode = VSGL_GLOSSY_ASG2;
         break;
+    case VSGL_PRESET_AUTO: /* balanced's knobs as ceilings, chosen per scene at render time (budget_auto.c) */
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, out);
+        out->auto_target = VSGL_AUTO_BALANCED;
+        break;
     default: /* BALANCED: lattice 192, not 128: at 128 the coarser clusters' emitter clip
                 takes 5-6 % of the light of three bundled rooms (metal floor + red wall
                 Diff 0.943, sphere Gloss 0.942, sun room Gloss 0.947 of Cycles); at 192
@@ -103,6 +107,7 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     CHECK_ENUM(visibility, VSGL_VISIBILITY_NONE, VSGL_VISIBILITY_RAY)
     CHECK_ENUM(leak_correction, VSGL_LEAK_AUTO, VSGL_LEAK_CLIP)
     CHECK_ENUM(sample_merging, VSGL_MERGE_AUTO, VSGL_MERGE_OFF)
+    CHECK_ENUM(auto_target, VSGL_AUTO_OFF, VSGL_AUTO_BALANCED)
 #undef CHECK_ENUM
     if (s->aa_samples > VSGL_AA_SAMPLES_MAX)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: aa_samples is %u (valid 1..%d)", s->aa_samples,
