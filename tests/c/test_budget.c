@@ -345,3 +345,113 @@ VT_TEST(budget_visibility_rays_skipped_only_in_a_convex_shell)
     }
     vsgl_context_destroy(ctx);
 }
+
+/* The footprint rules (budget.h) against sides worked by hand. */
+VT_TEST(budget_rsm_side_follows_the_footprint)
+{
+    /* the split of the settings' texels: equal weights and faces, footprints
+     * 1 and 1/4: texels 2 x 128^2 in proportion to 64 / 1 : 64 / 0.25, so
+     * the sides are 128 sqrt(2/5) = 80.95 and 128 sqrt(8/5) = 161.9 */
+    vsgl_light_share l[2] = {{.weight = 1.0, .footprint = 1.0, .faces = 1},
+                             {.weight = 1.0, .footprint = 0.25, .faces = 1}};
+    vsgl__light_budget(l, 2, 64, 128);
+    VT_CHECK(l[0].vsgl_count == 64 && l[1].vsgl_count == 64 && l[0].rsm_resolution == 81 &&
+             l[1].rsm_resolution == 162, "split: %u %u, RSM %u %u", l[0].vsgl_count, l[1].vsgl_count,
+             l[0].rsm_resolution, l[1].rsm_resolution);
+    /* the auto budget's absolute density: 85.33 texels per VSGL, 192 VSGLs:
+     * footprint 1 -> 128; 1/4 -> 256, capped at 200; 0.5 -> 181.02; 0 (or a
+     * light of weight 0) keeps its side; the floor rsm / 4 */
+    vsgl_light_share a[5] = {{.weight = 1, .footprint = 1.0, .vsgls = 192, .rsm_resolution = 7},
+                             {.weight = 1, .footprint = 0.25, .vsgls = 192, .rsm_resolution = 7},
+                             {.weight = 1, .footprint = 0.5, .vsgls = 192, .rsm_resolution = 7},
+                             {.weight = 1, .footprint = 0.0, .vsgls = 192, .rsm_resolution = 7},
+                             {.weight = 1, .footprint = 1.0, .vsgls = 1, .rsm_resolution = 7}};
+    vsgl__footprint_rsm(a, 5, VSGL__AUTO_TEXELS_PER_VSGL, 256, 200);
+    VT_CHECK(a[0].rsm_resolution == 128 && a[1].rsm_resolution == 200 && a[2].rsm_resolution == 181 &&
+             a[3].rsm_resolution == 7 && a[4].rsm_resolution == 64, "auto sides %u %u %u %u %u", a[0].rsm_resolution,
+             a[1].rsm_resolution, a[2].rsm_resolution, a[3].rsm_resolution, a[4].rsm_resolution);
+}
+
+typedef struct aplanes {
+    float comb[BW * 4 * BH * 4 * 3];
+} aplanes;
+
+static vsgl_result render_with(vsgl_context *ctx, fx_scene *fx, const vsgl_render_settings *s, float *comb,
+                               vsgl_render_stats *st)
+{
+    vsgl_scene *scene = NULL;
+    vsgl_result r = vsgl_scene_create(ctx, fx_desc(fx), &scene);
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = fx->camera.width;
+    o.height = fx->camera.height;
+    o.combined = comb;
+    if (r == VSGL_OK)
+        r = vsgl_render(ctx, scene, s, &o, st);
+    vsgl_scene_destroy(scene);
+    return r;
+}
+
+/* The auto preset: what it says it chose is what it rendered (the same
+ * pixels as balanced with those knobs set by hand), it chooses by the
+ * image size and the sharpest glossy surface seen, and a bad auto_target
+ * is refused by name. */
+VT_TEST(budget_auto_renders_what_it_says)
+{
+    static aplanes a, b;
+    vsgl_context *ctx = fx_context(2);
+    VT_REQUIRE(ctx, "context");
+    const struct {
+        uint32_t w, h;
+        float floor_roughness;
+        unsigned aa; /* below VSGL__AUTO_AA1_PIXELS: balanced's 2 */
+        const char *glossy;
+    } cases[3] = {{BW, BH, 0.3f, 2, "glossy asg2: roughness 0.30 seen"},
+                  {BW * 4, BH * 4, 0.3f, 2, "glossy asg2"},
+                  {BW, BH, 0.8f, 2, "glossy asg (not asg2): nothing seen sharper than roughness 0.50"}};
+    for (int c = 0; c < 3; ++c) {
+        fx_scene fx;
+        fx_room(&fx, cases[c].w, cases[c].h, cases[c].floor_roughness, 150.0f);
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_AUTO, &s);
+        VT_CHECK(s.auto_target == VSGL_AUTO_BALANCED && s.aa_samples == 2 && s.rsm_resolution == 256,
+                 "the auto preset is balanced's knobs with auto_target set");
+        vsgl_render_stats st = {.size = sizeof st};
+        VT_REQUIRE(render_with(ctx, &fx, &s, a.comb, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        unsigned aa = 0, v = 0, rsm = 0, fp = 0;
+        const char *l0 = strstr(st.budget, "light 0: ");
+        VT_CHECK(sscanf(st.budget, "auto: aa %u", &aa) == 1 && strstr(st.budget, cases[c].glossy) && l0 &&
+                 sscanf(l0, "light 0: 100 %% of the light on what the camera sees: %u VSGLs, RSM %u (uniform 192, "
+                        "256; footprint %u %%)", &v, &rsm, &fp) == 3, "case %d: budget text: %s", c, st.budget);
+        VT_CHECK(aa == cases[c].aa && v == 192 && rsm >= 64 && rsm < 256 && fp > 50,
+                 "case %d: aa %u, %u VSGLs, RSM %u, footprint %u", c, aa, v, rsm, fp);
+        /* the same knobs by hand: the same pixels */
+        vsgl_render_settings h;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &h);
+        h.aa_samples = aa;
+        h.rsm_resolution = rsm;
+        h.glossy_mode = strstr(st.budget, "glossy asg (not") ? VSGL_GLOSSY_ASG : VSGL_GLOSSY_ASG2;
+        VT_REQUIRE(render_with(ctx, &fx, &h, b.comb, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        size_t n = (size_t)cases[c].w * cases[c].h * 3;
+        VT_CHECK(memcmp(a.comb, b.comb, n * sizeof(float)) == 0, "case %d: auto differs from its knobs by hand", c);
+        /* and not the same as balanced itself (the RSM side changed) */
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &h);
+        VT_REQUIRE(render_with(ctx, &fx, &h, b.comb, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_CHECK(memcmp(a.comb, b.comb, n * sizeof(float)) != 0, "case %d: auto equals balanced", c);
+    }
+    /* aa from the image size: 320 x 240 takes 1 sample */
+    fx_scene big;
+    fx_room(&big, 320, 240, 0.3f, 150.0f);
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_AUTO, &s);
+    static float comb[320 * 240 * 3];
+    vsgl_render_stats st = {.size = sizeof st};
+    VT_CHECK(render_with(ctx, &big, &s, comb, &st) == VSGL_OK &&
+             strncmp(st.budget, "auto: aa 1 (not 2): 320x240, >= 76800 pixels", 44) == 0, "320x240: %s", st.budget);
+    /* a bad auto_target */
+    s.auto_target = 7;
+    VT_CHECK(render_with(ctx, &big, &s, comb, NULL) == VSGL_ERROR_INVALID_ARGUMENT &&
+             strstr(vsgl_context_last_error(ctx), "auto_target is 7"), "bad auto_target: %s",
+             vsgl_context_last_error(ctx));
+    vsgl_context_destroy(ctx);
+}

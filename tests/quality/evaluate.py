@@ -16,7 +16,7 @@ docs/img/quality/ instead):
     python3 tests/quality/evaluate.py [--size test|bench] [--acceptance] [--docs]
 
 Configurations (--configs, comma-separated; --set adds one more):
-  preview, balanced, quality   vsgl_render_settings_preset (read from the library at run time)
+  preview, balanced, quality, auto   vsgl_render_settings_preset (read from the library at run time)
   brute                        vsgl_reference_render: every RSM texel a VPL, exact BRDF,
                                RSM 128, aa 1, one shadow ray per pair
   km1024, fis128               balanced with fit_mode kmeans / fis and vsgl_count 1024 / 128
@@ -65,6 +65,7 @@ NAMED = {
     "preview": ("preview", {}),
     "balanced": ("balanced", {}),
     "quality": ("quality", {}),
+    "auto": ("auto", {}),
     "brute": ("brute", {}),
     "km1024": ("balanced", dict(fit_mode="kmeans", vsgl_count=1024)),
     "fis128": ("balanced", dict(fit_mode="fis", vsgl_count=128)),
@@ -111,8 +112,8 @@ class Config:
             unknown = set(self.changes) - set(BRUTE_DEFAULTS)
             if unknown:
                 raise SystemExit("brute takes %s, not %s" % (", ".join(BRUTE_DEFAULTS), ", ".join(sorted(unknown))))
-        elif base not in ("preview", "balanced", "quality"):
-            raise SystemExit("unknown preset %r (preview, balanced, quality or brute)" % base)
+        elif base not in ("preview", "balanced", "quality", "auto"):
+            raise SystemExit("unknown preset %r (preview, balanced, quality, auto or brute)" % base)
 
     @property
     def brute(self):
@@ -159,6 +160,8 @@ class Config:
             bits.append("leak correction %s" % {1: "off", 2: "on", 3: "clip only"}[s["leak_correction"]])
         if s["method"]:
             bits.append("brute-force method")
+        if s.get("auto_target"):
+            bits.append("auto: aa, RSM per light and glossy chosen per scene, at most these")
         return ", ".join(bits)
 
     def as_dict(self):

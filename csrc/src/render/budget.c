@@ -22,6 +22,12 @@ uint32_t vsgl__budget_vsgl_max(uint32_t n_vsgl)
     return n > VSGL_VSGL_COUNT_MAX ? VSGL_VSGL_COUNT_MAX : (uint32_t)n;
 }
 
+/* A light's footprint as the texel split uses it: (0, 1], 1 when unknown. */
+static double footprint_of(const vsgl_light_share *l)
+{
+    return l->footprint > 0.0 && l->footprint <= 1.0 ? l->footprint : 1.0;
+}
+
 static uint32_t clamp_side(double side, uint32_t lo, uint32_t hi)
 {
     if (!(side >= (double)lo))
@@ -93,7 +99,7 @@ void vsgl__light_budget(vsgl_light_share *lights, uint32_t count, uint32_t n_vsg
             continue;
         lights[i].vsgls += floor_n;
         texels += (double)lights[i].faces * (double)rsm * (double)rsm;
-        weighted += (double)lights[i].faces * lights[i].vsgls;
+        weighted += (double)lights[i].faces * lights[i].vsgls / footprint_of(&lights[i]);
     }
 
     /* Integer counts by largest remainder, so that they sum as the reals;
@@ -124,16 +130,31 @@ void vsgl__light_budget(vsgl_light_share *lights, uint32_t count, uint32_t n_vsg
         ++lights[best].vsgl_count;
         ++total;
     }
-    double per = weighted > 0.0 ? texels / weighted : 0.0; /* texels per VSGL */
+    double per = weighted > 0.0 ? texels / weighted : 0.0; /* texels per VSGL on a footprint */
     for (uint32_t i = 0; i < count; ++i) {
         if (lights[i].fraction > 0.0) {
             if (lights[i].vsgl_count < 1)
                 lights[i].vsgl_count = 1;
-            lights[i].rsm_resolution = clamp_side(sqrt(per * lights[i].vsgls), lo, hi);
+            lights[i].rsm_resolution = clamp_side(sqrt(per * lights[i].vsgls / footprint_of(&lights[i])), lo, hi);
         } else { /* the probe saw nothing */
             lights[i].vsgls = floor_n;
             lights[i].vsgl_count = floor_n >= 1.0 ? (uint32_t)ceil(floor_n) : 1u;
             lights[i].rsm_resolution = rsm / 2 > lo ? rsm / 2 : lo;
         }
+    }
+}
+
+void vsgl__footprint_rsm(vsgl_light_share *lights, uint32_t count, double texels_per_vsgl, uint32_t rsm,
+                         uint32_t hi)
+{
+    uint32_t lo = rsm / 4 > VSGL_RSM_RESOLUTION_MIN ? rsm / 4 : VSGL_RSM_RESOLUTION_MIN;
+    if (hi < lo)
+        hi = lo;
+    for (uint32_t i = 0; i < count; ++i) {
+        double f = lights[i].footprint, v = lights[i].vsgls;
+        if (!contributes(&lights[i]) || !(f > 0.0 && f <= 1.0) || !(v > 0.0 && v < INFINITY) ||
+            !(texels_per_vsgl > 0.0 && texels_per_vsgl < INFINITY))
+            continue;
+        lights[i].rsm_resolution = clamp_side(sqrt(texels_per_vsgl * v / f), lo, hi);
     }
 }

@@ -9,6 +9,7 @@
 #include "fit/vsgl_set.h"
 #include "rsm/rsm.h"
 #include "scene/camera.h"
+#include "scene/material.h"
 #include "core/context.h"
 #include "math/constants.h"
 
@@ -29,10 +30,39 @@ static void receivers_free(probe_receivers *r)
     memset(r, 0, sizeof *r);
 }
 
-/* Receivers: what a sparse grid of camera rays hits (normals facing the camera). */
-static vsgl_result camera_receivers(vsgl_context *ctx, const vsgl_scene *scene, probe_receivers *out)
+/* The glossy lobe a receiver's material has there (textures read at the hit): 1 and its roughness
+ * (sqrt of the smaller GGX alpha) if it contributes. */
+static int receiver_glossy(const vsgl_scene *scene, const vsgl_hit *hit, uint32_t material, float *roughness)
+{
+    uint32_t n = 0;
+    const vsgl_material *mats = vsgl__scene_materials(scene, &n);
+    if (material >= n)
+        return 0;
+    vsgl_material m = mats[material];
+    if (vsgl__scene_textured(scene)) {
+        float in[VSGL__SURF_N];
+        vsgl__scene_inputs(scene, hit, 0.0f, in);
+        vsgl__material_with_inputs(&mats[material], in, &m);
+    }
+    vsgl_brdf_params bp;
+    vsgl__material_params(&m, &bp);
+    if (!bp.glossy)
+        return 0;
+    float a = bp.alpha_x < bp.alpha_y ? bp.alpha_x : bp.alpha_y;
+    *roughness = sqrtf(a > 0.0f ? a : 0.0f);
+    return 1;
+}
+
+/* Receivers: what a sparse grid of camera rays hits (normals facing the camera); *view (may be NULL)
+ * what they see. */
+static vsgl_result camera_receivers(vsgl_context *ctx, const vsgl_scene *scene, probe_receivers *out,
+                                    vsgl_budget_view *view)
 {
     memset(out, 0, sizeof *out);
+    if (view) {
+        memset(view, 0, sizeof *view);
+        view->sharpest_roughness = 1.0f;
+    }
     const vsgl_camera *cam = vsgl__scene_camera(scene);
     vsgl_camera_model m;
     vsgl__camera_model(cam, &m);
@@ -71,30 +101,54 @@ static vsgl_result camera_receivers(vsgl_context *ctx, const vsgl_scene *scene, 
             continue;
         vsgl_surface sf;
         vsgl__scene_surface(scene, &hits[k], dir[k], &sf);
+        float rough = 1.0f;
+        if (view && receiver_glossy(scene, &hits[k], sf.material, &rough)) {
+            ++view->glossy;
+            if (rough < view->sharpest_roughness)
+                view->sharpest_roughness = rough;
+        }
         uint32_t c = out->count++;
         out->px[c] = sf.position.x; out->py[c] = sf.position.y; out->pz[c] = sf.position.z;
         out->nx[c] = sf.normal.x; out->ny[c] = sf.normal.y; out->nz[c] = sf.normal.z;
     }
+    if (view)
+        view->receivers = out->count;
 done:
     free(org); free(dir); free(tmin); free(tmax); free(hits);
     return r;
 }
 
+vsgl_result vsgl__budget_view(vsgl_context *ctx, const vsgl_scene *scene, vsgl_budget_view *view)
+{
+    probe_receivers rc;
+    vsgl_result r = camera_receivers(ctx, scene, &rc, view);
+    receivers_free(&rc);
+    return r;
+}
+
 /* One light's weight: the probe RSM's VPLs gathered at the receivers
- * (their reflected power if the camera sees nothing). */
+ * (their reflected power if the camera sees nothing), and in *footprint
+ * the fraction of its lit texels that send at least VSGL__FOOTPRINT_TEXEL
+ * of the mean lit texel's light onto the receivers (1 without receivers;
+ * `sent`: scratch of rsm->count doubles, NULL: footprint 1). */
 static double light_weight(const vsgl_scene *scene, const vsgl_rsm *rsm, int32_t estimator,
-                           const probe_receivers *rc)
+                           const probe_receivers *rc, double *sent, double *footprint)
 {
     v3 origin = vsgl__rsm_origin(rsm);
     double total = 0.0, reflected = 0.0;
+    size_t lit = 0;
+    *footprint = 1.0;
     for (size_t t = 0; t < rsm->count; ++t) {
         vsgl_moments mo[2];
+        if (sent)
+            sent[t] = -1.0; /* not lit */
         if (!vsgl__vpl_moments(scene, rsm, t, origin, estimator, mo))
             continue;
         double p = mo[0].weight + mo[1].weight; /* reflected power, W (RGB sum) */
         if (!(p > 0.0 && p < INFINITY))
             continue;
         reflected += p;
+        ++lit;
         /* clamped-cosine emission P/pi cos, 1/d^2 clamped by the footprint */
         float vx = rsm->pos[0][t], vy = rsm->pos[1][t], vz = rsm->pos[2][t];
         float mx = rsm->nrm[0][t], my = rsm->nrm[1][t], mz = rsm->nrm[2][t];
@@ -111,9 +165,18 @@ static double light_weight(const vsgl_scene *scene, const vsgl_rsm *rsm, int32_t
             e += ce * cr / ((d2 > 1e-30f ? d2 : 1e-30f) * (d2 > a ? d2 : a));
         }
         total += p * (double)e;
+        if (sent)
+            sent[t] = p * (double)e;
     }
     if (rc->count == 0)
         return reflected;
+    if (sent && lit && total > 0.0 && total < INFINITY) {
+        double limit = VSGL__FOOTPRINT_TEXEL * total / (double)lit;
+        size_t in = 0;
+        for (size_t t = 0; t < rsm->count; ++t)
+            in += sent[t] >= limit;
+        *footprint = (double)in / (double)lit;
+    }
     return total / (VSGL__PI_D * (double)rc->count);
 }
 
@@ -124,13 +187,19 @@ vsgl_result vsgl__budget_weights(vsgl_context *ctx, const vsgl_scene *scene, con
     const vsgl_light *lights = vsgl__scene_lights(scene, &light_count);
     uint32_t probe = s->rsm_resolution < VSGL__BUDGET_PROBE ? s->rsm_resolution : VSGL__BUDGET_PROBE;
     probe_receivers rc;
-    vsgl_result r = camera_receivers(ctx, scene, &rc);
+    vsgl_result r = camera_receivers(ctx, scene, &rc, NULL);
     if (r != VSGL_OK)
         return r;
     *receivers = rc.count;
+    double *sent = malloc(6 * (size_t)probe * probe * sizeof *sent);
+    if (!sent) {
+        receivers_free(&rc);
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "render: out of memory for the light budget's probe");
+    }
     for (uint32_t l = 0; l < light_count && r == VSGL_OK; ++l) {
         const vsgl_light *L = &lights[l];
         sh[l].weight = 0.0;
+        sh[l].footprint = 1.0;
         sh[l].faces = 1;
         if (!(L->power * (L->color[0] + L->color[1] + L->color[2]) > 0.0f))
             continue;
@@ -140,9 +209,11 @@ vsgl_result vsgl__budget_weights(vsgl_context *ctx, const vsgl_scene *scene, con
             break;
         sh[l].faces = rsm.faces ? rsm.faces : 1;
         if (rsm.total_flux[0] + rsm.total_flux[1] + rsm.total_flux[2] > 0.0)
-            sh[l].weight = light_weight(scene, &rsm, s->sharpness_estimator, &rc);
+            sh[l].weight = light_weight(scene, &rsm, s->sharpness_estimator, &rc,
+                                        rsm.count <= 6 * (size_t)probe * probe ? sent : NULL, &sh[l].footprint);
         vsgl__rsm_free(&rsm);
     }
+    free(sent);
     receivers_free(&rc);
     return r;
 }

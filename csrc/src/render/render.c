@@ -95,9 +95,11 @@ static void note_budget(vsgl_context *ctx, vsgl_render_stats *st, const char *fm
     va_end(ap);
 }
 
-/* The per-light budget (budget.h): each powered light's reflected power on
- * a probe RSM, then the shares. 0 lights or 1 powered light: `shares` is
- * left NULL and every light takes the settings as they are. */
+/* The per-light budget (budget.h): each powered light's reflected power and
+ * footprint on a probe RSM, then the shares, and each light's RSM side from
+ * its footprint. Without the auto budget, 0 lights or 1 powered light:
+ * `shares` is left NULL and every light takes the settings as they are;
+ * with it, a single light too gets its RSM side from its footprint. */
 static vsgl_result light_budget(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                                 vsgl_light_share **shares_out, vsgl_render_stats *st)
 {
@@ -106,10 +108,11 @@ static vsgl_result light_budget(vsgl_context *ctx, const vsgl_scene *scene, cons
     *shares_out = NULL;
     if (s->fit_mode == VSGL_FIT_TWO) /* two VSGLs per light whatever the budget */
         return VSGL_OK;
+    const int automatic = s->auto_target != VSGL_AUTO_OFF;
     uint32_t powered = 0;
     for (uint32_t l = 0; l < light_count; ++l)
         powered += lights[l].power * (lights[l].color[0] + lights[l].color[1] + lights[l].color[2]) > 0.0f;
-    if (powered < 2)
+    if (powered < (automatic ? 1u : 2u))
         return VSGL_OK;
     vsgl_light_share *sh = calloc(light_count, sizeof *sh);
     if (!sh)
@@ -123,28 +126,44 @@ static vsgl_result light_budget(vsgl_context *ctx, const vsgl_scene *scene, cons
         return r;
     }
     vsgl__light_budget(sh, light_count, s->vsgl_count, s->rsm_resolution);
+    /* the auto budget: each RSM side from the footprint at the measured
+     * texels per VSGL, never above the settings' side (vsgl__light_budget
+     * already split the settings' texels by footprint) */
+    const double density = automatic ? VSGL__AUTO_TEXELS_PER_VSGL
+                                     : (double)s->rsm_resolution * s->rsm_resolution / (double)s->vsgl_count;
+    if (automatic)
+        vsgl__footprint_rsm(sh, light_count, density, s->rsm_resolution, s->rsm_resolution);
     double t_probe = now_seconds() - t0;
     st->seconds_rsm += t_probe;
     uint32_t contributing = 0;
     for (uint32_t l = 0; l < light_count; ++l)
         contributing += sh[l].fraction > 0.0;
-    if (contributing < 2) { /* one light reflects anything: it takes the settings as they are */
+    if (contributing < (automatic ? 1u : 2u)) { /* one light reflects anything: the settings as they are */
         free(sh);
         return VSGL_OK;
     }
+    double texels = 0.0, uniform = 0.0;
     for (uint32_t l = 0; l < light_count; ++l) {
         if (!(lights[l].power * (lights[l].color[0] + lights[l].color[1] + lights[l].color[2]) > 0.0f))
             continue;
+        texels += (double)sh[l].faces * sh[l].rsm_resolution * sh[l].rsm_resolution;
+        uniform += (double)sh[l].faces * s->rsm_resolution * s->rsm_resolution;
         if (sh[l].fraction > 0.0)
             note_budget(ctx, st, "light %u: %.0f %% of the light on what the camera sees: %u VSGLs, RSM %u "
-                        "(uniform %u, %u)", l,
+                        "(uniform %u, %u; footprint %.0f %%)", l,
                         100.0 * sh[l].fraction, sh[l].vsgl_count, sh[l].rsm_resolution, s->vsgl_count,
-                        s->rsm_resolution);
+                        s->rsm_resolution, 100.0 * sh[l].footprint);
         else
             note_budget(ctx, st, "light %u: sends nothing the camera sees on a %u^2 probe: floor %u VSGLs, RSM %u",
                         l, s->rsm_resolution < VSGL__BUDGET_PROBE ? s->rsm_resolution : VSGL__BUDGET_PROBE,
                         sh[l].vsgl_count, sh[l].rsm_resolution);
     }
+    if (automatic)
+        note_budget(ctx, st, "RSM sides by footprint (%.0f texels per VSGL on it): %.0f %% of the uniform %u^2 "
+                    "texels", density, 100.0 * texels / uniform, s->rsm_resolution);
+    else
+        note_budget(ctx, st, "RSM texels split by VSGLs / footprint: %.0f %% of the uniform %u^2", 
+                    100.0 * texels / uniform, s->rsm_resolution);
     vsgl__log(ctx, VSGL_LOG_INFO, "budget: %u lights shared %u VSGLs and %u^2 RSM texels each by the light they "
               "send onto what the camera sees (%u probe receivers; probe %.4f s)", contributing, s->vsgl_count,
               s->rsm_resolution, receivers, t_probe);
@@ -479,6 +498,9 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
 
     vsgl_render_stats st;
     memset(&st, 0, sizeof st);
+    /* the auto budget: anti-aliasing and the glossy model for this scene (budget_auto.c) */
+    if (s.auto_target != VSGL_AUTO_OFF && (r = vsgl__auto_choose(ctx, scene, &s, &st)) != VSGL_OK)
+        return r;
     /* a convex shell (an empty closed room): visibility rays cannot find anything */
     int rays_skipped = 0;
     if (s.method == VSGL_METHOD_VSGL && s.visibility == VSGL_VISIBILITY_RAY && vsgl__scene_convex_shell(scene)) {
