@@ -5,7 +5,7 @@ object with the same attribute names) so the engine never touches bpy.
 """
 from dataclasses import dataclass, fields
 
-PRESETS = ("PREVIEW", "BALANCED", "QUALITY")
+PRESETS = ("PREVIEW", "BALANCED", "QUALITY", "AUTO")
 DEFAULT_TEMPLATE = "{render_dir}/vsgl/{scene}_{view_layer}_####.exr"
 
 # Advanced knobs, mirroring vsgl_render_settings (csrc/include/vsgl/render.h).
@@ -43,6 +43,8 @@ PRESET_VALUES = {
     "QUALITY": dict(_COMMON, aa_samples=2, rsm_resolution=512, vsgl_count=256, visibility="RAY",
                     shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
 }
+# AUTO: balanced's knobs as ceilings; the library chooses within them (auto_target, render.h)
+PRESET_VALUES["AUTO"] = dict(PRESET_VALUES["BALANCED"])
 assert all(PRESET_VALUES["BALANCED"][k] == v[1] for k, v in KNOBS.items())
 
 

@@ -69,6 +69,8 @@ def settings_for(options, libvsgl):
     preset, knobs = options.render_settings()
     if knobs is None:
         return libvsgl.render_settings_preset(preset)
+    if preset == "AUTO":  # the knobs are the auto budget's ceilings
+        return libvsgl.RenderSettings(auto_target=libvsgl.AUTO_BALANCED, **knobs)
     return libvsgl.RenderSettings(**knobs)
 
 

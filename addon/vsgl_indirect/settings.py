@@ -106,6 +106,12 @@ ITEMS = {
          "shaded, visibility "
          "rays: within 5 % of Cycles per pass on every bundled scene; the gather room in 0.39 s "
          "at relMSE 0.0047, about 1.6x Balanced's time"),
+        ("AUTO", "Auto",
+         "Balanced's error at less cost: Balanced's knobs as ceilings, and the library chooses for "
+         "the scene 1 sample per pixel from 320 x 240 pixels, one glossy lobe where nothing sharper "
+         "than roughness 0.5 is seen, and each light's RSM from the part of it that lights what the "
+         "camera sees (85 texels per VSGL there). The last-run box says what it chose and why; "
+         "docs/trade.md, \"The auto preset\", measures it against Balanced"),
     ],
     "method": [
         ("VSGL", "VSGL",

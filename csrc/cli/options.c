@@ -16,7 +16,8 @@ const char cli_usage[] =
     "Combined). Settings: the bundle's (or --preset), then the options below.\n"
     "\n"
     "  -o, --output PATH     EXR to write (default: the bundle's output path)\n"
-    "  --preset NAME         preview | balanced | quality\n"
+    "  --preset NAME         preview | balanced | quality | auto   (auto: balanced's knobs as ceilings;\n"
+    "                        aa, the glossy model and each light's RSM chosen for the scene; -v says what)\n"
     "  --aa N                N x N camera samples per pixel (1..16)\n"
     "  --rsm N               reflective shadow map side in texels (2..8192)\n"
     "  --fit NAME            two | fis | kmeans | lattice   (VSGL fit)\n"
@@ -104,8 +105,9 @@ static int parse_enum(const char *s, const char *const *names, const int *values
 typedef struct enum_opt { const char *name; const char *const *names; const int *values; size_t offset; } enum_opt;
 typedef struct num_opt { const char *name; uint32_t min; size_t offset; } num_opt;
 
-static const char *const preset_names[] = {"preview", "balanced", "quality", NULL};
-static const int preset_values[] = {VSGL_PRESET_PREVIEW, VSGL_PRESET_BALANCED, VSGL_PRESET_QUALITY};
+static const char *const preset_names[] = {"preview", "balanced", "quality", "auto", NULL};
+static const int preset_values[] = {VSGL_PRESET_PREVIEW, VSGL_PRESET_BALANCED, VSGL_PRESET_QUALITY,
+                                    VSGL_PRESET_AUTO};
 static const char *const fit_names[] = {"two", "fis", "kmeans", "lattice", NULL};
 static const int fit_values[] = {VSGL_FIT_TWO, VSGL_FIT_FIS, VSGL_FIT_KMEANS, VSGL_FIT_LATTICE};
 static const char *const sharp_names[] = {"toksvig", "banerjee", NULL};

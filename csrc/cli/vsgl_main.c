@@ -298,7 +298,7 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
                 stats.seconds_shade);
         fprintf(stderr, "vsgl: lights used %u, skipped %u; VSGLs %u; shading pairs %llu\n", stats.lights_used,
                 stats.lights_skipped, stats.vsgl_count, (unsigned long long)stats.shading_pairs);
-        /* several lights: what each got of the VSGL and RSM budget, and why */
+        /* several lights or the auto preset: what each light got of the budget, what auto chose, and why */
         for (const char *line = stats.budget; *line;) {
             const char *nl = strchr(line, '\n');
             size_t n = nl ? (size_t)(nl - line) : strlen(line);

@@ -91,7 +91,7 @@ expect_fail args_junk_number   2 "'2x' is not a whole number"    "$VSGL" render 
 expect_fail args_zero_vsgls    2 "'0' is not a whole number >= 1" "$VSGL" render "$SCENE" --vsgls 0
 expect_fail args_huge_number   2 "is not a whole number"         "$VSGL" render "$SCENE" --seed 99999999999
 expect_fail args_bad_enum      2 "'foo' is not one of two|fis|kmeans" "$VSGL" render "$SCENE" --fit=foo
-expect_fail args_bad_preset    2 "is not one of preview|balanced|quality" "$VSGL" render "$SCENE" --preset fast
+expect_fail args_bad_preset    2 "is not one of preview|balanced|quality|auto" "$VSGL" render "$SCENE" --preset fast
 expect_fail args_flag_value    2 "option --half takes no value"  "$VSGL" render "$SCENE" --half=1
 expect_fail args_two_scenes    2 "unexpected argument"           "$VSGL" render "$SCENE" other.vsglb
 expect_fail args_no_scene      2 "no scene bundle given"         "$VSGL" render -o "$T/x.exr"
@@ -252,6 +252,19 @@ if want render_half_verbose && expect_ok render_half_verbose "$VSGL" render "$SC
   done
   oiiotool --info "$T/from_bundle.exr" 2>&1 | grep -q "22 channel, half openexr" || errs="$errs [not half: $(oiiotool --info "$T/from_bundle.exr" 2>&1)]"
   if [ -z "$errs" ]; then ok render_half_verbose; else bad render_half_verbose "$errs"; fi
+fi
+
+# The auto preset says what it chose and why under -v (the 64x48 scene: below
+# 320x240, so aa stays 2; its one light's RSM from its footprint), and
+# --aa is a ceiling it keeps.
+if want render_auto && expect_ok render_auto "$VSGL" render "$SCENE" -o "$T/auto.exr" --preset auto --aa 3 -v; then
+  errs=""
+  for l in "vsgl: budget: auto: aa 3: 64x48, < 76800 pixels" "vsgl: budget: auto: glossy" \
+           "vsgl: budget: light 0: 100 % of the light on what the camera sees: 192 VSGLs, RSM " \
+           "vsgl: budget: RSM sides by footprint (85 texels per VSGL on it): "; do
+    grep -qF "$l" "$T/err" || errs="$errs [stderr lacks '$l']"
+  done
+  if [ -z "$errs" ]; then ok render_auto; else bad render_auto "$errs" "$(grep budget "$T/err" | tr '\n' '|')"; fi
 fi
 
 # Compression choices, read back by oiiotool; -v names the compression

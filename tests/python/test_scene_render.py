@@ -302,3 +302,31 @@ def test_render_glossy_mode_hybrid(lib, ctx):
     assert np.all(np.isfinite(hyb["glossy"])) and np.all(hyb["glossy"] >= 0)
     np.testing.assert_array_equal(hyb["diffuse"], asg2["diffuse"])
     assert L.GlossyMode.HYBRID == 4
+
+
+def test_auto_preset_says_what_it_chose(lib, ctx):
+    """The auto preset (render.h, VSGL_PRESET_AUTO): balanced's knobs with auto_target set; the render says
+    what it chose in stats["budget"], and rendering balanced with those knobs by hand gives the same pixels."""
+    require(lib, *ALL)
+    a = L.render_settings_preset("auto")
+    b = L.render_settings_preset("balanced")
+    assert a.auto_target == L.AUTO_BALANCED and b.auto_target == L.AUTO_OFF
+    knobs = lambda s: {k: v for k, v in s.as_dict().items() if k != "auto_target"}  # noqa: E731
+    assert knobs(a) == knobs(b)
+    scene = L.Scene(ctx, **floor_and_wall())
+    im, st = L.render(ctx, scene, a)
+    lines = st["budget"].splitlines()
+    assert lines[0].startswith("auto: aa ") and lines[1].startswith("auto: glossy "), st["budget"]
+    rsm = int(next(x for x in lines if x.startswith("light 0:")).split("RSM ")[1].split()[0])
+    aa = int(lines[0].split()[2].rstrip(":"))
+    by_hand = L.render_settings_preset("balanced")
+    by_hand.aa_samples, by_hand.rsm_resolution = aa, rsm
+    if "glossy asg (not" in st["budget"]:
+        by_hand.glossy_mode = L.GlossyMode.ASG
+    im2, st2 = L.render(ctx, scene, by_hand)
+    for k in im:
+        assert np.array_equal(im[k], im2[k]), k
+    assert st2["budget"] == ""
+    with pytest.raises(L.VsglError) as e:
+        L.render(ctx, scene, {"auto_target": 5})
+    assert e.value.code == L.Result.ERROR_INVALID_ARGUMENT and "auto_target" in e.value.message
