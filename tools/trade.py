@@ -62,12 +62,15 @@ SCENES = ["spot_metal_floor", "sun_opening", "box_point_area_glossy_green", "glo
 QUICK_SCENES = ["spot_metal_floor", "box_point_area_glossy_green"]
 SPP = [1, 2, 4, 8, 16, 64, 256, 1024]
 QUICK_SPP = [1, 4, 16]
-PRESETS = ["preview", "balanced", "quality"]
+PRESETS = ["preview", "balanced", "quality", "auto"]
 KNOBS = ["lattice 64:vsgl_count=64", "lattice 512:vsgl_count=512", "RSM 128:rsm_resolution=128",
          "RSM 512:rsm_resolution=512", "aa 1:aa_samples=1", "aa 4:aa_samples=4",
          "quality aa 4:preset=quality,aa_samples=4",
          # the glossy modes of issue 14 (docs/mrp.md) beside the k-means fit they are measured against
-         "k-means 256:fit_mode=kmeans,vsgl_count=256", "MRP:glossy_mode=3", "hybrid:glossy_mode=4"]
+         "k-means 256:fit_mode=kmeans,vsgl_count=256", "MRP:glossy_mode=3", "hybrid:glossy_mode=4",
+         # the auto preset with every RSM at 128 (a footprint of 1 at its 85 texels per VSGL): against auto,
+         # what sizing each light's RSM from its footprint buys; "aa 1" is auto's other knobs at a uniform 256
+         "auto RSM 128:preset=auto,rsm_resolution=128"]
 BRUTE = ["brute RSM 64:preset=brute,rsm_resolution=64", "brute RSM 128:preset=brute,rsm_resolution=128"]
 # scenes with more triangles: one library run per point, no brute force (dense_floor: balanced
 # ~20 s, brute force RSM 64 ~280 s at 320x240 here)
@@ -189,6 +192,9 @@ def run_brute_cached(ctx, arrays, case, cfg, exr_dir, name):
     return img, secs, vsgls, False
 
 
+LAST_BUDGET = {}  # the last library render's stats["budget"] (what the auto preset chose), by label
+
+
 def run_library(ctx, arrays, case, cfg, exr_dir):
     """(coloured passes, seconds dict) of one whole frame: scene creation, render, EXR write."""
     t0 = time.perf_counter()
@@ -201,6 +207,7 @@ def run_library(ctx, arrays, case, cfg, exr_dir):
         else:
             planes, st = L.render(ctx, sc, cfg.settings())
             vsgls = int(st["vsgl_count"])
+            LAST_BUDGET[cfg.label] = st.get("budget", "")
         t2 = time.perf_counter()
     passes = {EXR_PASSES[p]: np.asarray(a, np.float32) for p, a in planes.items() if p in EXR_PASSES}
     L.exr_write(ctx, os.path.join(exr_dir, "frame.exr"), passes, layer="VSGL")
@@ -278,7 +285,8 @@ def measure_scene(name, args, ctx, version, exr_dir):
             secs = min(secs, run_library(ctx, arrays, case, cfg, exr_dir)[1], key=lambda s: sum(s.values()))
         parts = dict(export=export, **secs)
         res["points"].append(dict(kind=kind, label=cfg.label, describe=cfg.describe(), seconds=sum(parts.values()),
-                                  parts=parts, vsgls=vsgls, **score(img, ref)))
+                                  parts=parts, vsgls=vsgls, budget=LAST_BUDGET.get(cfg.label, ""),
+                                  **score(img, ref)))
         images[cfg.label] = img["Combined"]
     if args.flicker_frames and not dense:
         small = scenes.case(name, FLICKER_SIZE)
@@ -304,7 +312,7 @@ def measure_scene(name, args, ctx, version, exr_dir):
 
 def time_at_size(name, args, ctx, version, export, exr_dir):
     """Whole-frame seconds at --time-size (no reference there): Cycles 1 and 4 spp, + OIDN, and the
-    presets balanced and quality (one run each)."""
+    presets balanced, quality and auto (one run each; what auto chose there in out["auto budget"])."""
     w, h = args.time_size
     out = dict(size=[w, h])
     S = sweeps([name], (w, h), TIME_SPP, version)[name]
@@ -317,10 +325,12 @@ def time_at_size(name, args, ctx, version, export, exr_dir):
         out["%d spp + OIDN" % spp] = meta["render_seconds"] + td
     case = scenes.case(name, (w, h))
     arrays = scenes.library_arrays(case, L)
-    for label in ("balanced", "quality"):
+    for label in ("balanced", "quality", "auto"):
         _, secs, _ = run_library(ctx, arrays, case, parse(label), exr_dir)
         out[label] = export + sum(secs.values())
-    log("%-28s at %dx%d: %s" % (name, w, h, ", ".join("%s %.2f s" % (k, v) for k, v in out.items() if k != "size")))
+    out["auto budget"] = LAST_BUDGET.get("auto", "")
+    times = ", ".join("%s %.2f s" % (k, v) for k, v in out.items() if k not in ("size", "auto budget"))
+    log("%-28s at %dx%d: %s" % (name, w, h, times))
     return out
 
 
@@ -457,6 +467,80 @@ def fmt(x, f="%.4f"):
     return "-" if x is None else f % x
 
 
+# The auto preset's gain (issue 11): the same error as balanced (combined relMSE within 5 %, FLIP within 2 %)
+# in less time, or less error in no more time
+AUTO_SAME = dict(relmse=1.05, flip=1.02)
+
+
+def auto_gain(a, b):
+    """(verdict, time ratio) of point a (auto) against point b (balanced)."""
+    tr = a["seconds"] / b["seconds"]
+    rr = a["Combined"]["relmse"] / b["Combined"]["relmse"]
+    fr = (a["flip"] or 0) / (b["flip"] or 1)
+    if rr <= AUTO_SAME["relmse"] and fr <= AUTO_SAME["flip"] and tr < 1:
+        return "gain: same error in %.2fx the time" % tr, tr
+    if rr < 1 and fr < 1 and tr <= 1:
+        return "gain: less error in %.2fx the time" % tr, tr
+    return "no gain", tr
+
+
+def auto_choice(budget):
+    """What the auto preset chose, from its budget lines, as one table cell."""
+    keep = [x.replace("auto: ", "") for x in budget.splitlines() if x.startswith("auto: ")]
+    keep += [x.split(": ", 1)[0] + ": RSM " + x.split("RSM ", 1)[1].split(" (")[0] + " (footprint " +
+             x.rsplit("footprint ", 1)[1] for x in budget.splitlines()
+             if x.startswith("light ") and "footprint" in x]
+    return "; ".join(keep).replace("|", "/") or "-"
+
+
+def auto_section(results, meta):
+    lines = ["", "## The auto preset", "",
+             "`auto` (VSGL_PRESET_AUTO) is balanced's knobs as ceilings; at render time the library chooses, by "
+             "rules measured on these scenes: 1 sample per pixel from 320 x 240 pixels (the `aa 1` knob was as "
+             "accurate as balanced's 2 x 2 there), one ASG glossy lobe where the camera's probe rays see nothing "
+             "sharper than roughness 0.5 (every bundled scene has a sharper one: asg2 stays), and each light's RSM "
+             "side from its footprint, 128^2 / 192 = 85 texels per VSGL on the part of its lit texels that "
+             "lights what the camera sees (`RSM 128` was as accurate as 256 where that is all of them). "
+             "Verdict: *gain* when auto's combined relMSE is within %d %% and its FLIP within %d %% of balanced's "
+             "in less time, or both lower in no more time. `aa 1` isolates the footprint (auto's other choices at a "
+             "uniform RSM 256), `auto RSM 128` what the footprint keeps where a light lights mostly what the "
+             "camera does not see (a uniform 128). Times: whole frames at the references' size (the fastest of %d "
+             "runs for the presets, one for the knobs)%s." % (
+                 round(100 * (AUTO_SAME["relmse"] - 1)), round(100 * (AUTO_SAME["flip"] - 1)), meta["repeat"],
+                 " and at %s (one run each)" % "x".join(map(str, meta["time_size"])) if meta["time_size"] else ""),
+             "", "| scene | auto chose | auto vs balanced: time, relMSE, FLIP | verdict | footprint: auto vs aa 1 "
+             "(RSM 256) | footprint: auto vs auto RSM 128 | %s |" % (
+                 "auto / balanced at %s" % "x".join(map(str, meta["time_size"])) if meta["time_size"] else "-"),
+             "|---|---|---|---|---|---|---|"]
+    gains = 0
+    for name, res in results.items():
+        a, b = point(res, "auto"), point(res, "balanced")
+        if a is None or b is None:
+            continue
+        verdict, _ = auto_gain(a, b)
+        gains += verdict.startswith("gain")
+
+        def vs(x, y):
+            if x is None or y is None:
+                return "-"
+            return "time %.2fx, relMSE %.5f vs %.5f, FLIP %.4f vs %.4f (%s)" % (
+                x["seconds"] / y["seconds"], x["Combined"]["relmse"], y["Combined"]["relmse"], x["flip"] or 0,
+                y["flip"] or 0, auto_gain(x, y)[0])
+        ta = res.get("time_at") or {}
+        big = "%.2f / %.2f s = %.2fx" % (ta["auto"], ta["balanced"], ta["auto"] / ta["balanced"]) \
+            if "auto" in ta else "-"
+        lines.append("| %s | %s | %.3f vs %.3f s (%.2fx), %.5f vs %.5f, %.4f vs %.4f | %s | %s | %s | %s |" % (
+            name, auto_choice(a.get("budget", "")), a["seconds"], b["seconds"], a["seconds"] / b["seconds"],
+            a["Combined"]["relmse"], b["Combined"]["relmse"], a["flip"] or 0, b["flip"] or 0, verdict,
+            vs(a, point(res, "aa 1")), vs(a, point(res, "auto RSM 128")), big))
+    lines += ["", "auto gains on %d of %d scenes." % (gains, sum(1 for r in results.values() if point(r, "auto")))]
+    timed = [(n, r["time_at"]) for n, r in results.items() if r.get("time_at", {}).get("auto budget")]
+    if timed:
+        lines += ["", "What auto chose at %s:" % "x".join(map(str, meta["time_size"])), ""]
+        lines += ["- %s: %s" % (n, auto_choice(t["auto budget"])) for n, t in timed]
+    return lines
+
+
 def markdown(results, meta, img_rel, png_rel):
     lines = ["# The trade: error against time, library vs Cycles and Cycles + OIDN (issue 11)", "",
              "Generated by `%s` on %s (do not edit by hand). Library %s, commit %s; this %d-core machine, "
@@ -518,13 +602,13 @@ def markdown(results, meta, img_rel, png_rel):
     timed = [(n, r["time_at"]) for n, r in results.items() if r.get("time_at")]
     if timed:
         w, h = timed[0][1]["size"]
-        cols = ["1 spp", "1 spp + OIDN", "4 spp", "4 spp + OIDN", "balanced", "quality"]
+        cols = ["1 spp", "1 spp + OIDN", "4 spp", "4 spp + OIDN", "balanced", "quality", "auto"]
         lines += ["", "### Whole-frame seconds at %dx%d" % (w, h), "",
                   "| scene | " + " | ".join(cols) + " | balanced <= 1/5 of 1 spp + OIDN | quality < 4 spp + OIDN |",
                   "|---|" + "---|" * (len(cols) + 2)]
         for n, t in timed:
             lines.append("| %s | %s | %s | %s |" % (
-                n, " | ".join("%.2f" % t[c] for c in cols),
+                n, " | ".join("%.2f" % t[c] if c in t else "-" for c in cols),
                 "PASS" if t["balanced"] <= t["1 spp + OIDN"] / 5 else "FAIL (%.2fx of it)" % (
                     t["balanced"] / t["1 spp + OIDN"]),
                 "PASS" if t["quality"] < t["4 spp + OIDN"] else "FAIL (%.2fx of it)" % (
@@ -533,6 +617,7 @@ def markdown(results, meta, img_rel, png_rel):
         if skipped:
             lines += ["", "Not timed at %dx%d: %s (the library takes minutes per preset there)." % (
                 w, h, ", ".join(skipped))]
+    lines += auto_section(results, meta)
     lines += ["", "## The presets and the library's own front", "",
               "Per scene, over the library's points only (presets, knobs, brute force): the configurations on the "
               "Pareto front of FLIP and of relMSE against time, whether each preset is on it, and whether `quality` "
@@ -660,6 +745,8 @@ def main():
             if point(res, label):
                 log("%-28s %-9s vs Cycles + OIDN at equal FLIP: %s"
                     % (name, label, ratio_text(res, label, "oidn", "flip")))
+        if point(res, "auto") and point(res, "balanced"):
+            log("%-28s auto      vs balanced: %s" % (name, auto_gain(point(res, "auto"), point(res, "balanced"))[0]))
 
 
 if __name__ == "__main__":
