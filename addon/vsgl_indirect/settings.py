@@ -110,8 +110,9 @@ ITEMS = {
          "Balanced's error at less cost: Balanced's knobs as ceilings, and the library chooses for "
          "the scene 1 sample per pixel from 320 x 240 pixels, one glossy lobe where nothing sharper "
          "than roughness 0.5 is seen, and each light's RSM from the part of it that lights what the "
-         "camera sees (85 texels per VSGL there). The last-run box says what it chose and why; "
-         "docs/trade.md, \"The auto preset\", measures it against Balanced"),
+         "camera sees (85 texels per VSGL there). Spot room at 320 x 240 (one run each, load 5): 0.41 s "
+         "at relMSE 0.0019 against Balanced's 1.11 s at 0.0019. The last-run box says what it chose "
+         "and why; docs/trade.md, \"The auto preset\", measures it on every bundled scene"),
     ],
     "method": [
         ("VSGL", "VSGL",
