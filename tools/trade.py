@@ -175,10 +175,14 @@ def brute_key(arrays, params):
     return h.hexdigest()[:16]
 
 
+def brute_path(arrays, case, cfg, name):
+    w, h = case["camera"]["res"]
+    return os.path.join(BRUTE_DIR, "%s_%dx%d_%s.npz" % (name, w, h, brute_key(arrays, cfg.brute_params(case))))
+
+
 def run_brute_cached(ctx, arrays, case, cfg, exr_dir, name):
     """run_library for a brute-force configuration through BRUTE_DIR: (passes, seconds, VPLs, cached?)."""
-    w, h = case["camera"]["res"]
-    path = os.path.join(BRUTE_DIR, "%s_%dx%d_%s.npz" % (name, w, h, brute_key(arrays, cfg.brute_params(case))))
+    path = brute_path(arrays, case, cfg, name)
     if os.path.exists(path):
         with np.load(path) as z:
             meta = json.loads(str(z["meta"]))
@@ -273,6 +277,9 @@ def measure_scene(name, args, ctx, version, exr_dir):
             res["skipped"].append(cfg.label)  # ~20-40 s a frame here: the presets only
             continue
         kind = "brute" if cfg.brute else ("preset" if cfg.label in PRESETS else "knob")
+        if cfg.brute and args.brute_cached_only and not os.path.exists(brute_path(arrays, case, cfg, name)):
+            res["skipped"].append(cfg.label + " (not in the brute-force cache; --brute-cached-only)")
+            continue
         if cfg.brute:
             img, secs, vsgls, cached = run_brute_cached(ctx, arrays, case, cfg, exr_dir, name)
             if cached:
@@ -648,7 +655,7 @@ def markdown(results, meta, img_rel, png_rel):
                   "one%s%s." % (
                       res["triangles"], ref["spp"], " / ".join("%.0f" % s for s in ref["seconds"]), ref["noise"],
                       fmt(ref["flip_seeds"]), res["export_seconds"], res["library_repeat"],
-                      ("; not run (minutes per frame here): " + ", ".join(res["skipped"]))
+                      ("; not run (minutes per frame here, or as said): " + ", ".join(res["skipped"]))
                       if res["skipped"] else "",
                       ("; from the brute-force cache: " + ", ".join(res["brute_cached"]))
                       if res.get("brute_cached") else ""), "",
@@ -692,6 +699,8 @@ def main():
     ap.add_argument("--flicker-frames", type=int, default=None,
                     help="frames of the presets' light animation at 160x120 (default 6; --quick 0)")
     ap.add_argument("--oidn-quality", default="high", choices=sorted(oidn.QUALITY))
+    ap.add_argument("--brute-cached-only", action="store_true",
+                    help="brute-force points only from build/trade/brute/ (a missing one is listed as not run)")
     ap.add_argument("--no-nice", action="store_true",
                     help="time the library and OIDN at this process's priority (default: nice 19, as the Cycles "
                          "renders always are)")
