@@ -21,7 +21,7 @@ else:  # a top-level module (the tests, tools/)
 # --------------------------------------------------------------------------
 
 BINDING_VERSION = (0, 3)
-BUNDLE_VERSION = (1, 3)
+BUNDLE_VERSION = (1, 4)
 
 
 class Result(enum.IntEnum):

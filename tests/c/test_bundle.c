@@ -122,6 +122,7 @@ static void make_scene(test_scene *s, unsigned seed)
     s->settings.seed = 1234567;
     s->settings.shade_stride = 3; /* format 1.3 */
     s->settings.edge_samples = 6;
+    s->settings.auto_target = VSGL_AUTO_BALANCED; /* format 1.4 */
 }
 
 static int same_bytes(const void *a, const void *b, size_t n)
@@ -184,11 +185,11 @@ VT_TEST(bundle_roundtrip_memory_is_bit_exact)
     if (bd) {
         check_same_scene(vsgl_bundle_scene(bd), &s.desc);
         const vsgl_render_settings *st = vsgl_bundle_settings(bd);
-        VT_CHECK(memcmp(st, &s.settings, sizeof *st) == 0, "settings seed %u aa %u stride %u edge %u", st->seed,
-                 st->aa_samples, st->shade_stride, st->edge_samples);
+        VT_CHECK(memcmp(st, &s.settings, sizeof *st) == 0, "settings seed %u aa %u stride %u edge %u auto %d", st->seed,
+                 st->aa_samples, st->shade_stride, st->edge_samples, st->auto_target);
         vsgl_bundle_info info = {.size = sizeof info};
         VT_CHECK(vsgl_bundle_get_info(bd, &info) == VSGL_OK, "info");
-        VT_CHECK(info.version_major == 1 && info.version_minor == 3 && info.has_frame && info.frame == -42 && info.has_settings &&
+        VT_CHECK(info.version_major == 1 && info.version_minor == 4 && info.has_frame && info.frame == -42 && info.has_settings &&
                      strcmp(info.output_path, "/tmp/out dir/frame_0042.exr") == 0,
                  "info %u.%u frame %d/%d settings %u path '%s'", info.version_major, info.version_minor, info.has_frame,
                  info.frame, info.has_settings, info.output_path);
@@ -274,7 +275,7 @@ VT_TEST(bundle_file_matches_independent_python_reader)
     snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s '%s'", script, path);
     int rc = run_capture(cmd, out, sizeof out);
     VT_CHECK(rc == 0 && strstr(out, "\nok\n"), "reference reader exit %d:\n%s", rc, out);
-    VT_CHECK(strstr(out, "version 1.3\n") && strstr(out, "section POS  esize 12 count 7 crc ok") &&
+    VT_CHECK(strstr(out, "version 1.4\n") && strstr(out, "section POS  esize 12 count 7 crc ok") &&
                  strstr(out, "section IDX  esize 12 count 5 crc ok") && strstr(out, "section LGHT esize 104 count 3 crc ok") &&
                  strstr(out, "camera type 0 fit 0 lens 50 size 320x240") && strstr(out, "light 2 type 2 power 300") &&
                  strstr(out, "output out.exr") && strstr(out, "frame 12") && strstr(out, "seed 1234567"),
@@ -370,9 +371,9 @@ VT_TEST(bundle_bad_headers_give_clear_errors)
 
     memcpy(t, b, n);
     wr32(t + 8, 2);
-    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 2.3, this library reads 1.x", "major 2");
+    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 2.4, this library reads 1.x", "major 2");
     wr32(t + 8, 0);
-    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 0.3", "major 0");
+    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 0.4", "major 0");
 
     memcpy(t, b, n);
     memset(t + n, 0, 16);
