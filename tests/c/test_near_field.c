@@ -204,6 +204,38 @@ VT_TEST(near_field_index_lists_every_cell_that_reaches_a_point)
     vsgl__vsgl_set_free(&set);
 }
 
+/* The diffuse plane of the fixture room's scene, shaded every pixel without
+ * visibility rays (a convex room), by `method` with leak correction `leak`;
+ * NULL if the render failed. *count: the VSGLs shaded. */
+static float *render_diffuse(vsgl_context *ctx, vsgl_scene *scene, uint32_t W, uint32_t H, int32_t method,
+                             int32_t leak, uint32_t *count)
+{
+    float *img = calloc((size_t)W * H * 3, sizeof(float));
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.shade_stride = 1;
+    s.aa_samples = 1;
+    s.rsm_resolution = 64;
+    s.visibility = VSGL_VISIBILITY_NONE;
+    s.method = method;
+    s.leak_correction = leak;
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = W;
+    o.height = H;
+    o.diffuse = img;
+    vsgl_render_stats st;
+    memset(&st, 0, sizeof st);
+    st.size = sizeof st;
+    if (!img || vsgl_render(ctx, scene, &s, &o, &st) != VSGL_OK) {
+        free(img);
+        return NULL;
+    }
+    if (count)
+        *count = st.vsgl_count;
+    return img;
+}
+
 /* A room lit by a spot (the fixture): with the near field the lattice's
  * diffuse light beside the junctions moves to the brute force's over the
  * same RSMs, where the far-field model alone is dark. */
@@ -217,24 +249,12 @@ VT_TEST(near_field_junctions_against_brute_force)
     vsgl_scene *scene;
     VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     size_t n = (size_t)W * H * 3;
-    float *img[3];
+    const int32_t method[3] = {VSGL_METHOD_BRUTE_FORCE, VSGL_METHOD_VSGL, VSGL_METHOD_VSGL};
     const int32_t leak[3] = {VSGL_LEAK_AUTO, VSGL_LEAK_AUTO, VSGL_LEAK_CLIP};
+    float *img[3];
     for (int k = 0; k < 3; ++k) {
-        img[k] = calloc(n, sizeof(float));
-        vsgl_render_settings s;
-        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
-        s.shade_stride = 1;
-        s.aa_samples = 1;
-        s.rsm_resolution = 64;
-        s.visibility = VSGL_VISIBILITY_NONE; /* a convex room */
-        s.method = k == 0 ? VSGL_METHOD_BRUTE_FORCE : VSGL_METHOD_VSGL;
-        s.leak_correction = leak[k];
-        vsgl_render_output o;
-        memset(&o, 0, sizeof o);
-        o.width = W;
-        o.height = H;
-        o.diffuse = img[k];
-        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "render %d: %s", k, vsgl_context_last_error(ctx));
+        img[k] = render_diffuse(ctx, scene, W, H, method[k], leak[k], NULL);
+        VT_REQUIRE(img[k], "render %d: %s", k, vsgl_context_last_error(ctx));
     }
     double e_near = acc_relmse(img[1], img[0], n), e_far = acc_relmse(img[2], img[0], n);
     double s0 = 0, s1 = 0, s2 = 0;
@@ -274,24 +294,8 @@ VT_TEST(lattice_specular_tail_against_brute_force)
     float *img[2];
     uint32_t count = 0;
     for (int k = 0; k < 2; ++k) {
-        img[k] = calloc(n, sizeof(float));
-        vsgl_render_settings s;
-        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
-        s.shade_stride = 1;
-        s.aa_samples = 1;
-        s.rsm_resolution = 64;
-        s.visibility = VSGL_VISIBILITY_NONE; /* a convex room */
-        s.method = k == 0 ? VSGL_METHOD_BRUTE_FORCE : VSGL_METHOD_VSGL;
-        vsgl_render_output o;
-        memset(&o, 0, sizeof o);
-        o.width = W;
-        o.height = H;
-        o.diffuse = img[k];
-        vsgl_render_stats st;
-        memset(&st, 0, sizeof st);
-        st.size = sizeof st;
-        VT_CHECK(vsgl_render(ctx, scene, &s, &o, &st) == VSGL_OK, "render %d: %s", k, vsgl_context_last_error(ctx));
-        count = st.vsgl_count;
+        img[k] = render_diffuse(ctx, scene, W, H, k ? VSGL_METHOD_VSGL : VSGL_METHOD_BRUTE_FORCE, VSGL_LEAK_AUTO, &count);
+        VT_REQUIRE(img[k], "render %d: %s", k, vsgl_context_last_error(ctx));
     }
     double e = acc_relmse(img[1], img[0], n);
     if (getenv("VSGL_TEST_VERBOSE"))
