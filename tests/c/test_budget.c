@@ -155,30 +155,45 @@ typedef struct bplanes {
     float comb[BW * BH * 3], gl[BW * BH * 3];
 } bplanes;
 
-static vsgl_result render_view(vsgl_context *ctx, const vsgl_scene *scene, vsgl_render_cache *cache, bplanes *p,
-                               vsgl_render_stats *st)
+/* One render of scene at w x h into comb (and gl, if not NULL), with settings
+ * s (NULL: the preview preset), through cache if not NULL. */
+static vsgl_result render_planes(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
+                                 vsgl_render_cache *cache, uint32_t w, uint32_t h, float *comb, float *gl,
+                                 vsgl_render_stats *st)
 {
-    vsgl_render_settings s;
-    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &s);
+    vsgl_render_settings preview;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &preview);
     vsgl_render_output o;
     memset(&o, 0, sizeof o);
-    o.width = BW;
-    o.height = BH;
-    o.combined = p->comb;
-    o.glossy_light = p->gl;
-    return vsgl_render_cached(ctx, scene, &s, cache, &o, st);
+    o.width = w;
+    o.height = h;
+    o.combined = comb;
+    o.glossy_light = gl;
+    return vsgl_render_cached(ctx, scene, s ? s : &preview, cache, &o, st);
 }
 
-/* render_view of a scene made from fx for this one render */
-static vsgl_result render(vsgl_context *ctx, fx_scene *fx, vsgl_render_cache *cache, bplanes *p,
-                          vsgl_render_stats *st)
+/* render_planes of a scene made from fx for this one render, at its camera's size */
+static vsgl_result render_fx(vsgl_context *ctx, fx_scene *fx, const vsgl_render_settings *s,
+                             vsgl_render_cache *cache, float *comb, float *gl, vsgl_render_stats *st)
 {
     vsgl_scene *scene = NULL;
     vsgl_result r = vsgl_scene_create(ctx, fx_desc(fx), &scene);
     if (r == VSGL_OK)
-        r = render_view(ctx, scene, cache, p, st);
+        r = render_planes(ctx, scene, s, cache, fx->camera.width, fx->camera.height, comb, gl, st);
     vsgl_scene_destroy(scene);
     return r;
+}
+
+static vsgl_result render_view(vsgl_context *ctx, const vsgl_scene *scene, vsgl_render_cache *cache, bplanes *p,
+                               vsgl_render_stats *st)
+{
+    return render_planes(ctx, scene, NULL, cache, BW, BH, p->comb, p->gl, st);
+}
+
+static vsgl_result render(vsgl_context *ctx, fx_scene *fx, vsgl_render_cache *cache, bplanes *p,
+                          vsgl_render_stats *st)
+{
+    return render_fx(ctx, fx, NULL, cache, p->comb, p->gl, st);
 }
 
 VT_TEST(budget_leaves_one_light_alone_and_reports_two)
@@ -379,17 +394,7 @@ typedef struct aplanes {
 static vsgl_result render_with(vsgl_context *ctx, fx_scene *fx, const vsgl_render_settings *s, float *comb,
                                vsgl_render_stats *st)
 {
-    vsgl_scene *scene = NULL;
-    vsgl_result r = vsgl_scene_create(ctx, fx_desc(fx), &scene);
-    vsgl_render_output o;
-    memset(&o, 0, sizeof o);
-    o.width = fx->camera.width;
-    o.height = fx->camera.height;
-    o.combined = comb;
-    if (r == VSGL_OK)
-        r = vsgl_render(ctx, scene, s, &o, st);
-    vsgl_scene_destroy(scene);
-    return r;
+    return render_fx(ctx, fx, s, NULL, comb, NULL, st);
 }
 
 /* The auto preset: what it says it chose is what it rendered (the same
