@@ -89,7 +89,10 @@ VT_TEST(near_field_form_factor_matches_quadrature)
                                         (float)rand() / RAND_MAX - 0.7f));
             float w;
             double got = vsgl__near_diffuse(&c, x, n, &w), want = quadrature(cuts[ci], x, n, 240);
-            if (want < 1e-4)
+            /* beyond the near field (weight 0) the value is never used and
+             * the function returns 0 early; a receiver on that boundary
+             * falls either side of it with the compiler's rounding */
+            if (want < 1e-4 || w == 0.0f)
                 continue;
             ++tested;
             int cut = 0;
