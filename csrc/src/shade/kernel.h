@@ -55,6 +55,11 @@ typedef struct vsgl_kernel_light {
     float planar;            /* weight of the planar glossy model (coherence^2 of a diffuse lobe, clip on), else 0 */
     float pvar;              /* its positional variance (var + the fit's overlap widening) */
     float u1x, u1y, u1z, u2x, u2y, u2z; /* an orthonormal basis of the cluster's plane */
+    /* A lattice cell cut by its surface's end (shade.h, vsgl__planar_glossy):
+     * the fold's weight (0: none), and per in-plane axis u1, u2 the boundary
+     * from the mean in units of sqrt(pvar) and the side the surface lies
+     * on (+1, -1; 0: not cut along that axis) */
+    float fold, fb1, fs1, fb2, fs2;
 } vsgl_kernel_light;
 
 /* Lobes a block needs (skip the work for lobes no lane has). */

@@ -221,6 +221,9 @@ typedef struct k_scratch {
     float vis[VSGL__KERNEL_BLOCK];                                             /* visibility x validity */
     float pexpo[VSGL__KERNEL_BLOCK], ppre[VSGL__KERNEL_BLOCK];                  /* the planar glossy's exp argument, factor */
     float kappa[VSGL__KERNEL_BLOCK], ct[VSGL__KERNEL_BLOCK];
+    /* the planar glossy's offsets and covariance (sigma units), for a fold */
+    float pd1[VSGL__KERNEL_BLOCK], pd2[VSGL__KERNEL_BLOCK], ps11[VSGL__KERNEL_BLOCK], ps22[VSGL__KERNEL_BLOCK],
+        ps12[VSGL__KERNEL_BLOCK], pidet[VSGL__KERNEL_BLOCK];
 } k_scratch;
 
 /* Stage 1: the incident radiance as one SG (Eq. 7), all but the exp.
@@ -418,6 +421,61 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     float qf = (s22 * d1 * d1 - 2.0f * s12 * d1 * e2 + s11 * e2 * e2) * idet;
     t->pexpo[i] = qf > 0.0f ? -0.5f * qf : 0.0f;
     t->ppre[i] = ok * t->vis[i] * kc * b->camp[i] * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu) * (is * is);
+    t->pd1[i] = d1;
+    t->pd2[i] = e2;
+    t->ps11[i] = s11;
+    t->ps22[i] = s22;
+    t->ps12[i] = s12;
+    t->pidet[i] = idet;
+}
+
+/* Phi(z), the standard normal CDF, from k_erfc_poly (within 1.5e-7). */
+static inline __attribute__((always_inline)) float k_ncdf(float z)
+{
+    float x = (z < 0.0f ? -z : z) * 0.70710678118654752f;
+    float e = 0.5f * k_erfc_poly(x) * k_exp(-x * x);
+    return z < 0.0f ? e : 1.0f - e;
+}
+
+/* The share of an image's footprint-blurred density on the surface's side
+ * of the boundary b (sigma units) along one axis: the product of the
+ * cluster's Gaussian about m and the footprint's about y (marginal
+ * variance f2) is a Gaussian of mean (m f2 + y) / (1 + f2) and variance
+ * f2 / (1 + f2). */
+static inline __attribute__((always_inline)) float k_fold_side(float m, float y, float f2, float bnd, float side)
+{
+    f2 = f2 > 1e-12f ? f2 : 1e-12f;
+    float i1 = 1.0f / (1.0f + f2);
+    float mp = (m * f2 + y) * i1;
+    return k_ncdf(side * (mp - bnd) * k_rsqrt_fine(f2 * i1));
+}
+
+/* Stage 4c (a lattice cell cut by its surface's end, L->fold > 0): the
+ * planar model's density with the cluster's Gaussian folded back at the
+ * boundary (an image mirrored across it) and each image kept to the
+ * surface's side (shade.h, vsgl__planar_glossy), blended in by L->fold;
+ * into ppre, with pexpo 0. */
+static inline __attribute__((always_inline)) void
+k_fold(size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
+{
+    const float d1 = t->pd1[i], d2 = t->pd2[i], s11 = t->ps11[i], s22 = t->ps22[i], s12 = t->ps12[i];
+    const float idet = t->pidet[i], f1 = s11 - 1.0f, f2 = s22 - 1.0f;
+    const int c1 = L->fs1 != 0.0f, c2 = L->fs2 != 0.0f;
+    float sum = 0.0f;
+    for (int a = 0; a <= c1; ++a)
+        for (int c = 0; c <= c2; ++c) {
+            float m1 = a ? 2.0f * L->fb1 : 0.0f, m2 = c ? 2.0f * L->fb2 : 0.0f;
+            float e1 = d1 - m1, e2 = d2 - m2;
+            float q = (s22 * e1 * e1 - 2.0f * s12 * e1 * e2 + s11 * e2 * e2) * idet;
+            float w = k_exp(q > 0.0f ? -0.5f * q : 0.0f);
+            if (c1)
+                w *= k_fold_side(m1, d1, f1, L->fb1, L->fs1);
+            if (c2)
+                w *= k_fold_side(m2, d2, f2, L->fb2, L->fs2);
+            sum += w;
+        }
+    t->ppre[i] *= (1.0f - L->fold) * k_exp(t->pexpo[i]) + L->fold * sum;
+    t->pexpo[i] = 0.0f;
 }
 
 /* Stage 5: the glossy lobe's exp and the accumulation, with the smooth
@@ -503,8 +561,13 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
             const int sg_only = none_planar;
             if (!all_planar)
                 K_FORN(k_glossy(b, i, t + j, kb, kc));
-            if (!sg_only)
+            if (!sg_only) {
                 K_FORN(k_planar(b, i, L + j, t + j, kb, kc));
+                for (int j = 0; j < NL; ++j)
+                    if (L[j].fold > 0.0f)
+                        for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
+                            k_fold(i, L + j, t + j);
+            }
             if (sg_only)
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 0));
             else if (all_planar)

@@ -70,6 +70,55 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
     return 1.0f - v->coherence * v->coherence * (1.0f - e);
 }
 
+/* Phi(t), the standard normal CDF (erfc, within 1e-7 absolute) */
+static float normal_cdf(float t)
+{
+    return 0.5f * erfcf(-t * 0.70710678f);
+}
+
+/* How much of a truncated lattice cell's Gaussian lies on its surface's
+ * side of its boundary along in-plane axis k (0: u, 1: v): the boundary
+ * b and the inside's sign (+1: u > b), or 0 if the cell is not cut there.
+ * A cut: the VPLs' extent ends short of the tent's (the surface ends). */
+static int cell_cut(const vsgl_vsgl *v, int k, float *b, float *sign)
+{
+    float h = v->cell_h, c = v->cell_centre[k];
+    float lo = v->cell_lo[k] - (c - h), hi = (c + h) - v->cell_hi[k];
+    if (!(h > 0.0f) || (lo < 0.05f * h && hi < 0.05f * h))
+        return 0;
+    if (lo >= hi) {
+        *b = v->cell_lo[k];
+        *sign = 1.0f;
+    } else {
+        *b = v->cell_hi[k];
+        *sign = -1.0f;
+    }
+    return 1;
+}
+
+/* How far the fold applies to v, in [0, 1]: a lattice cell on a plane
+ * facing its axis (facing x coherence 0.98 -> 0.995, as the near field's
+ * cells), cut along some axis; 0 for other clusters (a sphere's cells are
+ * cut by its curvature, not by a junction). */
+static float fold_weight(const vsgl_vsgl *v)
+{
+    float b, sgn;
+    if (!(v->cell_h > 0.0f) || (!cell_cut(v, 0, &b, &sgn) && !cell_cut(v, 1, &b, &sgn)))
+        return 0.0f;
+    const float nc[3] = {v->normal.x, v->normal.y, v->normal.z};
+    float facing = nc[v->cell_axis] * (v->cell_side ? -1.0f : 1.0f) * v->coherence;
+    float w = fminf(fmaxf((facing - 0.98f) / 0.015f, 0.0f), 1.0f);
+    return w * w * (3.0f - 2.0f * w);
+}
+
+/* The cell's in-plane axes u = axis + 1, v = axis + 2 (mod 3). */
+static void cell_axes(const vsgl_vsgl *v, v3 *u1, v3 *u2)
+{
+    const uint32_t a = v->cell_axis;
+    *u1 = v3_make(a == 2, a == 0, a == 1);
+    *u2 = v3_make(a == 1, a == 2, a == 0);
+}
+
 float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
 {
     v3 n = v->normal;
@@ -79,11 +128,17 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
     if (!(nz < -0.01f))
         return 0.0f; /* within 0.6 degrees of the plane: the footprint's density is ~0 (the kernel's bound) */
     float t = h / -nz;
-    v3 dlt = v3_sub(v3_add(x, v3_scale(lobe->z, t)), v->mean);
+    v3 y0 = v3_add(x, v3_scale(lobe->z, t));
+    v3 dlt = v3_sub(y0, v->mean);
     v3 ex = v3_scale(v3_sub(lobe->x, v3_scale(lobe->z, v3_dot(n, lobe->x) / nz)), t);
     v3 ey = v3_scale(v3_sub(lobe->y, v3_scale(lobe->z, v3_dot(n, lobe->y) / nz)), t);
     v3 u1, u2;
-    v3_basis(n, &u1, &u2);
+    float wf = fold_weight(v);
+    int fold = wf > 0.0f;
+    if (fold)
+        cell_axes(v, &u1, &u2);
+    else
+        v3_basis(n, &u1, &u2);
     float lam = fmaxf(lobe->lambda, 0.01f), mu = fmaxf(lobe->mu, 0.01f);
     float a1 = v3_dot(ex, u1), a2 = v3_dot(ex, u2), b1 = v3_dot(ey, u1), b2 = v3_dot(ey, u2);
     float d1 = v3_dot(dlt, u1), d2 = v3_dot(dlt, u2);
@@ -95,9 +150,36 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
     float det = var * (var + (a1 * a1 + a2 * a2) * il + (b1 * b1 + b2 * b2) * im) + cr * cr * il * im;
     if (!(det > 0.0f))
         return 0.0f;
-    float q = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
-    /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
-    return expf(lobe->log_amplitude - 0.5f * q) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
+    float scale = expf(lobe->log_amplitude) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
+    if (!fold) {
+        float q = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
+        /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
+        return scale * expf(-0.5f * q);
+    }
+    /* a cell cut by its surface's end: its Gaussian's part beyond the
+     * boundary folded back (an image mean mirrored across it), and each
+     * image's footprint-blurred density kept to the surface's side */
+    float bnd[2] = {0, 0}, sgn[2] = {0, 0}, mm[2] = {v3_dot(v->mean, u1), v3_dot(v->mean, u2)};
+    int cut[2] = {cell_cut(v, 0, &bnd[0], &sgn[0]), cell_cut(v, 1, &bnd[1], &sgn[1])};
+    float y0u[2] = {v3_dot(y0, u1), v3_dot(y0, u2)}, fp[2] = {s11 - var, s22 - var};
+    float sum = 0.0f;
+    for (int i1 = 0; i1 <= cut[0]; ++i1)
+        for (int i2 = 0; i2 <= cut[1]; ++i2) {
+            float m[2] = {i1 ? 2.0f * bnd[0] - mm[0] : mm[0], i2 ? 2.0f * bnd[1] - mm[1] : mm[1]};
+            float e1 = y0u[0] - m[0], e2 = y0u[1] - m[1];
+            float q = fmaxf((s22 * e1 * e1 - 2.0f * s12 * e1 * e2 + s11 * e2 * e2) / det, 0.0f);
+            float w = expf(-0.5f * q);
+            for (int k = 0; k < 2; ++k) {
+                if (!cut[k])
+                    continue;
+                float f2 = fmaxf(fp[k], 0.0f), mp = (m[k] * f2 + y0u[k] * var) / (var + f2);
+                float sp = sqrtf(var * f2 / (var + f2));
+                w *= sp > 0.0f ? normal_cdf(sgn[k] * (mp - bnd[k]) / sp) : (sgn[k] * (mp - bnd[k]) > 0.0f ? 1.0f : 0.0f);
+            }
+            sum += w;
+        }
+    float q0 = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
+    return scale * ((1.0f - wf) * expf(-0.5f * q0) + wf * sum);
 }
 
 /* The BRDF parameters of G-buffer sample i: its material's, from the
@@ -758,7 +840,22 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             o->planar = leak && v->lobe == VSGL__LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
             o->pvar = v->variance + v->widen;
             v3 u1, u2;
-            v3_basis(v->normal, &u1, &u2);
+            o->fold = o->planar > 0.0f ? fold_weight(v) : 0.0f;
+            o->fb1 = o->fs1 = o->fb2 = o->fs2 = 0.0f;
+            if (o->fold > 0.0f) {
+                cell_axes(v, &u1, &u2);
+                float is = 1.0f / sqrtf(fmaxf(o->pvar, VSGL__TINY)), b, sgn;
+                if (cell_cut(v, 0, &b, &sgn)) {
+                    o->fb1 = (b - v3_dot(v->mean, u1)) * is;
+                    o->fs1 = sgn;
+                }
+                if (cell_cut(v, 1, &b, &sgn)) {
+                    o->fb2 = (b - v3_dot(v->mean, u2)) * is;
+                    o->fs2 = sgn;
+                }
+            } else {
+                v3_basis(v->normal, &u1, &u2);
+            }
             o->u1x = u1.x; o->u1y = u1.y; o->u1z = u1.z;
             o->u2x = u2.x; o->u2y = u2.y; o->u2z = u2.z;
         }

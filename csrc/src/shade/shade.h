@@ -68,7 +68,16 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
  * radiance blurred by the footprint, N(y0 - mean; variance I + footprint) / pi.
  * Unlike the round spread SG it sees a plane foreshortened (a cabinet's
  * face reflecting the floor beside it: 0.65 -> 1.08 of the brute force's
- * glossy light in the sun room) and never anything behind the plane. */
+ * glossy light in the sun room) and never anything behind the plane.
+ * A lattice cell cut by its surface's end (its VPLs' extent short of its
+ * tent's, on a plane facing the cell's axis) has its Gaussian folded back
+ * at the boundary: an image mirrored across it, each image's blurred
+ * density kept to the surface's side (the 1-D product of the cluster's and
+ * the footprint's marginals, an erfc). The Gaussians of a surface's last
+ * lattice rows otherwise spill past the junction and the reflection of a
+ * lit wall darkened towards its foot (35 % at the junction of the red-wall
+ * room's floor; glossy structured error against Cycles 2-6x lower with the
+ * fold, docs/quality.md). */
 float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe);
 
 /* Shade every G-buffer sample with every VSGL; writes `planes`.

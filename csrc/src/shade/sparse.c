@@ -375,6 +375,40 @@ static float same_surface_weight(const shade_job *j, size_t s, size_t a)
     return wn * wp;
 }
 
+/* A junction: the sample's surface ends within its anchor cell against
+ * another surface that touches it (a wall's foot, a room's corner), so the
+ * anchors on its surface lie on one side of it only along a row or a
+ * column, and interpolation would extrapolate into the near field of the
+ * junction, where light changes fastest (1-px bright lines along a box's
+ * corners, a floor caustic's foot on a wall reduced to every other pixel).
+ * The sample is shaded itself there. `same` and `other`: bit dy * 2 + dx
+ * per anchor of the cell (of positive bilinear weight) on the sample's
+ * surface, and on another surface within SPARSE_JUNCTION times the
+ * farthest same-surface anchor's distance (further away it is an
+ * occluder's or a background's edge: a depth step, no near field). */
+#define SPARSE_JUNCTION 3.0f
+static inline int sparse_junction(unsigned same, unsigned other)
+{
+    const unsigned row0 = 0x3u, row1 = 0xcu, col0 = 0x5u, col1 = 0xau;
+    return (((same & row0) == 0) != ((same & row1) == 0) && (other & ((same & row0) ? row1 : row0))) ||
+           (((same & col0) == 0) != ((same & col1) == 0) && (other & ((same & col0) ? col1 : col0)));
+}
+
+/* other's bits of anchors within SPARSE_JUNCTION times the farthest
+ * same-surface one (squared distances d2 per anchor of the cell). */
+static inline unsigned sparse_touching(unsigned same, unsigned other, const float *d2)
+{
+    float far2 = 0.0f;
+    for (unsigned i = 0; i < 4; ++i)
+        if ((same >> i & 1u) && d2[i] > far2)
+            far2 = d2[i];
+    unsigned t = 0;
+    for (unsigned i = 0; i < 4; ++i)
+        if ((other >> i & 1u) && d2[i] <= SPARSE_JUNCTION * SPARSE_JUNCTION * far2)
+            t |= 1u << i;
+    return t;
+}
+
 /* The anchor cell around sample si: its raster position against the
  * anchors' (each shaded at its pixel's first sample); sample k of pixel
  * (x, y) lies at (x + (k % aa + 0.5) / aa, ...). */
@@ -434,8 +468,9 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
         uint32_t ax, ay;
         float tx, ty;
         sample_cell(j, si, spp, aa, inv_aa, &ax, &ay, &tx, &ty);
-        float wsum = 0.0f, L[6] = {0, 0, 0, 0, 0, 0};
+        float wsum = 0.0f, L[6] = {0, 0, 0, 0, 0, 0}, ad2[4] = {0, 0, 0, 0};
         float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {0.0f, 0.0f}, dx2[2] = {-1.0f, -1.0f}, dy2[2] = {-1.0f, -1.0f};
+        unsigned same = 0, other = 0;
         for (int dy = 0; dy < 2; ++dy)
             for (int dx = 0; dx < 2; ++dx) {
                 uint32_t cx = ax + (uint32_t)dx, cy = ay + (uint32_t)dy;
@@ -446,8 +481,15 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
                 if (as == SIZE_MAX || !(wb > 0.0f))
                     continue;
                 float w = wb * (as == si ? 1.0f : same_surface_weight(j, si, as));
-                if (!(w > 0.0f))
+                const unsigned bit = 1u << (dy * 2 + dx);
+                float d0 = g->pos[0][as] - g->pos[0][si], d1 = g->pos[1][as] - g->pos[1][si],
+                      dz = g->pos[2][as] - g->pos[2][si];
+                ad2[dy * 2 + dx] = d0 * d0 + d1 * d1 + dz * dz;
+                if (!(w > 0.0f)) {
+                    other |= bit;
                     continue;
+                }
+                same |= bit;
                 wsum += w;
                 const float *A = j->anchor_light + a * 6;
                 for (int c = 0; c < 6; ++c)
@@ -479,6 +521,8 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
                 smooth &= !(e > bound);
             }
         }
+        if (sparse_junction(same, sparse_touching(same, other, ad2)))
+            smooth = 0;
         if (wsum > 0.05f && smooth) {
             for (int c = 0; c < 6; ++c)
                 bt->interp[bi * 6 + c] = L[c] / wsum;
@@ -720,7 +764,8 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
             const float tx = plan->cell_tx[x * spp + k], ty = plan->cell_ty[y * spp + k];
             const float n[3] = {g->nrm[0][si], g->nrm[1][si], g->nrm[2][si]};
             const float xs[3] = {g->pos[0][si], g->pos[1][si], g->pos[2][si]};
-            float wsum = 0.0f;
+            float wsum = 0.0f, ad2[4] = {0, 0, 0, 0};
+            unsigned same = 0, other = 0;
             for (uint32_t dy = 0; dy < 2; ++dy)
                 for (uint32_t dx = 0; dx < 2; ++dx) {
                     uint32_t cx = ax + dx, cy = ay + dy;
@@ -731,12 +776,19 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
                     if (as == SIZE_MAX || !(wb > 0.0f))
                         continue;
                     float wa = wb * (as == si ? 1.0f : packed_surface_weight(n, xs, m, plan->geo + a * 8, j->plane_tol));
-                    if (!(wa > 0.0f))
+                    const float *q = plan->geo + a * 8;
+                    const float d0 = q[3] - xs[0], d1 = q[4] - xs[1], d2 = q[5] - xs[2];
+                    ad2[dy * 2 + dx] = d0 * d0 + d1 * d1 + d2 * d2;
+                    if (!(wa > 0.0f)) {
+                        other |= 1u << (dy * 2 + dx);
                         continue;
+                    }
+                    same |= 1u << (dy * 2 + dx);
                     wsum += wa;
                     w[dy * 2 + dx] = wa;
                 }
-            plan->direct[si] = wsum > 0.05f ? PLAN_NEAR : PLAN_ALONE;
+            plan->direct[si] =
+                wsum > 0.05f && !sparse_junction(same, sparse_touching(same, other, ad2)) ? PLAN_NEAR : PLAN_ALONE;
             if (!replay_sample(j, plan->pack, w, ax, ay, tx, ty, bt->interp + bi * 6))
                 bt->direct_of[bi] = SPARSE_MARK;
         }
