@@ -789,7 +789,7 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
                 }
             plan->direct[si] =
                 wsum > 0.05f && !sparse_junction(same, sparse_touching(same, other, ad2)) ? PLAN_NEAR : PLAN_ALONE;
-            if (!replay_sample(j, plan->pack, w, ax, ay, tx, ty, bt->interp + bi * 6))
+            if (plan->direct[si] == PLAN_ALONE || !replay_sample(j, plan->pack, w, ax, ay, tx, ty, bt->interp + bi * 6))
                 bt->direct_of[bi] = SPARSE_MARK;
         }
         if (++x == W) {
