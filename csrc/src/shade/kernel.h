@@ -56,10 +56,10 @@ typedef struct vsgl_kernel_light {
     float pvar;              /* its positional variance (var + the fit's overlap widening) */
     float u1x, u1y, u1z, u2x, u2y, u2z; /* an orthonormal basis of the cluster's plane */
     /* A lattice cell cut by its surface's end (shade.h, vsgl__planar_glossy):
-     * the fold's weight (0: none), and per in-plane axis u1, u2 the boundary
-     * from the mean in units of sqrt(pvar) and the side the surface lies
-     * on (+1, -1; 0: not cut along that axis) */
-    float fold, fb1, fs1, fb2, fs2;
+     * the fold's weight (0: none), and per in-plane axis u1, u2 and side
+     * (low: the surface above the cut, high: below) the cut from the mean
+     * in units of sqrt(pvar) and its weight (0: not cut there) */
+    float fold, fb[2][2], fa[2][2];
 } vsgl_kernel_light;
 
 /* Lobes a block needs (skip the work for lobes no lane has). */

@@ -437,43 +437,48 @@ static inline __attribute__((always_inline)) float k_ncdf(float z)
     return z < 0.0f ? e : 1.0f - e;
 }
 
-/* The share of an image's footprint-blurred density on the surface's side
- * of the boundary b (sigma units) along one axis: the product of the
- * cluster's Gaussian about m and the footprint's about y (marginal
- * variance f2) is a Gaussian of mean (m f2 + y) / (1 + f2) and variance
- * f2 / (1 + f2). */
-static inline __attribute__((always_inline)) float k_fold_side(float m, float y, float f2, float bnd, float side)
+/* Along one axis of a cut cell (sigma units, the cluster's mean at 0 and
+ * its variance 1): image img's mean (0: the cluster's, 1: mirrored across
+ * the low cut lo, 2: across the high cut hi) and weight, its
+ * footprint-blurred density's share on the surface's side of each cut,
+ * weighted by the cuts' weights al, ah (shade.c, fold_image: the product
+ * of the cluster's Gaussian and the footprint's about y, variance f2, is a
+ * Gaussian of mean (m f2 + y) / (1 + f2) and variance f2 / (1 + f2)). */
+static inline __attribute__((always_inline)) float k_fold_image(float lo, float hi, float al, float ah, int img,
+                                                                float y, float f2, float *m)
 {
+    *m = img == 0 ? 0.0f : 2.0f * (img == 1 ? lo : hi);
     f2 = f2 > 1e-12f ? f2 : 1e-12f;
-    float i1 = 1.0f / (1.0f + f2);
-    float mp = (m * f2 + y) * i1;
-    return k_ncdf(side * (mp - bnd) * k_rsqrt_fine(f2 * i1));
+    float i1 = 1.0f / (1.0f + f2), mp = (*m * f2 + y) * i1, isp = k_rsqrt_fine(f2 * i1);
+    float tl = k_ncdf((mp - lo) * isp), th = k_ncdf((hi - mp) * isp);
+    float wl = 1.0f - al + al * tl, wh = 1.0f - ah + ah * th;
+    return img == 0 ? wl * wh : img == 1 ? al * tl * wh : ah * th * wl;
 }
 
 /* Stage 4c (a lattice cell cut by its surface's end, L->fold > 0): the
- * planar model's density with the cluster's Gaussian folded back at the
- * boundary (an image mirrored across it) and each image kept to the
- * surface's side (shade.h, vsgl__planar_glossy), blended in by L->fold;
- * into ppre, with pexpo 0. */
+ * planar model's density with the cluster's Gaussian folded back at each
+ * cut (an image mirrored across it), every image kept to the surface's
+ * side (shade.c, vsgl__planar_glossy), blended in by L->fold; into ppre,
+ * with pexpo 0. */
 static inline __attribute__((always_inline)) void
 k_fold(size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
 {
     const float d1 = t->pd1[i], d2 = t->pd2[i], s11 = t->ps11[i], s22 = t->ps22[i], s12 = t->ps12[i];
-    const float idet = t->pidet[i], f1 = s11 - 1.0f, f2 = s22 - 1.0f;
-    const int c1 = L->fs1 != 0.0f, c2 = L->fs2 != 0.0f;
+    const float idet = t->pidet[i];
     float sum = 0.0f;
-    for (int a = 0; a <= c1; ++a)
-        for (int c = 0; c <= c2; ++c) {
-            float m1 = a ? 2.0f * L->fb1 : 0.0f, m2 = c ? 2.0f * L->fb2 : 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        if (a && !(L->fa[0][a - 1] > 0.0f))
+            continue;
+        float m1, w1 = k_fold_image(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], a, d1, s11 - 1.0f, &m1);
+        for (int c = 0; c < 3; ++c) {
+            if (c && !(L->fa[1][c - 1] > 0.0f))
+                continue;
+            float m2, w2 = k_fold_image(L->fb[1][0], L->fb[1][1], L->fa[1][0], L->fa[1][1], c, d2, s22 - 1.0f, &m2);
             float e1 = d1 - m1, e2 = d2 - m2;
             float q = (s22 * e1 * e1 - 2.0f * s12 * e1 * e2 + s11 * e2 * e2) * idet;
-            float w = k_exp(q > 0.0f ? -0.5f * q : 0.0f);
-            if (c1)
-                w *= k_fold_side(m1, d1, f1, L->fb1, L->fs1);
-            if (c2)
-                w *= k_fold_side(m2, d2, f2, L->fb2, L->fs2);
-            sum += w;
+            sum += w1 * w2 * k_exp(q > 0.0f ? -0.5f * q : 0.0f);
         }
+    }
     t->ppre[i] *= (1.0f - L->fold) * k_exp(t->pexpo[i]) + L->fold * sum;
     t->pexpo[i] = 0.0f;
 }
