@@ -364,3 +364,66 @@ VT_TEST(render_light_millimetres_from_a_wall_stays_finite_and_bounded)
     vsgl_scene_destroy(scene);
     vsgl_context_destroy(ctx);
 }
+
+/* The cuts where the planar glossy model folds (vsgl_vsgl.cell_ends): a
+ * floor lit only for x < 0.13 (a spot's rim, say) in the fixture room,
+ * whose walls rise at x = -1, x = 1 and y = 1 and whose floor stops at
+ * y = -1. With a one-lobe receiver mode only the surface's ends fold (the
+ * walls, the open end), never the rim; with two lobes the rim too. */
+VT_TEST(fit_lattice_marks_where_the_surface_ends)
+{
+    static lroom rm;
+    if (!lroom_open(&rm))
+        return;
+    plane_rsm h;
+    make_plane_rsm(&h, 128, 0, 0.0f, 3);
+    for (size_t t = 0; t < h.r.count; ++t)
+        if (h.r.pos[0][t] > 0.13f) {
+            h.r.material[t] = VSGL__RSM_EMPTY;
+            for (int c = 0; c < 3; ++c) {
+                h.r.total_flux[c] -= h.r.flux[c][t];
+                h.r.flux[c][t] = 0.0f;
+            }
+        }
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.vsgl_count = 64;
+    for (int two = 0; two < 2; ++two) {
+        s.glossy_mode = two ? VSGL_GLOSSY_ASG2 : VSGL_GLOSSY_ASG;
+        vsgl_vsgl_set lat = {0};
+        VT_REQUIRE(vsgl__fit_lattice(rm.ctx, rm.scene, &h.r, &s, &lat) == VSGL_OK, "lattice");
+        int rim = 0, rim_marked = 0, wall = 0, wall_marked = 0, open = 0, open_marked = 0;
+        for (size_t k = 0; k < lat.count; ++k) {
+            const vsgl_vsgl *v = &lat.items[k];
+            if (v->lobe != VSGL__LOBE_DIFFUSE || v->cell_axis != 2)
+                continue;
+            const float hh = v->cell_h;
+            /* x: in-plane axis 0; y: axis 1 */
+            if (v->cell_hi[0] < v->cell_centre[0] + 0.9f * hh) { /* cut at the rim, x = 0.13 */
+                ++rim;
+                rim_marked += (v->cell_ends >> 1) & 1u;
+            }
+            if (v->cell_lo[0] > v->cell_centre[0] - 0.9f * hh) { /* the wall x = -1 */
+                ++wall;
+                wall_marked += v->cell_ends & 1u;
+            }
+            if (v->cell_lo[1] > v->cell_centre[1] - 0.9f * hh) { /* the open end y = -1 */
+                ++open;
+                open_marked += (v->cell_ends >> 2) & 1u;
+            }
+            if (v->cell_hi[1] < v->cell_centre[1] + 0.9f * hh) { /* the wall y = 1 */
+                ++wall;
+                wall_marked += (v->cell_ends >> 3) & 1u;
+            }
+        }
+        VT_CHECK(rim > 0 && wall > 0 && open > 0, "cells cut: %d at the rim, %d at walls, %d at the open end", rim,
+                 wall, open);
+        VT_CHECK(wall_marked == wall && open_marked == open, "%s: %d of %d wall cuts and %d of %d open-end cuts marked",
+                 two ? "two lobes" : "one lobe", wall_marked, wall, open_marked, open);
+        VT_CHECK(rim_marked == (two ? rim : 0), "%s: %d of %d rim cuts marked", two ? "two lobes" : "one lobe",
+                 rim_marked, rim);
+        vsgl__vsgl_set_free(&lat);
+    }
+    free_plane_rsm(&h);
+    lroom_close(&rm);
+}

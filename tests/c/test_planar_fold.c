@@ -59,6 +59,7 @@ static int make_cell(int i, int j, int mark_cut, vsgl_vsgl *v)
     v->cell_lo[0] = (float)(cx - CELL_H);
     v->cell_hi[0] = (float)(cx + CELL_H);
     v->cell_lo[1] = (float)(mark_cut ? lo : cy - CELL_H);
+    v->cell_ends = mark_cut ? 1u << 2 : 0u; /* the plane ends at the cut, low side of v */
     v->cell_hi[1] = (float)(cy + CELL_H);
     return 1;
 }

@@ -34,6 +34,12 @@ typedef struct vsgl_vsgl {
     float cell_h;
     float cell_centre[2], cell_lo[2], cell_hi[2];
     uint32_t cell_axis, cell_side;
+    /* Bit 2 k + s: the VPLs' extent stops short of the tent on side s (0
+     * low, 1 high) of in-plane axis k because the surface ends there (a
+     * wall rises or the plane stops; probed in the scene), not at a
+     * shadow's edge or a spot's rim where it goes on: the planar glossy
+     * model's fold applies there (shade.h, vsgl__planar_glossy). */
+    uint32_t cell_ends;
 } vsgl_vsgl;
 
 typedef struct vsgl_vsgl_set {

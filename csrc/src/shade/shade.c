@@ -80,10 +80,11 @@ static float normal_cdf(float t)
  * axis + 2): where its VPLs' extent stops short of its tent's on the low
  * side (side 0, the surface at u > b) and the high side (1, u < b), and
  * each cut's weight: a smoothstep of the shortfall from 0.02 to 0.1
- * spacings, so that the fold comes in continuously as a surface's end, a
- * shadow's edge or a spot's rim enters the tent (a hard threshold made the
- * preview's glossy pass jitter as a sun moved: light flicker 0.004 ->
- * 0.014 in the thick-walled sun room). */
+ * spacings, so that the fold comes in continuously (a hard threshold made
+ * the preview's glossy pass jitter as a sun moved: light flicker 0.004 ->
+ * 0.014 in the thick-walled sun room). Only where the surface ends
+ * (vsgl_vsgl.cell_ends): a shadow's edge or a spot's rim moves with the
+ * light, and the cut, in texel steps. */
 typedef struct cell_cuts {
     float b[2][2], a[2][2]; /* [axis][side]: boundary (m, on the axis), weight */
 } cell_cuts;
@@ -101,6 +102,8 @@ static int cell_cuts_of(const vsgl_vsgl *v, cell_cuts *c)
         c->b[k][0] = v->cell_lo[k];
         c->b[k][1] = v->cell_hi[k];
         for (int sd = 0; sd < 2; ++sd) {
+            if (!(v->cell_ends >> (2 * k + sd) & 1u))
+                continue;
             float t = fminf(fmaxf((short_by[sd] - 0.02f) / 0.08f, 0.0f), 1.0f);
             c->a[k][sd] = t * t * (3.0f - 2.0f * t);
             any |= c->a[k][sd] > 0.0f;

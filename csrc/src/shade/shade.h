@@ -70,10 +70,11 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
  * face reflecting the floor beside it: 0.65 -> 1.08 of the brute force's
  * glossy light in the sun room) and never anything behind the plane.
  * A lattice cell cut by its surface's end (its VPLs' extent short of its
- * tent's, on a plane facing the cell's axis) has its Gaussian folded back
- * at the boundary: an image mirrored across it, each image's blurred
- * density kept to the surface's side (the 1-D product of the cluster's and
- * the footprint's marginals, an erfc). The Gaussians of a surface's last
+ * tent's, on a plane facing the cell's axis; the cuts vsgl_vsgl.cell_ends
+ * marks) has its Gaussian folded back at each cut: an image mirrored
+ * across it, each image's blurred density kept to the surface's side (the
+ * 1-D product of the cluster's and the footprint's marginals, an erfc),
+ * weighted by a smoothstep of the cut's depth. The Gaussians of a surface's last
  * lattice rows otherwise spill past the junction and the reflection of a
  * lit wall darkened towards its foot (35 % at the junction of the red-wall
  * room's floor; glossy structured error against Cycles 2-6x lower with the
