@@ -359,15 +359,6 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
             vsgl__grid_moments(f, &mo);
             if (vsgl__moments_to_vsgl(&mo, g.origin, s->sharpness_estimator, rsm->light, lobe, &v)) {
                 v.widen = (float)widen;
-                /* not with one-lobe receivers (ASG, SG: the preview) */
-                if (lobe == VSGL__LOBE_SPECULAR && r == VSGL_OK && s->glossy_mode != VSGL_GLOSSY_ASG &&
-                    s->glossy_mode != VSGL_GLOSSY_SG) {
-                    r = split_specular(&v, out);
-                    if (r != VSGL_OK) {
-                        r = vsgl__fail(ctx, r, "fit: out of memory");
-                        break;
-                    }
-                }
                 const int32_t *cc = map.cell + c * 3;
                 const double *e = map.ext + c * 4;
                 int ax = cc[0] >> 1, au = (ax + 1) % 3, av = (ax + 2) % 3;
@@ -387,6 +378,16 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
                     for (int sd = 0; sd < 2; ++sd)
                         if (short_by[sd] > 0.02 && (fold_moving || surface_ends(scene, &v, k, sd)))
                             v.cell_ends |= 1u << (2 * k + sd);
+                }
+                /* not with one-lobe receivers (ASG, SG: the preview); the
+                 * tail keeps the cell (the near field of specular emitters) */
+                if (lobe == VSGL__LOBE_SPECULAR && s->glossy_mode != VSGL_GLOSSY_ASG &&
+                    s->glossy_mode != VSGL_GLOSSY_SG) {
+                    r = split_specular(&v, out);
+                    if (r != VSGL_OK) {
+                        r = vsgl__fail(ctx, r, "fit: out of memory");
+                        break;
+                    }
                 }
                 r = vsgl__vsgl_set_push(out, &v);
                 if (r != VSGL_OK)

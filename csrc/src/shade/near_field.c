@@ -33,6 +33,11 @@
  * spacings of the VPLs' mean, none from three times it (a shadow or a
  * spot's edge crossing the cell moves the mean; the steps cannot). */
 #define VSGL__NEAR_UNIFORM 0.05f
+/* A specular cell's lobe leaves its plane at this cosine at least (the
+ * footprint's linearisation grows with 1 / cos). */
+#define VSGL__NEAR_SPECULAR_COS 0.1f
+/* Gauss-Legendre nodes of the footprint's mass over a step (per axis). */
+#define VSGL__NEAR_GL 8
 /* Grid cells per axis of the index at most. */
 #define VSGL__NEAR_GRID_MAX 64
 
@@ -106,12 +111,40 @@ static float polygon_form_factor(v3 x, v3 n, const v3 *p, int m)
     return fabsf(sum) * (0.5f * VSGL__INV_PI);
 }
 
+/* The mean of the tent 1 - |x - c| / h over [lo, hi]. */
+static double tent_mean(double lo, double hi, double c, double h)
+{
+    double m0 = 0.0, m1 = 0.0;
+    double a = fmin(hi, c) - c, b = lo - c; /* the rising side, y = x - c in [b, a] */
+    if (a > b) {
+        m0 += (a - b) + (a * a - b * b) / (2.0 * h);
+        m1 += (a * a - b * b) / 2.0 + (a * a * a - b * b * b) / (3.0 * h);
+    }
+    a = fmax(lo, c) - c;
+    b = hi - c; /* the falling side, y in [a, b] */
+    if (b > a) {
+        m0 += (b - a) - (b * b - a * a) / (2.0 * h);
+        m1 += (b * b - a * a) / 2.0 - (b * b * b - a * a * a) / (3.0 * h);
+    }
+    return m0 > 0.0 ? c + m1 / m0 : c;
+}
+
 int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
 {
     memset(c, 0, sizeof *c);
-    if (!(v->cell_h > 0.0f) || v->lobe != VSGL__LOBE_DIFFUSE || !(v->power[0] + v->power[1] + v->power[2] > 0.0f))
+    if (!(v->cell_h > 0.0f) || !(v->power[0] + v->power[1] + v->power[2] > 0.0f))
         return 0;
     uint32_t a = v->cell_axis;
+    if (v->lobe == VSGL__LOBE_SPECULAR) {
+        /* a lobe that leaves the plane's front by more than ~6 degrees */
+        float out = axis_of(v->axis, a) * (v->cell_side ? -1.0f : 1.0f);
+        if (!(v->sharpness > 0.0f) || !(out > VSGL__NEAR_SPECULAR_COS))
+            return 0;
+        c->lobe_axis = v->axis;
+        c->lambda = v->sharpness;
+    } else if (v->lobe != VSGL__LOBE_DIFFUSE) {
+        return 0;
+    }
     float h = v->cell_h;
     c->h = h;
     c->axis = a;
@@ -143,9 +176,107 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
     float du = su / area - axis_of(v->mean, (a + 1) % 3), dv = sv / area - axis_of(v->mean, (a + 2) % 3);
     float off = sqrtf(du * du + dv * dv) / h;
     c->fit = v->coherence * v->coherence *
-             smooth01((facing - VSGL__NEAR_FACING_LO) / (VSGL__NEAR_FACING_HI - VSGL__NEAR_FACING_LO)) *
-             (1.0f - smooth01((off - VSGL__NEAR_UNIFORM) / (2.0f * VSGL__NEAR_UNIFORM)));
+             smooth01((facing - VSGL__NEAR_FACING_LO) / (VSGL__NEAR_FACING_HI - VSGL__NEAR_FACING_LO));
+    if (c->lambda > 0.0f) {
+        /* a specular cell: irradiance linear across the steps, its mean
+         * the VPLs' (grad = M2^-1 (mean - centroid), M2 the steps' second
+         * moments), scaled down to stay >= 0 at the steps' corners (a
+         * sliver cell's mean is off its thin steps' centroid by more than
+         * a line can move it; dropping such cells left the strip beside a
+         * wall half lit) */
+        c->centroid[0] = su / area;
+        c->centroid[1] = sv / area;
+        double m[3] = {0.0, 0.0, 0.0};
+        for (uint32_t k = 0; k < c->nrect; ++k) {
+            const float *r = c->rect[k];
+            double a0 = r[0] - c->centroid[0], a1 = r[1] - c->centroid[0];
+            double b0 = r[2] - c->centroid[1], b1 = r[3] - c->centroid[1];
+            m[0] += (a1 * a1 * a1 - a0 * a0 * a0) / 3.0 * (b1 - b0);
+            m[1] += (a1 * a1 - a0 * a0) * 0.5 * (b1 * b1 - b0 * b0) * 0.5;
+            m[2] += (b1 * b1 * b1 - b0 * b0 * b0) / 3.0 * (a1 - a0);
+        }
+        double det = m[0] * m[2] - m[1] * m[1];
+        double g0 = 0.0, g1 = 0.0;
+        if (det > 0.0) {
+            /* the VPLs' mean against a uniformly lit truncated tent's (not the
+             * steps' centroid, which a sliver cell's steps miss): the part a
+             * gradient of irradiance moved it, x area */
+            double eu = (axis_of(v->mean, (a + 1) % 3) - tent_mean(v->cell_lo[0], v->cell_hi[0], v->cell_centre[0], h)) *
+                        area;
+            double ev = (axis_of(v->mean, (a + 2) % 3) - tent_mean(v->cell_lo[1], v->cell_hi[1], v->cell_centre[1], h)) *
+                        area;
+            g0 = (m[2] * eu - m[1] * ev) / det;
+            g1 = (m[0] * ev - m[1] * eu) / det;
+        }
+        double lowest = 1.0;
+        for (uint32_t k = 0; k < c->nrect; ++k)
+            for (int q = 0; q < 4; ++q) {
+                const float *r = c->rect[k];
+                double y0 = (q & 1 ? r[1] : r[0]) - c->centroid[0], y1 = (q & 2 ? r[3] : r[2]) - c->centroid[1];
+                double l = 1.0 + g0 * y0 + g1 * y1;
+                lowest = l < lowest ? l : lowest;
+            }
+        float scale = lowest < 0.0 ? (float)(1.0 / (1.0 - lowest)) : 1.0f;
+        c->grad[0] = (float)g0 * scale;
+        c->grad[1] = (float)g1 * scale;
+    } else {
+        c->fit *= 1.0f - smooth01((off - VSGL__NEAR_UNIFORM) / (2.0f * VSGL__NEAR_UNIFORM));
+    }
     return c->fit > 0.0f;
+}
+
+/* Phi(t), the standard normal CDF. */
+static float normal_cdf(float t)
+{
+    return 0.5f * erfcf(-t * 0.70710678f);
+}
+
+/* The mass of the 2-D Gaussian of mean (pu, pv) and covariance (cuu, cuv;
+ * cuv, cvv) over the rectangle [u0, u1] x [v0, v1], weighted by 1 + g .
+ * (y - o): Gauss-Legendre over u (within 6 sigma of the mean) of the
+ * density of u times the conditional mass (and first moment) of v given u. */
+static float gauss_rect(float pu, float pv, float cuu, float cuv, float cvv, const float *r, const float *g,
+                        const float *o)
+{
+    static const float gx[VSGL__NEAR_GL / 2] = {0.1834346425f, 0.5255324099f, 0.7966664774f, 0.9602898565f};
+    static const float gw[VSGL__NEAR_GL / 2] = {0.3626837834f, 0.3137066459f, 0.2223810345f, 0.1012285363f};
+    float su = sqrtf(cuu);
+    float u0 = fmaxf(r[0], pu - 6.0f * su), u1 = fminf(r[1], pu + 6.0f * su);
+    if (!(u1 > u0) || !(su > 0.0f))
+        return 0.0f;
+    float slope = cuv / cuu, sv = sqrtf(fmaxf(cvv - cuv * slope, 1e-12f * cvv)), isv = 1.0f / sv;
+    float mid = 0.5f * (u0 + u1), half = 0.5f * (u1 - u0), sum = 0.0f;
+    for (int k = 0; k < VSGL__NEAR_GL; ++k) {
+        float u = mid + (k & 1 ? -half : half) * gx[k >> 1], du = (u - pu) / su;
+        float mv = pv + slope * (u - pu);
+        float a = (r[2] - mv) * isv, b = (r[3] - mv) * isv;
+        float cond = normal_cdf(b) - normal_cdf(a);
+        /* the conditional first moment of v - o_v over [v0, v1] */
+        float first = (mv - o[1]) * cond - sv * 0.3989422804f * (expf(-0.5f * b * b) - expf(-0.5f * a * a));
+        sum += gw[k >> 1] * expf(-0.5f * du * du) * (cond * (1.0f + g[0] * (u - o[0])) + g[1] * first);
+    }
+    return sum * half / (su * 2.5066282746f);
+}
+
+/* A specular cell's light per watt at x (height above its plane), normal n
+ * (near_field.h). */
+static float near_specular(const vsgl_near_cell *c, v3 x, v3 n, float height)
+{
+    uint32_t a = c->axis;
+    float up = c->side ? -1.0f : 1.0f;
+    float cb = axis_of(c->lobe_axis, a) * up, cx = -v3_dot(c->lobe_axis, n);
+    if (!(cb > 0.0f) || !(cx > 0.0f))
+        return 0.0f;
+    float t = height / cb;
+    v3 p = v3_sub(x, v3_scale(c->lobe_axis, t));
+    uint32_t iu = (a + 1) % 3, iv = (a + 2) % 3;
+    float au = axis_of(c->lobe_axis, iu), av = axis_of(c->lobe_axis, iv), s = t * t / c->lambda, k = 1.0f / (cb * cb);
+    float cuu = s * (1.0f + au * au * k), cvv = s * (1.0f + av * av * k), cuv = s * au * av * k;
+    float pu = axis_of(p, iu), pv = axis_of(p, iv), frac = 0.0f;
+    for (uint32_t r = 0; r < c->nrect; ++r)
+        frac += gauss_rect(pu, pv, cuu, cuv, cvv, c->rect[r], c->grad, c->centroid);
+    /* inv_area = 1 / (pi S) */
+    return cx * frac * c->inv_area / cb;
 }
 
 float vsgl__near_diffuse(const vsgl_near_cell *c, v3 x, v3 n, float *weight)
@@ -164,6 +295,8 @@ float vsgl__near_diffuse(const vsgl_near_cell *c, v3 x, v3 n, float *weight)
               (1.0f - smooth01((height / c->h - VSGL__NEAR_HEIGHT_FULL) /
                                (VSGL__NEAR_HEIGHT_NONE - VSGL__NEAR_HEIGHT_FULL)));
     float front = smooth01(height / (VSGL__NEAR_BEHIND * c->h));
+    if (c->lambda > 0.0f)
+        return front * near_specular(c, x, n, height);
     float ff = 0.0f;
     for (uint32_t k = 0; k < c->nrect; ++k) {
         const float *q = c->rect[k];

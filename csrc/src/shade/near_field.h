@@ -27,10 +27,18 @@ typedef struct vsgl_near_cell {
     uint32_t axis, side;  /* the plane faces +axis (side 0) or -axis (side 1) */
     uint32_t nrect;       /* steps with any area */
     uint32_t vsgl;        /* its VSGL in the set */
+    /* a specular cluster (a metal floor's reflection of a lit wall): its
+     * lobe's axis and sharpness; lambda 0 for a Lambertian one */
+    v3 lobe_axis;
+    float lambda;
+    /* its irradiance across the steps, linear: 1 + grad . (y - centroid)
+     * (in-plane u, v; the steps' centroid), so that its mean is the VPLs' */
+    float grad[2], centroid[2];
 } vsgl_near_cell;
 
-/* The cell of v; 0 if the model does not apply to v (not a diffuse lattice
- * cluster, no power, a curved surface, or radiosity far from uniform). */
+/* The cell of v; 0 if the model does not apply to v (not a lattice
+ * cluster, no power, a curved surface, radiosity far from uniform, or a
+ * specular lobe that does not leave its plane's front). */
 int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c);
 
 /* The diffuse light per watt (irradiance / pi per W of the cluster's
@@ -38,7 +46,19 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c);
  * takes, in [0, 1]: the cell's fit, 1 within VSGL__NEAR_FULL spacings of
  * its centre and 0 beyond VSGL__NEAR_NONE, smooth between. 0 and weight
  * 0 behind or in the cell's plane (where the far-field term is ~0 too:
- * the emitter clip). */
+ * the emitter clip).
+ * A specular cell is its steps of uniform irradiance reflected through
+ * its lobe G(w) = e^{lambda (w.axis - 1)}: x sees the lobe's mass that
+ * falls in the steps as seen from x, the lobe's footprint on the plane
+ * about where its axis through x meets it (linearised: covariance
+ * (t^2 / lambda) (I + a a^T / cos^2 b), a the axis's in-plane part, t the
+ * distance, b its angle to the plane's normal), so E = P cos_x sum_k
+ * frac_k / (S cos b) with S the steps' area: a floor's caustic at a
+ * wall's foot is the steps' image, where the far field drew one
+ * lobe-sized blob per cluster. Its irradiance varies linearly across the
+ * steps so that their mean is the VPLs' (a spot's spill on a floor rises
+ * 5x towards the wall it lights; uniform, the caustic came out half as
+ * bright). */
 float vsgl__near_diffuse(const vsgl_near_cell *c, v3 x, v3 n, float *weight);
 
 /* The cells whose near field reaches each cell of a uniform grid (CSR),
