@@ -286,10 +286,11 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl
 
 /* 1 if cell v's surface ends at the cut on side sd of in-plane axis k
  * (vsgl_vsgl.cell_ends): something rises there (a ray along the plane,
- * just above it, from inside the cut outwards, is blocked) or the plane
- * stops (a ray down onto it just beyond the cut misses). A shadow's edge or
- * a spot's rim cuts the VPLs too, but the surface goes on there. */
-static int surface_ends(const vsgl_scene *scene, const vsgl_vsgl *v, int k, int sd)
+ * just above it, from inside the cut outwards, is blocked; the cut then
+ * moves to where it hit) or the plane stops (a ray down onto it just
+ * beyond the cut misses). A shadow's edge or a spot's rim cuts the VPLs
+ * too, but the surface goes on there. */
+static int surface_ends(const vsgl_scene *scene, vsgl_vsgl *v, int k, int sd)
 {
     const int a = (int)v->cell_axis, ax = (a + 1 + k) % 3, other = (a + 2 - k) % 3;
     const float h = v->cell_h, up = v->cell_side ? -1.0f : 1.0f, out = sd ? 1.0f : -1.0f;
@@ -302,8 +303,19 @@ static int surface_ends(const vsgl_scene *scene, const vsgl_vsgl *v, int k, int 
     p[ax] = b - out * inside;
     float d[3] = {0.0f, 0.0f, 0.0f};
     d[ax] = out;
-    if (vsgl__scene_occluded(scene, v3_make(p[0], p[1], p[2]), v3_make(d[0], d[1], d[2]), 0.0f, 2.0f * inside))
+    vsgl_hit hit;
+    if (vsgl__scene_intersect(scene, v3_make(p[0], p[1], p[2]), v3_make(d[0], d[1], d[2]), 0.0f, 2.0f * inside,
+                              &hit)) {
+        /* the wall's face: where the cut is, exactly (the VPLs' extent
+         * wanders by half a texel as the light moves, and the fold and the
+         * near field's steps with it) */
+        float at = p[ax] + out * hit.t;
+        if (sd)
+            v->cell_hi[k] = at;
+        else
+            v->cell_lo[k] = at;
         return 1;
+    }
     p[ax] = b + out * inside;
     d[ax] = 0.0f;
     d[a] = -up;
