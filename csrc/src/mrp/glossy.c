@@ -118,36 +118,30 @@ static double glossy_lobe(const vsgl__mrp_rect *rc, d3 x, double h, const vsgl_s
     return v > 0.0 && v < INFINITY ? v : 0.0;
 }
 
-int vsgl__mrp_glossy_parts(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha, const vsgl__mrp_options *opt,
-                           unsigned skip, double value[2], d3 axis[2])
+void vsgl__mrp_receiver_make(d3 n, d3 o, double alpha, const vsgl__mrp_options *opt, vsgl__mrp_receiver *out)
 {
-    const int parts = opt->lobes == 2 ? 2 : 1;
-    for (int q = 0; q < 2; ++q) {
-        value[q] = 0.0;
-        axis[q] = n;
-    }
-    double h = d3_dot(d3_sub(x, rc->center), rc->normal);
-    if (!(h > 0.0) || !(rc->half_u > 0.0) || !(rc->half_v > 0.0))
-        return parts;
+    memset(out, 0, sizeof *out);
+    out->n = n;
+    out->parts = opt->lobes == 2 ? 2 : 1;
     vsgl_sg g;
     vsgl__mrp_receiver_sg(n, o, alpha, &g);                /* Eq. 8 */
-    vsgl_asg ra;
-    memset(&ra, 0, sizeof ra);
-    if (opt->receiver_asg) { /* the library's warped ASG (stretched at grazing views) */
+    { /* the library's warped ASG (stretched at grazing views) */
         vsgl_vec3 nf = d3_to_v3(n), of = d3_to_v3(o), t;
         d3 t0, t1;
         d3_basis(n, &t0, &t1);
         t = d3_to_v3(t0);
         vsgl_asg ndf;
         vsgl_ndf_aniso_to_asg(&nf, &t, (float)alpha, (float)alpha, &ndf);
-        vsgl_warp_ndf_asg(&ndf, &of, &ra);
+        vsgl_warp_ndf_asg(&ndf, &of, &out->warped);
     }
-    for (int q = 0; q < parts; ++q) {
-        if (skip & (1u << q))
-            continue;
+    vsgl_asg ra;
+    memset(&ra, 0, sizeof ra);
+    if (opt->receiver_asg)
+        ra = out->warped;
+    for (int q = 0; q < out->parts; ++q) {
         vsgl_sg gq = g;
         vsgl_asg aq = ra;
-        if (parts == 2) { /* GGX's core (q 0) or tail (q 1): bandwidths x K, amplitude x C */
+        if (out->parts == 2) { /* GGX's core (q 0) or tail (q 1): bandwidths x K, amplitude x C */
             float k = q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K, c = q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C;
             gq.sharpness *= k;
             gq.log_amplitude += logf(c);
@@ -155,9 +149,33 @@ int vsgl__mrp_glossy_parts(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double al
             aq.mu *= k;
             aq.log_amplitude += logf(c);
         }
-        value[q] = glossy_lobe(rc, x, h, &gq, &aq, opt, &axis[q]);
+        out->sg[q] = gq;
+        out->asg[q] = aq;
     }
-    return parts;
+}
+
+int vsgl__mrp_glossy_parts_at(const vsgl__mrp_rect *rc, d3 x, const vsgl__mrp_receiver *rcv,
+                              const vsgl__mrp_options *opt, unsigned skip, double value[2], d3 axis[2])
+{
+    for (int q = 0; q < 2; ++q) {
+        value[q] = 0.0;
+        axis[q] = rcv->n;
+    }
+    double h = d3_dot(d3_sub(x, rc->center), rc->normal);
+    if (!(h > 0.0) || !(rc->half_u > 0.0) || !(rc->half_v > 0.0))
+        return rcv->parts;
+    for (int q = 0; q < rcv->parts; ++q)
+        if (!(skip & (1u << q)))
+            value[q] = glossy_lobe(rc, x, h, &rcv->sg[q], &rcv->asg[q], opt, &axis[q]);
+    return rcv->parts;
+}
+
+int vsgl__mrp_glossy_parts(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha, const vsgl__mrp_options *opt,
+                           unsigned skip, double value[2], d3 axis[2])
+{
+    vsgl__mrp_receiver rcv;
+    vsgl__mrp_receiver_make(n, o, alpha, opt, &rcv);
+    return vsgl__mrp_glossy_parts_at(rc, x, &rcv, opt, skip, value, axis);
 }
 
 double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha,

@@ -185,4 +185,22 @@ double vsgl__mrp_glossy_uniform(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, doub
 int vsgl__mrp_glossy_parts(const vsgl__mrp_rect *rc, d3 x, d3 n, d3 o, double alpha, const vsgl__mrp_options *opt,
                            unsigned skip, double value[2], d3 axis[2]);
 
+/* A receiver's lobes, computed once per shading point (normal n, view o,
+ * alpha) and shared by every rectangle it visits: Eq. 8's SG and the
+ * warped ASG per part (core, tail), and the warped ASG itself. */
+typedef struct vsgl__mrp_receiver {
+    d3 n;
+    int parts;       /* 1 or 2 (opt->lobes) */
+    vsgl_sg sg[2];   /* Eq. 8 per part (bandwidth x K, amplitude x C of shade/kernel.h) */
+    vsgl_asg asg[2]; /* the warped ASG per part (zero unless opt->receiver_asg) */
+    vsgl_asg warped; /* the warped ASG of the whole NDF (vsgl_warp_ndf_asg) */
+} vsgl__mrp_receiver;
+
+void vsgl__mrp_receiver_make(d3 n, d3 o, double alpha, const vsgl__mrp_options *opt, vsgl__mrp_receiver *out);
+
+/* vsgl__mrp_glossy_parts with the receiver's lobes made beforehand: the
+ * same values, bit for bit. */
+int vsgl__mrp_glossy_parts_at(const vsgl__mrp_rect *rc, d3 x, const vsgl__mrp_receiver *rcv,
+                              const vsgl__mrp_options *opt, unsigned skip, double value[2], d3 axis[2]);
+
 #endif

@@ -66,18 +66,15 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
     if (!bp.glossy || !(d3_dot(n, o) > 0.0))
         return;
     double alpha = sqrt((double)bp.alpha_x * bp.alpha_y);
+    vsgl__mrp_receiver rcv; /* the receiver's lobes, once for every cell */
+    vsgl__mrp_receiver_make(n, o, alpha, &j->opt, &rcv);
     vsgl_sg lobe;
     vsgl__mrp_receiver_sg(n, o, alpha, &lobe);
     d3 z = d3_of_v3(lobe.axis);
     /* e^{-9} of the peak of the widest lobe (GGX's tail when there are two)
      * along the warped ASG's wider axis (a grazing view stretches it in the
      * plane of incidence: Eq. 8's isotropic SG is up to 1/sqrt(2 |o.n|) narrower) */
-    vsgl_asg ndf, wa;
-    d3 t0, t1;
-    d3_basis(n, &t0, &t1);
-    v3 tf0 = d3_to_v3(t0), nf0 = d3_to_v3(n), of0 = d3_to_v3(o);
-    vsgl_ndf_aniso_to_asg(&nf0, &tf0, (float)alpha, (float)alpha, &ndf);
-    vsgl_warp_ndf_asg(&ndf, &of0, &wa);
+    const vsgl_asg wa = rcv.warped;
     double nu = fmin((double)wa.lambda, (double)wa.mu) * (j->opt.lobes == 2 ? VSGL__GGX_TAIL_K : 1.0);
     double spread = 3.0 / sqrt(nu > 1e-6 ? nu : 1e-6);
     /* the core's reach, where there are two lobes: cells beyond it skip the core */
@@ -175,7 +172,7 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
 #endif
                     d3 axis[2];
                     double v[2];
-                    int parts = vsgl__mrp_glossy_parts(&cell, x, n, o, alpha, &j->opt, skip, v, axis);
+                    int parts = vsgl__mrp_glossy_parts_at(&cell, x, &rcv, &j->opt, skip, v, axis);
                     for (int q = 0; q < parts; ++q) {
                         if (!(v[q] > 0.0))
                             continue;
