@@ -59,6 +59,13 @@ static double disk_radius(double d, double cs, double nu, double scale)
     return r < 1e30 ? r : 1e30;
 }
 
+double vsgl__mrp_lobe_disk_radius(const vsgl__mrp_receiver *rcv, int q, const vsgl__mrp_options *opt, double d,
+                                  double cs)
+{
+    double nu = opt->receiver_asg ? sqrt((double)rcv->asg[q].lambda * rcv->asg[q].mu) : 0.5 * rcv->sg[q].sharpness;
+    return disk_radius(d, cs, nu, opt->rd_scale);
+}
+
 /* y clamped onto the rectangle (in its plane). */
 static d3 clamp_to_rect(const vsgl__mrp_rect *rc, d3 y)
 {

@@ -198,6 +198,12 @@ typedef struct vsgl__mrp_receiver {
 
 void vsgl__mrp_receiver_make(d3 n, d3 o, double alpha, const vsgl__mrp_options *opt, vsgl__mrp_receiver *out);
 
+/* The sampling disk's radius (docs/mrp.md §3, step 3) that part @p q of
+ * the receiver uses for a rectangle whose clamped peak is at distance @p d,
+ * cos(sigma) @p cs. */
+double vsgl__mrp_lobe_disk_radius(const vsgl__mrp_receiver *rcv, int q, const vsgl__mrp_options *opt, double d,
+                                  double cs);
+
 /* vsgl__mrp_glossy_parts with the receiver's lobes made beforehand: the
  * same values, bit for bit. */
 int vsgl__mrp_glossy_parts_at(const vsgl__mrp_rect *rc, d3 x, const vsgl__mrp_receiver *rcv,

@@ -42,6 +42,40 @@ static d3 canonical(const float *fn)
     return big < 0.0 ? d3_scale(n, -1.0) : n;
 }
 
+static uint32_t ceil_shift(uint32_t n, uint32_t l) { return (n + (1u << l) - 1u) >> l; }
+
+/* Levels of a proxy's pyramid: down to one block along both sides. */
+static uint32_t pyramid_levels(uint32_t nu, uint32_t nv)
+{
+    uint32_t l = 1;
+    while (l < VSGL__MRP_MAX_LEVELS && (ceil_shift(nu, l - 1) > 1 || ceil_shift(nv, l - 1) > 1))
+        ++l;
+    return l;
+}
+
+/* Floats of levels 1 .. levels - 1 of one side. */
+static size_t pyramid_floats(uint32_t nu, uint32_t nv, uint32_t levels)
+{
+    size_t f = 0;
+    for (uint32_t l = 1; l < levels; ++l)
+        f += (size_t)ceil_shift(nu, l) * ceil_shift(nv, l) * 4;
+    return f;
+}
+
+const float *vsgl__mrp_level(const vsgl__mrp_proxy *p, int side, uint32_t level, uint32_t *nu, uint32_t *nv,
+                             uint32_t *stride)
+{
+    *nu = ceil_shift(p->nu, level);
+    *nv = ceil_shift(p->nv, level);
+    *stride = level ? 4 : 3;
+    if (level == 0)
+        return p->power + (size_t)side * p->nu * p->nv * 3;
+    size_t off = (size_t)side * pyramid_floats(p->nu, p->nv, p->levels);
+    for (uint32_t l = 1; l < level; ++l)
+        off += (size_t)ceil_shift(p->nu, l) * ceil_shift(p->nv, l) * 4;
+    return p->pyramid + off;
+}
+
 typedef struct group_rect { vsgl__mrp_rect rect; double area, coverage; } group_rect;
 
 static int by_area_desc(const void *a, const void *b)
@@ -167,7 +201,8 @@ vsgl_result vsgl__mrp_proxies_build(vsgl_context *ctx, const vsgl_scene *scene, 
         double lu = p->rect.half_u, lv = p->rect.half_v, big = lu > lv ? lu : lv;
         p->nu = (uint32_t)fmax(1.0, round(cells * lu / big));
         p->nv = (uint32_t)fmax(1.0, round(cells * lv / big));
-        floats += 2 * (size_t)p->nu * p->nv * 3;
+        p->levels = pyramid_levels(p->nu, p->nv);
+        floats += 2 * ((size_t)p->nu * p->nv * 3 + pyramid_floats(p->nu, p->nv, p->levels));
     }
     free(groups);
     out->storage = out->items ? calloc(floats + 1, sizeof(float)) : NULL;
@@ -177,8 +212,11 @@ vsgl_result vsgl__mrp_proxies_build(vsgl_context *ctx, const vsgl_scene *scene, 
     }
     float *at = out->storage;
     for (size_t k = 0; k < ng; ++k) {
-        out->items[k].power = at;
-        at += 2 * (size_t)out->items[k].nu * out->items[k].nv * 3;
+        vsgl__mrp_proxy *p = &out->items[k];
+        p->power = at;
+        at += 2 * (size_t)p->nu * p->nv * 3;
+        p->pyramid = at;
+        at += 2 * pyramid_floats(p->nu, p->nv, p->levels);
     }
     out->count = ng;
     return VSGL_OK;
@@ -229,6 +267,31 @@ void vsgl__mrp_proxies_finish(vsgl__mrp_proxy_set *set)
             for (size_t j = 0; j < (size_t)p->nu * p->nv * 3; ++j) {
                 c[j] *= scale;
                 p->side_total[side] += c[j];
+            }
+            for (uint32_t l = 1; l < p->levels; ++l) { /* each block: the mean of the cells it covers */
+                uint32_t bu, bv, st;
+                float *b = (float *)vsgl__mrp_level(p, side, l, &bu, &bv, &st);
+                for (uint32_t jv = 0; jv < bv; ++jv)
+                    for (uint32_t ju = 0; ju < bu; ++ju) {
+                        uint32_t u0 = ju << l, v0 = jv << l;
+                        uint32_t u1 = u0 + (1u << l) < p->nu ? u0 + (1u << l) : p->nu;
+                        uint32_t v1 = v0 + (1u << l) < p->nv ? v0 + (1u << l) : p->nv;
+                        double sum[3] = {0, 0, 0}, lo = INFINITY, hi = 0.0;
+                        for (uint32_t iv = v0; iv < v1; ++iv)
+                            for (uint32_t iu = u0; iu < u1; ++iu) {
+                                const float *cc = c + ((size_t)iv * p->nu + iu) * 3;
+                                double t = (double)cc[0] + cc[1] + cc[2];
+                                lo = fmin(lo, t);
+                                hi = fmax(hi, t);
+                                for (int ch = 0; ch < 3; ++ch)
+                                    sum[ch] += cc[ch];
+                            }
+                        double n = (double)(u1 - u0) * (v1 - v0);
+                        float *o = b + ((size_t)jv * bu + ju) * st;
+                        for (int ch = 0; ch < 3; ++ch)
+                            o[ch] = (float)(sum[ch] / n);
+                        o[3] = hi > 0.0 ? (float)((hi - lo) / (hi + lo)) : 0.0f; /* contrast */
+                    }
             }
         }
     }

@@ -18,7 +18,24 @@ typedef struct vsgl__mrp_proxy {
     uint32_t nu, nv;     /* cells along u and v (>= 1): square-ish cells, `cells` along the longer side */
     float *power;        /* [2][cells_v][cells_u][3]: sum of RSM flux x diffuse albedo (W), then radiance */
     float side_total[2]; /* sum over cells of the luminance-ish sum of channels, per side */
+    /* The cell pyramid (vsgl__mrp_proxies_finish): level l > 0 merges 2^l x 2^l cells (fewer at the
+     * far edges), its radiance the mean of the cells it covers, and their contrast; levels 1 .. levels - 1 of both sides,
+     * the last one a single cell. vsgl__mrp_level reads it (level 0 is power). */
+    uint32_t levels;
+    float *pyramid;
 } vsgl__mrp_proxy;
+
+/* Levels of the cell pyramid above level 0 (cells <= 64: at most 7 levels in all). */
+#define VSGL__MRP_MAX_LEVELS 8
+
+/* Level @p level (0 .. p->levels - 1) of side @p side of proxy @p p:
+ * [nv][nu][stride] with *nu = ceil(p->nu / 2^level),
+ * *nv = ceil(p->nv / 2^level): RGB radiance, and at levels > 0
+ * (*stride 4) the contrast (max - min) / (max + min) of its cells' sums of
+ * channels. Block (bu, bv) covers the cells
+ * [bu 2^level, min((bu + 1) 2^level, p->nu)) along u, likewise along v. */
+const float *vsgl__mrp_level(const vsgl__mrp_proxy *p, int side, uint32_t level, uint32_t *nu, uint32_t *nv,
+                             uint32_t *stride);
 
 typedef struct vsgl__mrp_proxy_set {
     vsgl__mrp_proxy *items;

@@ -9,12 +9,27 @@
 #include "shade/kernel.h"
 #include "vsgl/lobes.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* 1: cells are culled against the warped lobe's ASG (anisotropic); 0: only
  * the isotropic box around the peak (tools/mrp_quality.sh measures both). */
 #ifndef VSGL__MRP_CULL
 #define VSGL__MRP_CULL 1
+#endif
+/* A block of cells of the proxy's pyramid is shaded whole when its diagonal
+ * is at most this many times the lobe's sampling disk (its radius, at the
+ * block's clamped peak): the disk's Gaussian light blurs anything finer.
+ * 0: every cell on its own (the pass before the pyramid; docs/mrp.md §4
+ * measures both). */
+#ifndef VSGL__MRP_MERGE
+#define VSGL__MRP_MERGE 1.0
+#endif
+/* ... and when its cells' radiance (sum of channels) differs by at most this
+ * contrast (max - min) / (max + min): the edge of a sharp sun patch is
+ * shaded cell by cell. */
+#ifndef VSGL__MRP_MERGE_CONTRAST
+#define VSGL__MRP_MERGE_CONTRAST 0.25
 #endif
 /* Hybrid: 1 takes, in a pixel MRP takes, the larger of MRP's and the
  * on-proxy VSGLs' estimate of the proxies' light (no seam where MRP's
@@ -32,6 +47,7 @@ typedef struct mrp_job {
     vsgl__mrp_options opt;
     const float *glossy_q; /* hybrid: the VSGL glossy of the clusters off the proxies, else NULL */
     double max_alpha;      /* hybrid: the largest GGX alpha of a receiver that takes MRP */
+    double merge;          /* VSGL__MRP_MERGE */
 } mrp_job;
 
 /* Hybrid rule, first half: 1 if every glossy sample of pixel px is sharp
@@ -83,6 +99,11 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
      * above is isotropic: at grazing views the lobe is narrow across the
      * plane of incidence); bandwidth scales of the widest lobe and the core */
     const int cull = VSGL__MRP_CULL;
+#ifdef VSGL__MRP_EXACT_CELLS
+    const int exact = 1; /* the widest lobe's cells, one by one */
+#else
+    const int exact = 0;
+#endif
     const double k_wide = j->opt.lobes == 2 ? VSGL__GGX_TAIL_K : 1.0, k_core = j->opt.lobes == 2 ? VSGL__GGX_CORE_K : 1.0;
     const d3 wx = d3_of_v3(wa.x), wy = d3_of_v3(wa.y), wz = d3_of_v3(wa.z);
     v3 nf = d3_to_v3(n), of = d3_to_v3(o);
@@ -106,44 +127,68 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
             /* cells farther from the peak than the lobe's reach are skipped */
             double d = d3_length(d3_sub(y, x)), cs = d3_dot(d3_sub(x, y), plane.normal) / (d > 0.0 ? d : 1.0);
             double reach = d * spread / (cs > 0.05 ? cs : 0.05);
+            double h = d3_dot(d3_sub(x, plane.center), plane.normal);
             d3 dy = d3_sub(y, plane.center);
             /* cell (iu, iv) is where proxies.c put it: along the proxy's own v
              * (the back side's flipped plane.v would mirror its radiance) */
             const d3 pv0 = p->rect.v;
             double yu = d3_dot(dy, plane.u), yv = d3_dot(dy, pv0);
             double cu = plane.half_u / p->nu, cv = plane.half_v / p->nv;
-            const float *rad = p->power + (size_t)side * p->nu * p->nv * 3;
-            for (uint32_t iv = 0; iv < p->nv; ++iv) {
-                double mv = -plane.half_v + (2.0 * iv + 1.0) * cv;
-                double dv = fabs(yv - mv) - cv;
-                if (dv > reach)
-                    continue;
-                for (uint32_t iu = 0; iu < p->nu; ++iu) {
-                    const float *L = rad + ((size_t)iv * p->nu + iu) * 3;
+            /* each lobe walks the cell pyramid from its top: a block is taken whole when it is
+             * within the lobe's reach and no larger than VSGL__MRP_MERGE x the lobe's disk
+             * there, split into its four children when larger, dropped when out of reach */
+            for (int q = exact ? rcv.parts - 1 : 0; q < rcv.parts; ++q) {
+                const double reach_q = q == 0 ? reach * core_frac : reach, k_q = q == 0 ? k_core : k_wide;
+                uint32_t stack[3 * 64], sp = 0;
+                stack[sp++] = p->levels - 1, stack[sp++] = 0, stack[sp++] = 0;
+                while (sp) {
+                    uint32_t bv = stack[--sp], bu = stack[--sp], l = stack[--sp], nbu, nbv, st;
+                    const float *L = vsgl__mrp_level(p, side, l, &nbu, &nbv, &st);
+                    L += ((size_t)bv * nbu + bu) * st;
                     if (!(L[0] + L[1] + L[2] > 0.0f))
                         continue;
-                    double mu = -plane.half_u + (2.0 * iu + 1.0) * cu;
-                    double du = fabs(yu - mu) - cu;
-                    if (du > reach)
+                    uint32_t u0 = bu << l, v0 = bv << l;
+                    uint32_t u1 = u0 + (1u << l) < p->nu ? u0 + (1u << l) : p->nu;
+                    uint32_t v1 = v0 + (1u << l) < p->nv ? v0 + (1u << l) : p->nv;
+                    double mv = -plane.half_v + (double)(v0 + v1) * cv, hv = (double)(v1 - v0) * cv;
+                    double dv = fabs(yv - mv) - hv;
+                    if (dv > reach_q)
                         continue;
-                    unsigned skip = du > reach * core_frac || dv > reach * core_frac ? 1u : 0u;
+                    double mu = -plane.half_u + (double)(u0 + u1) * cu, hu = (double)(u1 - u0) * cu;
+                    double du = fabs(yu - mu) - hu;
+                    if (du > reach_q)
+                        continue;
                     vsgl__mrp_rect cell = plane;
                     cell.center = d3_add(plane.center, d3_add(d3_scale(plane.u, mu), d3_scale(pv0, mv)));
-                    cell.half_u = cu;
-                    cell.half_v = cv;
+                    cell.half_u = hu;
+                    cell.half_v = hv;
                     if (cull) { /* the lobe itself at the cell: its ASG exponent past e^{-9}, the cell's
                                  * angular radius taken off both offsets (conservative) */
                         d3 dc = d3_sub(cell.center, x);
-                        double dist = d3_length(dc), ang = sqrt(cu * cu + cv * cv) / (dist > 0.0 ? dist : 1e-30);
+                        double dist = d3_length(dc), ang = sqrt(hu * hu + hv * hv) / (dist > 0.0 ? dist : 1e-30);
                         d3 vd = d3_scale(dc, 1.0 / (dist > 0.0 ? dist : 1e-30));
                         if (d3_dot(vd, wz) < -ang)
                             continue;
                         double ax = fmax(0.0, fabs(d3_dot(vd, wx)) - ang), ay = fmax(0.0, fabs(d3_dot(vd, wy)) - ang);
                         double ex = (double)wa.lambda * ax * ax + (double)wa.mu * ay * ay;
-                        if (ex * k_wide > 9.0)
+                        if (ex * k_q > 9.0)
                             continue;
-                        if (ex * k_core > 9.0)
-                            skip |= 1u;
+                    }
+                    if (l > 0) { /* whole, or its children */
+                        double pu = fmin(fmax(yu, mu - hu), mu + hu), pv = fmin(fmax(yv, mv - hv), mv + hv);
+                        double db = sqrt(h * h + (yu - pu) * (yu - pu) + (yv - pv) * (yv - pv));
+                        double rd = vsgl__mrp_lobe_disk_radius(&rcv, q, &j->opt, db, db > 0.0 ? h / db : 1.0);
+                        if (exact || !(L[3] <= VSGL__MRP_MERGE_CONTRAST) ||
+                            !(2.0 * sqrt(hu * hu + hv * hv) <= j->merge * rd)) {
+                            uint32_t cnu = (p->nu + (1u << (l - 1)) - 1) >> (l - 1);
+                            uint32_t cnv = (p->nv + (1u << (l - 1)) - 1) >> (l - 1);
+                            for (uint32_t c = 0; c < 4; ++c) {
+                                uint32_t cbu = 2 * bu + (c & 1u), cbv = 2 * bv + (c >> 1);
+                                if (cbu < cnu && cbv < cnv && sp + 3 <= sizeof stack / sizeof stack[0])
+                                    stack[sp++] = l - 1, stack[sp++] = cbu, stack[sp++] = cbv;
+                            }
+                            continue;
+                        }
                     }
 #ifdef VSGL__MRP_EXACT_CELLS
                     { /* diagnostic build (tools/mrp_quality.sh): the exact BRDF integrated over the cell
@@ -152,7 +197,7 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
                         const int Q = VSGL__MRP_EXACT_CELLS;
                         for (int a = 0; a < Q; ++a)
                             for (int b = 0; b < Q; ++b) {
-                                double pu = mu + cu * (2.0 * (a + 0.5) / Q - 1.0), pv = mv + cv * (2.0 * (b + 0.5) / Q - 1.0);
+                                double pu = mu + hu * (2.0 * (a + 0.5) / Q - 1.0), pv = mv + hv * (2.0 * (b + 0.5) / Q - 1.0);
                                 d3 pp = d3_add(plane.center, d3_add(d3_scale(plane.u, pu), d3_scale(pv0, pv)));
                                 d3 wi = d3_sub(pp, x);
                                 double r2 = d3_dot(wi, wi);
@@ -163,7 +208,7 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
                                 float dif[3], gl[3];
                                 v3 tf = v3_make(g->tan[0][i], g->tan[1][i], g->tan[2][i]);
                                 vsgl__brdf_eval(&bp, nf, tf, d3_to_v3(wi), of, dif, gl);
-                                double w = 4.0 * cu * cv / (Q * Q) * cr / r2;
+                                double w = 4.0 * hu * hv / (Q * Q) * cr / r2;
                                 for (int c = 0; c < 3; ++c)
                                     acc[c] += w * gl[c] * ms[c] * L[c];
                             }
@@ -172,15 +217,14 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
 #endif
                     d3 axis[2];
                     double v[2];
-                    int parts = vsgl__mrp_glossy_parts_at(&cell, x, &rcv, &j->opt, skip, v, axis);
-                    for (int q = 0; q < parts; ++q) {
-                        if (!(v[q] > 0.0))
-                            continue;
-                        float sf[3];
-                        vsgl__specular_factor(&bp, nf, of, d3_to_v3(axis[q]), (float)alpha, sf);
-                        for (int c = 0; c < 3; ++c)
-                            acc[c] += v[q] * sf[c] * ms[c] * L[c];
-                    }
+                    unsigned skip = rcv.parts == 2 ? 1u << (1 - q) : 0u; /* this lobe only */
+                    vsgl__mrp_glossy_parts_at(&cell, x, &rcv, &j->opt, skip, v, axis);
+                    if (!(v[q] > 0.0))
+                        continue;
+                    float sf[3];
+                    vsgl__specular_factor(&bp, nf, of, d3_to_v3(axis[q]), (float)alpha, sf);
+                    for (int c = 0; c < 3; ++c)
+                        acc[c] += v[q] * sf[c] * ms[c] * L[c];
                 }
             }
         }
@@ -196,46 +240,157 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
  * and the mode's cost is per shading point. */
 #define MRP_GROUP_COS 0.99996
 
-static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
+/* Shading one pixel in 2 x 2 (MRP's cost is per shading point): anchors at
+ * the even columns and rows (and the last ones) are shaded; any other pixel
+ * takes the mean of its two or four neighbouring anchors when it and they
+ * lie on one flat surface (one material, normals within MRP_GROUP_COS, on
+ * one plane, every sample a hit) and the anchors' light differs by at most
+ * VSGL__MRP_SPARSE_CONTRAST ((max - min) / (max + min) of the sums of
+ * channels); elsewhere (edges, the rim of a reflection) it is shaded itself.
+ * 0 shades every pixel. docs/mrp.md §4 measures both. */
+#ifndef VSGL__MRP_SPARSE_CONTRAST
+#define VSGL__MRP_SPARSE_CONTRAST 0.1
+#endif
+
+/* Per pixel: its one flat surface, when all its samples hit one. */
+typedef struct mrp_surface {
+    float n[3], x[3];
+    uint32_t material;
+    uint8_t flat;  /* 1: every sample a hit, one group */
+    uint8_t state; /* 0 not shaded yet, 1 raw holds its light, 2 hybrid: a rough pixel (not MRP's) */
+} mrp_surface;
+
+typedef struct mrp_pass {
+    const mrp_job *j;
+    float *raw;          /* per pixel: MRP's light (RGB) */
+    mrp_surface *surf;
+    int phase;           /* 0 anchors, 1 the others, 2 write */
+} mrp_pass;
+
+/* MRP's light of pixel px (its samples grouped by surface) when @p shade,
+ * and its surface. */
+static void shade_pixel(const mrp_job *j, size_t px, int shade, float acc[3], mrp_surface *sf)
 {
-    (void)chunk;
-    const mrp_job *j = user;
     const vsgl_gbuffer *g = j->g;
     size_t spp = g->spp;
     unsigned char done[256];
-    for (size_t px = b; px < e; ++px) {
-        float acc[3] = {0, 0, 0};
-        if (j->glossy_q && !pixel_sharp(j, px))
-            continue; /* hybrid: a rough receiver keeps the VSGL glossy light */
-        memset(done, 0, sizeof done);
-        for (size_t s = 0; s < spp; ++s) {
-            size_t i = px * spp + s;
-            if (g->material[i] == VSGL__GBUFFER_MISS || (s < 256 && done[s]))
-                continue;
-            d3 n0 = d3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
-            d3 xs = d3_make(0, 0, 0), os = d3_make(0, 0, 0);
-            double ws = 0.0;
-            for (size_t t = s; t < spp; ++t) { /* s and the later samples of its group */
-                size_t k = px * spp + t;
-                if (t >= 256 && t != s)
-                    break;
-                if (t != s && (done[t] || g->material[k] != g->material[i] ||
-                               d3_dot(n0, d3_make(g->nrm[0][k], g->nrm[1][k], g->nrm[2][k])) < MRP_GROUP_COS))
-                    continue;
-                double w = vsgl__gbuffer_weight(g, k); /* the sample's share of its pixel */
-                xs = d3_add(xs, d3_scale(d3_make(g->pos[0][k], g->pos[1][k], g->pos[2][k]), w));
-                os = d3_add(os, d3_scale(d3_make(g->view[0][k], g->view[1][k], g->view[2][k]), w));
-                ws += w;
-                if (t < 256)
-                    done[t] = 1;
-            }
-            if (!(ws > 0.0))
-                continue;
-            float l[3];
-            sample_glossy(j, i, d3_scale(xs, 1.0 / ws), n0, d3_normalize(os), l);
-            for (int c = 0; c < 3; ++c)
-                acc[c] += (float)ws * l[c];
+    int groups = 0, misses = 0;
+    acc[0] = acc[1] = acc[2] = 0.0f;
+    memset(done, 0, sizeof done);
+    for (size_t s = 0; s < spp; ++s) {
+        size_t i = px * spp + s;
+        if (g->material[i] == VSGL__GBUFFER_MISS) {
+            misses += vsgl__gbuffer_weight(g, i) > 0.0f; /* an unused slot weighs 0 */
+            continue;
         }
+        if (s < 256 && done[s])
+            continue;
+        d3 n0 = d3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
+        d3 xs = d3_make(0, 0, 0), os = d3_make(0, 0, 0);
+        double ws = 0.0;
+        for (size_t t = s; t < spp; ++t) { /* s and the later samples of its group */
+            size_t k = px * spp + t;
+            if (t >= 256 && t != s)
+                break;
+            if (t != s && (done[t] || g->material[k] != g->material[i] ||
+                           d3_dot(n0, d3_make(g->nrm[0][k], g->nrm[1][k], g->nrm[2][k])) < MRP_GROUP_COS))
+                continue;
+            double w = vsgl__gbuffer_weight(g, k); /* the sample's share of its pixel */
+            xs = d3_add(xs, d3_scale(d3_make(g->pos[0][k], g->pos[1][k], g->pos[2][k]), w));
+            os = d3_add(os, d3_scale(d3_make(g->view[0][k], g->view[1][k], g->view[2][k]), w));
+            ws += w;
+            if (t < 256)
+                done[t] = 1;
+        }
+        if (!(ws > 0.0))
+            continue;
+        if (++groups == 1 && !shade) {
+            d3 xm = d3_scale(xs, 1.0 / ws);
+            sf->n[0] = (float)n0.x, sf->n[1] = (float)n0.y, sf->n[2] = (float)n0.z;
+            sf->x[0] = (float)xm.x, sf->x[1] = (float)xm.y, sf->x[2] = (float)xm.z;
+            sf->material = g->material[i];
+        }
+        if (!shade)
+            continue;
+        float l[3];
+        sample_glossy(j, i, d3_scale(xs, 1.0 / ws), n0, d3_normalize(os), l);
+        for (int c = 0; c < 3; ++c)
+            acc[c] += (float)ws * l[c];
+    }
+    if (!shade)
+        sf->flat = groups == 1 && misses == 0 && spp <= 256;
+}
+
+static int is_anchor(uint32_t v, uint32_t n) { return (v & 1u) == 0 || v + 1 == n; }
+
+/* The mean of the anchors around pixel (x, y) into acc when it may be
+ * interpolated (see VSGL__MRP_SPARSE_CONTRAST), else 0. */
+static int interpolate(const mrp_pass *P, uint32_t x, uint32_t y, float acc[3])
+{
+    const vsgl_gbuffer *g = P->j->g;
+    const mrp_surface *me = &P->surf[(size_t)y * g->width + x];
+    if (!me->flat)
+        return 0;
+    uint32_t xs[2] = {x, x}, ys[2] = {y, y};
+    int nx = 1, ny = 1;
+    if (!is_anchor(x, g->width))
+        xs[0] = x - 1, xs[1] = x + 1, nx = 2;
+    if (!is_anchor(y, g->height))
+        ys[0] = y - 1, ys[1] = y + 1, ny = 2;
+    float lo = INFINITY, hi = 0.0f, sum[3] = {0, 0, 0};
+    for (int b = 0; b < ny; ++b)
+        for (int a = 0; a < nx; ++a) {
+            size_t q = (size_t)ys[b] * g->width + xs[a];
+            const mrp_surface *o = &P->surf[q];
+            if (o->state != 1 || !o->flat || o->material != me->material)
+                return 0;
+            double dn = (double)o->n[0] * me->n[0] + (double)o->n[1] * me->n[1] + (double)o->n[2] * me->n[2];
+            double dx[3] = {(double)o->x[0] - me->x[0], (double)o->x[1] - me->x[1], (double)o->x[2] - me->x[2]};
+            double off = fabs(dx[0] * me->n[0] + dx[1] * me->n[1] + dx[2] * me->n[2]);
+            if (dn < MRP_GROUP_COS || off > 1e-3 * sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]) + 1e-6)
+                return 0;
+            const float *r = P->raw + q * 3;
+            float t = r[0] + r[1] + r[2];
+            lo = t < lo ? t : lo;
+            hi = t > hi ? t : hi;
+            for (int c = 0; c < 3; ++c)
+                sum[c] += r[c];
+        }
+    if (!(hi - lo <= (float)VSGL__MRP_SPARSE_CONTRAST * (hi + lo)))
+        return 0;
+    for (int c = 0; c < 3; ++c)
+        acc[c] = sum[c] / (float)(nx * ny);
+    return 1;
+}
+
+static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
+{
+    (void)chunk;
+    const mrp_pass *P = user;
+    const mrp_job *j = P->j;
+    const vsgl_gbuffer *g = j->g;
+    for (size_t px = b; px < e; ++px) {
+        uint32_t x = (uint32_t)(px % g->width), y = (uint32_t)(px / g->width);
+        mrp_surface *sf = &P->surf[px];
+        float *raw = P->raw + px * 3;
+        int anchor = VSGL__MRP_SPARSE_CONTRAST <= 0.0 || (is_anchor(x, g->width) && is_anchor(y, g->height));
+        if (P->phase == 0) /* every pixel's surface */
+            shade_pixel(j, px, 0, raw, sf);
+        if (P->phase < 2) {
+            if (anchor != (P->phase == 0))
+                continue;
+            if (j->glossy_q && !pixel_sharp(j, px)) {
+                sf->state = 2; /* hybrid: a rough receiver keeps the VSGL glossy light */
+                continue;
+            }
+            if (P->phase == 0 || !interpolate(P, x, y, raw))
+                shade_pixel(j, px, 1, raw, sf);
+            sf->state = 1;
+            continue;
+        }
+        if (sf->state != 1)
+            continue;
+        float acc[3] = {raw[0], raw[1], raw[2]};
         if (j->glossy_q) { /* hybrid: MRP where it finds lit proxies, with the VSGLs off them */
             if (!(acc[0] + acc[1] + acc[2] > 0.0f))
                 continue;
@@ -267,8 +422,17 @@ vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, c
 {
     uint32_t mcount = 0;
     mrp_job j = {scene, g, set, planes, vsgl__scene_materials(scene, &mcount), vsgl__mrp_options_default(),
-                 glossy_q, max_alpha};
+                 glossy_q, max_alpha, VSGL__MRP_MERGE};
     size_t pixels = (size_t)g->width * g->height;
-    int32_t r = vsgl__parallel_for(vsgl_context_thread_count(ctx), pixels, 64, mrp_chunk, &j);
+    mrp_pass P = {&j, malloc((pixels ? pixels : 1) * 3 * sizeof(float)), calloc(pixels ? pixels : 1, sizeof(mrp_surface)), 0};
+    int32_t r = 0;
+    if (!P.raw || !P.surf)
+        r = VSGL_ERROR_OUT_OF_MEMORY;
+    for (int phase = 0; phase < 3 && r == 0; ++phase) { /* anchors, the others, the planes */
+        P.phase = phase;
+        r = vsgl__parallel_for(vsgl_context_thread_count(ctx), pixels, 64, mrp_chunk, &P);
+    }
+    free(P.raw);
+    free(P.surf);
     return r == 0 ? VSGL_OK : vsgl__fail(ctx, (vsgl_result)r, "mrp: glossy shading failed");
 }
