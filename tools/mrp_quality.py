@@ -215,7 +215,8 @@ def docs(args):
            "interleaved medians where measured):", "", verdict(res), ""]
     for name in res["scenes"]:
         shown = lambda l: l not in ("balanced", "hybrid-km256") and "(" not in l  # noqa: E731
-        labels = [l for l in res["scenes"][name]["configs"] if shown(l) or l == "hybrid (MRP's light alone)"]
+        labels = [l for l in res["scenes"][name]["configs"]
+                  if shown(l) or l in ("hybrid (MRP's light alone)", "mrp (no pyramid, every pixel)")]
         fn = "mrp_quality_%s.png" % name
         image(res, arrs, name, labels, os.path.join(img_dir, fn))
         md += ["![%s, glossy pass (80 x 60): Cycles | %s; below, the signed error of each (red too bright, blue "

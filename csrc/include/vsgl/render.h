@@ -143,7 +143,15 @@ typedef struct vsgl_render_settings {
                                       BALANCED aims at the balanced preset's error at less cost:
                                       aa_samples, rsm_resolution and glossy_mode are chosen for the
                                       scene, at most as set; the other knobs are taken as set */
+    float mrp_min_area;          /**< glossy_mode MRP and HYBRID: the smallest planar face (m^2, the area of
+                                      the rectangle fitted to its coplanar triangles) made a rectangle
+                                      proxy. Larger: fewer proxies, less time, fewer surfaces reflected;
+                                      smaller: more. 0 means VSGL_MRP_MIN_AREA_DEFAULT; finite, >= 0
+                                      (docs/mrp.md §4) */
 } vsgl_render_settings;
+
+/** vsgl_render_settings.mrp_min_area when it is 0 (m^2). */
+#define VSGL_MRP_MIN_AREA_DEFAULT 0.25f
 
 /** @brief Fill @p out with a preset (VSGL_PRESET_*); unknown presets give BALANCED. */
 VSGL_API void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out);

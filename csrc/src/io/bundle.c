@@ -124,6 +124,8 @@ static const field settings_fields[] = {
     F(vsgl_render_settings, shade_stride, 'u', 1), F(vsgl_render_settings, edge_samples, 'u', 1),
     /* format 1.4: without it a bundle saved with the auto preset rendered with balanced's knobs */
     F(vsgl_render_settings, auto_target, 'i', 1),
+    /* format 1.5: the MRP glossy modes' proxy size threshold */
+    F(vsgl_render_settings, mrp_min_area, 'f', 1),
 };
 #define SLOT(m) F(vsgl_material_textures, m.texture, 'u', 1), F(vsgl_material_textures, m.filter, 'i', 1), \
     F(vsgl_material_textures, m.wrap, 'i', 1), F(vsgl_material_textures, m.channel, 'i', 1), \
@@ -238,7 +240,7 @@ static const section_kind kinds[S_COUNT] = {
     {"MATL", "materials", "material", 40, 1, 0, 0},
     {"LGHT", "lights", "light", 104, 1, 0, 0},
     {"CAM ", "camera", "camera", 104, 1, 0, 0},
-    {"RSET", "render settings", "settings", 64, 1, 0, 44},
+    {"RSET", "render settings", "settings", 68, 1, 0, 44},
     {"OUTP", "output path", "byte", 1, 0, 0, 0},
     {"FRME", "frame", "frame", 4, 0, 0, 0},
     /* format 1.2: textures */

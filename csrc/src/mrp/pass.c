@@ -74,7 +74,8 @@ vsgl_result vsgl__mrp_hybrid_pass(vsgl_context *ctx, const vsgl_scene *scene, co
                                   size_t *excluded)
 {
     vsgl__mrp_proxy_set set;
-    vsgl_result r = vsgl__mrp_proxies_build(ctx, scene, VSGL__MRP_MIN_AREA, VSGL__MRP_CELLS, &set);
+    vsgl_result r = vsgl__mrp_proxies_build(ctx, scene, s->mrp_min_area > 0.0f ? (double)s->mrp_min_area : VSGL__MRP_MIN_AREA,
+                                            VSGL__MRP_CELLS, &set);
     if (r != VSGL_OK)
         return r;
     size_t pixels = (size_t)g->width * g->height;

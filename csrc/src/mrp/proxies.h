@@ -89,9 +89,10 @@ vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, c
  * the proxy's cells carry), else 0. */
 int vsgl__mrp_on_proxy(const vsgl__mrp_proxy_set *set, const vsgl_vsgl *v);
 
-/* Defaults of the proxy pass (not settings yet): proxies of at least
- * VSGL__MRP_MIN_AREA m^2, VSGL__MRP_CELLS cells along their longer side. */
-#define VSGL__MRP_MIN_AREA 0.25
+/* Defaults of the proxy pass: proxies of at least VSGL__MRP_MIN_AREA m^2
+ * (the setting vsgl_render_settings.mrp_min_area's default),
+ * VSGL__MRP_CELLS cells along their longer side (a constant). */
+#define VSGL__MRP_MIN_AREA ((double)VSGL_MRP_MIN_AREA_DEFAULT)
 #ifndef VSGL__MRP_CELLS
 #define VSGL__MRP_CELLS 32
 #endif

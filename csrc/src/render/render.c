@@ -566,7 +566,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
             r = vsgl__shade_planned(ctx, scene, gb, vs, &s, &planes, VSGL__SHADE_KERNEL, &st.shading_pairs,
                                     !cache ? NULL : built_g ? &plan : &cache->plan);
             if (r == VSGL_OK && s.glossy_mode == VSGL_GLOSSY_MRP) /* the glossy plane from rectangle proxies */
-                r = vsgl__mrp_glossy_pass(ctx, scene, s.rsm_resolution, VSGL__MRP_MIN_AREA, VSGL__MRP_CELLS, gb,
+                r = vsgl__mrp_glossy_pass(ctx, scene, s.rsm_resolution, s.mrp_min_area, VSGL__MRP_CELLS, gb,
                                           &planes, NULL);
             else if (r == VSGL_OK && s.glossy_mode == VSGL_GLOSSY_HYBRID) /* MRP per pixel where it applies */
                 r = vsgl__mrp_hybrid_pass(ctx, scene, &s, gb, vs, &planes, NULL);

@@ -126,6 +126,11 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     if (s->edge_samples > VSGL_AA_SAMPLES_MAX)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: edge_samples is %u (valid 0..%d)",
                           s->edge_samples, VSGL_AA_SAMPLES_MAX);
+    if (!(s->mrp_min_area >= 0.0f) || !(s->mrp_min_area < INFINITY))
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: mrp_min_area is %g (valid: finite, >= 0; "
+                          "0 = %g m^2)", (double)s->mrp_min_area, (double)VSGL_MRP_MIN_AREA_DEFAULT);
+    if (s->mrp_min_area == 0.0f)
+        s->mrp_min_area = VSGL_MRP_MIN_AREA_DEFAULT;
     if (s->fis_iterations > VSGL_FIS_ITERATIONS_MAX)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: fis_iterations is %u (valid 1..%d)",
                           s->fis_iterations, VSGL_FIS_ITERATIONS_MAX);
