@@ -103,25 +103,34 @@ VT_TEST(asg_bessel_f_matches_trapezoid)
 
 /* ----------------------------------------------------------- eigen-solver */
 
-static void check_eigen(double a[3][3], const char *what, double scale)
+/* vsgl__eigen_sym3 (tol 1), or vsgl__eigen_sym3_fast (its closed form:
+ * tol 1e4, eigenvectors from cross products, ~1e-10 where the eigenvalues
+ * are 1e-6 apart) */
+static void check_eigen_with(int (*fn)(double[3][3], double[3], double[3][3]), double tol, double a[3][3],
+                             const char *what, double scale)
 {
     double w[3], v[3][3];
-    int sweeps = vsgl__eigen_sym3(a, w, v);
+    int sweeps = fn(a, w, v);
     VT_CHECK(sweeps >= 0 && sweeps < 32, "%s: sweeps %d", what, sweeps);
     VT_CHECK(w[0] >= w[1] && w[1] >= w[2], "%s: order %g %g %g", what, w[0], w[1], w[2]);
     for (int k = 0; k < 3; ++k) {
         for (int i = 0; i < 3; ++i) {
             double av = a[i][0] * v[0][k] + a[i][1] * v[1][k] + a[i][2] * v[2][k];
-            VT_CHECK_ABS(av, w[k] * v[i][k], 1e-13 * scale, "%s: residual k=%d i=%d", what, k, i);
+            VT_CHECK_ABS(av, w[k] * v[i][k], 1e-13 * tol * scale, "%s: residual k=%d i=%d", what, k, i);
         }
         for (int m = 0; m < 3; ++m) {
             double d = v[0][k] * v[0][m] + v[1][k] * v[1][m] + v[2][k] * v[2][m];
-            VT_CHECK_ABS(d, k == m ? 1.0 : 0.0, 1e-14, "%s: orthonormality %d %d", what, k, m);
+            VT_CHECK_ABS(d, k == m ? 1.0 : 0.0, 1e-14 * tol, "%s: orthonormality %d %d", what, k, m);
         }
     }
     double c0[3] = {v[0][0], v[1][0], v[2][0]}, c1[3] = {v[0][1], v[1][1], v[2][1]}, c2[3] = {v[0][2], v[1][2], v[2][2]}, x[3];
     cross_d(c0, c1, x);
-    VT_CHECK_ABS(dot_d(x, c2), 1.0, 1e-14, "%s: right-handed", what);
+    VT_CHECK_ABS(dot_d(x, c2), 1.0, 1e-14 * tol, "%s: right-handed", what);
+}
+
+static void check_eigen(double a[3][3], const char *what, double scale)
+{
+    check_eigen_with(vsgl__eigen_sym3, 1.0, a, what, scale);
 }
 
 VT_TEST(asg_eigen3_random_repeated_and_extreme)
@@ -164,6 +173,61 @@ VT_TEST(asg_eigen3_random_repeated_and_extreme)
     check_eigen(zero, "zero matrix", 1.0);
     double bad[3][3] = {{1, NAN, 0}, {0, 1, 0}, {0, 0, 1}}, w[3], v[3][3];
     VT_CHECK(vsgl__eigen_sym3(bad, w, v) == -1 && isnan(w[0]), "NaN entry");
+}
+
+/* The closed form (what vsgl_asg_product uses) against Jacobi: the same
+ * draws, and sums of two ASG forms (lambda x x^T + mu y y^T) as the
+ * product builds them; eigenvalues within 1e-10 of the scale (the
+ * trigonometric form loses ~1e-12 of it where two eigenvalues are close:
+ * still below float rounding of a bandwidth). */
+VT_TEST(asg_eigen3_fast_agrees_with_jacobi)
+{
+    vt_rng r = {212};
+    int closed = 0;
+    for (int t = 0; t < 6000; ++t) {
+        double a[3][3], scale;
+        int kind = t % 6;
+        if (kind < 5) {
+            double e[3], q0[3], q1[3], q2[3], tmp[3];
+            scale = log_uniform(&r, -12, 13);
+            for (int i = 0; i < 3; ++i)
+                e[i] = scale * vt_uniform(&r);
+            if (kind == 1) e[1] = e[0];
+            if (kind == 2) e[2] = e[1];
+            if (kind == 3) e[1] = e[2] = e[0];
+            if (kind == 4) e[2] = 0.0;
+            rand_unit(&r, q0);
+            rand_unit(&r, tmp);
+            cross_d(q0, tmp, q1);
+            double l = sqrt(dot_d(q1, q1));
+            for (int i = 0; i < 3; ++i)
+                q1[i] /= l;
+            cross_d(q0, q1, q2);
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    a[i][j] = e[0] * q0[i] * q0[j] + e[1] * q1[i] * q1[j] + e[2] * q2[i] * q2[j];
+        } else { /* two ASG forms, bandwidths 1e-3 .. 1e6 */
+            vsgl_asg p = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
+            vsgl_asg q = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
+            aq_asg fp = to_ref(&p), fq = to_ref(&q);
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    a[i][j] = p.lambda * fp.x[i] * fp.x[j] + p.mu * fp.y[i] * fp.y[j] + q.lambda * fq.x[i] * fq.x[j] +
+                              q.mu * fq.y[i] * fq.y[j];
+            scale = p.lambda + p.mu + q.lambda + q.mu;
+        }
+        char what[96];
+        snprintf(what, sizeof what, "draw %d kind %d", t, kind);
+        check_eigen_with(vsgl__eigen_sym3_fast, 1e4, a, what, scale);
+        double w[3], v[3][3], wj[3], vj[3][3];
+        closed += vsgl__eigen_sym3_fast(a, w, v) == 0;
+        vsgl__eigen_sym3(a, wj, vj);
+        for (int k = 0; k < 3; ++k)
+            VT_CHECK_ABS(w[k], wj[k], 1e-10 * scale, "%s: eigenvalue %d vs Jacobi", what, k);
+    }
+    VT_CHECK(closed > 3000, "the closed form took %d of 6000 draws", closed);
+    double bad[3][3] = {{1, NAN, 0}, {0, 1, 0}, {0, 0, 1}}, w[3], v[3][3];
+    VT_CHECK(vsgl__eigen_sym3_fast(bad, w, v) == -1 && isnan(w[0]), "NaN entry");
 }
 
 /* ------------------------------------------------------------ evaluation */

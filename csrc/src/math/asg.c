@@ -235,7 +235,7 @@ void vsgl_asg_product(const vsgl_asg *a, const vsgl_asg *b, vsgl_asg *out)
             m[i][j] = l1 * fa.x[i] * fa.x[j] + m1 * fa.y[i] * fa.y[j]
                     + l2 * fb.x[i] * fb.x[j] + m2 * fb.y[i] * fb.y[j];
     double w[3], v[3][3];
-    if (vsgl__eigen_sym3(m, w, v) < 0) { /* NaN bandwidths */
+    if (vsgl__eigen_sym3_fast(m, w, v) < 0) { /* NaN bandwidths */
         zero_lobe(&fa, out);
         out->lambda = out->mu = out->log_amplitude = NAN;
         return;

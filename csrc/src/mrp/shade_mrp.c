@@ -17,6 +17,11 @@
 #ifndef VSGL__MRP_CULL
 #define VSGL__MRP_CULL 1
 #endif
+/* A lobe reaches the cells where its ASG exponent is at most this (e^{-9}
+ * of its peak: 1e-4 of a 2-D Gaussian's energy lies beyond). */
+#ifndef VSGL__MRP_REACH
+#define VSGL__MRP_REACH 9.0
+#endif
 /* A block of cells of the proxy's pyramid is shaded whole when its diagonal
  * is at most this many times the lobe's sampling disk (its radius, at the
  * block's clamped peak): the disk's Gaussian light blurs anything finer.
@@ -92,7 +97,7 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
      * plane of incidence: Eq. 8's isotropic SG is up to 1/sqrt(2 |o.n|) narrower) */
     const vsgl_asg wa = rcv.warped;
     double nu = fmin((double)wa.lambda, (double)wa.mu) * (j->opt.lobes == 2 ? VSGL__GGX_TAIL_K : 1.0);
-    double spread = 3.0 / sqrt(nu > 1e-6 ? nu : 1e-6);
+    double spread = sqrt(VSGL__MRP_REACH / (nu > 1e-6 ? nu : 1e-6));
     /* the core's reach, where there are two lobes: cells beyond it skip the core */
     const double core_frac = j->opt.lobes == 2 ? sqrt((double)VSGL__GGX_TAIL_K / VSGL__GGX_CORE_K) : 1.0;
     /* per cell, the anisotropic test against the warped lobe (the box test
@@ -171,7 +176,7 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
                             continue;
                         double ax = fmax(0.0, fabs(d3_dot(vd, wx)) - ang), ay = fmax(0.0, fabs(d3_dot(vd, wy)) - ang);
                         double ex = (double)wa.lambda * ax * ax + (double)wa.mu * ay * ay;
-                        if (ex * k_q > 9.0)
+                        if (ex * k_q > VSGL__MRP_REACH)
                             continue;
                     }
                     if (l > 0) { /* whole, or its children */
