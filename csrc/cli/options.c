@@ -26,6 +26,8 @@ const char cli_usage[] =
     "  --diffuse NAME        sg | pulled-out | accurate   (receiver cosine)\n"
     "  --glossy NAME         asg | sg | asg2 | mrp | hybrid   (one ASG, one SG, GGX core + tail as two\n"
     "                        ASGs, rectangle proxies: the MRP paper, MRP per pixel where it applies)\n"
+    "  --mrp-min-area A      smallest planar face made a rectangle proxy by --glossy mrp | hybrid\n"
+    "                        (m^2, >= 0; 0 = the default 0.25)\n"
     "  --visibility NAME     none | ray\n"
     "  --leak NAME           auto | off | on | clip   (emitter clip and near field; clip: without the near field)\n"
     "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
@@ -264,7 +266,8 @@ static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t e
             continue;
         }
         /* Options with a value. */
-        int known = !strcmp(name, "-o") || !strcmp(name, "--output") || !strcmp(name, "--max-memory");
+        int known = !strcmp(name, "-o") || !strcmp(name, "--output") || !strcmp(name, "--max-memory") ||
+                    !strcmp(name, "--mrp-min-area");
         for (size_t k = 0; k < sizeof enum_opts / sizeof enum_opts[0]; ++k)
             known |= !strcmp(name, enum_opts[k].name);
         for (size_t k = 0; k < sizeof num_opts / sizeof num_opts[0]; ++k)
@@ -280,6 +283,16 @@ static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t e
             if (!*value)
                 return set_err(err, err_size, "option %s needs a non-empty path%s", name, "");
             o->output_path = value;
+            continue;
+        }
+        if (!strcmp(name, "--mrp-min-area")) {
+            char *end = NULL;
+            errno = 0;
+            double area = *value ? strtod(value, &end) : -1.0;
+            if (!end || *end || errno || !(area >= 0.0) || !(area <= 3.4e38))
+                return set_err(err, err_size, "option --mrp-min-area: '%s' is not an area in m^2 >= 0%s", value, "");
+            o->mrp_min_area_set = 1;
+            o->mrp_min_area = area;
             continue;
         }
         if (!strcmp(name, "--max-memory")) {
@@ -341,6 +354,7 @@ void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_r
     if (o->method >= 0) s->method = o->method;
     if (o->leak >= 0) s->leak_correction = o->leak;
     if (o->merge >= 0) s->sample_merging = o->merge;
+    if (o->mrp_min_area_set) s->mrp_min_area = (float)o->mrp_min_area;
 }
 
 static const char *name_of(const char *const *names, const int *values, int v)
@@ -353,10 +367,11 @@ static const char *name_of(const char *const *names, const int *values, int v)
 
 void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size)
 {
-    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u",
+    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u mrp_min_area=%g",
              name_of(method_names, method_values, s->method), s->aa_samples, s->rsm_resolution,
              name_of(fit_names, fit_values, s->fit_mode), s->vsgl_count, s->fis_iterations,
              name_of(sharp_names, sharp_values, s->sharpness_estimator), name_of(diffuse_names, diffuse_values, s->diffuse_mode),
              name_of(glossy_names, glossy_values, s->glossy_mode), name_of(vis_names, vis_values, s->visibility), s->seed,
-             name_of(leak_names, leak_values, s->leak_correction), name_of(merge_names, merge_values, s->sample_merging), s->shade_stride, s->edge_samples);
+             name_of(leak_names, leak_values, s->leak_correction), name_of(merge_names, merge_values, s->sample_merging), s->shade_stride, s->edge_samples,
+             (double)s->mrp_min_area);
 }

@@ -24,6 +24,8 @@ typedef struct cli_options {
     int half, verbose, dry_run;
     int pixel_type_given;   /* --half or --float was given */
     uint64_t max_memory;      /* --max-memory in bytes; 0 = what the machine has available */
+    int mrp_min_area_set;     /* --mrp-min-area was given */
+    double mrp_min_area;      /* its value (m^2, finite, >= 0) */
 } cli_options;
 
 /* Parse a byte size: digits with an optional K, M, G or T (powers of 1024)

@@ -299,6 +299,16 @@ if want args_glossy_hybrid && expect_ok "args_glossy_hybrid" "$VSGL" render "$SC
   if grep -q "glossy=hybrid" "$T/out"; then ok "args_glossy_hybrid"
   else bad "args_glossy_hybrid" "$(head -3 "$T/out" | tr '\n' '|')"; fi
 fi
+# --mrp-min-area: the MRP modes' proxy size threshold (vsgl_render_settings.mrp_min_area)
+if want args_mrp_min_area && expect_ok "args_mrp_min_area" "$VSGL" render "$SCENE" -o "$T/mrpa.exr" --glossy mrp \
+    --mrp-min-area 2.5 --dry-run; then
+  if grep -q "glossy=mrp.*mrp_min_area=2.5" "$T/out"; then ok "args_mrp_min_area"
+  else bad "args_mrp_min_area" "$(head -3 "$T/out" | tr '\n' '|')"; fi
+fi
+expect_fail args_bad_mrp_min_area 2 "option --mrp-min-area: '-1' is not an area in m^2 >= 0" "$VSGL" render "$SCENE" \
+  --mrp-min-area -1
+expect_fail args_bad_mrp_min_area_nan 2 "option --mrp-min-area: 'nan' is not an area in m^2 >= 0" "$VSGL" render "$SCENE" \
+  --mrp-min-area nan
 expect_fail args_bad_compression 2 "'lzma' is not one of zip|zips|piz|none|rle|pxr24|b44|b44a" "$VSGL" render "$SCENE" \
   --compression lzma
 
