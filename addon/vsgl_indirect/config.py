@@ -27,6 +27,7 @@ KNOBS = {
     "leak_correction": (("AUTO", "OFF", "ON", "CLIP"), "AUTO"),
     "diffuse_mode": (("SG", "PULLED_OUT", "ACCURATE"), "PULLED_OUT"),
     "glossy_mode": (("ASG", "SG", "ASG2", "MRP", "HYBRID"), "ASG2"),
+    "mrp_min_area": (None, 0.25),
 }
 
 # The presets' knob values: vsgl_render_settings_preset (csrc/src/shade/
@@ -34,7 +35,7 @@ KNOBS = {
 # tests/blender/addon/test_addon_ui.py checks the two agree.
 _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", fis_iterations=8,
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
-               diffuse_mode="PULLED_OUT")
+               diffuse_mode="PULLED_OUT", mrp_min_area=0.25)
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="NONE",
                     shade_stride=2, edge_samples=8),
@@ -89,6 +90,8 @@ def inactive_knobs(obj):
         out |= {"fis_iterations"}
     if obj.aa_samples <= 1:
         out.add("sample_merging")
+    if obj.glossy_mode not in ("MRP", "HYBRID") or obj.method == "BRUTE_FORCE":
+        out.add("mrp_min_area")
     return out
 
 
@@ -109,6 +112,7 @@ class Options:
     sharpness_estimator: str = "TOKSVIG"
     diffuse_mode: str = "PULLED_OUT"
     glossy_mode: str = "ASG"
+    mrp_min_area: float = 0.25      # m^2: the smallest face made a rectangle proxy (MRP, HYBRID)
     visibility: str = "RAY"
     seed: int = 0
     leak_correction: str = "AUTO"

@@ -280,6 +280,13 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                         "How the receiver's cosine is modelled in the diffuse integral")
     glossy_mode: _enum("glossy_mode", "Glossy Lobe",
                        "How the receiver's GGX lobe is modelled in the glossy integral")
+    mrp_min_area: FloatProperty(
+        name="Proxy Min Area", default=config.KNOBS["mrp_min_area"][1], min=0.0, soft_max=10.0,
+        description="Rectangle Proxies and Hybrid: the smallest planar face (m^2, the rectangle fitted "
+                    "to its coplanar triangles) reflected as a lit rectangle; the light of smaller "
+                    "faces is not in the glossy pass (Hybrid: their VSGLs carry it). 0.25 in every "
+                    "preset; the quality rooms' walls and floors (18-36 m^2) give the same image from "
+                    "0.25 to 10 (docs/mrp.md)")
     visibility: _enum("visibility", "Visibility", "Indirect shadows between VSGLs and receivers")
     seed: IntProperty(
         name="Seed", default=0, min=0,
