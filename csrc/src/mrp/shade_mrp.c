@@ -250,9 +250,12 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
  * takes the mean of its two or four neighbouring anchors when it and they
  * lie on one flat surface (one material, normals within MRP_GROUP_COS, on
  * one plane, every sample a hit) and the anchors' light differs by at most
- * VSGL__MRP_SPARSE_CONTRAST ((max - min) / (max + min) of the sums of
- * channels); elsewhere (edges, the rim of a reflection) it is shaded itself.
- * 0 shades every pixel. docs/mrp.md §4 measures both. */
+ * half of VSGL__MRP_SPARSE_CONTRAST ((max - min) / (max + min) of the sums
+ * of channels); from there to VSGL__MRP_SPARSE_CONTRAST it is shaded and
+ * blended with that mean (linearly in the contrast: a pixel does not jump
+ * between the two as a light moves); elsewhere (edges, the rim of a
+ * reflection) it is shaded itself. 0 shades every pixel. docs/mrp.md §4
+ * measures both. */
 #ifndef VSGL__MRP_SPARSE_CONTRAST
 #define VSGL__MRP_SPARSE_CONTRAST 0.1
 #endif
@@ -328,9 +331,10 @@ static void shade_pixel(const mrp_job *j, size_t px, int shade, float acc[3], mr
 
 static int is_anchor(uint32_t v, uint32_t n) { return (v & 1u) == 0 || v + 1 == n; }
 
-/* The mean of the anchors around pixel (x, y) into acc when it may be
- * interpolated (see VSGL__MRP_SPARSE_CONTRAST), else 0. */
-static int interpolate(const mrp_pass *P, uint32_t x, uint32_t y, float acc[3])
+/* The mean of the anchors around pixel (x, y) into acc and its weight
+ * (1: the mean alone, 0: shade the pixel, between: blend; see
+ * VSGL__MRP_SPARSE_CONTRAST). */
+static float interpolate(const mrp_pass *P, uint32_t x, uint32_t y, float acc[3])
 {
     const vsgl_gbuffer *g = P->j->g;
     const mrp_surface *me = &P->surf[(size_t)y * g->width + x];
@@ -361,11 +365,13 @@ static int interpolate(const mrp_pass *P, uint32_t x, uint32_t y, float acc[3])
             for (int c = 0; c < 3; ++c)
                 sum[c] += r[c];
         }
-    if (!(hi - lo <= (float)VSGL__MRP_SPARSE_CONTRAST * (hi + lo)))
+    const float t1 = (float)VSGL__MRP_SPARSE_CONTRAST, t0 = 0.5f * t1;
+    float contrast = hi > 0.0f ? (hi - lo) / (hi + lo) : 0.0f;
+    if (!(contrast < t1))
         return 0;
     for (int c = 0; c < 3; ++c)
         acc[c] = sum[c] / (float)(nx * ny);
-    return 1;
+    return contrast <= t0 ? 1.0f : (t1 - contrast) / (t1 - t0);
 }
 
 static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
@@ -388,8 +394,11 @@ static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
                 sf->state = 2; /* hybrid: a rough receiver keeps the VSGL glossy light */
                 continue;
             }
-            if (P->phase == 0 || !interpolate(P, x, y, raw))
+            float mean[3], w = P->phase == 0 ? 0.0f : interpolate(P, x, y, mean);
+            if (w < 1.0f)
                 shade_pixel(j, px, 1, raw, sf);
+            for (int c = 0; c < 3 && w > 0.0f; ++c)
+                raw[c] = w * mean[c] + (1.0f - w) * (w < 1.0f ? raw[c] : 0.0f);
             sf->state = 1;
             continue;
         }
