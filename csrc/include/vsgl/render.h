@@ -39,11 +39,11 @@ extern "C" {
                                error 0.0049 -> 0.0004, no bundled room worse (docs/quality.md); the
                                glossy stage at twice the cost */
 #define VSGL_GLOSSY_MRP  3 /**< experimental: glossy light from rectangle proxies (the MRP paper,
-                               docs/mrp.md): the scene's large planar faces (>= 0.25 m^2), lit by this
+                               docs/mrp.md): the scene's large planar faces (>= mrp_min_area), lit by this
                                frame's RSMs, reflected by each receiver's warped ASG lobe in closed form;
                                light from anything else (curved or small surfaces) is not in the glossy
-                               pass; several times slower than ASG2 (docs/mrp.md §4 says where it
-                               wins). Diffuse as ASG */
+                               pass; 1.2-2.7x the time of k-means 256 with ASG2 in the quality rooms
+                               (docs/mrp.md §4 says where it wins). Diffuse as ASG */
 #define VSGL_GLOSSY_HYBRID 4 /**< experimental: per pixel, where every glossy receiver is sharp
                                (roughness <= 0.5) and reaches a lit rectangle proxy, the proxies' light
                                as the larger of MRP's (above) and the on-proxy VSGLs' estimate, plus the
