@@ -41,6 +41,9 @@ ap.add_argument("--triangles", type=int, default=100_000)
 ap.add_argument("--size", default="960x540")
 ap.add_argument("--repeat", type=int, default=5)
 ap.add_argument("--quality", default="LIVE,PREVIEW", help="panel qualities to time, comma-separated")
+ap.add_argument("--save-bundle", metavar="PATH",
+                help="only write the room at --size with the first quality's settings as a scene bundle "
+                     "(for a C driver, e.g. tools/live_edit.c) and exit")
 args = ap.parse_args(argv)
 W, H = (int(v) for v in args.size.lower().split("x"))
 
@@ -107,10 +110,26 @@ def combined(w, h, scene, cam, quality):
     return images["combined"]
 
 
+def save_bundle(path, w, h, scene, cam, quality):
+    """The room as the live preview renders it, as a scene bundle."""
+    from vsgl_indirect import engine
+    lib = engine._binding()
+    arrays = engine.scene_arrays(view_data({}, w, h, scene, cam), lib)
+    ctx = lib.Context(log_level=lib.LogLevel.ERROR)
+    try:
+        lib.bundle_write(ctx, path, arrays, live.render_settings(lib, quality, w * h))
+    finally:
+        ctx.close()
+
+
 def main():
     light, cam, wave = build(args.triangles)
     scene = bpy.context.scene
     qualities = [q.strip().upper() for q in args.quality.split(",") if q.strip()]
+    if args.save_bundle:
+        save_bundle(args.save_bundle, W, H, scene, cam, qualities[0])
+        print("wrote %s (%dx%d, %s)" % (args.save_bundle, W, H, qualities[0]))
+        return
     rows = []
     for quality in qualities:
         for div in (1, 2):

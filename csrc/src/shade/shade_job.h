@@ -1,6 +1,7 @@
 /* Internal: the state shared by the shading paths of one vsgl__shade call
- * (shade.c: the full-resolution paths and the per-sample helpers; sparse.c:
- * shading one pixel in S x S and interpolating between them). */
+ * (shade.c: the full-resolution paths and the per-sample helpers; sparse.c,
+ * sparse_replay.c, sparse_plan.c: shading one pixel in S x S and
+ * interpolating between them). */
 #ifndef VSGL_SHADE_SHADE_JOB_H
 #define VSGL_SHADE_SHADE_JOB_H
 
@@ -39,7 +40,7 @@ struct vsgl_shade_plan {
     int32_t *dlane_of;              /* per sample: its lane in dlanes, or -1 (it was not shaded itself) */
     vsgl__plan_lane *dlanes;        /* the lanes of the samples the record shaded themselves */
     size_t ndlanes, dlanes_cap;
-    /* what a replay reads instead of recomputing it (sparse.c): */
+    /* what a replay reads instead of recomputing it (sparse_replay.c): */
     uint32_t *cell_x, *cell_y;      /* per (column, slot) and (row, slot): the anchor cell of a sample */
     float *cell_tx, *cell_ty;       /* its position in that cell, as sample_cell computes it */
     unsigned char *d2_ok;           /* per anchor: bit 0 (x), 1 (y): a second difference through its two
@@ -101,7 +102,7 @@ uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lan
 /* cd: NULL, or 4 floats per sample of the pixel that receive its colour factors (a plan's record) */
 void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls, float *cd);
 
-/* Shading plans (sparse.c): a new empty plan to record (NULL if memory is
+/* Shading plans (sparse_plan.c): a new empty plan to record (NULL if memory is
  * short), whether one fits this G-buffer and settings, whether a record
  * filled every row. */
 vsgl_shade_plan *vsgl__shade_plan_new(const vsgl_gbuffer *g, const vsgl_render_settings *s, uint32_t aw,

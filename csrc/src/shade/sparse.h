@@ -1,0 +1,77 @@
+/* Internal to shading one pixel in S x S (shade_stride > 1): what the
+ * record / classify path (sparse.c), the replay (sparse_replay.c) and the
+ * plan's lifetime (sparse_plan.c) share. See sparse.c for the method. */
+#ifndef VSGL_SHADE_SPARSE_H
+#define VSGL_SHADE_SPARSE_H
+
+#include "shade/shade_job.h"
+#include "core/context.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* A same-surface test's tolerances (see the file comment). */
+/* Normals within ~6 degrees: a curved surface at a grazing view (a sphere's
+ * rim) is shaded where its normal turns faster than that between anchors;
+ * with ~25 degrees its rim, interpolated from anchors further inside, jumped
+ * as the silhouette crossed them (the sphere room's glossy frame-to-frame
+ * change as the camera moves 0.114 -> 0.043 at 80 x 60; 0.053 shading 8 x 8
+ * samples in every pixel). Flat surfaces have one normal. */
+#define SPARSE_NORMAL_COS 0.995f
+#define SPARSE_PLANE_REL 0.05f
+/* Interpolate only where bilinear interpolation is accurate: its error at
+ * (tx, ty) in a cell is about (tx (1 - tx) d2x + ty (1 - ty) d2y) / 2, d2
+ * the anchors' second differences along x and y (from the anchors around
+ * the cell on the sample's surface). A sample is shaded itself where that
+ * exceeds SPARSE_TOL of its interpolated light plus SPARSE_FLOOR of the
+ * frame's mean, per lobe: a step between anchors of more than ~30 %, or a
+ * falloff steeper than ~1.8x per anchor (2 % shaded 1.35x the samples of
+ * the sphere room for no gain in its error). Where no second difference can be
+ * taken (fewer than three anchors in a row on the surface), anchors that
+ * differ by more than SPARSE_CONTRAST of their sum. */
+#define SPARSE_TOL 0.04f
+#define SPARSE_CONTRAST 0.1f
+#define SPARSE_FLOOR 0.002f
+
+/* Anchors, and samples shaded themselves, per parallel chunk: four kernel blocks. */
+#define SPARSE_CHUNK (4 * VSGL__KERNEL_BLOCK)
+
+/* Plan codes per sample (vsgl_shade_plan.direct): */
+#define PLAN_MISS (-2)
+#define PLAN_ALONE (-3)  /* no anchor shares its surface: always shaded itself */
+#define PLAN_NEAR (-1)   /* interpolated where the interpolation test passes (per render: it reads the light) */
+
+/* The rows of one batch (vsgl__shade_sparse_batch): their samples' interpolated light,
+ * which are shaded themselves, and those samples' light, packed in full kernel blocks. */
+typedef struct sparse_batch {
+    shade_job *j;
+    size_t first, ns;        /* the batch's first sample, its sample count */
+    float *interp;           /* 6 per sample */
+    size_t *direct_of;       /* per sample: SIZE_MAX (interpolated or a miss), else its index in dlist */
+    size_t *dlist;           /* the samples shaded themselves, in sample order */
+    float *dlight;           /* 6 per entry of dlist */
+    uint64_t *dpairs;        /* per chunk of dlist */
+    vsgl__plan_lane *lanes;  /* per entry of dlist: its lane (recorded, or for a replay read or made) */
+    uint32_t *nmarks;        /* a replay: per row of the batch, its samples to shade (plan->marks) */
+} sparse_batch;
+
+#define SPARSE_MARK (SIZE_MAX - 1) /* direct_of of a sample to shade, before it has its index */
+
+/* Entries [b, e) of the batch's list of samples shaded themselves, in full
+ * kernel blocks (sparse.c; vsgl__parallel_for's callback, user: a sparse_batch). */
+int32_t vsgl__sparse_direct(void *user, size_t chunk, size_t b, size_t e);
+
+/* The anchors' light packed for the interpolation (plan->pack), and for a
+ * replay their second differences and the test's floor (sparse_replay.c). */
+void vsgl__sparse_anchor_pack(shade_job *j);
+
+/* A sample's light interpolated from the packed anchors of its cell (ax, ay)
+ * at (tx, ty) with the weights w (4) into out (6), or 0 where it is to be
+ * shaded itself (sparse_replay.c). */
+int vsgl__sparse_interp(const shade_job *j, const float *pack, const float *w, uint32_t ax, uint32_t ay, float tx,
+                        float ty, float *out);
+
+/* vsgl__shade_sparse_batch for a replay (sparse_replay.c). */
+vsgl_result vsgl__sparse_replay_batch(vsgl_context *ctx, shade_job *j, size_t row, size_t end);
+
+#endif
