@@ -8,7 +8,8 @@
  * then moves its first light (or with --camera its camera) by 1 cm along x
  * N times (default 9), rendering each edit. Prints per edit the CPU time of
  * the process (all threads) and the wall time of vsgl_render_cached, and a
- * hash (FNV-1a over the bytes of all eight planes) of every frame: two
+ * hash (FNV-1a over the 64-bit words of all eight planes; --no-hash: none,
+ * and only Combined is asked for, as the live viewport does) of every frame: two
  * builds that print the same hashes rendered the same pixels bit for bit.
  * Ends with the medians. --settings K replaces the bundle's knobs:
  * 0 as saved, 1 stride 2 + 2x2 AA + 8x8 edge rays, 2 stride 3 + 2x2 AA,
@@ -41,18 +42,22 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/* FNV-1a over 64-bit words (n a multiple of 8) */
 static uint64_t fnv(uint64_t h, const void *p, size_t n)
 {
     const unsigned char *b = p;
-    for (size_t i = 0; i < n; ++i)
-        h = (h ^ b[i]) * 1099511628211ull;
+    for (size_t i = 0; i + 8 <= n; i += 8) {
+        uint64_t w;
+        memcpy(&w, b + i, 8);
+        h = (h ^ w) * 1099511628211ull;
+    }
     return h;
 }
 
 int main(int argc, char **argv)
 {
     const char *path = NULL;
-    int edits = 9, camera = 0, knobs = 0, quiet = 0;
+    int edits = 9, camera = 0, knobs = 0, quiet = 0, hash = 1;
     uint32_t threads = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--edits") && i + 1 < argc)
@@ -63,13 +68,15 @@ int main(int argc, char **argv)
             knobs = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--camera"))
             camera = 1;
+        else if (!strcmp(argv[i], "--no-hash"))
+            hash = 0;
         else if (!strcmp(argv[i], "--quiet"))
             quiet = 1;
         else
             path = argv[i];
     }
     if (!path || edits < 1 || edits > 1000) {
-        fprintf(stderr, "usage: live_edit BUNDLE [--edits N] [--threads T] [--camera] [--settings K] [--quiet]\n");
+        fprintf(stderr, "usage: live_edit BUNDLE [--edits N] [--threads T] [--camera] [--settings K] [--quiet] [--no-hash]\n");
         return 2;
     }
     vsgl_context_desc cd;
@@ -112,9 +119,9 @@ int main(int argc, char **argv)
     out.height = cam.height;
     float **rgb[7] = {&out.diffuse_light, &out.glossy_light, &out.diffuse_color, &out.glossy_color,
                       &out.diffuse, &out.glossy, &out.combined};
-    for (int k = 0; k < 7; ++k)
-        *rgb[k] = planes + (size_t)k * px * 3;
-    out.alpha = planes + 21 * px;
+    for (int k = 0; k < 7; ++k) /* without a hash only Combined, as the live viewport asks */
+        *rgb[k] = hash || k == 6 ? planes + (size_t)k * px * 3 : NULL;
+    out.alpha = hash ? planes + 21 * px : NULL;
     double *cpu = malloc((size_t)edits * sizeof *cpu), *wall = malloc((size_t)edits * sizeof *wall);
     uint64_t all = 1469598103934665603ull;
     for (int e = -1; e < edits; ++e) {
@@ -137,7 +144,7 @@ int main(int argc, char **argv)
             return 1;
         }
         double c1 = now(CLOCK_PROCESS_CPUTIME_ID), w1 = now(CLOCK_MONOTONIC);
-        uint64_t h = fnv(1469598103934665603ull, planes, px * 22 * sizeof(float));
+        uint64_t h = hash ? fnv(1469598103934665603ull, planes, px * 22 * sizeof(float)) : 0;
         all = fnv(all, &h, sizeof h);
         if (!quiet)
             printf("edit %2d: cpu %.4f wall %.4f (gbuffer %.4f rsm %.4f fit %.4f shade %.4f) hash %016llx\n", e,

@@ -85,6 +85,79 @@ VT_TEST(core_parallel_for_reports_lowest_failing_chunk)
         VT_CHECK(vsgl__parallel_for(t, 100, 7, fail_some, NULL) == 7, "threads %u", t);
 }
 
+/* The context's pool (vsgl__parallel_ctx): every chunk once, the same sums
+ * and failure codes as vsgl__parallel_for, for many loops in a row (each
+ * a new generation the workers must not miss or repeat), a loop inside a
+ * chunk of another (it falls back to threads of its own), and a pool
+ * ended by vsgl_context_destroy. */
+typedef struct pool_job {
+    vsgl_context *ctx;
+    unsigned char *seen;
+    double *partial;
+    const double *v;
+    int nest;
+} pool_job;
+
+static int32_t pool_chunk(void *user, size_t chunk, size_t b, size_t e)
+{
+    pool_job *j = user;
+    double s = 0;
+    for (size_t i = b; i < e; ++i) {
+        j->seen[i]++;
+        s += j->v[i];
+    }
+    j->partial[chunk] = s;
+    if (j->nest && chunk == 1) { /* a loop inside this one */
+        static double inner_partial[64];
+        static unsigned char inner_seen[1000];
+        pool_job in = {j->ctx, inner_seen, inner_partial, j->v, 0};
+        memset(inner_seen, 0, sizeof inner_seen);
+        if (vsgl__parallel_ctx(j->ctx, 1000, 17, pool_chunk, &in) != 0)
+            return 99;
+        for (int i = 0; i < 1000; ++i)
+            if (inner_seen[i] != 1)
+                return 98;
+    }
+    return 0;
+}
+
+VT_TEST(core_parallel_ctx_pool_matches_parallel_for)
+{
+    enum { N = 20011, CH = 97, NC = N / CH + 1 };
+    static double v[N], want[NC], got[NC];
+    static unsigned char seen[N];
+    vt_rng r = {7};
+    for (int i = 0; i < N; ++i)
+        v[i] = vt_uniform(&r) * 1e3 - 5e2;
+    pool_job ref = {NULL, seen, want, v, 0};
+    VT_REQUIRE(vsgl__parallel_for(1, N, CH, pool_chunk, &ref) == 0, "reference");
+    for (uint32_t t = 1; t <= 4; ++t) {
+        vsgl_context_desc d;
+        memset(&d, 0, sizeof d);
+        d.size = sizeof d;
+        d.thread_count = t;
+        vsgl_context *ctx = NULL;
+        VT_REQUIRE(vsgl_context_create(&d, &ctx) == VSGL_OK, "context");
+        for (int loop = 0; loop < 200; ++loop) {
+            memset(seen, 0, sizeof seen);
+            memset(got, 0, sizeof got);
+            pool_job j = {ctx, seen, got, v, loop % 50 == 3};
+            size_t count = loop % 7 == 0 ? (size_t)CH / 2 : N; /* one chunk now and then */
+            VT_CHECK(vsgl__parallel_ctx(ctx, count, CH, pool_chunk, &j) == 0, "threads %u loop %d", t, loop);
+            size_t bad = 0;
+            for (size_t i = 0; i < count; ++i)
+                bad += seen[i] != 1;
+            VT_CHECK(bad == 0, "threads %u loop %d: %zu items not run exactly once", t, loop, bad);
+            if (count == N)
+                VT_CHECK(memcmp(got, want, sizeof got) == 0, "threads %u loop %d: partial sums differ", t, loop);
+            VT_CHECK(vsgl__parallel_ctx(ctx, 100, 7, fail_some, NULL) == 7, "threads %u loop %d: failure", t, loop);
+        }
+        VT_CHECK(vsgl__parallel_ctx(ctx, 0, 7, fail_some, NULL) == 0, "empty loop");
+        vsgl_context_destroy(ctx);
+    }
+    VT_CHECK(vsgl__parallel_ctx(NULL, 100, 7, fail_some, NULL) == 7, "no context");
+}
+
 /* One rule for every size-prefixed struct: 0 = current, smaller = older
  * (tail zero), larger or shorter than the size field = refused, named. */
 VT_TEST(core_versioned_structs_follow_one_rule)

@@ -36,12 +36,15 @@ vsgl_result vsgl_context_create(const vsgl_context_desc *desc, vsgl_context **ou
     ctx->max_memory = d.max_memory;
     ctx->progress_base = 0.0f;
     ctx->progress_span = 1.0f;
+    atomic_init(&ctx->pool, NULL);
     *out = ctx;
     return VSGL_OK;
 }
 
 void vsgl_context_destroy(vsgl_context *ctx)
 {
+    if (ctx)
+        vsgl__pool_destroy(atomic_load(&ctx->pool));
     free(ctx);
 }
 

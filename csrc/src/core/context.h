@@ -3,6 +3,9 @@
 #define VSGL_CORE_CONTEXT_H
 
 #include "vsgl/base.h"
+#include "core/parallel.h"
+
+#include <stdatomic.h>
 
 #define VSGL__MESSAGE_MAX 512
 
@@ -16,6 +19,7 @@ struct vsgl_context {
     char last_error[VSGL__MESSAGE_MAX];
     float progress_base, progress_span; /* stage window of the overall progress */
     uint64_t max_memory;    /* 0 = what the machine has available (render/memory.c) */
+    _Atomic(vsgl__pool *) pool; /* worker threads of vsgl__parallel_ctx, started by its first loop */
 };
 
 #if defined(__GNUC__)

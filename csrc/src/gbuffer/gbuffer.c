@@ -153,7 +153,6 @@ int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted)
 static vsgl_result for_rows(vsgl_context *ctx, gb_job *job, vsgl_range_fn fn, float p0, float p1, const char *what)
 {
     vsgl_gbuffer *out = job->g;
-    uint32_t threads = vsgl_context_thread_count(ctx);
     uint32_t h = out->height;
     uint32_t step = (h + VSGL__GBUFFER_STEPS - 1) / VSGL__GBUFFER_STEPS;
     for (uint32_t row = 0; row < h; row += step) {
@@ -164,7 +163,7 @@ static vsgl_result for_rows(vsgl_context *ctx, gb_job *job, vsgl_range_fn fn, fl
                               (unsigned)h, what);
         }
         job->row0 = row;
-        int32_t r = vsgl__parallel_for(threads, rows, 1, fn, job);
+        int32_t r = vsgl__parallel_ctx(ctx, rows, 1, fn, job);
         if (r != 0) {
             vsgl__gbuffer_free(out);
             return vsgl__fail(ctx, r, "gbuffer: %s rows %u..%u failed", what, (unsigned)row,

@@ -430,10 +430,9 @@ static vsgl_result write_outputs(vsgl_context *ctx, const vsgl_pixel_planes *p, 
 {
     /* Refuse to hand out a non-finite value: that would be a bug. Every
      * value is checked before any output is written. */
-    const uint32_t threads = vsgl_context_thread_count(ctx);
     const size_t chunk = 16384; /* pixels */
     output_job oj = {p, out, 0};
-    if (vsgl__parallel_for(threads, pixels, chunk, output_chunk, &oj) != 0) {
+    if (vsgl__parallel_ctx(ctx, pixels, chunk, output_chunk, &oj) != 0) {
         for (size_t i = 0; i < pixels * 3; ++i)
             if (bad_value(p, i))
                 return vsgl__fail(ctx, VSGL_ERROR_INTERNAL,
@@ -442,7 +441,7 @@ static vsgl_result write_outputs(vsgl_context *ctx, const vsgl_pixel_planes *p, 
                                   i / 3, i % 3, (double)p->diffuse[i], (double)p->glossy[i]);
     }
     oj.pass = 1;
-    (void)vsgl__parallel_for(threads, pixels, chunk, output_chunk, &oj);
+    (void)vsgl__parallel_ctx(ctx, pixels, chunk, output_chunk, &oj);
     return VSGL_OK;
 }
 

@@ -157,12 +157,11 @@ vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
     }
     /* batches of rows so that progress and cancel run on this thread */
     size_t batch = rows / 16 > 0 ? rows / 16 : 1;
-    uint32_t threads = vsgl_context_thread_count(ctx);
     vsgl_result r = VSGL_OK;
     for (size_t b = 0; b < rows && r == VSGL_OK; b += batch) {
         size_t e = b + batch < rows ? b + batch : rows;
         rsm_job j = {scene, &l, out, b, partial + 3 * b};
-        r = vsgl__parallel_for(threads, e - b, 1, rsm_rows, &j);
+        r = vsgl__parallel_ctx(ctx, e - b, 1, rsm_rows, &j);
         if (r != VSGL_OK)
             r = vsgl__fail(ctx, r, "rsm: light %u: %s", light, vsgl_result_string(r));
         else if (vsgl__progress(ctx, "rsm", (float)e / (float)rows))

@@ -971,7 +971,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             r = vsgl__shade_sparse_batch(ctx, &j, row, end);
             if (r != VSGL_OK)
                 break;
-        } else if (vsgl__parallel_for(vsgl_context_thread_count(ctx), (end - row) * chunk, chunk,
+        } else if (vsgl__parallel_ctx(ctx, (end - row) * chunk, chunk,
                                       path == VSGL__SHADE_REFERENCE ? shade_chunk : shade_chunk_kernel, &j) != 0) {
             r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
             break;

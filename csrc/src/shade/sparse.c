@@ -114,7 +114,7 @@ vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
         if (j->anchor_sample[a] != SIZE_MAX)
             j->alist[nh++] = a;
     }
-    if (vsgl__parallel_for(vsgl_context_thread_count(ctx), nh, SPARSE_CHUNK, anchor_blocks, j) != 0)
+    if (vsgl__parallel_ctx(ctx, nh, SPARSE_CHUNK, anchor_blocks, j) != 0)
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory for the sparse anchors");
     if (plan && !j->replay) {
         memcpy(plan->anchor_sample, j->anchor_sample, na * sizeof *plan->anchor_sample);
@@ -510,7 +510,6 @@ vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row
         return vsgl__sparse_replay_batch(ctx, j, row, end);
     const vsgl_gbuffer *g = j->g;
     const size_t W = g->width, spp = g->spp;
-    const uint32_t threads = vsgl_context_thread_count(ctx);
     sparse_batch bt;
     memset(&bt, 0, sizeof bt);
     bt.j = j;
@@ -521,7 +520,7 @@ vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row
     bt.dlist = malloc((bt.ns + 1) * sizeof *bt.dlist);
     vsgl_result r = VSGL_OK;
     if (!bt.interp || !bt.direct_of || !bt.dlist ||
-        vsgl__parallel_for(threads, (end - row) * W, W, j->plan ? record_rows : sparse_classify, &bt) != 0) {
+        vsgl__parallel_ctx(ctx, (end - row) * W, W, j->plan ? record_rows : sparse_classify, &bt) != 0) {
         r = VSGL_ERROR_OUT_OF_MEMORY;
         goto done;
     }
@@ -538,8 +537,8 @@ vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row
     if (plan) /* a record keeps the lanes */
         bt.lanes = malloc((nd + 1) * sizeof *bt.lanes);
     if (!bt.dlight || !bt.dpairs || (plan && !bt.lanes) ||
-        vsgl__parallel_for(threads, nd, SPARSE_CHUNK, vsgl__sparse_direct, &bt) != 0 ||
-        vsgl__parallel_for(threads, (end - row) * W, W, sparse_resolve, &bt) != 0) {
+        vsgl__parallel_ctx(ctx, nd, SPARSE_CHUNK, vsgl__sparse_direct, &bt) != 0 ||
+        vsgl__parallel_ctx(ctx, (end - row) * W, W, sparse_resolve, &bt) != 0) {
         r = VSGL_ERROR_OUT_OF_MEMORY;
         goto done;
     }

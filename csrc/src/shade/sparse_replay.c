@@ -425,7 +425,6 @@ vsgl_result vsgl__sparse_replay_batch(vsgl_context *ctx, shade_job *j, size_t ro
 {
     vsgl_shade_plan *plan = j->plan;
     const size_t W = plan->width, spp = plan->spp, rows = end - row;
-    const uint32_t threads = vsgl_context_thread_count(ctx);
     sparse_batch bt;
     memset(&bt, 0, sizeof bt);
     bt.j = j;
@@ -446,7 +445,7 @@ vsgl_result vsgl__sparse_replay_batch(vsgl_context *ctx, shade_job *j, size_t ro
         }
     }
     bt.nmarks = malloc((rows + 1) * sizeof *bt.nmarks);
-    if (!bt.nmarks || vsgl__parallel_for(threads, rows * W, W, replay_rows, &bt) != 0) {
+    if (!bt.nmarks || vsgl__parallel_ctx(ctx, rows * W, W, replay_rows, &bt) != 0) {
         r = VSGL_ERROR_OUT_OF_MEMORY;
         goto done;
     }
@@ -470,8 +469,8 @@ vsgl_result vsgl__sparse_replay_batch(vsgl_context *ctx, shade_job *j, size_t ro
             bt.dlist[k] = bt.first + m[i];
         }
     }
-    if (vsgl__parallel_for(threads, nd, SPARSE_CHUNK, vsgl__sparse_direct, &bt) != 0 ||
-        vsgl__parallel_for(threads, nd, 1024, replay_fixup, &bt) != 0) {
+    if (vsgl__parallel_ctx(ctx, nd, SPARSE_CHUNK, vsgl__sparse_direct, &bt) != 0 ||
+        vsgl__parallel_ctx(ctx, nd, 1024, replay_fixup, &bt) != 0) {
         r = VSGL_ERROR_OUT_OF_MEMORY;
         goto done;
     }
