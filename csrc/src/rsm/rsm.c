@@ -1,7 +1,8 @@
 /* Reflective shadow maps: one ray per texel from the light, the hit becomes
  * a VPL carrying the power the light emits into the texel (rsm_light.c).
  * Rows are traced in parallel (deterministic chunks of one row); progress
- * is reported between batches of rows from the calling thread. */
+ * is reported between batches of rows from the calling thread. Each row's
+ * flux is summed in row order: the same map for any thread count or batch. */
 #include "rsm/rsm.h"
 
 #include "core/context.h"
@@ -155,8 +156,12 @@ vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
         vsgl__rsm_free(out);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "rsm: out of memory for %zu texels", n);
     }
-    /* batches of rows so that progress and cancel run on this thread */
-    size_t batch = rows / 16 > 0 ? rows / 16 : 1;
+    /* batches of rows so that progress and cancel run on this thread: 16,
+     * but none under 2^16 texels (each batch waits for its slowest row: a
+     * live light edit's 128^2 map is one batch, not 16) */
+    size_t batch = rows / 16 > 0 ? rows / 16 : 1, min_rows = ((size_t)1 << 16) / res + 1;
+    if (batch < min_rows)
+        batch = min_rows;
     vsgl_result r = VSGL_OK;
     for (size_t b = 0; b < rows && r == VSGL_OK; b += batch) {
         size_t e = b + batch < rows ? b + batch : rows;
