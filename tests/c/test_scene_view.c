@@ -2,6 +2,7 @@
  * exactly as a scene built with them; a refused view changes nothing. */
 #include "harness.h"
 #include "scene_fixture.h"
+#include "render/render_internal.h"
 
 #include <stdlib.h>
 
@@ -245,4 +246,45 @@ VT_TEST(render_cache_shading_plan_replays_bit_identically)
         vsgl_scene_destroy(scene);
         vsgl_context_destroy(ctx);
     }
+}
+
+/* A replay leaves DiffCol, GlossCol and coverage in the cache's planes as
+ * its record or last replay wrote them (sparse_replay.c); a render between
+ * them that wrote the planes otherwise (here every pixel shaded, then the
+ * colours overwritten as a render with other colours would) makes the next
+ * replay write them again: still equal to an uncached render. */
+VT_TEST(render_cache_replay_rewrites_colours_after_another_render)
+{
+    static planes8 cached, plain;
+    vsgl_render_settings sparse, full;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &sparse);
+    sparse.shade_stride = 4;
+    sparse.edge_samples = 0;
+    full = sparse;
+    full.shade_stride = 1;
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.25f, 200.0f);
+    vsgl_context *ctx = fx_context(2);
+    vsgl_scene *scene = NULL;
+    vsgl_render_cache *cache = NULL;
+    VT_REQUIRE(ctx != NULL, "context");
+    VT_REQUIRE(vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    const vsgl_render_settings *order[4] = {&sparse, &sparse, &full, &sparse}; /* record, replay, other, replay */
+    for (int k = 0; k < 4; ++k) {
+        fx.lights[0].world_from_light[3] += 0.05f;
+        VT_CHECK(vsgl_scene_set_view(ctx, scene, &fx.camera, fx.lights, fx.light_count) == VSGL_OK, "set_view");
+        VT_CHECK(render_planes(ctx, scene, order[k], cache, &cached, NULL) == VSGL_OK, "%s",
+                 vsgl_context_last_error(ctx));
+        VT_CHECK(render_planes(ctx, scene, order[k], NULL, &plain, NULL) == VSGL_OK, "uncached");
+        VT_CHECK(memcmp(&cached, &plain, sizeof plain) == 0, "render %d: cached render differs", k);
+        if (k == 2) { /* colours as another render could leave them */
+            VT_REQUIRE(cache->planes && cache->planes_floats >= (size_t)W * H * 13, "the cache keeps planes");
+            for (size_t i = (size_t)W * H * 6; i < (size_t)W * H * 13; ++i)
+                cache->planes[i] = 0.5f;
+        }
+    }
+    vsgl_render_cache_destroy(cache);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
 }

@@ -823,6 +823,10 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     uint64_t *per_chunk = calloc(chunks + 1, sizeof *per_chunk);
     if (!per_chunk)
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
+    /* a plan's colours stay in the planes only from its own record or replay to the next */
+    const float *colours_in = plan && *plan ? (*plan)->colours_in : NULL;
+    if (plan && *plan)
+        (*plan)->colours_in = NULL;
     v3 lo, hi;
     vsgl__scene_bounds(scene, &lo, &hi);
     float extent = v3_length(v3_sub(hi, lo));
@@ -946,6 +950,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             if (*plan && vsgl__shade_plan_matches(*plan, g, s, j.aw, j.ah)) {
                 j.plan = *plan;
                 j.replay = 1;
+                j.plan->colours_kept = colours_in == planes->diffuse_color;
             } else {
                 j.plan = vsgl__shade_plan_new(g, s, j.aw, j.ah);
             }
@@ -992,6 +997,8 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     free(j.alist);
     free(params);
     vsgl__near_index_free(&near);
+    if (j.plan && r == VSGL_OK)
+        j.plan->colours_in = planes->diffuse_color;
     if (j.plan && !j.replay) {
         if (r == VSGL_OK && vsgl__shade_plan_complete(j.plan)) {
             vsgl__shade_plan_free(*plan);

@@ -49,6 +49,10 @@ struct vsgl_shade_plan {
     /* a replay's working memory, kept between renders (no page faults per render) */
     float *pack;                    /* per anchor: 12 floats: light (6), its sum per lobe (2), d2 (4) */
     float *interp;                  /* 6 per sample of a batch */
+    const float *colours_in;        /* the planes (their diffuse_color) that hold this plan's DiffCol,
+                                       GlossCol and coverage of every pixel since its last record or
+                                       replay, or NULL; any other render clears it (shade.c) */
+    int colours_kept;               /* this replay: they are in j->planes already, not rewritten */
     uint32_t *direct_of, *marks;    /* per sample of a batch */
     size_t scratch_ns;              /* the samples they hold */
 };

@@ -196,10 +196,14 @@ static void replay_pixel(const shade_job *j, size_t px, const float *const *Ls)
             acc[3 + c] += cd[3] * L[3 + c];
         }
     }
-    const float *col = plan->colour + px * 7;
     for (int c = 0; c < 3; ++c) {
         pl->diffuse[px * 3 + c] = acc[c];
         pl->glossy[px * 3 + c] = acc[3 + c];
+    }
+    if (plan->colours_kept) /* the planes hold them from the last record or replay */
+        return;
+    const float *col = plan->colour + px * 7;
+    for (int c = 0; c < 3; ++c) {
         pl->diffuse_color[px * 3 + c] = col[c];
         pl->glossy_color[px * 3 + c] = col[3 + c];
     }
@@ -211,7 +215,7 @@ static inline void replay_pixel1(const shade_job *j, size_t px, const float *L)
 {
     const vsgl_shade_plan *plan = j->plan;
     const vsgl_pixel_planes *pl = j->planes;
-    const float *cd = plan->cd + px * 4, *col = plan->colour + px * 7;
+    const float *cd = plan->cd + px * 4;
     float *d = pl->diffuse + px * 3, *gl = pl->glossy + px * 3;
     if (L) {
         for (int c = 0; c < 3; ++c) {
@@ -222,6 +226,9 @@ static inline void replay_pixel1(const shade_job *j, size_t px, const float *L)
         for (int c = 0; c < 3; ++c)
             d[c] = gl[c] = 0.0f;
     }
+    if (plan->colours_kept) /* the planes hold them from the last record or replay */
+        return;
+    const float *col = plan->colour + px * 7;
     memcpy(pl->diffuse_color + px * 3, col, 3 * sizeof *col);
     memcpy(pl->glossy_color + px * 3, col + 3, 3 * sizeof *col);
     pl->coverage[px] = col[6];
