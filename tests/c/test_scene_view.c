@@ -252,7 +252,10 @@ VT_TEST(render_cache_shading_plan_replays_bit_identically)
  * its record or last replay wrote them (sparse_replay.c); a render between
  * them that wrote the planes otherwise (here every pixel shaded, then the
  * colours overwritten as a render with other colours would) makes the next
- * replay write them again: still equal to an uncached render. */
+ * replay write them again: still equal to an uncached render. Stride 4 with
+ * one sample per pixel also puts the record's four-pixel lanes
+ * (record_cell4, sparse.c) against the uncached render's per-sample
+ * classification (a 0.2 % change of its plane tolerance fails here). */
 VT_TEST(render_cache_replay_rewrites_colours_after_another_render)
 {
     static planes8 cached, plain;

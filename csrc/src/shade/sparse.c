@@ -38,6 +38,9 @@
 #if defined(__x86_64__) || defined(__i386__)
 #  include <xmmintrin.h>
 #endif
+#if defined(__SSE2__)
+#  include <emmintrin.h>
+#endif
 
 static size_t anchor_pixel(const shade_job *j, uint32_t ax, uint32_t ay)
 {
@@ -440,6 +443,104 @@ static inline float packed_surface_weight(const float *n, const float *x, uint32
     return wn * wp;
 }
 
+#if defined(__SSE2__)
+/* Four pixels px..px+3 of one row, one sample each, every one a hit, in one
+ * anchor cell (ax, ay) at tx[0..3], ty: record_rows below with the four
+ * samples in the lanes, the same operations per lane (packed_surface_weight,
+ * then vsgl__sparse_interp4 for replay_sample). */
+static void record_cell4(sparse_batch *bt, size_t px, uint32_t ax, uint32_t ay, const float *tx, float ty)
+{
+    const shade_job *j = bt->j;
+    vsgl_shade_plan *plan = j->plan;
+    const vsgl_gbuffer *g = j->g;
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    const __m128 n0 = _mm_loadu_ps(g->nrm[0] + px), n1 = _mm_loadu_ps(g->nrm[1] + px),
+                 n2 = _mm_loadu_ps(g->nrm[2] + px);
+    const __m128 x0 = _mm_loadu_ps(g->pos[0] + px), x1 = _mm_loadu_ps(g->pos[1] + px),
+                 x2 = _mm_loadu_ps(g->pos[2] + px);
+    const __m128i mat = _mm_loadu_si128((const __m128i *)(const void *)(g->material + px));
+    const __m128 vtx = _mm_loadu_ps(tx), abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    const __m128 tol0 = _mm_set1_ps(j->plane_tol);
+    __m128 w[4], wsum = zero;
+    /* the junction test's inputs (record_rows): per anchor, which lanes it is on the
+     * surface of (same) or not (other), and its squared distance per lane */
+    unsigned same_bits[4] = {0, 0, 0, 0}, other_bits[4] = {0, 0, 0, 0};
+    float ad2[4][4] = {{0}};
+    for (uint32_t dy = 0; dy < 2; ++dy)
+        for (uint32_t dx = 0; dx < 2; ++dx) {
+            const uint32_t cx = ax + dx, cy = ay + dy;
+            __m128 *wi = &w[dy * 2 + dx];
+            *wi = zero;
+            if (cx >= j->aw || cy >= j->ah)
+                continue;
+            const size_t a = (size_t)cy * j->aw + cx, as = j->anchor_sample[a];
+            if (as == SIZE_MAX)
+                continue;
+            const __m128 wb = _mm_mul_ps(dx ? vtx : _mm_sub_ps(one, vtx), _mm_set1_ps(dy ? ty : 1.0f - ty));
+            /* packed_surface_weight, four samples against anchor a */
+            const float *q = plan->geo + a * 8;
+            uint32_t qm;
+            memcpy(&qm, &q[6], sizeof qm);
+            const __m128 same = _mm_castsi128_ps(_mm_cmpeq_epi32(mat, _mm_set1_epi32((int)qm)));
+            const __m128 c = _mm_add_ps(_mm_add_ps(_mm_mul_ps(n0, _mm_set1_ps(q[0])), _mm_mul_ps(n1, _mm_set1_ps(q[1]))),
+                                        _mm_mul_ps(n2, _mm_set1_ps(q[2])));
+            const __m128 c_ok = _mm_cmpgt_ps(c, _mm_set1_ps(SPARSE_NORMAL_COS));
+            const __m128 wn = _mm_mul_ps(_mm_sub_ps(c, _mm_set1_ps(SPARSE_NORMAL_COS)),
+                                         _mm_set1_ps(1.0f / (1.0f - SPARSE_NORMAL_COS)));
+            const __m128 d0 = _mm_sub_ps(_mm_set1_ps(q[3]), x0), d1 = _mm_sub_ps(_mm_set1_ps(q[4]), x1),
+                         d2 = _mm_sub_ps(_mm_set1_ps(q[5]), x2);
+            const __m128 off = _mm_and_ps(
+                abs_mask, _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, n0), _mm_mul_ps(d1, n1)), _mm_mul_ps(d2, n2)));
+            const __m128 dd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, d0), _mm_mul_ps(d1, d1)), _mm_mul_ps(d2, d2));
+            const __m128 len = _mm_sqrt_ps(dd);
+            _mm_storeu_ps(ad2[dy * 2 + dx], dd);
+            const __m128 tol = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_PLANE_REL), len), tol0);
+            const __m128 wp = _mm_sub_ps(one, _mm_div_ps(off, tol));
+            const __m128 p_ok = _mm_and_ps(_mm_and_ps(same, c_ok), _mm_cmpgt_ps(wp, zero));
+            __m128 sw = _mm_and_ps(p_ok, _mm_mul_ps(wn, wp));
+            if (as >= px && as < px + 4) { /* the anchor is one of these samples: its weight 1 */
+                const __m128 self = _mm_castsi128_ps(
+                    _mm_cmpeq_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32((int)(as - px))));
+                sw = _mm_or_ps(_mm_and_ps(self, one), _mm_andnot_ps(self, sw));
+            }
+            const __m128 wa = _mm_mul_ps(wb, sw), on_b = _mm_cmpgt_ps(wb, zero), on_a = _mm_cmpgt_ps(wa, zero);
+            *wi = _mm_and_ps(_mm_and_ps(on_b, on_a), wa);
+            wsum = _mm_add_ps(wsum, *wi);
+            same_bits[dy * 2 + dx] = (unsigned)_mm_movemask_ps(_mm_and_ps(on_b, on_a));
+            other_bits[dy * 2 + dx] = (unsigned)_mm_movemask_ps(_mm_andnot_ps(on_a, on_b));
+        }
+    __m128 r0 = w[0], r1 = w[1], r2 = w[2], r3 = w[3];
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3); /* ri: the four weights of sample i */
+    float *w4 = plan->w4 + px * 4;
+    _mm_storeu_ps(w4, r0);
+    _mm_storeu_ps(w4 + 4, r1);
+    _mm_storeu_ps(w4 + 8, r2);
+    _mm_storeu_ps(w4 + 12, r3);
+    const unsigned near = (unsigned)_mm_movemask_ps(_mm_cmpgt_ps(wsum, _mm_set1_ps(0.05f)));
+    float out[6][4];
+    const unsigned ok = vsgl__sparse_interp4(j, plan->pack, w4, ax, ay, tx, ty, out);
+    for (unsigned k = 0; k < 4; ++k) {
+        const size_t si = px + k, bi = si - bt->first;
+        unsigned same = 0, other = 0;
+        float d2k[4];
+        for (unsigned i = 0; i < 4; ++i) {
+            same |= (same_bits[i] >> k & 1u) << i;
+            other |= (other_bits[i] >> k & 1u) << i;
+            d2k[i] = ad2[i][k];
+        }
+        plan->direct[si] =
+            near >> k & 1u && !sparse_junction(same, sparse_touching(same, other, d2k)) ? PLAN_NEAR : PLAN_ALONE;
+        if (plan->direct[si] == PLAN_NEAR && ok >> k & 1u) {
+            bt->direct_of[bi] = SIZE_MAX;
+            for (int c = 0; c < 6; ++c)
+                bt->interp[bi * 6 + c] = out[c][k];
+        } else {
+            bt->direct_of[bi] = SPARSE_MARK;
+        }
+    }
+}
+#endif
+
 /* Rows [b0, e0) of a record's batch (one row per chunk): sparse_classify
  * from the packed anchors (their surfaces, plan->geo, and light,
  * plan->pack) and the cell tables; records the weights and codes. */
@@ -454,6 +555,21 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
     (void)chunk;
     size_t px = j->base + b0, x = px % W, y = px / W;
     for (; px < j->base + e0; ++px) {
+#if defined(__SSE2__)
+        /* one sample per pixel (the live viewport's): four hit pixels of one cell at a time */
+        if (spp == 1 && x + 4 <= W && px + 4 <= j->base + e0 && plan->cell_x[x] == plan->cell_x[x + 3] &&
+            g->material[px] != VSGL__GBUFFER_MISS && g->material[px + 1] != VSGL__GBUFFER_MISS &&
+            g->material[px + 2] != VSGL__GBUFFER_MISS && g->material[px + 3] != VSGL__GBUFFER_MISS) {
+            record_cell4(bt, px, plan->cell_x[x], plan->cell_y[y], plan->cell_tx + x, plan->cell_ty[y]);
+            px += 3;
+            x += 3;
+            if (++x == W) {
+                x = 0;
+                ++y;
+            }
+            continue;
+        }
+#endif
         for (size_t k = 0; k < spp; ++k) {
             const size_t si = px * spp + k, bi = si - bt->first;
             float *w = plan->w4 + si * 4;

@@ -71,6 +71,14 @@ void vsgl__sparse_anchor_pack(shade_job *j);
 int vsgl__sparse_interp(const shade_job *j, const float *pack, const float *w, uint32_t ax, uint32_t ay, float tx,
                         float ty, float *out);
 
+#if defined(__SSE2__)
+/* The same for four samples of one row (one per pixel) in one cell, at
+ * tx[0..3], ty, with the weights w4 (4 per sample): their light into
+ * out[c][k], the samples that pass the test as bits (sparse_replay.c). */
+unsigned vsgl__sparse_interp4(const shade_job *j, const float *pack, const float *w4, uint32_t ax, uint32_t ay,
+                              const float *tx, float ty, float out[6][4]);
+#endif
+
 /* vsgl__shade_sparse_batch for a replay (sparse_replay.c). */
 vsgl_result vsgl__sparse_replay_batch(vsgl_context *ctx, shade_job *j, size_t row, size_t end);
 

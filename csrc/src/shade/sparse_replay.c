@@ -235,18 +235,17 @@ static inline void replay_pixel1(const shade_job *j, size_t px, const float *L)
 }
 
 #if defined(__SSE2__)
-/* Four pixels px..px+3 of one row (one sample each, interpolated from the
- * same cell (ax, ay), at tx[0..3], ty): replay_sample and replay_pixel1 with
- * the four samples in the lanes, the same operations per lane. Writes the
- * pixels whose samples pass the interpolation test; returns them as bits. */
-static unsigned replay_cell4(const shade_job *j, const float *pack, size_t px, uint32_t ax, uint32_t ay,
-                             const float *tx, float ty)
+/* Four samples of one row (one per pixel) interpolated from the same cell
+ * (ax, ay), at tx[0..3], ty, with the weights w4 (4 per sample):
+ * replay_sample with the four samples in the lanes, the same operations per
+ * lane. Their light into out[c][k] for the samples that pass the
+ * interpolation test, returned as bits. */
+static inline unsigned interp4(const shade_job *j, const float *pack, const float *w4, uint32_t ax, uint32_t ay,
+                               const float *tx, float ty, float out[6][4])
 {
-    const vsgl_shade_plan *plan = j->plan;
     const size_t a0 = (size_t)ay * j->aw + ax;
     const size_t sx = ax + 1 < j->aw ? 1 : 0, sy = ay + 1 < j->ah ? j->aw : 0;
     const float *q[4] = {pack + a0 * 12, pack + (a0 + sx) * 12, pack + (a0 + sy) * 12, pack + (a0 + sx + sy) * 12};
-    const float *w4 = plan->w4 + px * 4;
     __m128 r0 = _mm_loadu_ps(w4), r1 = _mm_loadu_ps(w4 + 4), r2 = _mm_loadu_ps(w4 + 8), r3 = _mm_loadu_ps(w4 + 12);
     _MM_TRANSPOSE4_PS(r0, r1, r2, r3); /* ri: anchor i's weight for each of the four samples */
     const __m128 zero = _mm_setzero_ps(), big = _mm_set1_ps(FLT_MAX), neg1 = _mm_set1_ps(-1.0f);
@@ -301,10 +300,29 @@ static unsigned replay_cell4(const shade_job *j, const float *pack, size_t px, u
     const unsigned bits = (unsigned)_mm_movemask_ps(ok);
     if (!bits)
         return 0;
-    float out[6][4];
     _Pragma("GCC unroll 8")
     for (int c = 0; c < 6; ++c)
         _mm_storeu_ps(out[c], _mm_div_ps(L[c], wsum));
+    return bits;
+}
+
+unsigned vsgl__sparse_interp4(const shade_job *j, const float *pack, const float *w4, uint32_t ax, uint32_t ay,
+                              const float *tx, float ty, float out[6][4])
+{
+    return interp4(j, pack, w4, ax, ay, tx, ty, out);
+}
+
+/* Four pixels px..px+3 of one row (one sample each, interpolated from the
+ * same cell (ax, ay), at tx[0..3], ty): interp4 and replay_pixel1. Writes
+ * the pixels whose samples pass the interpolation test; returns them as
+ * bits. */
+static unsigned replay_cell4(const shade_job *j, const float *pack, size_t px, uint32_t ax, uint32_t ay,
+                             const float *tx, float ty)
+{
+    float out[6][4];
+    const unsigned bits = interp4(j, pack, j->plan->w4 + px * 4, ax, ay, tx, ty, out);
+    if (!bits)
+        return 0;
     for (unsigned k = 0; k < 4; ++k)
         if (bits >> k & 1u) {
             const float light[6] = {out[0][k], out[1][k], out[2][k], out[3][k], out[4][k], out[5][k]};
