@@ -148,13 +148,18 @@ int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted)
     return ok;
 }
 
-/* Run `fn` over every row in VSGL__GBUFFER_STEPS steps, reporting progress
+/* Run `fn` over every row in VSGL__GBUFFER_STEPS steps, none under 2^17
+ * samples (each step is a parallel loop ending in a wait for its slowest
+ * row: a live viewport's 960 x 540 has 4, not 32), reporting progress
  * from p0 to p1 and checking for cancellation; frees *out on failure. */
 static vsgl_result for_rows(vsgl_context *ctx, gb_job *job, vsgl_range_fn fn, float p0, float p1, const char *what)
 {
     vsgl_gbuffer *out = job->g;
     uint32_t h = out->height;
     uint32_t step = (h + VSGL__GBUFFER_STEPS - 1) / VSGL__GBUFFER_STEPS;
+    const size_t row_samples = (size_t)out->width * out->spp, min_rows = ((size_t)1 << 17) / (row_samples ? row_samples : 1) + 1;
+    if (step < min_rows)
+        step = (uint32_t)(min_rows < h ? min_rows : h);
     for (uint32_t row = 0; row < h; row += step) {
         uint32_t rows = h - row < step ? h - row : step;
         if (vsgl__progress(ctx, "gbuffer", p0 + (p1 - p0) * (float)row / (float)h)) {
