@@ -413,3 +413,52 @@ VT_TEST(rsm_degenerate_lights_and_scenes)
     }
     vsgl_context_destroy(ctx);
 }
+
+/* vsgl__rsm_light_row (rsm.c's rows: the corner terms shared between
+ * neighbouring texels) against vsgl__rsm_light_texel per texel, bit for
+ * bit: point (cube faces), spots (3.x, a wide hard-edged cube-map spot, a
+ * 4.0+ spot in a scaled, rotated frame), sun, area; odd and even sizes. */
+VT_TEST(rsm_light_row_equals_texel_by_texel)
+{
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    const int types[] = {VSGL_LIGHT_POINT, VSGL_LIGHT_SPOT, VSGL_LIGHT_SPOT, VSGL_LIGHT_SPOT, VSGL_LIGHT_SUN, VSGL_LIGHT_AREA};
+    for (unsigned k = 0; k < sizeof types / sizeof types[0]; ++k) {
+        fx_scene s;
+        closed_box(&s);
+        vsgl_light *L = &s.lights[0];
+        set_light(L, types[k], 0.1f, 0.2f, 1.5f);
+        if (k == 2) { L->spot_size = 2.6f; L->spot_blend = 0.0f; }
+        if (k == 3) {
+            L->spot_size = 0.9f; L->spot_blend = 0.4f; L->flags = VSGL_LIGHT_FLAG_BLENDER_4;
+            fx_look_at(L->world_from_light, (float[3]){0.3f, 0.1f, 1.0f}, (float[3]){-1, 0.5f, 0.2f});
+            for (int c = 0; c < 3; ++c) { L->world_from_light[c] *= 1.5f; L->world_from_light[4 + c] *= 0.7f; }
+        }
+        vsgl_scene *sc = make(ctx, &s);
+        if (!sc)
+            continue;
+        for (uint32_t res = 31; res <= 64; res += 33) {
+            vsgl_rsm_light l;
+            vsgl__rsm_light_setup(sc, 0, res, &l);
+            v3 org[64], dir[64], o1, d1;
+            double fl[4 * 64], scratch[VSGL__RSM_ROW_SCRATCH(64)], f1[3], b1;
+            int lit[64];
+            size_t bad = 0, lit_texels = 0;
+            for (uint32_t face = 0; face < l.faces; ++face)
+                for (uint32_t row = 0; row < res; ++row) {
+                    vsgl__rsm_light_row(&l, face, row, org, dir, fl, lit, scratch);
+                    for (uint32_t c = 0; c < res; ++c) {
+                        int want = vsgl__rsm_light_texel(&l, face, row, c, &o1, &d1, f1, &b1);
+                        lit_texels += want != 0;
+                        bad += lit[c] != want || memcmp(&org[c], &o1, sizeof o1) != 0 ||
+                               memcmp(&dir[c], &d1, sizeof d1) != 0 || memcmp(&fl[4 * c], f1, sizeof f1) != 0 ||
+                               memcmp(&fl[4 * c + 3], &b1, sizeof b1) != 0;
+                    }
+                }
+            VT_CHECK(bad == 0 && lit_texels > 0, "case %u type %d res %u: %zu texels differ (%zu lit)", k, L->type, res,
+                     bad, lit_texels);
+        }
+        vsgl_scene_destroy(sc);
+    }
+    vsgl_context_destroy(ctx);
+}

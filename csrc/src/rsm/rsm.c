@@ -65,17 +65,19 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
     float *tmax = malloc(res * sizeof *tmax);
     vsgl_hit *hits = malloc(res * sizeof *hits);
     double *fl = malloc(res * 4 * sizeof *fl);
-    if (!org || !dir || !tmin || !tmax || !hits || !fl) {
-        free(org); free(dir); free(tmin); free(tmax); free(hits); free(fl);
+    double *scratch = malloc(VSGL__RSM_ROW_SCRATCH(res) * sizeof *scratch);
+    int *lit = malloc(res * sizeof *lit);
+    if (!org || !dir || !tmin || !tmax || !hits || !fl || !scratch || !lit) {
+        free(org); free(dir); free(tmin); free(tmax); free(hits); free(fl); free(scratch); free(lit);
         return VSGL_ERROR_OUT_OF_MEMORY;
     }
     for (size_t gr = begin; gr < end; ++gr) {
         size_t grow = j->first_row + gr;
         uint32_t face = (uint32_t)(grow / res), row = (uint32_t)(grow % res);
+        vsgl__rsm_light_row(l, face, row, org, dir, fl, lit, scratch);
         for (uint32_t c = 0; c < res; ++c) {
-            int lit = vsgl__rsm_light_texel(l, face, row, c, &org[c], &dir[c], &fl[4 * c], &fl[4 * c + 3]);
             tmin[c] = 0.0f;
-            tmax[c] = lit ? (l->type == VSGL_LIGHT_SUN ? l->sun_tmax : INFINITY) : -1.0f;
+            tmax[c] = lit[c] ? (l->type == VSGL_LIGHT_SUN ? l->sun_tmax : INFINITY) : -1.0f;
         }
         vsgl__scene_intersect_many(j->scene, res, org, dir, tmin, tmax, 1, hits);
         double s[3] = {0, 0, 0};
@@ -117,7 +119,7 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
         for (int k = 0; k < 3; ++k)
             j->partial[3 * (grow - j->first_row) + k] = s[k];
     }
-    free(org); free(dir); free(tmin); free(tmax); free(hits); free(fl);
+    free(org); free(dir); free(tmin); free(tmax); free(hits); free(fl); free(scratch); free(lit);
     return 0;
 }
 

@@ -250,13 +250,13 @@ static double face_spot_cos(const vsgl_rsm_light *l, const face_texel *t, double
     return spot_cos(l, loc[0], loc[1], loc[2]);
 }
 
-/* The spot's share of a texel of solid angle `beam`, over 4 pi. */
-static double spot_texel_weight(const vsgl_rsm_light *l, const face_texel *t, double beam)
+/* The spot's share of a texel of solid angle `beam`, over 4 pi, from the
+ * mask's cosines at its corners (c00 at (x0, y0), c01 at (x0, y1), ...). */
+static double spot_texel_weight_c(const vsgl_rsm_light *l, const face_texel *t, double beam, double c00, double c01,
+                                  double c10, double c11)
 {
     double x0 = t->x0, x1 = t->x1, y0 = t->y0, y1 = t->y1;
     double xc = 0.5 * (x0 + x1), yc = 0.5 * (y0 + y1);
-    double c00 = face_spot_cos(l, t, x0, y0), c01 = face_spot_cos(l, t, x0, y1);
-    double c10 = face_spot_cos(l, t, x1, y0), c11 = face_spot_cos(l, t, x1, y1);
     double cc = face_spot_cos(l, t, xc, yc);
     double cmin = fmin(fmin(fmin(c00, c01), fmin(c10, c11)), cc);
     double cmax = fmax(fmax(fmax(c00, c01), fmax(c10, c11)), cc);
@@ -280,6 +280,13 @@ static double spot_texel_weight(const vsgl_rsm_light *l, const face_texel *t, do
                 w += mk * (F[j + 1][i + 1] - F[j][i + 1] - F[j + 1][i] + F[j][i]);
         }
     return w / (4.0 * VSGL__PI_D);
+}
+
+/* The spot's share of a texel of solid angle `beam`, over 4 pi. */
+static double spot_texel_weight(const vsgl_rsm_light *l, const face_texel *t, double beam)
+{
+    return spot_texel_weight_c(l, t, beam, face_spot_cos(l, t, t->x0, t->y0), face_spot_cos(l, t, t->x0, t->y1),
+                               face_spot_cos(l, t, t->x1, t->y0), face_spot_cos(l, t, t->x1, t->y1));
 }
 
 /* Point and spot texels: rays from the centre through the texel's centre. */
@@ -377,6 +384,68 @@ int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, 
     for (int c = 0; c < 3; ++c)
         flux[c] = l->rgb[c] * w;
     return 1;
+}
+
+/* A row of a point/spot face: vsgl__rsm_light_texel for every column, with
+ * the values that depend on a texel corner alone (the solid-angle terms
+ * F(x, y) and the spot mask's cosines) computed once per corner and shared
+ * by the texels that meet there: the same functions of the same arguments,
+ * so the same results (a texel whose corners do not equal the table's, bit
+ * for bit, computes its own). */
+static void point_spot_row(const vsgl_rsm_light *l, uint32_t face, uint32_t row, v3 *org, v3 *dir, double *fl,
+                           int *lit, double *scratch)
+{
+    const uint32_t res = l->res;
+    double *X = scratch, *Ft = X + (res + 1), *Fb = Ft + (res + 1), *Ct = Fb + (res + 1), *Cb = Ct + (res + 1);
+    const int spot = l->type == VSGL_LIGHT_SPOT;
+    face_texel t = point_spot_texel(l, face, row, 0);
+    for (uint32_t i = 0; i <= res; ++i) {
+        face_texel ti = point_spot_texel(l, face, row, i < res ? i : res - 1);
+        X[i] = i < res ? ti.x0 : ti.x1;
+#define F(x, y) atan2((x) * (y), sqrt(1.0 + (x) * (x) + (y) * (y)))
+        Ft[i] = F(X[i], t.y1);
+        Fb[i] = F(X[i], t.y0);
+#undef F
+        if (spot) {
+            Ct[i] = face_spot_cos(l, &t, X[i], t.y1);
+            Cb[i] = face_spot_cos(l, &t, X[i], t.y0);
+        }
+    }
+    for (uint32_t c = 0; c < res; ++c) {
+        double *f = fl + 4 * c;
+        t = point_spot_texel(l, face, row, c);
+        if (!(t.x0 == X[c] && t.x1 == X[c + 1])) { /* (not expected: the same expressions) */
+            lit[c] = vsgl__rsm_light_texel(l, face, row, c, &org[c], &dir[c], f, &f[3]);
+            continue;
+        }
+        double loc[3];
+        loc[t.axis] = t.sign;
+        loc[t.ua] = 0.5 * (t.x0 + t.x1);
+        loc[t.va] = 0.5 * (t.y0 + t.y1);
+        dir[c] = v3_normalize(frame_dir(l, loc[0], loc[1], loc[2]));
+        org[c] = l->pos;
+        /* vsgl__rsm_rect_solid_angle(x0, x1, y0, y1): F(x1, y1) - F(x0, y1) - F(x1, y0) + F(x0, y0) */
+        const double beam = Ft[c + 1] - Ft[c] - Fb[c + 1] + Fb[c];
+        const double w = spot ? spot_texel_weight_c(l, &t, beam, Cb[c], Ct[c], Cb[c + 1], Ct[c + 1])
+                              : beam / (4.0 * VSGL__PI_D);
+        f[3] = beam;
+        f[0] = f[1] = f[2] = 0.0;
+        lit[c] = w > 0.0;
+        if (lit[c])
+            for (int k = 0; k < 3; ++k)
+                f[k] = l->rgb[k] * w;
+    }
+}
+
+void vsgl__rsm_light_row(const vsgl_rsm_light *l, uint32_t face, uint32_t row, v3 *org, v3 *dir, double *fl,
+                         int *lit, double *scratch)
+{
+    if (l->type == VSGL_LIGHT_POINT || l->type == VSGL_LIGHT_SPOT) {
+        point_spot_row(l, face, row, org, dir, fl, lit, scratch);
+        return;
+    }
+    for (uint32_t c = 0; c < l->res; ++c)
+        lit[c] = vsgl__rsm_light_texel(l, face, row, c, &org[c], &dir[c], &fl[4 * c], &fl[4 * c + 3]);
 }
 
 void vsgl__rsm_light_emitted(const vsgl_rsm_light *l, double out[3])

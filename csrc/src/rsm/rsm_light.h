@@ -42,6 +42,14 @@ void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res
 int vsgl__rsm_light_texel(const vsgl_rsm_light *l, uint32_t face, uint32_t row, uint32_t col,
                           v3 *org, v3 *dir, double flux[3], double *beam);
 
+/* vsgl__rsm_light_texel for every column of row `row` of face `face`:
+ * org, dir, lit (its return value): res each; fl: 4 per column (flux RGB,
+ * beam); scratch: VSGL__RSM_ROW_SCRATCH(res) doubles. The same values, bit
+ * for bit; point and spot lights share what texels share (their corners). */
+#define VSGL__RSM_ROW_SCRATCH(res) (5 * ((size_t)(res) + 1))
+void vsgl__rsm_light_row(const vsgl_rsm_light *l, uint32_t face, uint32_t row, v3 *org, v3 *dir, double *fl,
+                         int *lit, double *scratch);
+
 /* Total power the light emits (W, RGB) as Cycles defines it; for a sun the
  * power crossing the map's footprint. Used by tests and docs/units.md. */
 void vsgl__rsm_light_emitted(const vsgl_rsm_light *l, double out[3]);
