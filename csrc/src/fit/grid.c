@@ -100,7 +100,7 @@ vsgl_result vsgl__grid_build(vsgl_context *ctx, const vsgl_scene *scene, const v
         vsgl__grid_free(g);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "fit: out of memory");
     }
-    vsgl__parallel_for(vsgl_context_thread_count(ctx), rsm->count, CHUNK, level0_chunk, &j);
+    vsgl__parallel_ctx(ctx, rsm->count, CHUNK, level0_chunk, &j);
     for (size_t c = 0; c < chunks; ++c) {
         const double *p = j.partial + c * (VSGL__GRID_STRIDE + 1);
         for (int k = 0; k < VSGL__GRID_STRIDE; ++k)
