@@ -443,6 +443,15 @@ static int32_t replay_fixup(void *user, size_t chunk, size_t b, size_t e)
     return 0;
 }
 
+/* One sample per pixel: entries [b, e) shaded (vsgl__sparse_direct) and
+ * their pixels written at once (replay_fixup): each pixel reads its one
+ * entry, shaded just before in this chunk. One parallel loop, not two. */
+static int32_t replay_direct1(void *user, size_t chunk, size_t b, size_t e)
+{
+    int32_t r = vsgl__sparse_direct(user, chunk, b, e);
+    return r != 0 ? r : replay_fixup(user, chunk, b, e);
+}
+
 /* vsgl__shade_sparse_batch for a replay: interpolate and write what can be
  * (replay_rows), shade the rest in full kernel blocks (vsgl__sparse_direct), then
  * write their pixels (replay_fixup). */
@@ -494,8 +503,9 @@ vsgl_result vsgl__sparse_replay_batch(vsgl_context *ctx, shade_job *j, size_t ro
             bt.dlist[k] = bt.first + m[i];
         }
     }
-    if (vsgl__parallel_ctx(ctx, nd, SPARSE_CHUNK, vsgl__sparse_direct, &bt) != 0 ||
-        vsgl__parallel_ctx(ctx, nd, 1024, replay_fixup, &bt) != 0) {
+    if (spp == 1 ? vsgl__parallel_ctx(ctx, nd, SPARSE_CHUNK, replay_direct1, &bt) != 0
+                 : (vsgl__parallel_ctx(ctx, nd, SPARSE_CHUNK, vsgl__sparse_direct, &bt) != 0 ||
+                    vsgl__parallel_ctx(ctx, nd, 1024, replay_fixup, &bt) != 0)) {
         r = VSGL_ERROR_OUT_OF_MEMORY;
         goto done;
     }
