@@ -60,6 +60,7 @@ typedef struct vsgl_kernel_light {
      * (low: the surface above the cut, high: below) the cut from the mean
      * in units of sqrt(pvar) and its weight (0: not cut there) */
     float fold, fb[2][2], fa[2][2];
+    float freach; /* (sqrt(50) + 2 |farthest cut|)^2 / 2: where the fold can matter (k_shade) */
 } vsgl_kernel_light;
 
 /* Lobes a block needs (skip the work for lobes no lane has). */

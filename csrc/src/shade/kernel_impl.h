@@ -438,47 +438,63 @@ static inline __attribute__((always_inline)) float k_ncdf(float z)
 }
 
 /* Along one axis of a cut cell (sigma units, the cluster's mean at 0 and
- * its variance 1): image img's mean (0: the cluster's, 1: mirrored across
- * the low cut lo, 2: across the high cut hi) and weight, its
- * footprint-blurred density's share on the surface's side of each cut,
- * weighted by the cuts' weights al, ah (shade.c, fold_image: the product
- * of the cluster's Gaussian and the footprint's about y, variance f2, is a
- * Gaussian of mean (m f2 + y) / (1 + f2) and variance f2 / (1 + f2)). */
-static inline __attribute__((always_inline)) float k_fold_image(float lo, float hi, float al, float ah, int img,
-                                                                float y, float f2, float *m)
+ * its variance 1): the weight of the image of mean m (0: the cluster's,
+ * 2 lo: mirrored across the low cut lo, 2 hi: across the high cut hi,
+ * `which` 0, 1, 2), its footprint-blurred density's share on the
+ * surface's side of each cut, weighted by the cuts' weights al, ah
+ * (shade.c, fold_image: the product of the cluster's Gaussian and the
+ * footprint's about y, variance f2, is a Gaussian of mean (m f2 + y) / (1
+ * + f2) and variance f2 / (1 + f2)). Branch-free: the lane loop vectorises. */
+static inline __attribute__((always_inline)) float k_fold_weight(float lo, float hi, float al, float ah, float m,
+                                                                 int which, float y, float f2, float i1, float isp)
 {
-    *m = img == 0 ? 0.0f : 2.0f * (img == 1 ? lo : hi);
-    f2 = f2 > 1e-12f ? f2 : 1e-12f;
-    float i1 = 1.0f / (1.0f + f2), mp = (*m * f2 + y) * i1, isp = k_rsqrt_fine(f2 * i1);
+    float mp = (m * f2 + y) * i1;
     float tl = k_ncdf((mp - lo) * isp), th = k_ncdf((hi - mp) * isp);
     float wl = 1.0f - al + al * tl, wh = 1.0f - ah + ah * th;
-    return img == 0 ? wl * wh : img == 1 ? al * tl * wh : ah * th * wl;
+    return which == 0 ? wl * wh : which == 1 ? al * tl * wh : ah * th * wl;
 }
 
 /* Stage 4c (a lattice cell cut by its surface's end, L->fold > 0): the
  * planar model's density with the cluster's Gaussian folded back at each
  * cut (an image mirrored across it), every image kept to the surface's
  * side (shade.c, vsgl__planar_glossy), blended in by L->fold; into ppre,
- * with pexpo 0. */
+ * with pexpo 0. Images of a side without a cut have weight 0. */
 static inline __attribute__((always_inline)) void
 k_fold(size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
 {
     const float d1 = t->pd1[i], d2 = t->pd2[i], s11 = t->ps11[i], s22 = t->ps22[i], s12 = t->ps12[i];
     const float idet = t->pidet[i];
+    float f1 = s11 - 1.0f, f2 = s22 - 1.0f;
+    f1 = f1 > 1e-12f ? f1 : 1e-12f;
+    f2 = f2 > 1e-12f ? f2 : 1e-12f;
+    const float i1 = 1.0f / (1.0f + f1), i2 = 1.0f / (1.0f + f2);
+    const float isp1 = k_rsqrt_fine(f1 * i1), isp2 = k_rsqrt_fine(f2 * i2);
+    const float m1[3] = {0.0f, 2.0f * L->fb[0][0], 2.0f * L->fb[0][1]};
+    const float m2[3] = {0.0f, 2.0f * L->fb[1][0], 2.0f * L->fb[1][1]};
+    float w1[3], w2[3];
+    w1[0] = k_fold_weight(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], m1[0], 0, d1, f1, i1, isp1);
+    w1[1] = k_fold_weight(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], m1[1], 1, d1, f1, i1, isp1);
+    w1[2] = k_fold_weight(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], m1[2], 2, d1, f1, i1, isp1);
+    w2[0] = k_fold_weight(L->fb[1][0], L->fb[1][1], L->fa[1][0], L->fa[1][1], m2[0], 0, d2, f2, i2, isp2);
+    w2[1] = k_fold_weight(L->fb[1][0], L->fb[1][1], L->fa[1][0], L->fa[1][1], m2[1], 1, d2, f2, i2, isp2);
+    w2[2] = k_fold_weight(L->fb[1][0], L->fb[1][1], L->fa[1][0], L->fa[1][1], m2[2], 2, d2, f2, i2, isp2);
     float sum = 0.0f;
-    for (int a = 0; a < 3; ++a) {
-        if (a && !(L->fa[0][a - 1] > 0.0f))
-            continue;
-        float m1, w1 = k_fold_image(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], a, d1, s11 - 1.0f, &m1);
-        for (int c = 0; c < 3; ++c) {
-            if (c && !(L->fa[1][c - 1] > 0.0f))
-                continue;
-            float m2, w2 = k_fold_image(L->fb[1][0], L->fb[1][1], L->fa[1][0], L->fa[1][1], c, d2, s22 - 1.0f, &m2);
-            float e1 = d1 - m1, e2 = d2 - m2;
-            float q = (s22 * e1 * e1 - 2.0f * s12 * e1 * e2 + s11 * e2 * e2) * idet;
-            sum += w1 * w2 * k_exp(q > 0.0f ? -0.5f * q : 0.0f);
-        }
-    }
+#define K_FOLD_TERM(a, c)                                                                                       \
+    do {                                                                                                        \
+        float e1 = d1 - m1[a], e2 = d2 - m2[c];                                                                 \
+        float q = (s22 * e1 * e1 - 2.0f * s12 * e1 * e2 + s11 * e2 * e2) * idet;                                \
+        sum += w1[a] * w2[c] * k_exp(q > 0.0f ? -0.5f * q : 0.0f);                                             \
+    } while (0)
+    K_FOLD_TERM(0, 0);
+    K_FOLD_TERM(1, 0);
+    K_FOLD_TERM(2, 0);
+    K_FOLD_TERM(0, 1);
+    K_FOLD_TERM(1, 1);
+    K_FOLD_TERM(2, 1);
+    K_FOLD_TERM(0, 2);
+    K_FOLD_TERM(1, 2);
+    K_FOLD_TERM(2, 2);
+#undef K_FOLD_TERM
     t->ppre[i] *= (1.0f - L->fold) * k_exp(t->pexpo[i]) + L->fold * sum;
     t->pexpo[i] = 0.0f;
 }
@@ -568,10 +584,22 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
                 K_FORN(k_glossy(b, i, t + j, kb, kc));
             if (!sg_only) {
                 K_FORN(k_planar(b, i, L + j, t + j, kb, kc));
-                for (int j = 0; j < NL; ++j)
-                    if (L[j].fold > 0.0f)
+                /* the fold only where some lane sees the cell: an image lies
+                 * at most 2 |b| (sigma units) from the mean, so where every
+                 * lane's planar exponent is below -freach = -(sqrt(50) + 2
+                 * |b|)^2 / 2, every image's is below -25 (nil) */
+                for (int j = 0; j < NL; ++j) {
+                    if (!(L[j].fold > 0.0f))
+                        continue;
+                    float near = -1e30f;
+                    for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) {
+                        float e = t[j].ppre[i] > 0.0f ? t[j].pexpo[i] : -1e30f;
+                        near = e > near ? e : near;
+                    }
+                    if (near >= -L[j].freach)
                         for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
                             k_fold(i, L + j, t + j);
+                }
             }
             if (sg_only)
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 0));

@@ -876,15 +876,21 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             o->fold = o->planar > 0.0f ? fold_weight(v, &cuts) : 0.0f;
             memset(o->fb, 0, sizeof o->fb);
             memset(o->fa, 0, sizeof o->fa);
+            o->freach = 0.0f;
             if (o->fold > 0.0f) {
                 cell_axes(v, &u1, &u2);
                 float is = 1.0f / sqrtf(fmaxf(o->pvar, VSGL__TINY));
                 const float mm[2] = {v3_dot(v->mean, u1), v3_dot(v->mean, u2)};
+                float far2[2] = {0.0f, 0.0f};
                 for (int ax = 0; ax < 2; ++ax)
                     for (int sd = 0; sd < 2; ++sd) {
                         o->fb[ax][sd] = (cuts.b[ax][sd] - mm[ax]) * is;
                         o->fa[ax][sd] = cuts.a[ax][sd];
+                        if (o->fa[ax][sd] > 0.0f)
+                            far2[ax] = fmaxf(far2[ax], o->fb[ax][sd] * o->fb[ax][sd]);
                     }
+                float reach = sqrtf(50.0f) + 2.0f * sqrtf(far2[0] + far2[1]);
+                o->freach = 0.5f * reach * reach;
             } else {
                 v3_basis(v->normal, &u1, &u2);
             }
