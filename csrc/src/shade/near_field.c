@@ -111,22 +111,26 @@ static float polygon_form_factor(v3 x, v3 n, const v3 *p, int m)
     return fabsf(sum) * (0.5f * VSGL__INV_PI);
 }
 
-/* The mean of the tent 1 - |x - c| / h over [lo, hi]. */
-static double tent_mean(double lo, double hi, double c, double h)
+/* The tent 1 - |x - c| / h over [lo, hi]: its mass, mean and variance. */
+static void tent_moments(double lo, double hi, double c, double h, double *mass, double *mean, double *var)
 {
-    double m0 = 0.0, m1 = 0.0;
+    double m0 = 0.0, m1 = 0.0, m2 = 0.0;
     double a = fmin(hi, c) - c, b = lo - c; /* the rising side, y = x - c in [b, a] */
     if (a > b) {
         m0 += (a - b) + (a * a - b * b) / (2.0 * h);
         m1 += (a * a - b * b) / 2.0 + (a * a * a - b * b * b) / (3.0 * h);
+        m2 += (a * a * a - b * b * b) / 3.0 + (a * a * a * a - b * b * b * b) / (4.0 * h);
     }
     a = fmax(lo, c) - c;
     b = hi - c; /* the falling side, y in [a, b] */
     if (b > a) {
         m0 += (b - a) - (b * b - a * a) / (2.0 * h);
         m1 += (b * b - a * a) / 2.0 - (b * b * b - a * a * a) / (3.0 * h);
+        m2 += (b * b * b - a * a * a) / 3.0 - (b * b * b * b - a * a * a * a) / (4.0 * h);
     }
-    return m0 > 0.0 ? c + m1 / m0 : c;
+    *mass = m0;
+    *mean = m0 > 0.0 ? c + m1 / m0 : c;
+    *var = m0 > 0.0 ? fmax(m2 / m0 - (m1 / m0) * (m1 / m0), 0.0) : 0.0;
 }
 
 int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
@@ -171,13 +175,6 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
         }
     if (!(area > 0.0f))
         return 0;
-    c->box[0] = c->box[2] = INFINITY;
-    c->box[1] = c->box[3] = -INFINITY;
-    for (uint32_t k = 0; k < c->nrect; ++k)
-        for (int q = 0; q < 4; q += 2) {
-            c->box[q] = fminf(c->box[q], c->rect[k][q]);
-            c->box[q + 1] = fmaxf(c->box[q + 1], c->rect[k][q + 1]);
-        }
     c->inv_area = 1.0f / (VSGL__PI * area);
     float facing = axis_of(v->normal, a) * (c->side ? -1.0f : 1.0f) * v->coherence;
     float du = su / area - axis_of(v->mean, (a + 1) % 3), dv = sv / area - axis_of(v->mean, (a + 2) % 3);
@@ -185,47 +182,32 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
     c->fit = v->coherence * v->coherence *
              smooth01((facing - VSGL__NEAR_FACING_LO) / (VSGL__NEAR_FACING_HI - VSGL__NEAR_FACING_LO));
     if (c->lambda > 0.0f) {
-        /* a specular cell: irradiance linear across the steps, its mean
-         * the VPLs' (grad = M2^-1 (mean - centroid), M2 the steps' second
-         * moments), scaled down to stay >= 0 at the steps' corners (a
-         * sliver cell's mean is off its thin steps' centroid by more than
-         * a line can move it; dropping such cells left the strip beside a
-         * wall half lit) */
-        c->centroid[0] = su / area;
-        c->centroid[1] = sv / area;
-        double m[3] = {0.0, 0.0, 0.0};
-        for (uint32_t k = 0; k < c->nrect; ++k) {
-            const float *r = c->rect[k];
-            double a0 = r[0] - c->centroid[0], a1 = r[1] - c->centroid[0];
-            double b0 = r[2] - c->centroid[1], b1 = r[3] - c->centroid[1];
-            m[0] += (a1 * a1 * a1 - a0 * a0 * a0) / 3.0 * (b1 - b0);
-            m[1] += (a1 * a1 - a0 * a0) * 0.5 * (b1 * b1 - b0 * b0) * 0.5;
-            m[2] += (b1 * b1 * b1 - b0 * b0 * b0) / 3.0 * (a1 - a0);
+        /* a specular cell: its tent, truncated to the VPLs' extent, times
+         * an irradiance linear across it whose mean is the VPLs' (per axis:
+         * the tent is separable, so grad = (mean - the tent's) / its
+         * variance), scaled down to stay >= 0 at the corners (a sliver
+         * cell's mean can be off by more than a line can move it) */
+        double mass[2], mean[2], var[2];
+        const float mv[2] = {axis_of(v->mean, (a + 1) % 3), axis_of(v->mean, (a + 2) % 3)};
+        double lowest = 1.0, g[2];
+        for (int k = 0; k < 2; ++k) {
+            c->tlo[k] = fmaxf(v->cell_lo[k], v->cell_centre[k] - h);
+            c->thi[k] = fminf(v->cell_hi[k], v->cell_centre[k] + h);
+            tent_moments(c->tlo[k], c->thi[k], v->cell_centre[k], h, &mass[k], &mean[k], &var[k]);
+            g[k] = var[k] > 1e-12 * (double)h * h ? (mv[k] - mean[k]) / var[k] : 0.0;
+            c->centroid[k] = (float)mean[k];
         }
-        double det = m[0] * m[2] - m[1] * m[1];
-        double g0 = 0.0, g1 = 0.0;
-        if (det > 0.0) {
-            /* the VPLs' mean against a uniformly lit truncated tent's (not the
-             * steps' centroid, which a sliver cell's steps miss): the part a
-             * gradient of irradiance moved it, x area */
-            double eu = (axis_of(v->mean, (a + 1) % 3) - tent_mean(v->cell_lo[0], v->cell_hi[0], v->cell_centre[0], h)) *
-                        area;
-            double ev = (axis_of(v->mean, (a + 2) % 3) - tent_mean(v->cell_lo[1], v->cell_hi[1], v->cell_centre[1], h)) *
-                        area;
-            g0 = (m[2] * eu - m[1] * ev) / det;
-            g1 = (m[0] * ev - m[1] * eu) / det;
+        if (!(mass[0] > 0.0) || !(mass[1] > 0.0))
+            return 0;
+        for (int q = 0; q < 4; ++q) {
+            double l = 1.0 + g[0] * ((q & 1 ? c->thi[0] : c->tlo[0]) - mean[0]) +
+                       g[1] * ((q & 2 ? c->thi[1] : c->tlo[1]) - mean[1]);
+            lowest = l < lowest ? l : lowest;
         }
-        double lowest = 1.0;
-        for (uint32_t k = 0; k < c->nrect; ++k)
-            for (int q = 0; q < 4; ++q) {
-                const float *r = c->rect[k];
-                double y0 = (q & 1 ? r[1] : r[0]) - c->centroid[0], y1 = (q & 2 ? r[3] : r[2]) - c->centroid[1];
-                double l = 1.0 + g0 * y0 + g1 * y1;
-                lowest = l < lowest ? l : lowest;
-            }
         float scale = lowest < 0.0 ? (float)(1.0 / (1.0 - lowest)) : 1.0f;
-        c->grad[0] = (float)g0 * scale;
-        c->grad[1] = (float)g1 * scale;
+        c->grad[0] = (float)g[0] * scale;
+        c->grad[1] = (float)g[1] * scale;
+        c->inv_area = (float)(1.0 / (VSGL__PI * mass[0] * mass[1]));
     } else {
         c->fit *= 1.0f - smooth01((off - VSGL__NEAR_UNIFORM) / (2.0f * VSGL__NEAR_UNIFORM));
     }
@@ -242,38 +224,65 @@ static float normal_cdf_e(float z, float e)
     return z < 0.0f ? tail : 1.0f - tail;
 }
 
-/* The mass of the 2-D Gaussian of mean (pu, pv) and covariance (cuu, cuv;
- * cuv, cvv) over the rectangle [u0, u1] x [v0, v1], weighted by 1 + g .
- * (y - o): Gauss-Legendre over u (within 6 sigma of the mean) of the
- * density of u times the conditional mass (and first moment) of v given u. */
-static float gauss_rect(float pu, float pv, float cuu, float cuv, float cvv, const float *r, const float *g,
-                        const float *o)
+/* The integral of (al + be v) (v - o)^j N(v; m, s^2) over [lo, hi], j = 0
+ * (out[0]) and 1 (out[1]), from the CDF and density at the bounds. */
+static void lin_gauss(float al, float be, float o, float m, float s, float lo, float hi, float *out)
+{
+    float is = 1.0f / s, za = (lo - m) * is, zb = (hi - m) * is;
+    float ea = expf(-0.5f * za * za), eb = expf(-0.5f * zb * zb);
+    float d0 = normal_cdf_e(zb, eb) - normal_cdf_e(za, ea);
+    float pa = 0.3989422804f * ea, pb = 0.3989422804f * eb;
+    float d1 = m * d0 - s * (pb - pa);                                   /* int v N */
+    float d2 = (m * m + s * s) * d0 - s * ((m + hi) * pb - (m + lo) * pa); /* int v^2 N */
+    out[0] = al * d0 + be * d1;
+    out[1] = (al - be * o) * d1 + be * d2 - al * o * d0;
+}
+
+/* A specular cell's footprint mass: the 2-D Gaussian of mean (pu, pv) and
+ * covariance (cuu, cuv; cuv, cvv) over the cell's truncated tent times its
+ * linear irradiance, 1 + grad . (y - centroid): Gauss-Legendre over u on
+ * each side of the tent's peak (within 6 sigma of the mean), the
+ * conditional integral in v in closed form on each side of its peak. */
+static float tent_mass(const vsgl_near_cell *c, float pu, float pv, float cuu, float cuv, float cvv)
 {
     static const float gx[VSGL__NEAR_GL / 2] = {0.1834346425f, 0.5255324099f, 0.7966664774f, 0.9602898565f};
     static const float gw[VSGL__NEAR_GL / 2] = {0.3626837834f, 0.3137066459f, 0.2223810345f, 0.1012285363f};
-    float su = sqrtf(cuu);
-    float u0 = fmaxf(r[0], pu - 6.0f * su), u1 = fminf(r[1], pu + 6.0f * su);
-    if (!(u1 > u0) || !(su > 0.0f))
-        return 0.0f;
-    float slope = cuv / cuu, sv = sqrtf(fmaxf(cvv - cuv * slope, 1e-12f * cvv)), isv = 1.0f / sv;
     static const float gx4[2] = {0.3399810436f, 0.8611363116f}, gw4[2] = {0.6521451549f, 0.3478548451f};
-    float mid = 0.5f * (u0 + u1), half = 0.5f * (u1 - u0), sum = 0.0f;
-    /* 4 nodes where the interval spans at most 3 sigma (the integrand a
-     * smooth piece of the Gaussian), 8 where it holds its peak and tails */
-    const int nodes = u1 - u0 <= 3.0f * su ? 4 : VSGL__NEAR_GL;
-    const float *xs = nodes == 4 ? gx4 : gx, *ws = nodes == 4 ? gw4 : gw;
-    for (int k = 0; k < nodes; ++k) {
-        float u = mid + (k & 1 ? -half : half) * xs[k >> 1], du = (u - pu) / su;
-        float mv = pv + slope * (u - pu);
-        float a = (r[2] - mv) * isv, b = (r[3] - mv) * isv;
-        /* e^{-z^2 / 2} once per bound: the CDF's and the first moment's */
-        float ea = expf(-0.5f * a * a), eb = expf(-0.5f * b * b);
-        float cond = normal_cdf_e(b, eb) - normal_cdf_e(a, ea);
-        /* the conditional first moment of v - o_v over [v0, v1] */
-        float first = (mv - o[1]) * cond - sv * 0.3989422804f * (eb - ea);
-        sum += ws[k >> 1] * expf(-0.5f * du * du) * (cond * (1.0f + g[0] * (u - o[0])) + g[1] * first);
+    const uint32_t iu = (c->axis + 1) % 3, iv = (c->axis + 2) % 3;
+    const float cu = axis_of(c->centre, iu), cv = axis_of(c->centre, iv), h = c->h, ih = 1.0f / h;
+    float su = sqrtf(cuu);
+    if (!(su > 0.0f))
+        return 0.0f;
+    float slope = cuv / cuu, sv = sqrtf(fmaxf(cvv - cuv * slope, 1e-12f * cvv));
+    const float ubreak[3] = {c->tlo[0], fminf(fmaxf(cu, c->tlo[0]), c->thi[0]), c->thi[0]};
+    const float vbreak[3] = {c->tlo[1], fminf(fmaxf(cv, c->tlo[1]), c->thi[1]), c->thi[1]};
+    float sum = 0.0f;
+    for (int side = 0; side < 2; ++side) {
+        float u0 = fmaxf(ubreak[side], pu - 6.0f * su), u1 = fminf(ubreak[side + 1], pu + 6.0f * su);
+        if (!(u1 > u0))
+            continue;
+        float mid = 0.5f * (u0 + u1), half = 0.5f * (u1 - u0), part = 0.0f;
+        /* 4 nodes where the piece spans at most 3 sigma, 8 where it holds the peak and tails */
+        const int nodes = u1 - u0 <= 3.0f * su ? 4 : VSGL__NEAR_GL;
+        const float *xs = nodes == 4 ? gx4 : gx, *ws = nodes == 4 ? gw4 : gw;
+        for (int k = 0; k < nodes; ++k) {
+            float u = mid + (k & 1 ? -half : half) * xs[k >> 1], du = (u - pu) / su;
+            float tu = 1.0f - fabsf(u - cu) * ih, mvu = pv + slope * (u - pu), in[2] = {0.0f, 0.0f};
+            for (int vs = 0; vs < 2; ++vs) {
+                if (!(vbreak[vs + 1] > vbreak[vs]))
+                    continue;
+                /* the tent in v on this side: 1 -+ (v - cv) / h = al + be v */
+                float be = vs ? -ih : ih, al = 1.0f - be * cv, o[2];
+                lin_gauss(al, be, c->centroid[1], mvu, sv, vbreak[vs], vbreak[vs + 1], o);
+                in[0] += o[0];
+                in[1] += o[1];
+            }
+            part += ws[k >> 1] * expf(-0.5f * du * du) * tu *
+                    ((1.0f + c->grad[0] * (u - c->centroid[0])) * in[0] + c->grad[1] * in[1]);
+        }
+        sum += part * half;
     }
-    return sum * half / (su * 2.5066282746f);
+    return sum / (su * 2.5066282746f);
 }
 
 /* A specular cell's light per watt at x (height above its plane), normal n
@@ -290,15 +299,13 @@ static float near_specular(const vsgl_near_cell *c, v3 x, v3 n, float height)
     uint32_t iu = (a + 1) % 3, iv = (a + 2) % 3;
     float au = axis_of(c->lobe_axis, iu), av = axis_of(c->lobe_axis, iv), s = t * t / c->lambda, k = 1.0f / (cb * cb);
     float cuu = s * (1.0f + au * au * k), cvv = s * (1.0f + av * av * k), cuv = s * au * av * k;
-    float pu = axis_of(p, iu), pv = axis_of(p, iv), frac = 0.0f;
-    /* nothing where the footprint (6 sigma) misses the steps' outer box */
+    float pu = axis_of(p, iu), pv = axis_of(p, iv);
+    /* nothing where the footprint (6 sigma) misses the tent */
     float su6 = 6.0f * sqrtf(cuu), sv6 = 6.0f * sqrtf(cvv);
-    if (pu + su6 < c->box[0] || pu - su6 > c->box[1] || pv + sv6 < c->box[2] || pv - sv6 > c->box[3])
+    if (pu + su6 < c->tlo[0] || pu - su6 > c->thi[0] || pv + sv6 < c->tlo[1] || pv - sv6 > c->thi[1])
         return 0.0f;
-    for (uint32_t r = 0; r < c->nrect; ++r)
-        frac += gauss_rect(pu, pv, cuu, cuv, cvv, c->rect[r], c->grad, c->centroid);
-    /* inv_area = 1 / (pi S) */
-    return cx * frac * c->inv_area / cb;
+    /* inv_area = 1 / (pi x the truncated tent's mass) */
+    return cx * tent_mass(c, pu, pv, cuu, cuv, cvv) * c->inv_area / cb;
 }
 
 float vsgl__near_diffuse(const vsgl_near_cell *c, v3 x, v3 n, float *weight)

@@ -34,7 +34,7 @@ typedef struct vsgl_near_cell {
     /* its irradiance across the steps, linear: 1 + grad . (y - centroid)
      * (in-plane u, v; the steps' centroid), so that its mean is the VPLs' */
     float grad[2], centroid[2];
-    float box[4];         /* the steps' outer box: u0 u1 v0 v1 */
+    float tlo[2], thi[2];  /* its tent's support (u, v) truncated to the VPLs' extent */
 } vsgl_near_cell;
 
 /* The cell of v; 0 if the model does not apply to v (not a lattice
