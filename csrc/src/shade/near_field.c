@@ -191,10 +191,13 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
         const float mv[2] = {axis_of(v->mean, (a + 1) % 3), axis_of(v->mean, (a + 2) % 3)};
         double lowest = 1.0, g[2];
         for (int k = 0; k < 2; ++k) {
-            c->tlo[k] = fmaxf(v->cell_lo[k], v->cell_centre[k] - h);
-            c->thi[k] = fminf(v->cell_hi[k], v->cell_centre[k] + h);
-            tent_moments(c->tlo[k], c->thi[k], v->cell_centre[k], h, &mass[k], &mean[k], &var[k]);
-            g[k] = var[k] > 1e-12 * (double)h * h ? (mv[k] - mean[k]) / var[k] : 0.0;
+            /* relative to the lattice point (near_specular) */
+            const double ck = v->cell_centre[k];
+            double lo = fmax((double)v->cell_lo[k] - ck, -(double)h), hi = fmin((double)v->cell_hi[k] - ck, (double)h);
+            c->tlo[k] = (float)lo;
+            c->thi[k] = (float)hi;
+            tent_moments(lo, hi, 0.0, h, &mass[k], &mean[k], &var[k]);
+            g[k] = var[k] > 1e-12 * (double)h * h ? ((double)mv[k] - ck - mean[k]) / var[k] : 0.0;
             c->centroid[k] = (float)mean[k];
         }
         if (!(mass[0] > 0.0) || !(mass[1] > 0.0))
@@ -248,14 +251,15 @@ static float tent_mass(const vsgl_near_cell *c, float pu, float pv, float cuu, f
     static const float gx[VSGL__NEAR_GL / 2] = {0.1834346425f, 0.5255324099f, 0.7966664774f, 0.9602898565f};
     static const float gw[VSGL__NEAR_GL / 2] = {0.3626837834f, 0.3137066459f, 0.2223810345f, 0.1012285363f};
     static const float gx4[2] = {0.3399810436f, 0.8611363116f}, gw4[2] = {0.6521451549f, 0.3478548451f};
-    const uint32_t iu = (c->axis + 1) % 3, iv = (c->axis + 2) % 3;
-    const float cu = axis_of(c->centre, iu), cv = axis_of(c->centre, iv), h = c->h, ih = 1.0f / h;
+    /* (pu, pv), the tent's support and the centroid are relative to the
+     * lattice point: a scene 100 km from the origin keeps its digits */
+    const float h = c->h, ih = 1.0f / h;
     float su = sqrtf(cuu);
     if (!(su > 0.0f))
         return 0.0f;
     float slope = cuv / cuu, sv = sqrtf(fmaxf(cvv - cuv * slope, 1e-12f * cvv));
-    const float ubreak[3] = {c->tlo[0], fminf(fmaxf(cu, c->tlo[0]), c->thi[0]), c->thi[0]};
-    const float vbreak[3] = {c->tlo[1], fminf(fmaxf(cv, c->tlo[1]), c->thi[1]), c->thi[1]};
+    const float ubreak[3] = {c->tlo[0], fminf(fmaxf(0.0f, c->tlo[0]), c->thi[0]), c->thi[0]};
+    const float vbreak[3] = {c->tlo[1], fminf(fmaxf(0.0f, c->tlo[1]), c->thi[1]), c->thi[1]};
     float sum = 0.0f;
     for (int side = 0; side < 2; ++side) {
         float u0 = fmaxf(ubreak[side], pu - 6.0f * su), u1 = fminf(ubreak[side + 1], pu + 6.0f * su);
@@ -267,12 +271,12 @@ static float tent_mass(const vsgl_near_cell *c, float pu, float pv, float cuu, f
         const float *xs = nodes == 4 ? gx4 : gx, *ws = nodes == 4 ? gw4 : gw;
         for (int k = 0; k < nodes; ++k) {
             float u = mid + (k & 1 ? -half : half) * xs[k >> 1], du = (u - pu) / su;
-            float tu = 1.0f - fabsf(u - cu) * ih, mvu = pv + slope * (u - pu), in[2] = {0.0f, 0.0f};
+            float tu = 1.0f - fabsf(u) * ih, mvu = pv + slope * (u - pu), in[2] = {0.0f, 0.0f};
             for (int vs = 0; vs < 2; ++vs) {
                 if (!(vbreak[vs + 1] > vbreak[vs]))
                     continue;
                 /* the tent in v on this side: 1 -+ (v - cv) / h = al + be v */
-                float be = vs ? -ih : ih, al = 1.0f - be * cv, o[2];
+                float be = vs ? -ih : ih, al = 1.0f, o[2];
                 lin_gauss(al, be, c->centroid[1], mvu, sv, vbreak[vs], vbreak[vs + 1], o);
                 in[0] += o[0];
                 in[1] += o[1];
@@ -299,7 +303,7 @@ static float near_specular(const vsgl_near_cell *c, v3 x, v3 n, float height)
     uint32_t iu = (a + 1) % 3, iv = (a + 2) % 3;
     float au = axis_of(c->lobe_axis, iu), av = axis_of(c->lobe_axis, iv), s = t * t / c->lambda, k = 1.0f / (cb * cb);
     float cuu = s * (1.0f + au * au * k), cvv = s * (1.0f + av * av * k), cuv = s * au * av * k;
-    float pu = axis_of(p, iu), pv = axis_of(p, iv);
+    float pu = axis_of(p, iu) - axis_of(c->centre, iu), pv = axis_of(p, iv) - axis_of(c->centre, iv);
     /* nothing where the footprint (6 sigma) misses the tent */
     float su6 = 6.0f * sqrtf(cuu), sv6 = 6.0f * sqrtf(cvv);
     if (pu + su6 < c->tlo[0] || pu - su6 > c->thi[0] || pv + sv6 < c->tlo[1] || pv - sv6 > c->thi[1])

@@ -33,8 +33,8 @@ typedef struct vsgl_near_cell {
     float lambda;
     /* its irradiance across the steps, linear: 1 + grad . (y - centroid)
      * (in-plane u, v; the steps' centroid), so that its mean is the VPLs' */
-    float grad[2], centroid[2];
-    float tlo[2], thi[2];  /* its tent's support (u, v) truncated to the VPLs' extent */
+    float grad[2], centroid[2]; /* centroid: from the lattice point */
+    float tlo[2], thi[2];  /* its tent's support (u, v) truncated to the VPLs' extent, from the lattice point */
 } vsgl_near_cell;
 
 /* The cell of v; 0 if the model does not apply to v (not a lattice
