@@ -103,6 +103,32 @@ VT_TEST(asg_bessel_f_matches_trapezoid)
 
 /* ----------------------------------------------------------- eigen-solver */
 
+/* A symmetric 3x3 Q diag(e) Q^T, Q a random rotation, e drawn at a random
+ * scale 1e-12 .. 1e13 (kind 1-3: two or three equal, 4: one zero, 0:
+ * distinct); returns the scale. */
+static double rand_sym3(vt_rng *r, int kind, double e[3], double a[3][3])
+{
+    double q0[3], q1[3], q2[3], tmp[3];
+    double scale = log_uniform(r, -12, 13);
+    for (int i = 0; i < 3; ++i)
+        e[i] = scale * vt_uniform(r);
+    if (kind == 1) e[1] = e[0];
+    if (kind == 2) e[2] = e[1];
+    if (kind == 3) e[1] = e[2] = e[0];
+    if (kind == 4) e[2] = 0.0;
+    rand_unit(r, q0);
+    rand_unit(r, tmp);
+    cross_d(q0, tmp, q1);
+    double l = sqrt(dot_d(q1, q1));
+    for (int i = 0; i < 3; ++i)
+        q1[i] /= l;
+    cross_d(q0, q1, q2);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            a[i][j] = e[0] * q0[i] * q0[j] + e[1] * q1[i] * q1[j] + e[2] * q2[i] * q2[j];
+    return scale;
+}
+
 /* vsgl__eigen_sym3 (tol 1), or vsgl__eigen_sym3_fast (its closed form:
  * tol 1e4, eigenvectors from cross products, ~1e-10 where the eigenvalues
  * are 1e-6 apart) */
@@ -138,26 +164,9 @@ VT_TEST(asg_eigen3_random_repeated_and_extreme)
     vt_rng r = {202};
     for (int t = 0; t < 3000; ++t) {
         /* Q diag(e) Q^T with e drawn to repeat often, scales 1e-300 .. 1e13 */
-        double e[3], q0[3], q1[3], q2[3], tmp[3];
-        double scale = log_uniform(&r, -12, 13);
+        double e[3], a[3][3];
         int kind = t % 5;
-        for (int i = 0; i < 3; ++i)
-            e[i] = scale * vt_uniform(&r);
-        if (kind == 1) e[1] = e[0];
-        if (kind == 2) e[2] = e[1];
-        if (kind == 3) e[1] = e[2] = e[0];
-        if (kind == 4) e[2] = 0.0;
-        rand_unit(&r, q0);
-        rand_unit(&r, tmp);
-        cross_d(q0, tmp, q1);
-        double l = sqrt(dot_d(q1, q1));
-        for (int i = 0; i < 3; ++i)
-            q1[i] /= l;
-        cross_d(q0, q1, q2);
-        double a[3][3];
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                a[i][j] = e[0] * q0[i] * q0[j] + e[1] * q1[i] * q1[j] + e[2] * q2[i] * q2[j];
+        double scale = rand_sym3(&r, kind, e, a);
         char what[96];
         snprintf(what, sizeof what, "draw %d kind %d e=(%.3g %.3g %.3g)", t, kind, e[0], e[1], e[2]);
         check_eigen(a, what, scale);
@@ -188,24 +197,8 @@ VT_TEST(asg_eigen3_fast_agrees_with_jacobi)
         double a[3][3], scale;
         int kind = t % 6;
         if (kind < 5) {
-            double e[3], q0[3], q1[3], q2[3], tmp[3];
-            scale = log_uniform(&r, -12, 13);
-            for (int i = 0; i < 3; ++i)
-                e[i] = scale * vt_uniform(&r);
-            if (kind == 1) e[1] = e[0];
-            if (kind == 2) e[2] = e[1];
-            if (kind == 3) e[1] = e[2] = e[0];
-            if (kind == 4) e[2] = 0.0;
-            rand_unit(&r, q0);
-            rand_unit(&r, tmp);
-            cross_d(q0, tmp, q1);
-            double l = sqrt(dot_d(q1, q1));
-            for (int i = 0; i < 3; ++i)
-                q1[i] /= l;
-            cross_d(q0, q1, q2);
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j)
-                    a[i][j] = e[0] * q0[i] * q0[j] + e[1] * q1[i] * q1[j] + e[2] * q2[i] * q2[j];
+            double e[3];
+            scale = rand_sym3(&r, kind, e, a);
         } else { /* two ASG forms, bandwidths 1e-3 .. 1e6 */
             vsgl_asg p = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
             vsgl_asg q = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
