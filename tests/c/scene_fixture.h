@@ -88,6 +88,21 @@ static inline void fx_camera(fx_scene *s, const float eye[3], const float at[3],
     c->pixel_aspect_x = c->pixel_aspect_y = 1.0f;
 }
 
+/* The scene's only light: a white spot (radius 0) at eye aimed at `at`,
+ * power W, cone `size` rad, blend. */
+static inline void fx_spot(fx_scene *s, const float eye[3], const float at[3], float power, float size, float blend)
+{
+    vsgl_light *L = &s->lights[0];
+    memset(L, 0, sizeof *L);
+    L->type = VSGL_LIGHT_SPOT;
+    L->color[0] = L->color[1] = L->color[2] = 1.0f;
+    L->power = power;
+    fx_look_at(L->world_from_light, eye, at);
+    L->spot_size = size;
+    L->spot_blend = blend;
+    s->light_count = 1;
+}
+
 /* Room [-1,1] x [-1,1] x [0,2]: glossy grey floor (material 0), red left
  * wall x=-1 (1), green right wall x=+1 (2), white back wall y=+1 and
  * ceiling (3). A spot light at the ceiling aimed at the floor, power P. */
@@ -114,16 +129,8 @@ static inline void fx_room(fx_scene *s, uint32_t width, uint32_t height, float f
     m[2].roughness = 1.0f;
     m[3].base_color[0] = m[3].base_color[1] = m[3].base_color[2] = 0.8f;
     m[3].roughness = 1.0f;
-    vsgl_light *L = &s->lights[0];
-    L->type = VSGL_LIGHT_SPOT;
-    L->color[0] = L->color[1] = L->color[2] = 1.0f;
-    L->power = power;
     const float eye[3] = {-0.5f, -0.3f, 1.9f}, at[3] = {-0.9f, -0.2f, 0.0f};
-    fx_look_at(L->world_from_light, eye, at);
-    L->radius = 0.0f;
-    L->spot_size = 1.2f;
-    L->spot_blend = 0.2f;
-    s->light_count = 1;
+    fx_spot(s, eye, at, power, 1.2f, 0.2f);
     const float ceye[3] = {0.0f, -3.5f, 1.0f}, cat[3] = {0.0f, 0.0f, 0.8f};
     fx_camera(s, ceye, cat, 35.0f, width, height);
 }

@@ -58,15 +58,8 @@ static void metal_floor_room_aimed(fx_scene *s, uint32_t w, uint32_t h, float ro
     m[2] = m[1];
     m[3].base_color[0] = m[3].base_color[1] = m[3].base_color[2] = 0.7f;
     m[3].roughness = 1.0f;
-    vsgl_light *L = &s->lights[0];
-    L->type = VSGL_LIGHT_SPOT;
-    L->color[0] = L->color[1] = L->color[2] = 1.0f;
-    L->power = 2500.0f;
     const float eye[3] = {0.0f, -1.0f, 2.6f};
-    fx_look_at(L->world_from_light, eye, at);
-    L->spot_size = 40.0f * 3.14159265f / 180.0f;
-    L->spot_blend = 0.3f;
-    s->light_count = 1;
+    fx_spot(s, eye, at, 2500.0f, 40.0f * 3.14159265f / 180.0f, 0.3f);
     const float ceye[3] = {0.0f, -2.8f, 1.2f}, cat[3] = {0.0f, 3.0f, 0.6f};
     fx_camera(s, ceye, cat, 28.0f, w, h);
 }
