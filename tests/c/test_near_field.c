@@ -82,11 +82,11 @@ VT_TEST(near_field_form_factor_matches_quadrature)
         VT_REQUIRE(vsgl__near_cell(&v, 0, &c), "cut %g: no cell", cuts[ci]);
         VT_CHECK_REL(c.fit, 1.0f, 1e-5, "cut %g: uniform radiosity, a plane: fit %g", cuts[ci], c.fit);
         for (int t = 0; t < 40; ++t) {
-            float h = 0.1f + 0.8f * (float)rand() / RAND_MAX;
-            v3 x = v3_make(-1.5f + 3.0f * (float)rand() / RAND_MAX, -1.5f + 3.0f * (float)rand() / RAND_MAX, h);
+            float h = 0.1f + 0.8f * (float)rand() / (float)RAND_MAX;
+            v3 x = v3_make(-1.5f + 3.0f * (float)rand() / (float)RAND_MAX, -1.5f + 3.0f * (float)rand() / (float)RAND_MAX, h);
             /* normals all round, including ones whose tangent plane cuts the cell */
-            v3 n = v3_normalize(v3_make((float)rand() / RAND_MAX - 0.5f, (float)rand() / RAND_MAX - 0.5f,
-                                        (float)rand() / RAND_MAX - 0.7f));
+            v3 n = v3_normalize(v3_make((float)rand() / (float)RAND_MAX - 0.5f, (float)rand() / (float)RAND_MAX - 0.5f,
+                                        (float)rand() / (float)RAND_MAX - 0.7f));
             float w;
             double got = vsgl__near_diffuse(&c, x, n, &w), want = quadrature(cuts[ci], x, n, 240);
             /* beyond the near field (weight 0) the value is never used and
@@ -159,7 +159,7 @@ VT_TEST(near_field_index_lists_every_cell_that_reaches_a_point)
         v.cell_h = h;
         v.cell_axis = bin >> 1;
         v.cell_side = bin & 1;
-        float cu = -2.0f + 4.0f * (float)rand() / RAND_MAX, cv = -2.0f + 4.0f * (float)rand() / RAND_MAX;
+        float cu = -2.0f + 4.0f * (float)rand() / (float)RAND_MAX, cv = -2.0f + 4.0f * (float)rand() / (float)RAND_MAX;
         float za = (v.cell_side ? 2.0f : -2.0f);
         v.cell_centre[0] = cu;
         v.cell_centre[1] = cv;
@@ -180,10 +180,10 @@ VT_TEST(near_field_index_lists_every_cell_that_reaches_a_point)
     VT_REQUIRE(vsgl__near_index_build(&set, &ix), "index");
     int missing = 0, reached = 0;
     for (int t = 0; t < 3000; ++t) {
-        v3 x = v3_make(-2.0f + 4.0f * (float)rand() / RAND_MAX, -2.0f + 4.0f * (float)rand() / RAND_MAX,
-                       -2.0f + 4.0f * (float)rand() / RAND_MAX);
-        v3 n = v3_normalize(v3_make((float)rand() / RAND_MAX - 0.5f, (float)rand() / RAND_MAX - 0.5f,
-                                    (float)rand() / RAND_MAX - 0.5f));
+        v3 x = v3_make(-2.0f + 4.0f * (float)rand() / (float)RAND_MAX, -2.0f + 4.0f * (float)rand() / (float)RAND_MAX,
+                       -2.0f + 4.0f * (float)rand() / (float)RAND_MAX);
+        v3 n = v3_normalize(v3_make((float)rand() / (float)RAND_MAX - 0.5f, (float)rand() / (float)RAND_MAX - 0.5f,
+                                    (float)rand() / (float)RAND_MAX - 0.5f));
         size_t nc;
         const uint32_t *cand = vsgl__near_candidates(&ix, x, &nc);
         for (size_t k = 0; k < set.count; ++k) {
