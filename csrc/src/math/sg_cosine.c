@@ -2,6 +2,7 @@
  * (docs/math.md, "SG x clamped cosine"). Fit: tools/fit_cosine_sharpness.py. */
 #include "vsgl/sg.h"
 #include "math/constants.h"
+#include "math/normal.h"
 #include "math/sg_internal.h"
 
 /* Shorthands for the fitted constants (sg_internal.h, shared with the
@@ -17,13 +18,6 @@
 #define K_B2 VSGL__COS_K_B2
 #define K_PSI VSGL__COS_K_PSI
 
-/* erf(x) = 1 - P(x) exp(-x^2) for x >= 0 (Abramowitz & Stegun 7.1.26,
- * |error| <= 1.5e-7): returns P so the caller shares the exponential. */
-static float erfc_poly(float x)
-{
-    float k = 1.0f / (1.0f + 0.3275911f * x);
-    return k * (0.254829592f + k * (-0.284496736f + k * (1.421413741f + k * (-1.453152027f + k * 1.061405429f))));
-}
 
 float vsgl__sg_cosine_accurate(float l, float c)
 {
@@ -55,7 +49,7 @@ float vsgl__sg_cosine_accurate(float l, float c)
     float ex = expf(-x * x);
     float et = expf(-t * t);
     float omc2 = (1.0f - ac) * (1.0f + ac);
-    float s = (c > 0.0f ? c : 0.0f) - 0.5f * ac * erfc_poly(x) * ex + 0.5f * erfc_poly(t) * et
+    float s = (c > 0.0f ? c : 0.0f) - 0.5f * ac * vsgl__erfc_poly(x) * ex + 0.5f * vsgl__erfc_poly(t) * et
             + (ex - et) * (0.28209479177387814f / t); /* 1 / (2 sqrt(pi)) */
     float kappa = -((K_A1 + K_A2 * l) / (1.0f + l * (K_B1 + K_B2 * l))) / t;
     s += kappa * ((x * x - K_PSI) * ex - (t * t - K_PSI) * et);

@@ -6,6 +6,7 @@
  * surface ends, where the Gaussians' tails spill past it. */
 #include "shade/near_field.h"
 #include "math/constants.h"
+#include "math/normal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -217,23 +218,13 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
     return c->fit > 0.0f;
 }
 
-/* Phi(z), the standard normal CDF, given e = e^{-z^2 / 2}: Abramowitz &
- * Stegun 7.1.26 (within 1.5e-7; libm's erfcf was a tenth of a light edit). */
-static float normal_cdf_e(float z, float e)
-{
-    float x = fabsf(z) * 0.70710678f, k = 1.0f / (1.0f + 0.3275911f * x);
-    float tail = 0.5f * e * k * (0.254829592f + k * (-0.284496736f + k * (1.421413741f + k * (-1.453152027f +
-                                                                                           k * 1.061405429f))));
-    return z < 0.0f ? tail : 1.0f - tail;
-}
-
 /* The integral of (al + be v) (v - o)^j N(v; m, s^2) over [lo, hi], j = 0
  * (out[0]) and 1 (out[1]), from the CDF and density at the bounds. */
 static void lin_gauss(float al, float be, float o, float m, float s, float lo, float hi, float *out)
 {
     float is = 1.0f / s, za = (lo - m) * is, zb = (hi - m) * is;
     float ea = expf(-0.5f * za * za), eb = expf(-0.5f * zb * zb);
-    float d0 = normal_cdf_e(zb, eb) - normal_cdf_e(za, ea);
+    float d0 = vsgl__normal_cdf_e(zb, eb) - vsgl__normal_cdf_e(za, ea);
     float pa = 0.3989422804f * ea, pb = 0.3989422804f * eb;
     float d1 = m * d0 - s * (pb - pa);                                   /* int v N */
     float d2 = (m * m + s * s) * d0 - s * ((m + hi) * pb - (m + lo) * pa); /* int v^2 N */

@@ -4,6 +4,7 @@
  * smooth Fresnel/shadowing factor at the integrand's lobe axis. */
 #include "shade/shade.h"
 #include "math/constants.h"
+#include "math/normal.h"
 #include "shade/kernel.h"
 #include "shade/near_field.h"
 #include "shade/shade_job.h"
@@ -68,12 +69,6 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
         e *= (1.0f - w) + w * rho;
     }
     return 1.0f - v->coherence * v->coherence * (1.0f - e);
-}
-
-/* Phi(t), the standard normal CDF (erfc, within 1e-7 absolute) */
-static float normal_cdf(float t)
-{
-    return 0.5f * erfcf(-t * 0.70710678f);
 }
 
 /* A lattice cell's cuts along its in-plane axes k (u = axis + 1, v =
@@ -146,7 +141,7 @@ static float fold_image(float m0, float lo, float hi, float al, float ah, int im
     *m = img == 0 ? m0 : 2.0f * (img == 1 ? lo : hi) - m0;
     f2 = fmaxf(f2, 1e-12f * var);
     float i1 = 1.0f / (var + f2), mp = (*m * f2 + y * var) * i1, isp = 1.0f / sqrtf(var * f2 * i1);
-    float tl = normal_cdf((mp - lo) * isp), th = normal_cdf((hi - mp) * isp);
+    float tl = vsgl__normal_cdf((mp - lo) * isp), th = vsgl__normal_cdf((hi - mp) * isp);
     float wl = 1.0f - al + al * tl, wh = 1.0f - ah + ah * th;
     return img == 0 ? wl * wh : img == 1 ? al * tl * wh : ah * th * wl;
 }
