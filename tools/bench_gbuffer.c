@@ -20,31 +20,7 @@
 #include <string.h>
 #include <time.h>
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static double cpu_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+#include "bench_time.h"
 
 int main(int argc, char **argv)
 {
@@ -171,16 +147,16 @@ int main(int argc, char **argv)
     size_t hits = 0, count = 0;
     for (int r = 0; r < runs; ++r) {
         vsgl_scene *s = NULL;
-        double t0 = now(), c0 = cpu_now();
+        double t0 = bench_now(CLOCK_MONOTONIC), c0 = bench_now(CLOCK_PROCESS_CPUTIME_ID);
         vsgl_result res = vsgl_scene_create(ctx, &d, &s);
-        double t1 = now(), c1 = cpu_now();
+        double t1 = bench_now(CLOCK_MONOTONIC), c1 = bench_now(CLOCK_PROCESS_CPUTIME_ID);
         if (res != VSGL_OK) {
             fprintf(stderr, "scene: %s\n", vsgl_context_last_error(ctx));
             return 1;
         }
         vsgl_gbuffer g;
         res = vsgl__gbuffer_build(ctx, s, aa, 0, &g);
-        double t2 = now(), c2 = cpu_now();
+        double t2 = bench_now(CLOCK_MONOTONIC), c2 = bench_now(CLOCK_PROCESS_CPUTIME_ID);
         cb[r] = c1 - c0;
         cg[r] = c2 - c1;
         if (res != VSGL_OK) {
@@ -196,7 +172,7 @@ int main(int argc, char **argv)
         vsgl__gbuffer_free(&g);
         vsgl_scene_destroy(s);
     }
-    double mb = median(tb, runs), mg = median(tg, runs), mcb = median(cb, runs), mcg = median(cg, runs);
+    double mb = bench_median(tb, runs), mg = bench_median(tg, runs), mcb = bench_median(cb, runs), mcg = bench_median(cg, runs);
     printf("threads %u, triangles %zu, vertices %zu\n", vsgl_context_thread_count(ctx), t, nv);
     printf("scene build (validate + copy + BVH): %.3f s (median of %d), CPU time %.3f s\n", mb, runs, mcb);
     printf("gbuffer %ux%u aa=%u: %zu rays, %.1f%% hit, %.3f s (median of %d), %.2f Mrays/s; CPU time %.3f s (%.2f Mrays per CPU-second)\n",

@@ -23,24 +23,7 @@
 #include <string.h>
 #include <time.h>
 
-static double now(clockid_t c)
-{
-    struct timespec t;
-    clock_gettime(c, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+#include "bench_time.h"
 
 /* FNV-1a over 64-bit words (n a multiple of 8) */
 static uint64_t fnv(uint64_t h, const void *p, size_t n)
@@ -138,12 +121,12 @@ int main(int argc, char **argv)
         vsgl_render_stats st;
         memset(&st, 0, sizeof st);
         st.size = sizeof st;
-        double c0 = now(CLOCK_PROCESS_CPUTIME_ID), w0 = now(CLOCK_MONOTONIC);
+        double c0 = bench_now(CLOCK_PROCESS_CPUTIME_ID), w0 = bench_now(CLOCK_MONOTONIC);
         if (vsgl_render_cached(ctx, scene, &s, cache, &out, &st) != VSGL_OK) {
             fprintf(stderr, "render: %s\n", vsgl_context_last_error(ctx));
             return 1;
         }
-        double c1 = now(CLOCK_PROCESS_CPUTIME_ID), w1 = now(CLOCK_MONOTONIC);
+        double c1 = bench_now(CLOCK_PROCESS_CPUTIME_ID), w1 = bench_now(CLOCK_MONOTONIC);
         uint64_t h = hash ? fnv(1469598103934665603ull, planes, px * 22 * sizeof(float)) : 0;
         all = fnv(all, &h, sizeof h);
         if (!quiet)
@@ -157,7 +140,7 @@ int main(int argc, char **argv)
     }
     printf("%s edit, %ux%u, %d edits, threads %u: median cpu %.4f s, wall %.4f s; frames hash %016llx\n",
            camera ? "camera" : "light", cam.width, cam.height, edits, vsgl_context_thread_count(ctx),
-           median(cpu, edits), median(wall, edits), (unsigned long long)all);
+           bench_median(cpu, edits), bench_median(wall, edits), (unsigned long long)all);
     free(cpu);
     free(wall);
     free(planes);
