@@ -224,6 +224,10 @@ typedef struct k_scratch {
     /* the planar glossy's offsets and covariance (sigma units), for a fold */
     float pd1[VSGL__KERNEL_BLOCK], pd2[VSGL__KERNEL_BLOCK], ps11[VSGL__KERNEL_BLOCK], ps22[VSGL__KERNEL_BLOCK],
         ps12[VSGL__KERNEL_BLOCK], pidet[VSGL__KERNEL_BLOCK];
+    /* the half-vector model: its weight, the slope of the half vector, the
+     * cluster's slope covariance, and the factor common to its lobes */
+    float hvw[VSGL__KERNEL_BLOCK], hs1[VSGL__KERNEL_BLOCK], hs2[VSGL__KERNEL_BLOCK];
+    float hc11[VSGL__KERNEL_BLOCK], hc12[VSGL__KERNEL_BLOCK], hc22[VSGL__KERNEL_BLOCK], hpre[VSGL__KERNEL_BLOCK];
 } k_scratch;
 
 /* Stage 1: the incident radiance as one SG (Eq. 7), all but the exp.
@@ -429,6 +433,99 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     t->pidet[i] = idet;
 }
 
+/* Stage 4d (planar clusters, GGX as lobes; kernel.h VSGL__HV_*, shade/
+ * halfvec.c has the same in scalar form and the derivation): the
+ * half-vector model's weight and what its lobes share. The cluster is a
+ * Gaussian of directions about w = (mean - x) / d, covariance var/d^2 (P -
+ * p p^T) (P the projection off w, p the cluster's normal projected off w);
+ * the half vector h = (o + w) / |o + w| has slope s = (h.t, h.u) / h.n in
+ * the receiver's frame (t, u, n), and a change dl of the light's direction
+ * moves it by J dl, J's rows (I - h h^T)(e - s_e n) / (h.n |o + w|). */
+static inline __attribute__((always_inline)) void
+k_hv_shared(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
+{
+    float r = t->r[i];
+    float wx = (L->mx - b->x[i]) * r, wy = (L->my - b->y[i]) * r, wz = (L->mz - b->z[i]) * r;
+    float nx = b->nx[i], ny = b->ny[i], nz = b->nz[i];
+    /* a tangent frame of the normal: the lobe's X made perpendicular to it */
+    float xd = b->Xx[i] * nx + b->Xy[i] * ny + b->Xz[i] * nz;
+    float tx = b->Xx[i] - xd * nx, ty = b->Xy[i] - xd * ny, tz = b->Xz[i] - xd * nz;
+    float tl = k_rsqrt(tx * tx + ty * ty + tz * tz + 1e-24f);
+    tx *= tl; ty *= tl; tz *= tl;
+    float ux = ny * tz - nz * ty, uy = nz * tx - nx * tz, uz = nx * ty - ny * tx;
+    float hx = b->ox[i] + wx, hy = b->oy[i] + wy, hz = b->oz[i] + wz;
+    float im = k_rsqrt(hx * hx + hy * hy + hz * hz + 1e-24f);
+    hx *= im; hy *= im; hz *= im;
+    float hn = hx * nx + hy * ny + hz * nz;
+    float hnc = hn > 0.1f ? hn : 0.1f; /* below VSGL__HV_HN_LO the weight is 0 anyway */
+    float ihn = 1.0f / hnc;
+    float s1 = (hx * tx + hy * ty + hz * tz) * ihn, s2 = (hx * ux + hy * uy + hz * uz) * ihn;
+    float e1x = tx - s1 * nx, e1y = ty - s1 * ny, e1z = tz - s1 * nz;
+    float e2x = ux - s2 * nx, e2y = uy - s2 * ny, e2z = uz - s2 * nz;
+    float he1 = hx * e1x + hy * e1y + hz * e1z, he2 = hx * e2x + hy * e2y + hz * e2z;
+    float sc = ihn * im;
+    float a1x = (e1x - he1 * hx) * sc, a1y = (e1y - he1 * hy) * sc, a1z = (e1z - he1 * hz) * sc;
+    float a2x = (e2x - he2 * hx) * sc, a2y = (e2y - he2 * hy) * sc, a2z = (e2z - he2 * hz) * sc;
+    float nc = wx * L->nx + wy * L->ny + wz * L->nz;
+    float px = L->nx - nc * wx, py = L->ny - nc * wy, pz = L->nz - nc * wz;
+    float a1w = a1x * wx + a1y * wy + a1z * wz, a2w = a2x * wx + a2y * wy + a2z * wz;
+    float a1p = a1x * px + a1y * py + a1z * pz, a2p = a2x * px + a2y * py + a2z * pz;
+    float sv = L->var * r * r;
+    t->hc11[i] = sv * (a1x * a1x + a1y * a1y + a1z * a1z - a1w * a1w - a1p * a1p);
+    t->hc22[i] = sv * (a2x * a2x + a2y * a2y + a2z * a2z - a2w * a2w - a2p * a2p);
+    t->hc12[i] = sv * (a1x * a2x + a1y * a2y + a1z * a2z - a1w * a2w - a1p * a2p);
+    t->hs1[i] = s1;
+    t->hs2[i] = s2;
+    /* the weight: small spread, half vector well above the horizon, a lane with alpha */
+    float ws = (VSGL__HV_SPREAD_HI - sv) * (1.0f / (VSGL__HV_SPREAD_HI - VSGL__HV_SPREAD_LO));
+    ws = ws < 0.0f ? 0.0f : (ws > 1.0f ? 1.0f : ws);
+    float wh = (hn - VSGL__HV_HN_LO) * (1.0f / (VSGL__HV_HN_HI - VSGL__HV_HN_LO));
+    wh = wh < 0.0f ? 0.0f : (wh > 1.0f ? 1.0f : wh);
+    float w = ws * ws * (3.0f - 2.0f * ws) * wh * wh * (3.0f - 2.0f * wh);
+    float a = b->alpha[i];
+    float h = t->h[i];
+    w = a > 0.0f && h > 0.0f ? w : 0.0f;
+    t->hvw[i] = w;
+    /* Smith's shadowing-masking with the cluster's direction over the one
+     * with the lobe's axis, where M (f0r..) is taken */
+    float a2 = a * a;
+    float co = b->ox[i] * nx + b->oy[i] * ny + b->oz[i] * nz;
+    co = co > 1e-4f ? co : 1e-4f;
+    float ci = wx * nx + wy * ny + wz * nz;
+    ci = ci > 0.0f ? ci : 0.0f;
+    float ca = b->Zx[i] * nx + b->Zy[i] * ny + b->Zz[i] * nz;
+    ca = ca > 1e-4f ? ca : 1e-4f;
+    float so = sqrtf(a2 + (1.0f - a2) * co * co);
+    float gc = ci / (ci * so + co * sqrtf(a2 + (1.0f - a2) * ci * ci));
+    float ga = ca / (ca * so + co * sqrtf(a2 + (1.0f - a2) * ca * ca));
+    float ih2 = ihn * ihn;
+    /* radiance N / pi, the emitter's cos / d^2 = h r^3, and D's 1 / h.n^4 */
+    float pre = w * t->vis[i] * h * r * r * r * (1.0f / VSGL__PI) * ih2 * ih2 * (gc / ga);
+    t->hpre[i] = w > 0.0f ? pre : 0.0f; /* a select: r^3 overflows where w is 0 (a receiver at the mean) */
+}
+
+/* One lobe (k, c) of the half-vector model: the lobe's slope covariance
+ * alpha^2 / 2k plus the cluster's, evaluated at s: into ppre, pexpo. */
+static inline __attribute__((always_inline)) void
+k_hv_lobe(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t, float kb, float kc)
+{
+    float a = b->alpha[i];
+    float al2 = a * a * (0.5f / kb);
+    float c11 = al2 + t->hc11[i], c22 = al2 + t->hc22[i], c12 = t->hc12[i];
+    float det = c11 * c22 - c12 * c12;
+    det = det > 1e-30f ? det : 1e-30f;
+    float s1 = t->hs1[i], s2 = t->hs2[i];
+    float q = (c22 * s1 * s1 - 2.0f * c12 * s1 * s2 + c11 * s2 * s2) / det;
+    t->pexpo[i] = q > 0.0f ? -0.5f * q : 0.0f;
+    t->ppre[i] = t->hpre[i] * (kc / kb) * (0.5f / VSGL__PI) * k_rsqrt(det);
+}
+
+/* The planar model's share where the half-vector model takes over. */
+static inline __attribute__((always_inline)) void k_hv_rest(size_t i, k_scratch *restrict t)
+{
+    t->ppre[i] *= 1.0f - t->hvw[i];
+}
+
 /* Phi(z), the standard normal CDF, from k_erfc_poly (within 1.5e-7). */
 static inline __attribute__((always_inline)) float k_ncdf(float z)
 {
@@ -511,6 +608,8 @@ k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
         gint = t->gpre[i] * k_exp(t->expo[i]);
     else if (form == 1)  /* the planar model alone */
         gint = t->ppre[i] * k_exp(t->pexpo[i]);
+    else if (form == 3) /* the half-vector model (its weight in ppre) */
+        gint = L->planar * t->ppre[i] * k_exp(t->pexpo[i]);
     else
         gint = (1.0f - L->planar) * t->gpre[i] * k_exp(t->expo[i]) + L->planar * t->ppre[i] * k_exp(t->pexpo[i]);
     b->ls[0][i] += L->pr * gint * b->f0r[i];
@@ -576,6 +675,15 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         }
         /* one ASG, or GGX's core and tail as two (kernel.h, VSGL__KERNEL_GGX_TAIL) */
         const int two = (lobes & VSGL__KERNEL_GGX_TAIL) != 0;
+        /* with GGX as lobes, planar clusters that subtend little are taken
+         * by the half-vector model (kernel.h VSGL__HV_*) */
+        int hv = 0;
+        if (two && !none_planar) {
+            K_FORN(k_hv_shared(b, i, L + j, t + j));
+            for (int j = 0; j < NL; ++j)
+                for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
+                    hv |= t[j].hvw[i] > 0.0f;
+        }
         for (int q = 0; q < 1 + two; ++q) {
             const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
             const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
@@ -600,6 +708,8 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
                         for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
                             k_fold(i, L + j, t + j);
                 }
+                if (hv)
+                    K_FORN(k_hv_rest(i, t + j));
             }
             if (sg_only)
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 0));
@@ -607,6 +717,14 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 1));
             else
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 2));
+        }
+        if (hv) {
+            static const float hk[VSGL__HV_LOBES] = {VSGL__HV_K0, VSGL__HV_K1, VSGL__HV_K2, VSGL__HV_K3};
+            static const float hc[VSGL__HV_LOBES] = {VSGL__HV_C0, VSGL__HV_C1, VSGL__HV_C2, VSGL__HV_C3};
+            for (int q = 0; q < VSGL__HV_LOBES; ++q) {
+                K_FORN(k_hv_lobe(b, i, t + j, hk[q], hc[q]));
+                K_FORN(k_glossy_sum(b, i, L + j, t + j, 3));
+            }
         }
     }
 }

@@ -3,6 +3,7 @@
  * receiver NDF as an ASG (or SG) convolved with the incident SG, with the
  * smooth Fresnel/shadowing factor at the integrand's lobe axis. */
 #include "shade/shade.h"
+#include "shade/halfvec.h"
 #include "math/constants.h"
 #include "math/normal.h"
 #include "shade/kernel.h"
@@ -293,6 +294,14 @@ static vsgl_asg ggx_part(const vsgl_asg *a, int q)
     return r;
 }
 
+/* The receiver's GGX alpha for the half-vector model (halfvec.h), 0 where
+ * it does not apply: anisotropic roughness (the model is isotropic). */
+static float hv_alpha(const receiver *r)
+{
+    float ax = r->bp.alpha_x, ay = r->bp.alpha_y;
+    return r->glossy && fabsf(ax - ay) <= 1e-3f * fmaxf(ax, ay) ? r->alpha : 0.0f;
+}
+
 /* Glossy integral of the receiver's lobe with the incident SG, and the
  * axis where the smooth factor is evaluated: the receiver's lobe axis
  * (Xu et al. Eq. 30), the same for every VSGL, as in the kernel. */
@@ -317,6 +326,11 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
 {
     int parts = two_lobes(j->s->glossy_mode) ? 2 : 1;
     float sum = 0.0f;
+    /* with GGX as lobes, a planar cluster that subtends little through the
+     * half-vector model (halfvec.h), the planar one taking the rest */
+    float hw = 0.0f, hv = 0.0f;
+    if (parts == 2 && j->leak && v->lobe == VSGL__LOBE_DIFFUSE && v->coherence > 0.0f)
+        hv = vsgl__halfvec_glossy(v, r->x, r->n, r->o, r->asg.z, hv_alpha(r), &hw);
     for (int q = 0; q < parts; ++q) {
         float gi = glossy_integral(j, r, in, axis, q);
         if (j->leak && v->lobe == VSGL__LOBE_DIFFUSE) {
@@ -326,11 +340,11 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
             else if (parts == 2)
                 lobe = ggx_part(&r->asg, q);
             float k2 = v->coherence * v->coherence;
-            gi = (1.0f - k2) * gi + k2 * vsgl__planar_glossy(v, r->x, &lobe);
+            gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * vsgl__planar_glossy(v, r->x, &lobe);
         }
         sum += gi;
     }
-    return sum;
+    return sum + v->coherence * v->coherence * hw * hv;
 }
 
 static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
@@ -428,7 +442,7 @@ static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z
     b->Xx[k] = 1.0f; b->Xy[k] = b->Xz[k] = 0.0f;
     b->Yy[k] = 1.0f; b->Yx[k] = b->Yz[k] = 0.0f;
     b->Zz[k] = 1.0f; b->Zx[k] = b->Zy[k] = 0.0f;
-    b->lam[k] = b->mu[k] = b->camp[k] = 0.0f;
+    b->lam[k] = b->mu[k] = b->camp[k] = b->alpha[k] = 0.0f;
     b->f0r[k] = b->f0g[k] = b->f0b[k] = 0.0f;
 }
 
@@ -454,11 +468,12 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
         b->lam[k] = r->asg.lambda;
         b->mu[k] = r->asg.mu;
         b->camp[k] = expf(r->asg.log_amplitude);
+        b->alpha[k] = hv_alpha(r);
     } else {
         b->Xx[k] = 1.0f; b->Xy[k] = b->Xz[k] = 0.0f;
         b->Yy[k] = 1.0f; b->Yx[k] = b->Yz[k] = 0.0f;
         b->Zz[k] = 1.0f; b->Zx[k] = b->Zy[k] = 0.0f;
-        b->lam[k] = b->mu[k] = b->camp[k] = 0.0f;
+        b->lam[k] = b->mu[k] = b->camp[k] = b->alpha[k] = 0.0f;
     }
     float m[3] = {0.0f, 0.0f, 0.0f};
     if (r->glossy && j->s->glossy_mode != VSGL_GLOSSY_MRP) {
@@ -511,7 +526,7 @@ static void lane_get(const vsgl_kernel_block *b, size_t k, vsgl__plan_lane *o)
     *v++ = b->Xx[k]; *v++ = b->Xy[k]; *v++ = b->Xz[k];
     *v++ = b->Yx[k]; *v++ = b->Yy[k]; *v++ = b->Yz[k];
     *v++ = b->Zx[k]; *v++ = b->Zy[k]; *v++ = b->Zz[k];
-    *v++ = b->lam[k]; *v++ = b->mu[k]; *v++ = b->camp[k];
+    *v++ = b->lam[k]; *v++ = b->mu[k]; *v++ = b->camp[k]; *v++ = b->alpha[k];
     *v++ = b->f0r[k]; *v++ = b->f0g[k]; *v = b->f0b[k];
 }
 
@@ -525,7 +540,7 @@ static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o)
     b->Xx[k] = *v++; b->Xy[k] = *v++; b->Xz[k] = *v++;
     b->Yx[k] = *v++; b->Yy[k] = *v++; b->Yz[k] = *v++;
     b->Zx[k] = *v++; b->Zy[k] = *v++; b->Zz[k] = *v++;
-    b->lam[k] = *v++; b->mu[k] = *v++; b->camp[k] = *v++;
+    b->lam[k] = *v++; b->mu[k] = *v++; b->camp[k] = *v++; b->alpha[k] = *v++;
     b->f0r[k] = *v++; b->f0g[k] = *v++; b->f0b[k] = *v;
 }
 

@@ -10,9 +10,9 @@
 #include "shade/near_field.h"
 #include "scene/material.h"
 
-/* A kernel lane's receiver fields (25 floats, shade.c: lane_get/lane_put). */
+/* A kernel lane's receiver fields (26 floats, shade.c: lane_get/lane_put). */
 typedef struct vsgl__plan_lane {
-    float v[25];
+    float v[26];
 } vsgl__plan_lane;
 
 /* A shading plan (shade_stride > 1): what shading a G-buffer needs that no
