@@ -17,6 +17,12 @@ fit, int (g - f)^2 x dx, overshoots GGX by 25-34 % at x = 2-3.)
 
     python3 tools/fit_ggx_lobes.py          # prints the constants and the ratios g / f
 
+With --lobes 4 it fits the four lobes of the half-vector model
+(VSGL__HV_*, csrc/src/shade/kernel.h) the same way over x <= 10: GGX's
+tail out to ten alphas, where a lit wall's haze on a metal floor lies.
+
+    python3 tools/fit_ggx_lobes.py --lobes 4
+
 Needs numpy and scipy (pip install scipy).
 """
 import sys
@@ -59,7 +65,60 @@ def fit():
     return lobes(best.x)
 
 
+def model_n(k, c, x):
+    """sum_i c_i exp(-k_i x^2)."""
+    return sum(ci * np.exp(-ki * x * x) for ki, ci in zip(k, c))
+
+
+def objective_n(k, c, x_max=10.0, n=6001):
+    x = np.linspace(0.0, x_max, n)
+    e = ((model_n(k, c, x) - ggx(x)) / ggx(x)) ** 2 * x
+    return float(np.sum((e[1:] + e[:-1]) * 0.5 * np.diff(x)))
+
+
+def lobes_n(params, n):
+    """(k, c) from the free parameters (log k_i, log weights of the energy shares, the last share's weight 1)."""
+    k = np.exp(params[:n])
+    w = np.exp(np.append(params[n:], 0.0))
+    return k, w / w.sum() * k
+
+
+def fit_n(n=4, x_max=10.0, starts=40):
+    from scipy.optimize import minimize
+    rng = np.random.default_rng(1)
+    best = None
+    for _ in range(starts):
+        k0 = np.sort(np.exp(rng.uniform(np.log(0.005), np.log(3.0), n)))[::-1]
+        p0 = np.concatenate([np.log(k0), rng.normal(0.0, 1.0, n - 1)])
+        r = minimize(lambda p: objective_n(*lobes_n(p, n), x_max=x_max), p0, method="Nelder-Mead",
+                     options=dict(maxiter=40000, xatol=1e-10, fatol=1e-16))
+        if best is None or r.fun < best.fun:
+            best = r
+    k, c = lobes_n(best.x, n)
+    order = np.argsort(-k)
+    return k[order], c[order]
+
+
+def main_n(n):
+    try:
+        k, c = fit_n(n)
+    except ImportError:
+        sys.exit("fit_ggx_lobes.py needs scipy: python3 -m pip install scipy")
+    for i, (ki, ci) in enumerate(zip(k, c)):
+        print("#define VSGL__HV_K%d %.5gf" % (i, ki))
+        print("#define VSGL__HV_C%d %.5gf" % (i, ci))
+    print("energy shares " + " ".join("%.3f" % (ci / ki) for ki, ci in zip(k, c)) +
+          "; objective %.5f" % objective_n(k, c))
+    xs = np.array([0.0, 1.0, 2.0, 3.0, 5.0, 7.0, 10.0])
+    print("x = tan / alpha: " + " ".join("%5.1f" % x for x in xs))
+    print("lobes / GGX:     " + " ".join("%5.2f" % r for r in model_n(k, c, xs) / ggx(xs)))
+
+
 def main():
+    if "--lobes" in sys.argv:
+        n = int(sys.argv[sys.argv.index("--lobes") + 1])
+        if n != 2:
+            return main_n(n)
     try:
         k1, c1, k2, c2 = fit()
     except ImportError:

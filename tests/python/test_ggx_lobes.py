@@ -48,3 +48,35 @@ def test_two_lobes_follow_ggx_within_three_alphas():
     # one lobe is 47 % too bright at one alpha and half as bright at two
     one = np.exp(-x * x) / F.ggx(x)
     assert np.max(np.abs(one - 1.0)) > 0.45
+
+
+def header_hv_constants():
+    text = open(os.path.join(ROOT, "csrc", "src", "shade", "kernel.h")).read()
+    get = lambda name: float(re.search(r"#define VSGL__HV_%s ([0-9.e+-]+)f" % name, text).group(1))  # noqa: E731
+    return np.array([get("K%d" % i) for i in range(4)]), np.array([get("C%d" % i) for i in range(4)])
+
+
+def test_four_lobes_keep_ggx_integral_and_follow_its_tail():
+    """The half-vector model's four lobes (VSGL__HV_*): GGX's integral, and
+    its shape out to ten alphas (0.85 at the peak, 1.09 at one alpha)."""
+    k, c = header_hv_constants()
+    assert abs(float(np.sum(c / k)) - 1.0) < 1e-3
+    x = np.linspace(0.0, 10.0, 1001)
+    ratio = F.model_n(k, c, x) / F.ggx(x)
+    assert np.all(np.abs(ratio - 1.0) < 0.16), float(np.max(np.abs(ratio - 1.0)))
+    tail = ratio[x >= 2.0]
+    assert np.all(np.abs(tail - 1.0) < 0.04), float(np.max(np.abs(tail - 1.0)))
+    # the two lobes fall to a third of GGX by five alphas: the haze they miss
+    k1, c1, k2, c2 = header_constants()
+    assert F.model(k1, c1, k2, c2, np.array([5.0]))[0] / F.ggx(np.array([5.0]))[0] < 0.35
+
+
+def test_four_lobes_minimise_the_stated_objective():
+    k, c = header_hv_constants()
+    base = F.objective_n(k, c)
+    shares = c / k
+    for i in range(4):
+        for f in (1.03, 0.97):
+            k2 = k.copy()
+            k2[i] *= f
+            assert F.objective_n(k2, shares * k2) > base, (i, f)
