@@ -105,6 +105,12 @@ void vsgl__sample_lane(const shade_job *j, size_t i, vsgl__plan_lane *lane);
 uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lanes, size_t n, float *light);
 /* cd: NULL, or 4 floats per sample of the pixel that receive its colour factors (a plan's record) */
 void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls, float *cd);
+#if defined(__SSE2__)
+/* vsgl__write_pixel of pixels px..px+3 at once, bit for bit, where the
+ * G-buffer has one sample per pixel and j->params is set (pixel4.c); cd:
+ * NULL or 16 floats (4 per pixel, a miss's left as they are). */
+void vsgl__write_pixels4(const shade_job *j, size_t px, const float *const Ls[4], float *cd);
+#endif
 
 /* Shading plans (sparse_plan.c): a new empty plan to record (NULL if memory is
  * short), whether one fits this G-buffer and settings, whether a record

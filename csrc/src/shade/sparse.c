@@ -385,6 +385,17 @@ int32_t vsgl__sparse_direct(void *user, size_t chunk, size_t b, size_t e)
     return rc;
 }
 
+/* A record: pixel px's colours and coverage, as the replay writes them. */
+static inline void keep_colour(vsgl_shade_plan *plan, const vsgl_pixel_planes *pl, size_t px)
+{
+    float *col = plan->colour + px * 7;
+    for (int c = 0; c < 3; ++c) {
+        col[c] = pl->diffuse_color[px * 3 + c];
+        col[3 + c] = pl->glossy_color[px * 3 + c];
+    }
+    col[6] = pl->coverage[px];
+}
+
 /* Rows [b0, e0) of the batch: every pixel from its samples' light and
  * colours (a record keeps the colours and factors: replay_pixel). */
 static int32_t sparse_resolve(void *user, size_t chunk, size_t b0, size_t e0)
@@ -399,6 +410,22 @@ static int32_t sparse_resolve(void *user, size_t chunk, size_t b0, size_t e0)
     const int record = plan && b0 % W == 0 && e0 - b0 == W;
     const float *Ls[VSGL__GBUFFER_MAX_SPP];
     for (size_t px = j->base + b0; px < j->base + e0; ++px) {
+#if defined(__SSE2__)
+        if (spp == 1 && j->params && px + 4 <= j->base + e0) { /* four pixels' colours at once (pixel4.c) */
+            for (size_t k = 0; k < 4; ++k) {
+                size_t bi = px + k - bt->first;
+                Ls[k] = g->material[px + k] == VSGL__GBUFFER_MISS ? NULL
+                        : bt->direct_of[bi] != SIZE_MAX           ? bt->dlight + bt->direct_of[bi] * 6
+                                                                  : bt->interp + bi * 6;
+            }
+            vsgl__write_pixels4(j, px, Ls, record ? plan->cd + px * 4 : NULL);
+            if (record)
+                for (size_t k = 0; k < 4; ++k)
+                    keep_colour(plan, pl, px + k);
+            px += 3;
+            continue;
+        }
+#endif
         for (size_t k = 0; k < spp; ++k) {
             size_t si = px * spp + k, bi = si - bt->first;
             if (g->material[si] == VSGL__GBUFFER_MISS)
@@ -407,14 +434,8 @@ static int32_t sparse_resolve(void *user, size_t chunk, size_t b0, size_t e0)
                 Ls[k] = bt->direct_of[bi] != SIZE_MAX ? bt->dlight + bt->direct_of[bi] * 6 : bt->interp + bi * 6;
         }
         vsgl__write_pixel(j, px, Ls, record ? plan->cd + px * spp * 4 : NULL);
-        if (record) {
-            float *col = plan->colour + px * 7;
-            for (int c = 0; c < 3; ++c) {
-                col[c] = pl->diffuse_color[px * 3 + c];
-                col[3 + c] = pl->glossy_color[px * 3 + c];
-            }
-            col[6] = pl->coverage[px];
-        }
+        if (record)
+            keep_colour(plan, pl, px);
     }
     if (record)
         for (size_t y = (j->base + b0) / W; y < (j->base + e0) / W; ++y)
