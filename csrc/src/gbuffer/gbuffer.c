@@ -37,10 +37,33 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
     const v3 zero = v3_make(0.0f, 0.0f, 0.0f);
     if (m == 0 || m > VSGL__GBUFFER_BATCH)
         return;
-    for (uint32_t k = 0; k < m; ++k)
+    uint32_t k0 = 0;
+#if defined(__SSE2__)
+    for (; k0 + 4 <= m; k0 += 4) /* four rays at a time, the same as one by one */
+        vsgl__camera_ray4(&j->cam, rx + k0, ry + k0, org + k0, dir + k0, tmin + k0, tmax + k0);
+#endif
+    for (uint32_t k = k0; k < m; ++k)
         vsgl__camera_ray(&j->cam, rx[k], ry[k], &org[k], &dir[k], &tmin[k], &tmax[k]);
     vsgl__scene_intersect_many(j->scene, m, org, dir, tmin, tmax, 1, hit);
     for (uint32_t k = 0; k < m; ++k) {
+#if defined(__SSE2__)
+        if (!g->surf[0] && k % 4 == 0 && k + 4 <= m && hit[k].triangle != VSGL__HIT_NONE &&
+            hit[k + 1].triangle != VSGL__HIT_NONE && hit[k + 2].triangle != VSGL__HIT_NONE &&
+            hit[k + 3].triangle != VSGL__HIT_NONE) { /* four hits' surfaces at once (scene/surface4.c) */
+            vsgl_surface sf4[4];
+            vsgl__scene_surface4(j->scene, &hit[k], &dir[k], sf4);
+            for (uint32_t q = 0; q < 4; ++q) {
+                size_t i = dst[k + q];
+                store3(g->view, i, v3_neg(dir[k + q]));
+                store3(g->pos, i, sf4[q].position);
+                store3(g->nrm, i, sf4[q].normal);
+                store3(g->tan, i, sf4[q].tangent);
+                g->material[i] = sf4[q].material;
+            }
+            k += 3;
+            continue;
+        }
+#endif
         size_t i = dst[k];
         store3(g->view, i, v3_neg(dir[k]));
         if (hit[k].triangle == VSGL__HIT_NONE) {

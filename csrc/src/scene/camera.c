@@ -87,3 +87,43 @@ void vsgl__camera_ray(const vsgl_camera_model *m, float px, float py, v3 *org, v
     *tmin = m->clip_start * len;
     *tmax = m->clip_end * len;
 }
+
+#if defined(__SSE2__)
+#  include <emmintrin.h>
+
+void vsgl__camera_ray4(const vsgl_camera_model *m, const float *px, const float *py, v3 org[4], v3 dir[4],
+                       float tmin[4], float tmax[4])
+{
+    if (m->ortho) {
+        for (int k = 0; k < 4; ++k)
+            vsgl__camera_ray(m, px[k], py[k], &org[k], &dir[k], &tmin[k], &tmax[k]);
+        return;
+    }
+    /* vsgl__camera_ray's perspective branch, lane by lane the same operations */
+    const __m128 fx = _mm_div_ps(_mm_loadu_ps(px), _mm_set1_ps((float)m->width));
+    const __m128 fy = _mm_div_ps(_mm_loadu_ps(py), _mm_set1_ps((float)m->height));
+    const __m128 x = _mm_add_ps(_mm_set1_ps(m->left), _mm_mul_ps(fx, _mm_set1_ps(m->right_edge - m->left)));
+    const __m128 y = _mm_sub_ps(_mm_set1_ps(m->top), _mm_mul_ps(fy, _mm_set1_ps(m->top - m->bottom)));
+    const __m128 dx = _mm_add_ps(_mm_set1_ps(m->forward.x), _mm_add_ps(_mm_mul_ps(_mm_set1_ps(m->right.x), x),
+                                                                       _mm_mul_ps(_mm_set1_ps(m->up.x), y)));
+    const __m128 dy = _mm_add_ps(_mm_set1_ps(m->forward.y), _mm_add_ps(_mm_mul_ps(_mm_set1_ps(m->right.y), x),
+                                                                       _mm_mul_ps(_mm_set1_ps(m->up.y), y)));
+    const __m128 dz = _mm_add_ps(_mm_set1_ps(m->forward.z), _mm_add_ps(_mm_mul_ps(_mm_set1_ps(m->right.z), x),
+                                                                       _mm_mul_ps(_mm_set1_ps(m->up.z), y)));
+    const __m128 len = _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_set1_ps(1.0f)));
+    /* v3_normalize(d) */
+    const __m128 l = _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)));
+    const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(l, _mm_setzero_ps()), _mm_cmplt_ps(l, _mm_set1_ps(INFINITY)));
+    const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), l);
+    float D[3][4];
+    _mm_storeu_ps(D[0], _mm_and_ps(ok, _mm_mul_ps(dx, inv)));
+    _mm_storeu_ps(D[1], _mm_and_ps(ok, _mm_mul_ps(dy, inv)));
+    _mm_storeu_ps(D[2], _mm_and_ps(ok, _mm_mul_ps(dz, inv)));
+    _mm_storeu_ps(tmin, _mm_mul_ps(_mm_set1_ps(m->clip_start), len));
+    _mm_storeu_ps(tmax, _mm_mul_ps(_mm_set1_ps(m->clip_end), len));
+    for (int k = 0; k < 4; ++k) {
+        org[k] = m->origin;
+        dir[k] = v3_make(D[0][k], D[1][k], D[2][k]);
+    }
+}
+#endif

@@ -30,4 +30,11 @@ void vsgl__camera_model(const vsgl_camera *cam, vsgl_camera_model *out);
 void vsgl__camera_ray(const vsgl_camera_model *m, float px, float py, v3 *org, v3 *dir,
                       float *tmin, float *tmax);
 
+#if defined(__SSE2__)
+/* vsgl__camera_ray at raster positions (px[k], py[k]), k < 4, bit for bit
+ * (perspective in SSE2 lanes; orthographic one ray at a time). */
+void vsgl__camera_ray4(const vsgl_camera_model *m, const float *px, const float *py, v3 org[4], v3 dir[4],
+                       float tmin[4], float tmax[4]);
+#endif
+
 #endif

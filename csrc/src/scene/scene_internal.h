@@ -46,6 +46,10 @@ uint32_t vsgl__scene_source_triangle(const vsgl_scene *scene, uint32_t triangle)
 
 /* Surface attributes at a hit seen along ray direction dir. */
 void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, vsgl_surface *out);
+#if defined(__SSE2__)
+/* The same for four hits (every one a hit), bit for bit (scene/surface4.c). */
+void vsgl__scene_surface4(const vsgl_scene *scene, const vsgl_hit hit[4], const v3 dir[4], vsgl_surface out[4]);
+#endif
 
 /* Textures (scene/texture.h). A scene whose materials read textures or
  * corner colours is "textured": the stages then evaluate the material
