@@ -119,7 +119,8 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
             uint32_t m = (uint32_t)(n - b < VSGL__GBUFFER_BATCH ? n - b : VSGL__GBUFFER_BATCH);
             for (uint32_t k = 0; k < m; ++k) {
                 size_t idx = b + k;
-                uint32_t col = (uint32_t)(idx / grid), s = (uint32_t)(idx % grid);
+                /* (one sample per pixel: no integer division per sample) */
+                uint32_t col = grid == 1 ? (uint32_t)idx : (uint32_t)(idx / grid), s = grid == 1 ? 0u : (uint32_t)(idx % grid);
                 rx[k] = (float)col + ((float)(s % aa) + 0.5f) * inv;
                 ry[k] = (float)row + ((float)(s / aa) + 0.5f) * inv;
                 dst[k] = base + (size_t)col * spp + s;

@@ -540,17 +540,22 @@ static void record_cell4(sparse_batch *bt, size_t px, uint32_t ax, uint32_t ay, 
     const unsigned near = (unsigned)_mm_movemask_ps(_mm_cmpgt_ps(wsum, _mm_set1_ps(0.05f)));
     float out[6][4];
     const unsigned ok = vsgl__sparse_interp4(j, plan->pack, w4, ax, ay, tx, ty, out);
+    /* no anchor of the cell off a lane's surface: no junction (sparse_touching gives 0) in any lane */
+    const unsigned any_other = other_bits[0] | other_bits[1] | other_bits[2] | other_bits[3];
     for (unsigned k = 0; k < 4; ++k) {
         const size_t si = px + k, bi = si - bt->first;
-        unsigned same = 0, other = 0;
-        float d2k[4];
-        for (unsigned i = 0; i < 4; ++i) {
-            same |= (same_bits[i] >> k & 1u) << i;
-            other |= (other_bits[i] >> k & 1u) << i;
-            d2k[i] = ad2[i][k];
+        int junction = 0;
+        if (any_other >> k & 1u) {
+            unsigned same = 0, other = 0;
+            float d2k[4];
+            for (unsigned i = 0; i < 4; ++i) {
+                same |= (same_bits[i] >> k & 1u) << i;
+                other |= (other_bits[i] >> k & 1u) << i;
+                d2k[i] = ad2[i][k];
+            }
+            junction = sparse_junction(same, sparse_touching(same, other, d2k));
         }
-        plan->direct[si] =
-            near >> k & 1u && !sparse_junction(same, sparse_touching(same, other, d2k)) ? PLAN_NEAR : PLAN_ALONE;
+        plan->direct[si] = near >> k & 1u && !junction ? PLAN_NEAR : PLAN_ALONE;
         if (plan->direct[si] == PLAN_NEAR && ok >> k & 1u) {
             bt->direct_of[bi] = SIZE_MAX;
             for (int c = 0; c < 6; ++c)
