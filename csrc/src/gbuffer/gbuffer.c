@@ -31,8 +31,9 @@ static void store3(float *const a[3], size_t i, v3 v)
 void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const float *rx, const float *ry,
                         const size_t *dst, float foot)
 {
-    v3 org[VSGL__GBUFFER_BATCH] = {{0}}, dir[VSGL__GBUFFER_BATCH] = {{0}};
-    float tmin[VSGL__GBUFFER_BATCH] = {0}, tmax[VSGL__GBUFFER_BATCH] = {0};
+    /* not zeroed (2 KB per call): entries [0, m) are written by the camera rays before anything reads them */
+    v3 org[VSGL__GBUFFER_BATCH], dir[VSGL__GBUFFER_BATCH];
+    float tmin[VSGL__GBUFFER_BATCH], tmax[VSGL__GBUFFER_BATCH];
     vsgl_hit hit[VSGL__GBUFFER_BATCH];
     const v3 zero = v3_make(0.0f, 0.0f, 0.0f);
     if (m == 0 || m > VSGL__GBUFFER_BATCH)
