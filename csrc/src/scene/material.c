@@ -251,6 +251,18 @@ void vsgl__dielectric_albedo_table(const vsgl_material *m, vsgl_albedo_table *t)
     t->diffuse_power = (float)(2.0 * acc / 64.0);
 }
 
+void vsgl__ms_scale3(const vsgl_brdf_params *p, float cos_view, float out[3])
+{
+    if (!p->multiscatter) {
+        out[0] = out[1] = out[2] = 1.0f;
+        return;
+    }
+    float e1 = vsgl__ggx_white_albedo(sqrtf(sqrtf(p->alpha_x * p->alpha_y)), cos_view);
+    e1 = e1 > 0.05f ? e1 : 0.05f;
+    for (int c = 0; c < 3; ++c)
+        out[c] = 1.0f + p->fms[c] * (1.0f - e1) / e1;
+}
+
 float vsgl__ms_scale(const vsgl_brdf_params *p, int channel, float cos_view)
 {
     if (!p->multiscatter)

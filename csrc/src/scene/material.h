@@ -77,6 +77,8 @@ float vsgl__ggx_white_albedo_avg(float roughness);
  * not apply it (its two directions are symmetric); callers that know the
  * view direction do. */
 float vsgl__ms_scale(const vsgl_brdf_params *p, int channel, float cos_view);
+/* The three channels' vsgl__ms_scale at once (the albedo looked up once). */
+void vsgl__ms_scale3(const vsgl_brdf_params *p, float cos_view, float out[3]);
 
 /* GlossCol of Cycles for this material seen from wo: what the GlossInd pass
  * is divided by. Blender 3.x writes the specular closure's weight, i.e.

@@ -231,8 +231,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->glossy = r->bp.glossy && v3_dot(r->n, r->o) > 0.0f;
     if (!r->glossy)
         return;
-    for (int c = 0; c < 3; ++c)
-        r->ms[c] = vsgl__ms_scale(&r->bp, c, v3_dot(r->n, r->o));
+    vsgl__ms_scale3(&r->bp, v3_dot(r->n, r->o), r->ms);
     if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
         vsgl_sg ndf;
         vsgl_ndf_to_sg(&r->n, r->alpha, VSGL_NDF_GGX, &ndf);
