@@ -27,12 +27,33 @@ static v3 rand_dir(vt_rng *r)
     }
 }
 
+static void check_surface4(int with_uvs);
+
 VT_TEST(scene_surface4_equals_scene_surface_bit_for_bit)
+{
+    check_surface4(0);
+}
+
+/* with corner UVs: the tangent is dP/du where the UVs give one (random
+ * UVs; every fifth triangle's degenerate, det 0: the edge's tangent) */
+VT_TEST(scene_surface4_equals_scene_surface_with_uvs)
+{
+    check_surface4(1);
+}
+
+static void check_surface4(int with_uvs)
 {
     fx_scene fx;
     fx_room(&fx, 16, 12, 0.3f, 50.0f);
     fx.materials[2].anisotropy = 0.5f;
     fx.materials[2].anisotropic_rotation = 0.3f; /* the green wall: the scalar lanes */
+    if (with_uvs) /* rotated off the axes, so that no product in dP/du is exact by accident */
+        for (uint32_t i = 0; i < fx.vertex_count; ++i) {
+            float *p = fx.positions + i * 3, x = p[0], y = p[1], z = p[2];
+            p[0] = 0.8f * x - 0.6f * y;
+            p[1] = 0.48f * x + 0.64f * y - 0.6f * z;
+            p[2] = 0.36f * x + 0.48f * y + 0.8f * z;
+        }
     const vsgl_scene_desc *d0 = fx_desc(&fx);
     vsgl_scene_desc desc = *d0;
     static float cn[FX_MAX_TRIS * 9];
@@ -55,6 +76,12 @@ VT_TEST(scene_surface4_equals_scene_surface_bit_for_bit)
         }
     }
     desc.corner_normals = cn;
+    static float uvs[FX_MAX_TRIS * 6];
+    for (uint32_t t = 0; t < fx.triangle_count; ++t)
+        for (int c = 0; c < 6; ++c)
+            uvs[t * 6 + c] = t % 5 == 4 ? 0.25f : urand(&rng, -2.0f, 2.0f);
+    if (with_uvs)
+        desc.corner_uvs = uvs;
     vsgl_context *ctx = fx_context(1);
     vsgl_scene *scene = NULL;
     VT_REQUIRE(ctx && vsgl_scene_create(ctx, &desc, &scene) == VSGL_OK, "scene: %s",

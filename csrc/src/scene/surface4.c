@@ -1,13 +1,13 @@
 /* Surface attributes of four hits at once: vsgl__scene_surface (raytrace.c)
  * in SSE2 lanes, for the camera G-buffer (a camera edit of the live
  * viewport computes them for every pixel). Its chain of a normalised
- * shading normal and a tangent from the triangle's first edge (two square
- * roots and two divisions per hit, each waiting on the last) runs for four
- * hits side by side. Every lane does the same operations in the same
+ * shading normal and a tangent (dP/du from the corner UVs, else from the
+ * triangle's first edge: square roots and divisions, each waiting on the
+ * last) runs for four hits side by side. Every lane does the same operations in the same
  * order as the scalar function, so the results are bit for bit the same
  * (tests/c/test_surface4.c); a lane that leaves the common path (its
  * tangent degenerate, an anisotropic rotation) and scenes with corner
- * tangents or UVs take the scalar function. */
+ * tangents (exported for anisotropic materials) take the scalar function. */
 #include "scene/scene_data.h"
 
 #if defined(__SSE2__)
@@ -63,9 +63,18 @@ static inline __m128 select4(__m128 mask, __m128 a, __m128 b)
     return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
 }
 
+/* orthogonalize(t, n): the component of t orthogonal to unit n, normalised (raytrace.c). */
+static inline v3x4 orthogonalize4(v3x4 t, v3x4 n)
+{
+    const __m128 d = dot4(n, t);
+    const v3x4 o = {_mm_sub_ps(t.x, _mm_mul_ps(n.x, d)), _mm_sub_ps(t.y, _mm_mul_ps(n.y, d)),
+                    _mm_sub_ps(t.z, _mm_mul_ps(n.z, d))};
+    return normalize4(o);
+}
+
 void vsgl__scene_surface4(const vsgl_scene *scene, const vsgl_hit hit[4], const v3 dir[4], vsgl_surface out[4])
 {
-    if (scene->corner_tangents || scene->corner_uvs) {
+    if (scene->corner_tangents) {
         for (int k = 0; k < 4; ++k)
             vsgl__scene_surface(scene, &hit[k], dir[k], &out[k]);
         return;
@@ -97,12 +106,36 @@ void vsgl__scene_surface4(const vsgl_scene *scene, const vsgl_hit hit[4], const 
     const __m128 flip = _mm_and_ps(_mm_cmpgt_ps(dot4(ng, d), _mm_setzero_ps()), _mm_set1_ps(-0.0f));
     ng.x = _mm_xor_ps(ng.x, flip), ng.y = _mm_xor_ps(ng.y, flip), ng.z = _mm_xor_ps(ng.z, flip);
     n.x = _mm_xor_ps(n.x, flip), n.y = _mm_xor_ps(n.y, flip), n.z = _mm_xor_ps(n.z, flip);
-    /* orthogonalize(p1 - p0, n): no corner tangents nor UVs */
+    /* no corner tangents: dP/du from the UVs where they give one, else orthogonalize(p1 - p0, n) */
     const v3x4 e = {_mm_sub_ps(p1.x, p0.x), _mm_sub_ps(p1.y, p0.y), _mm_sub_ps(p1.z, p0.z)};
-    const __m128 en = dot4(n, e);
-    const v3x4 to = {_mm_sub_ps(e.x, _mm_mul_ps(n.x, en)), _mm_sub_ps(e.y, _mm_mul_ps(n.y, en)),
-                     _mm_sub_ps(e.z, _mm_mul_ps(n.z, en))};
-    const v3x4 t = normalize4(to);
+    v3x4 t = orthogonalize4(e, n);
+    if (scene->corner_uvs) {
+        const float *uv[4];
+        for (int k = 0; k < 4; ++k)
+            uv[k] = scene->corner_uvs + (size_t)tri[k] * 6;
+        const __m128 u0 = _mm_setr_ps(uv[0][0], uv[1][0], uv[2][0], uv[3][0]),
+                     v0 = _mm_setr_ps(uv[0][1], uv[1][1], uv[2][1], uv[3][1]);
+        const __m128 du1 = _mm_sub_ps(_mm_setr_ps(uv[0][2], uv[1][2], uv[2][2], uv[3][2]), u0),
+                     dv1 = _mm_sub_ps(_mm_setr_ps(uv[0][3], uv[1][3], uv[2][3], uv[3][3]), v0),
+                     du2 = _mm_sub_ps(_mm_setr_ps(uv[0][4], uv[1][4], uv[2][4], uv[3][4]), u0),
+                     dv2 = _mm_sub_ps(_mm_setr_ps(uv[0][5], uv[1][5], uv[2][5], uv[3][5]), v0);
+        const __m128 det = _mm_sub_ps(_mm_mul_ps(du1, dv2), _mm_mul_ps(du2, dv1));
+        const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), det);
+        /* det != 0 && isfinite(1 / det) */
+        const __m128 ok = _mm_and_ps(_mm_cmpneq_ps(det, _mm_setzero_ps()),
+                                     _mm_cmplt_ps(_mm_and_ps(inv, _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff))),
+                                                  _mm_set1_ps(INFINITY)));
+        const v3x4 e2 = {_mm_sub_ps(p2.x, p0.x), _mm_sub_ps(p2.y, p0.y), _mm_sub_ps(p2.z, p0.z)};
+        const v3x4 dpdu = {_mm_mul_ps(_mm_sub_ps(_mm_mul_ps(e.x, dv2), _mm_mul_ps(e2.x, dv1)), inv),
+                           _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(e.y, dv2), _mm_mul_ps(e2.y, dv1)), inv),
+                           _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(e.z, dv2), _mm_mul_ps(e2.z, dv1)), inv)};
+        v3x4 tu = orthogonalize4(dpdu, n);
+        tu.x = _mm_and_ps(ok, tu.x), tu.y = _mm_and_ps(ok, tu.y), tu.z = _mm_and_ps(ok, tu.z);
+        const __m128 from_edge = is_zero4(tu); /* no usable UVs, or dP/du along n */
+        t.x = select4(from_edge, t.x, tu.x);
+        t.y = select4(from_edge, t.y, tu.y);
+        t.z = select4(from_edge, t.z, tu.z);
+    }
     const unsigned scalar = (unsigned)_mm_movemask_ps(is_zero4(t)); /* v3_basis: the scalar function */
     float f[12][4];
     _mm_storeu_ps(f[0], pos.x), _mm_storeu_ps(f[1], pos.y), _mm_storeu_ps(f[2], pos.z);
