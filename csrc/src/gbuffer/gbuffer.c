@@ -28,6 +28,35 @@ static void store3(float *const a[3], size_t i, v3 v)
     a[2][i] = v.z;
 }
 
+/* Sample i's surface sf seen along the ray of batch entry k, with its
+ * material inputs in a textured G-buffer (textures filtered over the
+ * sample's footprint, foot pixels a side, at the hit, on the surface). */
+static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_surface *sf, float rx, float ry, v3 org,
+                      v3 dir, const vsgl_hit *hit, float foot)
+{
+    store3(g->view, i, v3_neg(dir));
+    store3(g->pos, i, sf->position);
+    store3(g->nrm, i, sf->normal);
+    store3(g->tan, i, sf->tangent);
+    g->material[i] = sf->material;
+    if (!g->surf[0])
+        return;
+    v3 o1, d1, o2, d2;
+    float t0, t1;
+    vsgl__camera_ray(&j->cam, rx + foot, ry, &o1, &d1, &t0, &t1);
+    vsgl__camera_ray(&j->cam, rx, ry + foot, &o2, &d2, &t0, &t1);
+    float t = hit->t;
+    v3 p0 = v3_add(org, v3_scale(dir, t));
+    v3 ex = v3_sub(v3_add(o1, v3_scale(d1, t)), p0), ey = v3_sub(v3_add(o2, v3_scale(d2, t)), p0);
+    v3 cr = v3_cross(ex, ey);
+    float cs = fabsf(v3_dot(sf->geometric_normal, dir));
+    float area = sqrtf(v3_dot(cr, cr)) / fmaxf(cs, 0.02f);
+    float in[VSGL__SURF_N];
+    vsgl__scene_inputs(j->scene, hit, area, in);
+    for (int q = 0; q < VSGL__SURF_N; ++q)
+        g->surf[q][i] = in[q];
+}
+
 void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const float *rx, const float *ry,
                         const size_t *dst, float foot)
 {
@@ -48,26 +77,20 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
     vsgl__scene_intersect_many(j->scene, m, org, dir, tmin, tmax, 1, hit);
     for (uint32_t k = 0; k < m; ++k) {
 #if defined(__SSE2__)
-        if (!g->surf[0] && k % 4 == 0 && k + 4 <= m && hit[k].triangle != VSGL__HIT_NONE &&
-            hit[k + 1].triangle != VSGL__HIT_NONE && hit[k + 2].triangle != VSGL__HIT_NONE &&
+        if (k % 4 == 0 && k + 4 <= m && hit[k].triangle != VSGL__HIT_NONE && hit[k + 1].triangle != VSGL__HIT_NONE &&
+            hit[k + 2].triangle != VSGL__HIT_NONE &&
             hit[k + 3].triangle != VSGL__HIT_NONE) { /* four hits' surfaces at once (scene/surface4.c) */
             vsgl_surface sf4[4];
             vsgl__scene_surface4(j->scene, &hit[k], &dir[k], sf4);
-            for (uint32_t q = 0; q < 4; ++q) {
-                size_t i = dst[k + q];
-                store3(g->view, i, v3_neg(dir[k + q]));
-                store3(g->pos, i, sf4[q].position);
-                store3(g->nrm, i, sf4[q].normal);
-                store3(g->tan, i, sf4[q].tangent);
-                g->material[i] = sf4[q].material;
-            }
+            for (uint32_t q = 0; q < 4; ++q)
+                store_hit(j, g, dst[k + q], &sf4[q], rx[k + q], ry[k + q], org[k + q], dir[k + q], &hit[k + q], foot);
             k += 3;
             continue;
         }
 #endif
         size_t i = dst[k];
-        store3(g->view, i, v3_neg(dir[k]));
         if (hit[k].triangle == VSGL__HIT_NONE) {
+            store3(g->view, i, v3_neg(dir[k]));
             store3(g->pos, i, zero);
             store3(g->nrm, i, zero);
             store3(g->tan, i, zero);
@@ -79,27 +102,7 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
         }
         vsgl_surface sf;
         vsgl__scene_surface(j->scene, &hit[k], dir[k], &sf);
-        store3(g->pos, i, sf.position);
-        store3(g->nrm, i, sf.normal);
-        store3(g->tan, i, sf.tangent);
-        g->material[i] = sf.material;
-        if (g->surf[0]) {
-            /* the sample's footprint (foot pixels a side) at the hit, on the surface */
-            v3 o1, d1, o2, d2;
-            float t0, t1;
-            vsgl__camera_ray(&j->cam, rx[k] + foot, ry[k], &o1, &d1, &t0, &t1);
-            vsgl__camera_ray(&j->cam, rx[k], ry[k] + foot, &o2, &d2, &t0, &t1);
-            float t = hit[k].t;
-            v3 p0 = v3_add(org[k], v3_scale(dir[k], t));
-            v3 ex = v3_sub(v3_add(o1, v3_scale(d1, t)), p0), ey = v3_sub(v3_add(o2, v3_scale(d2, t)), p0);
-            v3 cr = v3_cross(ex, ey);
-            float cs = fabsf(v3_dot(sf.geometric_normal, dir[k]));
-            float area = sqrtf(v3_dot(cr, cr)) / fmaxf(cs, 0.02f);
-            float in[VSGL__SURF_N];
-            vsgl__scene_inputs(j->scene, &hit[k], area, in);
-            for (int q = 0; q < VSGL__SURF_N; ++q)
-                g->surf[q][i] = in[q];
-        }
+        store_hit(j, g, i, &sf, rx[k], ry[k], org[k], dir[k], &hit[k], foot);
     }
 }
 
