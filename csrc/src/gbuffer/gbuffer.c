@@ -28,23 +28,21 @@ static void store3(float *const a[3], size_t i, v3 v)
     a[2][i] = v.z;
 }
 
-/* Sample i's surface sf seen along the ray of batch entry k, with its
- * material inputs in a textured G-buffer (textures filtered over the
- * sample's footprint, foot pixels a side, at the hit, on the surface). */
-static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_surface *sf, float rx, float ry, v3 org,
-                      v3 dir, const vsgl_hit *hit, float foot)
+/* Sample i's surface sf seen along the ray (org, dir), with its material
+ * inputs in a textured G-buffer: textures filtered over the sample's
+ * footprint at the hit, on the surface, from the rays fr = (o1, d1, o2, d2)
+ * one footprint (foot pixels) to the right and down (NULL if untextured). */
+static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_surface *sf, v3 org, v3 dir,
+                      const vsgl_hit *hit, const v3 *fr)
 {
     store3(g->view, i, v3_neg(dir));
     store3(g->pos, i, sf->position);
     store3(g->nrm, i, sf->normal);
     store3(g->tan, i, sf->tangent);
     g->material[i] = sf->material;
-    if (!g->surf[0])
+    if (!g->surf[0] || !fr)
         return;
-    v3 o1, d1, o2, d2;
-    float t0, t1;
-    vsgl__camera_ray(&j->cam, rx + foot, ry, &o1, &d1, &t0, &t1);
-    vsgl__camera_ray(&j->cam, rx, ry + foot, &o2, &d2, &t0, &t1);
+    const v3 o1 = fr[0], d1 = fr[1], o2 = fr[2], d2 = fr[3];
     float t = hit->t;
     v3 p0 = v3_add(org, v3_scale(dir, t));
     v3 ex = v3_sub(v3_add(o1, v3_scale(d1, t)), p0), ey = v3_sub(v3_add(o2, v3_scale(d2, t)), p0);
@@ -82,8 +80,18 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
             hit[k + 3].triangle != VSGL__HIT_NONE) { /* four hits' surfaces at once (scene/surface4.c) */
             vsgl_surface sf4[4];
             vsgl__scene_surface4(j->scene, &hit[k], &dir[k], sf4);
+            v3 o1[4], d1[4], o2[4], d2[4], fr[4][4];
+            if (g->surf[0]) { /* the footprint's rays */
+                float t0[4], t1[4], rxf[4], ryf[4];
+                for (uint32_t q = 0; q < 4; ++q)
+                    rxf[q] = rx[k + q] + foot, ryf[q] = ry[k + q] + foot;
+                vsgl__camera_ray4(&j->cam, rxf, ry + k, o1, d1, t0, t1);
+                vsgl__camera_ray4(&j->cam, rx + k, ryf, o2, d2, t0, t1);
+                for (uint32_t q = 0; q < 4; ++q)
+                    fr[q][0] = o1[q], fr[q][1] = d1[q], fr[q][2] = o2[q], fr[q][3] = d2[q];
+            }
             for (uint32_t q = 0; q < 4; ++q)
-                store_hit(j, g, dst[k + q], &sf4[q], rx[k + q], ry[k + q], org[k + q], dir[k + q], &hit[k + q], foot);
+                store_hit(j, g, dst[k + q], &sf4[q], org[k + q], dir[k + q], &hit[k + q], g->surf[0] ? fr[q] : NULL);
             k += 3;
             continue;
         }
@@ -102,7 +110,13 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
         }
         vsgl_surface sf;
         vsgl__scene_surface(j->scene, &hit[k], dir[k], &sf);
-        store_hit(j, g, i, &sf, rx[k], ry[k], org[k], dir[k], &hit[k], foot);
+        v3 fr[4];
+        if (g->surf[0]) { /* the footprint's rays */
+            float t0, t1;
+            vsgl__camera_ray(&j->cam, rx[k] + foot, ry[k], &fr[0], &fr[1], &t0, &t1);
+            vsgl__camera_ray(&j->cam, rx[k], ry[k] + foot, &fr[2], &fr[3], &t0, &t1);
+        }
+        store_hit(j, g, i, &sf, org[k], dir[k], &hit[k], g->surf[0] ? fr : NULL);
     }
 }
 
