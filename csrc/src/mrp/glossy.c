@@ -4,6 +4,7 @@
  * quadrature of the exact BRDF over the rectangle (tests/c/test_mrp_glossy.c). */
 #include "mrp/mrp.h"
 #include "mrp/geom.h"
+#include "math/asg_internal.h"
 #include "math/constants.h"
 #include "vsgl/lobes.h"
 #include "shade/kernel.h"
@@ -118,7 +119,12 @@ static double glossy_lobe(const vsgl__mrp_rect *rc, d3 x, double h, const vsgl_s
     } else if (opt->receiver_asg) {                        /* ASG x ASG (Xu Eq. 13), integrated */
         vsgl_asg prod;
         vsgl_asg_product(&light, ra, &prod);
-        v = vsgl_asg_integral(&prod);
+        /* vsgl_asg_integral, its float included (the product's frame is orthonormal, or its
+         * amplitude 0), with the faster unit integral */
+        v = prod.log_amplitude == -INFINITY
+                ? 0.0
+                : (float)(exp((double)prod.log_amplitude) *
+                          vsgl__mrp_asg_integral_unit(vsgl__asg_clamp_bw(prod.lambda), vsgl__asg_clamp_bw(prod.mu)));
     } else {
         v = vsgl__mrp_convolve(&light, g);                 /* Eq. 11 */
     }

@@ -103,6 +103,13 @@ double vsgl__mrp_disk_radiance(double overlap, double k, double t, double L_y);
  * l -> 0. */
 double vsgl__mrp_bandwidth(double l);
 
+/* The integral of the unit ASG (vsgl__asg_integral_unit) within 1e-9 of
+ * it, faster: for min(lambda, mu) >= VSGL__ASG_EQ10_MIN_MU Eq. 10's small
+ * second term (<= e^{-min} sqrt(max / min) of the first) with a polynomial
+ * Bessel function, and none where it is below 2^-54 of the first (the
+ * same double); vsgl__asg_integral_unit below. */
+double vsgl__mrp_asg_integral_unit(double lambda, double mu);
+
 /* How the ASG light's amplitude is normalised (Eq. 33-35). */
 #define VSGL__MRP_NORM_PAPER 0 /* Eq. 34-35: t = sqrt(lambda mu) C / pi (0 when a bandwidth is 0) */
 #define VSGL__MRP_NORM_EXACT 1 /* t = C / (exact integral of the unit ASG), finite for any bandwidths */
