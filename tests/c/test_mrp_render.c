@@ -200,7 +200,7 @@ VT_TEST(mrp_render_spot_metal_floor_against_brute_force)
                 size_t np = 0;
                 double t0 = now();
                 VT_CHECK(vsgl__mrp_glossy_pass(ctx, scene, s.rsm_resolution, VSGL__MRP_MIN_AREA, cells[c], &g, &planes,
-                                               &np) == VSGL_OK, "pass");
+                                               &np, NULL) == VSGL_OK, "pass");
                 printf("      MRP pass, %2u cells: relMSE %.4f  sum ratio %.3f  %.3f s (%zu proxies)\n", cells[c],
                        relmse(pl, ref, n), ratio(pl, ref, n), now() - t0, np);
             }
@@ -356,6 +356,58 @@ VT_TEST(mrp_hybrid_rule_against_asg2_and_mrp)
         vsgl_scene_destroy(scene);
     }
     free(buf);
+    vsgl_context_destroy(ctx);
+}
+
+/* MRP and the hybrid take each light's RSM as the fit builds it (render.c,
+ * vsgl__fit_lights_mrp); when the fit comes from a render cache the pass
+ * builds its own RSMs, as before. Both glossy planes bit-identical, and
+ * not black (a lost RSM would leave the proxies dark). */
+VT_TEST(mrp_pass_takes_the_fits_rsms_bit_identically)
+{
+    const uint32_t w = 40, h = 30;
+    const size_t n = (size_t)w * h * 3;
+    fx_scene fx;
+    metal_floor_room(&fx, w, h, 0.2f);
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    vsgl_render_cache *cache = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+    float *a = calloc(2 * n, sizeof(float)), *b = a ? a + n : NULL;
+    VT_REQUIRE(a, "memory");
+    const int modes[2] = {VSGL_GLOSSY_MRP, VSGL_GLOSSY_HYBRID};
+    for (int m = 0; m < 2; ++m) {
+        VT_REQUIRE(vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.aa_samples = 1;
+        s.rsm_resolution = 64;
+        s.glossy_mode = modes[m];
+        vsgl_render_output out;
+        memset(&out, 0, sizeof out);
+        out.width = w;
+        out.height = h;
+        vsgl_render_stats st;
+        memset(&st, 0, sizeof st);
+        st.size = sizeof st;
+        out.glossy = a; /* the fit's RSMs */
+        VT_CHECK(vsgl_render_cached(ctx, scene, &s, cache, &out, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_CHECK(st.reused == 0, "first render: reused %u", st.reused);
+        out.glossy = b; /* the fit from the cache: the pass's own RSMs */
+        VT_CHECK(vsgl_render_cached(ctx, scene, &s, cache, &out, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_CHECK(st.reused & VSGL_REUSED_FIT, "second render: reused %u", st.reused);
+        double sum = 0.0;
+        size_t diff = 0;
+        for (size_t i = 0; i < n; ++i) {
+            sum += a[i];
+            diff += a[i] != b[i];
+        }
+        VT_CHECK(diff == 0 && sum > 0.0, "mode %d: %zu values differ (glossy sum %g)", (int)modes[m], diff, sum);
+        vsgl_render_cache_destroy(cache);
+    }
+    free(a);
+    vsgl_scene_destroy(scene);
     vsgl_context_destroy(ctx);
 }
 

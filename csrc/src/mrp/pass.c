@@ -11,12 +11,12 @@
  * (hybrid: glossy_q the VSGL glossy of the clusters off the proxies). */
 static vsgl_result run_pass(vsgl_context *ctx, const vsgl_scene *scene, uint32_t rsm_resolution,
                             vsgl__mrp_proxy_set *set, const vsgl_gbuffer *g, const vsgl_pixel_planes *planes,
-                            const float *glossy_q)
+                            const float *glossy_q, int lit)
 {
     vsgl_result r = VSGL_OK;
     uint32_t light_count = 0;
     (void)vsgl__scene_lights(scene, &light_count);
-    for (uint32_t l = 0; l < light_count && r == VSGL_OK && set->count; ++l) {
+    for (uint32_t l = 0; l < light_count && r == VSGL_OK && set->count && !lit; ++l) {
         const vsgl_light *L = &vsgl__scene_lights(scene, &light_count)[l];
         if (!(L->power * (L->color[0] + L->color[1] + L->color[2]) > 0.0f))
             continue;
@@ -40,16 +40,17 @@ static vsgl_result run_pass(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
 
 vsgl_result vsgl__mrp_glossy_pass(vsgl_context *ctx, const vsgl_scene *scene, uint32_t rsm_resolution,
                                   double min_area, uint32_t cells, const vsgl_gbuffer *g,
-                                  const vsgl_pixel_planes *planes, size_t *proxies)
+                                  const vsgl_pixel_planes *planes, size_t *proxies, vsgl__mrp_proxy_set *lit)
 {
-    vsgl__mrp_proxy_set set;
-    vsgl_result r = vsgl__mrp_proxies_build(ctx, scene, min_area, cells, &set);
+    vsgl__mrp_proxy_set own, *set = lit ? lit : &own;
+    vsgl_result r = lit ? VSGL_OK : vsgl__mrp_proxies_build(ctx, scene, min_area, cells, &own);
     if (r != VSGL_OK)
         return r;
     if (proxies)
-        *proxies = set.count;
-    r = run_pass(ctx, scene, rsm_resolution, &set, g, planes, NULL);
-    vsgl__mrp_proxies_free(&set);
+        *proxies = set->count;
+    r = run_pass(ctx, scene, rsm_resolution, set, g, planes, NULL, lit != NULL);
+    if (!lit)
+        vsgl__mrp_proxies_free(&own);
     return r;
 }
 
@@ -71,11 +72,13 @@ int vsgl__mrp_on_proxy(const vsgl__mrp_proxy_set *set, const vsgl_vsgl *v)
 
 vsgl_result vsgl__mrp_hybrid_pass(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                                   const vsgl_gbuffer *g, const vsgl_vsgl_set *vsgls, const vsgl_pixel_planes *planes,
-                                  size_t *excluded)
+                                  size_t *excluded, vsgl__mrp_proxy_set *lit)
 {
-    vsgl__mrp_proxy_set set;
-    vsgl_result r = vsgl__mrp_proxies_build(ctx, scene, s->mrp_min_area > 0.0f ? (double)s->mrp_min_area : VSGL__MRP_MIN_AREA,
-                                            VSGL__MRP_CELLS, &set);
+    vsgl__mrp_proxy_set own, *sp = lit ? lit : &own;
+    vsgl_result r = lit ? VSGL_OK
+                        : vsgl__mrp_proxies_build(ctx, scene,
+                                                  s->mrp_min_area > 0.0f ? (double)s->mrp_min_area : VSGL__MRP_MIN_AREA,
+                                                  VSGL__MRP_CELLS, &own);
     if (r != VSGL_OK)
         return r;
     size_t pixels = (size_t)g->width * g->height;
@@ -87,7 +90,7 @@ vsgl_result vsgl__mrp_hybrid_pass(vsgl_context *ctx, const vsgl_scene *scene, co
         r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "mrp: out of memory for %zu pixels", pixels);
     /* the VSGLs off every proxy: their glossy light goes with MRP's in the pixels MRP takes */
     for (size_t k = 0; k < vsgls->count && r == VSGL_OK; ++k) {
-        if (vsgl__mrp_on_proxy(&set, &vsgls->items[k]))
+        if (vsgl__mrp_on_proxy(sp, &vsgls->items[k]))
             ++off;
         else
             r = vsgl__vsgl_set_push(&q, &vsgls->items[k]);
@@ -100,9 +103,10 @@ vsgl_result vsgl__mrp_hybrid_pass(vsgl_context *ctx, const vsgl_scene *scene, co
         r = vsgl__shade_planned(ctx, scene, g, &q, s, &pq, VSGL__SHADE_KERNEL, &pairs, NULL);
     }
     if (r == VSGL_OK)
-        r = run_pass(ctx, scene, s->rsm_resolution, &set, g, planes, pq.glossy);
+        r = run_pass(ctx, scene, s->rsm_resolution, sp, g, planes, pq.glossy, lit != NULL);
     vsgl__vsgl_set_free(&q);
     free(buf);
-    vsgl__mrp_proxies_free(&set);
+    if (!lit)
+        vsgl__mrp_proxies_free(&own);
     return r;
 }

@@ -103,18 +103,24 @@ int vsgl__mrp_on_proxy(const vsgl__mrp_proxy_set *set, const vsgl_vsgl *v);
  * radiance, then vsgl__mrp_shade_glossy into planes->glossy. Writes the
  * proxy count to *proxies (may be NULL). Reports progress as stage "mrp"
  * (after each light's RSM and after shading); a cancel there returns
- * VSGL_ERROR_CANCELLED. */
+ * VSGL_ERROR_CANCELLED.
+ * @p lit (may be NULL): proxies built with the same @p min_area and
+ * @p cells to which every light's RSM at @p rsm_resolution was already
+ * added (vsgl__mrp_proxies_add_rsm, as the fit builds them:
+ * vsgl__fit_lights_mrp); the pass then builds neither proxies nor RSMs and
+ * finishes and shades @p lit (the caller frees it). The same planes. */
 vsgl_result vsgl__mrp_glossy_pass(vsgl_context *ctx, const vsgl_scene *scene, uint32_t rsm_resolution,
                                   double min_area, uint32_t cells, const vsgl_gbuffer *g,
-                                  const vsgl_pixel_planes *planes, size_t *proxies);
+                                  const vsgl_pixel_planes *planes, size_t *proxies, vsgl__mrp_proxy_set *lit);
 
 /* VSGL_GLOSSY_HYBRID: planes holds the VSGL pass of @p vsgls (two-lobe
  * glossy). Builds the proxies, shades the VSGLs off every proxy again into
  * a scratch plane (their glossy light; *excluded receives the number left
  * out, may be NULL) and runs the MRP pass with the hybrid rule of
- * vsgl__mrp_shade_glossy. */
+ * vsgl__mrp_shade_glossy. @p lit: as for vsgl__mrp_glossy_pass (its proxies
+ * of the settings' mrp_min_area, VSGL__MRP_CELLS cells), or NULL. */
 vsgl_result vsgl__mrp_hybrid_pass(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                                   const vsgl_gbuffer *g, const vsgl_vsgl_set *vsgls, const vsgl_pixel_planes *planes,
-                                  size_t *excluded);
+                                  size_t *excluded, vsgl__mrp_proxy_set *lit);
 
 #endif

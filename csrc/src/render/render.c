@@ -222,6 +222,14 @@ static size_t drop_negligible_specular(vsgl_vsgl_set *set, size_t first, double 
 vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                              vsgl_vsgl_set *set, vsgl_render_stats *st)
 {
+    return vsgl__fit_lights_mrp(ctx, scene, s, set, st, NULL, NULL);
+}
+
+vsgl_result vsgl__fit_lights_mrp(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
+                                 vsgl_vsgl_set *set, vsgl_render_stats *st, vsgl__mrp_proxy_set *mrp, int *mrp_lit)
+{
+    if (mrp_lit)
+        *mrp_lit = mrp != NULL;
     uint32_t light_count = 0;
     (void)vsgl__scene_lights(scene, &light_count);
     vsgl_light_share *shares = NULL;
@@ -242,6 +250,12 @@ vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const v
             break;
         if (!lit)
             continue;
+        if (mrp && mrp_lit && *mrp_lit) { /* the MRP pass's proxies take this RSM's light (before the fit) */
+            if (ls.rsm_resolution == s->rsm_resolution)
+                vsgl__mrp_proxies_add_rsm(mrp, scene, &rsm);
+            else
+                *mrp_lit = 0; /* the auto budget's own RSM size: the MRP pass builds its own */
+        }
         double t0 = now_seconds();
         size_t before = set->count;
         switch (s->fit_mode) {
@@ -520,6 +534,9 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     vsgl__progress_window(ctx, 0.0f, 0.1f);
     const vsgl_gbuffer *gb = &g; /* the cache's, or this render's own */
     int built_g = 0, built_set = 0;
+    vsgl__mrp_proxy_set mrp_set; /* MRP, hybrid: the proxies, lit by the fit's RSMs when mrp_lit */
+    memset(&mrp_set, 0, sizeof mrp_set);
+    int has_mrp_set = 0, mrp_lit = 0;
     vsgl_shade_plan *plan = NULL; /* the shading plan recorded for a G-buffer this render builds */
     if (vsgl__cache_gbuffer_hit(cache, scene, s.aa_samples, s.edge_samples)) {
         gb = &cache->g;
@@ -554,7 +571,17 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
             memcpy(st.skipped, cache->f_skipped, sizeof st.skipped);
             memcpy(st.budget, cache->f_budget, sizeof st.budget);
         } else {
-            r = vsgl__fit_lights(ctx, scene, &s, &set, &st);
+            /* MRP and the hybrid: the proxies take each light's RSM as the fit builds it (their
+             * pass would build every RSM again) */
+            if (s.glossy_mode == VSGL_GLOSSY_MRP || s.glossy_mode == VSGL_GLOSSY_HYBRID) {
+                double area = s.glossy_mode == VSGL_GLOSSY_MRP ? (double)s.mrp_min_area
+                              : s.mrp_min_area > 0.0f           ? (double)s.mrp_min_area
+                                                                : VSGL__MRP_MIN_AREA;
+                r = vsgl__mrp_proxies_build(ctx, scene, area, VSGL__MRP_CELLS, &mrp_set);
+                has_mrp_set = r == VSGL_OK;
+            }
+            if (r == VSGL_OK)
+                r = vsgl__fit_lights_mrp(ctx, scene, &s, &set, &st, has_mrp_set ? &mrp_set : NULL, &mrp_lit);
             built_set = 1;
         }
         st.vsgl_count = (uint32_t)vs->count;
@@ -566,9 +593,9 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
                                     !cache ? NULL : built_g ? &plan : &cache->plan);
             if (r == VSGL_OK && s.glossy_mode == VSGL_GLOSSY_MRP) /* the glossy plane from rectangle proxies */
                 r = vsgl__mrp_glossy_pass(ctx, scene, s.rsm_resolution, s.mrp_min_area, VSGL__MRP_CELLS, gb,
-                                          &planes, NULL);
+                                          &planes, NULL, mrp_lit ? &mrp_set : NULL);
             else if (r == VSGL_OK && s.glossy_mode == VSGL_GLOSSY_HYBRID) /* MRP per pixel where it applies */
-                r = vsgl__mrp_hybrid_pass(ctx, scene, &s, gb, vs, &planes, NULL);
+                r = vsgl__mrp_hybrid_pass(ctx, scene, &s, gb, vs, &planes, NULL, mrp_lit ? &mrp_set : NULL);
             st.seconds_shade = now_seconds() - t0;
         }
     }
@@ -584,6 +611,8 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
                       "the indirect light is black", light_count);
     }
 done:
+    if (has_mrp_set)
+        vsgl__mrp_proxies_free(&mrp_set);
     vsgl__progress_window(ctx, 0.0f, 1.0f);
     if (own_buf)
         free(buf);

@@ -24,6 +24,16 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
 vsgl_result vsgl__fit_lights(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
                              vsgl_vsgl_set *set, vsgl_render_stats *st);
 
+/* vsgl__fit_lights, and each light's RSM also added to the MRP proxies
+ * @p mrp (vsgl__mrp_proxies_add_rsm, before its fit; may be NULL): *mrp_lit
+ * is 1 when every lit light's RSM was (its size the settings'
+ * rsm_resolution, as the MRP pass would build it), else 0 (the auto
+ * budget gave a light another size: the pass builds its own RSMs). */
+struct vsgl__mrp_proxy_set;
+vsgl_result vsgl__fit_lights_mrp(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s,
+                                 vsgl_vsgl_set *set, vsgl_render_stats *st, struct vsgl__mrp_proxy_set *mrp,
+                                 int *mrp_lit);
+
 /* What a vsgl_render_cache holds (render_cache.c). */
 struct vsgl_render_cache {
     int has_g;                   /* the G-buffer of g_scene seen by g_camera with g_aa, g_edge_aa */
