@@ -258,9 +258,9 @@ VT_TEST(mrp_render_off_centre_patch_against_brute_force)
     double e = relmse(mr, ref, n), q = ratio(mr, ref, n);
     if (tables())
         printf("    off-centre patch: MRP glossy relMSE %.4f against the brute force, sum ratio %.3f\n", e, q);
-    /* measured 0.099, sum 0.949 (RSM 64: the brute force's own VPLs are coarse); the mirrored cells
-     * gave 0.60, sum 0.69 */
-    VT_CHECK(e < 0.2 && q > 0.85 && q < 1.15, "MRP relMSE %g, sum ratio %g against the brute force", e, q);
+    /* measured 0.098, sum 0.927 (RSM 64: the brute force's own VPLs are coarse; the lobes' reach
+     * e^{-6}: e^{-9} gave 0.929, e^{-1.5} 0.864); the mirrored cells gave 0.60, sum 0.69 */
+    VT_CHECK(e < 0.2 && q > 0.91 && q < 1.15, "MRP relMSE %g, sum ratio %g against the brute force", e, q);
     vsgl_scene_destroy(scene);
     free(buf);
     vsgl_context_destroy(ctx);

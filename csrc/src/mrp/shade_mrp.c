@@ -17,10 +17,13 @@
 #ifndef VSGL__MRP_CULL
 #define VSGL__MRP_CULL 1
 #endif
-/* A lobe reaches the cells where its ASG exponent is at most this (e^{-9}
- * of its peak: 1e-4 of a 2-D Gaussian's energy lies beyond). */
+/* A lobe reaches the cells where its ASG exponent is at most this (e^{-6}
+ * of its peak: 0.25 % of a 2-D Gaussian's energy lies beyond). e^{-9}
+ * (1e-4) took 1.35x the lobe terms on the quality suite's metal floors for
+ * the same hybrid glossy relMSE, FLIP and light flicker (docs/mrp.md §4);
+ * MRP alone loses 0.3 % of its glossy light, its FLIP +0.001-0.003. */
 #ifndef VSGL__MRP_REACH
-#define VSGL__MRP_REACH 9.0
+#define VSGL__MRP_REACH 6.0
 #endif
 /* A block of cells of the proxy's pyramid is shaded whole when its diagonal
  * is at most this many times the lobe's sampling disk (its radius, at the
@@ -92,7 +95,7 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
     vsgl_sg lobe;
     vsgl__mrp_receiver_sg(n, o, alpha, &lobe);
     d3 z = d3_of_v3(lobe.axis);
-    /* e^{-9} of the peak of the widest lobe (GGX's tail when there are two)
+    /* e^{-REACH} of the peak of the widest lobe (GGX's tail when there are two)
      * along the warped ASG's wider axis (a grazing view stretches it in the
      * plane of incidence: Eq. 8's isotropic SG is up to 1/sqrt(2 |o.n|) narrower) */
     const vsgl_asg wa = rcv.warped;
@@ -167,7 +170,7 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
                     cell.center = d3_add(plane.center, d3_add(d3_scale(plane.u, mu), d3_scale(pv0, mv)));
                     cell.half_u = hu;
                     cell.half_v = hv;
-                    if (cull) { /* the lobe itself at the cell: its ASG exponent past e^{-9}, the cell's
+                    if (cull) { /* the lobe itself at the cell: its ASG exponent past REACH, the cell's
                                  * angular radius taken off both offsets (conservative) */
                         d3 dc = d3_sub(cell.center, x);
                         double dist = d3_length(dc), ang = sqrt(hu * hu + hv * hv) / (dist > 0.0 ? dist : 1e-30);
@@ -410,7 +413,7 @@ static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
                 continue;
 #if VSGL__MRP_HYBRID_MAX
             /* the proxies' light as the larger of MRP's and the on-proxy VSGLs' (all - off):
-             * MRP stops at e^{-9} of its tail lobe, the VSGLs keep a haze beyond it */
+             * MRP stops at e^{-VSGL__MRP_REACH} of its tail lobe, the VSGLs keep a haze beyond it */
             const float *ga = j->planes->glossy + px * 3, *gq = j->glossy_q + px * 3;
             float pm = acc[0] + acc[1] + acc[2], pv = 0.0f, pvc[3];
             for (int c = 0; c < 3; ++c) {
