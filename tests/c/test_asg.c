@@ -223,6 +223,45 @@ VT_TEST(asg_eigen3_fast_agrees_with_jacobi)
     VT_CHECK(vsgl__eigen_sym3_fast(bad, w, v) == -1 && isnan(w[0]), "NaN entry");
 }
 
+/* vsgl__eigen_sym3_smallest: where it answers, the eigenvalues and the
+ * smallest's eigenvector of vsgl__eigen_sym3_fast bit for bit (or, where
+ * _fast's extra orthogonality test sent it to Jacobi, Jacobi's within 1e-6). */
+VT_TEST(asg_eigen3_smallest_is_the_fast_solvers)
+{
+    vt_rng r = {213};
+    int answered = 0;
+    for (int t = 0; t < 6000; ++t) {
+        double a[3][3], e[3];
+        int kind = t % 6;
+        if (kind < 5) {
+            (void)rand_sym3(&r, kind, e, a);
+        } else {
+            vsgl_asg p = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
+            vsgl_asg q = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
+            aq_asg fp = to_ref(&p), fq = to_ref(&q);
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    a[i][j] = p.lambda * fp.x[i] * fp.x[j] + p.mu * fp.y[i] * fp.y[j] + q.lambda * fq.x[i] * fq.x[j] +
+                              q.mu * fq.y[i] * fq.y[j];
+        }
+        double w[3], v[3][3], ws[3], z[3];
+        int f = vsgl__eigen_sym3_fast(a, w, v), sm = vsgl__eigen_sym3_smallest(a, ws, z);
+        if (sm == 0) {
+            ++answered;
+            if (f == 0) {
+                VT_CHECK(w[0] == ws[0] && w[1] == ws[1] && w[2] == ws[2], "draw %d: eigenvalues differ", t);
+                VT_CHECK(z[0] == v[0][2] && z[1] == v[1][2] && z[2] == v[2][2], "draw %d: eigenvector differs", t);
+            } else { /* _fast's extra orthogonality test sent it to Jacobi: the same pair within 1e-6 */
+                double d = fabs(z[0] * v[0][2] + z[1] * v[1][2] + z[2] * v[2][2]);
+                VT_CHECK(d > 1.0 - 1e-6, "draw %d: eigenvector %g from Jacobi's", t, d);
+            }
+        }
+    }
+    VT_CHECK(answered > 2500, "answered %d of 6000 draws", answered);
+    double bad[3][3] = {{1, NAN, 0}, {0, 1, 0}, {0, 0, 1}}, w[3], z[3];
+    VT_CHECK(vsgl__eigen_sym3_smallest(bad, w, z) == -1, "NaN entry");
+}
+
 /* ------------------------------------------------------------ evaluation */
 
 VT_TEST(asg_eval_matches_definition_and_reorthonormalises)

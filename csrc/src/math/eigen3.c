@@ -109,13 +109,16 @@ static int eigvec(double a[3][3], double w, double scale, double out[3])
     return 1;
 }
 
-int vsgl__eigen_sym3_fast(double a_in[3][3], double w[3], double v[3][3])
+/* The closed-form eigenvalues ws[0] >= ws[1] >= ws[2] of the symmetric a
+ * (copied from a_in's upper triangle) and the scale |trace/3| + sqrt(p); 0
+ * when they are well separated (more than 1e-6 of the scale apart), -1
+ * otherwise (not finite, repeated or nearly so: the caller's fallback). */
+static int closed_form(double a_in[3][3], double a[3][3], double ws[3], double *scale_out)
 {
-    double a[3][3];
     for (int i = 0; i < 3; ++i)
         for (int j = i; j < 3; ++j) {
             if (!isfinite(a_in[i][j]))
-                return vsgl__eigen_sym3(a_in, w, v);
+                return -1;
             a[i][j] = a[j][i] = a_in[i][j];
         }
     /* eigenvalues in closed form (Smith 1961; Kopp 2008's dsyevc3 in the
@@ -126,16 +129,25 @@ int vsgl__eigen_sym3_fast(double a_in[3][3], double w[3], double v[3][3])
     double q = 0.5 * (k00 * (k11 * k22 - a[1][2] * a[1][2]) - a[0][1] * (a[0][1] * k22 - a[1][2] * a[0][2]) +
                       a[0][2] * (a[0][1] * a[1][2] - k11 * a[0][2]));
     double scale = fabs(m) + sqrt(p);
+    *scale_out = scale;
     if (!(p > 1e-24 * scale * scale))
-        return vsgl__eigen_sym3(a_in, w, v);
+        return -1;
     double sp = sqrt(p), disc = p * p * p - q * q;
     double phi = atan2(sqrt(disc > 0.0 ? disc : 0.0), q) / 3.0;
     double c = cos(phi), s = sin(phi);
     double e0 = m + 2.0 * sp * c, e1 = m - sp * (c + 1.7320508075688772 * s), e2 = m - sp * (c - 1.7320508075688772 * s);
     /* sort: e0 >= e2 >= e1 for phi in [0, pi/3] */
-    double ws[3] = {e0, e2 > e1 ? e2 : e1, e2 > e1 ? e1 : e2};
-    /* well separated, or Jacobi (repeated eigenvalues: any basis of the eigenspace) */
+    ws[0] = e0, ws[1] = e2 > e1 ? e2 : e1, ws[2] = e2 > e1 ? e1 : e2;
+    /* well separated, or the caller's fallback (repeated eigenvalues: any basis of the eigenspace) */
     if (!(ws[0] - ws[1] > 1e-6 * scale) || !(ws[1] - ws[2] > 1e-6 * scale))
+        return -1;
+    return 0;
+}
+
+int vsgl__eigen_sym3_fast(double a_in[3][3], double w[3], double v[3][3])
+{
+    double a[3][3], ws[3], scale;
+    if (closed_form(a_in, a, ws, &scale) != 0)
         return vsgl__eigen_sym3(a_in, w, v);
     double x[3], z[3];
     if (!eigvec(a, ws[0], scale, x) || !eigvec(a, ws[2], scale, z) ||
@@ -149,5 +161,13 @@ int vsgl__eigen_sym3_fast(double a_in[3][3], double w[3], double v[3][3])
         v[r][1] = y[r];
         v[r][2] = z[r];
     }
+    return 0;
+}
+
+int vsgl__eigen_sym3_smallest(double a_in[3][3], double w[3], double z[3])
+{
+    double a[3][3], scale;
+    if (closed_form(a_in, a, w, &scale) != 0 || !eigvec(a, w[2], scale, z))
+        return -1;
     return 0;
 }

@@ -19,4 +19,11 @@ int vsgl__eigen_sym3(double a[3][3], double w[3], double v[3][3]);
  * eigenvalues agree with it to 1e-10 of the scale (tests/c/test_asg.c). */
 int vsgl__eigen_sym3_fast(double a[3][3], double w[3], double v[3][3]);
 
+/* vsgl__eigen_sym3_fast's closed form for the eigenvalues w[0] >= w[1] >=
+ * w[2] and the unit eigenvector z of the smallest only (the same values, bit
+ * for bit, and z = its column 2 up to sign). Returns 0, or -1 where
+ * vsgl__eigen_sym3_fast would fall back to Jacobi (not finite, eigenvalues
+ * within 1e-6 of the scale): then w and z are unspecified. */
+int vsgl__eigen_sym3_smallest(double a[3][3], double w[3], double z[3]);
+
 #endif

@@ -5,6 +5,7 @@
 #include "mrp/mrp.h"
 #include "mrp/geom.h"
 #include "math/asg_internal.h"
+#include "math/eigen3.h"
 #include "math/constants.h"
 #include "vsgl/lobes.h"
 #include "shade/kernel.h"
@@ -77,11 +78,49 @@ static d3 clamp_to_rect(const vsgl__mrp_rect *rc, d3 y)
     return d3_add(rc->center, d3_add(d3_scale(rc->u, cu), d3_scale(rc->v, cv)));
 }
 
+/* vsgl_asg_product of the ASGs (frame rows x, y, z; bandwidths; log
+ * amplitudes) a and b, integrated (vsgl_asg_integral with the faster unit
+ * integral): Xu et al.'s Eq. 13, in double from the frames the callers
+ * already hold (not through float ASGs and their frames again), and only the
+ * smallest eigenpair of the summed quadratic form (the integral needs no
+ * other axis). -1 where the closed-form eigenvalues are not well separated
+ * (vsgl__eigen_sym3_smallest): the caller takes the library's product. */
+static double product_integral(const double (*fa)[3], double la, double ma, double aa, const double (*fb)[3],
+                               double lb, double mb, double ab)
+{
+    const double cap = (double)VSGL_SHARPNESS_MAX;
+    la = la > 0.0 ? (la < cap ? la : cap) : 0.0, ma = ma > 0.0 ? (ma < cap ? ma : cap) : 0.0;
+    lb = lb > 0.0 ? (lb < cap ? lb : cap) : 0.0, mb = mb > 0.0 ? (mb < cap ? mb : cap) : 0.0;
+    double m[3][3], w[3], z[3];
+    for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j)
+            m[i][j] = m[j][i] = la * fa[0][i] * fa[0][j] + ma * fa[1][i] * fa[1][j] + lb * fb[0][i] * fb[0][j] +
+                                mb * fb[1][i] * fb[1][j];
+    if (vsgl__eigen_sym3_smallest(m, w, z) != 0)
+        return -1.0;
+    /* z's sign: the hemisphere of z_a + z_b; the smooth terms at z */
+    double zs = 0.0, ca = 0.0, cb = 0.0;
+    for (int r = 0; r < 3; ++r) {
+        zs += z[r] * (fa[2][r] + fb[2][r]);
+        ca += z[r] * fa[2][r];
+        cb += z[r] * fb[2][r];
+    }
+    if (zs < 0.0)
+        ca = -ca, cb = -cb;
+    if (!(ca > 0.0) || !(cb > 0.0) || !(ca * cb > 0.0))
+        return 0.0;
+    double lam = w[0] - w[2], mu = w[1] - w[2];
+    lam = lam < cap ? (lam > 0.0 ? lam : 0.0) : cap;
+    mu = mu < cap ? (mu > 0.0 ? mu : 0.0) : cap;
+    return exp(aa + ab - w[2]) * ca * cb * vsgl__mrp_asg_integral_unit(lam, mu);
+}
+
 /* One Gaussian receiver lobe (g: Eq. 8's SG, ra: the warped ASG; the
- * active one per opt->receiver_asg) against the rectangle: steps 2-6 of
- * docs/mrp.md §3. h > 0 is x's height over the plane. */
+ * active one per opt->receiver_asg; rf: ra's frame in double, or NULL)
+ * against the rectangle: steps 2-6 of docs/mrp.md §3. h > 0 is x's height
+ * over the plane. */
 static double glossy_lobe(const vsgl__mrp_rect *rc, d3 x, double h, const vsgl_sg *g, const vsgl_asg *ra,
-                          const vsgl__mrp_options *opt, d3 *axis)
+                          const double (*rf)[3], const vsgl__mrp_options *opt, d3 *axis)
 {
     d3 z = d3_of_v3(g->axis), y;
     if (g->log_amplitude == -INFINITY || !vsgl__mrp_peak(rc, x, d3_scale(z, -1.0), &y))
@@ -109,9 +148,17 @@ static double glossy_lobe(const vsgl__mrp_rect *rc, d3 x, double h, const vsgl_s
     vsgl_asg light;
     /* the light's extent: the disk, or the disk of the overlap's area (a cell smaller than the disk) */
     double rl = opt->shrink > 0.0 && A < 1.0 ? fmin(rd, opt->shrink * rd * sqrt(A)) : rd;
+    double v = -1.0;
+    if (rf && opt->receiver_asg && !opt->sg_only) {        /* Eq. 28-35, ASG x ASG in double */
+        double lf[3][3], ll, lm, laa;
+        if (!vsgl__mrp_asg_light_d(x, p, rc->normal, rl, C, opt->norm, lf, &ll, &lm, &laa))
+            return 0.0;
+        v = product_integral((const double(*)[3])lf, ll, lm, laa, rf, (double)ra->lambda, (double)ra->mu, (double)ra->log_amplitude);
+        if (v >= 0.0)
+            return v > 0.0 && v < INFINITY ? v : 0.0;
+    }
     if (!vsgl__mrp_asg_light(x, p, rc->normal, rl, C, opt->norm, &light))
         return 0.0;                                        /* Eq. 28-35 */
-    double v;
     if (opt->sg_only) {                                    /* Eq. 37 */
         vsgl_sg ls;
         vsgl__mrp_asg_to_sg(&light, 1, &ls);
@@ -164,6 +211,10 @@ void vsgl__mrp_receiver_make(d3 n, d3 o, double alpha, const vsgl__mrp_options *
         }
         out->sg[q] = gq;
         out->asg[q] = aq;
+        vsgl__frame f; /* the ASG's frame as vsgl_asg_product would make it, once */
+        out->framed[q] = opt->receiver_asg && vsgl__asg_frame(&aq, &f);
+        for (int r = 0; r < 3; ++r)
+            out->frame[q][0][r] = f.x[r], out->frame[q][1][r] = f.y[r], out->frame[q][2][r] = f.z[r];
     }
 }
 
@@ -179,7 +230,8 @@ int vsgl__mrp_glossy_parts_at(const vsgl__mrp_rect *rc, d3 x, const vsgl__mrp_re
         return rcv->parts;
     for (int q = 0; q < rcv->parts; ++q)
         if (!(skip & (1u << q)))
-            value[q] = glossy_lobe(rc, x, h, &rcv->sg[q], &rcv->asg[q], opt, &axis[q]);
+            value[q] = glossy_lobe(rc, x, h, &rcv->sg[q], &rcv->asg[q], rcv->framed[q] ? rcv->frame[q] : NULL, opt,
+                                   &axis[q]);
     return rcv->parts;
 }
 

@@ -59,9 +59,9 @@ static void zero_asg(vsgl_asg *out)
     out->log_amplitude = -INFINITY;
 }
 
-int vsgl__mrp_asg_light(d3 x, d3 y, d3 n_d, double rd, double C, int norm, vsgl_asg *out)
+int vsgl__mrp_asg_light_d(d3 x, d3 y, d3 n_d, double rd, double C, int norm, double frame[3][3], double *lambda,
+                          double *mu, double *log_amplitude)
 {
-    zero_asg(out);
     d3 xy = d3_sub(y, x);
     double d = d3_length(xy);
     if (!(d > 0.0) || !(d < INFINITY) || !(C > 0.0) || !(C < INFINITY) || !(rd > 0.0))
@@ -73,20 +73,36 @@ int vsgl__mrp_asg_light(d3 x, d3 y, d3 n_d, double rd, double C, int norm, vsgl_
     d3 u, v;
     vsgl__mrp_disk_axes(yx, n_d, &u, &v);
     double lm = rd / d, ln = lm * (cs < 1.0 ? cs : 1.0);      /* Eq. 29 at distance d */
-    double lam = vsgl__mrp_bandwidth(lm), mu = vsgl__mrp_bandwidth(ln); /* Eq. 32 */
+    double lam = vsgl__mrp_bandwidth(lm), m = vsgl__mrp_bandwidth(ln); /* Eq. 32 */
     double integral;                                           /* of the unit ASG */
     if (norm == VSGL__MRP_NORM_PAPER)
-        integral = lam > 0.0 && mu > 0.0 ? VSGL__PI_D / sqrt(lam * mu) : INFINITY; /* Eq. 34 */
+        integral = lam > 0.0 && m > 0.0 ? VSGL__PI_D / sqrt(lam * m) : INFINITY; /* Eq. 34 */
     else
-        integral = vsgl__mrp_asg_integral_unit(lam, mu);
+        integral = vsgl__mrp_asg_integral_unit(lam, m);
     if (!(integral > 0.0) || !(integral < INFINITY))
         return 0;
-    out->z = d3_to_v3(z);
-    out->x = d3_to_v3(v);                      /* m = v, Eq. 28 */
-    out->y = d3_to_v3(d3_cross(z, v));         /* n = yx x v up to sign; the ASG is even in it */
+    d3 w = d3_cross(z, v); /* n = yx x v up to sign; the ASG is even in it */
+    const d3 axes[3] = {v, w, z}; /* m = v, Eq. 28 */
+    for (int k = 0; k < 3; ++k)
+        frame[k][0] = axes[k].x, frame[k][1] = axes[k].y, frame[k][2] = axes[k].z;
+    *lambda = lam;
+    *mu = m;
+    *log_amplitude = log(C) - log(integral); /* Eq. 35: t = C / integral */
+    return 1;
+}
+
+int vsgl__mrp_asg_light(d3 x, d3 y, d3 n_d, double rd, double C, int norm, vsgl_asg *out)
+{
+    zero_asg(out);
+    double f[3][3], lam, mu, la;
+    if (!vsgl__mrp_asg_light_d(x, y, n_d, rd, C, norm, f, &lam, &mu, &la))
+        return 0;
+    out->z = v3_make((float)f[2][0], (float)f[2][1], (float)f[2][2]);
+    out->x = v3_make((float)f[0][0], (float)f[0][1], (float)f[0][2]);
+    out->y = v3_make((float)f[1][0], (float)f[1][1], (float)f[1][2]);
     out->lambda = (float)lam;
     out->mu = (float)mu;
-    out->log_amplitude = (float)(log(C) - log(integral)); /* Eq. 35: t = C / integral */
+    out->log_amplitude = (float)la;
     return 1;
 }
 

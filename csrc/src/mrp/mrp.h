@@ -123,6 +123,12 @@ double vsgl__mrp_asg_integral_unit(double lambda, double mu);
  * x is on or behind the disk's plane, x = y, C <= 0 or not finite. */
 int vsgl__mrp_asg_light(d3 x, d3 y, d3 n_d, double rd, double C, int norm, vsgl_asg *out);
 
+/* The same light in double: its frame (rows: x = m, y, z), bandwidths and
+ * log amplitude, as vsgl__mrp_asg_light rounds them to its float ASG.
+ * Returns 0 (outputs untouched) where vsgl__mrp_asg_light returns 0. */
+int vsgl__mrp_asg_light_d(d3 x, d3 y, d3 n_d, double rd, double C, int norm, double frame[3][3], double *lambda,
+                          double *mu, double *log_amplitude);
+
 /* Eq. 8: the receiver's NDF as an SG in light-direction space: axis
  * reflect(o, n), sharpness 2 / (4 |o.n| alpha^2), amplitude 1 / (pi alpha^2)
  * (the library's vsgl_ndf_to_sg + vsgl_warp_ndf_sg). */
@@ -201,6 +207,8 @@ typedef struct vsgl__mrp_receiver {
     vsgl_sg sg[2];   /* Eq. 8 per part (bandwidth x K, amplitude x C of shade/kernel.h) */
     vsgl_asg asg[2]; /* the warped ASG per part (zero unless opt->receiver_asg) */
     vsgl_asg warped; /* the warped ASG of the whole NDF (vsgl_warp_ndf_asg) */
+    int framed[2];           /* 1: frame[q] holds asg[q]'s frame (rows x, y, z) in double */
+    double frame[2][3][3];
 } vsgl__mrp_receiver;
 
 void vsgl__mrp_receiver_make(d3 n, d3 o, double alpha, const vsgl__mrp_options *opt, vsgl__mrp_receiver *out);
