@@ -359,6 +359,62 @@ VT_TEST(mrp_hybrid_rule_against_asg2_and_mrp)
     vsgl_context_destroy(ctx);
 }
 
+/* vsgl__mrp_proxies_add_rsm reuses a texel's material parameters while its
+ * neighbours share its material: the same cells, bit for bit, as adding the
+ * texels one at a time (each then computing its own), with a spot on a
+ * room's corner (the metal floor, the back and the side wall: three
+ * materials interleaved along the RSM's rows). */
+VT_TEST(mrp_proxies_add_rsm_material_reuse_is_exact)
+{
+    fx_scene fx;
+    const float at[3] = {2.9f, 2.9f, 0.1f};
+    metal_floor_room_aimed(&fx, 32, 24, 0.2f, at);
+    vsgl_context *ctx = NULL;
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_context_create(NULL, &ctx) == VSGL_OK, "context");
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene");
+    vsgl__mrp_proxy_set a, b;
+    VT_REQUIRE(vsgl__mrp_proxies_build(ctx, scene, 0.25, 16, &a) == VSGL_OK, "build");
+    VT_REQUIRE(vsgl__mrp_proxies_build(ctx, scene, 0.25, 16, &b) == VSGL_OK, "build");
+    vsgl_rsm rsm;
+    VT_REQUIRE(vsgl__rsm_build(ctx, scene, 0, 64, &rsm) == VSGL_OK, "rsm");
+    vsgl__mrp_proxies_add_rsm(&a, scene, &rsm);
+    int changes = 0;
+    uint32_t prev = VSGL__RSM_EMPTY;
+    for (size_t i = 0; i < rsm.count; ++i) { /* one texel at a time */
+        if (rsm.material[i] == VSGL__RSM_EMPTY)
+            continue;
+        changes += prev != VSGL__RSM_EMPTY && rsm.material[i] != prev;
+        prev = rsm.material[i];
+        vsgl_rsm one = rsm;
+        one.count = 1;
+        for (int c = 0; c < 3; ++c) {
+            one.pos[c] = rsm.pos[c] + i, one.nrm[c] = rsm.nrm[c] + i, one.flux[c] = rsm.flux[c] + i;
+            one.tan[c] = rsm.tan[c] ? rsm.tan[c] + i : NULL, one.wi[c] = rsm.wi[c] ? rsm.wi[c] + i : NULL;
+        }
+        one.area = rsm.area ? rsm.area + i : NULL;
+        one.material = rsm.material + i;
+        for (int q = 0; q < VSGL__SURF_N; ++q)
+            one.surf[q] = rsm.surf[q] ? rsm.surf[q] + i : NULL;
+        vsgl__mrp_proxies_add_rsm(&b, scene, &one);
+    }
+    VT_CHECK(changes > 20, "the lit texels' material changes %d times along the rows", changes);
+    size_t diff = 0, lit = 0;
+    for (size_t k = 0; k < a.count; ++k) {
+        const vsgl__mrp_proxy *p = &a.items[k], *q = &b.items[k];
+        for (size_t i = 0; i < 2 * (size_t)p->nu * p->nv * 3; ++i) {
+            diff += p->power[i] != q->power[i];
+            lit += p->power[i] > 0.0f;
+        }
+    }
+    VT_CHECK(diff == 0 && lit > 100, "%zu of the cells' values differ (%zu lit)", diff, lit);
+    vsgl__rsm_free(&rsm);
+    vsgl__mrp_proxies_free(&a);
+    vsgl__mrp_proxies_free(&b);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
 /* MRP and the hybrid take each light's RSM as the fit builds it (render.c,
  * vsgl__fit_lights_mrp); when the fit comes from a render cache the pass
  * builds its own RSMs, as before. Both glossy planes bit-identical, and

@@ -226,6 +226,11 @@ void vsgl__mrp_proxies_add_rsm(vsgl__mrp_proxy_set *set, const vsgl_scene *scene
 {
     uint32_t mcount = 0;
     const vsgl_material *materials = vsgl__scene_materials(scene, &mcount);
+    vsgl_material last; /* the material of the last texel added, and its parameters */
+    vsgl_brdf_params bp;
+    int have = 0;
+    memset(&last, 0, sizeof last);
+    memset(&bp, 0, sizeof bp);
     for (size_t i = 0; i < rsm->count; ++i) {
         if (rsm->material[i] == VSGL__RSM_EMPTY)
             continue;
@@ -244,8 +249,11 @@ void vsgl__mrp_proxies_add_rsm(vsgl__mrp_proxy_set *set, const vsgl_scene *scene
             uint32_t iv = (uint32_t)fmin(p->nv - 1.0, floor((cv / p->rect.half_v + 1.0) * 0.5 * p->nv));
             vsgl_material m;
             vsgl__rsm_material(rsm, materials, i, &m);
-            vsgl_brdf_params bp;
-            vsgl__material_params(&m, &bp);
+            if (!have || memcmp(&m, &last, sizeof m) != 0) { /* neighbouring texels share their material */
+                vsgl__material_params(&m, &bp);
+                last = m;
+                have = 1;
+            }
             int side = cn > 0.0 ? 0 : 1;
             float *cell = p->power + (((size_t)side * p->nv + iv) * p->nu + iu) * 3;
             for (int c = 0; c < 3; ++c)
