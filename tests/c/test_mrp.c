@@ -42,6 +42,23 @@ static vsgl__mrp_rect rect_xy(double half_u, double half_v)
     return rc;
 }
 
+/* geom.h's inline d_max / d_min: libm's fmax / fmin for every pair of
+ * special and random values (NaN gives the other argument; equal values
+ * compare equal, zeros of either sign included). */
+VT_TEST(mrp_inline_fmax_fmin_are_libms)
+{
+    const double sp[9] = {0.0, -0.0, 1.0, -1.0, 1e-310, -3.5e300, INFINITY, -INFINITY, NAN};
+    vt_rng r = {1416u};
+    for (int t = 0; t < 20000; ++t) {
+        double a = t < 81 ? sp[t % 9] : (vt_uniform(&r) - 0.5) * 1e3;
+        double b = t < 81 ? sp[t / 9] : (t % 5 == 0 ? a : (vt_uniform(&r) - 0.5) * 1e3);
+        double m[4] = {d_max(a, b), fmax(a, b), d_min(a, b), fmin(a, b)};
+        for (int k = 0; k < 4; k += 2)
+            VT_CHECK((isnan(m[k]) && isnan(m[k + 1])) || m[k] == m[k + 1], "%s(%g, %g): %g vs libm %g",
+                     k ? "min" : "max", a, b, m[k], m[k + 1]);
+    }
+}
+
 /* ---------------------------------------------------------------- Eq. 12 */
 
 VT_TEST(mrp_peak_eq12_is_the_mirror_point)

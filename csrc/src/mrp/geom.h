@@ -22,6 +22,11 @@ static inline int d3_is_zero(d3 a) { return a.x == 0.0 && a.y == 0.0 && a.z == 0
 static inline int d3_finite(d3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 static inline vsgl_vec3 d3_to_v3(d3 a) { return v3_make((float)a.x, (float)a.y, (float)a.z); }
 static inline d3 d3_of_v3(vsgl_vec3 a) { return d3_make(a.x, a.y, a.z); }
+/* fmax / fmin inline (libm's are calls at -O2): the same value for every
+ * input, NaN included (a NaN argument gives the other one), and for equal
+ * arguments the second, as glibc's maxsd/minsd-based ones. */
+static inline double d_max(double a, double b) { return a > b ? a : (b != b ? a : b); }
+static inline double d_min(double a, double b) { return a < b ? a : (b != b ? a : b); }
 /* Orthonormal completion of unit z (Duff et al. 2017), double precision. */
 static inline void d3_basis(d3 z, d3 *x, d3 *y)
 {

@@ -66,10 +66,10 @@ static int overlap_box(double cu, double cv, double r, double a, double b, doubl
     if (!(du * du + dv * dv < r * r) || !(a > 0.0) || !(b > 0.0))
         return 0;
     double wu = sqrt(r * r - dv * dv), wv = sqrt(r * r - du * du);
-    box[0] = fmax(-a, cu - wu);
-    box[1] = fmin(a, cu + wu);
-    box[2] = fmax(-b, cv - wv);
-    box[3] = fmin(b, cv + wv);
+    box[0] = d_max(-a, cu - wu);
+    box[1] = d_min(a, cu + wu);
+    box[2] = d_max(-b, cv - wv);
+    box[3] = d_min(b, cv + wv);
     return box[1] > box[0] && box[3] > box[2];
 }
 
@@ -80,7 +80,7 @@ double vsgl__mrp_overlap_bbox(const vsgl__mrp_rect *rc, d3 y, double rd)
     if (!(rd > 0.0) || !(rd < INFINITY) || !overlap_box(cu, cv, rd, rc->half_u, rc->half_v, box))
         return 0.0;
     /* (b-a)/r in [0, 2] each (clamped: a centre far from the origin rounds) */
-    double su = fmin((box[1] - box[0]) / rd, 2.0), sv = fmin((box[3] - box[2]) / rd, 2.0);
+    double su = d_min((box[1] - box[0]) / rd, 2.0), sv = d_min((box[3] - box[2]) / rd, 2.0);
     return su * sv / VSGL__PI_D;
 }
 
@@ -98,7 +98,7 @@ d3 vsgl__mrp_overlap_center(const vsgl__mrp_rect *rc, d3 y, double rd)
 static double circ_prim(double x)
 {
     x = x < -1.0 ? -1.0 : (x > 1.0 ? 1.0 : x);
-    return 0.5 * (x * sqrt(fmax(0.0, 1.0 - x * x)) + asin(x));
+    return 0.5 * (x * sqrt(d_max(0.0, 1.0 - x * x)) + asin(x));
 }
 
 static void sort_small(double *v, int n)
@@ -117,10 +117,10 @@ static void sort_small(double *v, int n)
  * circle, so each piece integrates in closed form. */
 static double unit_disk_box_area(double x0, double x1, double y0, double y1)
 {
-    x0 = fmax(x0, -1.0);
-    x1 = fmin(x1, 1.0);
-    y0 = fmax(y0, -1.0);
-    y1 = fmin(y1, 1.0);
+    x0 = d_max(x0, -1.0);
+    x1 = d_min(x1, 1.0);
+    y0 = d_max(y0, -1.0);
+    y1 = d_min(y1, 1.0);
     if (!(x1 > x0) || !(y1 > y0))
         return 0.0;
     double br[6];
@@ -129,7 +129,7 @@ static double unit_disk_box_area(double x0, double x1, double y0, double y1)
     br[nb++] = x1;
     const double ys[2] = {y0, y1};
     for (int k = 0; k < 2; ++k) {
-        double w = sqrt(fmax(0.0, 1.0 - ys[k] * ys[k]));
+        double w = sqrt(d_max(0.0, 1.0 - ys[k] * ys[k]));
         if (w > x0 && w < x1)
             br[nb++] = w;
         if (-w > x0 && -w < x1)
@@ -141,7 +141,7 @@ static double unit_disk_box_area(double x0, double x1, double y0, double y1)
         double a = br[p], b = br[p + 1];
         if (!(b > a))
             continue;
-        double m = 0.5 * (a + b), s = sqrt(fmax(0.0, 1.0 - m * m));
+        double m = 0.5 * (a + b), s = sqrt(d_max(0.0, 1.0 - m * m));
         int top_c = y1 < s, bot_c = y0 > -s; /* the bound is the constant y1 / y0 */
         double top = top_c ? y1 : s, bot = bot_c ? y0 : -s;
         if (!(top > bot))

@@ -141,6 +141,12 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
              * (the back side's flipped plane.v would mirror its radiance) */
             const d3 pv0 = p->rect.v;
             double yu = d3_dot(dy, plane.u), yv = d3_dot(dy, pv0);
+            const float *lv[VSGL__MRP_MAX_LEVELS]; /* this side's pyramid levels, looked up once */
+            uint32_t lnu[VSGL__MRP_MAX_LEVELS], lst[VSGL__MRP_MAX_LEVELS];
+            for (uint32_t l = 0; l < p->levels && l < VSGL__MRP_MAX_LEVELS; ++l) {
+                uint32_t nv_l;
+                lv[l] = vsgl__mrp_level(p, side, l, &lnu[l], &nv_l, &lst[l]);
+            }
             double cu = plane.half_u / p->nu, cv = plane.half_v / p->nv;
             /* each lobe walks the cell pyramid from its top: a block is taken whole when it is
              * within the lobe's reach and no larger than VSGL__MRP_MERGE x the lobe's disk
@@ -150,9 +156,8 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
                 uint32_t stack[3 * 64], sp = 0;
                 stack[sp++] = p->levels - 1, stack[sp++] = 0, stack[sp++] = 0;
                 while (sp) {
-                    uint32_t bv = stack[--sp], bu = stack[--sp], l = stack[--sp], nbu, nbv, st;
-                    const float *L = vsgl__mrp_level(p, side, l, &nbu, &nbv, &st);
-                    L += ((size_t)bv * nbu + bu) * st;
+                    uint32_t bv = stack[--sp], bu = stack[--sp], l = stack[--sp];
+                    const float *L = lv[l] + ((size_t)bv * lnu[l] + bu) * lst[l];
                     if (!(L[0] + L[1] + L[2] > 0.0f))
                         continue;
                     uint32_t u0 = bu << l, v0 = bv << l;
@@ -177,13 +182,13 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
                         d3 vd = d3_scale(dc, 1.0 / (dist > 0.0 ? dist : 1e-30));
                         if (d3_dot(vd, wz) < -ang)
                             continue;
-                        double ax = fmax(0.0, fabs(d3_dot(vd, wx)) - ang), ay = fmax(0.0, fabs(d3_dot(vd, wy)) - ang);
+                        double ax = d_max(0.0, fabs(d3_dot(vd, wx)) - ang), ay = d_max(0.0, fabs(d3_dot(vd, wy)) - ang);
                         double ex = (double)wa.lambda * ax * ax + (double)wa.mu * ay * ay;
                         if (ex * k_q > VSGL__MRP_REACH)
                             continue;
                     }
                     if (l > 0) { /* whole, or its children */
-                        double pu = fmin(fmax(yu, mu - hu), mu + hu), pv = fmin(fmax(yv, mv - hv), mv + hv);
+                        double pu = d_min(d_max(yu, mu - hu), mu + hu), pv = d_min(d_max(yv, mv - hv), mv + hv);
                         double db = sqrt(h * h + (yu - pu) * (yu - pu) + (yv - pv) * (yv - pv));
                         double rd = vsgl__mrp_lobe_disk_radius(&rcv, q, &j->opt, db, db > 0.0 ? h / db : 1.0);
                         if (exact || !(L[3] <= VSGL__MRP_MERGE_CONTRAST) ||
