@@ -348,9 +348,10 @@ VT_TEST(mrp_hybrid_rule_against_asg2_and_mrp)
                        "MRP %.4f (sum %.3f), ASG2 lattice %.4f\n", e_h, q_h, e_m, q_m, e_a);
             /* every cluster of this room's lattice lies on a wall or is a specular floor cluster:
              * in the floor's pixels the hybrid takes the larger of MRP's and the on-proxy VSGLs'
-             * light. Measured 0.0588 (sum 1.029) against MRP 0.0391 (0.943) and ASG2 0.0493 (1.03):
-             * the larger of two estimates is biased up; against Cycles it helps (docs/mrp.md §4) */
-            VT_CHECK(e_h < 1.25 * e_a && q_h > 0.9 && q_h < 1.1 && q_h >= q_m, "hybrid %g (sum %g) vs MRP %g (sum %g), "
+             * light. Measured 0.0519 (sum 1.031) against MRP 0.0388 (0.939) and ASG2 0.0464 (1.03)
+             * with the hybrid's reach e^{-3} (e^{-6}: 0.0531, 1.033): the larger of two estimates
+             * is biased up; against Cycles it helps (docs/mrp.md §4) */
+            VT_CHECK(e_h < 1.2 * e_a && q_h > 0.9 && q_h < 1.1 && q_h >= q_m, "hybrid %g (sum %g) vs MRP %g (sum %g), "
                      "ASG2 %g", e_h, q_h, e_m, q_m, e_a);
         }
         vsgl_scene_destroy(scene);

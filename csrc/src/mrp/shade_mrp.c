@@ -25,6 +25,13 @@
 #ifndef VSGL__MRP_REACH
 #define VSGL__MRP_REACH 6.0
 #endif
+/* The same in the hybrid, where beyond MRP's reach the VSGLs' estimate of
+ * the proxies' light takes over (the larger of the two, VSGL__MRP_HYBRID_MAX):
+ * e^{-3} halves the lobe terms against e^{-6}, and the hybrid's glossy
+ * relMSE against Cycles falls (docs/mrp.md §4, "Speed, second round"). */
+#ifndef VSGL__MRP_REACH_HYBRID
+#define VSGL__MRP_REACH_HYBRID 3.0
+#endif
 /* A block of cells of the proxy's pyramid is shaded whole when its diagonal
  * is at most this many times the lobe's sampling disk (its radius, at the
  * block's clamped peak): the disk's Gaussian light blurs anything finer.
@@ -56,6 +63,7 @@ typedef struct mrp_job {
     const float *glossy_q; /* hybrid: the VSGL glossy of the clusters off the proxies, else NULL */
     double max_alpha;      /* hybrid: the largest GGX alpha of a receiver that takes MRP */
     double merge;          /* VSGL__MRP_MERGE */
+    double reach;          /* VSGL__MRP_REACH, or VSGL__MRP_REACH_HYBRID in the hybrid */
 } mrp_job;
 
 /* Hybrid rule, first half: 1 if every glossy sample of pixel px is sharp
@@ -100,7 +108,7 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
      * plane of incidence: Eq. 8's isotropic SG is up to 1/sqrt(2 |o.n|) narrower) */
     const vsgl_asg wa = rcv.warped;
     double nu = fmin((double)wa.lambda, (double)wa.mu) * (j->opt.lobes == 2 ? VSGL__GGX_TAIL_K : 1.0);
-    double spread = sqrt(VSGL__MRP_REACH / (nu > 1e-6 ? nu : 1e-6));
+    double spread = sqrt(j->reach / (nu > 1e-6 ? nu : 1e-6));
     /* the core's reach, where there are two lobes: cells beyond it skip the core */
     const double core_frac = j->opt.lobes == 2 ? sqrt((double)VSGL__GGX_TAIL_K / VSGL__GGX_CORE_K) : 1.0;
     /* per cell, the anisotropic test against the warped lobe (the box test
@@ -184,7 +192,7 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
                             continue;
                         double ax = d_max(0.0, fabs(d3_dot(vd, wx)) - ang), ay = d_max(0.0, fabs(d3_dot(vd, wy)) - ang);
                         double ex = (double)wa.lambda * ax * ax + (double)wa.mu * ay * ay;
-                        if (ex * k_q > VSGL__MRP_REACH)
+                        if (ex * k_q > j->reach)
                             continue;
                     }
                     if (l > 0) { /* whole, or its children */
@@ -418,7 +426,7 @@ static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
                 continue;
 #if VSGL__MRP_HYBRID_MAX
             /* the proxies' light as the larger of MRP's and the on-proxy VSGLs' (all - off):
-             * MRP stops at e^{-VSGL__MRP_REACH} of its tail lobe, the VSGLs keep a haze beyond it */
+             * MRP stops at e^{-VSGL__MRP_REACH_HYBRID} of its tail lobe, the VSGLs keep a haze beyond it */
             const float *ga = j->planes->glossy + px * 3, *gq = j->glossy_q + px * 3;
             float pm = acc[0] + acc[1] + acc[2], pv = 0.0f, pvc[3];
             for (int c = 0; c < 3; ++c) {
@@ -444,7 +452,7 @@ vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, c
 {
     uint32_t mcount = 0;
     mrp_job j = {scene, g, set, planes, vsgl__scene_materials(scene, &mcount), vsgl__mrp_options_default(),
-                 glossy_q, max_alpha, VSGL__MRP_MERGE};
+                 glossy_q, max_alpha, VSGL__MRP_MERGE, glossy_q ? VSGL__MRP_REACH_HYBRID : VSGL__MRP_REACH};
     size_t pixels = (size_t)g->width * g->height;
     mrp_pass P = {&j, malloc((pixels ? pixels : 1) * 3 * sizeof(float)), calloc(pixels ? pixels : 1, sizeof(mrp_surface)), 0};
     int32_t r = 0;
