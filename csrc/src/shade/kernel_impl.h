@@ -677,14 +677,19 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         const int two = (lobes & VSGL__KERNEL_GGX_TAIL) != 0;
         /* with GGX as lobes, planar clusters that subtend little are taken
          * by the half-vector model (kernel.h VSGL__HV_*) */
-        int hv = 0;
+        int hv = 0, hv_all = 1;
         if (two && !none_planar) {
             K_FORN(k_hv_shared(b, i, L + j, t + j));
             for (int j = 0; j < NL; ++j)
-                for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
+                for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) {
                     hv |= t[j].hvw[i] > 0.0f;
+                    hv_all &= t[j].hvw[i] == 1.0f;
+                }
         }
-        for (int q = 0; q < 1 + two; ++q) {
+        /* planar clusters that every lane sees through the half-vector
+         * model alone: the lobes' pass would add zeros */
+        const int skip_lobes = hv && hv_all && all_planar;
+        for (int q = 0; q < (skip_lobes ? 0 : 1 + two); ++q) {
             const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
             const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
             const int sg_only = none_planar;
