@@ -184,6 +184,23 @@ VT_TEST(asg_eigen3_random_repeated_and_extreme)
     VT_CHECK(vsgl__eigen_sym3(bad, w, v) == -1 && isnan(w[0]), "NaN entry");
 }
 
+/* The quadratic form of two random ASGs (bandwidths 1e-3 .. 1e6), as the
+ * ASG x ASG product builds it: a = sum lambda x x^T + mu y y^T; returns
+ * the bandwidths' sum (the matrix's scale). */
+static double rand_asg_pair_matrix(vt_rng *rp, double a[3][3])
+{
+    vt_rng r = *rp;
+    vsgl_asg p = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
+    vsgl_asg q = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
+    aq_asg fp = to_ref(&p), fq = to_ref(&q);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            a[i][j] = p.lambda * fp.x[i] * fp.x[j] + p.mu * fp.y[i] * fp.y[j] + q.lambda * fq.x[i] * fq.x[j] +
+                      q.mu * fq.y[i] * fq.y[j];
+    *rp = r;
+    return p.lambda + p.mu + q.lambda + q.mu;
+}
+
 /* The closed form (what vsgl_asg_product uses) against Jacobi: the same
  * draws, and sums of two ASG forms (lambda x x^T + mu y y^T) as the
  * product builds them; eigenvalues within 1e-10 of the scale (the
@@ -200,14 +217,7 @@ VT_TEST(asg_eigen3_fast_agrees_with_jacobi)
             double e[3];
             scale = rand_sym3(&r, kind, e, a);
         } else { /* two ASG forms, bandwidths 1e-3 .. 1e6 */
-            vsgl_asg p = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
-            vsgl_asg q = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
-            aq_asg fp = to_ref(&p), fq = to_ref(&q);
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j)
-                    a[i][j] = p.lambda * fp.x[i] * fp.x[j] + p.mu * fp.y[i] * fp.y[j] + q.lambda * fq.x[i] * fq.x[j] +
-                              q.mu * fq.y[i] * fq.y[j];
-            scale = p.lambda + p.mu + q.lambda + q.mu;
+            scale = rand_asg_pair_matrix(&r, a);
         }
         char what[96];
         snprintf(what, sizeof what, "draw %d kind %d", t, kind);
@@ -236,13 +246,7 @@ VT_TEST(asg_eigen3_smallest_is_the_fast_solvers)
         if (kind < 5) {
             (void)rand_sym3(&r, kind, e, a);
         } else {
-            vsgl_asg p = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
-            vsgl_asg q = rand_asg(&r, log_uniform(&r, -3, 6), log_uniform(&r, -3, 6), 0.0);
-            aq_asg fp = to_ref(&p), fq = to_ref(&q);
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j)
-                    a[i][j] = p.lambda * fp.x[i] * fp.x[j] + p.mu * fp.y[i] * fp.y[j] + q.lambda * fq.x[i] * fq.x[j] +
-                              q.mu * fq.y[i] * fq.y[j];
+            (void)rand_asg_pair_matrix(&r, a);
         }
         double w[3], v[3][3], ws[3], z[3];
         int f = vsgl__eigen_sym3_fast(a, w, v), sm = vsgl__eigen_sym3_smallest(a, ws, z);

@@ -5,6 +5,7 @@
  * with misses, grazing and back-facing views, unnormalised normals past
  * the clamp and signed zeros in the light. */
 #include "harness.h"
+#include "rand_dir.h"
 #include "scene_fixture.h"
 #include "shade/shade_job.h"
 
@@ -14,20 +15,6 @@
 #if defined(__SSE2__)
 enum { NPX = 4096 };
 
-static float urand(vt_rng *r, float lo, float hi)
-{
-    return lo + (hi - lo) * (float)vt_uniform(r);
-}
-
-static v3 rand_dir(vt_rng *r)
-{
-    for (;;) {
-        v3 d = v3_make(urand(r, -1, 1), urand(r, -1, 1), urand(r, -1, 1));
-        float l = v3_length(d);
-        if (l > 0.1f && l <= 1.0f)
-            return v3_scale(d, 1.0f / l);
-    }
-}
 
 typedef struct planes_buf {
     float d[NPX * 3], gl[NPX * 3], dc[NPX * 3], gc[NPX * 3], cov[NPX], cd[NPX * 4];

@@ -5,6 +5,7 @@
  * an anisotropic rotation) and vsgl__camera_ray4 against vsgl__camera_ray
  * (perspective with shifts and both sensor fits, orthographic). */
 #include "harness.h"
+#include "rand_dir.h"
 #include "scene_fixture.h"
 #include "scene/camera.h"
 #include "scene/scene_internal.h"
@@ -12,20 +13,6 @@
 #include <string.h>
 
 #if defined(__SSE2__)
-static float urand(vt_rng *r, float lo, float hi)
-{
-    return lo + (hi - lo) * (float)vt_uniform(r);
-}
-
-static v3 rand_dir(vt_rng *r)
-{
-    for (;;) {
-        v3 d = v3_make(urand(r, -1, 1), urand(r, -1, 1), urand(r, -1, 1));
-        float l = v3_length(d);
-        if (l > 0.1f && l <= 1.0f)
-            return v3_scale(d, 1.0f / l);
-    }
-}
 
 static void check_surface4(int with_uvs);
 
