@@ -42,7 +42,7 @@ vsgl_result vsgl__mrp_glossy_pass(vsgl_context *ctx, const vsgl_scene *scene, ui
                                   double min_area, uint32_t cells, const vsgl_gbuffer *g,
                                   const vsgl_pixel_planes *planes, size_t *proxies, vsgl__mrp_proxy_set *lit)
 {
-    vsgl__mrp_proxy_set own, *set = lit ? lit : &own;
+    vsgl__mrp_proxy_set own = {0}, *set = lit ? lit : &own;
     vsgl_result r = lit ? VSGL_OK : vsgl__mrp_proxies_build(ctx, scene, min_area, cells, &own);
     if (r != VSGL_OK)
         return r;
@@ -74,7 +74,7 @@ vsgl_result vsgl__mrp_hybrid_pass(vsgl_context *ctx, const vsgl_scene *scene, co
                                   const vsgl_gbuffer *g, const vsgl_vsgl_set *vsgls, const vsgl_pixel_planes *planes,
                                   size_t *excluded, vsgl__mrp_proxy_set *lit)
 {
-    vsgl__mrp_proxy_set own, *sp = lit ? lit : &own;
+    vsgl__mrp_proxy_set own = {0}, *sp = lit ? lit : &own;
     vsgl_result r = lit ? VSGL_OK
                         : vsgl__mrp_proxies_build(ctx, scene,
                                                   s->mrp_min_area > 0.0f ? (double)s->mrp_min_area : VSGL__MRP_MIN_AREA,

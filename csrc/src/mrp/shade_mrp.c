@@ -149,8 +149,8 @@ static void sample_glossy(const mrp_job *j, size_t i, d3 x, d3 n, d3 o, float ou
              * (the back side's flipped plane.v would mirror its radiance) */
             const d3 pv0 = p->rect.v;
             double yu = d3_dot(dy, plane.u), yv = d3_dot(dy, pv0);
-            const float *lv[VSGL__MRP_MAX_LEVELS]; /* this side's pyramid levels, looked up once */
-            uint32_t lnu[VSGL__MRP_MAX_LEVELS], lst[VSGL__MRP_MAX_LEVELS];
+            const float *lv[VSGL__MRP_MAX_LEVELS] = {0}; /* this side's pyramid levels, looked up once */
+            uint32_t lnu[VSGL__MRP_MAX_LEVELS] = {0}, lst[VSGL__MRP_MAX_LEVELS] = {0};
             for (uint32_t l = 0; l < p->levels && l < VSGL__MRP_MAX_LEVELS; ++l) {
                 uint32_t nv_l;
                 lv[l] = vsgl__mrp_level(p, side, l, &lnu[l], &nv_l, &lst[l]);
