@@ -104,9 +104,9 @@ def main_n(n):
         k, c = fit_n(n)
     except ImportError:
         sys.exit("fit_ggx_lobes.py needs scipy: python3 -m pip install scipy")
-    for i, (ki, ci) in enumerate(zip(k, c)):
-        print("#define VSGL__HV_K%d %.5gf" % (i, ki))
-        print("#define VSGL__HV_C%d %.5gf" % (i, ci))
+    print("#define VSGL__HV_LOBES %d" % n)
+    print("#define VSGL__HV_K_LIST {%s}" % ", ".join("%.5gf" % v for v in k))
+    print("#define VSGL__HV_C_LIST {%s}" % ", ".join("%.5gf" % v for v in c))
     print("energy shares " + " ".join("%.3f" % (ci / ki) for ki, ci in zip(k, c)) +
           "; objective %.5f" % objective_n(k, c))
     xs = np.array([0.0, 1.0, 2.0, 3.0, 5.0, 7.0, 10.0])

@@ -52,8 +52,11 @@ def test_two_lobes_follow_ggx_within_three_alphas():
 
 def header_hv_constants():
     text = open(os.path.join(ROOT, "csrc", "src", "shade", "kernel.h")).read()
-    get = lambda name: float(re.search(r"#define VSGL__HV_%s ([0-9.e+-]+)f" % name, text).group(1))  # noqa: E731
-    return np.array([get("K%d" % i) for i in range(4)]), np.array([get("C%d" % i) for i in range(4)])
+    get = lambda name: np.array([float(v) for v in re.findall(  # noqa: E731
+        r"([0-9.e+-]+)f", re.search(r"#define VSGL__HV_%s_LIST \{([^}]*)\}" % name, text).group(1))])
+    k, c = get("K"), get("C")
+    assert len(k) == len(c) == int(re.search(r"#define VSGL__HV_LOBES (\d+)", text).group(1))
+    return k, c
 
 
 def test_four_lobes_keep_ggx_integral_and_follow_its_tail():

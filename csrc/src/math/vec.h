@@ -25,6 +25,12 @@ static inline v3 v3_normalize(v3 a)
     return (l > 0.0f && l < INFINITY) ? v3_scale(a, 1.0f / l) : v3_make(0.0f, 0.0f, 0.0f);
 }
 static inline float clampf(float x, float lo, float hi) { return x < lo ? lo : (x > hi ? hi : x); }
+/* 3t^2 - 2t^3 of t clamped to [0, 1]: the smooth blend weights of shade/. */
+static inline float smoothstep01f(float t)
+{
+    t = clampf(t, 0.0f, 1.0f);
+    return t * t * (3.0f - 2.0f * t);
+}
 
 /* Orthonormal basis (x, y) completing unit z, continuous except at one
  * point (Duff et al. 2017, "Building an orthonormal basis, revisited"). */

@@ -5,12 +5,6 @@
 
 #include <math.h>
 
-static float smooth01(float t)
-{
-    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-    return t * t * (3.0f - 2.0f * t);
-}
-
 /* Smith's height-correlated G2 / (4 ci co) times 4 ci, without the
  * constant: ci / (ci So + co Si) (scene/material.c vsgl__specular_factor). */
 static float smith_term(float ci, float co, float a2)
@@ -36,8 +30,8 @@ float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float 
     v3 h = v3_scale(hs, 1.0f / m);
     float hn = v3_dot(h, n);
     float sv = v->variance * r * r;
-    float wgt = smooth01((VSGL__HV_SPREAD_HI - sv) / (VSGL__HV_SPREAD_HI - VSGL__HV_SPREAD_LO)) *
-                smooth01((hn - VSGL__HV_HN_LO) / (VSGL__HV_HN_HI - VSGL__HV_HN_LO));
+    float wgt = smoothstep01f((VSGL__HV_SPREAD_HI - sv) / (VSGL__HV_SPREAD_HI - VSGL__HV_SPREAD_LO)) *
+                smoothstep01f((hn - VSGL__HV_HN_LO) / (VSGL__HV_HN_HI - VSGL__HV_HN_LO));
     if (!(wgt > 0.0f))
         return 0.0f;
     v3 t, u;
@@ -52,8 +46,8 @@ float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float 
     for (int i = 0; i < 2; ++i)
         for (int k = 0; k < 2; ++k)
             cov[i][k] = sv * (v3_dot(a[i], a[k]) - v3_dot(a[i], w) * v3_dot(a[k], w) - v3_dot(a[i], p) * v3_dot(a[k], p));
-    static const float K[VSGL__HV_LOBES] = {VSGL__HV_K0, VSGL__HV_K1, VSGL__HV_K2, VSGL__HV_K3};
-    static const float C[VSGL__HV_LOBES] = {VSGL__HV_C0, VSGL__HV_C1, VSGL__HV_C2, VSGL__HV_C3};
+    static const float K[VSGL__HV_LOBES] = VSGL__HV_K_LIST;
+    static const float C[VSGL__HV_LOBES] = VSGL__HV_C_LIST;
     float ed = 0.0f; /* E[D] h.n^4 */
     for (int q = 0; q < VSGL__HV_LOBES; ++q) {
         float al2 = alpha * alpha * 0.5f / K[q];

@@ -99,14 +99,8 @@ typedef struct vsgl_kernel_light {
  * VSGL__HV_HN_HI, blended out by _LO: below it the slope mapping is too
  * curved to linearise). */
 #define VSGL__HV_LOBES 4
-#define VSGL__HV_K0 1.3917f
-#define VSGL__HV_C0 0.72905f
-#define VSGL__HV_K1 0.35132f
-#define VSGL__HV_C1 0.1126f
-#define VSGL__HV_K2 0.099116f
-#define VSGL__HV_C2 0.011354f
-#define VSGL__HV_K3 0.022969f
-#define VSGL__HV_C3 0.00094364f
+#define VSGL__HV_K_LIST {1.3917f, 0.35132f, 0.099116f, 0.022969f}
+#define VSGL__HV_C_LIST {0.72905f, 0.1126f, 0.011354f, 0.00094364f}
 #define VSGL__HV_SPREAD_LO 0.003f
 #define VSGL__HV_SPREAD_HI 0.01f
 #define VSGL__HV_HN_LO 0.3f

@@ -724,8 +724,8 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 2));
         }
         if (hv) {
-            static const float hk[VSGL__HV_LOBES] = {VSGL__HV_K0, VSGL__HV_K1, VSGL__HV_K2, VSGL__HV_K3};
-            static const float hc[VSGL__HV_LOBES] = {VSGL__HV_C0, VSGL__HV_C1, VSGL__HV_C2, VSGL__HV_C3};
+            static const float hk[VSGL__HV_LOBES] = VSGL__HV_K_LIST;
+            static const float hc[VSGL__HV_LOBES] = VSGL__HV_C_LIST;
             for (int q = 0; q < VSGL__HV_LOBES; ++q) {
                 K_FORN(k_hv_lobe(b, i, t + j, hk[q], hc[q]));
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 3));

@@ -42,12 +42,6 @@
 /* Grid cells per axis of the index at most. */
 #define VSGL__NEAR_GRID_MAX 64
 
-static float smooth01(float t)
-{
-    t = clampf(t, 0.0f, 1.0f);
-    return t * t * (3.0f - 2.0f * t);
-}
-
 static float axis_of(v3 p, uint32_t a)
 {
     return a == 0 ? p.x : a == 1 ? p.y : p.z;
@@ -181,7 +175,7 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
     float du = su / area - axis_of(v->mean, (a + 1) % 3), dv = sv / area - axis_of(v->mean, (a + 2) % 3);
     float off = sqrtf(du * du + dv * dv) / h;
     c->fit = v->coherence * v->coherence *
-             smooth01((facing - VSGL__NEAR_FACING_LO) / (VSGL__NEAR_FACING_HI - VSGL__NEAR_FACING_LO));
+             smoothstep01f((facing - VSGL__NEAR_FACING_LO) / (VSGL__NEAR_FACING_HI - VSGL__NEAR_FACING_LO));
     if (c->lambda > 0.0f) {
         /* a specular cell: its tent, truncated to the VPLs' extent, times
          * an irradiance linear across it whose mean is the VPLs' (per axis:
@@ -213,7 +207,7 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
         c->grad[1] = (float)g[1] * scale;
         c->inv_area = (float)(1.0 / (VSGL__PI * mass[0] * mass[1]));
     } else {
-        c->fit *= 1.0f - smooth01((off - VSGL__NEAR_UNIFORM) / (2.0f * VSGL__NEAR_UNIFORM));
+        c->fit *= 1.0f - smoothstep01f((off - VSGL__NEAR_UNIFORM) / (2.0f * VSGL__NEAR_UNIFORM));
     }
     return c->fit > 0.0f;
 }
@@ -315,10 +309,10 @@ float vsgl__near_diffuse(const vsgl_near_cell *c, v3 x, v3 n, float *weight)
     float r = v3_length(v3_sub(x, c->centre)) / c->h;
     if (!(r < VSGL__NEAR_NONE) || !(height < VSGL__NEAR_HEIGHT_NONE * c->h))
         return 0.0f;
-    *weight = c->fit * (1.0f - smooth01((r - VSGL__NEAR_FULL) / (VSGL__NEAR_NONE - VSGL__NEAR_FULL))) *
-              (1.0f - smooth01((height / c->h - VSGL__NEAR_HEIGHT_FULL) /
+    *weight = c->fit * (1.0f - smoothstep01f((r - VSGL__NEAR_FULL) / (VSGL__NEAR_NONE - VSGL__NEAR_FULL))) *
+              (1.0f - smoothstep01f((height / c->h - VSGL__NEAR_HEIGHT_FULL) /
                                (VSGL__NEAR_HEIGHT_NONE - VSGL__NEAR_HEIGHT_FULL)));
-    float front = smooth01(height / (VSGL__NEAR_BEHIND * c->h));
+    float front = smoothstep01f(height / (VSGL__NEAR_BEHIND * c->h));
     if (c->lambda > 0.0f)
         return front * near_specular(c, x, n, height);
     float ff = 0.0f;

@@ -44,12 +44,6 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
     return 1;
 }
 
-static float smoothstep01(float t)
-{
-    t = clampf(t, 0.0f, 1.0f);
-    return t * t * (3.0f - 2.0f * t);
-}
-
 float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
 {
     if (!on)
@@ -61,8 +55,8 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
     float s = var > 0.0f ? d2 / var : 0.0f;
     float w = s / (s + VSGL__CLIP_NEAR);
     /* the parallel clip in the near field only: far away the receiver's own cosine does it */
-    float par = 1.0f - (1.0f - smoothstep01((1.0f - v3_dot(n, v->normal)) * (1.0f / VSGL__CLIP_PARALLEL))) * (1.0f - w);
-    float e = smoothstep01(h / (VSGL__CLIP_BEHIND * sqrtf(var) + VSGL__TINY)) * par;
+    float par = 1.0f - (1.0f - smoothstep01f((1.0f - v3_dot(n, v->normal)) * (1.0f / VSGL__CLIP_PARALLEL))) * (1.0f - w);
+    float e = smoothstep01f(h / (VSGL__CLIP_BEHIND * sqrtf(var) + VSGL__TINY)) * par;
     if (v->lobe == VSGL__LOBE_DIFFUSE) {
         float c = d2 > 0.0f ? clampf(h / sqrtf(d2), 0.0f, 1.0f) : 0.0f;
         float ld = vsgl_sg_cosine_sharpness();
