@@ -89,7 +89,7 @@ VT_TEST(halfvec_glossy_follows_ggx_into_its_tail)
                 part.lambda *= K[q];
                 part.mu *= K[q];
                 part.log_amplitude += logf(C[q]);
-                asg += vsgl__planar_glossy(&v, v3_make(0, 0, 0), &part) * M;
+                asg += vsgl__planar_glossy(&v, v3_make(0, 0, 0), v3_make(0, 0, 1), &part) * M;
             }
             double want = quadrature(alpha, x, o, 0.0, wy, mz, var);
             double e = fabs(hv / want - 1.0), ea = fabs(asg / want - 1.0);

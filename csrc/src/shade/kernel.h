@@ -66,6 +66,18 @@ typedef struct vsgl_kernel_light {
     float freach; /* (sqrt(50) + 2 |farthest cut|)^2 / 2: where the fold can matter (k_shade) */
 } vsgl_kernel_light;
 
+/* The planar model's receiver horizon (shade.h, vsgl__planar_glossy): where
+ * the lobe's axis is within asin(HI) of the receiver's tangent plane, its
+ * footprint on a cluster's plane reaches past the horizon (a sphere's rim
+ * reflected lit floor below it: hot dots that crawl as the camera moves);
+ * there the part of the cluster x footprint below the tangent plane is
+ * dropped, fully below LO. Not everywhere: a cluster's Gaussian spills
+ * past its surface's end, and that spill stands for light that is there
+ * (the red-wall room's glossy structured error +8 % with the cut applied
+ * to every pair, docs/quality.md). */
+#define VSGL__HORIZON_HI 0.3f
+#define VSGL__HORIZON_LO 0.1f
+
 /* Lobes a block needs (skip the work for lobes no lane has). */
 #define VSGL__KERNEL_DIFFUSE 1
 #define VSGL__KERNEL_GLOSSY  2

@@ -376,6 +376,14 @@ k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t, f
     t->gpre[i] = kc * b->camp[i] * (gz > 0.0f ? gz : 0.0f) * (VSGL__PI * rp * ilin) * t->amp[i];
 }
 
+/* Phi(z), the standard normal CDF, from k_erfc_poly (within 1.5e-7). */
+static inline __attribute__((always_inline)) float k_ncdf(float z)
+{
+    float x = (z < 0.0f ? -z : z) * 0.70710678118654752f;
+    float e = 0.5f * k_erfc_poly(x) * k_exp(-x * x);
+    return z < 0.0f ? e : 1.0f - e;
+}
+
 /* Stage 4b: glossy light from a planar cluster (shade.h, vsgl__planar_glossy):
  * the radiance of the cluster's plane where the lobe's axis meets it,
  * blurred by the lobe's footprint there: all but the exp. */
@@ -424,7 +432,21 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     float idet = 1.0f / det;
     float qf = (s22 * d1 * d1 - 2.0f * s12 * d1 * e2 + s11 * e2 * e2) * idet;
     t->pexpo[i] = qf > 0.0f ? -0.5f * qf : 0.0f;
-    t->ppre[i] = ok * t->vis[i] * kc * b->camp[i] * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu) * (is * is);
+    /* the receiver's horizon where its lobe grazes it (kernel.h,
+     * VSGL__HORIZON_*): the share of the cluster x footprint product (mean
+     * S^-1 d, covariance I - S^-1 in sigma units) above the receiver's
+     * tangent plane, along nu, the normal's part in the cluster's plane */
+    float nu1 = b->nx[i] * L->u1x + b->ny[i] * L->u1y + b->nz[i] * L->u1z;
+    float nu2 = b->nx[i] * L->u2x + b->ny[i] * L->u2y + b->nz[i] * L->u2z;
+    float g0 = (b->nx[i] * dx + b->ny[i] * dy + b->nz[i] * dz) * is +
+               (nu1 * (s22 * d1 - s12 * e2) + nu2 * (s11 * e2 - s12 * d1)) * idet;
+    float gv = nu1 * nu1 + nu2 * nu2 - (s22 * nu1 * nu1 - 2.0f * s12 * nu1 * nu2 + s11 * nu2 * nu2) * idet;
+    gv = gv > 1e-12f ? gv : 1e-12f;
+    float zn = zx * b->nx[i] + zy * b->ny[i] + zz * b->nz[i];
+    float gw = (VSGL__HORIZON_HI - zn) * (1.0f / (VSGL__HORIZON_HI - VSGL__HORIZON_LO));
+    gw = gw < 0.0f ? 0.0f : (gw > 1.0f ? 1.0f : gw);
+    float hz = 1.0f - (1.0f - k_ncdf(g0 * k_rsqrt(gv))) * gw * gw * (3.0f - 2.0f * gw);
+    t->ppre[i] = ok * hz * t->vis[i] * kc * b->camp[i] * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu) * (is * is);
     t->pd1[i] = d1;
     t->pd2[i] = e2;
     t->ps11[i] = s11;
@@ -526,13 +548,6 @@ static inline __attribute__((always_inline)) void k_hv_rest(size_t i, k_scratch 
     t->ppre[i] *= 1.0f - t->hvw[i];
 }
 
-/* Phi(z), the standard normal CDF, from k_erfc_poly (within 1.5e-7). */
-static inline __attribute__((always_inline)) float k_ncdf(float z)
-{
-    float x = (z < 0.0f ? -z : z) * 0.70710678118654752f;
-    float e = 0.5f * k_erfc_poly(x) * k_exp(-x * x);
-    return z < 0.0f ? e : 1.0f - e;
-}
 
 /* Along one axis of a cut cell (sigma units, the cluster's mean at 0 and
  * its variance 1): the weight of the image of mean m (0: the cluster's,

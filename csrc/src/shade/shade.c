@@ -141,7 +141,28 @@ static float fold_image(float m0, float lo, float hi, float al, float ah, int im
     return img == 0 ? wl * wh : img == 1 ? al * tl * wh : ah * th * wl;
 }
 
-float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
+/* The receiver's horizon in the planar model where its lobe grazes it
+ * (kernel.h, VSGL__HORIZON_*): the share of the product of the cluster's
+ * Gaussian and the footprint's (S = var I + footprint; mean var S^-1 d
+ * from the cluster's, covariance var I - var^2 S^-1) above the receiver's
+ * tangent plane, n_r . (y - x) > 0, taken along nu, the normal's part in
+ * the cluster's plane (u1, u2). */
+static float planar_horizon(const vsgl_vsgl *v, v3 x, v3 nr, vsgl_vec3 z, float var, float d1, float d2, float s11,
+                            float s22, float s12, float det, v3 u1, v3 u2)
+{
+    float zn = nr.x * z.x + nr.y * z.y + nr.z * z.z;
+    float gw = smoothstep01f((VSGL__HORIZON_HI - zn) / (VSGL__HORIZON_HI - VSGL__HORIZON_LO));
+    if (!(gw > 0.0f))
+        return 1.0f;
+    float nu1 = v3_dot(nr, u1), nu2 = v3_dot(nr, u2);
+    float g0 = v3_dot(nr, v3_sub(v->mean, x)) + var * (nu1 * (s22 * d1 - s12 * d2) + nu2 * (s11 * d2 - s12 * d1)) / det;
+    float gv = var * (nu1 * nu1 + nu2 * nu2 - var * (s22 * nu1 * nu1 - 2.0f * s12 * nu1 * nu2 + s11 * nu2 * nu2) / det);
+    gv = fmaxf(gv, 1e-12f * var);
+    float above = 0.5f * erfcf(-g0 / sqrtf(2.0f * gv));
+    return 1.0f - (1.0f - above) * gw;
+}
+
+float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe)
 {
     v3 n = v->normal;
     float h = v3_dot(n, v3_sub(x, v->mean)), nz = v3_dot(n, lobe->z);
@@ -174,6 +195,7 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe)
         return 0.0f;
     /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
     float scale = expf(lobe->log_amplitude) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
+    scale *= planar_horizon(v, x, nr, lobe->z, var, d1, d2, s11, s22, s12, det, u1, u2);
     float q0 = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
     if (!(wf > 0.0f))
         return scale * expf(-0.5f * q0);
@@ -333,7 +355,7 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
             else if (parts == 2)
                 lobe = ggx_part(&r->asg, q);
             float k2 = v->coherence * v->coherence;
-            gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * vsgl__planar_glossy(v, r->x, &lobe);
+            gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * vsgl__planar_glossy(v, r->x, r->n, &lobe);
         }
         sum += gi;
     }

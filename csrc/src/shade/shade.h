@@ -66,6 +66,8 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
  * spread maps to a footprint of covariance J diag(1/2lambda, 1/2mu) J^T
  * there; the result is the lobe's integral pi / sqrt(lambda mu) times the
  * radiance blurred by the footprint, N(y0 - mean; variance I + footprint) / pi.
+ * Where the lobe grazes the receiver's tangent plane (normal nr), the
+ * part below that plane is dropped (kernel.h, VSGL__HORIZON_*).
  * Unlike the round spread SG it sees a plane foreshortened (a cabinet's
  * face reflecting the floor beside it: 0.65 -> 1.08 of the brute force's
  * glossy light in the sun room) and never anything behind the plane.
@@ -79,7 +81,7 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
  * lit wall darkened towards its foot (35 % at the junction of the red-wall
  * room's floor; glossy structured error against Cycles 2-6x lower with the
  * fold, docs/quality.md). */
-float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, const vsgl_asg *lobe);
+float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe);
 
 /* Shade every G-buffer sample with every VSGL; writes `planes`.
  * `pairs` receives the number of sample x VSGL evaluations. */
