@@ -21,7 +21,7 @@ else:  # a top-level module (the tests, tools/)
 # --------------------------------------------------------------------------
 
 BINDING_VERSION = (0, 3)
-BUNDLE_VERSION = (1, 5)
+BUNDLE_VERSION = (1, 6)
 
 
 class Result(enum.IntEnum):
@@ -399,6 +399,7 @@ class vsgl_render_settings(_Struct):
         ("edge_samples", c_uint32),
         ("auto_target", c_int32),
         ("mrp_min_area", c_float),
+        ("glossy_lobes", c_uint32),
     ]
     _enums = {
         "method": Method, "fit_mode": FitMode, "sharpness_estimator": SharpnessEstimator,

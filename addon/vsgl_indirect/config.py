@@ -27,6 +27,7 @@ KNOBS = {
     "leak_correction": (("AUTO", "OFF", "ON", "CLIP"), "AUTO"),
     "diffuse_mode": (("SG", "PULLED_OUT", "ACCURATE"), "PULLED_OUT"),
     "glossy_mode": (("ASG", "SG", "ASG2", "MRP", "HYBRID"), "ASG2"),
+    "glossy_lobes": (None, 4),
     "mrp_min_area": (None, 0.25),
 }
 
@@ -35,14 +36,14 @@ KNOBS = {
 # tests/blender/addon/test_addon_ui.py checks the two agree.
 _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", fis_iterations=8,
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
-               diffuse_mode="PULLED_OUT", mrp_min_area=0.25)
+               diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4)
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="NONE",
                     shade_stride=2, edge_samples=8),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
                      shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
-    "QUALITY": dict(_COMMON, aa_samples=2, rsm_resolution=512, vsgl_count=256, visibility="RAY",
-                    shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
+    "QUALITY": dict(_COMMON, aa_samples=3, rsm_resolution=512, vsgl_count=256, visibility="RAY",
+                    shade_stride=2, edge_samples=8, glossy_mode="ASG2", glossy_lobes=5),
 }
 # AUTO: balanced's knobs as ceilings; the library chooses within them (auto_target, render.h)
 PRESET_VALUES["AUTO"] = dict(PRESET_VALUES["BALANCED"])
@@ -92,6 +93,8 @@ def inactive_knobs(obj):
         out.add("sample_merging")
     if obj.glossy_mode not in ("MRP", "HYBRID") or obj.method == "BRUTE_FORCE":
         out.add("mrp_min_area")
+    if obj.glossy_mode != "ASG2" or obj.method == "BRUTE_FORCE":
+        out.add("glossy_lobes")
     return out
 
 
@@ -113,6 +116,7 @@ class Options:
     diffuse_mode: str = "PULLED_OUT"
     glossy_mode: str = "ASG"
     mrp_min_area: float = 0.25      # m^2: the smallest face made a rectangle proxy (MRP, HYBRID)
+    glossy_lobes: int = 4           # GGX's lobes in the half-vector model (ASG2): 4 or 5
     visibility: str = "RAY"
     seed: int = 0
     leak_correction: str = "AUTO"

@@ -13,7 +13,7 @@ from . import checks, config, engine, runner
 QUALITY_KNOBS = ("method", "aa_samples", "edge_samples", "shade_stride", "sample_merging", "visibility", "seed")
 LIGHT_KNOBS = ("rsm_resolution", "fit_mode", "vsgl_count", "fis_iterations",
                "sharpness_estimator", "leak_correction")
-MATERIAL_KNOBS = ("diffuse_mode", "glossy_mode", "mrp_min_area")
+MATERIAL_KNOBS = ("diffuse_mode", "glossy_mode", "glossy_lobes", "mrp_min_area")
 assert set(QUALITY_KNOBS + LIGHT_KNOBS + MATERIAL_KNOBS) == set(config.KNOBS)
 
 #: Blender's report icons: an error is a cross, a warning a triangle.

@@ -26,6 +26,8 @@ const char cli_usage[] =
     "  --diffuse NAME        sg | pulled-out | accurate   (receiver cosine)\n"
     "  --glossy NAME         asg | sg | asg2 | mrp | hybrid   (one ASG, one SG, GGX core + tail as two\n"
     "                        ASGs, rectangle proxies: the MRP paper, MRP per pixel where it applies)\n"
+    "  --glossy-lobes N      4 | 5             (GGX as N lobes where --glossy asg2 reflects a small lit\n"
+    "                        surface; 5: closer to GGX's peak, one lobe more per such pair)\n"
     "  --mrp-min-area A      smallest planar face made a rectangle proxy by --glossy mrp | hybrid\n"
     "                        (m^2, >= 0; 0 = the default 0.25)\n"
     "  --visibility NAME     none | ray\n"
@@ -162,6 +164,7 @@ static const num_opt num_opts[] = {
     {"--vsgls", 1, offsetof(cli_options, vsgls)},
     {"--shade-stride", 1, offsetof(cli_options, stride)},
     {"--edge-samples", 0, offsetof(cli_options, edge)},
+    {"--glossy-lobes", 0, offsetof(cli_options, lobes)},
     {"--threads", 0, offsetof(cli_options, threads)},
     {"--seed", 0, offsetof(cli_options, seed)},
 };
@@ -345,6 +348,7 @@ void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_r
     if (o->vsgls.set) s->vsgl_count = o->vsgls.value;
     if (o->stride.set) s->shade_stride = o->stride.value;
     if (o->edge.set) s->edge_samples = o->edge.value;
+    if (o->lobes.set) s->glossy_lobes = o->lobes.value;
     if (o->seed.set) s->seed = o->seed.value;
     if (o->fit >= 0) s->fit_mode = o->fit;
     if (o->sharpness >= 0) s->sharpness_estimator = o->sharpness;
@@ -367,11 +371,11 @@ static const char *name_of(const char *const *names, const int *values, int v)
 
 void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size)
 {
-    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u mrp_min_area=%g",
+    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u mrp_min_area=%g glossy_lobes=%u",
              name_of(method_names, method_values, s->method), s->aa_samples, s->rsm_resolution,
              name_of(fit_names, fit_values, s->fit_mode), s->vsgl_count, s->fis_iterations,
              name_of(sharp_names, sharp_values, s->sharpness_estimator), name_of(diffuse_names, diffuse_values, s->diffuse_mode),
              name_of(glossy_names, glossy_values, s->glossy_mode), name_of(vis_names, vis_values, s->visibility), s->seed,
              name_of(leak_names, leak_values, s->leak_correction), name_of(merge_names, merge_values, s->sample_merging), s->shade_stride, s->edge_samples,
-             (double)s->mrp_min_area);
+             (double)s->mrp_min_area, s->glossy_lobes);
 }

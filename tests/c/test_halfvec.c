@@ -80,7 +80,7 @@ VT_TEST(halfvec_glossy_follows_ggx_into_its_tail)
             float M = vsgl_specular_factor(&n, &ov, &lobe.z, (float)alpha, 1.0f);
             float w;
             double hv = vsgl__halfvec_glossy(&v, v3_make(0, 0, 0), v3_make(0, 0, 1), v3_make(ov.x, ov.y, ov.z), axis,
-                                             (float)alpha, &w) * M;
+                                             (float)alpha, VSGL__HV_LOBES, &w) * M;
             /* the planar model with GGX's core and tail (kernel.h VSGL__GGX_*) */
             double asg = 0.0;
             const float K[2] = {VSGL__GGX_CORE_K, VSGL__GGX_TAIL_K}, C[2] = {VSGL__GGX_CORE_C, VSGL__GGX_TAIL_C};

@@ -135,6 +135,8 @@ VT_TEST(kernel_shading_matches_reference_path)
             b.s.diffuse_mode = mode;
             /* the glossy lobe as one ASG, or as GGX's core and tail */
             b.s.glossy_mode = (k + mode) % 2 ? VSGL_GLOSSY_ASG2 : VSGL_GLOSSY_ASG;
+            /* the half-vector model's four lobes and the quality preset's five, both on the lattice */
+            b.s.glossy_lobes = 4u + (unsigned)((k / 2 + mode) % 2);
             float *ref = shade(&b, VSGL__SHADE_REFERENCE);
             float *vec = shade(&b, VSGL__SHADE_KERNEL);
             float *sca = shade(&b, VSGL__SHADE_KERNEL_SCALAR);

@@ -157,7 +157,7 @@ fi
 # ---- dry run --------------------------------------------------------------------
 if want dry_run; then
   if expect_ok dry_run "$VSGL" render "$SCENE" -o "$T/dry.exr" --dry-run --preset quality; then
-    if grep -q "dry run: .* would render 64x48 to $T/dry.exr with method=vsgl aa=2 rsm=512 fit=lattice" "$T/out" && [ ! -e "$T/dry.exr" ]; then
+    if grep -q "dry run: .* would render 64x48 to $T/dry.exr with method=vsgl aa=3 rsm=512 fit=lattice" "$T/out" && [ ! -e "$T/dry.exr" ]; then
       ok dry_run; else bad dry_run "$(cat "$T/out")" "file exists: $([ -e "$T/dry.exr" ] && echo yes || echo no)"; fi
   fi
 fi
@@ -309,6 +309,14 @@ expect_fail args_bad_mrp_min_area 2 "option --mrp-min-area: '-1' is not an area 
   --mrp-min-area -1
 expect_fail args_bad_mrp_min_area_nan 2 "option --mrp-min-area: 'nan' is not an area in m^2 >= 0" "$VSGL" render "$SCENE" \
   --mrp-min-area nan
+# --glossy-lobes: GGX's lobes in the half-vector glossy model (vsgl_render_settings.glossy_lobes)
+if want args_glossy_lobes && expect_ok "args_glossy_lobes" "$VSGL" render "$SCENE" -o "$T/lobes.exr" --glossy asg2 \
+    --glossy-lobes 5 --dry-run; then
+  if grep -q "glossy=asg2.*glossy_lobes=5" "$T/out"; then ok "args_glossy_lobes"
+  else bad "args_glossy_lobes" "$(head -3 "$T/out" | tr '\n' '|')"; fi
+fi
+expect_fail args_bad_glossy_lobes 1 "settings: glossy_lobes is 3 (valid 4 or 5; 0 = 4)" "$VSGL" render "$SCENE" \
+  --glossy-lobes 3 --dry-run
 expect_fail args_bad_compression 2 "'lzma' is not one of zip|zips|piz|none|rle|pxr24|b44|b44a" "$VSGL" render "$SCENE" \
   --compression lzma
 

@@ -148,6 +148,10 @@ typedef struct vsgl_render_settings {
                                       proxy. Larger: fewer proxies, less time, fewer surfaces reflected;
                                       smaller: more. 0 means VSGL_MRP_MIN_AREA_DEFAULT; finite, >= 0
                                       (docs/mrp.md §4) */
+    uint32_t glossy_lobes;       /**< glossy_mode ASG2: the Gaussian lobes GGX is taken as where a small lit
+                                      surface is reflected (the half-vector model, docs/pipeline.md): 4 (0
+                                      means 4; the balanced preset) or 5 (the quality preset: 0.96 of
+                                      GGX's peak instead of 0.85, one lobe more per such pair) */
 } vsgl_render_settings;
 
 /** vsgl_render_settings.mrp_min_area when it is 0 (m^2). */

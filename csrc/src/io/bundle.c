@@ -126,6 +126,8 @@ static const field settings_fields[] = {
     F(vsgl_render_settings, auto_target, 'i', 1),
     /* format 1.5: the MRP glossy modes' proxy size threshold */
     F(vsgl_render_settings, mrp_min_area, 'f', 1),
+    /* format 1.6: the half-vector glossy model's lobe count (the quality preset's 5) */
+    F(vsgl_render_settings, glossy_lobes, 'u', 1),
 };
 #define SLOT(m) F(vsgl_material_textures, m.texture, 'u', 1), F(vsgl_material_textures, m.filter, 'i', 1), \
     F(vsgl_material_textures, m.wrap, 'i', 1), F(vsgl_material_textures, m.channel, 'i', 1), \

@@ -9,7 +9,8 @@
 /* Glossy light per watt of planar Lambertian cluster v (radiance N(y)/pi
  * on its plane, N its Gaussian of variance v->variance per axis) at a
  * receiver at x with unit normal n, view o, isotropic GGX of roughness
- * alpha, through the BRDF's D and shadowing-masking relative to those at
+ * alpha, GGX as `lobes` Gaussian lobes (4, or 5: kernel.h VSGL__HV_*,
+ * VSGL__HV5_*), through the BRDF's D and shadowing-masking relative to those at
  * the lobe's axis `axis` (the caller multiplies by the smooth factor M
  * there, as for the ASG models); *weight receives the model's weight in
  * [0, 1] (0: not applicable, the planar model stands).
@@ -30,6 +31,6 @@
  * reflected wall. Valid where the cluster subtends little and the half
  * vector stands well above the horizon: the weight blends it out beyond
  * (kernel.h). */
-float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float alpha, float *weight);
+float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float alpha, int lobes, float *weight);
 
 #endif

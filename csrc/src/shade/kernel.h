@@ -100,7 +100,8 @@ typedef struct vsgl_kernel_light {
  * VSGL__KERNEL_GGX_TAIL; shade/halfvec.h): the cluster seen from the
  * receiver as a Gaussian of directions, mapped through the half vector
  * into the receiver's slope space and convolved there with GGX as four
- * Gaussian lobes c exp(-k x^2), x = |slope| / alpha, fitted at equal
+ * Gaussian lobes c exp(-k x^2) (five with vsgl_render_settings.glossy_lobes
+ * 5: VSGL__HV5_*, VSGL__KERNEL_HV5), x = |slope| / alpha, fitted at equal
  * integral to GGX's 1/(1 + x^2)^2 by the relative error over x in [0, 10]
  * (tools/fit_ggx_lobes.py --lobes 4; within 15 % of GGX up to 10 alpha: 0.85
  * of its peak, 1.09 at one alpha, within 4 % from 2 to 10 alpha, where the two lobes above hold 3.4 % of the energy
@@ -113,6 +114,12 @@ typedef struct vsgl_kernel_light {
 #define VSGL__HV_LOBES 4
 #define VSGL__HV_K_LIST {1.3917f, 0.35132f, 0.099116f, 0.022969f}
 #define VSGL__HV_C_LIST {0.72905f, 0.1126f, 0.011354f, 0.00094364f}
+/* Five lobes (tools/fit_ggx_lobes.py --lobes 5): 0.96 of GGX's peak, within
+ * 1 % from one alpha to ten; one lobe more per pair of the model. */
+#define VSGL__HV5_LOBES 5
+#define VSGL__HV5_K_LIST {2.0583f, 0.6556f, 0.2263f, 0.077476f, 0.019603f}
+#define VSGL__HV5_C_LIST {0.6639f, 0.24442f, 0.042696f, 0.0063297f, 0.0006717f}
+#define VSGL__KERNEL_HV5 8 /* the half-vector model with five lobes */
 #define VSGL__HV_SPREAD_LO 0.003f
 #define VSGL__HV_SPREAD_HI 0.01f
 #define VSGL__HV_HN_LO 0.3f

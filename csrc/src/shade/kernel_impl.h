@@ -739,9 +739,11 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 2));
         }
         if (hv) {
-            static const float hk[VSGL__HV_LOBES] = VSGL__HV_K_LIST;
-            static const float hc[VSGL__HV_LOBES] = VSGL__HV_C_LIST;
-            for (int q = 0; q < VSGL__HV_LOBES; ++q) {
+            static const float hk4[VSGL__HV_LOBES] = VSGL__HV_K_LIST, hc4[VSGL__HV_LOBES] = VSGL__HV_C_LIST;
+            static const float hk5[VSGL__HV5_LOBES] = VSGL__HV5_K_LIST, hc5[VSGL__HV5_LOBES] = VSGL__HV5_C_LIST;
+            const int five = (lobes & VSGL__KERNEL_HV5) != 0;
+            const float *hk = five ? hk5 : hk4, *hc = five ? hc5 : hc4;
+            for (int q = 0; q < (five ? VSGL__HV5_LOBES : VSGL__HV_LOBES); ++q) {
                 K_FORN(k_hv_lobe(b, i, t + j, hk[q], hc[q]));
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 3));
             }

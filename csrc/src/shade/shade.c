@@ -345,7 +345,7 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
      * half-vector model (halfvec.h), the planar one taking the rest */
     float hw = 0.0f, hv = 0.0f;
     if (parts == 2 && j->leak && v->lobe == VSGL__LOBE_DIFFUSE && v->coherence > 0.0f)
-        hv = vsgl__halfvec_glossy(v, r->x, r->n, r->o, r->asg.z, hv_alpha(r), &hw);
+        hv = vsgl__halfvec_glossy(v, r->x, r->n, r->o, r->asg.z, hv_alpha(r), (int)j->s->glossy_lobes, &hw);
     for (int q = 0; q < parts; ++q) {
         float gi = glossy_integral(j, r, in, axis, q);
         if (j->leak && v->lobe == VSGL__LOBE_DIFFUSE) {
@@ -612,7 +612,7 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
     for (size_t k = 0; k < n; ++k)
         lobes |= (blk->diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk->camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0);
     if ((lobes & VSGL__KERNEL_GLOSSY) && two_lobes(j->s->glossy_mode))
-        lobes |= VSGL__KERNEL_GGX_TAIL;
+        lobes |= VSGL__KERNEL_GGX_TAIL | (j->s->glossy_lobes == VSGL__HV5_LOBES ? VSGL__KERNEL_HV5 : 0);
     for (size_t k = n; k < VSGL__KERNEL_BLOCK; ++k) {
         /* padding lanes: shaded, never read; at lane 0's position so that
          * they do not change the block's choice of short forms */
