@@ -19,16 +19,17 @@ make -s build/libvsgl.so
 # isotropic cell cull only (before the lobe's ASG test); the exact BRDF
 # integrated over each cell instead of the MRP term (diagnostic: what the
 # cells' radiance allows); the hybrid with MRP's light alone in its pixels
-# (before the larger-of-two rule); the cell pyramid off (every cell on its
+# (before the larger-of-two rule) and with the larger of the two (the rule
+# before VSGL__MRP_HYBRID_RATIO 2); the cell pyramid off (every cell on its
 # own) and every pixel shaded (no 2 x 2 interpolation): the pass before
 # both speed-ups. Stills only.
 for v in "one:-DVSGL__MRP_LOBES=1:one lobe:mrp:glossy_mode=3" \
          "shrink:-DVSGL__MRP_SHRINK=1.0:shrink 1:mrp:glossy_mode=3" \
          "nocull:-DVSGL__MRP_CULL=0:box cull only:mrp:glossy_mode=3" \
          "exact:-DVSGL__MRP_EXACT_CELLS=4:exact cells:mrp:glossy_mode=3" \
-         "hybmrp:-DVSGL__MRP_HYBRID_MAX=0:MRP's light alone:hybrid:glossy_mode=4" \
-         "slow:-DVSGL__MRP_MERGE=0 -DVSGL__MRP_SPARSE_CONTRAST=0:no pyramid, every pixel:mrp:glossy_mode=3" \
-         "slowhyb:-DVSGL__MRP_MERGE=0 -DVSGL__MRP_SPARSE_CONTRAST=0:no pyramid, every pixel:hybrid:glossy_mode=4"; do
+         "hybmrp:-DVSGL__MRP_HYBRID_RATIO=0:MRP's light alone:hybrid:glossy_mode=4" \
+         "hybmax:-DVSGL__MRP_HYBRID_RATIO=1:the larger of the two, the rule before:hybrid:glossy_mode=4" \
+         "slow:-DVSGL__MRP_MERGE=0 -DVSGL__MRP_SPARSE_CONTRAST=0:no pyramid, every pixel:mrp:glossy_mode=3"; do
     tag=${v%%:*}; rest=${v#*:}; flags=${rest%%:*}; rest=${rest#*:}; label=${rest%%:*}; cfg=${rest#*:}
     dir=build/mrp_variants/$tag
     rm -rf "$dir"
@@ -38,4 +39,4 @@ for v in "one:-DVSGL__MRP_LOBES=1:one lobe:mrp:glossy_mode=3" \
 done
 "$PY" tools/mrp_quality.py time "$OUT/time.json"
 "$PY" tools/mrp_quality.py docs --timing "$OUT/time.json" "$OUT/main.npz" "$OUT/one.npz" "$OUT/shrink.npz" "$OUT/nocull.npz" "$OUT/exact.npz" \
-    "$OUT/hybmrp.npz" "$OUT/slow.npz" "$OUT/slowhyb.npz"
+    "$OUT/hybmrp.npz" "$OUT/hybmax.npz" "$OUT/slow.npz"

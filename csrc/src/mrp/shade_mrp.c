@@ -26,9 +26,8 @@
 #define VSGL__MRP_REACH 6.0
 #endif
 /* The same in the hybrid, where beyond MRP's reach the VSGLs' estimate of
- * the proxies' light takes over (the larger of the two, VSGL__MRP_HYBRID_MAX):
- * e^{-3} halves the lobe terms against e^{-6}, and the hybrid's glossy
- * relMSE against Cycles falls (docs/mrp.md §4, "Speed, second round"). */
+ * the proxies' light takes over (VSGL__MRP_HYBRID_RATIO): e^{-3} halves the
+ * lobe terms against e^{-6} (docs/mrp.md §4, "Speed, second round"). */
 #ifndef VSGL__MRP_REACH_HYBRID
 #define VSGL__MRP_REACH_HYBRID 3.0
 #endif
@@ -46,11 +45,17 @@
 #ifndef VSGL__MRP_MERGE_CONTRAST
 #define VSGL__MRP_MERGE_CONTRAST 0.25
 #endif
-/* Hybrid: 1 takes, in a pixel MRP takes, the larger of MRP's and the
- * on-proxy VSGLs' estimate of the proxies' light (no seam where MRP's
- * reach ends: a dark band showed there); 0: MRP's alone (docs/mrp.md §4). */
-#ifndef VSGL__MRP_HYBRID_MAX
-#define VSGL__MRP_HYBRID_MAX 1
+/* Hybrid: in a pixel MRP takes, the proxies' light is MRP's where it is
+ * more than this many times the on-proxy VSGLs' estimate of it, else the
+ * VSGLs'. 2: MRP only where the VSGLs miss most of the light it finds.
+ * Since the half-vector model (docs/pipeline.md), the lattice's light is
+ * closer to Cycles than MRP's wherever MRP's is at most 1.5x it: on the
+ * quality suite's metal floors this rule leaves the lattice's light in
+ * every pixel (docs/mrp.md §4). 1: the larger of the two (the rule before:
+ * no seam where MRP's reach ends, but MRP's excess at the rim of every
+ * reflection); 0: MRP's light alone (a dark band where its reach ends). */
+#ifndef VSGL__MRP_HYBRID_RATIO
+#define VSGL__MRP_HYBRID_RATIO 2.0
 #endif
 
 typedef struct mrp_job {
@@ -424,19 +429,17 @@ static int32_t mrp_chunk(void *user, size_t chunk, size_t b, size_t e)
         if (j->glossy_q) { /* hybrid: MRP where it finds lit proxies, with the VSGLs off them */
             if (!(acc[0] + acc[1] + acc[2] > 0.0f))
                 continue;
-#if VSGL__MRP_HYBRID_MAX
-            /* the proxies' light as the larger of MRP's and the on-proxy VSGLs' (all - off):
-             * MRP stops at e^{-VSGL__MRP_REACH_HYBRID} of its tail lobe, the VSGLs keep a haze beyond it */
+            /* the proxies' light: MRP's, or the on-proxy VSGLs' (all - off) where MRP's is not above
+             * VSGL__MRP_HYBRID_RATIO times theirs (MRP stops at e^{-VSGL__MRP_REACH_HYBRID} of its tail lobe) */
             const float *ga = j->planes->glossy + px * 3, *gq = j->glossy_q + px * 3;
             float pm = acc[0] + acc[1] + acc[2], pv = 0.0f, pvc[3];
             for (int c = 0; c < 3; ++c) {
                 pvc[c] = ga[c] > gq[c] ? ga[c] - gq[c] : 0.0f;
                 pv += pvc[c];
             }
-            if (pv > pm)
+            if (!(pm > (float)VSGL__MRP_HYBRID_RATIO * pv))
                 for (int c = 0; c < 3; ++c)
                     acc[c] = pvc[c];
-#endif
             for (int c = 0; c < 3; ++c)
                 acc[c] += j->glossy_q[px * 3 + c];
         }
