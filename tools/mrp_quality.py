@@ -181,7 +181,7 @@ def image(res, arrs, name, labels, path):
     ref = arrs["%s|ref" % name]
     e = imgutil.exposure_for(ref)
     lum = imgutil.luminance
-    heads, top, bot = [["cycles", "glossy pass"]], [imgutil.tonemap(ref, e)], [np.zeros(ref.shape)]
+    heads, top, bot = [["cycles", "glossy pass", ""]], [imgutil.tonemap(ref, e)], [np.zeros(ref.shape)]
     for lab in labels:
         key = "%s|%s" % (name, lab)
         if key not in arrs:
@@ -190,7 +190,8 @@ def image(res, arrs, name, labels, path):
         c = res["scenes"][name]["configs"][lab]
         top.append(imgutil.tonemap(img, e))
         bot.append(imgutil.signed_error(lum(img) - lum(ref), 4 * e))
-        heads.append([lab[:14], "relmse %.4f" % c["relmse"]])
+        base, _, var = lab.partition(" (")  # a variant's label on a second line
+        heads.append([base, "(" + var if var else "", "relmse %.4f" % c["relmse"]])
     up = 3
     rows = [[imgutil.upscale(t, up) for t in row] for row in (top, bot)]
     h, w = rows[0][0].shape[:2]
@@ -202,6 +203,57 @@ def image(res, arrs, name, labels, path):
         cols.append(np.concatenate(parts, axis=0))
     sep = np.ones((cols[0].shape[0], 1, 3))
     imgutil.save_png(path, np.concatenate(sum([[c, sep] for c in cols], [])[:-1], axis=1))
+
+
+MRP_ALONE = "hybrid (MRP's light alone)"
+RATIOS = (0.0, 1.0, 1.25, 1.5, 2.0, 3.0)
+
+
+def ratio_sweep(res, arrs):
+    """The hybrid's ratio rule (VSGL__MRP_HYBRID_RATIO) replayed per pixel from the stills: MRP's light
+    (the hybrid's MRP pass alone, variant hybmrp) where its sum of channels is above r times balanced's,
+    balanced's elsewhere. The off-proxy clusters' light is left out of the comparison (the floor's
+    specular clusters: little at the floor's own pixels), so ratio 1 and 2 give about the hybrid's rows."""
+    import metrics
+    lines = ["| scene | ratio r | pixels taking MRP | glossy relMSE | glossy FLIP |", "|---|---|---|---|---|"]
+    for name in res["scenes"]:
+        keys = ["%s|%s" % (name, l) for l in ("ref", "balanced", MRP_ALONE)]
+        if not all(k in arrs for k in keys):
+            continue
+        ref, bal, mrp = (arrs[k].astype(np.float64) for k in keys)
+        for r in RATIOS:
+            take = mrp.sum(2) > r * bal.sum(2)
+            a = np.where(take[..., None], mrp, bal)
+            row = (name, "%g" % r, int(take.sum()), metrics.relmse(a, ref), _f(metrics.flip(a, ref), "%.4f"))
+            lines.append("| %s | %s | %d | %.5f | %s |" % row)
+        row = (name, metrics.relmse(bal, ref), _f(metrics.flip(bal, ref), "%.4f"))
+        lines.append("| %s | balanced | 0 | %.5f | %s |" % row)
+    return "\n".join(lines)
+
+
+def win_map(res, arrs, path):
+    """Per scene a row: Cycles | balanced | MRP's light (the hybrid's pass alone) | where each is closer to
+    Cycles (per-pixel relMSE term: green MRP's light, magenta balanced's; brightness the difference)."""
+    import imgutil
+    rows = []
+    for name in res["scenes"]:
+        keys = ["%s|%s" % (name, l) for l in ("ref", "balanced", MRP_ALONE)]
+        if not all(k in arrs for k in keys):
+            continue
+        ref, bal, mrp = (arrs[k].astype(np.float64) for k in keys)
+        err = lambda a: np.mean((a - ref) ** 2 / (ref * ref + 0.01), axis=2)  # noqa: E731 (metrics.relmse per pixel)
+        d = err(bal) - err(mrp)
+        t = np.clip(d / (np.percentile(np.abs(d), 99) or 1.0), -1, 1)
+        win = np.stack([np.clip(-t, 0, 1), np.clip(t, 0, 1), np.clip(-t, 0, 1)], -1)
+        e = imgutil.exposure_for(ref)
+        tiles = [imgutil.tonemap(ref, e), imgutil.tonemap(bal, e), imgutil.tonemap(mrp, e), win]
+        up = [imgutil.upscale(x, 3) for x in tiles]
+        sep = np.ones((up[0].shape[0], 1, 3))
+        rows.append(np.concatenate(sum([[x, sep] for x in up], [])[:-1], axis=1))
+        rows.append(np.ones((1, rows[-1].shape[1], 3)))
+    if rows:
+        imgutil.save_png(path, np.concatenate(rows[:-1], axis=0))
+    return bool(rows)
 
 
 def docs(args):
@@ -220,10 +272,19 @@ def docs(args):
                "ratio to k-means 256):" % t["rounds"], "", timing_table(t), ""]
     md += ["The acceptance, per scene and configuration (k-means 256 as the reference; the time from the "
            "interleaved medians where measured):", "", verdict(res), ""]
+    sweep = ratio_sweep(res, arrs)
+    if sweep.count("\n") > 1:
+        md += ["The hybrid's ratio rule replayed per pixel from these stills (`ratio_sweep`: MRP's light, the "
+               "hybrid's pass alone, where it is above r times balanced's, balanced's elsewhere; r 0 is MRP's light "
+               "alone, 1 the rule before, 2 the default):", "", sweep, ""]
+    if win_map(res, arrs, os.path.join(img_dir, "mrp_quality_win.png")):
+        md += ["![Per scene (spot_metal_floor, metal_floor_red_wall, sun_opening): Cycles | balanced | MRP's light "
+               "(the hybrid's pass alone) | per pixel, which of the two is closer to Cycles (green MRP's light, "
+               "magenta balanced's)](img/mrp_quality_win.png)", ""]
     for name in res["scenes"]:
         shown = lambda l: l != "hybrid-km256" and "(" not in l  # noqa: E731
         labels = [l for l in res["scenes"][name]["configs"]
-                  if shown(l) or l in ("hybrid (the larger of the two, the rule before)", "hybrid (MRP's light alone)")]
+                  if shown(l) or l in ("hybrid (ratio 1, the rule before)", "hybrid (MRP's light alone)")]
         fn = "mrp_quality_%s.png" % name
         image(res, arrs, name, labels, os.path.join(img_dir, fn))
         md += ["![%s, glossy pass (80 x 60): Cycles | %s; below, the signed error of each (red too bright, blue "

@@ -28,7 +28,7 @@ for v in "one:-DVSGL__MRP_LOBES=1:one lobe:mrp:glossy_mode=3" \
          "nocull:-DVSGL__MRP_CULL=0:box cull only:mrp:glossy_mode=3" \
          "exact:-DVSGL__MRP_EXACT_CELLS=4:exact cells:mrp:glossy_mode=3" \
          "hybmrp:-DVSGL__MRP_HYBRID_RATIO=0:MRP's light alone:hybrid:glossy_mode=4" \
-         "hybmax:-DVSGL__MRP_HYBRID_RATIO=1:the larger of the two, the rule before:hybrid:glossy_mode=4" \
+         "hybmax:-DVSGL__MRP_HYBRID_RATIO=1:ratio 1, the rule before:hybrid:glossy_mode=4" \
          "slow:-DVSGL__MRP_MERGE=0 -DVSGL__MRP_SPARSE_CONTRAST=0:no pyramid, every pixel:mrp:glossy_mode=3"; do
     tag=${v%%:*}; rest=${v#*:}; flags=${rest%%:*}; rest=${rest#*:}; label=${rest%%:*}; cfg=${rest#*:}
     dir=build/mrp_variants/$tag
