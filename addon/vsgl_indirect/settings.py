@@ -170,12 +170,13 @@ ITEMS = {
         ("MRP", "Rectangle Proxies",
          "Experimental: the glossy light of the large planar faces (walls, floors, 0.25 m^2 and "
          "up) as lit rectangles reflected in closed form (the MRP paper, docs/mrp.md): lower glossy "
-         "error than k-means 256 in the red-wall and sun rooms, but several times slower on metal "
-         "floors; light from curved or small surfaces is not in the glossy pass"),
+         "relMSE than k-means 256 in the red-wall and sun rooms, higher than Two ASGs (balanced) "
+         "in every quality room; light from curved or small surfaces is not in the glossy pass"),
         ("HYBRID", "Hybrid",
-         "Experimental: Rectangle Proxies for sharp glossy surfaces (roughness up to 0.5) facing "
-         "lit walls, plus the light of clusters off the walls; Two ASGs everywhere else "
-         "(docs/mrp.md)"),
+         "Experimental: Two ASGs, except on sharp glossy surfaces (roughness up to 0.5) where "
+         "Rectangle Proxies find more than twice the light of the clusters on the walls; in the "
+         "metal-floor rooms no pixel does, so it renders as Two ASGs with the proxy pass's time "
+         "on top (docs/mrp.md)"),
     ],
     "visibility": [
         ("NONE", "None",

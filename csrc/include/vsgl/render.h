@@ -44,11 +44,13 @@ extern "C" {
                                light from anything else (curved or small surfaces) is not in the glossy
                                pass; 1.2-2.7x the time of k-means 256 with ASG2 in the quality rooms
                                (docs/mrp.md §4 says where it wins). Diffuse as ASG */
-#define VSGL_GLOSSY_HYBRID 4 /**< experimental: per pixel, where every glossy receiver is sharp
-                               (roughness <= 0.5) and reaches a lit rectangle proxy, the proxies' light
-                               as the larger of MRP's (above) and the on-proxy VSGLs' estimate, plus the
-                               VSGLs whose clusters lie on no proxy (nothing counts twice); the two-lobe
-                               VSGL term (ASG2) everywhere else (docs/mrp.md §4). Diffuse as ASG2 */
+#define VSGL_GLOSSY_HYBRID 4 /**< experimental: ASG2, except where every glossy receiver of a pixel is
+                               sharp (roughness <= 0.5) and MRP (above) finds more than twice the
+                               on-proxy VSGLs' estimate of the proxies' light: there MRP's light plus
+                               the VSGLs whose clusters lie on no proxy (nothing counts twice). Since
+                               the half-vector model no pixel of the quality suite's metal floors
+                               qualifies: the same glossy pass as ASG2 at the cost of the MRP pass on
+                               top (docs/mrp.md §4). Diffuse as ASG2 */
 
 #define VSGL_VISIBILITY_NONE 0
 #define VSGL_VISIBILITY_RAY  1  /**< one ray from the shading point to each VSGL centre / VPL */

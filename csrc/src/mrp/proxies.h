@@ -71,9 +71,10 @@ void vsgl__mrp_proxies_free(vsgl__mrp_proxy_set *set);
  * shading) is overwritten.
  * Hybrid (@p glossy_q not NULL: the VSGL glossy plane of the clusters off
  * every proxy): a pixel whose glossy samples all have alpha <= @p max_alpha
- * and receive MRP light gets glossy_q + the larger of MRP's light and the
- * on-proxy clusters' (planes->glossy - glossy_q); every other pixel keeps
- * the VSGL glossy light already in planes->glossy (docs/mrp.md §4). */
+ * and receive MRP light gets glossy_q + MRP's light where that is above
+ * VSGL__MRP_HYBRID_RATIO (shade_mrp.c) times the on-proxy clusters'
+ * (planes->glossy - glossy_q), else keeps planes->glossy; every other pixel
+ * keeps the VSGL glossy light already in planes->glossy (docs/mrp.md §4). */
 vsgl_result vsgl__mrp_shade_glossy(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
                                    const vsgl__mrp_proxy_set *set, const vsgl_pixel_planes *planes,
                                    const float *glossy_q, double max_alpha);
