@@ -42,8 +42,9 @@ extern "C" {
                                docs/mrp.md): the scene's large planar faces (>= mrp_min_area), lit by this
                                frame's RSMs, reflected by each receiver's warped ASG lobe in closed form;
                                light from anything else (curved or small surfaces) is not in the glossy
-                               pass; 1.2-2.7x the time of k-means 256 with ASG2 in the quality rooms
-                               (docs/mrp.md §4 says where it wins). Diffuse as ASG */
+                               pass; 0.9-1.5x the one-thread CPU of k-means 256 in the quality rooms,
+                               with a glossy error above ASG2's (balanced) in all of them (docs/mrp.md
+                               §4). Diffuse as ASG */
 #define VSGL_GLOSSY_HYBRID 4 /**< experimental: ASG2, except where every glossy receiver of a pixel is
                                sharp (roughness <= 0.5) and MRP (above) finds more than twice the
                                on-proxy VSGLs' estimate of the proxies' light: there MRP's light plus
