@@ -48,10 +48,10 @@
 /* Hybrid: in a pixel MRP takes, the proxies' light is MRP's where it is
  * more than this many times the on-proxy VSGLs' estimate of it, else the
  * VSGLs'. 2: MRP only where the VSGLs miss most of the light it finds.
- * Since the half-vector model (docs/pipeline.md), the lattice's light is
- * closer to Cycles than MRP's wherever MRP's is at most 1.5x it: on the
- * quality suite's metal floors this rule leaves the lattice's light in
- * every pixel (docs/mrp.md §4). 1: the larger of the two (the rule before:
+ * Since the half-vector model (docs/pipeline.md), taking MRP's light where
+ * it is 1x-1.5x the lattice's moves the quality rooms' glossy pass away
+ * from Cycles; on their metal floors this rule leaves the lattice's light
+ * in every pixel (docs/mrp.md §4). 1: the larger of the two (the rule before:
  * no seam where MRP's reach ends, but MRP's excess at the rim of every
  * reflection); 0: MRP's light alone (a dark band where its reach ends). */
 #ifndef VSGL__MRP_HYBRID_RATIO
