@@ -291,3 +291,99 @@ VT_TEST(render_cache_replay_rewrites_colours_after_another_render)
     vsgl_scene_destroy(scene);
     vsgl_context_destroy(ctx);
 }
+
+/* The live preview while the view moves (addon live.NavigationSchedule):
+ * each view rendered through the cache at a coarser size (1/2, 1/3 in each
+ * direction) or a coarser shade stride, a coarse render cancelled half-way,
+ * then the full render of the view at rest through the same cache (the
+ * refine): every plane equal to a plain render of that view bit for bit,
+ * and a light edit after it (the replay of the refine's plan) as well. */
+enum { CW = (W + 1) / 2, CH = (H + 1) / 2 };
+
+static int32_t cancel_at_shade(void *user, const char *stage, float fraction)
+{
+    (void)stage;
+    return *(const int *)user && fraction > 0.5f;
+}
+
+VT_TEST(render_cache_refine_after_coarse_views_equals_a_plain_render)
+{
+    static planes8 cached, plain;
+    static float small[W * H * 3];
+    vsgl_render_settings live;
+    vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &live); /* the add-on's Live quality */
+    live.shade_stride = 4;
+    live.edge_samples = 0;
+    vsgl_render_settings coarse_stride = live;
+    coarse_stride.shade_stride = 8;
+    for (uint32_t threads = 1; threads <= 2; ++threads) {
+        fx_scene fx;
+        fx_room(&fx, W, H, 0.25f, 200.0f);
+        int cancel = 0;
+        vsgl_context_desc cd;
+        memset(&cd, 0, sizeof cd);
+        cd.size = sizeof cd;
+        cd.thread_count = threads;
+        cd.progress = cancel_at_shade;
+        cd.progress_user = &cancel;
+        vsgl_context *ctx = NULL;
+        vsgl_scene *scene = NULL;
+        vsgl_render_cache *cache = NULL;
+        VT_REQUIRE(vsgl_context_create(&cd, &ctx) == VSGL_OK, "context");
+        VT_REQUIRE(vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
+        VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_CHECK(render_planes(ctx, scene, &live, cache, &cached, NULL) == VSGL_OK, "first full render");
+        const vsgl_camera full_camera = fx.camera;
+        for (int round = 0; round < 3; ++round) {
+            /* the view moves: three coarse views, the last one cancelled half-way in round 1 */
+            for (int k = 0; k < 3; ++k) {
+                const float eye[3] = {0.3f - 0.1f * (float)(round * 3 + k), -3.0f, 1.2f}, at[3] = {0.0f, 0.0f, 0.7f};
+                fx_look_at(fx.camera.world_from_camera, eye, at);
+                vsgl_camera c = fx.camera;
+                const vsgl_render_settings *s = &live;
+                if (round == 2) {
+                    s = &coarse_stride; /* full size, a coarser stride */
+                } else {
+                    c.width = round == 0 ? CW : (W + 2) / 3;
+                    c.height = round == 0 ? CH : (H + 2) / 3;
+                }
+                VT_CHECK(vsgl_scene_set_view(ctx, scene, &c, fx.lights, fx.light_count) == VSGL_OK, "set_view");
+                vsgl_render_output o;
+                memset(&o, 0, sizeof o);
+                o.width = c.width;
+                o.height = c.height;
+                o.combined = small;
+                cancel = round == 1 && k == 2;
+                vsgl_result r = vsgl_render_cached(ctx, scene, s, cache, &o, NULL);
+                VT_CHECK(r == (cancel ? VSGL_ERROR_CANCELLED : VSGL_OK), "round %d coarse view %d: %s", round, k,
+                         vsgl_context_last_error(ctx));
+                cancel = 0;
+            }
+            /* the view rests: the refine at the full size */
+            fx.camera.width = full_camera.width;
+            fx.camera.height = full_camera.height;
+            VT_CHECK(vsgl_scene_set_view(ctx, scene, &fx.camera, fx.lights, fx.light_count) == VSGL_OK, "set_view");
+            vsgl_render_stats st = {.size = sizeof st};
+            VT_CHECK(render_planes(ctx, scene, &live, cache, &cached, &st) == VSGL_OK, "%s",
+                     vsgl_context_last_error(ctx));
+            VT_CHECK(round == 2 || !(st.reused & VSGL_REUSED_GBUFFER), "round %d: the refine took a coarse G-buffer",
+                     round); /* round 2's coarse views were at the full size: its G-buffer is the view's */
+            VT_CHECK(render_planes(ctx, scene, &live, NULL, &plain, NULL) == VSGL_OK, "uncached");
+            for (int p = 0; p < 7; ++p)
+                VT_CHECK(memcmp(cached.p[p], plain.p[p], sizeof plain.p[p]) == 0,
+                         "threads %u round %d: the refine's plane %d differs from a plain render", threads, round, p);
+            VT_CHECK(memcmp(cached.alpha, plain.alpha, sizeof plain.alpha) == 0, "round %d: alpha differs", round);
+            /* a light edit after the rest replays the refine's plan */
+            fx.lights[0].world_from_light[3] += 0.05f;
+            VT_CHECK(vsgl_scene_set_view(ctx, scene, &fx.camera, fx.lights, fx.light_count) == VSGL_OK, "set_view");
+            VT_CHECK(render_planes(ctx, scene, &live, cache, &cached, &st) == VSGL_OK, "light edit");
+            VT_CHECK(st.reused & VSGL_REUSED_GBUFFER, "round %d: the light edit did not reuse the refine", round);
+            VT_CHECK(render_planes(ctx, scene, &live, NULL, &plain, NULL) == VSGL_OK, "uncached");
+            VT_CHECK(memcmp(&cached, &plain, sizeof plain) == 0, "threads %u round %d: light edit after the refine "
+                     "differs from a plain render", threads, round);
+        }
+        vsgl_render_cache_destroy(cache);
+        vsgl_scene_destroy(scene);
+        vsgl_context_destroy(ctx);
+    }
+}
