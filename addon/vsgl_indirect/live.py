@@ -1,6 +1,8 @@
 """Live preview logic without Blender: the viewport's camera as a
-``vsgl_camera``, the display encoding of a pass, and the scheduler that
-renders the newest edit on a worker thread and drops superseded ones.
+``vsgl_camera``, the display encoding of a pass, when to render what
+(NavigationSchedule: coarse while the view moves, full once it rests), and
+the scheduler that renders the newest edit on a worker thread and drops
+superseded ones.
 
 viewport.py is the Blender glue (handlers, drawing, panel); everything here
 is testable headless.
@@ -16,6 +18,13 @@ from . import convert
 DEBOUNCE_S = 0.04
 #: Viewport resolution divisors offered in the panel.
 SCALES = (1, 2, 3, 4)
+#: The panel's default divider while the view moves (``coarse``): each
+#: camera edit renders 1/2 x 1/2 of the pixels, drawn enlarged, until the
+#: view rests. Measured in docs/performance.md ("Navigation"): ~1/3 of the
+#: full camera edit's time; FLIP 0.02-0.04 against the full image.
+COARSE_DEFAULT = 2
+#: The largest divider while moving offered in the panel.
+COARSE_MAX = 4
 
 #: The panel's "Live" quality: the preview preset without edge rays,
 #: shading one pixel in 4 x 4 (not 2 x 2). On the live room its Combined
@@ -111,13 +120,72 @@ def _srgb_lut():
     return _LUT[0]
 
 
+class NavigationSchedule:
+    """When the live preview renders what (the timer's logic, no Blender).
+
+    Cycles' viewport renders at a coarse resolution while the view moves;
+    so does this. ``view_changed(now)`` when the viewport's matrices or
+    size changed, ``edited(now)`` for a scene edit or a changed setting;
+    ``next(now, coarse_busy)`` on every timer tick says what to start
+    (``tick(now, view_key, coarse_busy)``: both, the view's change seen as a
+    new ``view_key``):
+
+    * ``"coarse"``: the view moved and ``coarse`` > 1: render the view at
+      1/``coarse`` of the pixels in each direction (drawn enlarged) at once,
+      without waiting for the debounce; not while a coarse render is
+      running or waiting (``coarse_busy``): the newest view is rendered when
+      it ends, so the motion is drawn as fast as coarse images come;
+    * ``"full"``: nothing changed for ``debounce`` seconds: the full image
+      (the same as with ``coarse`` 1);
+    * None: nothing to start.
+
+    A scene edit asks only for the full render (a light edit is close to the
+    coarse one's cost; a geometry edit is mostly export). With ``coarse`` 1
+    every change waits for the debounce and renders full, as before.
+    """
+
+    def __init__(self, coarse=1, debounce=DEBOUNCE_S):
+        self.coarse = int(coarse)
+        self.debounce = float(debounce)
+        self.dirty_since = None   # the newest change the full render waits for, or None
+        self.moved = False        # the view moved since the last coarse render was started
+        self.view_key = None      # the view seen by the last tick
+
+    def view_changed(self, now):
+        self.dirty_since = now
+        self.moved = True
+
+    def edited(self, now):
+        self.dirty_since = now
+
+    def tick(self, now, view_key, coarse_busy=False):
+        if view_key != self.view_key:
+            self.view_key = view_key
+            self.view_changed(now)
+        return self.next(now, coarse_busy)
+
+    def next(self, now, coarse_busy=False):
+        if self.dirty_since is not None and now - self.dirty_since >= self.debounce:
+            self.dirty_since = None
+            self.moved = False
+            return "full"
+        if self.moved and self.coarse > 1 and not coarse_busy:
+            self.moved = False
+            return "coarse"
+        return None
+
+
 class Job:
     """One render of one edit: ``cancelled`` is polled by the library's
-    progress callback, so a superseded render stops within a block."""
+    progress callback, so a superseded render stops within a block. A job
+    that is not ``interruptible`` (a coarse render while the view moves: a
+    fraction of a full one) runs to its end even when superseded; a newer
+    submit only replaces it while it waits."""
 
-    def __init__(self, seq, key):
+    def __init__(self, seq, key, interruptible=True):
         self.seq = seq
         self.key = key
+        self.interruptible = bool(interruptible)
         self.cancelled = threading.Event()
         self.t_submit = time.perf_counter()
 
@@ -127,9 +195,10 @@ class LiveRenderer:
 
     ``submit(key, work)`` starts ``work(job)`` for a new edit (``work`` runs
     on the worker thread and returns the result; it must poll
-    ``job.cancelled``). A newer submit cancels the running job; at most one
-    job waits behind it, the newest, so a burst of edits renders the first
-    and the last, never the ones between. ``poll()`` (main thread) returns a
+    ``job.cancelled``). A newer submit cancels the running job (unless that
+    was submitted with ``interruptible=False``: it ends and its image is
+    shown); at most one job waits behind it, the newest, so a burst of edits
+    renders the first and the last, never the ones between. ``poll()`` (main thread) returns a
     new finished result once, or None. A request whose key equals the last
     submitted one is ignored.
     """
@@ -146,14 +215,14 @@ class LiveRenderer:
         self.errors = []
         self.dropped = 0
 
-    def submit(self, key, work):
+    def submit(self, key, work, interruptible=True):
         with self._lock:
             if key is not None and key == self.last_key:
                 return None
             self.last_key = key
             self._seq += 1
-            job = Job(self._seq, key)
-            if self._running is not None:
+            job = Job(self._seq, key, interruptible)
+            if self._running is not None and self._running.interruptible:
                 self._running.cancelled.set()
             if self._pending is not None:
                 self.dropped += 1
@@ -187,6 +256,12 @@ class LiveRenderer:
     def busy(self):
         with self._lock:
             return self._running is not None or self._pending is not None
+
+    def busy_uninterruptible(self):
+        """A job submitted with ``interruptible=False`` is running or waiting."""
+        with self._lock:
+            return ((self._running is not None and not self._running.interruptible)
+                    or (self._pending is not None and not self._pending[0].interruptible))
 
     def poll(self):
         """(seq, key, value, seconds from submit) of a result not returned before, else None."""

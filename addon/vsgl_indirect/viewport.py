@@ -3,8 +3,11 @@
 Toggle in the 3D viewport's sidebar (N) > VSGL. While it is on, every edit
 (a light or object moved, a material changed) and every view change
 re-renders the indirect light of that view on a worker thread and draws it
-over the viewport. Edits are debounced (live.DEBOUNCE_S) and a newer edit
-cancels the render of an older one. Meshes are read from Blender only when
+over the viewport. While the view moves, each view is rendered at once at a
+coarser resolution (the panel's "Divider While Moving") and drawn enlarged;
+once the view rests, and after every other edit, the full image follows
+(debounced, live.DEBOUNCE_S; live.NavigationSchedule). A newer edit cancels
+the full render of an older one. Meshes are read from Blender only when
 their geometry changed (the export's mesh cache). Scene logic lives in
 live.py; this module is the bpy glue: handlers, a timer, drawing.
 """
@@ -28,8 +31,8 @@ class _Session:
         self.renderer = live.LiveRenderer()
         self.mesh_cache = {}
         self.scene_serial = 0        # bumped by depsgraph updates
-        self.dirty_since = time.perf_counter()
-        self.view_key = None
+        self.schedule = live.NavigationSchedule()   # coarse while moving, full at rest
+        self.schedule.edited(time.perf_counter())
         self.image = None            # (display RGBA float32, w, h)
         self.texture = None          # (gpu texture, image serial)
         self.image_serial = 0
@@ -46,6 +49,12 @@ class _Session:
         self.lib_cache = None                  # libvsgl.RenderCache: G-buffer / VSGLs of the last render
         self.updates = 0                       # depsgraph updates seen
         self.current_job = None
+        self.coarse_submits = 0                # coarse renders started (the view moving)
+
+    @property
+    def dirty_since(self):
+        """When the newest change waiting for its full render happened, or None."""
+        return self.schedule.dirty_since
 
     def close(self):
         self.renderer.cancel(wait=True)
@@ -107,7 +116,8 @@ def _on_depsgraph_update(scene, depsgraph=None):
             del s.mesh_cache[k]
     s.scene_serial += 1
     s.updates += 1
-    s.dirty_since = s.last_edit = time.perf_counter()
+    s.last_edit = time.perf_counter()
+    s.schedule.edited(s.last_edit)
 
 
 def _view_key(region, rv3d, props):
@@ -115,10 +125,12 @@ def _view_key(region, rv3d, props):
             region.width, region.height, int(props.scale))
 
 
-def _submit(session, context_scene, depsgraph, region, rv3d, space, props):
-    """Export on this (main) thread, render on the worker."""
+def _submit(session, context_scene, depsgraph, region, rv3d, space, props, coarse=1):
+    """Export on this (main) thread, render on the worker. ``coarse`` > 1:
+    the view while it moves, at 1/coarse of the pixels in each direction
+    (drawn enlarged), not cancelled by a newer edit."""
     t0 = time.perf_counter()
-    w, h = live.internal_size(region.width, region.height, props.scale)
+    w, h = live.internal_size(region.width, region.height, int(props.scale) * max(1, int(coarse)))
     try:
         sd = export.collect(depsgraph, context_scene, require_lights=False, camera=False,
                             mesh_cache=session.mesh_cache)
@@ -136,16 +148,21 @@ def _submit(session, context_scene, depsgraph, region, rv3d, space, props):
         session.message = "no light with non-zero power"
         session.image = None
         return
-    key = (session.scene_serial, _view_key(region, rv3d, props), props.quality)
+    coarse = max(1, int(coarse))
+    key = (session.scene_serial, _view_key(region, rv3d, props), props.quality, coarse)
     preset = props.quality
     threads = context_scene.vsgl_indirect.threads if hasattr(context_scene, "vsgl_indirect") else 0
     exposure = context_scene.view_settings.exposure
 
     def work(job):
-        return _render(session, sd, preset, threads, job, exposure, t_export)
+        out = _render(session, sd, preset, threads, job, exposure, t_export)
+        if out is not None:
+            out["coarse"] = coarse
+        return out
 
-    if session.renderer.submit(key, work) is not None:
+    if session.renderer.submit(key, work, interruptible=coarse == 1) is not None:
         session.submits += 1
+        session.coarse_submits += coarse > 1
         session.last_submit = time.perf_counter()
 
 
@@ -232,15 +249,17 @@ def _tick():
         return 0.05
     props = bpy.context.window_manager.vsgl_live
     vk = _view_key(region, rv3d, props)
-    if vk != s.view_key:
-        s.view_key = vk
-        s.dirty_since = s.last_edit = time.perf_counter()
-    if s.dirty_since is not None and time.perf_counter() - s.dirty_since >= live.DEBOUNCE_S:
-        s.dirty_since = None
+    now = time.perf_counter()
+    s.schedule.coarse = int(props.coarse)
+    if vk != s.schedule.view_key:
+        s.last_edit = now
+    what = s.schedule.tick(now, vk, coarse_busy=s.renderer.busy_uninterruptible())
+    if what is not None:
         scene = win.scene
         with bpy.context.temp_override(window=win, area=area, region=region):
             depsgraph = bpy.context.evaluated_depsgraph_get()
-        _submit(s, scene, depsgraph, region, rv3d, space, props)
+        _submit(s, scene, depsgraph, region, rv3d, space, props,
+                coarse=s.schedule.coarse if what == "coarse" else 1)
     r = s.renderer.poll()
     if r is not None:
         seq, key, value, seconds = r
@@ -339,7 +358,7 @@ def session():
 def _redraw(self, context):
     s = _SESSION
     if s is not None:
-        s.dirty_since = time.perf_counter()
+        s.schedule.edited(time.perf_counter())
         s.renderer.last_key = None
 
 
@@ -363,6 +382,12 @@ class VSGLLiveProps(bpy.types.PropertyGroup):
         name="Resolution Divider", min=1, max=4, default=2, **_REDRAW,
         description="Render the viewport at 1/N of its pixels in each direction: 2 renders a "
                     "quarter of the pixels, about 3-4x faster")
+    coarse: bpy.props.IntProperty(
+        name="Divider While Moving", min=1, max=live.COARSE_MAX, default=live.COARSE_DEFAULT, **_REDRAW,
+        description="While the view moves, render each view at 1/N of the Resolution Divider's pixels in "
+                    "each direction and draw it enlarged (as Cycles' viewport does while navigating); once "
+                    "the view rests, the full image follows, the same as with 1. 2: about a third of the "
+                    "time per view. 1: off")
     display: bpy.props.EnumProperty(
         name="Display",
         items=(("INDIRECT", "Indirect Only", "Show only the indirect light (the AOV's Combined pass)"),
@@ -412,6 +437,7 @@ class VIEW3D_PT_vsgl_live(bpy.types.Panel):
         col.use_property_decorate = False
         col.prop(props, "quality")
         col.prop(props, "scale")
+        col.prop(props, "coarse")
         col.prop(props, "display")
         if on:
             if s.message:
@@ -423,7 +449,9 @@ class VIEW3D_PT_vsgl_live(bpy.types.Panel):
                     1000 * t["total"], 1000 * t["render"], 1000 * t["scene"], 1000 * t["export"]))
             if s.image is not None:
                 img = s.image
-                layout.label(text="%d x %d, %d triangles" % (img["width"], img["height"], img["triangles"]))
+                layout.label(text="%d x %d%s, %d triangles" % (
+                    img["width"], img["height"], " (moving)" if img.get("coarse", 1) > 1 else "",
+                    img["triangles"]))
 
 
 def _wrap(text, width):

@@ -207,6 +207,7 @@ def test_operator_and_panel_register():
     assert hasattr(bpy.types.WindowManager, "vsgl_live")
     props = bpy.context.window_manager.vsgl_live
     assert props.quality == "LIVE" and props.scale == 2 and props.display == "INDIRECT"
+    assert props.coarse == live.COARSE_DEFAULT == 2
     for p in props.bl_rna.properties:
         if p.identifier != "rna_type":
             assert len(p.description) > 20, p.identifier
@@ -265,3 +266,147 @@ def test_scene_signature_sees_textures_and_materials():
     sd.textures = [(np.zeros((2, 2, 4), np.float32), 1)]
     sd.materials = [dict(base_color=(0.5, 0.5, 0.6))]
     assert not viewport._equal(a, viewport._scene_signature(sd))
+
+
+def test_navigation_schedule_coarse_while_moving_full_at_rest():
+    """live.NavigationSchedule, on a fake clock: each view change starts a
+    coarse render at once (never two at a time), a rest of the debounce the
+    full one; a scene edit only the full one; coarse 1 is the old debounce."""
+    s = live.NavigationSchedule(coarse=2, debounce=0.04)
+    assert s.tick(0.00, "v0") == "coarse"              # the first view: a quick coarse image
+    assert s.tick(0.02, "v1") == "coarse"              # moving: at once, no debounce
+    assert s.tick(0.04, "v2", coarse_busy=True) is None   # one coarse render at a time...
+    assert s.tick(0.05, "v2", coarse_busy=True) is None
+    assert s.tick(0.06, "v2") == "coarse"              # ...the newest view when it ends
+    assert s.tick(0.07, "v2") is None                  # resting, within the debounce
+    assert s.tick(0.079, "v2") is None
+    assert s.tick(0.081, "v2") == "full"               # rested 40 ms since the last change (0.04)
+    assert s.tick(0.2, "v2") is None and s.dirty_since is None
+    s.edited(0.30)                                     # a light moved: no coarse render
+    assert s.tick(0.31, "v2") is None and s.tick(0.339, "v2") is None
+    assert s.tick(0.341, "v2") == "full"
+    s.edited(0.40)                                     # an edit while the view moves
+    assert s.tick(0.41, "v3") == "coarse" and s.tick(0.43, "v4") == "coarse"
+    assert s.tick(0.46, "v4") is None and s.tick(0.471, "v4") == "full"
+    off = live.NavigationSchedule(coarse=1, debounce=0.04)
+    assert [off.tick(t, "v%d" % i) for i, t in enumerate((0.0, 0.02, 0.04))] == [None] * 3
+    assert off.tick(0.07, "v2") is None and off.tick(0.081, "v2") == "full"
+
+
+def test_scheduler_lets_a_coarse_render_end_and_cancels_a_full_one():
+    """A full render is cancelled by a newer submit; a coarse one
+    (interruptible=False) runs to its end and its image is delivered, while
+    a newer coarse one waiting behind it is replaced by the newest."""
+    r = live.LiveRenderer()
+    started = {k: threading.Event() for k in ("f1", "c1", "f2")}
+    release = threading.Event()
+    ran = []
+
+    def slow(job):
+        ran.append(job.key)
+        started[job.key].set()
+        while not job.cancelled.is_set() and not release.is_set():
+            time.sleep(0.001)
+        return None if job.cancelled.is_set() else job.key
+
+    f1 = r.submit("f1", slow)
+    assert started["f1"].wait(5)
+    c1 = r.submit("c1", slow, interruptible=False)     # the view moves: the full render is superseded
+    assert started["c1"].wait(5) and f1.cancelled.is_set()
+    assert r.busy_uninterruptible()
+    r.submit("c2", slow, interruptible=False)          # waits behind c1 ...
+    f2 = r.submit("f2", slow)                          # ... replaced by the rest's full render
+    assert not c1.cancelled.is_set() and r.dropped == 1
+    release.set()
+    assert r.wait(5)
+    assert ran == ["f1", "c1", "f2"] and not f2.cancelled.is_set()
+    assert r.poll()[2] == "f2" and not r.busy_uninterruptible()
+    release.clear()
+    c3 = r.submit("c3", lambda job: "c3", interruptible=False)
+    assert r.wait(5) and not c3.cancelled.is_set() and r.poll()[2] == "c3"
+
+
+def test_live_navigation_renders_coarse_then_the_full_image(scene):
+    """The timer's logic without a viewport: views change on every tick for
+    a while (coarse renders at 1/2 x 1/2 through the session's one cache,
+    with a full render superseded and cancelled on the way), then rest: the
+    last image is the full one, equal to a plain (uncached) library render
+    of that view with the Live settings and to a session that never went
+    coarse."""
+    room(scene)
+    w, h = 48, 28
+    scene.render.resolution_x, scene.render.resolution_y = w, h
+    cam = scene.camera
+    mesh_cache = {}
+    s = viewport._Session(0)
+    sch = live.NavigationSchedule(coarse=2, debounce=0.04)
+    shown = []
+
+    def view_sd(x, div):
+        cam.location.x = x
+        d = bpy.context.evaluated_depsgraph_get()
+        vw, vh = live.internal_size(w, h, div)
+        sd = export.collect(d, scene, camera=False, mesh_cache=mesh_cache)
+        sd.camera = live.view_camera(cam.matrix_world.inverted(), _projection(cam, d, vw, vh), vw, vh,
+                                     cam.data.clip_start, cam.data.clip_end)
+        sd.width, sd.height = vw, vh
+        return sd
+
+    x0 = cam.location.x
+    try:
+        views = [x0 + 0.02 * i for i in range(5)]
+        t = 0.0
+        for tick in range(12):
+            t = 0.02 * tick
+            x = views[min(tick, len(views) - 1)]
+            what = sch.tick(t, x, coarse_busy=s.renderer.busy_uninterruptible())
+            if what is not None:
+                div = sch.coarse if what == "coarse" else 1
+                sd = view_sd(x, div)
+                s.renderer.submit((x, div), lambda job, sd=sd: viewport._render(s, sd, "LIVE", 0, job, 0.0, 0.0),
+                                  interruptible=div == 1)
+                s.renderer.wait(30)                    # renders are quick here: each ends before the next tick
+                got = s.renderer.poll()
+                shown.append((what, x, got[2]["width"], got[2]["height"], got[2]))
+            if tick == 2:                              # a full render superseded by the next view
+                gate, started = threading.Event(), threading.Event()
+
+                def held(job, sd=view_sd(x, 1)):
+                    started.set()
+                    gate.wait(5)
+                    return viewport._render(s, sd, "LIVE", 0, job, 0.0, 0.0)
+                full = s.renderer.submit(("held", x), held)
+                assert started.wait(5)
+                s.renderer.submit(("moved", x), lambda job, sd=view_sd(x, 2): viewport._render(
+                    s, sd, "LIVE", 0, job, 0.0, 0.0), interruptible=False)
+                assert full.cancelled.is_set()
+                gate.set()
+                assert s.renderer.wait(30)
+                assert s.renderer.poll()[2]["width"] == w // 2
+        coarse = [v for v in shown if v[0] == "coarse"]
+        assert len(coarse) == len(views) and all((v[2], v[3]) == (w // 2, h // 2) for v in coarse)
+        assert shown[-1][:4] == ("full", views[-1], w, h)
+        assert [v[0] for v in shown].count("full") == 1
+        refine = shown[-1][4]
+        fresh = viewport._Session(0)
+        try:
+            plain = viewport._render(fresh, view_sd(views[-1], 1), "LIVE", 0, live.Job(1, "k"), 0.0, 0.0)
+        finally:
+            fresh.close()
+        np.testing.assert_array_equal(refine["rgba"], plain["rgba"])
+        ref_sd = view_sd(views[-1], 1)
+        lib = engine._binding()
+        arrays = engine.scene_arrays(ref_sd, lib)
+        ctx = lib.Context(log_level=lib.LogLevel.ERROR)
+        try:
+            sc = lib.Scene(ctx, **arrays)
+            try:
+                images, _ = lib.render(ctx, sc, live.render_settings(lib, "LIVE"), ("combined",))
+            finally:
+                sc.close()
+        finally:
+            ctx.close()
+        np.testing.assert_array_equal(refine["rgba"], live.display_rgba(images["combined"]))
+    finally:
+        cam.location.x = x0
+        s.close()
