@@ -2,6 +2,7 @@
 from Blender's data to a displayable image, without Blender's drawing.
 
     python3 tools/bench_live.py [--triangles N] [--size 960x540] [--repeat 5] [--quality LIVE,PREVIEW]
+                                [--coarse 2]
 
 Runs in the pip bpy module (or `blender -b --python tools/bench_live.py --`).
 Builds a room with a subdivided object of about N triangles (default 100k),
@@ -17,6 +18,16 @@ without edge rays, shading 1 pixel in 4 x 4; PREVIEW: the preset as F12
 renders it). Then the error of each quality's image against PREVIEW's
 (Combined, the last view: relMSE and mean FLIP as tests/quality/metrics.py
 computes them).
+Navigation (--coarse N, default 2, the panel's Divider While Moving; 0
+skips it), at the full size for each quality: "camera moved, 1/N" is a
+camera edit rendered at 1/N of the size in each direction, as the live
+preview renders each view while the view moves (live.NavigationSchedule);
+"refine after 1/N" the full image of that view right after it (the view at
+rest: a full camera edit, the coarse render's G-buffer replaced), through
+the same cache. Then the coarse image's error against the full one of the
+same view (Combined, enlarged to the full size by repeating pixels, as a
+GPU texture drawn without filtering, and bilinearly): what the artist sees
+while the view moves.
 Targets (issue 12): library time <= 50 ms at 960x540; <= 200 ms with the
 export for a 100k-triangle scene. Prints measured/target ratios.
 """
@@ -41,6 +52,8 @@ ap.add_argument("--triangles", type=int, default=100_000)
 ap.add_argument("--size", default="960x540")
 ap.add_argument("--repeat", type=int, default=5)
 ap.add_argument("--quality", default="LIVE,PREVIEW", help="panel qualities to time, comma-separated")
+ap.add_argument("--coarse", default="2",
+                help="dividers while the view moves to time at the full size, comma-separated (0: none)")
 ap.add_argument("--save-bundle", metavar="PATH",
                 help="only write the room at --size with the first quality's settings as a scene bundle "
                      "(for a C driver, e.g. tools/live_edit.c) and exit")
@@ -93,6 +106,28 @@ def edit_cost(session, cache, w, h, scene, cam, edit, quality):
     return dict(out["timings"], cpu=time.process_time() - c0, triangles=sd.triangle_count)
 
 
+def enlarge(img, h, w, bilinear=False):
+    """``img`` (h0, w0, 3) drawn over h x w pixels as a texture stretched over
+    the region: each pixel centre samples the texture at the same relative
+    place; nearest texel, or bilinear with the edges clamped."""
+    import numpy as np
+    h0, w0 = img.shape[:2]
+    y = (np.arange(h) + 0.5) * h0 / h - 0.5
+    x = (np.arange(w) + 0.5) * w0 / w - 0.5
+    if not bilinear:
+        yi = np.clip(np.floor(y + 0.5).astype(int), 0, h0 - 1)
+        xi = np.clip(np.floor(x + 0.5).astype(int), 0, w0 - 1)
+        return img[yi][:, xi]
+    y0 = np.clip(np.floor(y).astype(int), 0, h0 - 1)
+    x0 = np.clip(np.floor(x).astype(int), 0, w0 - 1)
+    y1, x1 = np.minimum(y0 + 1, h0 - 1), np.minimum(x0 + 1, w0 - 1)
+    fy = np.clip(y - y0, 0.0, 1.0)[:, None, None]
+    fx = np.clip(x - x0, 0.0, 1.0)[None, :, None]
+    a = img[y0][:, x0] * (1 - fx) + img[y0][:, x1] * fx
+    b = img[y1][:, x0] * (1 - fx) + img[y1][:, x1] * fx
+    return (a * (1 - fy) + b * fy).astype(np.float32)
+
+
 def combined(w, h, scene, cam, quality):
     """The linear Combined pass the live preview renders at ``quality``."""
     from vsgl_indirect import engine
@@ -126,6 +161,7 @@ def main():
     light, cam, wave = build(args.triangles)
     scene = bpy.context.scene
     qualities = [q.strip().upper() for q in args.quality.split(",") if q.strip()]
+    coarse = [int(c) for c in args.coarse.split(",") if c.strip() and int(c) > 1]
     if args.save_bundle:
         save_bundle(args.save_bundle, W, H, scene, cam, qualities[0])
         print("wrote %s (%dx%d, %s)" % (args.save_bundle, W, H, qualities[0]))
@@ -144,9 +180,19 @@ def main():
                         ("geometry edit",
                          lambda: (cache.clear(), setattr(wave.location, "z", wave.location.z + 0.001)))):
                     ts = [edit_cost(session, cache, w, h, scene, cam, edit, quality) for _ in range(args.repeat)]
-                    med = {k: statistics.median(t[k] for t in ts)
-                           for k in ("export", "scene", "render", "encode", "gbuffer", "rsm", "fit", "shade", "cpu")}
-                    rows.append((quality, w, h, div, name, med, ts[0]["triangles"]))
+                    rows.append((quality, w, h, div, name, _median(ts), ts[0]["triangles"]))
+                if div == 1:
+                    for n in coarse:   # navigation: each view coarse, then its full image (the rest)
+                        cw, ch = live.internal_size(w, h, n)
+                        moving, rest = [], []
+                        for _ in range(args.repeat):
+                            moving.append(edit_cost(session, cache, cw, ch, scene, cam,
+                                                    lambda: setattr(cam.location, "x", cam.location.x + 0.01),
+                                                    quality))
+                            rest.append(edit_cost(session, cache, w, h, scene, cam, lambda: None, quality))
+                        rows.append((quality, cw, ch, n, "camera moved, 1/%d" % n, _median(moving),
+                                     moving[0]["triangles"]))
+                        rows.append((quality, w, h, 1, "refine after 1/%d" % n, _median(rest), rest[0]["triangles"]))
             finally:
                 session.close()
     print("live preview, %d triangles, median of %d edits (s); machine: %d cores, load %s"
@@ -162,13 +208,20 @@ def main():
               % (quality, "%dx%d" % (w, h), name, m["export"], m["scene"], m["render"], m["encode"], total,
                  "%.2fx, %.2fx" % (lib / 0.050, total / 0.200),
                  "%.3f + %.3f + %.3f + %.3f" % (m["gbuffer"], m["rsm"], m["fit"], m["shade"]), m["cpu"]))
-        if div == 1 and name != "geometry edit":
+        if name.startswith("camera moved, 1/"):
+            targets.append("%s %s %s (while the view moves, drawn at %dx%d): library %.3f s / 0.050 s = %.2f, "
+                           "with export %.3f s / 0.200 s = %.2f"
+                           % (quality, "%dx%d" % (w, h), name, W, H, lib, lib / 0.050, total, total / 0.200))
+        elif name.startswith("refine"):
+            targets.append("%s %s %s (the full image once the view rests): library %.3f s, with export %.3f s"
+                           % (quality, "%dx%d" % (w, h), name, lib, total))
+        elif div == 1 and name != "geometry edit":
             targets.append("%s %s %s: library %.3f s / 0.050 s = %.2f, with export %.3f s / 0.200 s = %.2f"
                            % (quality, "%dx%d" % (w, h), name, lib, lib / 0.050, total, total / 0.200))
     print("issue 12 targets, measured/target (<= 1 meets it):")
     for t in targets:
         print("  " + t)
-    if any(q != "PREVIEW" for q in qualities):
+    if any(q != "PREVIEW" for q in qualities) or coarse:
         sys.path.insert(0, os.path.join(REPO, "tests", "quality"))
         import metrics
         print("error against the preview preset's image (Combined, last view): relMSE, mean FLIP"
@@ -182,6 +235,26 @@ def main():
                     f = metrics.flip(a, ref)
                     print("  %-8s %dx%d: relMSE %.2e, FLIP %s"
                           % (quality, w, h, metrics.relmse(a, ref), "n/a" if f is None else "%.4f" % f))
+        if coarse:
+            print("while the view moves: the coarse image enlarged against the full one (same quality and view, "
+                  "Combined): relMSE, mean FLIP, pixels repeated / bilinear")
+            for quality in qualities:
+                full = combined(W, H, scene, cam, quality)
+                for n in coarse:
+                    cw, ch = live.internal_size(W, H, n)
+                    small = combined(cw, ch, scene, cam, quality)
+                    out = []
+                    for bilinear in (False, True):
+                        a = enlarge(small, H, W, bilinear)
+                        f = metrics.flip(a, full)
+                        out.append("relMSE %.2e, FLIP %s" % (metrics.relmse(a, full),
+                                                             "n/a" if f is None else "%.4f" % f))
+                    print("  %-8s %dx%d at 1/%d (%dx%d): %s / %s" % (quality, W, H, n, cw, ch, out[0], out[1]))
+
+
+def _median(ts):
+    return {k: statistics.median(t[k] for t in ts)
+            for k in ("export", "scene", "render", "encode", "gbuffer", "rsm", "fit", "shade", "cpu")}
 
 
 main()
