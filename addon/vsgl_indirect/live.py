@@ -20,8 +20,9 @@ DEBOUNCE_S = 0.04
 SCALES = (1, 2, 3, 4)
 #: The panel's default divider while the view moves (``coarse``): each
 #: camera edit renders 1/2 x 1/2 of the pixels, drawn enlarged, until the
-#: view rests. Measured in docs/performance.md ("Navigation"): ~1/3 of the
-#: full camera edit's time; FLIP 0.02-0.04 against the full image.
+#: view rests. Measured in docs/performance.md ("Issue 12: navigation"):
+#: ~1/3 of a full camera edit's time; mean FLIP 0.02-0.04 against the full
+#: image.
 COARSE_DEFAULT = 2
 #: The largest divider while moving offered in the panel.
 COARSE_MAX = 4
