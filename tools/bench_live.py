@@ -239,17 +239,19 @@ def main():
             print("while the view moves: the coarse image enlarged against the full one (same quality and view, "
                   "Combined): relMSE, mean FLIP, pixels repeated / bilinear")
             for quality in qualities:
-                full = combined(W, H, scene, cam, quality)
-                for n in coarse:
-                    cw, ch = live.internal_size(W, H, n)
-                    small = combined(cw, ch, scene, cam, quality)
-                    out = []
-                    for bilinear in (False, True):
-                        a = enlarge(small, H, W, bilinear)
-                        f = metrics.flip(a, full)
-                        out.append("relMSE %.2e, FLIP %s" % (metrics.relmse(a, full),
-                                                             "n/a" if f is None else "%.4f" % f))
-                    print("  %-8s %dx%d at 1/%d (%dx%d): %s / %s" % (quality, W, H, n, cw, ch, out[0], out[1]))
+                for div in (1, 2):     # the full size, and the panel's default Resolution Divider
+                    w, h = live.internal_size(W, H, div)
+                    full = combined(w, h, scene, cam, quality)
+                    for n in coarse:
+                        cw, ch = live.internal_size(w, h, n)
+                        small = combined(cw, ch, scene, cam, quality)
+                        out = []
+                        for bilinear in (False, True):
+                            a = enlarge(small, h, w, bilinear)
+                            f = metrics.flip(a, full)
+                            out.append("relMSE %.2e, FLIP %s" % (metrics.relmse(a, full),
+                                                                 "n/a" if f is None else "%.4f" % f))
+                        print("  %-8s %dx%d at 1/%d (%dx%d): %s / %s" % (quality, w, h, n, cw, ch, out[0], out[1]))
 
 
 def _median(ts):
