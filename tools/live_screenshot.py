@@ -84,10 +84,10 @@ def run(i):
         LOG.append("step %d: %s  edit->image %.0f ms (render %.0f, scene %.0f, export %.0f, encode %.0f) %s"
                    % (i, STEPS[i - 1].__doc__, 1000 * (s.last_done - s.last_edit), 1000 * t["render"],
                       1000 * t["scene"], 1000 * t["export"], 1000 * t["encode"], s.message)
-                   + " [renders %d, depsgraph updates %d; edit->submit %.0f ms, submit->result %.0f ms, "
-                     "result seen %.0f ms later]" % (s.submits, s.updates, 1000 * (s.last_submit - s.last_edit),
-                                                     1000 * t["total"],
-                                                     1000 * (s.last_done - s.last_submit - t["total"])))
+                   + " [renders %d (coarse %d), depsgraph updates %d; edit->submit %.0f ms, "
+                     "submit->result %.0f ms, result seen %.0f ms later]"
+                   % (s.submits, s.coarse_submits, s.updates, 1000 * (s.last_submit - s.last_edit),
+                      1000 * t["total"], 1000 * (s.last_done - s.last_submit - t["total"])))
     if i == len(STEPS):
         with open(os.path.join(OUT, "live.txt"), "w") as fh:
             fh.write("\n".join(LOG) + "\n")
