@@ -124,6 +124,7 @@ static void make_scene(test_scene *s, unsigned seed)
     s->settings.edge_samples = 6;
     s->settings.auto_target = VSGL_AUTO_BALANCED; /* format 1.4 */
     s->settings.mrp_min_area = 1.5f;               /* format 1.5 */
+    s->settings.glossy_lobes = 5;                  /* format 1.6 */
 }
 
 static int same_bytes(const void *a, const void *b, size_t n)

@@ -242,7 +242,7 @@ static const section_kind kinds[S_COUNT] = {
     {"MATL", "materials", "material", 40, 1, 0, 0},
     {"LGHT", "lights", "light", 104, 1, 0, 0},
     {"CAM ", "camera", "camera", 104, 1, 0, 0},
-    {"RSET", "render settings", "settings", 68, 1, 0, 44},
+    {"RSET", "render settings", "settings", 72, 1, 0, 44},
     {"OUTP", "output path", "byte", 1, 0, 0, 0},
     {"FRME", "frame", "frame", 4, 0, 0, 0},
     /* format 1.2: textures */

@@ -18,6 +18,7 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
     out->fis_iterations = 8;
     out->shade_stride = 1;
     out->mrp_min_area = VSGL_MRP_MIN_AREA_DEFAULT; /* what 0 means, spelled out (the add-on's panel shows it) */
+    out->glossy_lobes = 4;                         /* the same */
     /* Every preset fits on the lattice: the importance-drawn fits flicker
      * as a light moves (0.1-0.75 of the AOV per 1/1000-extent step, docs/
      * quality.md) and break a reflection into blotches; with the emitter
