@@ -384,12 +384,39 @@ static inline __attribute__((always_inline)) float k_ncdf(float z)
     return z < 0.0f ? e : 1.0f - e;
 }
 
+/* How close lane i's lobe axis lies to its tangent plane, 0 (n.z >=
+ * VSGL__HORIZON_HI) to 1 (<= _LO), before the smoothstep. */
+static inline __attribute__((always_inline)) float k_graze_weight(const vsgl_kernel_block *restrict b, size_t i)
+{
+    float zn = b->Zx[i] * b->nx[i] + b->Zy[i] * b->ny[i] + b->Zz[i] * b->nz[i];
+    float gw = (VSGL__HORIZON_HI - zn) * (1.0f / (VSGL__HORIZON_HI - VSGL__HORIZON_LO));
+    return gw < 0.0f ? 0.0f : (gw > 1.0f ? 1.0f : gw);
+}
+
+/* The share of a planar cluster x footprint product above the receiver's
+ * tangent plane (k_planar): d = mean - x, d1, e2 the footprint's offset and
+ * s11.. idet its covariance S, all in sigma units; weighted in by how
+ * close the lobe's axis is to the tangent plane (kernel.h VSGL__HORIZON_*). */
+static inline __attribute__((always_inline)) float
+k_horizon(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, float dx, float dy,
+          float dz, float d1, float e2, float s11, float s22, float s12, float idet)
+{
+    float nu1 = b->nx[i] * L->u1x + b->ny[i] * L->u1y + b->nz[i] * L->u1z;
+    float nu2 = b->nx[i] * L->u2x + b->ny[i] * L->u2y + b->nz[i] * L->u2z;
+    float g0 = (b->nx[i] * dx + b->ny[i] * dy + b->nz[i] * dz) +
+               (nu1 * (s22 * d1 - s12 * e2) + nu2 * (s11 * e2 - s12 * d1)) * idet;
+    float gv = nu1 * nu1 + nu2 * nu2 - (s22 * nu1 * nu1 - 2.0f * s12 * nu1 * nu2 + s11 * nu2 * nu2) * idet;
+    gv = gv > 1e-12f ? gv : 1e-12f;
+    float gw = k_graze_weight(b, i);
+    return 1.0f - (1.0f - k_ncdf(g0 * k_rsqrt(gv))) * gw * gw * (3.0f - 2.0f * gw);
+}
+
 /* Stage 4b: glossy light from a planar cluster (shade.h, vsgl__planar_glossy):
  * the radiance of the cluster's plane where the lobe's axis meets it,
  * blurred by the lobe's footprint there: all but the exp. */
 static inline __attribute__((always_inline)) void
 k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t,
-         float kb, float kc)
+         float kb, float kc, int graze)
 {
     /* lengths in units of the cluster's sigma, so that nothing overflows:
      * the axis must meet the plane at t <= 1e4 sigma and >= 0.6 degrees
@@ -435,17 +462,9 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     /* the receiver's horizon where its lobe grazes it (kernel.h,
      * VSGL__HORIZON_*): the share of the cluster x footprint product (mean
      * S^-1 d, covariance I - S^-1 in sigma units) above the receiver's
-     * tangent plane, along nu, the normal's part in the cluster's plane */
-    float nu1 = b->nx[i] * L->u1x + b->ny[i] * L->u1y + b->nz[i] * L->u1z;
-    float nu2 = b->nx[i] * L->u2x + b->ny[i] * L->u2y + b->nz[i] * L->u2z;
-    float g0 = (b->nx[i] * dx + b->ny[i] * dy + b->nz[i] * dz) * is +
-               (nu1 * (s22 * d1 - s12 * e2) + nu2 * (s11 * e2 - s12 * d1)) * idet;
-    float gv = nu1 * nu1 + nu2 * nu2 - (s22 * nu1 * nu1 - 2.0f * s12 * nu1 * nu2 + s11 * nu2 * nu2) * idet;
-    gv = gv > 1e-12f ? gv : 1e-12f;
-    float zn = zx * b->nx[i] + zy * b->ny[i] + zz * b->nz[i];
-    float gw = (VSGL__HORIZON_HI - zn) * (1.0f / (VSGL__HORIZON_HI - VSGL__HORIZON_LO));
-    gw = gw < 0.0f ? 0.0f : (gw > 1.0f ? 1.0f : gw);
-    float hz = 1.0f - (1.0f - k_ncdf(g0 * k_rsqrt(gv))) * gw * gw * (3.0f - 2.0f * gw);
+     * tangent plane, along nu, the normal's part in the cluster's plane;
+     * `graze` 0 (no lane of the block grazes, k_graze_weight): 1 */
+    float hz = graze ? k_horizon(b, i, L, dx * is, dy * is, dz * is, d1, e2, s11, s22, s12, idet) : 1.0f;
     t->ppre[i] = ok * hz * t->vis[i] * kc * b->camp[i] * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu) * (is * is);
     t->pd1[i] = d1;
     t->pd2[i] = e2;
@@ -547,7 +566,6 @@ static inline __attribute__((always_inline)) void k_hv_rest(size_t i, k_scratch 
 {
     t->ppre[i] *= 1.0f - t->hvw[i];
 }
-
 
 /* Along one axis of a cut cell (sigma units, the cluster's mean at 0 and
  * its variance 1): the weight of the image of mean m (0: the cluster's,
@@ -704,6 +722,10 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         /* planar clusters that every lane sees through the half-vector
          * model alone: the lobes' pass would add zeros */
         const int skip_lobes = hv && hv_all && all_planar;
+        /* the receiver's horizon only in blocks where some lane's lobe grazes it */
+        int graze = 0;
+        for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
+            graze |= b->camp[i] > 0.0f && k_graze_weight(b, i) > 0.0f;
         for (int q = 0; q < (skip_lobes ? 0 : 1 + two); ++q) {
             const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
             const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
@@ -711,7 +733,10 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
             if (!all_planar)
                 K_FORN(k_glossy(b, i, t + j, kb, kc));
             if (!sg_only) {
-                K_FORN(k_planar(b, i, L + j, t + j, kb, kc));
+                if (graze)
+                    K_FORN(k_planar(b, i, L + j, t + j, kb, kc, 1));
+                else
+                    K_FORN(k_planar(b, i, L + j, t + j, kb, kc, 0));
                 /* the fold only where some lane sees the cell: an image lies
                  * at most 2 |b| (sigma units) from the mean, so where every
                  * lane's planar exponent is below -freach = -(sqrt(50) + 2
