@@ -241,7 +241,8 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
          * operations rounds differently near the plane */
         int plain = trial % 4 < 2;
         /* every third trial with the glossy lobe as GGX's core and tail */
-        const int32_t lob = VSGL__KERNEL_DIFFUSE | VSGL__KERNEL_GLOSSY | (trial % 3 == 0 ? VSGL__KERNEL_GGX_TAIL : 0);
+        const int32_t lob = VSGL__KERNEL_DIFFUSE | VSGL__KERNEL_GLOSSY | (trial % 3 == 0 ? VSGL__KERNEL_GGX_TAIL : 0) |
+                            (trial % 2 ? VSGL__KERNEL_GRAZE : 0); /* the horizon cut in half the trials */
         for (int k = 0; k < 8; ++k) {
             random_light(&r, &L[k], trial % 2);
             if (plain)

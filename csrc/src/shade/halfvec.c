@@ -46,11 +46,10 @@ float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float 
     for (int i = 0; i < 2; ++i)
         for (int k = 0; k < 2; ++k)
             cov[i][k] = sv * (v3_dot(a[i], a[k]) - v3_dot(a[i], w) * v3_dot(a[k], w) - v3_dot(a[i], p) * v3_dot(a[k], p));
-    static const float K4[VSGL__HV_LOBES] = VSGL__HV_K_LIST, C4[VSGL__HV_LOBES] = VSGL__HV_C_LIST;
-    static const float K5[VSGL__HV5_LOBES] = VSGL__HV5_K_LIST, C5[VSGL__HV5_LOBES] = VSGL__HV5_C_LIST;
-    const float *K = lobes == VSGL__HV5_LOBES ? K5 : K4, *C = lobes == VSGL__HV5_LOBES ? C5 : C4;
+    const float *K, *C;
+    const int nl = vsgl__hv_lobe_set(lobes, &K, &C);
     float ed = 0.0f; /* E[D] h.n^4 */
-    for (int q = 0; q < (lobes == VSGL__HV5_LOBES ? VSGL__HV5_LOBES : VSGL__HV_LOBES); ++q) {
+    for (int q = 0; q < nl; ++q) {
         float al2 = alpha * alpha * 0.5f / K[q];
         float c11 = al2 + cov[0][0], c22 = al2 + cov[1][1], c12 = cov[0][1];
         float det = c11 * c22 - c12 * c12;

@@ -78,9 +78,22 @@ typedef struct vsgl_kernel_light {
 #define VSGL__HORIZON_HI 0.3f
 #define VSGL__HORIZON_LO 0.1f
 
+/* How close a lobe's axis lies to the receiver's tangent plane, from its
+ * cosine zn = n.z: 0 at VSGL__HORIZON_HI and above, 1 at _LO and below
+ * (before the smoothstep). One form for the kernel, the scalar path and
+ * the block's VSGL__KERNEL_GRAZE bit. */
+static inline float vsgl__graze_ramp(float zn)
+{
+    float gw = (VSGL__HORIZON_HI - zn) * (1.0f / (VSGL__HORIZON_HI - VSGL__HORIZON_LO));
+    return gw < 0.0f ? 0.0f : (gw > 1.0f ? 1.0f : gw);
+}
+
 /* Lobes a block needs (skip the work for lobes no lane has). */
 #define VSGL__KERNEL_DIFFUSE 1
 #define VSGL__KERNEL_GLOSSY  2
+/* Some glossy lane's lobe grazes its tangent plane (vsgl__graze_ramp > 0):
+ * the planar model's horizon cut runs for this block (kernel.h above) */
+#define VSGL__KERNEL_GRAZE  16
 /* The glossy lobe as GGX's core and tail: two ASGs of the lane's frame with
  * bandwidths x VSGL_GGX_{CORE,TAIL}_K and amplitudes x _C, fitted to GGX's
  * 1/(1 + x^2)^2, x = tan / alpha, at equal integral, minimising the relative
@@ -120,6 +133,17 @@ typedef struct vsgl_kernel_light {
 #define VSGL__HV5_K_LIST {2.0583f, 0.6556f, 0.2263f, 0.077476f, 0.019603f}
 #define VSGL__HV5_C_LIST {0.6639f, 0.24442f, 0.042696f, 0.0063297f, 0.0006717f}
 #define VSGL__KERNEL_HV5 8 /* the half-vector model with five lobes */
+/* The half-vector model's lobes (k, c), `count` 4 or 5 (VSGL__HV_*,
+ * VSGL__HV5_*): returns how many, for the kernel and halfvec.c alike. */
+static inline int vsgl__hv_lobe_set(int count, const float **k, const float **c)
+{
+    static const float k4[VSGL__HV_LOBES] = VSGL__HV_K_LIST, c4[VSGL__HV_LOBES] = VSGL__HV_C_LIST;
+    static const float k5[VSGL__HV5_LOBES] = VSGL__HV5_K_LIST, c5[VSGL__HV5_LOBES] = VSGL__HV5_C_LIST;
+    const int five = count == VSGL__HV5_LOBES;
+    *k = five ? k5 : k4;
+    *c = five ? c5 : c4;
+    return five ? VSGL__HV5_LOBES : VSGL__HV_LOBES;
+}
 #define VSGL__HV_SPREAD_LO 0.003f
 #define VSGL__HV_SPREAD_HI 0.01f
 #define VSGL__HV_HN_LO 0.3f

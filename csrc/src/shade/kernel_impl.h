@@ -384,15 +384,6 @@ static inline __attribute__((always_inline)) float k_ncdf(float z)
     return z < 0.0f ? e : 1.0f - e;
 }
 
-/* How close lane i's lobe axis lies to its tangent plane, 0 (n.z >=
- * VSGL__HORIZON_HI) to 1 (<= _LO), before the smoothstep. */
-static inline __attribute__((always_inline)) float k_graze_weight(const vsgl_kernel_block *restrict b, size_t i)
-{
-    float zn = b->Zx[i] * b->nx[i] + b->Zy[i] * b->ny[i] + b->Zz[i] * b->nz[i];
-    float gw = (VSGL__HORIZON_HI - zn) * (1.0f / (VSGL__HORIZON_HI - VSGL__HORIZON_LO));
-    return gw < 0.0f ? 0.0f : (gw > 1.0f ? 1.0f : gw);
-}
-
 /* The share of a planar cluster x footprint product above the receiver's
  * tangent plane (k_planar): d = mean - x, d1, e2 the footprint's offset and
  * s11.. idet its covariance S, all in sigma units; weighted in by how
@@ -407,7 +398,7 @@ k_horizon(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light
                (nu1 * (s22 * d1 - s12 * e2) + nu2 * (s11 * e2 - s12 * d1)) * idet;
     float gv = nu1 * nu1 + nu2 * nu2 - (s22 * nu1 * nu1 - 2.0f * s12 * nu1 * nu2 + s11 * nu2 * nu2) * idet;
     gv = gv > 1e-12f ? gv : 1e-12f;
-    float gw = k_graze_weight(b, i);
+    float gw = vsgl__graze_ramp(b->Zx[i] * b->nx[i] + b->Zy[i] * b->ny[i] + b->Zz[i] * b->nz[i]);
     return 1.0f - (1.0f - k_ncdf(g0 * k_rsqrt(gv))) * gw * gw * (3.0f - 2.0f * gw);
 }
 
@@ -463,7 +454,7 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
      * VSGL__HORIZON_*): the share of the cluster x footprint product (mean
      * S^-1 d, covariance I - S^-1 in sigma units) above the receiver's
      * tangent plane, along nu, the normal's part in the cluster's plane;
-     * `graze` 0 (no lane of the block grazes, k_graze_weight): 1 */
+     * `graze` 0 (no lane of the block grazes: VSGL__KERNEL_GRAZE): 1 */
     float hz = graze ? k_horizon(b, i, L, dx * is, dy * is, dz * is, d1, e2, s11, s22, s12, idet) : 1.0f;
     t->ppre[i] = ok * hz * t->vis[i] * kc * b->camp[i] * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu) * (is * is);
     t->pd1[i] = d1;
@@ -723,9 +714,7 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
          * model alone: the lobes' pass would add zeros */
         const int skip_lobes = hv && hv_all && all_planar;
         /* the receiver's horizon only in blocks where some lane's lobe grazes it */
-        int graze = 0;
-        for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
-            graze |= b->camp[i] > 0.0f && k_graze_weight(b, i) > 0.0f;
+        const int graze = (lobes & VSGL__KERNEL_GRAZE) != 0;
         for (int q = 0; q < (skip_lobes ? 0 : 1 + two); ++q) {
             const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
             const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
@@ -764,11 +753,9 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 2));
         }
         if (hv) {
-            static const float hk4[VSGL__HV_LOBES] = VSGL__HV_K_LIST, hc4[VSGL__HV_LOBES] = VSGL__HV_C_LIST;
-            static const float hk5[VSGL__HV5_LOBES] = VSGL__HV5_K_LIST, hc5[VSGL__HV5_LOBES] = VSGL__HV5_C_LIST;
-            const int five = (lobes & VSGL__KERNEL_HV5) != 0;
-            const float *hk = five ? hk5 : hk4, *hc = five ? hc5 : hc4;
-            for (int q = 0; q < (five ? VSGL__HV5_LOBES : VSGL__HV_LOBES); ++q) {
+            const float *hk, *hc;
+            const int nhv = vsgl__hv_lobe_set(lobes & VSGL__KERNEL_HV5 ? VSGL__HV5_LOBES : VSGL__HV_LOBES, &hk, &hc);
+            for (int q = 0; q < nhv; ++q) {
                 K_FORN(k_hv_lobe(b, i, t + j, hk[q], hc[q]));
                 K_FORN(k_glossy_sum(b, i, L + j, t + j, 3));
             }

@@ -150,8 +150,7 @@ static float fold_image(float m0, float lo, float hi, float al, float ah, int im
 static float planar_horizon(const vsgl_vsgl *v, v3 x, v3 nr, vsgl_vec3 z, float var, float d1, float d2, float s11,
                             float s22, float s12, float det, v3 u1, v3 u2)
 {
-    float zn = nr.x * z.x + nr.y * z.y + nr.z * z.z;
-    float gw = smoothstep01f((VSGL__HORIZON_HI - zn) / (VSGL__HORIZON_HI - VSGL__HORIZON_LO));
+    float gw = smoothstep01f(vsgl__graze_ramp(nr.x * z.x + nr.y * z.y + nr.z * z.z));
     if (!(gw > 0.0f))
         return 1.0f;
     float nu1 = v3_dot(nr, u1), nu2 = v3_dot(nr, u2);
@@ -613,6 +612,10 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
         lobes |= (blk->diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk->camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0);
     if ((lobes & VSGL__KERNEL_GLOSSY) && two_lobes(j->s->glossy_mode))
         lobes |= VSGL__KERNEL_GGX_TAIL | (j->s->glossy_lobes == VSGL__HV5_LOBES ? VSGL__KERNEL_HV5 : 0);
+    for (size_t k = 0; k < n && !(lobes & VSGL__KERNEL_GRAZE); ++k)
+        if (blk->camp[k] > 0.0f &&
+            vsgl__graze_ramp(blk->Zx[k] * blk->nx[k] + blk->Zy[k] * blk->ny[k] + blk->Zz[k] * blk->nz[k]) > 0.0f)
+            lobes |= VSGL__KERNEL_GRAZE;
     for (size_t k = n; k < VSGL__KERNEL_BLOCK; ++k) {
         /* padding lanes: shaded, never read; at lane 0's position so that
          * they do not change the block's choice of short forms */
