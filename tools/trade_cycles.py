@@ -7,7 +7,7 @@ Builds each scene with tests/blender/cycles_ref.py's build_blender, times the
 add-on's export of it (vsgl_indirect.export.collect on the evaluated
 depsgraph, as a render does: the fastest of 3), then renders it once per
 spp (after a 1-spp warm-up render that is not kept) with cycles_ref.render_cycles (the quality references' one-bounce
-settings, pixel centres, no denoising) plus the Normal pass (a guide for
+settings, each pixel its area's average, no denoising) plus the Normal pass (a guide for
 OIDN). Each render is stored as an .npz (DiffInd, GlossInd, DiffCol,
 GlossCol, Normal; meta: render seconds = the render call, scene sync
 included, the faster of two up to 16 spp; export seconds) under --out, named by refs.path with the digest

@@ -127,7 +127,8 @@ GATHER_CASE = dict(
     lights=[dict(type="SPOT", energy=300.0, loc=(-0.4, -0.3, 1.9), rot=(20, -25, 0), spot_size=50, spot_blend=0.2),
             dict(type="AREA", energy=60.0, loc=(0.5, 0.6, 1.98), rot=(0, 0, 0), shape="SQUARE", size=0.3)],
     # slightly off-centre so that no room edge projects onto a row or column
-    # of pixel centres (Cycles' +-0.005 px jitter would then split it)
+    # of pixel centres (written for a 0.01 px filter; the render is a 1 px box:
+    # render_cycles)
     camera=dict(type="PERSP", lens=30.0, loc=(0.0137, -3.613, 1.0071), rot=(90, 0, 0), res=(80, 60)),
     samples=2048,
 )
@@ -313,6 +314,14 @@ def one_bounce(cy, samples, seed):
     cy.caustics_refractive = True
 
 
+# The box pixel filter below is rendered 1 px wide whatever filter_width says:
+# Blender's Cycles sync sets the film's filter width to 1 for FILTER_BOX. So a
+# many-sample render is the average over each pixel's area (its DiffCol mixes
+# the colours of the surfaces a silhouette pixel covers), not the pixel
+# centre; a 1-spp render's one sample happens to lie at the centre
+# (docs/validation.md). The library's aa x aa samples and edge refinement
+# estimate the same area average. The line stays: changing this function's
+# text would re-key (re-render) every cached reference (tests/quality/refs.py).
 def render_cycles(case, passes, path_prefix, samples, seed=1):
     sc = bpy.context.scene
     sc.render.engine = "CYCLES"
@@ -775,8 +784,8 @@ def suite_gather(lib, ctx, out_dir, report):
                   "%d spp%s. Library: brute-force gather, aa %d, visibility rays, "
                   "RSM per light at the given size.\n"
                   % (W, H, case["samples"], "" if secs is None else " (rendered in %.0f s)" % secs, GATHER_AA))
-    report.append("Cycles reference = mean of two %d-spp renders (seeds 1, 2), pixel centres only (box filter "
-                  "0.01 px, like the G-buffer at aa 1); its own noise, relMSE(c1, c2)/4: diffuse %.4f, "
+    report.append("Cycles reference = mean of two %d-spp renders (seeds 1, 2), each pixel the average over its area "
+                  "(Cycles renders a box pixel filter 1 px wide: render_cycles); its own noise, relMSE(c1, c2)/4: diffuse %.4f, "
                   "glossy %.4f, combined %.4f. relMSE = mean((a-b)^2/(b^2+0.01)) over pixels and channels "
                   "of the coloured planes DiffInd*DiffCol, GlossInd*GlossCol.\n" % (half, floor_d, floor_g, floor_c))
     report.append("Interior pixels (3x3 neighbourhood of one material colour, %.0f %% of the image): Cycles "

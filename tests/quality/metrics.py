@@ -216,6 +216,49 @@ def motion_change(first, last, steps):
     return math.sqrt(max(dot, 0.0) / s) / steps if s > 0 and steps > 0 else float("nan")
 
 
+def motion_steps(seq_a, seq_b):
+    """The motion's own change at every step of an animation, in flicker()'s
+    RMS form, from two independent renders (seeds) of every frame: step t is
+    sqrt(max(0, d_a . d_b)) / |m_t| with d = f[t+1] - f[t] per seed and m_t
+    the seeds' mean (their noise is independent: E[d_a . d_b] = |d|^2). Unlike
+    motion_change's straight line from the first to the last frame, it keeps
+    what does not move at a steady rate: an edge crossing a pixel (the
+    references are pixel-area averages) changes it in one or two frames, not
+    a little in each. Returns the list over steps."""
+    a = [np.asarray(x, np.float64) for x in seq_a]
+    b = [np.asarray(x, np.float64) for x in seq_b]
+    if len(a) != len(b) or len(a) < 2:
+        raise ValueError("motion_steps: %d frames against %d" % (len(a), len(b)))
+    out = []
+    for t in range(len(a) - 1):
+        dot = float(np.sum((a[t + 1] - a[t]) * (b[t + 1] - b[t])))
+        s = float(np.sum((0.5 * (a[t] + b[t])) ** 2))
+        out.append(math.sqrt(max(dot, 0.0) / s) if s > 0 else float("nan"))
+    return out
+
+
+def excess_over_seeds(frames, seq_a, seq_b):
+    """Median over steps of how much a sequence changes beyond the motion
+    rendered by two independent seeds of every frame: sqrt(max(0, (df - d_a)
+    . (df - d_b))) / |f[t]|, df = f[t+1] - f[t], d_a and d_b the seeds' own
+    steps. The product of the two differences removes the seeds' noise
+    (E[(df - d_a) . (df - d_b)] = |df - d|^2), so this is excess_flicker
+    against the noise-free motion itself rather than against a dense render
+    of the same method (which shares its model's errors)."""
+    f = [np.asarray(x, np.float64) for x in frames]
+    a = [np.asarray(x, np.float64) for x in seq_a]
+    b = [np.asarray(x, np.float64) for x in seq_b]
+    if not (len(f) == len(a) == len(b)) or len(f) < 2:
+        raise ValueError("excess_over_seeds: %d frames against %d and %d" % (len(f), len(a), len(b)))
+    out = []
+    for t in range(len(f) - 1):
+        df = f[t + 1] - f[t]
+        dot = float(np.sum((df - (a[t + 1] - a[t])) * (df - (b[t + 1] - b[t]))))
+        s = float(np.sum(f[t] ** 2))
+        out.append(math.sqrt(max(dot, 0.0) / s) if s > 0 else float("nan"))
+    return float(np.median(out))
+
+
 def all_metrics(img, ref_seeds, k=4):
     """Every still metric of one configuration's passes against the
     reference seeds (each a dict of coloured passes). Returns

@@ -5,8 +5,9 @@
         [--anim light|camera --frame N] [--check-builder] [--force]
 
 Builds each scene with tests/blender/cycles_ref.py's build_blender and renders
-it with its render_cycles (max_bounces 1, no clamps, blur_glossy 0, box filter
-0.01 px = pixel centres, fixed seed, no denoising, world strength 0), passes
+it with its render_cycles (max_bounces 1, no clamps, blur_glossy 0, box pixel
+filter: 1 px wide whatever its width is set to, so each pixel is the average
+over its area; fixed seed, no denoising, world strength 0), passes
 DiffInd, GlossInd, DiffCol, GlossCol, once per seed; stores each as an .npz
 under --out (refs.py names and keys them; existing ones are kept unless
 --force).

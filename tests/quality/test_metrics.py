@@ -149,6 +149,49 @@ def test_motion_change_removes_independent_noise():
     assert still < 0.2 * want
 
 
+def _edge_sequence(n=12, h=30, w=40, speed=0.35):
+    """A bright square sliding right by `speed` px a frame over a dim
+    background, each pixel the area it covers (a box-filtered edge)."""
+    xs = np.arange(w, dtype=np.float64)
+    out = []
+    for t in range(n):
+        left = 10.0 + speed * t
+        cover = np.clip(np.minimum(xs + 1, left + 12) - np.maximum(xs, left), 0, 1)
+        img = 0.1 + 0.9 * np.tile(cover, (h, 1))
+        out.append(np.repeat(img[..., None], 3, axis=2))
+    return out
+
+
+def test_motion_steps_keep_an_edges_jumps_and_remove_noise():
+    truth = _edge_sequence()
+    rng = np.random.default_rng(11)
+    seeds = [[f + rng.normal(0, 0.1, f.shape) for f in truth] for _ in range(2)]
+    want = [M._rel(truth[t + 1] - truth[t], truth[t]) for t in range(len(truth) - 1)]
+    got = M.motion_steps(seeds[0], seeds[1])
+    assert max(abs(g - w) for g, w in zip(got, want)) < 0.15 * max(want)
+    assert abs(np.median(got) - np.median(want)) < 0.1 * np.median(want)
+    naive = M.flicker(seeds[0])["median"]
+    assert naive > 1.5 * np.median(want)  # one seed's steps are noise-dominated here
+    # the straight line from the first to the last frame misses the edge's per-frame change
+    line = M.motion_change((seeds[0][0], seeds[1][0]), (seeds[0][-1], seeds[1][-1]), len(truth) - 1)
+    assert line < 0.8 * np.median(want)
+    with pytest.raises(ValueError):
+        M.motion_steps(seeds[0], seeds[1][:-1])
+
+
+def test_excess_over_seeds_is_zero_for_the_truth_and_sees_a_jittering_edge():
+    truth = _edge_sequence()
+    rng = np.random.default_rng(12)
+    seeds = [[f + rng.normal(0, 0.05, f.shape) for f in truth] for _ in range(2)]
+    step = np.median([M._rel(truth[t + 1] - truth[t], truth[t]) for t in range(len(truth) - 1)])
+    assert M.excess_over_seeds(truth, seeds[0], seeds[1]) < 0.2 * step
+    # point-sampled (aliased) edge: the same motion in whole-pixel jumps
+    aliased = [np.where(f > 0.55, 1.0, 0.1) for f in truth]
+    assert M.excess_over_seeds(aliased, seeds[0], seeds[1]) > 0.5 * step
+    with pytest.raises(ValueError):
+        M.excess_over_seeds(truth[:-1], seeds[0], seeds[1])
+
+
 def test_jitter_of_a_ramp_is_zero_and_of_a_reshuffle_is_not():
     base = _img(7)
     ramp = [base * (1 + 0.01 * t) for t in range(8)]
