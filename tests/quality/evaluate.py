@@ -245,9 +245,12 @@ class Renderer:
 
 
 def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, brute_anim=False, want_images=True,
-                   log=print, repeat=1, camera_truth=False, motion_truth=False):
+                   log=print, repeat=1, camera_truth=False, motion_truth=False, camera_steps=True):
     """Every metric of every configuration on one scene. Returns (result
-    dict, images dict for the pictures)."""
+    dict, images dict for the pictures). motion_truth: Cycles' own change of
+    each animation; with camera_steps, the camera's from every frame (both
+    seeds, MOTION_STEPS + 1 renders each) and each configuration's change in
+    excess of it, else from its first and last frames like the light's."""
     truth = None
     if camera_truth and "camera" in anims:
         base = scenes.case(name, anim_size)
@@ -264,7 +267,7 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
         motion = {}
         asz = (anim_size[0], anim_size[1], spp)
         for kind in anims:
-            if kind == "camera":
+            if kind == "camera" and camera_steps:
                 cam_seeds = [[M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, f, refdir)[name]]
                              for f in range(max(frames, MOTION_STEPS + 1))]
                 steps = {p: M.motion_steps([x[0][p] for x in cam_seeds[:MOTION_STEPS + 1]],
