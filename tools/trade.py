@@ -558,7 +558,8 @@ def markdown(results, meta, img_rel, png_rel):
                  "the Cycles renders niced (`nice -n 19`), the library and OIDN not (`--no-nice`)"
                  if not meta.get("niced", True) else "every run niced (`nice -n 19`)"), "",
              "**Size** %dx%d pixels. **Truth**: Cycles %s one-bounce references, two seeds of %d spp each (their "
-             "mean, %d spp in all), each pixel the average over its area (a 1-px box filter); the issue asks >= 4096 spp, this run uses what fits the machine "
+             "mean, %d spp in all), each pixel the average over its area (a 1-px box filter); the issue asks "
+             ">= 4096 spp, this run uses what fits the machine "
              "(`--ref-spp` raises it). **Cycles**: the same settings, one render per spp (seed %d), its time the "
              "render call as measured when it was rendered (scene sync included). **Cycles + OIDN**: the coloured "
              "combined indirect pass (DiffInd x DiffCol + GlossInd x GlossCol) of that render denoised by "

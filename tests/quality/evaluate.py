@@ -449,11 +449,11 @@ def camera_cell(e):
         return "-"
     out = "%s / %s" % (_f(f["Diff"]["median"], "%.4f"), _f(f["Gloss"]["median"], "%.4f"))
     if f["Diff"].get("excess_cycles") is not None:
-        out += " (above Cycles' motion: %s / %s)" % (_f(f["Diff"]["excess_cycles"], "%.4f"),
-                                                      _f(f["Gloss"]["excess_cycles"], "%.4f"))
+        out += " (above Cycles' motion: %s / %s)" % (
+            _f(f["Diff"]["excess_cycles"], "%.4f"), _f(f["Gloss"]["excess_cycles"], "%.4f"))
     if f["Diff"].get("excess") is not None:
-        out += " (above the dense render: %s / %s)" % (_f(f["Diff"]["excess"], "%.4f"),
-                                                        _f(f["Gloss"]["excess"], "%.4f"))
+        out += " (above the dense render: %s / %s)" % (
+            _f(f["Diff"]["excess"], "%.4f"), _f(f["Gloss"]["excess"], "%.4f"))
     return out
 
 
@@ -500,7 +500,8 @@ def markdown(results, args, img_rel):
              "by itself, and this is what a renderer adds to it; **above the dense render** (with --camera-truth) "
              "= the same against the method's own frames rendered with 8 x 8 samples and every pixel shaded "
              "(median of |(f[t+1] - f[t]) - (g[t+1] - g[t])| / |f[t]|; a diagnostic: the dense render shares the "
-             "model's errors, and at 80x60 it is itself not converged at silhouettes); **jitter** = the median relative RMS of "
+             "model's errors, and at 80x60 it is itself not converged at silhouettes); **jitter** = the median "
+             "relative RMS of "
              "(f[t+1] - f[t]) - (f[n] - f[0]) / n, the change in excess of the sequence's own straight-line trend "
              "(a smooth motion's is ~0; a reshuffling fit's, or an edge jumping across pixels, is not), checked "
              "for the camera against the dense render's own (with --camera-truth).", ""]
