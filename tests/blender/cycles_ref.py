@@ -787,7 +787,8 @@ def suite_gather(lib, ctx, out_dir, report):
     report.append("Cycles reference = mean of two %d-spp renders (seeds 1, 2), each pixel the average over its area "
                   "(Cycles renders a box pixel filter 1 px wide: render_cycles); its own noise, relMSE(c1, c2)/4: "
                   "diffuse %.4f, glossy %.4f, combined %.4f. relMSE = mean((a-b)^2/(b^2+0.01)) over pixels and "
-                  "channels of the coloured planes DiffInd*DiffCol, GlossInd*GlossCol.\n" % (half, floor_d, floor_g, floor_c))
+                  "channels of the coloured planes DiffInd*DiffCol, GlossInd*GlossCol.\n"
+                  % (half, floor_d, floor_g, floor_c))
     report.append("Interior pixels (3x3 neighbourhood of one material colour, %.0f %% of the image): Cycles "
                   "noise there %.4f.\n" % (100 * inner.mean(), floor_ci))
     report.append("| RSM | VPLs | relMSE diffuse | relMSE glossy | relMSE combined | combined, interior | "
