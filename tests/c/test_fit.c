@@ -250,6 +250,57 @@ static double total_weight(const vsgl_vsgl_set *s)
     return w;
 }
 
+/* k-means clusters stay on one side of a crease: an RSM of two lit walls
+ * meeting at a right angle (columns u < 32 on the plane x = 0, normal +x;
+ * the rest on y = 0, normal +y; neighbours in the image across the corner
+ * line). A cluster spanning both had its mean off both walls and normals
+ * too incoherent for the emitter clip (sun_opening: a wall lit ~85x too
+ * brightly by the window). Every VSGL's coherence is ~1 with the normal
+ * term in the assignment; without it, clusters along the corner mixed both
+ * walls (coherence ~0.7-0.95). */
+VT_TEST(fit_kmeans_clusters_do_not_straddle_a_crease)
+{
+    static room rm;
+    if (!room_open(&rm))
+        return;
+    hand_rsm h;
+    make_rsm(&h, 64, 5, 0.0f, 1.0f);
+    vsgl_rsm *r = &h.r;
+    for (int c = 0; c < 3; ++c)
+        r->total_flux[c] = 0.01f * (float)r->count;
+    for (size_t t = 0; t < r->count; ++t) {
+        uint32_t u = (uint32_t)(t % 64), v = (uint32_t)(t / 64);
+        int wall_x = u < 32;
+        float a = 0.02f * (float)(wall_x ? 32 - u : u - 32) + 0.01f, z = 0.02f * (float)v + 0.01f;
+        r->material[t] = 0;
+        r->pos[0][t] = wall_x ? 0.0f : a;
+        r->pos[1][t] = wall_x ? a : 0.0f;
+        r->pos[2][t] = z;
+        r->nrm[0][t] = r->wi[0][t] = wall_x ? 1.0f : 0.0f;
+        r->nrm[1][t] = r->wi[1][t] = wall_x ? 0.0f : 1.0f;
+        r->nrm[2][t] = r->wi[2][t] = 0.0f;
+        for (int c = 0; c < 3; ++c)
+            r->flux[c][t] = 0.01f;
+    }
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    const uint32_t counts[3] = {8, 32, 128};
+    for (int i = 0; i < 3; ++i) {
+        s.vsgl_count = counts[i];
+        vsgl_vsgl_set km = {0};
+        VT_CHECK(vsgl__fit_kmeans(rm.ctx, rm.scene, r, &s, &km) == VSGL_OK, "kmeans N=%u", counts[i]);
+        float worst = 1.0f;
+        for (size_t k = 0; k < km.count; ++k)
+            if (km.items[k].lobe == VSGL__LOBE_DIFFUSE && km.items[k].coherence < worst)
+                worst = km.items[k].coherence;
+        printf("    N=%u: %zu VSGLs, least coherent diffuse cluster %.4f\n", counts[i], km.count, worst);
+        VT_CHECK(worst > 0.999f, "N=%u: a cluster mixes both walls (coherence %.4f)", counts[i], worst);
+        vsgl__vsgl_set_free(&km);
+    }
+    free_rsm(&h);
+    room_close(&rm);
+}
+
 VT_TEST(fit_fis_and_kmeans_conserve_total_power)
 {
     static room rm;

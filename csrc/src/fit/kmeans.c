@@ -14,7 +14,16 @@ typedef struct centre {
     uint32_t face;
     float x, y;          /* level-0 texel coordinates */
     v3 p;                /* world position */
+    v3 n;                /* the centre texel's normal (0 if it has none) */
 } centre;
+
+/* The cost of a VPL whose normal is perpendicular to a centre's, on the
+ * scale of the image and world terms (1: as far as another cube face). A
+ * cluster then does not straddle a crease: one spanning the corner of two
+ * walls had its mean off both, 0.12 m from a wall it partly lies on, and its
+ * normals too incoherent for the emitter clip; it lit that wall ~85x too
+ * brightly (sun_opening, k-means 256, a blotch by the window wall). */
+#define KMEANS_NORMAL_WEIGHT 1.0f
 
 typedef struct assign_job {
     const vsgl_rsm *rsm;
@@ -42,6 +51,7 @@ static int32_t assign_chunk(void *user, size_t chunk, size_t b, size_t e)
         }
         float x = (float)(rem % r->res) + 0.5f, y = (float)(rem / r->res) + 0.5f;
         v3 p = v3_make(r->pos[0][t], r->pos[1][t], r->pos[2][t]);
+        v3 nt = v3_make(r->nrm[0][t], r->nrm[1][t], r->nrm[2][t]);
         float best = FLT_MAX;
         uint32_t arg = 0;
         for (uint32_t k = 0; k < j->n; ++k) {
@@ -53,6 +63,7 @@ static int32_t assign_chunk(void *user, size_t chunk, size_t b, size_t e)
             }
             v3 d = v3_sub(p, c->p);
             float dist = di + v3_dot(d, d) * j->world_weight;
+            dist += KMEANS_NORMAL_WEIGHT * (1.0f - (nt.x * c->n.x + nt.y * c->n.y + nt.z * c->n.z));
             if (dist < best) {
                 best = dist;
                 arg = k;
@@ -93,6 +104,11 @@ vsgl_result vsgl__fit_kmeans(vsgl_context *ctx, const vsgl_scene *scene, const v
         c[i].p = v3_make((float)(g.origin.x + (m[7] + m[VSGL__GRID_FIELDS + 7]) / w),
                          (float)(g.origin.y + (m[8] + m[VSGL__GRID_FIELDS + 8]) / w),
                          (float)(g.origin.z + (m[9] + m[VSGL__GRID_FIELDS + 9]) / w));
+        c[i].n = v3_make(0.0f, 0.0f, 0.0f);
+        if (tx < rsm->res && ty < rsm->res) {
+            size_t ri = ((size_t)c[i].face * rsm->res + ty) * rsm->res + tx;
+            c[i].n = v3_make(rsm->nrm[0][ri], rsm->nrm[1][ri], rsm->nrm[2][ri]);
+        }
     }
     v3 lo, hi;
     vsgl__scene_bounds(scene, &lo, &hi);
