@@ -153,6 +153,15 @@ def _rel(d, f):
     return float(np.sqrt(np.sum(np.asarray(d, np.float64) ** 2) / s)) if s > 0 else float("nan")
 
 
+def _rel_cross(da, db, f):
+    """_rel of a change d seen twice with independent noise, da = d + n_a and
+    db = d + n_b: sqrt(max(0, da . db)) / |f|, since E[da . db] = |d|^2 (0
+    when the product is negative: no change measurable above the noise)."""
+    s = float(np.sum(np.asarray(f, np.float64) ** 2))
+    dot = float(np.sum(np.asarray(da, np.float64) * np.asarray(db, np.float64)))
+    return math.sqrt(max(dot, 0.0) / s) if s > 0 else float("nan")
+
+
 def _rel_l1(d, f):
     s = float(np.sum(np.abs(np.asarray(f, np.float64))))
     return float(np.sum(np.abs(np.asarray(d, np.float64)))) / s if s > 0 else float("nan")
@@ -211,9 +220,7 @@ def motion_change(first, last, steps):
     the product is negative (no change measurable above the noise)."""
     a0, b0 = (np.asarray(x, np.float64) for x in first)
     a1, b1 = (np.asarray(x, np.float64) for x in last)
-    dot = float(np.sum((a1 - a0) * (b1 - b0)))
-    s = float(np.sum((0.5 * (a0 + b0)) ** 2))
-    return math.sqrt(max(dot, 0.0) / s) / steps if s > 0 and steps > 0 else float("nan")
+    return _rel_cross(a1 - a0, b1 - b0, 0.5 * (a0 + b0)) / steps if steps > 0 else float("nan")
 
 
 def motion_steps(seq_a, seq_b):
@@ -229,12 +236,7 @@ def motion_steps(seq_a, seq_b):
     b = [np.asarray(x, np.float64) for x in seq_b]
     if len(a) != len(b) or len(a) < 2:
         raise ValueError("motion_steps: %d frames against %d" % (len(a), len(b)))
-    out = []
-    for t in range(len(a) - 1):
-        dot = float(np.sum((a[t + 1] - a[t]) * (b[t + 1] - b[t])))
-        s = float(np.sum((0.5 * (a[t] + b[t])) ** 2))
-        out.append(math.sqrt(max(dot, 0.0) / s) if s > 0 else float("nan"))
-    return out
+    return [_rel_cross(a[t + 1] - a[t], b[t + 1] - b[t], 0.5 * (a[t] + b[t])) for t in range(len(a) - 1)]
 
 
 def excess_over_seeds(frames, seq_a, seq_b):
@@ -250,13 +252,9 @@ def excess_over_seeds(frames, seq_a, seq_b):
     b = [np.asarray(x, np.float64) for x in seq_b]
     if not (len(f) == len(a) == len(b)) or len(f) < 2:
         raise ValueError("excess_over_seeds: %d frames against %d and %d" % (len(f), len(a), len(b)))
-    out = []
-    for t in range(len(f) - 1):
-        df = f[t + 1] - f[t]
-        dot = float(np.sum((df - (a[t + 1] - a[t])) * (df - (b[t + 1] - b[t]))))
-        s = float(np.sum(f[t] ** 2))
-        out.append(math.sqrt(max(dot, 0.0) / s) if s > 0 else float("nan"))
-    return float(np.median(out))
+    df = [f[t + 1] - f[t] for t in range(len(f) - 1)]
+    return float(np.median([_rel_cross(df[t] - (a[t + 1] - a[t]), df[t] - (b[t + 1] - b[t]), f[t])
+                            for t in range(len(df))]))
 
 
 def all_metrics(img, ref_seeds, k=4):

@@ -63,7 +63,7 @@ static int32_t assign_chunk(void *user, size_t chunk, size_t b, size_t e)
             }
             v3 d = v3_sub(p, c->p);
             float dist = di + v3_dot(d, d) * j->world_weight;
-            dist += KMEANS_NORMAL_WEIGHT * (1.0f - (nt.x * c->n.x + nt.y * c->n.y + nt.z * c->n.z));
+            dist += KMEANS_NORMAL_WEIGHT * (1.0f - v3_dot(nt, c->n));
             if (dist < best) {
                 best = dist;
                 arg = k;
