@@ -185,10 +185,20 @@ def test_render_settings_preset(lib):
 
 def test_floor_alone_has_no_brute_force_indirect_light(lib, ctx):
     """Physics, independent of the method: a single plane cannot light
-    itself, so the brute-force reference is exactly black on it."""
+    itself, so the brute-force reference is exactly black on it. Alone, its
+    texels have nothing in front of them and are not gathered at all
+    (vsgl__rsm_drop_outward); with a speck of geometry above the floor,
+    behind the camera and unlit, they are gathered and still give nothing."""
     require(lib, "vsgl_scene_create", "vsgl_reference_render")
     scene = L.Scene(ctx, **floor_and_wall(wall=False))
     images, stats = L.reference_render(ctx, scene, rsm_res=32)
+    assert stats["vpl_count"] == 0
+    assert np.all(images["diffuse_light"] == 0) and np.all(images["glossy_light"] == 0)
+    s = floor_and_wall(wall=False)
+    n = len(s["positions"])
+    s["positions"] = np.vstack([s["positions"], np.array([[0, -7, 1.5], [0.01, -7, 1.5], [0, -7, 1.51]], np.float32)])
+    s["indices"] = np.vstack([s["indices"], np.array([[n, n + 1, n + 2]], np.uint32)])
+    images, stats = L.reference_render(ctx, L.Scene(ctx, **s), rsm_res=32)
     assert stats["vpl_count"] > 0
     assert np.all(images["diffuse_light"] == 0) and np.all(images["glossy_light"] == 0)
     scene = L.Scene(ctx, **floor_and_wall(wall=True))

@@ -48,6 +48,8 @@ TOL_BRUTE = 0.06
 # pass, and quality's structured error (combined pass) against balanced's, where a tie within the
 # references' noise is allowed (the spot room: both at its noise floor).
 MAX_FLICKER_LIGHT = 0.015
+# (or Cycles' own change where the motion itself changes more: the sun rooms' Diff at 0.015, since their
+# lattice is spent on the room's inside only and follows the sliding patch as Cycles does)
 # ... and at most max(0.01, MOTION_SLACK x the motion's own change in Cycles) (evaluate.py --motion-truth:
 # frames 0 and 11 in Cycles, both seeds; the estimate's own spread is ~10 %): a sun patch sliding across
 # a floor changes the room's indirect light by 0.013-0.015 a frame in Cycles itself.
@@ -221,11 +223,13 @@ def main(argv=None):
         for label in ("preview", "balanced", "quality"):
             e = r["configs"][label]
             fl = e["flicker"]["light"]
-            cnt.check(all(fl[p]["median"] <= MAX_FLICKER_LIGHT for p in ("Diff", "Gloss")),
-                      "%s %s: the light animation's flicker Diff %.4f, Gloss %.4f (<= %g; second/first %.2f / %.2f)"
-                      % (label, n, fl["Diff"]["median"], fl["Gloss"]["median"], MAX_FLICKER_LIGHT,
-                         fl["Diff"]["ratio"], fl["Gloss"]["ratio"]))
             own = r["motion"]["light"]
+            cap = {p: max(MAX_FLICKER_LIGHT, own[p]) for p in ("Diff", "Gloss")}
+            cnt.check(all(fl[p]["median"] <= cap[p] for p in ("Diff", "Gloss")),
+                      "%s %s: the light animation's flicker Diff %.4f, Gloss %.4f (<= %.4f / %.4f: max(%g, Cycles' "
+                      "own change); second/first %.2f / %.2f)"
+                      % (label, n, fl["Diff"]["median"], fl["Gloss"]["median"], cap["Diff"], cap["Gloss"],
+                         MAX_FLICKER_LIGHT, fl["Diff"]["ratio"], fl["Gloss"]["ratio"]))
             lim = {p: max(0.01, MOTION_SLACK * own[p]) for p in ("Diff", "Gloss")}
             cnt.check(all(fl[p]["median"] <= lim[p] for p in ("Diff", "Gloss")),
                       "%s %s: the light animation's flicker Diff %.4f, Gloss %.4f (<= %.4f / %.4f: max(0.01, %g x "

@@ -24,6 +24,8 @@ static vsgl_result run_pass(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
         r = vsgl__rsm_build(ctx, scene, l, rsm_resolution, &rsm);
         if (r != VSGL_OK)
             break;
+        double outward[3]; /* texels facing out of the scene: nothing in front of them to light */
+        vsgl__rsm_drop_outward(scene, &rsm, outward);
         vsgl__mrp_proxies_add_rsm(set, scene, &rsm);
         vsgl__rsm_free(&rsm);
         if (vsgl__progress(ctx, "mrp", 0.5f * (float)(l + 1) / (float)light_count))

@@ -58,7 +58,7 @@ static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt,
  * power or its RSM is empty (then `rsm` holds nothing to free). The
  * progress window of the step is [p0, p0 + dp). */
 static vsgl_result light_rsm(vsgl_context *ctx, const vsgl_scene *scene, uint32_t l, uint32_t resolution,
-                             float p0, float dp, vsgl_rsm *rsm, int *lit, vsgl_render_stats *st)
+                             int drop_outward, float p0, float dp, vsgl_rsm *rsm, int *lit, vsgl_render_stats *st)
 {
     uint32_t light_count = 0;
     const vsgl_light *L = &vsgl__scene_lights(scene, &light_count)[l];
@@ -75,6 +75,14 @@ static vsgl_result light_rsm(vsgl_context *ctx, const vsgl_scene *scene, uint32_
     st->seconds_rsm += now_seconds() - t0;
     if (r != VSGL_OK)
         return r;
+    if (drop_outward) {
+        double total = rsm->total_flux[0] + rsm->total_flux[1] + rsm->total_flux[2], out[3];
+        vsgl__rsm_drop_outward(scene, rsm, out);
+        if (out[0] + out[1] + out[2] > 0.0)
+            note_skip(ctx, st, "light %u: %.1f %% of its power falls on surfaces facing out of the scene (the "
+                      "outside of walls or a roof: nothing in front of them to light): not modelled", l,
+                      100.0 * (out[0] + out[1] + out[2]) / total);
+    }
     if (!(rsm->total_flux[0] + rsm->total_flux[1] + rsm->total_flux[2] > 0.0)) {
         note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
         ++st->lights_skipped;
@@ -244,7 +252,9 @@ vsgl_result vsgl__fit_lights_mrp(vsgl_context *ctx, const vsgl_scene *scene, con
         }
         vsgl_rsm rsm;
         int lit;
-        r = light_rsm(ctx, scene, l, ls.rsm_resolution, 0.1f + 0.3f * (float)l / (float)light_count,
+        /* the papers' model (leak correction off) lets the outside's clusters leak in: kept */
+        r = light_rsm(ctx, scene, l, ls.rsm_resolution, ls.leak_correction != VSGL_LEAK_OFF,
+                      0.1f + 0.3f * (float)l / (float)light_count,
                       0.3f / (float)light_count, &rsm, &lit, st);
         if (r != VSGL_OK)
             break;
@@ -316,7 +326,7 @@ static vsgl_result brute_force(vsgl_context *ctx, const vsgl_scene *scene, const
     }
     for (uint32_t l = 0; l < light_count && r == VSGL_OK; ++l) {
         int lit;
-        r = light_rsm(ctx, scene, l, s->rsm_resolution, 0.1f + 0.2f * (float)l / (float)light_count,
+        r = light_rsm(ctx, scene, l, s->rsm_resolution, 1, 0.1f + 0.2f * (float)l / (float)light_count,
                       0.2f / (float)light_count, &rsms[used], &lit, st);
         if (r == VSGL_OK && lit) {
             ++used;

@@ -52,6 +52,31 @@ typedef struct rsm_job {
     double *partial;         /* per row: flux sums (3) */
 } rsm_job;
 
+/* A texel at p whose surface faces out of the scene: every corner of the
+ * scene's box lies behind its tangent plane (normal n, within tol), so
+ * nothing is in front of it to light (the outside of a room's walls and
+ * roof under a sun). */
+static int faces_out(v3 p, v3 n, v3 lo, v3 hi, float tol)
+{
+    for (int c = 0; c < 8; ++c) {
+        v3 q = v3_make(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+        if (v3_dot(v3_sub(q, p), n) > tol)
+            return 0;
+    }
+    return 1;
+}
+
+static void clear_texel(vsgl_rsm *o, size_t i)
+{
+    for (int k = 0; k < 3; ++k)
+        o->pos[k][i] = o->nrm[k][i] = o->tan[k][i] = o->wi[k][i] = o->flux[k][i] = 0.0f;
+    o->material[i] = VSGL__RSM_EMPTY;
+    o->area[i] = 0.0f;
+    if (o->surf[0])
+        for (int q = 0; q < VSGL__SURF_N; ++q)
+            o->surf[q][i] = 0.0f;
+}
+
 static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
 {
     (void)chunk;
@@ -84,13 +109,7 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
         for (uint32_t c = 0; c < res; ++c) {
             size_t i = grow * res + c;
             if (hits[c].triangle == VSGL__HIT_NONE || !(tmax[c] >= 0.0f)) {
-                for (int k = 0; k < 3; ++k)
-                    o->pos[k][i] = o->nrm[k][i] = o->tan[k][i] = o->wi[k][i] = o->flux[k][i] = 0.0f;
-                o->material[i] = VSGL__RSM_EMPTY;
-                o->area[i] = 0.0f;
-                if (o->surf[0])
-                    for (int q = 0; q < VSGL__SURF_N; ++q)
-                        o->surf[q][i] = 0.0f;
+                clear_texel(o, i);
                 continue;
             }
             vsgl_surface sf;
@@ -187,4 +206,30 @@ vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
             out->total_flux[k] += partial[3 * i + k];
     free(partial);
     return VSGL_OK;
+}
+
+void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped[3])
+{
+    v3 lo, hi;
+    vsgl__scene_bounds(scene, &lo, &hi);
+    float tol = 1e-5f * v3_length(v3_sub(hi, lo));
+    for (int k = 0; k < 3; ++k)
+        dropped[k] = 0.0;
+    for (size_t i = 0; i < r->count; ++i) {
+        if (r->material[i] == VSGL__RSM_EMPTY)
+            continue;
+        v3 p = v3_make(r->pos[0][i], r->pos[1][i], r->pos[2][i]), n = v3_make(r->nrm[0][i], r->nrm[1][i], r->nrm[2][i]);
+        if (!faces_out(p, n, lo, hi, tol))
+            continue;
+        for (int k = 0; k < 3; ++k)
+            dropped[k] += (double)r->flux[k][i];
+        clear_texel(r, i);
+    }
+    if (!(dropped[0] + dropped[1] + dropped[2] > 0.0))
+        return; /* nothing dropped: the total as built */
+    for (int k = 0; k < 3; ++k) /* the sum of what is left, not a difference (no rounding residue) */
+        r->total_flux[k] = 0.0;
+    for (size_t i = 0; i < r->count; ++i)
+        for (int k = 0; k < 3; ++k)
+            r->total_flux[k] += (double)r->flux[k][i];
 }

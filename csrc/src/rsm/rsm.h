@@ -40,5 +40,11 @@ void vsgl__rsm_material(const vsgl_rsm *r, const vsgl_material *materials, size_
 /* Build the RSM of light `light` at `res` texels per side. */
 vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res, vsgl_rsm *out);
 void vsgl__rsm_free(vsgl_rsm *r);
+/* Empties the texels whose surface faces out of the scene: every corner of
+ * its bounding box lies behind their tangent plane, so nothing is in front
+ * of them to light (the outside of a room's walls and roof under a sun;
+ * the emitter clip gives them nothing to light, the exact gather no
+ * receiver). Sets dropped to their power and total_flux to what is left. */
+void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped[3]);
 
 #endif

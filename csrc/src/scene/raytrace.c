@@ -42,9 +42,16 @@ int vsgl__scene_intersect(const vsgl_scene *scene, v3 org, v3 dir, float tmin, f
     return 1;
 }
 
+/* 1 if the segment org + [tmin, tmax] dir is proven unblocked from bounds
+ * (scene/occluders.c); 0: trace it. */
+static int proven_clear(const vsgl_scene *scene, v3 org, v3 dir, float tmin, float tmax)
+{
+    return vsgl__scene_segment_clear(scene, v3_add(org, v3_scale(dir, tmin)), v3_add(org, v3_scale(dir, tmax)));
+}
+
 int vsgl__scene_occluded(const vsgl_scene *scene, v3 org, v3 dir, float tmin, float tmax)
 {
-    if (scene->triangle_count == 0 || !(tmin <= tmax))
+    if (scene->triangle_count == 0 || !(tmin <= tmax) || proven_clear(scene, org, dir, tmin, tmax))
         return 0;
     struct RTCIntersectContext ic;
     rtcInitIntersectContext(&ic);
@@ -102,28 +109,25 @@ void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *or
     struct RTCIntersectContext ic;
     rtcInitIntersectContext(&ic);
     ic.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    for (uint32_t b = 0; b < n; b += BATCH) {
-        uint32_t m = n - b < BATCH ? n - b : BATCH;
-        for (uint32_t i = 0; i < m; ++i) {
-            float lo = tmin[b + i], hi = tmax[b + i];
-            fill_ray(&r[i], org[b + i], dir[b + i], lo, hi);
-            if (!(lo <= hi)) { /* empty interval: inactive ray, never blocked */
-                r[i].tnear = 0.0f;
-                r[i].tfar = -INFINITY;
-            }
+    uint32_t idx[BATCH];
+    uint32_t b = 0;
+    while (b < n) {
+        /* the next up to BATCH rays that need tracing: empty intervals and
+         * segments proven clear from bounds are unblocked without a ray */
+        uint32_t m = 0;
+        for (; b < n && m < BATCH; ++b) {
+            float lo = tmin[b], hi = tmax[b];
+            blocked[b] = 0;
+            if (scene->triangle_count == 0 || !(lo <= hi) || proven_clear(scene, org[b], dir[b], lo, hi))
+                continue;
+            fill_ray(&r[m], org[b], dir[b], lo, hi);
+            idx[m++] = b;
         }
-        if (scene->triangle_count > 0) {
-            /* Embree marks a blocked ray with tfar = -inf; remember inactive ones */
-            unsigned char active[BATCH] = {0};
-            for (uint32_t i = 0; i < m; ++i)
-                active[i] = r[i].tfar != -INFINITY;
-            rtcOccluded1M(scene->rtc, &ic, r, m, sizeof(struct RTCRay));
-            for (uint32_t i = 0; i < m; ++i)
-                blocked[b + i] = (unsigned char)(active[i] && r[i].tfar == -INFINITY);
-        } else {
-            for (uint32_t i = 0; i < m; ++i)
-                blocked[b + i] = 0;
-        }
+        if (m == 0)
+            continue;
+        rtcOccluded1M(scene->rtc, &ic, r, m, sizeof(struct RTCRay)); /* a blocked ray gets tfar = -inf */
+        for (uint32_t i = 0; i < m; ++i)
+            blocked[idx[i]] = (unsigned char)(r[i].tfar == -INFINITY);
     }
 }
 

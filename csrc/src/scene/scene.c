@@ -57,6 +57,7 @@ void vsgl_scene_destroy(vsgl_scene *s)
     free(s->material_textures);
     free(s->corner_colors);
     free(s->uv_density);
+    free(s->occ_boxes);
     free(s);
 }
 
@@ -292,6 +293,9 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
         return r;
     s->vertex_count = d->vertex_count;
     s->convex_shell = vsgl__scene_test_convex_shell(s); /* geometry never changes after this */
+    r = vsgl__scene_build_occluders(ctx, s);
+    if (r != VSGL_OK)
+        return r;
     rtcCommitScene(s->rtc);
     return embree_check(ctx, s, "building the BVH");
 }

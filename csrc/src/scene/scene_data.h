@@ -39,12 +39,19 @@ struct vsgl_scene {
     float *uv_density;           /* triangle_count: UV area / world area (0 without UVs); NULL if untextured */
     int textured;                /* some material reads a texture or corner colours */
     v3 lo, hi;                   /* bounds of the valid triangles (0,0,0 when empty) */
+    v3 occ_inner_lo, occ_inner_hi; /* scene/occluders.c: segments strictly inside meet no face triangle */
+    uint32_t occ_count;          /* boxes around the triangles off the bounds' faces */
+    float *occ_boxes;            /* occ_count * 6 (lo xyz, hi xyz), padded; NULL when occ_count is 0 */
+    float occ_union[6];          /* the boxes' union */
     int convex_shell;            /* vsgl__scene_convex_shell, decided once when the scene is built */
     uint64_t identity;           /* creation time (CLOCK_MONOTONIC ns): with the address, tells this scene's
                                     geometry and materials from a destroyed one's at the same address;
                                     kept by vsgl_scene_set_view (render caches key on both) */
     char embree_message[VSGL__SCENE_EMBREE_MESSAGE]; /* first Embree error seen */
 };
+
+/* The occluders' bounds (occluders.c), once the triangles and bounds are set. */
+vsgl_result vsgl__scene_build_occluders(vsgl_context *ctx, vsgl_scene *s);
 
 /* Validation (validate.c): first error -> vsgl__fail with a message naming the element. */
 vsgl_result vsgl__validate_scene_desc(vsgl_context *ctx, const vsgl_scene_desc *d);

@@ -82,6 +82,11 @@ const vsgl_camera *vsgl__scene_camera(const vsgl_scene *scene);
 uint64_t vsgl__scene_identity(const vsgl_scene *scene);
 /* Bounding box of the valid triangles; lo = hi = (0,0,0) when there are none. */
 void vsgl__scene_bounds(const vsgl_scene *scene, v3 *lo, v3 *hi);
+/* 1 if no triangle can block the segment from a to b, proven from bounds
+ * (scene/occluders.c): both ends inside the scene's box, clear of the
+ * triangles on its faces, and the segment misses the boxes of all others.
+ * 0 means "trace it": it may or may not be blocked. */
+int vsgl__scene_segment_clear(const vsgl_scene *scene, v3 a, v3 b);
 /* 1 if every triangle's plane has all of the scene's vertices on one side
  * (scene/convex.c): no surface can block light between two others, so
  * visibility rays find nothing. 0 otherwise, and above 2048 triangles. */

@@ -111,6 +111,8 @@ vsgl_result vsgl_reference_render(vsgl_context *ctx, const vsgl_scene *scene, ui
         rc = vsgl__rsm_build(ctx, scene, built, rsm_res, &rsms[built]);
         if (rc != VSGL_OK)
             break;
+        double outward[3]; /* texels facing out of the scene light no receiver: not gathered */
+        vsgl__rsm_drop_outward(scene, &rsms[built], outward);
         const vsgl_rsm *R = &rsms[built];
         st.rsm_bytes += (uint64_t)R->count * (16 * sizeof(float) + sizeof(uint32_t));
         for (int c = 0; c < 3; ++c)

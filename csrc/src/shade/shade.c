@@ -259,6 +259,12 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     }
 }
 
+/* No visibility ray where a VSGL cannot light the receiver
+ * (visibility_rays): its clip at least this, the receiver below this
+ * fraction of the behind fade. */
+#define VSGL__VIS_SKIP_CLIP 0.999f
+#define VSGL__VIS_SKIP_BEHIND 1e-3f
+
 /* Where visibility rays aim for VSGL v: its mean, pushed off its surface
  * along its mean normal by one sigma. A curved surface's cluster has its
  * mean inside the object (a sphere's cap: the mean of points on it lies
@@ -272,12 +278,19 @@ static v3 ray_target(const vsgl_vsgl *v)
 /* Visibility of `target` (a VSGL's ray target) from receivers rec[0..n), n <=
  * VSGL__KERNEL_BLOCK: one batched occlusion query (Embree ray streams) from
  * each receiver offset along its normal; vis[k] = 0 if blocked, else 1. A
- * receiver at the target traces an empty segment (visible). */
-static void visibility_rays(const shade_job *j, v3 target, const receiver *rec, size_t n, float *vis)
+ * receiver at the target traces an empty segment (visible). With L (the
+ * VSGL's kernel light; NULL: every lane traced), no ray for a receiver the
+ * VSGL cannot light: behind or within 1e-3 of the behind fade of its plane
+ * (VSGL__CLIP_BEHIND sigma) with its emitter clip at >= 0.999 (its light
+ * there is at most 0.1 % of the unclipped lobe's: a floor's clusters and the
+ * floor's own receivers, a wall's cluster and the wall beside it); vis 1. */
+static void visibility_rays(const shade_job *j, v3 target, const vsgl_kernel_light *L, const receiver *rec,
+                            size_t n, float *vis)
 {
     v3 org[VSGL__KERNEL_BLOCK], dir[VSGL__KERNEL_BLOCK];
     float tmin[VSGL__KERNEL_BLOCK], tmax[VSGL__KERNEL_BLOCK];
     unsigned char blocked[VSGL__KERNEL_BLOCK];
+    const int may_skip = L && L->clip >= VSGL__VIS_SKIP_CLIP;
     for (size_t k = 0; k < n; ++k) {
         org[k] = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
         v3 d = v3_sub(target, org[k]);
@@ -285,8 +298,13 @@ static void visibility_rays(const shade_job *j, v3 target, const receiver *rec, 
         dir[k] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
         tmin[k] = 0.0f;
         tmax[k] = dist > j->eps ? dist - j->eps : 0.0f;
+        if (may_skip) { /* the kernel's h (kernel_impl.h, k_geometry) */
+            float h = -((L->mx - rec[k].x.x) * L->nx + (L->my - rec[k].x.y) * L->ny + (L->mz - rec[k].x.z) * L->nz);
+            if (h * L->ibehind < VSGL__VIS_SKIP_BEHIND)
+                tmax[k] = -1.0f; /* an empty interval: not traced, visible */
+        }
     }
-    vsgl__scene_occluded_many(j->scene, (uint32_t)n, org, dir, tmin, tmax, 0, blocked);
+    vsgl__scene_occluded_many(j->scene, (uint32_t)n, org, dir, tmin, tmax, 1, blocked);
     for (size_t k = 0; k < n; ++k)
         vis[k] = blocked[k] ? 0.0f : 1.0f;
 }
@@ -400,7 +418,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                     in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), VSGL__TINY));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
                     float vis;
-                    visibility_rays(j, ray_target(v), &r, 1, &vis);
+                    visibility_rays(j, ray_target(v), NULL, &r, 1, &vis);
                     if (vis == 0.0f)
                         continue;
                 }
@@ -590,7 +608,7 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
             continue;
         if (j->s->visibility == VSGL_VISIBILITY_RAY) {
             float vis;
-            visibility_rays(j, ray_target(v), r, 1, &vis);
+            visibility_rays(j, ray_target(v), NULL, r, 1, &vis);
             e *= vis;
         }
         for (int k = 0; k < 3; ++k)
@@ -633,7 +651,7 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
             for (size_t v = 0; v < count; v += 2) {
                 size_t m = count - v < 2 ? count - v : 2;
                 for (size_t q = 0; q < m; ++q)
-                    visibility_rays(j, ray_target(&j->set->items[j->korder[v + q]]), rec, n,
+                    visibility_rays(j, ray_target(&j->set->items[j->korder[v + q]]), &j->klights[v + q], rec, n,
                                     vis + q * VSGL__KERNEL_BLOCK);
                 kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
             }

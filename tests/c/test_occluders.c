@@ -1,0 +1,208 @@
+/* What is decided from bounds before a ray or a fit: segments proven
+ * unblocked (scene/occluders.c), checked against an exact segment-triangle
+ * test in double precision; and RSM texels facing out of the scene
+ * (vsgl__rsm_drop_outward), against the sun's power on the one outside
+ * wall it lights. */
+#include "harness.h"
+#include "scene_fixture.h"
+#include "rsm/rsm.h"
+#include "scene/scene_internal.h"
+
+#include <string.h>
+
+/* Does segment a-b meet triangle p0 p1 p2 (Moller-Trumbore, double, ends
+ * and edges included)? */
+static int segment_meets_triangle(const double a[3], const double b[3], const float *p0, const float *p1,
+                                  const float *p2)
+{
+    double d[3], e1[3], e2[3], s[3], h[3], q[3];
+    for (int k = 0; k < 3; ++k) {
+        d[k] = b[k] - a[k];
+        e1[k] = (double)p1[k] - p0[k];
+        e2[k] = (double)p2[k] - p0[k];
+        s[k] = a[k] - p0[k];
+    }
+    h[0] = d[1] * e2[2] - d[2] * e2[1];
+    h[1] = d[2] * e2[0] - d[0] * e2[2];
+    h[2] = d[0] * e2[1] - d[1] * e2[0];
+    double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+    if (fabs(det) < 1e-18)
+        return 0; /* parallel: a segment in the triangle's plane counts as not blocked */
+    double u = (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]) / det;
+    q[0] = s[1] * e1[2] - s[2] * e1[1];
+    q[1] = s[2] * e1[0] - s[0] * e1[2];
+    q[2] = s[0] * e1[1] - s[1] * e1[0];
+    double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+    double t = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
+    const double m = 1e-9;
+    return u >= -m && v >= -m && u + v <= 1.0 + m && t >= -m && t <= 1.0 + m;
+}
+
+static uint32_t next(uint32_t *x)
+{
+    *x ^= *x << 13;
+    *x ^= *x >> 17;
+    *x ^= *x << 5;
+    return *x;
+}
+
+static double uniform(uint32_t *x) { return (next(x) >> 8) * (1.0 / 16777216.0); }
+
+/* The fixture room (its walls on the bounds' faces) with two blocks in it
+ * (12 triangles each: one box around both; 96 each: a box per leaf of the
+ * split), or only the walls. Random segments, half of them from a point on a wall
+ * (offset off it like a shading ray's origin): a segment called clear must
+ * meet no triangle, and in the room with blocks a good share of them is
+ * clear (with the walls alone, every segment inside). End points outside
+ * the bounds are never called clear. */
+/* Scene arrays with room for the blocks' many small triangles. */
+#define OCC_TRIS 256
+static float occ_pos[OCC_TRIS * 9];
+static uint32_t occ_idx[OCC_TRIS * 3], occ_mat[OCC_TRIS];
+
+/* Blocks [lo, hi] as 6 quads, each face cut into n x n pieces (so that the
+ * occluders' split has enough triangles to make leaves), into `fx`'s
+ * arrays copied to occ_*: returns the triangle count. */
+static uint32_t copy_with_pieces(const fx_scene *fx, const float (*lo)[3], const float (*hi)[3], int blocks, int n)
+{
+    uint32_t t = 0;
+    for (uint32_t i = 0; i < fx->triangle_count; ++i, ++t) {
+        for (int k = 0; k < 3; ++k) {
+            memcpy(occ_pos + 9 * t + 3 * k, fx->positions + 3 * fx->indices[3 * i + k], 3 * sizeof(float));
+            occ_idx[3 * t + k] = 3 * t + (uint32_t)k;
+        }
+        occ_mat[t] = fx->material_indices[i];
+    }
+    for (int b = 0; b < blocks; ++b)
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side)
+                for (int u = 0; u < n; ++u)
+                    for (int v = 0; v < n; ++v)
+                        for (int half = 0; half < 2; ++half, ++t) {
+                            const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+                            const int cu[3] = {0, 1, half ? 1 : 0}, cv[3] = {0, half ? 1 : 1, half ? 0 : 1};
+                            for (int k = 0; k < 3; ++k) {
+                                float *p = occ_pos + 9 * t + 3 * k;
+                                p[axis] = side ? hi[b][axis] : lo[b][axis];
+                                p[a1] = lo[b][a1] + (hi[b][a1] - lo[b][a1]) * (float)(u + cu[k]) / (float)n;
+                                p[a2] = lo[b][a2] + (hi[b][a2] - lo[b][a2]) * (float)(v + cv[k]) / (float)n;
+                                occ_idx[3 * t + k] = 3 * t + (uint32_t)k;
+                            }
+                            occ_mat[t] = 3;
+                        }
+    return t;
+}
+
+VT_TEST(occluders_never_call_a_blocked_segment_clear)
+{
+    vsgl_context *ctx = fx_context(1);
+    VT_REQUIRE(ctx, "context");
+    /* two blocks: one on the floor, one under the ceiling across the room */
+    const float lo[2][3] = {{-0.6f, -0.2f, 0.0f}, {0.4f, 0.5f, 1.2f}}, hi[2][3] = {{-0.2f, 0.3f, 0.7f}, {0.8f, 0.9f, 1.5f}};
+    int clear_one_box = 0;
+    for (int blocks = 0; blocks < 3; ++blocks) { /* none, two of 12 triangles, two of 96 (leaves) */
+        fx_scene fx;
+        fx_room(&fx, 8, 6, 0.5f, 100.0f);
+        uint32_t tris = copy_with_pieces(&fx, lo, hi, blocks ? 2 : 0, blocks == 2 ? 2 : 1);
+        vsgl_scene_desc d = *fx_desc(&fx);
+        d.vertex_count = 3 * tris;
+        d.positions = occ_pos;
+        d.triangle_count = tris;
+        d.indices = occ_idx;
+        d.material_indices = occ_mat;
+        vsgl_scene *sc = NULL;
+        VT_REQUIRE(vsgl_scene_create(ctx, &d, &sc) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        uint32_t rng = 12345u; /* the same segments in each scene */
+        int clear = 0, wrong = 0, inside = 0, outside_clear = 0;
+        const int n = 20000;
+        for (int i = 0; i < n; ++i) {
+            double a[3], b[3];
+            for (int k = 0; k < 3; ++k) {
+                a[k] = k == 2 ? 2.0 * uniform(&rng) : 2.0 * uniform(&rng) - 1.0;
+                b[k] = k == 2 ? 2.0 * uniform(&rng) : 2.0 * uniform(&rng) - 1.0;
+            }
+            if (i & 1) { /* on the floor, the left wall or the ceiling, 1e-4 off it */
+                int w = (int)(next(&rng) % 3);
+                if (w == 0) a[2] = 1e-4;
+                else if (w == 1) a[0] = -1.0 + 1e-4;
+                else a[2] = 2.0 - 1e-4;
+            }
+            if (i % 7 == 0) /* past the bounds, by 1 um to 1 cm */
+                b[1] = -1.0 - 1e-6 * pow(10.0, 4.0 * uniform(&rng));
+            int blocked = 0;
+            for (uint32_t t = 0; t < tris && !blocked; ++t)
+                blocked = segment_meets_triangle(a, b, occ_pos + 9 * t, occ_pos + 9 * t + 3, occ_pos + 9 * t + 6);
+            int c = vsgl__scene_segment_clear(sc, v3_make((float)a[0], (float)a[1], (float)a[2]),
+                                              v3_make((float)b[0], (float)b[1], (float)b[2]));
+            clear += c;
+            inside += i % 7 != 0;
+            outside_clear += c && i % 7 == 0;
+            if (c && blocked && wrong++ < 4)
+                VT_REPORT("blocks %d: segment (%g %g %g)-(%g %g %g) called clear, but it meets a triangle", blocks,
+                          a[0], a[1], a[2], b[0], b[1], b[2]);
+        }
+        VT_CHECK(outside_clear == 0, "blocks %d: %d segments leaving the bounds called clear", blocks, outside_clear);
+        if (blocks == 2) /* the leaves' boxes leave the space between the blocks free */
+            VT_CHECK(clear > clear_one_box * 11 / 10, "leaves: %d clear, one box around both: %d", clear,
+                     clear_one_box);
+        clear_one_box = clear;
+        if (blocks)
+            VT_CHECK(clear > inside / 4, "blocks %d: only %d of %d segments inside called clear", blocks, clear,
+                     inside);
+        else
+            VT_CHECK(clear == inside, "walls only: %d of %d segments inside called clear", clear, inside);
+        vsgl_scene_destroy(sc);
+    }
+    vsgl_context_destroy(ctx);
+}
+
+/* An open-top box (the fixture room with a front wall, no ceiling) under a
+ * sun from (3, 0, 4): it lights the floor and the inside of the left wall
+ * through the top, and the outside of the right wall x = +1 (4 m^2 at
+ * cos 0.6). Only that outside is dropped: its power is E 0.6 x 4, and
+ * every texel left has a corner of the box in front of it. */
+VT_TEST(rsm_drop_outward_takes_only_the_outside_of_a_wall)
+{
+    vsgl_context *ctx = fx_context(1);
+    VT_REQUIRE(ctx, "context");
+    fx_scene fx;
+    fx_room(&fx, 8, 6, 0.5f, 100.0f);
+    fx.triangle_count -= 2; /* no ceiling (the room's last quad) */
+    fx.vertex_count -= 4;
+    const float front[4][3] = {{-1, -1, 0}, {-1, -1, 2}, {1, -1, 2}, {1, -1, 0}};
+    fx_quad(&fx, front, 3);
+    vsgl_light *L = &fx.lights[0];
+    memset(L, 0, sizeof *L);
+    L->type = VSGL_LIGHT_SUN;
+    L->color[0] = L->color[1] = L->color[2] = 1.0f;
+    L->power = 3.0f; /* W/m^2 */
+    const float eye[3] = {3, 0, 4}, at[3] = {0, 0, 0};
+    fx_look_at(L->world_from_light, eye, at);
+    fx.light_count = 1;
+    vsgl_scene *sc = NULL;
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &sc) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    vsgl_rsm r;
+    VT_REQUIRE(vsgl__rsm_build(ctx, sc, 0, 256, &r) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    double before = r.total_flux[0], dropped[3];
+    vsgl__rsm_drop_outward(sc, &r, dropped);
+    /* texel footprints straddle the wall's edges: error ~ perimeter / res */
+    VT_CHECK_REL(dropped[0], 3.0 * 0.6 * 4.0, 0.01, "the right wall's outside");
+    VT_CHECK_REL(r.total_flux[0], before - dropped[0], 1e-9, "what is left");
+    int facing_out = 0;
+    for (size_t i = 0; i < r.count; ++i) {
+        if (r.material[i] == VSGL__RSM_EMPTY)
+            continue;
+        double best = -1e30;
+        for (int c = 0; c < 8; ++c) {
+            double q[3] = {c & 1 ? 1.0 : -1.0, c & 2 ? 1.0 : -1.0, c & 4 ? 2.0 : 0.0}, h = 0.0;
+            for (int k = 0; k < 3; ++k)
+                h += (q[k] - r.pos[k][i]) * r.nrm[k][i];
+            best = h > best ? h : best;
+        }
+        facing_out += best <= 1e-3;
+    }
+    VT_CHECK(facing_out == 0, "%d texels left with the whole box behind them", facing_out);
+    vsgl__rsm_free(&r);
+    vsgl_scene_destroy(sc);
+    vsgl_context_destroy(ctx);
+}
