@@ -293,3 +293,53 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
     printf("    (skipped: the ISA clones are built by GCC on x86-64 only)\n");
 #endif
 }
+
+/* A glossy receiver at a planar cluster's very mean (d = 0: a scene 1e5 m
+ * from the origin quantises positions to 8 mm, so a G-buffer sample can
+ * land on a cluster's mean exactly), in a block whose other lanes take the
+ * half-vector model: every output finite. The cluster's slope spread var /
+ * d^2 was ~1e23 there, the half-vector lobe's determinant overflowed, and
+ * the pixel's glossy light was NaN (the render refused it). */
+VT_TEST(kernel_receiver_at_a_planar_clusters_mean_is_finite)
+{
+    vt_rng r = {77};
+    static vsgl_kernel_block b, ref;
+    vsgl_kernel_light L;
+    memset(&L, 0, sizeof L);
+    L.mx = 0.3f; L.my = 0.2f; L.mz = 1.0f;  /* a ceiling patch facing down */
+    L.var = 0.01f; L.pvar = L.var; L.var2 = 2.0f * L.var; L.ivar = 1.0f / L.var; L.valid = 1.0f;
+    L.az = 1.0f; L.nz = -1.0f; L.u1x = 1.0f; L.u2y = 1.0f;
+    L.c0 = 1.0f / (6.2831853f * vsgl_sg_integral(0.0f));
+    L.pr = L.pg = L.pb = 1.0f;
+    L.clip = 1.0f; L.planar = 1.0f; L.conv = 1.0f;
+    L.ibehind = 1.0f / (0.02f * sqrtf(L.var));
+    memset(&b, 0, sizeof b);
+    for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k) {
+        /* a floor below it, seen from above at random; lane 0 at the mean */
+        float x = k ? (float)(2.0 * vt_uniform(&r) - 1.0) : L.mx, y = k ? (float)(2.0 * vt_uniform(&r) - 1.0) : L.my;
+        b.x[k] = x; b.y[k] = y; b.z[k] = k ? 0.0f : L.mz;
+        b.nz[k] = 1.0f;
+        double ph = 6.283185307 * vt_uniform(&r), el = 0.3 + 1.2 * vt_uniform(&r);
+        b.ox[k] = (float)(cos(el) * cos(ph)); b.oy[k] = (float)(cos(el) * sin(ph)); b.oz[k] = (float)sin(el);
+        /* the lobe's axis: the view mirrored about the normal */
+        b.Zx[k] = -b.ox[k]; b.Zy[k] = -b.oy[k]; b.Zz[k] = b.oz[k];
+        b.Xx[k] = 1.0f; b.Yy[k] = 1.0f;
+        b.lam[k] = b.mu[k] = 200.0f;
+        b.camp[k] = 10.0f;
+        b.alpha[k] = 0.05f;
+        b.f0r[k] = b.f0g[k] = b.f0b[k] = 0.5f;
+        b.diffuse[k] = 1.0f;
+    }
+    const int32_t lob = VSGL__KERNEL_DIFFUSE | VSGL__KERNEL_GLOSSY | VSGL__KERNEL_GGX_TAIL;
+    ref = b;
+    vsgl__kernel_shade(&b, &L, 1, NULL, VSGL_COSINE_PULLED_OUT, lob);
+    vsgl__kernel_shade_scalar(&ref, &L, 1, NULL, VSGL_COSINE_PULLED_OUT, lob);
+    int bad = 0, lit = 0;
+    for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k)
+        for (int c = 0; c < 3; ++c) {
+            bad += !isfinite(b.ls[c][k]) || !isfinite(b.ld[c][k]) || !isfinite(ref.ls[c][k]) || !isfinite(ref.ld[c][k]);
+            lit += b.ls[c][k] > 0.0f;
+        }
+    VT_CHECK(bad == 0, "%d non-finite outputs (lane 0 glossy %g, scalar build %g)", bad, b.ls[0][0], ref.ls[0][0]);
+    VT_CHECK(lit > 0, "no lane got glossy light: the block does not reach the half-vector model");
+}

@@ -502,7 +502,12 @@ k_hv_shared(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_lig
     float px = L->nx - nc * wx, py = L->ny - nc * wy, pz = L->nz - nc * wz;
     float a1w = a1x * wx + a1y * wy + a1z * wz, a2w = a2x * wx + a2y * wy + a2z * wz;
     float a1p = a1x * px + a1y * py + a1z * pz, a2p = a2x * px + a2y * py + a2z * pz;
+    /* clamped far past VSGL__HV_SPREAD_HI (the weight is 0 there anyway):
+     * a receiver within ~1e-6 of the mean (a scene 1e5 from the origin
+     * quantises positions to 8 mm) made var r^2 ~1e23, k_hv_lobe's
+     * determinant overflowed to inf and its rsqrt gave 0 x NaN = NaN */
     float sv = L->var * r * r;
+    sv = sv < 1e3f * VSGL__HV_SPREAD_HI ? sv : 1e3f * VSGL__HV_SPREAD_HI;
     t->hc11[i] = sv * (a1x * a1x + a1y * a1y + a1z * a1z - a1w * a1w - a1p * a1p);
     t->hc22[i] = sv * (a2x * a2x + a2y * a2y + a2z * a2z - a2w * a2w - a2p * a2p);
     t->hc12[i] = sv * (a1x * a2x + a1y * a2y + a1z * a2z - a1w * a2w - a1p * a2p);
