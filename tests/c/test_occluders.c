@@ -206,3 +206,73 @@ VT_TEST(rsm_drop_outward_takes_only_the_outside_of_a_wall)
     vsgl_scene_destroy(sc);
     vsgl_context_destroy(ctx);
 }
+
+/* A closed room with a 0.4 m square opening in its roof under a sun from
+ * (1, 0, 4): the power that enters is E x 0.16 m^2 x cos(14 deg), all of it
+ * on the floor. vsgl__rsm_build_inward's map covers only the square around
+ * the opening, on the whole map's grid refined `zoom` times: it holds the
+ * same texels as the whole map built at res x zoom (after both drop what
+ * faces out), and its power is the analytic one within a texel of that
+ * finer grid along the opening's edges. */
+VT_TEST(rsm_build_inward_zooms_a_sun_onto_an_opening)
+{
+    vsgl_context *ctx = fx_context(1);
+    VT_REQUIRE(ctx, "context");
+    fx_scene fx;
+    fx_room(&fx, 8, 6, 0.5f, 100.0f);
+    fx.triangle_count -= 2; /* the roof, rebuilt around the opening */
+    fx.vertex_count -= 4;
+    const float o = 0.2f, front[4][3] = {{-1, -1, 0}, {-1, -1, 2}, {1, -1, 2}, {1, -1, 0}};
+    const float strips[4][4] = {{-1, -o, -1, 1}, {o, 1, -1, 1}, {-o, o, -1, -o}, {-o, o, o, 1}}; /* x0 x1 y0 y1 */
+    for (int k = 0; k < 4; ++k) {
+        const float *s = strips[k];
+        const float q[4][3] = {{s[0], s[2], 2}, {s[0], s[3], 2}, {s[1], s[3], 2}, {s[1], s[2], 2}};
+        fx_quad(&fx, q, 3);
+    }
+    fx_quad(&fx, front, 3);
+    vsgl_light *L = &fx.lights[0];
+    memset(L, 0, sizeof *L);
+    L->type = VSGL_LIGHT_SUN;
+    L->color[0] = L->color[1] = L->color[2] = 1.0f;
+    L->power = 3.0f; /* W/m^2 */
+    const float eye[3] = {1, 0, 4}, at[3] = {0, 0, 0};
+    fx_look_at(L->world_from_light, eye, at);
+    fx.light_count = 1;
+    vsgl_scene *sc = NULL;
+    VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &sc) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    const double exact = 3.0 * (2 * o) * (2 * o) * 4.0 / sqrt(17.0);
+    const uint32_t res = 64;
+    vsgl_rsm whole, win, fine;
+    double dropped[3];
+    VT_REQUIRE(vsgl__rsm_build(ctx, sc, 0, res, &whole) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    vsgl__rsm_drop_outward(sc, &whole, dropped);
+    VT_REQUIRE(vsgl__rsm_build_inward(ctx, sc, 0, res, &win, dropped) == VSGL_OK, "%s",
+               vsgl_context_last_error(ctx));
+    VT_CHECK(whole.zoom == 1 && win.zoom == 4, "zoom %u (whole map %u): the opening and its margin span 1/4 "
+             "to 1/8 of the map", win.zoom, whole.zoom);
+    VT_REQUIRE(vsgl__rsm_build(ctx, sc, 0, res * win.zoom, &fine) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    vsgl__rsm_drop_outward(sc, &fine, dropped);
+    size_t n_win = 0, n_fine = 0, n_whole = 0;
+    for (size_t i = 0; i < whole.count; ++i)
+        n_whole += whole.material[i] != VSGL__RSM_EMPTY;
+    for (size_t i = 0; i < win.count; ++i)
+        n_win += win.material[i] != VSGL__RSM_EMPTY;
+    for (size_t i = 0; i < fine.count; ++i)
+        n_fine += fine.material[i] != VSGL__RSM_EMPTY;
+    /* the same grid: the same texels (ray origins are rounded apart in the last bits) */
+    VT_CHECK(n_win + 2 >= n_fine && n_fine + 2 >= n_win, "%zu texels in the window, %zu in the finer whole map",
+             n_win, n_fine);
+    VT_CHECK_REL(win.total_flux[0], fine.total_flux[0], 1e-3, "the window's power against the finer whole map's");
+    double e_whole = fabs(whole.total_flux[0] / exact - 1), e_win = fabs(win.total_flux[0] / exact - 1);
+    /* a texel of the finer grid is ~1.1 cm across the beam: the opening's 1.55 m edge x 0.5 texel / 0.155 m^2 */
+    VT_CHECK(e_win < 0.03, "window power %.5f W against %.5f W through the opening (%.2f %%)", win.total_flux[0],
+             exact, 100 * e_win);
+    printf("    power through the opening %.5f W: whole map at %u %.5f (%.2f %%), window %.5f (%.2f %%); %zu texels in "
+           "the room, %zu with the whole map\n", exact, res, whole.total_flux[0], 100 * e_whole, win.total_flux[0],
+           100 * e_win, n_win, n_whole);
+    vsgl__rsm_free(&whole);
+    vsgl__rsm_free(&win);
+    vsgl__rsm_free(&fine);
+    vsgl_scene_destroy(sc);
+    vsgl_context_destroy(ctx);
+}

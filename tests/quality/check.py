@@ -214,7 +214,7 @@ def main(argv=None):
 
         r, _ = E.evaluate_scene(n, cfgs, "test", E.ANIM_SIZES["test"], args.frames, ["light", "camera"], args.refs,
                                 rend, want_images=False, log=lambda line: print("INFO " + line, flush=True),
-                                motion_truth=True, camera_steps=False)  # the light's own change is checked
+                                motion_truth=True, steps=False)  # the light's own change is checked
         results["scenes"][n] = r
         b = r["configs"]["brute"]["still"]
         cnt.check(all(abs(b[p]["bias"] - 1) <= TOL_BRUTE for p in ("Diff", "Gloss")),

@@ -80,13 +80,12 @@ ACCEPT = dict(flicker=0.01, bias=0.05, bias_preview=0.30, structured_x=3.0)
 # over frames of |(f[t+1] - f[t]) - (g[t+1] - g[t])| / |f[t]| (RMS form), g the dense frames.
 CAMERA_TRUTH = ("balanced", dict(aa_samples=8, shade_stride=1, edge_samples=0, visibility=0))
 # The motion's own change in Cycles (--motion-truth), rendered with both reference seeds; the product of
-# the two seeds' frame differences gives the per-frame change without their noise. The light animation:
-# its first and last frames (metrics.motion_change; a light moving 1/1000 of the room a frame changes
-# each pixel at a steady rate). The camera animation: every frame (metrics.motion_steps, the median
-# over the steps), since a silhouette crossing a pixel changes it in a frame or two, which the straight
-# line from the first to the last frame spreads over all steps (glossy_sphere_floor Gloss 0.034 that
+# the two seeds' frame differences gives the per-frame change without their noise. Every frame of both
+# animations (metrics.motion_steps, the median over the steps): a silhouette crossing a pixel changes it
+# in a frame or two, which the straight line from the first to the last frame (metrics.motion_change,
+# what check.py uses for time) spreads over all steps (glossy_sphere_floor's camera Gloss 0.034 that
 # way, 0.040 step by step); those frames also give each configuration's change in excess of Cycles' own
-# (metrics.excess_over_seeds). A sun's patch sliding across a floor changes the indirect light of a room
+# (metrics.excess_over_seeds), which tells a fit that reshuffles from one that follows the motion. A sun's patch sliding across a floor changes the indirect light of a room
 # by more than 0.01 a frame in Cycles itself; a renderer steadier than that would be wrong. The
 # acceptance then reads "flicker <= max(0.01, the motion's own change)" beside the issue's 0.01.
 # Always over MOTION_STEPS frames, whatever --frames is: over 5 steps the seeds' noise moves the
@@ -245,12 +244,12 @@ class Renderer:
 
 
 def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, brute_anim=False, want_images=True,
-                   log=print, repeat=1, camera_truth=False, motion_truth=False, camera_steps=True):
+                   log=print, repeat=1, camera_truth=False, motion_truth=False, steps=True):
     """Every metric of every configuration on one scene. Returns (result
     dict, images dict for the pictures). motion_truth: Cycles' own change of
-    each animation; with camera_steps, the camera's from every frame (both
-    seeds, MOTION_STEPS + 1 renders each) and each configuration's change in
-    excess of it, else from its first and last frames like the light's."""
+    each animation; with steps, from every frame (both seeds, MOTION_STEPS + 1
+    renders each) and each configuration's change in excess of it, else from
+    its first and last frames (metrics.motion_change)."""
     truth = None
     if camera_truth and "camera" in anims:
         base = scenes.case(name, anim_size)
@@ -261,19 +260,21 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
     seeds = [M.coloured(p) for p, _ in R]
     ref = {p: 0.5 * (seeds[0][p] + seeds[1][p]) for p in PASSES}
     motion = None
-    cam_seeds = None  # the camera animation in Cycles, every frame, both seeds: [(seed 1, seed 2) per frame]
+    anim_seeds = {}  # each animation in Cycles, every frame, both seeds: {kind: [(seed 1, seed 2) per frame]}
     motion_steps = None
     if motion_truth and anims:
         motion = {}
+        motion_steps = {}
         asz = (anim_size[0], anim_size[1], spp)
         for kind in anims:
-            if kind == "camera" and camera_steps:
-                cam_seeds = [[M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, f, refdir)[name]]
-                             for f in range(max(frames, MOTION_STEPS + 1))]
-                steps = {p: M.motion_steps([x[0][p] for x in cam_seeds[:MOTION_STEPS + 1]],
-                                           [x[1][p] for x in cam_seeds[:MOTION_STEPS + 1]]) for p in PASSES}
-                motion_steps = {p: [round(v, 5) for v in steps[p]] for p in PASSES}
-                motion[kind] = {p: float(np.median(steps[p])) for p in PASSES}
+            if steps:
+                seq = [[M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, f, refdir)[name]]
+                       for f in range(max(frames, MOTION_STEPS + 1))]
+                anim_seeds[kind] = seq
+                st = {p: M.motion_steps([x[0][p] for x in seq[:MOTION_STEPS + 1]],
+                                        [x[1][p] for x in seq[:MOTION_STEPS + 1]]) for p in PASSES}
+                motion_steps[kind] = {p: [round(v, 5) for v in st[p]] for p in PASSES}
+                motion[kind] = {p: float(np.median(st[p])) for p in PASSES}
                 continue
             f0 = [M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, 0, refdir)[name]]
             f1 = [M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, MOTION_STEPS, refdir)[name]]
@@ -322,10 +323,10 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
                 if kind == "camera" and truth is not None:
                     entry["flicker"][kind][p]["excess"] = M.excess_flicker([x[p] for x in seq],
                                                                            [x[p] for x in truth])
-                if kind == "camera" and cam_seeds is not None:
+                if kind in anim_seeds:
                     entry["flicker"][kind][p]["excess_cycles"] = M.excess_over_seeds(
-                        [x[p] for x in seq], [x[0][p] for x in cam_seeds[:frames]],
-                        [x[1][p] for x in cam_seeds[:frames]])
+                        [x[p] for x in seq], [x[0][p] for x in anim_seeds[kind][:frames]],
+                        [x[1][p] for x in anim_seeds[kind][:frames]])
             if want_images and kind == "light":
                 images["anim"][cfg.label] = [x["Combined"] for x in seq]
         if anim_t:
@@ -366,8 +367,8 @@ def acceptance(res):
                     "PASS" if all(f <= lim for f, lim in over) else
                     "FAIL (%s)" % ", ".join("%.3f > %.3f" % (f, lim) for f, lim in over if f > lim))
             exc = [e["flicker"][k][p].get("excess_cycles") for p in ("Diff", "Gloss")]
-            if k == "camera" and None not in exc:
-                a["camera flicker above Cycles' own motion <= %.2f" % ACCEPT["flicker"]] = (
+            if None not in exc:
+                a["%s flicker above Cycles' own motion <= %.2f" % (k, ACCEPT["flicker"])] = (
                     "PASS" if max(exc) <= ACCEPT["flicker"] else "FAIL (%.3f)" % max(exc))
             ex = [e["flicker"][k][p].get("excess") for p in ("Diff", "Gloss")]
             if k == "camera" and None not in ex:
@@ -442,9 +443,9 @@ def own(motion, kind):
     return "" if not m else " (Cycles' own: %s / %s)" % (_f(m["Diff"], "%.4f"), _f(m["Gloss"], "%.4f"))
 
 
-def camera_cell(e):
-    """Summary cell: camera flicker Diff / Gloss, and above the motion's own change when measured."""
-    f = e["flicker"].get("camera")
+def flicker_cell(e, kind):
+    """Summary cell: an animation's flicker Diff / Gloss, and above the motion's own change when measured."""
+    f = e["flicker"].get(kind)
     if not f:
         return "-"
     out = "%s / %s" % (_f(f["Diff"]["median"], "%.4f"), _f(f["Gloss"]["median"], "%.4f"))
@@ -489,12 +490,11 @@ def markdown(results, args, img_rel):
              "L1 form (median sum|f[t+1]-f[t]|/sum|f[t]|; the RMS form is dominated by hot pixels where there "
              "are any, e.g. the brute force's at junctions); **the motion's own change** (with --motion-truth) = the "
              "per-frame change of the same animation in Cycles without its noise (the product of the two seeds' "
-             "differences: E[d1 . d2] = |d|^2): for the camera, every frame rendered with both seeds and the median "
-             "over the steps (metrics.motion_steps: an edge crossing a pixel changes it in a frame or two, which a "
-             "straight line from the first to the last frame spreads over all of them and underestimates); for the "
-             "light, from the first and last frames (metrics.motion_change; a light moving 1/1000 of the room a "
-             "frame changes each pixel at a steady rate); the acceptance then also reads flicker <= max(0.01, "
-             "that); **above Cycles' motion** (with --motion-truth) = the camera animation's change in excess of "
+             "differences: E[d1 . d2] = |d|^2): every frame rendered with both seeds and the median over the steps "
+             "(metrics.motion_steps: an edge crossing a pixel changes it in a frame or two, which a straight line "
+             "from the first to the last frame spreads over all of them and underestimates); the acceptance then "
+             "also reads flicker <= max(0.01, that); **above Cycles' motion** (with --motion-truth) = an "
+             "animation's change in excess of "
              "Cycles' own, frame by frame, without Cycles' noise (metrics.excess_over_seeds: the median over steps "
              "of sqrt((df - d1) . (df - d2)) / |f[t]|): a moving view changes some rooms by more than 0.01 a frame "
              "by itself, and this is what a renderer adds to it; **above the dense render** (with --camera-truth) "
@@ -525,16 +525,17 @@ def markdown(results, args, img_rel):
                      _f(r["reference"]["agreement"]["Gloss"], "%.2f")), ""]
         mo = r.get("motion")
         if mo:
-            body += ["The motion's own change per frame in Cycles (both seeds; the light from frames 0 and %d, "
-                     "metrics.motion_change; the camera the median over its %d steps, metrics.motion_steps), "
-                     "Diff / Gloss: %s." % (
-                         MOTION_STEPS, MOTION_STEPS,
-                         "; ".join("%s %s / %s" % (k, _f(v["Diff"], "%.4f"), _f(v["Gloss"], "%.4f"))
-                                   for k, v in mo.items())), ""]
-            ms = r.get("motion_steps")
-            if ms:
-                body += ["The camera's steps in Cycles, Diff: %s; Gloss: %s." % (
-                    " ".join(_f(v, "%.4f") for v in ms["Diff"]), " ".join(_f(v, "%.4f") for v in ms["Gloss"])), ""]
+            ms = r.get("motion_steps") or {}
+            if "Diff" in ms:  # a result from before the light's steps were rendered: the camera's only
+                ms = dict(camera=ms)
+            how = {k: ("the median over its %d steps, metrics.motion_steps" % MOTION_STEPS if k in ms else
+                       "from frames 0 and %d, metrics.motion_change" % MOTION_STEPS) for k in mo}
+            body += ["The motion's own change per frame in Cycles (both seeds), Diff / Gloss: %s." % "; ".join(
+                "%s %s / %s (%s)" % (k, _f(v["Diff"], "%.4f"), _f(v["Gloss"], "%.4f"), how[k])
+                for k, v in mo.items()), ""]
+            for k, v in ms.items():
+                body += ["The %s animation's steps in Cycles, Diff: %s; Gloss: %s." % (
+                    k, " ".join(_f(x, "%.4f") for x in v["Diff"]), " ".join(_f(x, "%.4f") for x in v["Gloss"])), ""]
         acc = acceptance(r) if args.acceptance else {}
         head = ("| config | time s | VSGLs/VPLs | bias D | bias G | bias C | relMSE D | relMSE G | relMSE C | "
                 "struct D | struct G | struct C | FLIP | flicker light D/G | flicker camera D/G |")
@@ -572,8 +573,8 @@ def markdown(results, args, img_rel):
                     name, label, e["seconds"], _f(s["Diff"]["bias"]), _f(s["Gloss"]["bias"]),
                     _f(s["Diff"]["structured"], "%.5f"), _ratio(s["Diff"]["structured"], nz["Diff"]["s4"]),
                     _f(s["Gloss"]["structured"], "%.5f"), _ratio(s["Gloss"]["structured"], nz["Gloss"]["s4"]),
-                    _f(e["flip"], "%.4f"), fl("light").split(" (")[0] + own(mo, "light"),
-                    camera_cell(e) + own(mo, "camera")))
+                    _f(e["flip"], "%.4f"), flicker_cell(e, "light") + own(mo, "light"),
+                    flicker_cell(e, "camera") + own(mo, "camera")))
         body.append("")
         body.append("Configurations: " + "; ".join("**%s** = %s" % (l, e["describe"]) for l, e in r["configs"].items())
                     + ".")

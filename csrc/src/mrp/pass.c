@@ -21,11 +21,10 @@ static vsgl_result run_pass(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
         if (!(L->power * (L->color[0] + L->color[1] + L->color[2]) > 0.0f))
             continue;
         vsgl_rsm rsm;
-        r = vsgl__rsm_build(ctx, scene, l, rsm_resolution, &rsm);
+        double outward[3]; /* texels facing out of the scene: nothing in front of them to light */
+        r = vsgl__rsm_build_inward(ctx, scene, l, rsm_resolution, &rsm, outward);
         if (r != VSGL_OK)
             break;
-        double outward[3]; /* texels facing out of the scene: nothing in front of them to light */
-        vsgl__rsm_drop_outward(scene, &rsm, outward);
         vsgl__mrp_proxies_add_rsm(set, scene, &rsm);
         vsgl__rsm_free(&rsm);
         if (vsgl__progress(ctx, "mrp", 0.5f * (float)(l + 1) / (float)light_count))

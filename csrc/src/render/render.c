@@ -54,6 +54,16 @@ static void note_skip(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt,
     va_end(ap);
 }
 
+/* Appends one line to the stats' budget text (whole lines only). */
+static void note_budget(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...) VSGL_PRINTF(3, 4);
+static void note_budget(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    append_note(ctx, "budget", st->budget, sizeof st->budget, 192, NULL, fmt, ap);
+    va_end(ap);
+}
+
 /* The RSM of light `l`, or a noted skip: *lit = 0 when the light has no
  * power or its RSM is empty (then `rsm` holds nothing to free). The
  * progress window of the step is [p0, p0 + dp). */
@@ -71,18 +81,21 @@ static vsgl_result light_rsm(vsgl_context *ctx, const vsgl_scene *scene, uint32_
     }
     double t0 = now_seconds();
     vsgl__progress_window(ctx, p0, dp);
-    vsgl_result r = vsgl__rsm_build(ctx, scene, l, resolution, rsm);
+    double out[3] = {0, 0, 0};
+    vsgl_result r = drop_outward ? vsgl__rsm_build_inward(ctx, scene, l, resolution, rsm, out)
+                                 : vsgl__rsm_build(ctx, scene, l, resolution, rsm);
     st->seconds_rsm += now_seconds() - t0;
     if (r != VSGL_OK)
         return r;
-    if (drop_outward) {
-        double total = rsm->total_flux[0] + rsm->total_flux[1] + rsm->total_flux[2], out[3];
-        vsgl__rsm_drop_outward(scene, rsm, out);
-        if (out[0] + out[1] + out[2] > 0.0)
-            note_skip(ctx, st, "light %u: %.1f %% of its power falls on surfaces facing out of the scene (the "
-                      "outside of walls or a roof: nothing in front of them to light): not modelled", l,
-                      100.0 * (out[0] + out[1] + out[2]) / total);
+    if (out[0] + out[1] + out[2] > 0.0) {
+        double kept = rsm->total_flux[0] + rsm->total_flux[1] + rsm->total_flux[2];
+        note_skip(ctx, st, "light %u: %.1f %% of its power falls on surfaces facing out of the scene (the "
+                  "outside of walls or a roof: nothing in front of them to light): not modelled", l,
+                  100.0 * (out[0] + out[1] + out[2]) / (out[0] + out[1] + out[2] + kept));
     }
+    if (rsm->zoom > 1)
+        note_budget(ctx, st, "light %u: its RSM covers the 1/%u of the scene's extent that the rest of its "
+                    "light falls on, at %u x the texel density", l, rsm->zoom, rsm->zoom * rsm->zoom);
     if (!(rsm->total_flux[0] + rsm->total_flux[1] + rsm->total_flux[2] > 0.0)) {
         note_skip(ctx, st, "light %u: lights no geometry (its RSM is empty)", l);
         ++st->lights_skipped;
@@ -93,15 +106,6 @@ static vsgl_result light_rsm(vsgl_context *ctx, const vsgl_scene *scene, uint32_
     return VSGL_OK;
 }
 
-/* Appends one line to the stats' budget text (whole lines only). */
-static void note_budget(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...) VSGL_PRINTF(3, 4);
-static void note_budget(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    append_note(ctx, "budget", st->budget, sizeof st->budget, 192, NULL, fmt, ap);
-    va_end(ap);
-}
 
 /* The per-light budget (budget.h): each powered light's reflected power and
  * footprint on a probe RSM, then the shares, and each light's RSM side from

@@ -142,7 +142,8 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
     return 0;
 }
 
-vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res, vsgl_rsm *out)
+static vsgl_result build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res, uint32_t zoom,
+                         int64_t col0, int64_t row0, vsgl_rsm *out)
 {
     memset(out, 0, sizeof *out);
     uint32_t nl = 0;
@@ -153,7 +154,9 @@ vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "rsm: resolution %u (valid 1..16384)", res);
     vsgl_rsm_light l;
     vsgl__rsm_light_setup(scene, light, res, &l);
+    vsgl__rsm_light_window(&l, zoom, col0, row0);
     out->light = light;
+    out->zoom = l.type == VSGL_LIGHT_SUN && zoom > 1 ? zoom : 1;
     out->faces = l.faces;
     out->res = res;
     out->count = (size_t)l.faces * res * res;
@@ -205,6 +208,54 @@ vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
         for (int k = 0; k < 3; ++k)
             out->total_flux[k] += partial[3 * i + k];
     free(partial);
+    return VSGL_OK;
+}
+
+vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res, vsgl_rsm *out)
+{
+    return build(ctx, scene, light, res, 1, 0, 0, out);
+}
+
+vsgl_result vsgl__rsm_build_inward(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res,
+                                   vsgl_rsm *out, double dropped[3])
+{
+    vsgl_result r = build(ctx, scene, light, res, 1, 0, 0, out);
+    if (r != VSGL_OK)
+        return r;
+    vsgl__rsm_drop_outward(scene, out, dropped);
+    uint32_t n = 0;
+    if (vsgl__scene_lights(scene, &n)[light].type != VSGL_LIGHT_SUN || out->faces != 1)
+        return VSGL_OK;
+    /* the texels left: their bounding square, one texel wider on each side
+     * (the region they sample ends within a texel of their centres) */
+    int64_t c0 = res, c1 = -1, r0 = res, r1 = -1;
+    for (uint32_t row = 0; row < res; ++row)
+        for (uint32_t col = 0; col < res; ++col)
+            if (out->material[(size_t)row * res + col] != VSGL__RSM_EMPTY) {
+                c0 = col < c0 ? col : c0; c1 = col > c1 ? col : c1;
+                r0 = row < r0 ? row : r0; r1 = row > r1 ? row : r1;
+            }
+    if (c1 < 0)
+        return VSGL_OK;
+    int64_t side = (c1 - c0 > r1 - r0 ? c1 - c0 : r1 - r0) + 3;
+    uint32_t zoom = 1;
+    while (zoom < VSGL__RSM_MAX_ZOOM && side * (int64_t)zoom * 2 <= (int64_t)res)
+        zoom *= 2;
+    if (zoom == 1)
+        return VSGL_OK;
+    /* the square centred on them, on the grid refined zoom times */
+    int64_t pad_c = ((int64_t)res - (c1 - c0 + 3) * (int64_t)zoom) / 2,
+            pad_r = ((int64_t)res - (r1 - r0 + 3) * (int64_t)zoom) / 2;
+    vsgl_rsm fine_map;
+    r = build(ctx, scene, light, res, zoom, (c0 - 1) * zoom - pad_c, (r0 - 1) * zoom - pad_r, &fine_map);
+    if (r != VSGL_OK) {
+        vsgl__rsm_free(out);
+        return r;
+    }
+    vsgl__rsm_free(out);
+    *out = fine_map;
+    double again[3]; /* the power dropped is the first map's: the same light on the same faces */
+    vsgl__rsm_drop_outward(scene, out, again);
     return VSGL_OK;
 }
 

@@ -10,7 +10,7 @@
 /* Structure of arrays; texel index = (face * res + row) * res + col.
  * faces = 6 for point lights and spots wider than 120 degrees (cube map in
  * the light's frame), 1 otherwise (spot: perspective image over the cone;
- * sun: orthographic over the scene bounds; area: concentric map of the
+ * sun: orthographic over the scene bounds or a window of it; area: concentric map of the
  * cosine-weighted hemisphere). Per-type details: rsm_light.c, docs/units.md.
  * Each texel's flux is
  * the RGB power (W) arriving on the surface patch it sees, with the
@@ -19,6 +19,7 @@
 typedef struct vsgl_rsm {
     uint32_t light;                /* scene light index */
     uint32_t faces, res;
+    uint32_t zoom;                 /* sun: the map's texel is 1/zoom of the whole map's (vsgl__rsm_build_inward) */
     size_t count;                  /* faces * res * res */
     float *pos[3];                 /* VPL position, world */
     float *nrm[3];                 /* shading normal at the VPL, facing the light */
@@ -47,4 +48,14 @@ void vsgl__rsm_free(vsgl_rsm *r);
  * receiver). Sets dropped to their power and total_flux to what is left. */
 void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped[3]);
 
+/* Refinement cap of vsgl__rsm_build_inward: a sun's window is at least
+ * 1/VSGL__RSM_MAX_ZOOM of the scene's extent. */
+#define VSGL__RSM_MAX_ZOOM 16u
+/* vsgl__rsm_build, then vsgl__rsm_drop_outward (dropped: its power). A
+ * sun's map then covers only the square around the texels left, at the
+ * same res: a room lit through an opening gets its texels inside the room
+ * (zoom in the result: the whole map's grid refined zoom times, a power of
+ * two; 1 when the texels left span more than half the map). */
+vsgl_result vsgl__rsm_build_inward(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res,
+                                   vsgl_rsm *out, double dropped[3]);
 #endif

@@ -11,7 +11,9 @@
  *   elliptical cone for a non-uniform scale). One perspective face over the
  *   cone when its widest half-angle is <= 60 degrees, else a cube.
  * - sun: orthographic map over the scene bounds, W/m^2 times the texel's
- *   area across the beam; sun angle ignored (parallel rays).
+ *   area across the beam; sun angle ignored (parallel rays). A window
+ *   (vsgl__rsm_light_window) takes a square of the map at a finer step of
+ *   the same grid.
  * - area: one face, concentric (Shirley-Chiu) map of the cosine-weighted
  *   hemisphere below the light: every texel carries the same projected
  *   solid angle pi/res^2, so the flux is L A (pi/res^2) times the spread
@@ -189,6 +191,16 @@ void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res
     default:
         break;
     }
+}
+
+void vsgl__rsm_light_window(vsgl_rsm_light *l, uint32_t zoom, int64_t col0, int64_t row0)
+{
+    if (l->type != VSGL_LIGHT_SUN || zoom <= 1)
+        return;
+    l->sun_u = v3_scale(l->sun_u, 1.0f / (float)zoom);
+    l->sun_v = v3_scale(l->sun_v, 1.0f / (float)zoom);
+    l->sun_origin = v3_add(l->sun_origin, v3_add(v3_scale(l->sun_u, (float)col0), v3_scale(l->sun_v, (float)row0)));
+    l->sun_texel_area /= (double)zoom * zoom;
 }
 
 /* Concentric map of [0,1]^2 to the unit disk (Shirley & Chiu 1997). */

@@ -35,6 +35,11 @@ typedef struct vsgl_rsm_light {
 /* Prepare light `index` of the scene for an RSM of `res` texels per side. */
 void vsgl__rsm_light_setup(const vsgl_scene *scene, uint32_t index, uint32_t res, vsgl_rsm_light *out);
 
+/* A sun's map (else nothing): the square of res x res texels at column
+ * col0, row row0 of the same map at res * zoom texels per side, i.e. the
+ * texel grid of the whole map refined `zoom` times (its phase kept: a window
+ * that moves by whole texels samples the same points). */
+void vsgl__rsm_light_window(vsgl_rsm_light *l, uint32_t zoom, int64_t col0, int64_t row0);
 /* Texel (face, row, col): ray origin and unit direction, the power (W,
  * RGB) the light emits into the texel's cone / beam, and the beam's size:
  * solid angle (sr) for point/spot/area, cross-section (m^2) for a sun.

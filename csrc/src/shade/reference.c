@@ -108,11 +108,11 @@ vsgl_result vsgl_reference_render(vsgl_context *ctx, const vsgl_scene *scene, ui
     t0 = now_s();
     uint32_t built = 0;
     for (; built < nl && rc == VSGL_OK; ++built) {
-        rc = vsgl__rsm_build(ctx, scene, built, rsm_res, &rsms[built]);
+        double outward[3]; /* texels facing out of the scene light no receiver: not gathered (a sun's map
+                              then covers what is left, as vsgl_render's) */
+        rc = vsgl__rsm_build_inward(ctx, scene, built, rsm_res, &rsms[built], outward);
         if (rc != VSGL_OK)
             break;
-        double outward[3]; /* texels facing out of the scene light no receiver: not gathered */
-        vsgl__rsm_drop_outward(scene, &rsms[built], outward);
         const vsgl_rsm *R = &rsms[built];
         st.rsm_bytes += (uint64_t)R->count * (16 * sizeof(float) + sizeof(uint32_t));
         for (int c = 0; c < 3; ++c)
