@@ -14,8 +14,8 @@ Checks that hold today and can fail; prints PASS/FAIL lines and ends with
   (issue 9 measured this on its rooms: the RSM holds the light);
 
 then measures the presets (still and both animations, VSGL_QUALITY_FRAMES
-frames, default 12) and checks what they hold (MAX_FLICKER_LIGHT, the light
-animation's flicker against the motion's own change in Cycles (MOTION_SLACK),
+frames, default 12) and checks what they hold (MAX_EXCESS_LIGHT, the light
+animation's change beyond the motion's own change in Cycles, step by step,
 MAX_FLICKER_CAMERA, MAX_BIAS, MAX_STRUCT_GLOSS, QUALITY_OVER_BALANCED below; every one fails with
 the session-1 presets: flicker 0.12-0.74, bias up to 3.4x; the camera checks
 and the 5 % bias of balanced and quality fail with the session-3 presets),
@@ -47,13 +47,17 @@ TOL_BRUTE = 0.06
 # reported as INFO acceptance lines): the median light-animation flicker per pass, the bias per
 # pass, and quality's structured error (combined pass) against balanced's, where a tie within the
 # references' noise is allowed (the spot room: both at its noise floor).
-MAX_FLICKER_LIGHT = 0.015
-# (or Cycles' own change where the motion itself changes more: the sun rooms' Diff at 0.015, since their
-# lattice is spent on the room's inside only and follows the sliding patch as Cycles does)
-# ... and at most max(0.01, MOTION_SLACK x the motion's own change in Cycles) (evaluate.py --motion-truth:
-# frames 0 and 11 in Cycles, both seeds; the estimate's own spread is ~10 %): a sun patch sliding across
-# a floor changes the room's indirect light by 0.013-0.015 a frame in Cycles itself.
-MOTION_SLACK = 1.25
+# The light animation: its change beyond the motion's own change in Cycles, step by step (evaluate.py
+# --motion-truth; metrics.excess_over_seeds against both seeds of every frame, which removes their noise).
+# A sun patch sliding across a floor changes a room's indirect light by 0.008-0.045 a frame in Cycles
+# itself, unevenly (an edge of the patch crossing a junction), so a bound on the raw change would be
+# either too loose for the small lights or fail a renderer that follows the motion. Balanced and quality:
+# the issue's 0.01 (measured at 12 frames, before a sun's RSM covered only what it lights: 0.0101 /
+# 0.0108 in sun_opening_thick; after: 0.0024 / 0.0071). The preview: its one-ASG glossy lobe on a
+# lattice of 32 jumps as the sun's patch slides over a glossy cabinet (Gloss 0.024 in the sun rooms,
+# 0.013 at the old RSM window; the two-ASG lobes give 0.009-0.011 there but 0.013 on the sphere at 1.6 x
+# the time at 960x540), so its bound is the issue's tolerance for a preview, 3 x.
+MAX_EXCESS_LIGHT = dict(preview=0.03, balanced=0.01, quality=0.01)
 # The camera animation, where a moving view's own change stays below 0.01 a frame at 80x60 (the
 # sphere's rim and the sun rooms' sunlit patch change more than that by themselves: INFO there):
 # 0.012-0.028 per frame before edge pixels were refined (crawling silhouettes), 0.006-0.010 after.
@@ -214,7 +218,7 @@ def main(argv=None):
 
         r, _ = E.evaluate_scene(n, cfgs, "test", E.ANIM_SIZES["test"], args.frames, ["light", "camera"], args.refs,
                                 rend, want_images=False, log=lambda line: print("INFO " + line, flush=True),
-                                motion_truth=True, steps=False)  # the light's own change is checked
+                                motion_truth=True, steps=("light",), steps_frames=args.frames)
         results["scenes"][n] = r
         b = r["configs"]["brute"]["still"]
         cnt.check(all(abs(b[p]["bias"] - 1) <= TOL_BRUTE for p in ("Diff", "Gloss")),
@@ -223,19 +227,13 @@ def main(argv=None):
         for label in ("preview", "balanced", "quality"):
             e = r["configs"][label]
             fl = e["flicker"]["light"]
-            own = r["motion"]["light"]
-            cap = {p: max(MAX_FLICKER_LIGHT, own[p]) for p in ("Diff", "Gloss")}
-            cnt.check(all(fl[p]["median"] <= cap[p] for p in ("Diff", "Gloss")),
-                      "%s %s: the light animation's flicker Diff %.4f, Gloss %.4f (<= %.4f / %.4f: max(%g, Cycles' "
-                      "own change); second/first %.2f / %.2f)"
-                      % (label, n, fl["Diff"]["median"], fl["Gloss"]["median"], cap["Diff"], cap["Gloss"],
-                         MAX_FLICKER_LIGHT, fl["Diff"]["ratio"], fl["Gloss"]["ratio"]))
-            lim = {p: max(0.01, MOTION_SLACK * own[p]) for p in ("Diff", "Gloss")}
-            cnt.check(all(fl[p]["median"] <= lim[p] for p in ("Diff", "Gloss")),
-                      "%s %s: the light animation's flicker Diff %.4f, Gloss %.4f (<= %.4f / %.4f: max(0.01, %g x "
-                      "Cycles' own change %.4f / %.4f))" % (label, n, fl["Diff"]["median"], fl["Gloss"]["median"],
-                                                            lim["Diff"], lim["Gloss"], MOTION_SLACK, own["Diff"],
-                                                            own["Gloss"]))
+            exc = {p: fl[p]["excess_cycles"] for p in ("Diff", "Gloss")}
+            cnt.check(all(exc[p] <= MAX_EXCESS_LIGHT[label] for p in ("Diff", "Gloss")),
+                      "%s %s: the light animation changes beyond Cycles' own change, step by step, Diff %.4f, "
+                      "Gloss %.4f (<= %g; flicker %.4f / %.4f, Cycles' own from frames 0 and %d %.4f / %.4f)"
+                      % (label, n, exc["Diff"], exc["Gloss"], MAX_EXCESS_LIGHT[label], fl["Diff"]["median"],
+                         fl["Gloss"]["median"], E.MOTION_STEPS, r["motion"]["light"]["Diff"],
+                         r["motion"]["light"]["Gloss"]))
             fc = e["flicker"]["camera"]
             if n in CAMERA_SCENES:
                 cnt.check(all(fc[p]["median"] <= MAX_FLICKER_CAMERA for p in ("Diff", "Gloss")),

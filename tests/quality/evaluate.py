@@ -244,12 +244,15 @@ class Renderer:
 
 
 def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, brute_anim=False, want_images=True,
-                   log=print, repeat=1, camera_truth=False, motion_truth=False, steps=True):
+                   log=print, repeat=1, camera_truth=False, motion_truth=False, steps=True, steps_frames=None):
     """Every metric of every configuration on one scene. Returns (result
     dict, images dict for the pictures). motion_truth: Cycles' own change of
-    each animation; with steps, from every frame (both seeds, MOTION_STEPS + 1
-    renders each) and each configuration's change in excess of it, else from
-    its first and last frames (metrics.motion_change)."""
+    each animation; for the kinds in steps (True: all), from every frame
+    (both seeds, MOTION_STEPS + 1 renders each) and each configuration's
+    change in excess of it, else from its first and last frames
+    (metrics.motion_change). steps_frames: render only that many frames for
+    those kinds (the excess over the first steps_frames frames; the motion's
+    own change then from frames 0 and MOTION_STEPS)."""
     truth = None
     if camera_truth and "camera" in anims:
         base = scenes.case(name, anim_size)
@@ -267,10 +270,13 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
         motion_steps = {}
         asz = (anim_size[0], anim_size[1], spp)
         for kind in anims:
-            if steps:
-                seq = [[M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, f, refdir)[name]]
-                       for f in range(max(frames, MOTION_STEPS + 1))]
-                anim_seeds[kind] = seq
+            stepped = steps is True or kind in (steps or ())
+            if stepped:
+                n = min(frames, steps_frames) if steps_frames else max(frames, MOTION_STEPS + 1)
+                anim_seeds[kind] = [[M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, f, refdir)[name]]
+                                    for f in range(n)]
+            if stepped and not steps_frames:
+                seq = anim_seeds[kind]
                 st = {p: M.motion_steps([x[0][p] for x in seq[:MOTION_STEPS + 1]],
                                         [x[1][p] for x in seq[:MOTION_STEPS + 1]]) for p in PASSES}
                 motion_steps[kind] = {p: [round(v, 5) for v in st[p]] for p in PASSES}
@@ -324,9 +330,10 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
                     entry["flicker"][kind][p]["excess"] = M.excess_flicker([x[p] for x in seq],
                                                                            [x[p] for x in truth])
                 if kind in anim_seeds:
+                    m = len(anim_seeds[kind][:frames])
                     entry["flicker"][kind][p]["excess_cycles"] = M.excess_over_seeds(
-                        [x[p] for x in seq], [x[0][p] for x in anim_seeds[kind][:frames]],
-                        [x[1][p] for x in anim_seeds[kind][:frames]])
+                        [x[p] for x in seq[:m]], [x[0][p] for x in anim_seeds[kind][:m]],
+                        [x[1][p] for x in anim_seeds[kind][:m]])
             if want_images and kind == "light":
                 images["anim"][cfg.label] = [x["Combined"] for x in seq]
         if anim_t:
