@@ -83,10 +83,11 @@ CAMERA_TRUTH = ("balanced", dict(aa_samples=8, shade_stride=1, edge_samples=0, v
 # the two seeds' frame differences gives the per-frame change without their noise. Every frame of both
 # animations (metrics.motion_steps, the median over the steps): a silhouette crossing a pixel changes it
 # in a frame or two, which the straight line from the first to the last frame (metrics.motion_change,
-# what check.py uses for time) spreads over all steps (glossy_sphere_floor's camera Gloss 0.034 that
-# way, 0.040 step by step); those frames also give each configuration's change in excess of Cycles' own
-# (metrics.excess_over_seeds), which tells a fit that reshuffles from one that follows the motion. A sun's patch sliding across a floor changes the indirect light of a room
-# by more than 0.01 a frame in Cycles itself; a renderer steadier than that would be wrong. The
+# the light's and the camera's over 0 and MOTION_STEPS in check.py, for time) spreads over all steps
+# (glossy_sphere_floor's camera Gloss 0.034 that way, 0.040 step by step); those frames also give each
+# configuration's change in excess of Cycles' own (metrics.excess_over_seeds), which tells a fit that
+# reshuffles from one that follows the motion. A sun's patch sliding across a floor changes the
+# indirect light of a room by more than 0.01 a frame in Cycles itself; a renderer steadier than that would be wrong. The
 # acceptance then reads "flicker <= max(0.01, the motion's own change)" beside the issue's 0.01.
 # Always over MOTION_STEPS frames, whatever --frames is: over 5 steps the seeds' noise moves the
 # light's estimate by 30 % (sun_opening Diff 0.0083 against 0.0128 over 11).
