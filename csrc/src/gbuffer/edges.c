@@ -126,6 +126,34 @@ static uint32_t nearest_group(const vsgl_gbuffer *sub, const size_t *founder, ui
     return best;
 }
 
+/* Slot `to` (a copy of one of group q's rays) takes the mean shading normal
+ * of the group's rays on its material: the representative ray jumps from
+ * one ray to the next as an edge moves across the pixel, the mean moves by
+ * one ray's share; on a curved surface's rim, whose normal (and glossy
+ * light) turns across the pixel, that is what makes the slot's shading
+ * follow the edge smoothly. The tangent is made orthogonal to it. */
+static void mean_normal(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, const uint8_t *group, uint32_t q,
+                        uint32_t n)
+{
+    v3 sum = v3_make(0.0f, 0.0f, 0.0f);
+    for (uint32_t s = 0; s < n; ++s)
+        if (group[s] == q && sub->material[s] == g->material[to])
+            sum = v3_add(sum, at3(sub->nrm, s));
+    float len = v3_length(sum);
+    if (!(len > 0.0f))
+        return;
+    v3 m = v3_scale(sum, 1.0f / len), t = at3(g->tan, to);
+    t = v3_sub(t, v3_scale(m, v3_dot(m, t)));
+    float tl = v3_length(t);
+    if (!(tl > 1e-6f))
+        return;
+    t = v3_scale(t, 1.0f / tl);
+    for (int k = 0; k < 3; ++k) {
+        g->nrm[k][to] = k == 0 ? m.x : (k == 1 ? m.y : m.z);
+        g->tan[k][to] = k == 0 ? t.x : (k == 1 ? t.y : t.z);
+    }
+}
+
 /* Refine pixel (x, y): trace E x E rays into `sub` and rewrite its slots. */
 static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint32_t y)
 {
@@ -186,6 +214,8 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint3
         }
         copy_sample(g, base + q, sub, rep);
         g->weight[base + q] = (float)count[q] / (float)n;
+        if (sub->material[rep] != VSGL__GBUFFER_MISS && count[q] > 1)
+            mean_normal(g, base + q, sub, group, q, n);
     }
     for (uint32_t q = groups; q < spp; ++q)
         vsgl__gbuffer_clear_slot(g, base + q, base);
