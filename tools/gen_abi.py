@@ -52,8 +52,8 @@ ENUMS = [
     ("ExrPixelType", "VSGL_EXR_", ("FLOAT", "HALF")),
     ("ExrCompression", "VSGL_EXR_", None),
 ]
-#: Names after an enum's prefix that are limits or flags, not enumerators.
-NOT_ENUMERATOR = re.compile(r"^(MAX|MIN)_|_(MAX|MIN|COUNT|KNOWN)$|^(MAX|MIN|COUNT)$|^FLAGS?_")
+#: Names after an enum's prefix that are limits, defaults or flags, not enumerators.
+NOT_ENUMERATOR = re.compile(r"^(MAX|MIN)_|_(MAX|MIN|COUNT|KNOWN|DEFAULT)$|^(MAX|MIN|COUNT)$|^FLAGS?_")
 #: Defines written as tuples instead: (name, [defines]).
 VERSIONS = [("BINDING_VERSION", ["VSGL_VERSION_MAJOR", "VSGL_VERSION_MINOR"]),
             ("BUNDLE_VERSION", ["VSGL_BUNDLE_VERSION_MAJOR", "VSGL_BUNDLE_VERSION_MINOR"])]

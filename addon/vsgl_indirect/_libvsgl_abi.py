@@ -206,6 +206,7 @@ RSM_RESOLUTION_MAX = 8192
 VSGL_COUNT_MAX = 65536
 FIS_ITERATIONS_MAX = 32
 SHADE_STRIDE_MAX = 8
+VISIBILITY_BUDGET_DEFAULT = 0.02
 MRP_MIN_AREA_DEFAULT = 0.25
 REUSED_GBUFFER = 1
 REUSED_FIT = 2
@@ -400,6 +401,7 @@ class vsgl_render_settings(_Struct):
         ("auto_target", c_int32),
         ("mrp_min_area", c_float),
         ("glossy_lobes", c_uint32),
+        ("visibility_budget", c_float),
     ]
     _enums = {
         "method": Method, "fit_mode": FitMode, "sharpness_estimator": SharpnessEstimator,
@@ -649,10 +651,11 @@ __all__ = [
     "FILTER_LINEAR", "FILTER_CLOSEST", "WRAP_REPEAT", "WRAP_EXTEND", "WRAP_CLIP",
     "MATERIAL_TEXTURES_VERTEX_COLOR", "MATERIAL_TEXTURES_FLAGS_KNOWN", "LIGHT_FLAG_BLENDER_4",
     "LIGHT_FLAGS_KNOWN", "AUTO_OFF", "AUTO_BALANCED", "AA_SAMPLES_MAX", "RSM_RESOLUTION_MIN",
-    "RSM_RESOLUTION_MAX", "VSGL_COUNT_MAX", "FIS_ITERATIONS_MAX", "SHADE_STRIDE_MAX", "MRP_MIN_AREA_DEFAULT",
-    "REUSED_GBUFFER", "REUSED_FIT", "EXR_COMPRESSION_COUNT", "EXR_MAX_CHANNELS", "vsgl_log_fn",
-    "vsgl_progress_fn", "vsgl_vec3", "vsgl_context_desc", "vsgl_sg", "vsgl_asg", "vsgl_material",
-    "vsgl_texture", "vsgl_texture_slot", "vsgl_material_textures", "vsgl_light", "vsgl_camera",
-    "vsgl_scene_desc", "vsgl_scene_info", "vsgl_render_settings", "vsgl_render_output", "vsgl_render_stats",
-    "vsgl_memory_estimate", "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options", "vsgl_bundle_options",
-    "vsgl_bundle_info", "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS", "FIELD_C_NAMES", "PROTOTYPES"]
+    "RSM_RESOLUTION_MAX", "VSGL_COUNT_MAX", "FIS_ITERATIONS_MAX", "SHADE_STRIDE_MAX",
+    "VISIBILITY_BUDGET_DEFAULT", "MRP_MIN_AREA_DEFAULT", "REUSED_GBUFFER", "REUSED_FIT",
+    "EXR_COMPRESSION_COUNT", "EXR_MAX_CHANNELS", "vsgl_log_fn", "vsgl_progress_fn", "vsgl_vec3",
+    "vsgl_context_desc", "vsgl_sg", "vsgl_asg", "vsgl_material", "vsgl_texture", "vsgl_texture_slot",
+    "vsgl_material_textures", "vsgl_light", "vsgl_camera", "vsgl_scene_desc", "vsgl_scene_info",
+    "vsgl_render_settings", "vsgl_render_output", "vsgl_render_stats", "vsgl_memory_estimate",
+    "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options", "vsgl_bundle_options", "vsgl_bundle_info",
+    "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS", "FIELD_C_NAMES", "PROTOTYPES"]

@@ -18,6 +18,7 @@ KNOBS = {
     "edge_samples": (None, 8),
     "sample_merging": (("AUTO", "OFF"), "AUTO"),
     "visibility": (("NONE", "RAY"), "RAY"),
+    "visibility_budget": (None, 0.02),
     "seed": (None, 0),
     "rsm_resolution": (None, 256),
     "fit_mode": (("TWO", "FIS", "KMEANS", "LATTICE"), "LATTICE"),
@@ -36,7 +37,7 @@ KNOBS = {
 # tests/blender/addon/test_addon_ui.py checks the two agree.
 _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", fis_iterations=8,
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
-               diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4)
+               diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4, visibility_budget=0.02)
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="NONE",
                     shade_stride=2, edge_samples=8),
@@ -95,6 +96,8 @@ def inactive_knobs(obj):
         out.add("mrp_min_area")
     if obj.glossy_mode != "ASG2" or obj.method == "BRUTE_FORCE":
         out.add("glossy_lobes")
+    if obj.visibility != "RAY" or obj.method == "BRUTE_FORCE":
+        out.add("visibility_budget")
     return out
 
 
@@ -118,6 +121,7 @@ class Options:
     mrp_min_area: float = 0.25      # m^2: the smallest face made a rectangle proxy (MRP, HYBRID)
     glossy_lobes: int = 4           # GGX's lobes in the half-vector model (ASG2): 4 or 5
     visibility: str = "RAY"
+    visibility_budget: float = 0.02  # Visibility Rays: the weakest VSGLs' share of a receiver's light without a ray
     seed: int = 0
     leak_correction: str = "AUTO"
     sample_merging: str = "AUTO"

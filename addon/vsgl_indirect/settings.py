@@ -295,6 +295,12 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "preset; the quality rooms' walls and floors (18-36 m^2) give the same image from "
                     "0.25 to 10 (docs/mrp.md)")
     visibility: _enum("visibility", "Visibility", "Indirect shadows between VSGLs and receivers")
+    visibility_budget: FloatProperty(
+        name="Ray Budget", default=config.KNOBS["visibility_budget"][1], min=-1.0, max=0.5, soft_min=0.0,
+        description="Visibility Rays only: at each pixel, the weakest VSGLs, whose light there sums to at "
+                    "most this fraction of all of theirs, trace no ray and take the others' visibility. "
+                    "0.02 in every preset (the sphere room: 5.8x fewer rays, the same image within "
+                    "0.001 FLIP); 0 = 0.02; negative: a ray for every VSGL")
     seed: IntProperty(
         name="Seed", default=0, min=0,
         description="Seed of the FIS and k-means cluster draws: moves where their clusters fall, "

@@ -47,7 +47,11 @@ VT_TEST(accuracy_fis_error_falls_with_vsgl_count_on_three_scenes)
 
 /* A partition between the lit red wall and the green wall: with visibility
  * rays the VSGL render moves towards the brute-force reference with
- * visibility (indirect shadows), and the green wall loses red light. */
+ * visibility (indirect shadows), and the green wall loses red light. The
+ * budget (visibility_budget 0.02: no ray for the weakest 2 % of each
+ * receiver's light) keeps that: it differs from a ray for every pair by a
+ * small part of what visibility changes, and the more it skips (0.5: half
+ * of every receiver's light without its own ray) the more it differs. */
 VT_TEST(accuracy_visibility_casts_indirect_shadows)
 {
     const uint32_t W = 40, H = 30;
@@ -60,9 +64,10 @@ VT_TEST(accuracy_visibility_casts_indirect_shadows)
     vsgl_context_create(NULL, &ctx);
     VT_CHECK(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     float *bf = calloc(W * H * 3, sizeof(float)), *on = calloc(W * H * 3, sizeof(float)),
-          *off = calloc(W * H * 3, sizeof(float));
-    float *planes[3] = {bf, on, off};
-    for (int k = 0; k < 3; ++k) {
+          *off = calloc(W * H * 3, sizeof(float)), *all = calloc(W * H * 3, sizeof(float)),
+          *half = calloc(W * H * 3, sizeof(float));
+    float *planes[5] = {bf, on, off, all, half};
+    for (int k = 0; k < 5; ++k) {
         vsgl_render_settings s;
         vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
         s.shade_stride = 1; /* every pixel shaded, no visibility rays: the model alone */
@@ -71,6 +76,7 @@ VT_TEST(accuracy_visibility_casts_indirect_shadows)
         s.vsgl_count = 128;
         s.method = k == 0 ? VSGL_METHOD_BRUTE_FORCE : VSGL_METHOD_VSGL;
         s.visibility = k == 2 ? VSGL_VISIBILITY_NONE : VSGL_VISIBILITY_RAY;
+        s.visibility_budget = k == 3 ? -1.0f : (k == 4 ? 0.5f : 0.0f); /* every pair; half; the default */
         vsgl_render_output o;
         memset(&o, 0, sizeof o);
         o.width = W;
@@ -80,6 +86,12 @@ VT_TEST(accuracy_visibility_casts_indirect_shadows)
     }
     double e_on = acc_relmse(on, bf, W * H * 3), e_off = acc_relmse(off, bf, W * H * 3);
     VT_CHECK(e_on < 0.5 * e_off, "relMSE with visibility %.4g, without %.4g (reference with visibility)", e_on, e_off);
+    double d_budget = acc_relmse(on, all, W * H * 3), d_off = acc_relmse(off, all, W * H * 3),
+           d_half = acc_relmse(half, all, W * H * 3);
+    printf("    relMSE against a ray for every pair: budget 0.02 %.3g, 0.5 %.3g, no visibility %.3g\n", d_budget, d_half,
+           d_off);
+    VT_CHECK(d_budget < 0.05 * d_off && d_budget < d_half, "the budget's difference to every ray %.4g (0.5: %.4g; no "
+             "visibility: %.4g)", d_budget, d_half, d_off);
     /* red light on the green wall (right edge columns, middle rows) */
     double red_on = 0, red_off = 0;
     for (uint32_t y = H / 3; y < 2 * H / 3; ++y)
@@ -94,6 +106,8 @@ VT_TEST(accuracy_visibility_casts_indirect_shadows)
     free(bf);
     free(on);
     free(off);
+    free(all);
+    free(half);
     vsgl_scene_destroy(scene);
     vsgl_context_destroy(ctx);
 }

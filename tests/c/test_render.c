@@ -134,6 +134,8 @@ VT_TEST(render_rejects_bad_settings_and_sizes_without_touching_output)
         {"rsm_resolution", 100000, "settings: rsm_resolution is 100000"},
         {"aa_samples", 99, "settings: aa_samples is 99"},
         {"glossy_lobes", 3, "settings: glossy_lobes is 3 (valid 4 or 5; 0 = 4)"},
+        {"visibility_budget", 1, "settings: visibility_budget is 0.6 (valid: at most 0.5"},
+        {"visibility_budget", 2, "settings: visibility_budget is nan (valid: at most 0.5"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         vsgl_render_settings bad = s;
@@ -142,6 +144,8 @@ VT_TEST(render_rejects_bad_settings_and_sizes_without_touching_output)
         if (i == 2) bad.rsm_resolution = (uint32_t)cases[i].value;
         if (i == 3) bad.aa_samples = (uint32_t)cases[i].value;
         if (i == 4) bad.glossy_lobes = (uint32_t)cases[i].value;
+        if (i == 5) bad.visibility_budget = 0.6f;
+        if (i == 6) bad.visibility_budget = NAN;
         memset(&p, 0x7f, sizeof p);
         err[0] = 0;
         VT_CHECK(render_room(0, &bad, &p, NULL, err, sizeof err) == VSGL_ERROR_INVALID_ARGUMENT, "%s", cases[i].field);

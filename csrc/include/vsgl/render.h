@@ -155,7 +155,18 @@ typedef struct vsgl_render_settings {
                                       surface is reflected (the half-vector model, docs/pipeline.md): 4 (0
                                       means 4; the balanced preset) or 5 (the quality preset: 0.96 of
                                       GGX's peak instead of 0.85, one lobe more per such pair) */
+    float visibility_budget;     /**< visibility RAY: at each receiver, the VSGLs whose light there (radiant
+                                      intensity over squared distance times the receiver's cosine, no BRDF)
+                                      sums to at most this fraction of all of theirs, the weakest first, trace
+                                      no ray and take the visibility of the others, weighted by that light:
+                                      fewer rays (5.8x fewer in a room with a sphere at 0.02) for an error of
+                                      at most the fraction times how unevenly the VSGLs are shadowed. 0 means
+                                      VSGL_VISIBILITY_BUDGET_DEFAULT; negative: a ray for every pair; at most
+                                      0.5 */
 } vsgl_render_settings;
+
+/** vsgl_render_settings.visibility_budget when it is 0. */
+#define VSGL_VISIBILITY_BUDGET_DEFAULT 0.02f
 
 /** vsgl_render_settings.mrp_min_area when it is 0 (m^2). */
 #define VSGL_MRP_MIN_AREA_DEFAULT 0.25f

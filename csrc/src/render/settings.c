@@ -19,6 +19,7 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
     out->shade_stride = 1;
     out->mrp_min_area = VSGL_MRP_MIN_AREA_DEFAULT; /* what 0 means, spelled out (the add-on's panel shows it) */
     out->glossy_lobes = 4;                         /* the same */
+    out->visibility_budget = VSGL_VISIBILITY_BUDGET_DEFAULT; /* the same */
     /* Every preset fits on the lattice: the importance-drawn fits flicker
      * as a light moves (0.1-0.75 of the AOV per 1/1000-extent step, docs/
      * quality.md) and break a reflection into blotches; with the emitter
@@ -141,6 +142,14 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     if (s->glossy_lobes != 4 && s->glossy_lobes != 5)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: glossy_lobes is %u (valid 4 or 5; 0 = 4)",
                           s->glossy_lobes);
+    if (!(s->visibility_budget <= 0.5f) || s->visibility_budget != s->visibility_budget)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: visibility_budget is %g (valid: at most "
+                          "0.5; 0 = %g, negative = a ray for every pair)", (double)s->visibility_budget,
+                          (double)VSGL_VISIBILITY_BUDGET_DEFAULT);
+    if (s->visibility_budget == 0.0f)
+        s->visibility_budget = VSGL_VISIBILITY_BUDGET_DEFAULT;
+    else if (s->visibility_budget < 0.0f)
+        s->visibility_budget = -1.0f; /* off */
     if (s->fis_iterations > VSGL_FIS_ITERATIONS_MAX)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: fis_iterations is %u (valid 1..%d)",
                           s->fis_iterations, VSGL_FIS_ITERATIONS_MAX);
