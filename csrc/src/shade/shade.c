@@ -753,12 +753,12 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
             j->path == VSGL__SHADE_KERNEL_SCALAR ? vsgl__kernel_shade_scalar : vsgl__kernel_shade;
         const size_t count = j->set->count;
         /* per VSGL: visibility and skip bits (2 x 64), its light at each lane (64 floats) */
-        uint64_t *bits = j->s->visibility == VSGL_VISIBILITY_RAY
-                             ? malloc((count ? count : 1) * (2 * sizeof *bits + VSGL__KERNEL_BLOCK * sizeof(float)))
-                             : NULL;
-        if (bits) {
+        const int rays = j->s->visibility == VSGL_VISIBILITY_RAY;
+        uint64_t *bits = rays ? malloc(2 * (count ? count : 1) * sizeof *bits) : NULL;
+        float *weights = rays ? malloc((count ? count : 1) * VSGL__KERNEL_BLOCK * sizeof *weights) : NULL;
+        if (bits && weights) {
             float share[VSGL__KERNEL_BLOCK];
-            block_visibility(j, rec, n, bits, bits + count, (float *)(bits + 2 * count), share);
+            block_visibility(j, rec, n, bits, bits + count, weights, share);
             /* two VSGLs per kernel call, the pairs it interleaves */
             for (size_t v = 0; v < count; v += 2) {
                 size_t m = count - v < 2 ? count - v : 2;
@@ -768,10 +768,19 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
                                                           : (float)((bits[v + q] >> k) & 1u);
                 kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
             }
-            free(bits);
+        } else if (rays) { /* no memory for the budget: a ray for every pair, two VSGLs at a time */
+            for (size_t v = 0; v < count; v += 2) {
+                size_t m = count - v < 2 ? count - v : 2;
+                for (size_t q = 0; q < m; ++q)
+                    visibility_rays(j, ray_target(&j->set->items[j->korder[v + q]]), &j->klights[v + q], rec, n,
+                                    NULL, vis + q * VSGL__KERNEL_BLOCK);
+                kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
+            }
         } else {
             kernel(blk, j->klights, count, NULL, j->s->diffuse_mode, lobes);
         }
+        free(bits);
+        free(weights);
         pairs += (uint64_t)n * j->set->count;
         if ((lobes & VSGL__KERNEL_DIFFUSE) && j->near->start)
             for (size_t k = 0; k < n; ++k)
