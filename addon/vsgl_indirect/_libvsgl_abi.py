@@ -21,7 +21,7 @@ else:  # a top-level module (the tests, tools/)
 # --------------------------------------------------------------------------
 
 BINDING_VERSION = (0, 3)
-BUNDLE_VERSION = (1, 6)
+BUNDLE_VERSION = (1, 7)
 
 
 class Result(enum.IntEnum):
