@@ -30,6 +30,13 @@ if "$py" -c 'import bpy' >/dev/null 2>&1; then
 else
   echo "live preview: skipped: cannot import bpy in $py (tools/install_bpy.sh installs it)"
 fi
+echo "== visibility rays: their cost over the shade stage without them, and their error gain (issue 12)"
+if "$py" -c 'import numpy' >/dev/null 2>&1; then
+  if [ "${BENCH_QUICK:-0}" = 1 ]; then "$py" tools/bench_visibility.py --size 480x270 --repeat 1
+  else "$py" tools/bench_visibility.py; fi
+else
+  echo "visibility: skipped: $py lacks numpy"
+fi
 echo "== EXR writing: every compression, float and half"
 tools/bench_exr.sh
 echo "== the trade: error against whole-frame time, library vs Cycles and Cycles + OIDN (issue 11)"

@@ -71,8 +71,8 @@ def main(argv=None):
                     TARGET, "PASS" if shade / base <= TARGET else "FAIL"), total)
             if seeds:
                 m = M.all_metrics(rend.render(small, cfg)[0], seeds)
-                line += " | struct D %.5f G %.5f, FLIP %.4f" % (m["Diff"]["structured"], m["Gloss"]["structured"],
-                                                                m["flip"] if m.get("flip") is not None else float("nan"))
+                flip = m["flip"] if m.get("flip") is not None else float("nan")
+                line += " | struct D %.5f G %.5f, FLIP %.4f" % (m["Diff"]["structured"], m["Gloss"]["structured"], flip)
             print(line, flush=True)
     return 0
 

@@ -9,3 +9,31 @@
 #endif
 #define KERNEL_NAME vsgl__kernel_shade
 #include "shade/kernel_impl.h"
+
+/* e^y for y <= 0 within a few per cent (Schraudolph's exponent trick). */
+static inline float rough_exp(float y)
+{
+    y = y < -80.0f ? -80.0f : y;
+    union { float f; int32_t i; } u;
+    u.i = (int32_t)(12102203.0f * y + 1065353216.0f);
+    return u.f;
+}
+
+KERNEL_ATTR void vsgl__kernel_pair_weights(const vsgl_kernel_light *lights, size_t count, const float *p,
+                                           const float *q, float *w, float *total)
+{
+    enum { B = VSGL__KERNEL_BLOCK };
+    for (size_t v = 0; v < count; ++v) {
+        const vsgl_kernel_light *L = &lights[v];
+        const float pw = (0.2126f * L->pr + 0.7152f * L->pg + 0.0722f * L->pb) * L->c0;
+        float *wv = w + v * B;
+        for (size_t k = 0; k < B; ++k) {
+            float dx = p[k] - L->mx, dy = p[B + k] - L->my, dz = p[2 * B + k] - L->mz;
+            float d2 = dx * dx + dy * dy + dz * dz, id = d2 > 0.0f ? 1.0f / sqrtf(d2) : 0.0f;
+            float ce = -(L->ax * dx + L->ay * dy + L->az * dz) * id;
+            float cr = -(q[k] * dx + q[B + k] * dy + q[2 * B + k] * dz) * id;
+            wv[k] = pw * rough_exp(L->lv * (ce - 1.0f)) * ((cr > 0.0f ? cr : 0.0f) + 0.05f) / (d2 + L->var);
+            total[k] += wv[k];
+        }
+    }
+}

@@ -160,4 +160,14 @@ void vsgl__kernel_shade(vsgl_kernel_block *b, const vsgl_kernel_light *lights, s
 void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count,
                                const float *visibility, int32_t diffuse_mode, int32_t lobes);
 
+/* The visibility budget's order of importance (shade.c): the light of each
+ * of lights[0, count) at the VSGL__KERNEL_BLOCK receivers at p with normals
+ * q (3 x VSGL__KERNEL_BLOCK each, component-major; unused lanes any finite
+ * values), without the BRDF: its radiant intensity towards the receiver
+ * over the squared distance (plus its variance) times the receiver's
+ * cosine (plus 0.05), the exponential within a few per cent. w: count x
+ * VSGL__KERNEL_BLOCK (VSGL-major); total[k] += each receiver's sum. */
+void vsgl__kernel_pair_weights(const vsgl_kernel_light *lights, size_t count, const float *p, const float *q,
+                               float *w, float *total);
+
 #endif

@@ -292,15 +292,20 @@ static void visibility_rays(const shade_job *j, v3 target, const vsgl_kernel_lig
     unsigned char blocked[VSGL__KERNEL_BLOCK];
     const int may_skip = L && L->clip >= VSGL__VIS_SKIP_CLIP;
     for (size_t k = 0; k < n; ++k) {
+        if (skip && skip[k]) {
+            org[k] = rec[k].x;
+            dir[k] = rec[k].n;
+            tmin[k] = 0.0f;
+            tmax[k] = -1.0f; /* not traced */
+            continue;
+        }
         org[k] = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
         v3 d = v3_sub(target, org[k]);
         float dist = v3_length(d);
         dir[k] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
         tmin[k] = 0.0f;
         tmax[k] = dist > j->eps ? dist - j->eps : 0.0f;
-        if (skip && skip[k])
-            tmax[k] = -1.0f;
-        else if (may_skip) { /* the kernel's h (kernel_impl.h, k_geometry) */
+        if (may_skip) { /* the kernel's h (kernel_impl.h, k_geometry) */
             float h = -((L->mx - rec[k].x.x) * L->nx + (L->my - rec[k].x.y) * L->ny + (L->mz - rec[k].x.z) * L->nz);
             if (h * L->ibehind < VSGL__VIS_SKIP_BEHIND)
                 tmax[k] = -1.0f; /* an empty interval: not traced, visible */
@@ -623,35 +628,10 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
 
 #define VIS_BUCKETS 49 /* log2 steps of a pair's share of its receiver's light */
 
-/* e^y for y <= 0 within a few per cent (Schraudolph's exponent trick):
- * an order of importance, not light. */
-static inline float rough_exp(float y)
-{
-    y = y < -80.0f ? -80.0f : y;
-    union { float f; int32_t i; } u;
-    u.i = (int32_t)(12102203.0f * y + 1065353216.0f);
-    return u.f;
-}
-
-/* Light of VSGL L at the block's receivers (positions p, normals q: 3 x
- * VSGL__KERNEL_BLOCK, component-major; unused lanes zero), without the
- * BRDF: an order of importance. One loop of a fixed count: vectorised. */
-static void pair_weights(const vsgl_kernel_light *L, const float *p, const float *q, float *w)
-{
-    const float pw = 0.2126f * L->pr + 0.7152f * L->pg + 0.0722f * L->pb;
-    for (size_t k = 0; k < VSGL__KERNEL_BLOCK; ++k) {
-        float dx = p[k] - L->mx, dy = p[VSGL__KERNEL_BLOCK + k] - L->my, dz = p[2 * VSGL__KERNEL_BLOCK + k] - L->mz;
-        float d2 = dx * dx + dy * dy + dz * dz, id = d2 > 0.0f ? 1.0f / sqrtf(d2) : 0.0f;
-        float ce = -(L->ax * dx + L->ay * dy + L->az * dz) * id;
-        float cr = -(q[k] * dx + q[VSGL__KERNEL_BLOCK + k] * dy + q[2 * VSGL__KERNEL_BLOCK + k] * dz) * id;
-        w[k] = pw * L->c0 * rough_exp(L->lv * (ce - 1.0f)) * ((cr > 0.0f ? cr : 0.0f) + 0.05f) / (d2 + L->var);
-    }
-}
-
 /* Visibility of every (VSGL, receiver) pair of a block: bit k of vis[v] and
  * skip[v] for receiver k and kernel light v; the pairs under each
  * receiver's budget (vsgl_render_settings.visibility_budget: the VSGLs
- * whose light there, pair_weights, sums to at most that fraction of all of
+ * whose light there, vsgl__kernel_pair_weights, sums to at most that fraction of all of
  * theirs, the weakest first; glossy_sphere_floor at 320 x 240: 26.4 M rays
  * -> 4.5 M at 0.02) are skipped and get share[k], the traced pairs' mean
  * visibility weighted by their light. w: count x VSGL__KERNEL_BLOCK floats. */
@@ -664,10 +644,10 @@ static void block_visibility(const shade_job *j, const receiver *rec, size_t n, 
     double seen[VSGL__KERNEL_BLOCK], lit[VSGL__KERNEL_BLOCK];
     memset(p, 0, sizeof p);
     memset(q, 0, sizeof q);
+    memset(total, 0, sizeof total);
     for (size_t k = 0; k < n; ++k) {
         p[k] = rec[k].x.x; p[B + k] = rec[k].x.y; p[2 * B + k] = rec[k].x.z;
         q[k] = rec[k].n.x; q[B + k] = rec[k].n.y; q[2 * B + k] = rec[k].n.z;
-        total[k] = 0.0f;
         cut[k] = -1.0f; /* nothing skipped */
         seen[k] = lit[k] = 0.0;
         for (int b = 0; b < VIS_BUCKETS; ++b)
@@ -675,12 +655,7 @@ static void block_visibility(const shade_job *j, const receiver *rec, size_t n, 
     }
     const float budget = j->s->visibility_budget;
     if (budget > 0.0f) {
-        for (size_t v = 0; v < count; ++v) {
-            float *wv = w + v * B;
-            pair_weights(&j->klights[v], p, q, wv);
-            for (size_t k = 0; k < n; ++k)
-                total[k] += wv[k];
-        }
+        vsgl__kernel_pair_weights(j->klights, count, p, q, w, total);
         float inv[VSGL__KERNEL_BLOCK];
         for (size_t k = 0; k < n; ++k)
             inv[k] = total[k] > 0.0f ? 1.0f / total[k] : 0.0f;
