@@ -112,13 +112,17 @@ void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *or
     uint32_t idx[BATCH];
     uint32_t b = 0;
     while (b < n) {
-        /* the next up to BATCH rays that need tracing: empty intervals and
-         * segments proven clear from bounds are unblocked without a ray */
+        /* the next up to BATCH rays that need tracing: empty intervals are
+         * unblocked without a ray. Not the bounds test of the single query:
+         * in a coherent stream Embree's ray costs less than the test (the
+         * balanced shade stage at 960 x 540: sun room 1.61 -> 1.38 s, sphere
+         * room 3.44 -> 3.34 s, a 500k-triangle floor 8.97 -> 8.90 s without
+         * it, once the visibility budget had cut the rays) */
         uint32_t m = 0;
         for (; b < n && m < BATCH; ++b) {
             float lo = tmin[b], hi = tmax[b];
             blocked[b] = 0;
-            if (scene->triangle_count == 0 || !(lo <= hi) || proven_clear(scene, org[b], dir[b], lo, hi))
+            if (scene->triangle_count == 0 || !(lo <= hi))
                 continue;
             fill_ray(&r[m], org[b], dir[b], lo, hi);
             idx[m++] = b;

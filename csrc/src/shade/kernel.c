@@ -37,3 +37,20 @@ KERNEL_ATTR void vsgl__kernel_pair_weights(const vsgl_kernel_light *lights, size
         }
     }
 }
+
+KERNEL_ATTR void vsgl__kernel_weight_levels(const float *w, size_t count, const float *total, float *sums)
+{
+    enum { B = VSGL__KERNEL_BLOCK, NL = VSGL__VIS_LEVELS };
+    float thr[NL][B];
+    for (int l = 0; l < NL; ++l)
+        for (size_t k = 0; k < B; ++k) {
+            thr[l][k] = total[k] * (1.0f / (float)(1u << (VSGL__VIS_LEVEL0 + l)));
+            sums[l * B + k] = 0.0f;
+        }
+    for (size_t v = 0; v < count; ++v) {
+        const float *wv = w + v * B;
+        for (int l = 0; l < NL; ++l)
+            for (size_t k = 0; k < B; ++k)
+                sums[l * B + k] += wv[k] <= thr[l][k] ? wv[k] : 0.0f;
+    }
+}

@@ -169,5 +169,11 @@ void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *li
  * VSGL__KERNEL_BLOCK (VSGL-major); total[k] += each receiver's sum. */
 void vsgl__kernel_pair_weights(const vsgl_kernel_light *lights, size_t count, const float *p, const float *q,
                                float *w, float *total);
+/* The candidate cuts of the budget: level l is the weights at most
+ * total[k] x 2^-(VSGL__VIS_LEVEL0 + l); sums[l * VSGL__KERNEL_BLOCK + k]
+ * receives their sum for receiver k, l < VSGL__VIS_LEVELS. */
+#define VSGL__VIS_LEVELS 12
+#define VSGL__VIS_LEVEL0 4
+void vsgl__kernel_weight_levels(const float *w, size_t count, const float *total, float *sums);
 
 #endif

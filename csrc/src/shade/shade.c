@@ -626,7 +626,6 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
     *ld2 = fmaxf(*ld2 + d[2], 0.0f);
 }
 
-#define VIS_BUCKETS 49 /* log2 steps of a pair's share of its receiver's light */
 
 /* Visibility of every (VSGL, receiver) pair of a block: bit k of vis[v] and
  * skip[v] for receiver k and kernel light v; the pairs under each
@@ -635,12 +634,12 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
  * theirs, the weakest first; glossy_sphere_floor at 320 x 240: 26.4 M rays
  * -> 4.5 M at 0.02) are skipped and get share[k], the traced pairs' mean
  * visibility weighted by their light. w: count x VSGL__KERNEL_BLOCK floats. */
+_Static_assert(VSGL__KERNEL_BLOCK <= 64, "block_visibility keeps a block's lanes in 64-bit masks");
 static void block_visibility(const shade_job *j, const receiver *rec, size_t n, uint64_t *vis, uint64_t *skip,
                              float *w, float *share)
 {
     const size_t count = j->set->count, B = VSGL__KERNEL_BLOCK;
     float p[3 * VSGL__KERNEL_BLOCK], q[3 * VSGL__KERNEL_BLOCK], total[VSGL__KERNEL_BLOCK], cut[VSGL__KERNEL_BLOCK];
-    float hist[VSGL__KERNEL_BLOCK][VIS_BUCKETS];
     double seen[VSGL__KERNEL_BLOCK], lit[VSGL__KERNEL_BLOCK];
     memset(p, 0, sizeof p);
     memset(q, 0, sizeof q);
@@ -650,30 +649,16 @@ static void block_visibility(const shade_job *j, const receiver *rec, size_t n, 
         q[k] = rec[k].n.x; q[B + k] = rec[k].n.y; q[2 * B + k] = rec[k].n.z;
         cut[k] = -1.0f; /* nothing skipped */
         seen[k] = lit[k] = 0.0;
-        for (int b = 0; b < VIS_BUCKETS; ++b)
-            hist[k][b] = 0.0f;
     }
     const float budget = j->s->visibility_budget;
     if (budget > 0.0f) {
         vsgl__kernel_pair_weights(j->klights, count, p, q, w, total);
-        float inv[VSGL__KERNEL_BLOCK];
-        for (size_t k = 0; k < n; ++k)
-            inv[k] = total[k] > 0.0f ? 1.0f / total[k] : 0.0f;
-        for (size_t v = 0; v < count; ++v)
-            for (size_t k = 0; k < n; ++k) {
-                /* bucket b: share in (2^-(b+1), 2^-b], from the float's exponent */
-                union { float f; int32_t i; } u = {w[v * B + k] * inv[k]};
-                int32_t b = u.f > 0.0f ? 126 - ((u.i >> 23) & 0xff) : VIS_BUCKETS - 1;
-                hist[k][b < 0 ? 0 : (b >= VIS_BUCKETS ? VIS_BUCKETS - 1 : b)] += w[v * B + k];
-            }
-        for (size_t k = 0; k < n; ++k) { /* the weakest buckets whose sum fits the budget */
-            float sum = 0.0f, room = budget * total[k];
-            int b = VIS_BUCKETS;
-            while (b > 0 && sum + hist[k][b - 1] <= room)
-                sum += hist[k][--b];
-            if (b < VIS_BUCKETS) /* buckets >= b: share <= 2^-b */
-                cut[k] = total[k] * ldexpf(1.0f, -b);
-        }
+        float sums[VSGL__VIS_LEVELS * VSGL__KERNEL_BLOCK];
+        vsgl__kernel_weight_levels(w, count, total, sums);
+        for (size_t k = 0; k < n; ++k) /* the highest cut whose pairs' light fits the budget */
+            for (int l = 0; l < VSGL__VIS_LEVELS && cut[k] < 0.0f; ++l)
+                if (sums[l * B + k] <= budget * total[k])
+                    cut[k] = total[k] * (1.0f / (float)(1u << (VSGL__VIS_LEVEL0 + l)));
     }
     unsigned char sk[VSGL__KERNEL_BLOCK];
     float vv[VSGL__KERNEL_BLOCK];
@@ -684,6 +669,10 @@ static void block_visibility(const shade_job *j, const receiver *rec, size_t n, 
             sk[k] = cut[k] >= 0.0f && wv[k] <= cut[k];
             sbits |= (uint64_t)sk[k] << k;
         }
+        vis[v] = 0;
+        skip[v] = sbits;
+        if (sbits == (n < 64 ? ((uint64_t)1 << n) - 1 : ~(uint64_t)0))
+            continue; /* no ray for this VSGL at any receiver of the block */
         visibility_rays(j, ray_target(&j->set->items[j->korder[v]]), &j->klights[v], rec, n, sk, vv);
         uint64_t vbits = 0;
         for (size_t k = 0; k < n; ++k) {
@@ -694,7 +683,6 @@ static void block_visibility(const shade_job *j, const receiver *rec, size_t n, 
             }
         }
         vis[v] = vbits;
-        skip[v] = sbits;
     }
     for (size_t k = 0; k < n; ++k)
         share[k] = seen[k] > 0.0 ? (float)(lit[k] / seen[k]) : 1.0f;
