@@ -279,13 +279,19 @@ static double exact_coverage(uint32_t col, uint32_t row, double x0, double k, do
     return (double)in / (n * n);
 }
 
+/* The plane z = z0, half-width h, cut by the slanted edge x = x0 + k y. */
+static void slanted_plane(plane_scene *p, float z0, float x0, float k, float h)
+{
+    plane_init(p, z0, h, 0);
+    float v[12] = {-h, -h, z0, x0 - k * h, -h, z0, x0 + k * h, h, z0, -h, h, z0};
+    memcpy(p->pos, v, sizeof v);
+}
+
 VT_TEST(gbuffer_edge_refinement_resolves_coverage)
 {
-    const float z0 = -5.0f, x0 = 0.3f, k = 0.37f, h = 100.0f;
+    const float z0 = -5.0f, x0 = 0.3f, k = 0.37f;
     plane_scene p;
-    plane_init(&p, z0, h, 0);
-    float v[12] = {-h, -h, z0, x0 - k * h, -h, z0, x0 + k * h, h, z0, -h, h, z0};
-    memcpy(p.pos, v, sizeof v);
+    slanted_plane(&p, z0, x0, k, 100.0f);
     vsgl_gbuffer ref[2];
     memset(ref, 0, sizeof ref);
     uint32_t threads[2] = {1, 2};
@@ -390,14 +396,11 @@ VT_TEST(gbuffer_edge_refinement_resolves_coverage)
  * by only ~1e-3 rad (the mean: ~3e-4, rounding). */
 VT_TEST(gbuffer_edge_slot_takes_its_surfaces_mean_normal)
 {
-    const float z0 = -5.0f, x0 = 0.3f, k = 0.37f, h = 2.0f;
     plane_scene p;
-    plane_init(&p, z0, h, 0);
-    float v[12] = {-h, -h, z0, x0 - k * h, -h, z0, x0 + k * h, h, z0, -h, h, z0};
-    memcpy(p.pos, v, sizeof v);
+    slanted_plane(&p, -5.0f, 0.3f, 0.37f, 2.0f);
     float cn[18];
     for (int t = 0; t < 6; ++t) { /* corners of triangles {0,1,2}, {0,2,3} */
-        const float *q = v + 3 * p.ix[t];
+        const float *q = p.pos + 3 * p.ix[t];
         cn[3 * t] = -2.0f * q[0];
         cn[3 * t + 1] = 0.0f;
         cn[3 * t + 2] = 1.0f;

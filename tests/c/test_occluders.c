@@ -156,6 +156,20 @@ VT_TEST(occluders_never_call_a_blocked_segment_clear)
     vsgl_context_destroy(ctx);
 }
 
+/* The fixture's only light: a white sun of 3 W/m^2 from (x, 0, 4) towards
+ * the origin. */
+static void sun_only(fx_scene *fx, float x)
+{
+    vsgl_light *L = &fx->lights[0];
+    memset(L, 0, sizeof *L);
+    L->type = VSGL_LIGHT_SUN;
+    L->color[0] = L->color[1] = L->color[2] = 1.0f;
+    L->power = 3.0f; /* W/m^2 */
+    const float eye[3] = {x, 0, 4}, at[3] = {0, 0, 0};
+    fx_look_at(L->world_from_light, eye, at);
+    fx->light_count = 1;
+}
+
 /* An open-top box (the fixture room with a front wall, no ceiling) under a
  * sun from (3, 0, 4): it lights the floor and the inside of the left wall
  * through the top, and the outside of the right wall x = +1 (4 m^2 at
@@ -171,14 +185,7 @@ VT_TEST(rsm_drop_outward_takes_only_the_outside_of_a_wall)
     fx.vertex_count -= 4;
     const float front[4][3] = {{-1, -1, 0}, {-1, -1, 2}, {1, -1, 2}, {1, -1, 0}};
     fx_quad(&fx, front, 3);
-    vsgl_light *L = &fx.lights[0];
-    memset(L, 0, sizeof *L);
-    L->type = VSGL_LIGHT_SUN;
-    L->color[0] = L->color[1] = L->color[2] = 1.0f;
-    L->power = 3.0f; /* W/m^2 */
-    const float eye[3] = {3, 0, 4}, at[3] = {0, 0, 0};
-    fx_look_at(L->world_from_light, eye, at);
-    fx.light_count = 1;
+    sun_only(&fx, 3.0f);
     vsgl_scene *sc = NULL;
     VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &sc) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     vsgl_rsm r;
@@ -230,14 +237,7 @@ VT_TEST(rsm_build_inward_zooms_a_sun_onto_an_opening)
         fx_quad(&fx, q, 3);
     }
     fx_quad(&fx, front, 3);
-    vsgl_light *L = &fx.lights[0];
-    memset(L, 0, sizeof *L);
-    L->type = VSGL_LIGHT_SUN;
-    L->color[0] = L->color[1] = L->color[2] = 1.0f;
-    L->power = 3.0f; /* W/m^2 */
-    const float eye[3] = {1, 0, 4}, at[3] = {0, 0, 0};
-    fx_look_at(L->world_from_light, eye, at);
-    fx.light_count = 1;
+    sun_only(&fx, 1.0f);
     vsgl_scene *sc = NULL;
     VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &sc) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     const double exact = 3.0 * (2 * o) * (2 * o) * 4.0 / sqrt(17.0);
