@@ -61,11 +61,22 @@ def knobs_of(obj):
     return {k: getattr(obj, k) for k in KNOBS}
 
 
+def same_knob_value(a, b):
+    """Knob values equal; floats within float32 rounding (Blender's
+    FloatProperty and the library's settings hold 0.02 as 0.0199999996)."""
+    if isinstance(a, float) or isinstance(b, float):
+        try:
+            return abs(float(a) - float(b)) <= 1e-6 * max(1.0, abs(float(b)))
+        except (TypeError, ValueError):
+            return False
+    return a == b
+
+
 def differing_knobs(obj, preset=None):
     """Names of the knobs of ``obj`` that differ from ``preset`` (default:
     ``obj.preset``), in KNOBS order."""
     want = preset_knobs(preset or obj.preset)
-    return [k for k in KNOBS if getattr(obj, k) != want[k]]
+    return [k for k in KNOBS if not same_knob_value(getattr(obj, k), want[k])]
 
 
 def matching_preset(obj):
