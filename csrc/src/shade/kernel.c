@@ -19,8 +19,8 @@ static inline float rough_exp(float y)
     return u.f;
 }
 
-KERNEL_ATTR void vsgl__kernel_pair_weights(const vsgl_kernel_light *lights, size_t count, const float *p,
-                                           const float *q, float *w, float *total)
+KERNEL_ATTR void vsgl__kernel_pair_weights(const vsgl_kernel_block *b, const vsgl_kernel_light *lights,
+                                           size_t count, float *w, float *total)
 {
     enum { B = VSGL__KERNEL_BLOCK };
     for (size_t v = 0; v < count; ++v) {
@@ -28,11 +28,20 @@ KERNEL_ATTR void vsgl__kernel_pair_weights(const vsgl_kernel_light *lights, size
         const float pw = (0.2126f * L->pr + 0.7152f * L->pg + 0.0722f * L->pb) * L->c0;
         float *wv = w + v * B;
         for (size_t k = 0; k < B; ++k) {
-            float dx = p[k] - L->mx, dy = p[B + k] - L->my, dz = p[2 * B + k] - L->mz;
+            /* i: unit direction from the receiver to the VSGL */
+            float dx = L->mx - b->x[k], dy = L->my - b->y[k], dz = L->mz - b->z[k];
             float d2 = dx * dx + dy * dy + dz * dz, id = d2 > 0.0f ? 1.0f / sqrtf(d2) : 0.0f;
-            float ce = -(L->ax * dx + L->ay * dy + L->az * dz) * id;
-            float cr = -(q[k] * dx + q[B + k] * dy + q[2 * B + k] * dz) * id;
-            wv[k] = pw * rough_exp(L->lv * (ce - 1.0f)) * ((cr > 0.0f ? cr : 0.0f) + 0.05f) / (d2 + L->var);
+            float ix = dx * id, iy = dy * id, iz = dz * id;
+            float ce = L->ax * ix + L->ay * iy + L->az * iz; /* the VSGL's axis . (-i): -(a . -i) */
+            float cr = b->nx[k] * ix + b->ny[k] * iy + b->nz[k] * iz;
+            float gx = b->Xx[k] * ix + b->Xy[k] * iy + b->Xz[k] * iz, gy = b->Yx[k] * ix + b->Yy[k] * iy + b->Yz[k] * iz;
+            float gz = b->Zx[k] * ix + b->Zy[k] * iy + b->Zz[k] * iz;
+            float spread = L->var * id * id; /* the VSGL's angular variance as seen from the receiver */
+            float gl = b->camp[k] * (gz > 0.0f ? gz : 0.0f) *
+                       rough_exp(-b->lam[k] * gx * gx / (1.0f + b->lam[k] * spread) -
+                                 b->mu[k] * gy * gy / (1.0f + b->mu[k] * spread));
+            float df = b->diffuse[k] * ((cr > 0.0f ? cr : 0.0f) + 0.05f) * (1.0f / 3.14159265f);
+            wv[k] = pw * rough_exp(L->lv * (ce - 1.0f)) * (df + gl) / (d2 + L->var);
             total[k] += wv[k];
         }
     }

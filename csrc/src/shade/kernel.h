@@ -161,14 +161,17 @@ void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *li
                                const float *visibility, int32_t diffuse_mode, int32_t lobes);
 
 /* The visibility budget's order of importance (shade.c): the light of each
- * of lights[0, count) at the VSGL__KERNEL_BLOCK receivers at p with normals
- * q (3 x VSGL__KERNEL_BLOCK each, component-major; unused lanes any finite
- * values), without the BRDF: its radiant intensity towards the receiver
- * over the squared distance (plus its variance) times the receiver's
- * cosine (plus 0.05), the exponential within a few per cent. w: count x
- * VSGL__KERNEL_BLOCK (VSGL-major); total[k] += each receiver's sum. */
-void vsgl__kernel_pair_weights(const vsgl_kernel_light *lights, size_t count, const float *p, const float *q,
-                               float *w, float *total);
+ * of lights[0, count) at the block's receivers (every lane; padding lanes
+ * are finite), its radiant intensity towards the receiver over the squared
+ * distance (plus its variance), times what the receiver makes of it: the
+ * diffuse lobe's cosine (plus 0.05) / pi where it is shaded, plus the
+ * warped GGX lobe's ASG towards the VSGL, widened by the VSGL's extent as
+ * seen from the receiver (a sharp lobe's light comes from the few VSGLs in
+ * its mirror direction, which the cosine alone would rank low); the
+ * exponentials within a few per cent. w: count x VSGL__KERNEL_BLOCK
+ * (VSGL-major); total[k] += each receiver's sum. */
+void vsgl__kernel_pair_weights(const vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count, float *w,
+                               float *total);
 /* The candidate cuts of the budget: level l is the weights at most
  * total[k] x 2^-(VSGL__VIS_LEVEL0 + l); sums[l * VSGL__KERNEL_BLOCK + k]
  * receives their sum for receiver k, l < VSGL__VIS_LEVELS. */

@@ -635,24 +635,20 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
  * -> 4.5 M at 0.02) are skipped and get share[k], the traced pairs' mean
  * visibility weighted by their light. w: count x VSGL__KERNEL_BLOCK floats. */
 _Static_assert(VSGL__KERNEL_BLOCK <= 64, "block_visibility keeps a block's lanes in 64-bit masks");
-static void block_visibility(const shade_job *j, const receiver *rec, size_t n, uint64_t *vis, uint64_t *skip,
-                             float *w, float *share)
+static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, const receiver *rec, size_t n,
+                             uint64_t *vis, uint64_t *skip, float *w, float *share)
 {
     const size_t count = j->set->count, B = VSGL__KERNEL_BLOCK;
-    float p[3 * VSGL__KERNEL_BLOCK], q[3 * VSGL__KERNEL_BLOCK], total[VSGL__KERNEL_BLOCK], cut[VSGL__KERNEL_BLOCK];
+    float total[VSGL__KERNEL_BLOCK], cut[VSGL__KERNEL_BLOCK];
     double seen[VSGL__KERNEL_BLOCK], lit[VSGL__KERNEL_BLOCK];
-    memset(p, 0, sizeof p);
-    memset(q, 0, sizeof q);
     memset(total, 0, sizeof total);
     for (size_t k = 0; k < n; ++k) {
-        p[k] = rec[k].x.x; p[B + k] = rec[k].x.y; p[2 * B + k] = rec[k].x.z;
-        q[k] = rec[k].n.x; q[B + k] = rec[k].n.y; q[2 * B + k] = rec[k].n.z;
         cut[k] = -1.0f; /* nothing skipped */
         seen[k] = lit[k] = 0.0;
     }
     const float budget = j->s->visibility_budget;
     if (budget > 0.0f) {
-        vsgl__kernel_pair_weights(j->klights, count, p, q, w, total);
+        vsgl__kernel_pair_weights(blk, j->klights, count, w, total);
         float sums[VSGL__VIS_LEVELS * VSGL__KERNEL_BLOCK];
         vsgl__kernel_weight_levels(w, count, total, sums);
         for (size_t k = 0; k < n; ++k) /* the highest cut whose pairs' light fits the budget */
@@ -721,7 +717,7 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
         float *weights = rays ? malloc((count ? count : 1) * VSGL__KERNEL_BLOCK * sizeof *weights) : NULL;
         if (bits && weights) {
             float share[VSGL__KERNEL_BLOCK];
-            block_visibility(j, rec, n, bits, bits + count, weights, share);
+            block_visibility(j, blk, rec, n, bits, bits + count, weights, share);
             /* two VSGLs per kernel call, the pairs it interleaves */
             for (size_t v = 0; v < count; v += 2) {
                 size_t m = count - v < 2 ? count - v : 2;
