@@ -656,29 +656,55 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
                 if (sums[l * B + k] <= budget * total[k])
                     cut[k] = total[k] * (1.0f / (float)(1u << (VSGL__VIS_LEVEL0 + l)));
     }
-    unsigned char sk[VSGL__KERNEL_BLOCK];
-    float vv[VSGL__KERNEL_BLOCK];
+    /* per VSGL: the receivers it traces a ray from, compacted (as visibility_rays, without the skipped) */
+    v3 org[VSGL__KERNEL_BLOCK], dir[VSGL__KERNEL_BLOCK];
+    float tmin[VSGL__KERNEL_BLOCK], tmax[VSGL__KERNEL_BLOCK];
+    unsigned char blocked[VSGL__KERNEL_BLOCK];
+    uint32_t idx[VSGL__KERNEL_BLOCK];
+    for (size_t k = 0; k < n; ++k)
+        tmin[k] = 0.0f;
     for (size_t v = 0; v < count; ++v) {
         const float *wv = w + v * B;
-        uint64_t sbits = 0;
+        const vsgl_kernel_light *L = &j->klights[v];
+        const v3 target = ray_target(&j->set->items[j->korder[v]]);
+        const int may_skip = L->clip >= VSGL__VIS_SKIP_CLIP;
+        uint64_t sbits = 0, vbits = 0;
+        uint32_t m = 0;
         for (size_t k = 0; k < n; ++k) {
-            sk[k] = cut[k] >= 0.0f && wv[k] <= cut[k];
-            sbits |= (uint64_t)sk[k] << k;
+            if (cut[k] >= 0.0f && wv[k] <= cut[k]) {
+                sbits |= (uint64_t)1 << k;
+                continue;
+            }
+            if (may_skip) { /* the VSGL cannot light it: visible, no ray (visibility_rays) */
+                float h = -((L->mx - rec[k].x.x) * L->nx + (L->my - rec[k].x.y) * L->ny + (L->mz - rec[k].x.z) * L->nz);
+                if (h * L->ibehind < VSGL__VIS_SKIP_BEHIND) {
+                    vbits |= (uint64_t)1 << k;
+                    if (cut[k] >= 0.0f) { /* weights exist only under a budget */
+                        seen[k] += wv[k];
+                        lit[k] += wv[k];
+                    }
+                    continue;
+                }
+            }
+            v3 o = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps)), d = v3_sub(target, o);
+            float dist = v3_length(d);
+            org[m] = o;
+            dir[m] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
+            tmax[m] = dist > j->eps ? dist - j->eps : 0.0f;
+            idx[m++] = (uint32_t)k;
         }
-        vis[v] = 0;
-        skip[v] = sbits;
-        if (sbits == (n < 64 ? ((uint64_t)1 << n) - 1 : ~(uint64_t)0))
-            continue; /* no ray for this VSGL at any receiver of the block */
-        visibility_rays(j, ray_target(&j->set->items[j->korder[v]]), &j->klights[v], rec, n, sk, vv);
-        uint64_t vbits = 0;
-        for (size_t k = 0; k < n; ++k) {
-            vbits |= (uint64_t)(vv[k] > 0.0f) << k;
-            if (!sk[k] && cut[k] >= 0.0f) {
+        if (m)
+            vsgl__scene_occluded_many(j->scene, m, org, dir, tmin, tmax, 1, blocked);
+        for (uint32_t i = 0; i < m; ++i) {
+            size_t k = idx[i];
+            vbits |= (uint64_t)!blocked[i] << k;
+            if (cut[k] >= 0.0f) {
                 seen[k] += wv[k];
-                lit[k] += wv[k] * vv[k];
+                lit[k] += blocked[i] ? 0.0f : wv[k];
             }
         }
         vis[v] = vbits;
+        skip[v] = sbits;
     }
     for (size_t k = 0; k < n; ++k)
         share[k] = seen[k] > 0.0 ? (float)(lit[k] / seen[k]) : 1.0f;
