@@ -10,7 +10,9 @@
 #define KERNEL_NAME vsgl__kernel_shade
 #include "shade/kernel_impl.h"
 
-/* e^y for y <= 0 within a few per cent (Schraudolph's exponent trick). */
+/* e^y for y <= 0 within a few per cent (Schraudolph's exponent trick): an
+ * order of importance needs no more; the kernel's k_exp made the budget's
+ * weights cost 4 % of the sun room's shade stage more. */
 static inline float rough_exp(float y)
 {
     y = y < -80.0f ? -80.0f : y;

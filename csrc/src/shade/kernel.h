@@ -167,8 +167,7 @@ void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *li
  * diffuse lobe's cosine (plus 0.05) / pi where it is shaded, plus the
  * warped GGX lobe's ASG towards the VSGL, widened by the VSGL's extent as
  * seen from the receiver (a sharp lobe's light comes from the few VSGLs in
- * its mirror direction, which the cosine alone would rank low); the
- * exponentials within a few per cent. w: count x VSGL__KERNEL_BLOCK
+ * its mirror direction, which the cosine alone would rank low). w: count x VSGL__KERNEL_BLOCK
  * (VSGL-major); total[k] += each receiver's sum. */
 void vsgl__kernel_pair_weights(const vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count, float *w,
                                float *total);

@@ -275,45 +275,56 @@ static v3 ray_target(const vsgl_vsgl *v)
     return v3_add(v->mean, v3_scale(v->normal, v->coherence * sqrtf(v->variance)));
 }
 
-/* Visibility of `target` (a VSGL's ray target) from receivers rec[0..n), n <=
- * VSGL__KERNEL_BLOCK: one batched occlusion query (Embree ray streams) from
- * each receiver offset along its normal; vis[k] = 0 if blocked, else 1. A
- * receiver at the target traces an empty segment (visible). With L (the
- * VSGL's kernel light; NULL: every lane traced), no ray for a receiver the
- * VSGL cannot light: behind or within 1e-3 of the behind fade of its plane
- * (VSGL__CLIP_BEHIND sigma) with its emitter clip at >= 0.999 (its light
- * there is at most 0.1 % of the unclipped lobe's: a floor's clusters and the
- * floor's own receivers, a wall's cluster and the wall beside it); vis 1. */
-static void visibility_rays(const shade_job *j, v3 target, const vsgl_kernel_light *L, const receiver *rec,
-                            size_t n, const unsigned char *skip, float *vis)
+/* Visibility of `target` (a VSGL's ray target) from the receivers k <
+ * n <= VSGL__KERNEL_BLOCK whose bit is set in `lanes`: one batched
+ * occlusion query (an Embree ray stream) of just those, each from the
+ * receiver offset along its normal. Returns their visible bits (a blocked
+ * ray's bit and every lane outside `lanes` are 0). A receiver at the target
+ * traces an empty segment (visible). With L (the VSGL's kernel light;
+ * NULL: every lane traced), no ray for a receiver the VSGL cannot light:
+ * behind or within 1e-3 of the behind fade of its plane (VSGL__CLIP_BEHIND
+ * sigma) with its emitter clip at >= 0.999 (its light there is at most
+ * 0.1 % of the unclipped lobe's: a floor's clusters and the floor's own
+ * receivers, a wall's cluster and the wall beside it); visible. */
+_Static_assert(VSGL__KERNEL_BLOCK <= 64, "a block's lanes are kept in 64-bit masks");
+static uint64_t visibility_rays(const shade_job *j, v3 target, const vsgl_kernel_light *L, const receiver *rec,
+                                size_t n, uint64_t lanes)
 {
     v3 org[VSGL__KERNEL_BLOCK], dir[VSGL__KERNEL_BLOCK];
     float tmin[VSGL__KERNEL_BLOCK], tmax[VSGL__KERNEL_BLOCK];
     unsigned char blocked[VSGL__KERNEL_BLOCK];
+    uint32_t idx[VSGL__KERNEL_BLOCK], m = 0;
+    uint64_t visible = 0;
     const int may_skip = L && L->clip >= VSGL__VIS_SKIP_CLIP;
     for (size_t k = 0; k < n; ++k) {
-        if (skip && skip[k]) {
-            org[k] = rec[k].x;
-            dir[k] = rec[k].n;
-            tmin[k] = 0.0f;
-            tmax[k] = -1.0f; /* not traced */
+        if (!((lanes >> k) & 1u))
             continue;
-        }
-        org[k] = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
-        v3 d = v3_sub(target, org[k]);
-        float dist = v3_length(d);
-        dir[k] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
-        tmin[k] = 0.0f;
-        tmax[k] = dist > j->eps ? dist - j->eps : 0.0f;
         if (may_skip) { /* the kernel's h (kernel_impl.h, k_geometry) */
             float h = -((L->mx - rec[k].x.x) * L->nx + (L->my - rec[k].x.y) * L->ny + (L->mz - rec[k].x.z) * L->nz);
-            if (h * L->ibehind < VSGL__VIS_SKIP_BEHIND)
-                tmax[k] = -1.0f; /* an empty interval: not traced, visible */
+            if (h * L->ibehind < VSGL__VIS_SKIP_BEHIND) {
+                visible |= (uint64_t)1 << k; /* not traced */
+                continue;
+            }
         }
+        v3 o = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps)), d = v3_sub(target, o);
+        float dist = v3_length(d);
+        org[m] = o;
+        dir[m] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
+        tmin[m] = 0.0f;
+        tmax[m] = dist > j->eps ? dist - j->eps : 0.0f;
+        idx[m++] = (uint32_t)k;
     }
-    vsgl__scene_occluded_many(j->scene, (uint32_t)n, org, dir, tmin, tmax, 1, blocked);
-    for (size_t k = 0; k < n; ++k)
-        vis[k] = blocked[k] ? 0.0f : 1.0f;
+    if (m)
+        vsgl__scene_occluded_many(j->scene, m, org, dir, tmin, tmax, 1, blocked);
+    for (uint32_t i = 0; i < m; ++i)
+        visible |= (uint64_t)!blocked[i] << idx[i];
+    return visible;
+}
+
+/* The bits of lanes [0, n). */
+static uint64_t lanes_of(size_t n)
+{
+    return n < 64 ? ((uint64_t)1 << n) - 1 : ~(uint64_t)0;
 }
 
 /* GGX as two lobes, core and tail (kernel.h): ASG2 and the hybrid's VSGL term. */
@@ -424,9 +435,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 if (j->leak)
                     in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), VSGL__TINY));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
-                    float vis;
-                    visibility_rays(j, ray_target(v), NULL, &r, 1, NULL, &vis);
-                    if (vis == 0.0f)
+                    if (!visibility_rays(j, ray_target(v), NULL, &r, 1, 1))
                         continue;
                 }
                 if (has_diffuse) {
@@ -614,9 +623,8 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
         if (e == 0.0f)
             continue;
         if (j->s->visibility == VSGL_VISIBILITY_RAY) {
-            float vis;
-            visibility_rays(j, ray_target(v), NULL, r, 1, NULL, &vis);
-            e *= vis;
+            if (!visibility_rays(j, ray_target(v), NULL, r, 1, 1))
+                e = 0.0f;
         }
         for (int k = 0; k < 3; ++k)
             d[k] += v->power[k] * e;
@@ -634,7 +642,6 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
  * theirs, the weakest first; glossy_sphere_floor at 320 x 240: 26.4 M rays
  * -> 4.5 M at 0.02) are skipped and get share[k], the traced pairs' mean
  * visibility weighted by their light. w: count x VSGL__KERNEL_BLOCK floats. */
-_Static_assert(VSGL__KERNEL_BLOCK <= 64, "block_visibility keeps a block's lanes in 64-bit masks");
 static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, const receiver *rec, size_t n,
                              uint64_t *vis, uint64_t *skip, float *w, float *share)
 {
@@ -656,63 +663,64 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
                 if (sums[l * B + k] <= budget * total[k])
                     cut[k] = total[k] * (1.0f / (float)(1u << (VSGL__VIS_LEVEL0 + l)));
     }
-    /* per VSGL: the receivers it traces a ray from, compacted (as visibility_rays, without the skipped) */
-    v3 org[VSGL__KERNEL_BLOCK], dir[VSGL__KERNEL_BLOCK];
-    float tmin[VSGL__KERNEL_BLOCK], tmax[VSGL__KERNEL_BLOCK];
-    unsigned char blocked[VSGL__KERNEL_BLOCK];
-    uint32_t idx[VSGL__KERNEL_BLOCK];
-    for (size_t k = 0; k < n; ++k)
-        tmin[k] = 0.0f;
     for (size_t v = 0; v < count; ++v) {
-        const float *wv = w + v * B;
-        const vsgl_kernel_light *L = &j->klights[v];
-        const v3 target = ray_target(&j->set->items[j->korder[v]]);
-        const int may_skip = L->clip >= VSGL__VIS_SKIP_CLIP;
-        uint64_t sbits = 0, vbits = 0;
-        uint32_t m = 0;
-        for (size_t k = 0; k < n; ++k) {
-            if (cut[k] >= 0.0f && wv[k] <= cut[k]) {
-                sbits |= (uint64_t)1 << k;
-                continue;
-            }
-            if (may_skip) { /* the VSGL cannot light it: visible, no ray (visibility_rays) */
-                float h = -((L->mx - rec[k].x.x) * L->nx + (L->my - rec[k].x.y) * L->ny + (L->mz - rec[k].x.z) * L->nz);
-                if (h * L->ibehind < VSGL__VIS_SKIP_BEHIND) {
-                    vbits |= (uint64_t)1 << k;
-                    if (cut[k] >= 0.0f) { /* weights exist only under a budget */
-                        seen[k] += wv[k];
-                        lit[k] += wv[k];
-                    }
-                    continue;
-                }
-            }
-            v3 o = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps)), d = v3_sub(target, o);
-            float dist = v3_length(d);
-            org[m] = o;
-            dir[m] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
-            tmax[m] = dist > j->eps ? dist - j->eps : 0.0f;
-            idx[m++] = (uint32_t)k;
-        }
-        if (m)
-            vsgl__scene_occluded_many(j->scene, m, org, dir, tmin, tmax, 1, blocked);
-        for (uint32_t i = 0; i < m; ++i) {
-            size_t k = idx[i];
-            vbits |= (uint64_t)!blocked[i] << k;
-            if (cut[k] >= 0.0f) {
-                seen[k] += wv[k];
-                lit[k] += blocked[i] ? 0.0f : wv[k];
-            }
-        }
-        vis[v] = vbits;
+        const float *wv = budget > 0.0f ? w + v * B : NULL; /* weights exist only under a budget */
+        uint64_t sbits = 0;
+        for (size_t k = 0; wv && k < n; ++k)
+            sbits |= (uint64_t)(cut[k] >= 0.0f && wv[k] <= cut[k]) << k;
         skip[v] = sbits;
+        vis[v] = 0;
+        if (sbits == lanes_of(n))
+            continue; /* no ray for this VSGL at any receiver of the block */
+        uint64_t vbits = visibility_rays(j, ray_target(&j->set->items[j->korder[v]]), &j->klights[v], rec, n,
+                                         lanes_of(n) & ~sbits);
+        vis[v] = vbits;
+        for (size_t k = 0; wv && k < n; ++k)
+            if (!((sbits >> k) & 1u)) {
+                seen[k] += wv[k];
+                lit[k] += (vbits >> k) & 1u ? wv[k] : 0.0f;
+            }
     }
     for (size_t k = 0; k < n; ++k)
         share[k] = seen[k] > 0.0 ? (float)(lit[k] / seen[k]) : 1.0f;
 }
 
+/* The visibility budget's working memory, allocated once per list of
+ * receivers (not per block): per VSGL its visibility and skip bits and,
+ * under a budget, its light at each lane. bits NULL: no rays, or no memory
+ * (then every pair traces its ray, as without a budget). */
+typedef struct vis_scratch {
+    uint64_t *bits;  /* 2 x count: visible, skipped */
+    float *weights;  /* count x VSGL__KERNEL_BLOCK, or NULL without a budget */
+} vis_scratch;
+
+static void vis_scratch_init(const shade_job *j, vis_scratch *vs)
+{
+    const size_t count = j->set->count ? j->set->count : 1;
+    vs->bits = NULL;
+    vs->weights = NULL;
+    if (j->s->visibility != VSGL_VISIBILITY_RAY)
+        return;
+    vs->bits = malloc(2 * count * sizeof *vs->bits);
+    if (vs->bits && j->s->visibility_budget > 0.0f) {
+        vs->weights = malloc(count * VSGL__KERNEL_BLOCK * sizeof *vs->weights);
+        if (!vs->weights) {
+            free(vs->bits);
+            vs->bits = NULL;
+        }
+    }
+}
+
+static void vis_scratch_free(vis_scratch *vs)
+{
+    free(vs->bits);
+    free(vs->weights);
+}
+
 /* Shade a filled block of n receivers (lanes [0, n) of blk, rec[k].x and
  * .n for visibility rays) and write 6 floats per receiver to light. */
-static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const receiver *rec, size_t n, float *light)
+static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel_block *blk, const receiver *rec,
+                          size_t n, float *light)
 {
     float vis[2 * VSGL__KERNEL_BLOCK]; /* visibility of two VSGLs */
     uint64_t pairs = 0;
@@ -737,13 +745,10 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
         void (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t) =
             j->path == VSGL__SHADE_KERNEL_SCALAR ? vsgl__kernel_shade_scalar : vsgl__kernel_shade;
         const size_t count = j->set->count;
-        /* per VSGL: visibility and skip bits (2 x 64), its light at each lane (64 floats) */
-        const int rays = j->s->visibility == VSGL_VISIBILITY_RAY;
-        uint64_t *bits = rays ? malloc(2 * (count ? count : 1) * sizeof *bits) : NULL;
-        float *weights = rays ? malloc((count ? count : 1) * VSGL__KERNEL_BLOCK * sizeof *weights) : NULL;
-        if (bits && weights) {
+        if (vs->bits) {
+            uint64_t *bits = vs->bits;
             float share[VSGL__KERNEL_BLOCK];
-            block_visibility(j, blk, rec, n, bits, bits + count, weights, share);
+            block_visibility(j, blk, rec, n, bits, bits + count, vs->weights, share);
             /* two VSGLs per kernel call, the pairs it interleaves */
             for (size_t v = 0; v < count; v += 2) {
                 size_t m = count - v < 2 ? count - v : 2;
@@ -753,19 +758,20 @@ static uint64_t run_block(const shade_job *j, vsgl_kernel_block *blk, const rece
                                                           : (float)((bits[v + q] >> k) & 1u);
                 kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
             }
-        } else if (rays) { /* no memory for the budget: a ray for every pair, two VSGLs at a time */
+        } else if (j->s->visibility == VSGL_VISIBILITY_RAY) { /* no memory for it: a ray for every pair */
             for (size_t v = 0; v < count; v += 2) {
                 size_t m = count - v < 2 ? count - v : 2;
-                for (size_t q = 0; q < m; ++q)
-                    visibility_rays(j, ray_target(&j->set->items[j->korder[v + q]]), &j->klights[v + q], rec, n,
-                                    NULL, vis + q * VSGL__KERNEL_BLOCK);
+                for (size_t q = 0; q < m; ++q) {
+                    uint64_t bits = visibility_rays(j, ray_target(&j->set->items[j->korder[v + q]]),
+                                                    &j->klights[v + q], rec, n, lanes_of(n));
+                    for (size_t k = 0; k < n; ++k)
+                        vis[q * VSGL__KERNEL_BLOCK + k] = (float)((bits >> k) & 1u);
+                }
                 kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
             }
         } else {
             kernel(blk, j->klights, count, NULL, j->s->diffuse_mode, lobes);
         }
-        free(bits);
-        free(weights);
         pairs += (uint64_t)n * j->set->count;
         if ((lobes & VSGL__KERNEL_DIFFUSE) && j->near->start)
             for (size_t k = 0; k < n; ++k)
@@ -793,6 +799,8 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
     vsgl_kernel_block blk;
     receiver rec[VSGL__KERNEL_BLOCK];
     uint64_t pairs = 0;
+    vis_scratch vs;
+    vis_scratch_init(j, &vs);
     for (size_t s0 = 0; s0 < nshaded; s0 += VSGL__KERNEL_BLOCK) {
         size_t n = nshaded - s0 < VSGL__KERNEL_BLOCK ? nshaded - s0 : VSGL__KERNEL_BLOCK;
         for (size_t k = 0; k < n; ++k) {
@@ -808,8 +816,9 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
             if (lanes)
                 lane_get(&blk, k, &lanes[s0 + k]);
         }
-        pairs += run_block(j, &blk, rec, n, light + s0 * 6);
+        pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
     }
+    vis_scratch_free(&vs);
     return pairs;
 }
 
@@ -829,6 +838,8 @@ uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lan
     vsgl_kernel_block blk;
     receiver rec[VSGL__KERNEL_BLOCK];
     uint64_t pairs = 0;
+    vis_scratch vs;
+    vis_scratch_init(j, &vs);
     for (size_t s0 = 0; s0 < n_total; s0 += VSGL__KERNEL_BLOCK) {
         size_t n = n_total - s0 < VSGL__KERNEL_BLOCK ? n_total - s0 : VSGL__KERNEL_BLOCK;
         for (size_t k = 0; k < n; ++k) {
@@ -836,8 +847,9 @@ uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lan
             rec[k].x = v3_make(blk.x[k], blk.y[k], blk.z[k]);
             rec[k].n = v3_make(blk.nx[k], blk.ny[k], blk.nz[k]);
         }
-        pairs += run_block(j, &blk, rec, n, light + s0 * 6);
+        pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
     }
+    vis_scratch_free(&vs);
     return pairs;
 }
 
