@@ -259,13 +259,14 @@ VT_TEST(rsm_build_inward_zooms_a_sun_onto_an_opening)
         n_win += win.material[i] != VSGL__RSM_EMPTY;
     for (size_t i = 0; i < fine.count; ++i)
         n_fine += fine.material[i] != VSGL__RSM_EMPTY;
-    /* the same grid: the same texels (ray origins are rounded apart in the last bits) */
-    VT_CHECK(n_win + 2 >= n_fine && n_fine + 2 >= n_win, "%zu texels in the window, %zu in the finer whole map",
+    /* the same grid: the same texels, but for the edges the window traces
+     * again (rsm_edges.c: the outer ring of partly lit texels) */
+    VT_CHECK(n_win >= n_fine && n_win <= n_fine + n_fine / 10, "%zu texels in the window, %zu in the finer whole map",
              n_win, n_fine);
-    VT_CHECK_REL(win.total_flux[0], fine.total_flux[0], 1e-3, "the window's power against the finer whole map's");
     double e_whole = fabs(whole.total_flux[0] / exact - 1), e_win = fabs(win.total_flux[0] / exact - 1);
-    /* a texel of the finer grid is ~1.1 cm across the beam: the opening's 1.55 m edge x 0.5 texel / 0.155 m^2 */
-    VT_CHECK(e_win < 0.03, "window power %.5f W against %.5f W through the opening (%.2f %%)", win.total_flux[0],
+    /* a texel of the finer grid is ~1.1 cm across the beam; the edge texels
+     * carry the fraction of their 16 rays that land inside */
+    VT_CHECK(e_win < 0.005, "window power %.5f W against %.5f W through the opening (%.2f %%)", win.total_flux[0],
              exact, 100 * e_win);
     printf("    power through the opening %.5f W: whole map at %u %.5f (%.2f %%), window %.5f (%.2f %%); %zu texels in "
            "the room, %zu with the whole map\n", exact, res, whole.total_flux[0], 100 * e_whole, win.total_flux[0],
@@ -274,5 +275,57 @@ VT_TEST(rsm_build_inward_zooms_a_sun_onto_an_opening)
     vsgl__rsm_free(&win);
     vsgl__rsm_free(&fine);
     vsgl_scene_destroy(sc);
+    vsgl_context_destroy(ctx);
+}
+
+/* The same room, the sun turned in 24 small steps (its patch slides by
+ * ~1/5 of a texel of the whole 64^2 map per step): the power through the
+ * opening is E A cos at every step. Texels lit whole or not at all by one
+ * ray put it off by up to half the edge texels (1.7 % for the finer whole
+ * map at x = 1) and move it in steps as the edge crosses texel centres;
+ * the edge texels traced with 16 rays each keep it within 0.3 % throughout
+ * (0.17 % measured). */
+VT_TEST(rsm_edges_keep_a_sliding_opening_power_steady)
+{
+    vsgl_context *ctx = fx_context(2);
+    VT_REQUIRE(ctx, "context");
+    fx_scene fx;
+    fx_room(&fx, 8, 6, 0.5f, 100.0f);
+    fx.triangle_count -= 2;
+    fx.vertex_count -= 4;
+    const float o = 0.2f, front[4][3] = {{-1, -1, 0}, {-1, -1, 2}, {1, -1, 2}, {1, -1, 0}};
+    const float strips[4][4] = {{-1, -o, -1, 1}, {o, 1, -1, 1}, {-o, o, -1, -o}, {-o, o, o, 1}};
+    for (int k = 0; k < 4; ++k) {
+        const float *s = strips[k];
+        const float q[4][3] = {{s[0], s[2], 2}, {s[0], s[3], 2}, {s[1], s[3], 2}, {s[1], s[2], 2}};
+        fx_quad(&fx, q, 3);
+    }
+    fx_quad(&fx, front, 3);
+    double worst = 0.0, worst_plain = 0.0, lo = INFINITY, hi = -INFINITY;
+    for (int step = 0; step < 24; ++step) {
+        float x = 1.0f + 0.004f * (float)step;
+        sun_only(&fx, x);
+        vsgl_scene *sc = NULL;
+        VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &sc) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        const double exact = 3.0 * (2 * o) * (2 * o) * 4.0 / sqrt((double)x * x + 16.0);
+        vsgl_rsm win, plain;
+        double dropped[3];
+        VT_REQUIRE(vsgl__rsm_build_inward(ctx, sc, 0, 64, &win, dropped) == VSGL_OK, "%s",
+                   vsgl_context_last_error(ctx));
+        VT_REQUIRE(vsgl__rsm_build(ctx, sc, 0, 64 * win.zoom, &plain) == VSGL_OK, "%s",
+                   vsgl_context_last_error(ctx));
+        vsgl__rsm_drop_outward(sc, &plain, dropped);
+        double e = win.total_flux[0] / exact - 1.0, ep = plain.total_flux[0] / exact - 1.0;
+        worst = fmax(worst, fabs(e));
+        worst_plain = fmax(worst_plain, fabs(ep));
+        lo = fmin(lo, e);
+        hi = fmax(hi, e);
+        vsgl__rsm_free(&win);
+        vsgl__rsm_free(&plain);
+        vsgl_scene_destroy(sc);
+    }
+    VT_CHECK(worst < 0.003, "the power through the opening off by up to %.3f %% as the sun turns", 100 * worst);
+    printf("    power through the opening over 24 steps: within %.3f %% (range %.3f %%); one ray per texel "
+           "at the same grid: within %.3f %%\n", 100 * worst, 100 * (hi - lo), 100 * worst_plain);
     vsgl_context_destroy(ctx);
 }

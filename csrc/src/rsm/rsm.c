@@ -56,7 +56,7 @@ typedef struct rsm_job {
  * scene's box lies behind its tangent plane (normal n, within tol), so
  * nothing is in front of it to light (the outside of a room's walls and
  * roof under a sun). */
-static int faces_out(v3 p, v3 n, v3 lo, v3 hi, float tol)
+int vsgl__rsm_faces_out(v3 p, v3 n, v3 lo, v3 hi, float tol)
 {
     for (int c = 0; c < 8; ++c) {
         v3 q = v3_make(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
@@ -66,7 +66,7 @@ static int faces_out(v3 p, v3 n, v3 lo, v3 hi, float tol)
     return 1;
 }
 
-static void clear_texel(vsgl_rsm *o, size_t i)
+void vsgl__rsm_clear_texel(vsgl_rsm *o, size_t i)
 {
     for (int k = 0; k < 3; ++k)
         o->pos[k][i] = o->nrm[k][i] = o->tan[k][i] = o->wi[k][i] = o->flux[k][i] = 0.0f;
@@ -75,6 +75,30 @@ static void clear_texel(vsgl_rsm *o, size_t i)
     if (o->surf[0])
         for (int q = 0; q < VSGL__SURF_N; ++q)
             o->surf[q][i] = 0.0f;
+}
+
+void vsgl__rsm_fill_texel(const vsgl_scene *scene, vsgl_rsm *o, size_t i, const vsgl_hit *hit, v3 dir,
+                          const v3 *position, const double flux[3], double beam)
+{
+    vsgl_surface sf;
+    vsgl__scene_surface(scene, hit, dir, &sf);
+    v3 wi = v3_neg(dir), p = position ? *position : sf.position;
+    o->pos[0][i] = p.x; o->pos[1][i] = p.y; o->pos[2][i] = p.z;
+    o->nrm[0][i] = sf.normal.x; o->nrm[1][i] = sf.normal.y; o->nrm[2][i] = sf.normal.z;
+    o->tan[0][i] = sf.tangent.x; o->tan[1][i] = sf.tangent.y; o->tan[2][i] = sf.tangent.z;
+    o->wi[0][i] = wi.x; o->wi[1][i] = wi.y; o->wi[2][i] = wi.z;
+    /* footprint: beam / cos at the surface */
+    double cs = fabs((double)v3_dot(sf.geometric_normal, wi));
+    o->area[i] = (float)(beam / fmax(cs, 1e-3));
+    for (int k = 0; k < 3; ++k)
+        o->flux[k][i] = (float)flux[k];
+    o->material[i] = sf.material;
+    if (o->surf[0]) {
+        float in[VSGL__SURF_N];
+        vsgl__scene_inputs(scene, hit, o->area[i], in);
+        for (int q = 0; q < VSGL__SURF_N; ++q)
+            o->surf[q][i] = in[q];
+    }
 }
 
 static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
@@ -109,31 +133,13 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
         for (uint32_t c = 0; c < res; ++c) {
             size_t i = grow * res + c;
             if (hits[c].triangle == VSGL__HIT_NONE || !(tmax[c] >= 0.0f)) {
-                clear_texel(o, i);
+                vsgl__rsm_clear_texel(o, i);
                 continue;
             }
-            vsgl_surface sf;
-            vsgl__scene_surface(j->scene, &hits[c], dir[c], &sf);
-            v3 wi = v3_neg(dir[c]);
-            o->pos[0][i] = sf.position.x; o->pos[1][i] = sf.position.y; o->pos[2][i] = sf.position.z;
-            o->nrm[0][i] = sf.normal.x; o->nrm[1][i] = sf.normal.y; o->nrm[2][i] = sf.normal.z;
-            o->tan[0][i] = sf.tangent.x; o->tan[1][i] = sf.tangent.y; o->tan[2][i] = sf.tangent.z;
-            o->wi[0][i] = wi.x; o->wi[1][i] = wi.y; o->wi[2][i] = wi.z;
-            /* footprint: beam / cos at the surface (times d^2 for a cone) */
-            double cs = fabs((double)v3_dot(sf.geometric_normal, wi));
             double t2 = l->type == VSGL_LIGHT_SUN ? 1.0 : (double)hits[c].t * hits[c].t;
-            o->area[i] = (float)(fl[4 * c + 3] * t2 / fmax(cs, 1e-3));
-            for (int k = 0; k < 3; ++k) {
-                o->flux[k][i] = (float)fl[4 * c + k];
+            vsgl__rsm_fill_texel(j->scene, o, i, &hits[c], dir[c], NULL, &fl[4 * c], fl[4 * c + 3] * t2);
+            for (int k = 0; k < 3; ++k)
                 s[k] += (double)o->flux[k][i];
-            }
-            o->material[i] = sf.material;
-            if (o->surf[0]) {
-                float in[VSGL__SURF_N];
-                vsgl__scene_inputs(j->scene, &hits[c], o->area[i], in);
-                for (int q = 0; q < VSGL__SURF_N; ++q)
-                    o->surf[q][i] = in[q];
-            }
         }
         for (int k = 0; k < 3; ++k)
             j->partial[3 * (grow - j->first_row) + k] = s[k];
@@ -216,6 +222,23 @@ vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t
     return build(ctx, scene, light, res, 1, 0, 0, out);
 }
 
+/* The map of a sun built with (zoom, col0, row0): its edges smoothed. */
+static vsgl_result smooth(vsgl_context *ctx, const vsgl_scene *scene, vsgl_rsm *out, uint32_t zoom, int64_t col0,
+                          int64_t row0)
+{
+    vsgl_rsm_light l;
+    vsgl__rsm_light_setup(scene, out->light, out->res, &l);
+    vsgl__rsm_light_window(&l, zoom, col0, row0);
+    size_t traced;
+    vsgl_result r = vsgl__rsm_smooth_edges(ctx, scene, &l, out, &traced);
+    if (r != VSGL_OK)
+        vsgl__rsm_free(out);
+    else
+        vsgl__log(ctx, VSGL_LOG_DEBUG, "rsm: light %u: %zu texels at the edge of its light traced again with %d rays "
+                  "each", out->light, traced, VSGL__RSM_EDGE_RAYS);
+    return r;
+}
+
 vsgl_result vsgl__rsm_build_inward(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res,
                                    vsgl_rsm *out, double dropped[3])
 {
@@ -242,12 +265,13 @@ vsgl_result vsgl__rsm_build_inward(vsgl_context *ctx, const vsgl_scene *scene, u
     while (zoom < VSGL__RSM_MAX_ZOOM && side * (int64_t)zoom * 2 <= (int64_t)res)
         zoom *= 2;
     if (zoom == 1)
-        return VSGL_OK;
+        return smooth(ctx, scene, out, 1, 0, 0);
     /* the square centred on them, on the grid refined zoom times */
     int64_t pad_c = ((int64_t)res - (c1 - c0 + 3) * (int64_t)zoom) / 2,
             pad_r = ((int64_t)res - (r1 - r0 + 3) * (int64_t)zoom) / 2;
+    int64_t col0 = (c0 - 1) * zoom - pad_c, row0 = (r0 - 1) * zoom - pad_r;
     vsgl_rsm fine_map;
-    r = build(ctx, scene, light, res, zoom, (c0 - 1) * zoom - pad_c, (r0 - 1) * zoom - pad_r, &fine_map);
+    r = build(ctx, scene, light, res, zoom, col0, row0, &fine_map);
     if (r != VSGL_OK) {
         vsgl__rsm_free(out);
         return r;
@@ -256,7 +280,7 @@ vsgl_result vsgl__rsm_build_inward(vsgl_context *ctx, const vsgl_scene *scene, u
     *out = fine_map;
     double again[3]; /* the power dropped is the first map's: the same light on the same faces */
     vsgl__rsm_drop_outward(scene, out, again);
-    return VSGL_OK;
+    return smooth(ctx, scene, out, zoom, col0, row0);
 }
 
 void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped[3])
@@ -270,11 +294,11 @@ void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped
         if (r->material[i] == VSGL__RSM_EMPTY)
             continue;
         v3 p = v3_make(r->pos[0][i], r->pos[1][i], r->pos[2][i]), n = v3_make(r->nrm[0][i], r->nrm[1][i], r->nrm[2][i]);
-        if (!faces_out(p, n, lo, hi, tol))
+        if (!vsgl__rsm_faces_out(p, n, lo, hi, tol))
             continue;
         for (int k = 0; k < 3; ++k)
             dropped[k] += (double)r->flux[k][i];
-        clear_texel(r, i);
+        vsgl__rsm_clear_texel(r, i);
     }
     if (!(dropped[0] + dropped[1] + dropped[2] > 0.0))
         return; /* nothing dropped: the total as built */

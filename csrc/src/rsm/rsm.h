@@ -48,6 +48,17 @@ void vsgl__rsm_free(vsgl_rsm *r);
  * receiver). Sets dropped to their power and total_flux to what is left. */
 void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped[3]);
 
+/* Texel helpers shared by the map's builders (rsm.c, rsm_edges.c).
+ * faces_out: a surface at p with normal n has every corner of the box
+ * [lo, hi] behind its tangent plane (within tol). fill_texel: texel i sees
+ * `hit` along unit `dir` (position overrides the hit's point when not
+ * NULL), carries `flux` (W, RGB), its footprint = beam (m^2 across the
+ * beam, times d^2 for a cone) over the cosine at the surface. */
+int vsgl__rsm_faces_out(v3 p, v3 n, v3 lo, v3 hi, float tol);
+void vsgl__rsm_clear_texel(vsgl_rsm *o, size_t i);
+void vsgl__rsm_fill_texel(const vsgl_scene *scene, vsgl_rsm *o, size_t i, const vsgl_hit *hit, v3 dir,
+                          const v3 *position, const double flux[3], double beam);
+
 /* Refinement cap of vsgl__rsm_build_inward: a sun's window is at least
  * 1/VSGL__RSM_MAX_ZOOM of the scene's extent. */
 #define VSGL__RSM_MAX_ZOOM 16u
@@ -58,4 +69,15 @@ void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped
  * two; 1 when the texels left span more than half the map). */
 vsgl_result vsgl__rsm_build_inward(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res,
                                    vsgl_rsm *out, double dropped[3]);
+
+/* A sun's map (else nothing): every texel that carries power next to one
+ * that carries none, or the other way round, traced again with
+ * VSGL__RSM_EDGE_RAYS rays across it; it keeps the fraction of its power
+ * that lands on surfaces facing into the scene, at their mean position on
+ * the surface nearest its centre (rsm_edges.c). vsgl__rsm_build_inward
+ * does this to its result. traced: how many texels. */
+#define VSGL__RSM_EDGE_RAYS 16
+struct vsgl_rsm_light;
+vsgl_result vsgl__rsm_smooth_edges(vsgl_context *ctx, const vsgl_scene *scene, const struct vsgl_rsm_light *l,
+                                   vsgl_rsm *r, size_t *traced);
 #endif
