@@ -275,6 +275,20 @@ static v3 ray_target(const vsgl_vsgl *v)
     return v3_add(v->mean, v3_scale(v->normal, v->coherence * sqrtf(v->variance)));
 }
 
+/* 1 if VSGLs a and b (kernel lights ka, kb) get the same visibility rays at
+ * every receiver: the same ray target and the same skip test
+ * (visibility_rays). The lattice's glossy clusters split into a core and a
+ * tail (fit/lattice.c) are such pairs: a quarter of the sun rooms' VSGLs. */
+static int same_rays(const vsgl_vsgl *a, const vsgl_kernel_light *ka, const vsgl_vsgl *b,
+                     const vsgl_kernel_light *kb)
+{
+    return a->mean.x == b->mean.x && a->mean.y == b->mean.y && a->mean.z == b->mean.z &&
+           a->normal.x == b->normal.x && a->normal.y == b->normal.y && a->normal.z == b->normal.z &&
+           a->coherence == b->coherence && a->variance == b->variance && ka->clip == kb->clip &&
+           ka->ibehind == kb->ibehind && ka->mx == kb->mx && ka->my == kb->my && ka->mz == kb->mz &&
+           ka->nx == kb->nx && ka->ny == kb->ny && ka->nz == kb->nz;
+}
+
 /* Visibility of `target` (a VSGL's ray target) from the receivers k <
  * n <= VSGL__KERNEL_BLOCK whose bit is set in `lanes`: one batched
  * occlusion query (an Embree ray stream) of just those, each from the
@@ -672,8 +686,14 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
         vis[v] = 0;
         if (sbits == lanes_of(n))
             continue; /* no ray for this VSGL at any receiver of the block */
-        uint64_t vbits = visibility_rays(j, ray_target(&j->set->items[j->korder[v]]), &j->klights[v], rec, n,
-                                         lanes_of(n) & ~sbits);
+        uint64_t want = lanes_of(n) & ~sbits, vbits = 0;
+        if (v > 0 && j->ray_twin && j->ray_twin[v]) { /* the light before's rays, where it traced them */
+            uint64_t have = want & lanes_of(n) & ~skip[v - 1];
+            vbits = vis[v - 1] & have;
+            want &= ~have;
+        }
+        if (want)
+            vbits |= visibility_rays(j, ray_target(&j->set->items[j->korder[v]]), &j->klights[v], rec, n, want);
         vis[v] = vbits;
         for (size_t k = 0; wv && k < n; ++k)
             if (!((sbits >> k) & 1u)) {
@@ -1089,10 +1109,14 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
         free(kl);
         kl = sorted;
     }
+    unsigned char *twin = path != VSGL__SHADE_REFERENCE && s->visibility == VSGL_VISIBILITY_RAY
+                              ? calloc(set->count + 1, 1) : NULL; /* no memory: every light traces its own */
+    for (size_t k = 1; twin && k < set->count; ++k)
+        twin[k] = same_rays(&set->items[korder[k]], &kl[k], &set->items[korder[k - 1]], &kl[k - 1]);
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
                    eps, 0, per_chunk, kl, korder, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
-                   0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL};
+                   0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL, twin};
     /* untextured: each material's BRDF parameters once, not once per sample */
     vsgl_brdf_params *params = g->surf[0] ? NULL : malloc(((size_t)material_count + 1) * sizeof *params);
     if (params)
@@ -1162,6 +1186,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     free(per_chunk);
     free(kl);
     free(korder);
+    free(twin);
     free(j.anchor_sample);
     free(j.anchor_light);
     free(j.anchor_d2);

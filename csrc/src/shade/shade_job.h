@@ -86,6 +86,9 @@ typedef struct shade_job {
     int replay;
     const vsgl_brdf_params *params; /* NULL, or per material (no sample has inputs of its own) */
     const vsgl_near_index *near;    /* the lattice clusters' near fields (near_field.h) */
+    const unsigned char *ray_twin;  /* NULL, or per kernel light: 1 if its visibility rays are those of the
+                                       light before it (a glossy cluster's core and tail: the same target
+                                       and skip test), which block_visibility then does not trace again */
 } shade_job;
 
 /* Receiver lobe of one sample, set up once and used for every VSGL. */
