@@ -135,6 +135,35 @@ void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *or
     }
 }
 
+void vsgl__scene_occluded_towards(const vsgl_scene *scene, uint32_t n, const v3 *org, v3 target, float eps,
+                                  unsigned char *blocked)
+{
+    enum { BATCH = 64 };
+    struct RTCRay r[BATCH];
+    struct RTCIntersectContext ic;
+    rtcInitIntersectContext(&ic);
+    ic.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    uint32_t idx[BATCH];
+    uint32_t b = 0;
+    while (b < n) {
+        uint32_t m = 0;
+        for (; b < n && m < BATCH; ++b) {
+            v3 d = v3_sub(target, org[b]);
+            float dist = v3_length(d);
+            blocked[b] = 0;
+            if (scene->triangle_count == 0 || !(dist > eps)) /* at the target, or no scene: visible */
+                continue;
+            fill_ray(&r[m], org[b], v3_scale(d, 1.0f / dist), 0.0f, dist - eps);
+            idx[m++] = b;
+        }
+        if (m == 0)
+            continue;
+        rtcOccluded1M(scene->rtc, &ic, r, m, sizeof(struct RTCRay));
+        for (uint32_t i = 0; i < m; ++i)
+            blocked[idx[i]] = (unsigned char)(r[i].tfar == -INFINITY);
+    }
+}
+
 static v3 load3(const float *p) { return v3_make(p[0], p[1], p[2]); }
 
 static v3 interp(v3 a, v3 b, v3 c, float w, float u, float v)

@@ -7,6 +7,8 @@
 #else
 #  define KERNEL_ATTR
 #endif
+#include <string.h>
+
 #define KERNEL_NAME vsgl__kernel_shade
 #include "shade/kernel_impl.h"
 
@@ -64,4 +66,62 @@ KERNEL_ATTR void vsgl__kernel_weight_levels(const float *w, size_t count, const 
             for (size_t k = 0; k < B; ++k)
                 sums[l * B + k] += wv[k] <= thr[l][k] ? wv[k] : 0.0f;
     }
+}
+
+/* Lane masks and bytes: bit k of a mask is byte k (0 or 1) of 64 bytes.
+ * Eight at a time: a multiply packs eight 0/1 bytes into their bits, and
+ * one spreads eight bits into bytes (each bit lands in its byte, and
+ * adding 0x7f carries it into the byte's top bit). */
+_Static_assert(VSGL__KERNEL_BLOCK == 64, "lane masks are 64 bits");
+static inline uint64_t pack_bytes(const unsigned char *m)
+{
+    uint64_t out = 0;
+    for (int i = 0; i < 8; ++i) {
+        uint64_t x;
+        memcpy(&x, m + 8 * i, 8);
+        out |= ((x * 0x0102040810204080ull) >> 56) << (8 * i);
+    }
+    return out;
+}
+
+static inline void spread_bits(uint64_t bits, unsigned char *m)
+{
+    for (int i = 0; i < 8; ++i) {
+        uint64_t x = (((bits >> (8 * i)) & 0xffu) * 0x0101010101010101ull) & 0x8040201008040201ull;
+        x = ((x + 0x7f7f7f7f7f7f7f7full) >> 7) & 0x0101010101010101ull;
+        memcpy(m + 8 * i, &x, 8);
+    }
+}
+
+KERNEL_ATTR uint64_t vsgl__kernel_lanes_within(const float *w, const float *cut)
+{
+    enum { B = VSGL__KERNEL_BLOCK };
+    unsigned char m[B];
+    for (size_t k = 0; k < B; ++k)
+        m[k] = (unsigned char)((cut[k] >= 0.0f) & (w[k] <= cut[k]));
+    return pack_bytes(m);
+}
+
+KERNEL_ATTR void vsgl__kernel_vis_accumulate(const float *w, uint64_t traced, uint64_t visible, double *seen,
+                                             double *lit)
+{
+    enum { B = VSGL__KERNEL_BLOCK };
+    unsigned char t[B], v[B];
+    spread_bits(traced, t);
+    spread_bits(traced & visible, v);
+    for (size_t k = 0; k < B; ++k) {
+        double x = (double)w[k];
+        seen[k] += t[k] ? x : 0.0;
+        lit[k] += v[k] ? x : 0.0;
+    }
+}
+
+KERNEL_ATTR void vsgl__kernel_vis_fill(uint64_t skipped, uint64_t visible, const float *share, float *out)
+{
+    enum { B = VSGL__KERNEL_BLOCK };
+    unsigned char s[B], v[B];
+    spread_bits(skipped, s);
+    spread_bits(visible, v);
+    for (size_t k = 0; k < B; ++k)
+        out[k] = s[k] ? share[k] : (float)v[k];
 }

@@ -178,4 +178,15 @@ void vsgl__kernel_pair_weights(const vsgl_kernel_block *b, const vsgl_kernel_lig
 #define VSGL__VIS_LEVEL0 4
 void vsgl__kernel_weight_levels(const float *w, size_t count, const float *total, float *sums);
 
+/* The budget's per-VSGL bookkeeping over a block's VSGL__KERNEL_BLOCK lanes
+ * (shade.c), as lane masks (bit k: lane k), vectorised:
+ *  - lanes_within: the lanes whose cut[k] >= 0 and w[k] <= cut[k];
+ *  - vis_accumulate: seen[k] += w[k] on the traced lanes, lit[k] += w[k]
+ *    on those that are visible (the same sums as lane by lane);
+ *  - vis_fill: out[k] = share[k] on the skipped lanes, else 1 or 0 as the
+ *    lane is visible. */
+uint64_t vsgl__kernel_lanes_within(const float *w, const float *cut);
+void vsgl__kernel_vis_accumulate(const float *w, uint64_t traced, uint64_t visible, double *seen, double *lit);
+void vsgl__kernel_vis_fill(uint64_t skipped, uint64_t visible, const float *share, float *out);
+
 #endif

@@ -289,12 +289,18 @@ static int same_rays(const vsgl_vsgl *a, const vsgl_kernel_light *ka, const vsgl
            ka->nx == kb->nx && ka->ny == kb->ny && ka->nz == kb->nz;
 }
 
+/* The bits of lanes [0, n). */
+static uint64_t lanes_of(size_t n)
+{
+    return n < 64 ? ((uint64_t)1 << n) - 1 : ~(uint64_t)0;
+}
+
 /* Visibility of `target` (a VSGL's ray target) from the receivers k <
  * n <= VSGL__KERNEL_BLOCK whose bit is set in `lanes`: one batched
  * occlusion query (an Embree ray stream) of just those, each from the
  * receiver offset along its normal. Returns their visible bits (a blocked
- * ray's bit and every lane outside `lanes` are 0). A receiver at the target
- * traces an empty segment (visible). With L (the VSGL's kernel light;
+ * ray's bit and every lane outside `lanes` are 0). A receiver within eps
+ * of the target traces no ray (visible). With L (the VSGL's kernel light;
  * NULL: every lane traced), no ray for a receiver the VSGL cannot light:
  * behind or within 1e-3 of the behind fade of its plane (VSGL__CLIP_BEHIND
  * sigma) with its emitter clip at >= 0.999 (its light there is at most
@@ -304,15 +310,13 @@ _Static_assert(VSGL__KERNEL_BLOCK <= 64, "a block's lanes are kept in 64-bit mas
 static uint64_t visibility_rays(const shade_job *j, v3 target, const vsgl_kernel_light *L, const receiver *rec,
                                 size_t n, uint64_t lanes)
 {
-    v3 org[VSGL__KERNEL_BLOCK], dir[VSGL__KERNEL_BLOCK];
-    float tmin[VSGL__KERNEL_BLOCK], tmax[VSGL__KERNEL_BLOCK];
+    v3 org[VSGL__KERNEL_BLOCK];
     unsigned char blocked[VSGL__KERNEL_BLOCK];
     uint32_t idx[VSGL__KERNEL_BLOCK], m = 0;
     uint64_t visible = 0;
     const int may_skip = L && L->clip >= VSGL__VIS_SKIP_CLIP;
-    for (size_t k = 0; k < n; ++k) {
-        if (!((lanes >> k) & 1u))
-            continue;
+    for (uint64_t rest = lanes & lanes_of(n); rest; rest &= rest - 1) {
+        uint32_t k = (uint32_t)__builtin_ctzll(rest);
         if (may_skip) { /* the kernel's h (kernel_impl.h, k_geometry) */
             float h = -((L->mx - rec[k].x.x) * L->nx + (L->my - rec[k].x.y) * L->ny + (L->mz - rec[k].x.z) * L->nz);
             if (h * L->ibehind < VSGL__VIS_SKIP_BEHIND) {
@@ -320,25 +324,14 @@ static uint64_t visibility_rays(const shade_job *j, v3 target, const vsgl_kernel
                 continue;
             }
         }
-        v3 o = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps)), d = v3_sub(target, o);
-        float dist = v3_length(d);
-        org[m] = o;
-        dir[m] = dist > 0.0f ? v3_scale(d, 1.0f / dist) : rec[k].n;
-        tmin[m] = 0.0f;
-        tmax[m] = dist > j->eps ? dist - j->eps : 0.0f;
-        idx[m++] = (uint32_t)k;
+        org[m] = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
+        idx[m++] = k;
     }
     if (m)
-        vsgl__scene_occluded_many(j->scene, m, org, dir, tmin, tmax, 1, blocked);
+        vsgl__scene_occluded_towards(j->scene, m, org, target, j->eps, blocked);
     for (uint32_t i = 0; i < m; ++i)
         visible |= (uint64_t)!blocked[i] << idx[i];
     return visible;
-}
-
-/* The bits of lanes [0, n). */
-static uint64_t lanes_of(size_t n)
-{
-    return n < 64 ? ((uint64_t)1 << n) - 1 : ~(uint64_t)0;
 }
 
 /* GGX as two lobes, core and tail (kernel.h): ASG2 and the hybrid's VSGL term. */
@@ -663,7 +656,7 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
     float total[VSGL__KERNEL_BLOCK], cut[VSGL__KERNEL_BLOCK];
     double seen[VSGL__KERNEL_BLOCK], lit[VSGL__KERNEL_BLOCK];
     memset(total, 0, sizeof total);
-    for (size_t k = 0; k < n; ++k) {
+    for (size_t k = 0; k < B; ++k) {
         cut[k] = -1.0f; /* nothing skipped */
         seen[k] = lit[k] = 0.0;
     }
@@ -679,9 +672,7 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
     }
     for (size_t v = 0; v < count; ++v) {
         const float *wv = budget > 0.0f ? w + v * B : NULL; /* weights exist only under a budget */
-        uint64_t sbits = 0;
-        for (size_t k = 0; wv && k < n; ++k)
-            sbits |= (uint64_t)(cut[k] >= 0.0f && wv[k] <= cut[k]) << k;
+        uint64_t sbits = wv ? vsgl__kernel_lanes_within(wv, cut) & lanes_of(n) : 0;
         skip[v] = sbits;
         vis[v] = 0;
         if (sbits == lanes_of(n))
@@ -695,13 +686,10 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
         if (want)
             vbits |= visibility_rays(j, ray_target(&j->set->items[j->korder[v]]), &j->klights[v], rec, n, want);
         vis[v] = vbits;
-        for (size_t k = 0; wv && k < n; ++k)
-            if (!((sbits >> k) & 1u)) {
-                seen[k] += wv[k];
-                lit[k] += (vbits >> k) & 1u ? wv[k] : 0.0f;
-            }
+        if (wv)
+            vsgl__kernel_vis_accumulate(wv, lanes_of(n) & ~sbits, vbits, seen, lit);
     }
-    for (size_t k = 0; k < n; ++k)
+    for (size_t k = 0; k < B; ++k)
         share[k] = seen[k] > 0.0 ? (float)(lit[k] / seen[k]) : 1.0f;
 }
 
@@ -773,9 +761,7 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
             for (size_t v = 0; v < count; v += 2) {
                 size_t m = count - v < 2 ? count - v : 2;
                 for (size_t q = 0; q < m; ++q)
-                    for (size_t k = 0; k < n; ++k)
-                        vis[q * VSGL__KERNEL_BLOCK + k] = (bits[count + v + q] >> k) & 1u ? share[k]
-                                                          : (float)((bits[v + q] >> k) & 1u);
+                    vsgl__kernel_vis_fill(bits[count + v + q], bits[v + q], share, vis + q * VSGL__KERNEL_BLOCK);
                 kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
             }
         } else if (j->s->visibility == VSGL_VISIBILITY_RAY) { /* no memory for it: a ray for every pair */
