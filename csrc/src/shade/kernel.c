@@ -51,20 +51,61 @@ KERNEL_ATTR void vsgl__kernel_pair_weights(const vsgl_kernel_block *b, const vsg
     }
 }
 
-KERNEL_ATTR void vsgl__kernel_weight_levels(const float *w, size_t count, const float *total, float *sums)
+/* Level l's threshold at receiver k: total[k] x 2^-(VSGL__VIS_LEVEL0 + l). */
+static inline float level_threshold(float total, int l)
 {
-    enum { B = VSGL__KERNEL_BLOCK, NL = VSGL__VIS_LEVELS };
-    float thr[NL][B];
-    for (int l = 0; l < NL; ++l)
-        for (size_t k = 0; k < B; ++k) {
-            thr[l][k] = total[k] * (1.0f / (float)(1u << (VSGL__VIS_LEVEL0 + l)));
-            sums[l * B + k] = 0.0f;
-        }
+    return total * (1.0f / (float)(1u << (VSGL__VIS_LEVEL0 + l)));
+}
+
+/* The sums of the weights at most each receiver's threshold thr[q * B + k]
+ * (-1: none), q < nq, over the VSGLs in order. */
+static inline void threshold_sums(const float *w, size_t count, const float *thr, int nq, float *sums)
+{
+    enum { B = VSGL__KERNEL_BLOCK };
+    for (int q = 0; q < nq; ++q)
+        for (size_t k = 0; k < B; ++k)
+            sums[q * B + k] = 0.0f;
     for (size_t v = 0; v < count; ++v) {
         const float *wv = w + v * B;
-        for (int l = 0; l < NL; ++l)
+        for (int q = 0; q < nq; ++q)
             for (size_t k = 0; k < B; ++k)
-                sums[l * B + k] += wv[k] <= thr[l][k] ? wv[k] : 0.0f;
+                sums[q * B + k] += wv[k] <= thr[q * B + k] ? wv[k] : 0.0f;
+    }
+}
+
+/* The first level whose sum fits the budget, searched in two passes: the
+ * last level of each group of G first, then the levels before it in the
+ * first group whose last fits. The sums only fall from level to level (each
+ * holds the next one's weights and more, added in the same order), so this
+ * is the level a pass over every level finds, from 6 sums per VSGL instead
+ * of 12. */
+KERNEL_ATTR void vsgl__kernel_weight_level(const float *w, size_t count, const float *total, float budget,
+                                           int *level)
+{
+    enum { B = VSGL__KERNEL_BLOCK, NL = VSGL__VIS_LEVELS, G = 3, NG = NL / G };
+    _Static_assert(NL % G == 0, "the levels split into groups of G");
+    float thr[NG * B], sums[NG * B];
+    int group[B];
+    for (int g = 0; g < NG; ++g)
+        for (size_t k = 0; k < B; ++k)
+            thr[g * B + k] = level_threshold(total[k], G * g + G - 1);
+    threshold_sums(w, count, thr, NG, sums);
+    for (size_t k = 0; k < B; ++k) {
+        group[k] = -1;
+        for (int g = NG - 1; g >= 0; --g)
+            if (sums[g * B + k] <= budget * total[k])
+                group[k] = g;
+    }
+    for (int q = 0; q < G - 1; ++q)
+        for (size_t k = 0; k < B; ++k)
+            thr[q * B + k] = group[k] >= 0 ? level_threshold(total[k], G * group[k] + q) : -1.0f;
+    threshold_sums(w, count, thr, G - 1, sums);
+    for (size_t k = 0; k < B; ++k) {
+        int l = group[k] >= 0 ? G * group[k] + G - 1 : -1;
+        for (int q = G - 2; q >= 0 && l >= 0; --q)
+            if (sums[q * B + k] <= budget * total[k])
+                l = G * group[k] + q;
+        level[k] = l;
     }
 }
 

@@ -663,12 +663,11 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
     const float budget = j->s->visibility_budget;
     if (budget > 0.0f) {
         vsgl__kernel_pair_weights(blk, j->klights, count, w, total);
-        float sums[VSGL__VIS_LEVELS * VSGL__KERNEL_BLOCK];
-        vsgl__kernel_weight_levels(w, count, total, sums);
+        int level[VSGL__KERNEL_BLOCK];
+        vsgl__kernel_weight_level(w, count, total, budget, level);
         for (size_t k = 0; k < n; ++k) /* the highest cut whose pairs' light fits the budget */
-            for (int l = 0; l < VSGL__VIS_LEVELS && cut[k] < 0.0f; ++l)
-                if (sums[l * B + k] <= budget * total[k])
-                    cut[k] = total[k] * (1.0f / (float)(1u << (VSGL__VIS_LEVEL0 + l)));
+            if (level[k] >= 0)
+                cut[k] = total[k] * (1.0f / (float)(1u << (VSGL__VIS_LEVEL0 + level[k])));
     }
     for (size_t v = 0; v < count; ++v) {
         const float *wv = budget > 0.0f ? w + v * B : NULL; /* weights exist only under a budget */
