@@ -23,31 +23,51 @@ static inline float rough_exp(float y)
     return u.f;
 }
 
+/* The pair weight of VSGL L at lane k of block b (vsgl__kernel_pair_weights);
+ * glossy 0: the block has no glossy receiver (its glossy term is 0). */
+static inline float pair_weight(const vsgl_kernel_block *b, const vsgl_kernel_light *L, float pw, size_t k,
+                                int glossy)
+{
+    /* i: unit direction from the receiver to the VSGL */
+    float dx = L->mx - b->x[k], dy = L->my - b->y[k], dz = L->mz - b->z[k];
+    float d2 = dx * dx + dy * dy + dz * dz, id = d2 > 0.0f ? 1.0f / sqrtf(d2) : 0.0f;
+    float ix = dx * id, iy = dy * id, iz = dz * id;
+    float ce = L->ax * ix + L->ay * iy + L->az * iz; /* the VSGL's axis . (-i): -(a . -i) */
+    float cr = b->nx[k] * ix + b->ny[k] * iy + b->nz[k] * iz;
+    float gl = 0.0f;
+    if (glossy) {
+        float gx = b->Xx[k] * ix + b->Xy[k] * iy + b->Xz[k] * iz, gy = b->Yx[k] * ix + b->Yy[k] * iy + b->Yz[k] * iz;
+        float gz = b->Zx[k] * ix + b->Zy[k] * iy + b->Zz[k] * iz;
+        float spread = L->var * id * id; /* the VSGL's angular variance as seen from the receiver */
+        gl = b->camp[k] * (gz > 0.0f ? gz : 0.0f) *
+             rough_exp(-b->lam[k] * gx * gx / (1.0f + b->lam[k] * spread) -
+                       b->mu[k] * gy * gy / (1.0f + b->mu[k] * spread));
+    }
+    float df = b->diffuse[k] * ((cr > 0.0f ? cr : 0.0f) + 0.05f) * (1.0f / 3.14159265f);
+    return pw * rough_exp(L->lv * (ce - 1.0f)) * (df + gl) / (d2 + L->var);
+}
+
 KERNEL_ATTR void vsgl__kernel_pair_weights(const vsgl_kernel_block *b, const vsgl_kernel_light *lights,
                                            size_t count, float *w, float *total)
 {
     enum { B = VSGL__KERNEL_BLOCK };
+    int glossy = 0;
+    for (size_t k = 0; k < B; ++k)
+        glossy |= b->camp[k] > 0.0f;
     for (size_t v = 0; v < count; ++v) {
         const vsgl_kernel_light *L = &lights[v];
         const float pw = (0.2126f * L->pr + 0.7152f * L->pg + 0.0722f * L->pb) * L->c0;
         float *wv = w + v * B;
-        for (size_t k = 0; k < B; ++k) {
-            /* i: unit direction from the receiver to the VSGL */
-            float dx = L->mx - b->x[k], dy = L->my - b->y[k], dz = L->mz - b->z[k];
-            float d2 = dx * dx + dy * dy + dz * dz, id = d2 > 0.0f ? 1.0f / sqrtf(d2) : 0.0f;
-            float ix = dx * id, iy = dy * id, iz = dz * id;
-            float ce = L->ax * ix + L->ay * iy + L->az * iz; /* the VSGL's axis . (-i): -(a . -i) */
-            float cr = b->nx[k] * ix + b->ny[k] * iy + b->nz[k] * iz;
-            float gx = b->Xx[k] * ix + b->Xy[k] * iy + b->Xz[k] * iz, gy = b->Yx[k] * ix + b->Yy[k] * iy + b->Yz[k] * iz;
-            float gz = b->Zx[k] * ix + b->Zy[k] * iy + b->Zz[k] * iz;
-            float spread = L->var * id * id; /* the VSGL's angular variance as seen from the receiver */
-            float gl = b->camp[k] * (gz > 0.0f ? gz : 0.0f) *
-                       rough_exp(-b->lam[k] * gx * gx / (1.0f + b->lam[k] * spread) -
-                                 b->mu[k] * gy * gy / (1.0f + b->mu[k] * spread));
-            float df = b->diffuse[k] * ((cr > 0.0f ? cr : 0.0f) + 0.05f) * (1.0f / 3.14159265f);
-            wv[k] = pw * rough_exp(L->lv * (ce - 1.0f)) * (df + gl) / (d2 + L->var);
-            total[k] += wv[k];
-        }
+        if (glossy) /* two loops, each vectorised without a branch */
+            for (size_t k = 0; k < B; ++k) {
+                wv[k] = pair_weight(b, L, pw, k, 1);
+                total[k] += wv[k];
+            }
+        else
+            for (size_t k = 0; k < B; ++k) {
+                wv[k] = pair_weight(b, L, pw, k, 0);
+                total[k] += wv[k];
+            }
     }
 }
 
