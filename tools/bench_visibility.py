@@ -29,15 +29,18 @@ WAYS = (("no visibility", dict(visibility=0)), ("ray budget", dict()), ("every p
 TARGET = 2.0
 
 
-def shade_seconds(ctx, case, cfg, repeat):
-    best = None
+def shade_seconds(ctx, case, cfgs, repeat):
+    """The fastest shade stage (and its whole render) of each configuration
+    over `repeat` rounds, the configurations taken in turn within a round:
+    a machine whose load drifts slows them alike, not the last one."""
+    best = [None] * len(cfgs)
     with E.L.Scene(ctx, **scenes.library_arrays(case, E.L)) as sc:
         for _ in range(repeat):
-            t0 = time.perf_counter()
-            _, st = E.L.render(ctx, sc, cfg.settings(), planes=("diffuse", "glossy"))
-            total = time.perf_counter() - t0
-            cur = (st["seconds_shade"], total)
-            best = cur if best is None or cur[0] < best[0] else best
+            for i, cfg in enumerate(cfgs):
+                t0 = time.perf_counter()
+                _, st = E.L.render(ctx, sc, cfg.settings(), planes=("diffuse", "glossy"))
+                cur = (st["seconds_shade"], time.perf_counter() - t0)
+                best[i] = cur if best[i] is None or cur[0] < best[i][0] else best[i]
     return best
 
 
@@ -52,7 +55,7 @@ def main(argv=None):
     rend = E.Renderer()
     have_refs = refs.blender_version(refs.DEFAULT_DIR) is not None and not refs.missing(
         args.scenes.split(","), scenes.size_of("test"), refs.DEFAULT_DIR)
-    print("visibility: balanced at %dx%d (shade stage, best of %d) on %d cores; errors against Cycles at 80x60%s"
+    print("visibility: balanced at %dx%d (shade stage, best of %d rounds, the three in turn) on %d cores; errors against Cycles at 80x60%s"
           % (w, h, args.repeat, os.cpu_count() or 0, "" if have_refs else " skipped (no cached references)"))
     for name in args.scenes.split(","):
         big = scenes.case(name, (w, h))
@@ -60,11 +63,11 @@ def main(argv=None):
         seeds = None
         if have_refs:
             seeds = [M.coloured(p) for p, _ in refs.ensure([name], scenes.size_of("test"), refs.DEFAULT_DIR)[name]]
-        base = None
-        for label, knobs in WAYS:
-            cfg = E.Config(label, "balanced", knobs)
-            shade, total = shade_seconds(ctx, big, cfg, args.repeat)
-            base = shade if base is None else base
+        cfgs = [E.Config(label, "balanced", knobs) for label, knobs in WAYS]
+        times = shade_seconds(ctx, big, cfgs, args.repeat)
+        base = times[0][0]
+        for cfg, (shade, total) in zip(cfgs, times):
+            label = cfg.label
             line = "  %-20s %-14s shade %6.3f s (%.2fx no visibility%s), frame %6.3f s" % (
                 name, label, shade, shade / base,
                 "" if label == "no visibility" else "; target <= %.1fx: %s" % (

@@ -139,28 +139,34 @@ void vsgl__scene_occluded_towards(const vsgl_scene *scene, uint32_t n, const v3 
                                   unsigned char *blocked)
 {
     enum { BATCH = 64 };
-    struct RTCRay r[BATCH];
+    float ox[BATCH], oy[BATCH], oz[BATCH], dx[BATCH], dy[BATCH], dz[BATCH], t0[BATCH], t1[BATCH], tm[BATCH];
+    unsigned int mask[BATCH], id[BATCH], flags[BATCH];
+    uint32_t idx[BATCH];
+    struct RTCRayNp rays = {ox, oy, oz, t0, dx, dy, dz, tm, t1, mask, id, flags};
     struct RTCIntersectContext ic;
     rtcInitIntersectContext(&ic);
     ic.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    uint32_t idx[BATCH];
-    uint32_t b = 0;
-    while (b < n) {
-        uint32_t m = 0;
-        for (; b < n && m < BATCH; ++b) {
-            v3 d = v3_sub(target, org[b]);
-            float dist = v3_length(d);
-            blocked[b] = 0;
-            if (scene->triangle_count == 0 || !(dist > eps)) /* at the target, or no scene: visible */
+    for (uint32_t b = 0; b < n;) {
+        uint32_t c = n - b < BATCH ? n - b : BATCH, m = 0;
+        /* the segments, then the ones longer than eps packed to the front */
+        for (uint32_t i = 0; i < c; ++i) {
+            float ex = target.x - org[b + i].x, ey = target.y - org[b + i].y, ez = target.z - org[b + i].z;
+            float dist = sqrtf(ex * ex + ey * ey + ez * ez), inv = 1.0f / dist;
+            blocked[b + i] = 0;
+            if (scene->triangle_count == 0 || !(dist > eps))
                 continue;
-            fill_ray(&r[m], org[b], v3_scale(d, 1.0f / dist), 0.0f, dist - eps);
-            idx[m++] = b;
+            ox[m] = org[b + i].x; oy[m] = org[b + i].y; oz[m] = org[b + i].z;
+            dx[m] = ex * inv; dy[m] = ey * inv; dz[m] = ez * inv;
+            t0[m] = 0.0f; t1[m] = dist - eps; tm[m] = 0.0f;
+            mask[m] = 0xFFFFFFFFu; id[m] = 0; flags[m] = 0;
+            idx[m++] = b + i;
         }
+        b += c;
         if (m == 0)
             continue;
-        rtcOccluded1M(scene->rtc, &ic, r, m, sizeof(struct RTCRay));
+        rtcOccludedNp(scene->rtc, &ic, &rays, m);
         for (uint32_t i = 0; i < m; ++i)
-            blocked[idx[i]] = (unsigned char)(r[i].tfar == -INFINITY);
+            blocked[idx[i]] = (unsigned char)(t1[i] == -INFINITY);
     }
 }
 
