@@ -135,27 +135,28 @@ void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *or
     }
 }
 
-void vsgl__scene_occluded_towards(const vsgl_scene *scene, uint32_t n, const v3 *org, v3 target, float eps,
-                                  unsigned char *blocked)
+void vsgl__scene_occluded_towards(const vsgl_scene *scene, uint32_t n, const uint32_t *lane, const float *ox,
+                                  const float *oy, const float *oz, v3 target, float eps, unsigned char *blocked)
 {
     enum { BATCH = 64 };
-    float ox[BATCH], oy[BATCH], oz[BATCH], dx[BATCH], dy[BATCH], dz[BATCH], t0[BATCH], t1[BATCH], tm[BATCH];
+    float rx[BATCH], ry[BATCH], rz[BATCH], dx[BATCH], dy[BATCH], dz[BATCH], t0[BATCH], t1[BATCH], tm[BATCH];
     unsigned int mask[BATCH], id[BATCH], flags[BATCH];
     uint32_t idx[BATCH];
-    struct RTCRayNp rays = {ox, oy, oz, t0, dx, dy, dz, tm, t1, mask, id, flags};
+    struct RTCRayNp rays = {rx, ry, rz, t0, dx, dy, dz, tm, t1, mask, id, flags};
     struct RTCIntersectContext ic;
     rtcInitIntersectContext(&ic);
     ic.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     for (uint32_t b = 0; b < n;) {
         uint32_t c = n - b < BATCH ? n - b : BATCH, m = 0;
-        /* the segments, then the ones longer than eps packed to the front */
+        /* the segments longer than eps, packed to the front */
         for (uint32_t i = 0; i < c; ++i) {
-            float ex = target.x - org[b + i].x, ey = target.y - org[b + i].y, ez = target.z - org[b + i].z;
+            uint32_t k = lane[b + i];
+            float ex = target.x - ox[k], ey = target.y - oy[k], ez = target.z - oz[k];
             float dist = sqrtf(ex * ex + ey * ey + ez * ez), inv = 1.0f / dist;
             blocked[b + i] = 0;
             if (scene->triangle_count == 0 || !(dist > eps))
                 continue;
-            ox[m] = org[b + i].x; oy[m] = org[b + i].y; oz[m] = org[b + i].z;
+            rx[m] = ox[k]; ry[m] = oy[k]; rz[m] = oz[k];
             dx[m] = ex * inv; dy[m] = ey * inv; dz[m] = ez * inv;
             t0[m] = 0.0f; t1[m] = dist - eps; tm[m] = 0.0f;
             mask[m] = 0xFFFFFFFFu; id[m] = 0; flags[m] = 0;

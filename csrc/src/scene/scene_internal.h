@@ -41,10 +41,11 @@ void vsgl__scene_intersect_many(const vsgl_scene *scene, uint32_t n, const v3 *o
 void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *org, const v3 *dir,
                                const float *tmin, const float *tmax, int coherent, unsigned char *blocked);
 
-/* vsgl__scene_occluded_many for the segments from org[i] to `target`,
- * short of it by eps (a segment of eps or less: unblocked, no ray). Thread-safe. */
-void vsgl__scene_occluded_towards(const vsgl_scene *scene, uint32_t n, const v3 *org, v3 target, float eps,
-                                  unsigned char *blocked);
+/* vsgl__scene_occluded_many for the segments from origin lane[i] (ox, oy,
+ * oz: coordinates indexed by lane) to `target`, short of it by eps (a
+ * segment of eps or less: unblocked, no ray); blocked[i], i < n. Thread-safe. */
+void vsgl__scene_occluded_towards(const vsgl_scene *scene, uint32_t n, const uint32_t *lane, const float *ox,
+                                  const float *oy, const float *oz, v3 target, float eps, unsigned char *blocked);
 
 /* Index in the caller's triangle array of validated triangle `triangle`. */
 uint32_t vsgl__scene_source_triangle(const vsgl_scene *scene, uint32_t triangle);

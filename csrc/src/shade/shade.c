@@ -307,10 +307,25 @@ static uint64_t lanes_of(size_t n)
  * 0.1 % of the unclipped lobe's: a floor's clusters and the floor's own
  * receivers, a wall's cluster and the wall beside it); visible. */
 _Static_assert(VSGL__KERNEL_BLOCK <= 64, "a block's lanes are kept in 64-bit masks");
-static uint64_t visibility_rays(const shade_job *j, v3 target, const vsgl_kernel_light *L, const receiver *rec,
-                                size_t n, uint64_t lanes)
+/* Where visibility rays start: receiver k offset along its normal by eps
+ * (coordinates by lane). */
+typedef struct ray_origins {
+    float x[VSGL__KERNEL_BLOCK], y[VSGL__KERNEL_BLOCK], z[VSGL__KERNEL_BLOCK];
+} ray_origins;
+
+static void origins_of(const shade_job *j, const receiver *rec, size_t n, ray_origins *o)
 {
-    v3 org[VSGL__KERNEL_BLOCK];
+    for (size_t k = 0; k < n; ++k) {
+        v3 p = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
+        o->x[k] = p.x;
+        o->y[k] = p.y;
+        o->z[k] = p.z;
+    }
+}
+
+static uint64_t visibility_rays(const shade_job *j, v3 target, const vsgl_kernel_light *L, const receiver *rec,
+                                const ray_origins *org, size_t n, uint64_t lanes)
+{
     unsigned char blocked[VSGL__KERNEL_BLOCK];
     uint32_t idx[VSGL__KERNEL_BLOCK], m = 0;
     uint64_t visible = 0;
@@ -324,14 +339,21 @@ static uint64_t visibility_rays(const shade_job *j, v3 target, const vsgl_kernel
                 continue;
             }
         }
-        org[m] = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
         idx[m++] = k;
     }
     if (m)
-        vsgl__scene_occluded_towards(j->scene, m, org, target, j->eps, blocked);
+        vsgl__scene_occluded_towards(j->scene, m, idx, org->x, org->y, org->z, target, j->eps, blocked);
     for (uint32_t i = 0; i < m; ++i)
         visible |= (uint64_t)!blocked[i] << idx[i];
     return visible;
+}
+
+/* visibility_rays from one receiver to one VSGL's target (every lane traced). */
+static int visible_from(const shade_job *j, const vsgl_vsgl *v, const receiver *r)
+{
+    ray_origins o;
+    origins_of(j, r, 1, &o);
+    return (int)(visibility_rays(j, ray_target(v), NULL, r, &o, 1, 1) & 1u);
 }
 
 /* GGX as two lobes, core and tail (kernel.h): ASG2 and the hybrid's VSGL term. */
@@ -442,7 +464,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 if (j->leak)
                     in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), VSGL__TINY));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
-                    if (!visibility_rays(j, ray_target(v), NULL, &r, 1, 1))
+                    if (!visible_from(j, v, &r))
                         continue;
                 }
                 if (has_diffuse) {
@@ -630,7 +652,7 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
         if (e == 0.0f)
             continue;
         if (j->s->visibility == VSGL_VISIBILITY_RAY) {
-            if (!visibility_rays(j, ray_target(v), NULL, r, 1, 1))
+            if (!visible_from(j, v, r))
                 e = 0.0f;
         }
         for (int k = 0; k < 3; ++k)
@@ -653,6 +675,8 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
                              uint64_t *vis, uint64_t *skip, float *w, float *share)
 {
     const size_t count = j->set->count, B = VSGL__KERNEL_BLOCK;
+    ray_origins org_s, *org = &org_s;
+    origins_of(j, rec, n, org);
     float total[VSGL__KERNEL_BLOCK], cut[VSGL__KERNEL_BLOCK];
     double seen[VSGL__KERNEL_BLOCK], lit[VSGL__KERNEL_BLOCK];
     memset(total, 0, sizeof total);
@@ -683,7 +707,7 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
             want &= ~have;
         }
         if (want)
-            vbits |= visibility_rays(j, ray_target(&j->set->items[j->korder[v]]), &j->klights[v], rec, n, want);
+            vbits |= visibility_rays(j, ray_target(&j->set->items[j->korder[v]]), &j->klights[v], rec, org, n, want);
         vis[v] = vbits;
         if (wv)
             vsgl__kernel_vis_accumulate(wv, lanes_of(n) & ~sbits, vbits, seen, lit);
@@ -764,11 +788,13 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
                 kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
             }
         } else if (j->s->visibility == VSGL_VISIBILITY_RAY) { /* no memory for it: a ray for every pair */
+            ray_origins org;
+            origins_of(j, rec, n, &org);
             for (size_t v = 0; v < count; v += 2) {
                 size_t m = count - v < 2 ? count - v : 2;
                 for (size_t q = 0; q < m; ++q) {
                     uint64_t bits = visibility_rays(j, ray_target(&j->set->items[j->korder[v + q]]),
-                                                    &j->klights[v + q], rec, n, lanes_of(n));
+                                                    &j->klights[v + q], rec, &org, n, lanes_of(n));
                     for (size_t k = 0; k < n; ++k)
                         vis[q * VSGL__KERNEL_BLOCK + k] = (float)((bits >> k) & 1u);
                 }
