@@ -55,7 +55,8 @@ def main(argv=None):
     rend = E.Renderer()
     have_refs = refs.blender_version(refs.DEFAULT_DIR) is not None and not refs.missing(
         args.scenes.split(","), scenes.size_of("test"), refs.DEFAULT_DIR)
-    print("visibility: balanced at %dx%d (shade stage, best of %d rounds, the three in turn) on %d cores; errors against Cycles at 80x60%s"
+    print("visibility: balanced at %dx%d (shade stage, best of %d rounds, the three in turn) on %d cores; "
+          "errors against Cycles at 80x60%s"
           % (w, h, args.repeat, os.cpu_count() or 0, "" if have_refs else " skipped (no cached references)"))
     for name in args.scenes.split(","):
         big = scenes.case(name, (w, h))
