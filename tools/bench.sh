@@ -8,20 +8,24 @@ cd "$(dirname "$0")/.."
 objs=$(ls csrc/src/*/*.c | sed 's|^|build/obj/|; s|\.c$|.o|')
 flags="-O2 -march=native -Itests/c -Icsrc/include -Icsrc/src"
 libs="-lembree3 -lOpenEXRCore-3_1 -lpthread -lm"
-mkdir -p build/bench
-cc $flags tools/bench/bench_shade.c $objs $libs -o build/bench/bench_shade
-cc $flags tools/bench/bench_kernel.c $objs $libs -o build/bench/bench_kernel
-if [ -f tools/bench_gbuffer.c ]; then cc $flags tools/bench_gbuffer.c $objs $libs -o build/bench/bench_gbuffer; fi
+# BENCH_DIR: where the programs go; BENCH_BUILD_ONLY=1: build them and stop
+# (tests/tools/run_tools.sh checks that they still build)
+bin=${BENCH_DIR:-build/bench}
+mkdir -p "$bin"
+cc $flags tools/bench/bench_shade.c $objs $libs -o "$bin/bench_shade"
+cc $flags tools/bench/bench_kernel.c $objs $libs -o "$bin/bench_kernel"
+if [ -f tools/bench_gbuffer.c ]; then cc $flags tools/bench_gbuffer.c $objs $libs -o "$bin/bench_gbuffer"; fi
+if [ "${BENCH_BUILD_ONLY:-0}" = 1 ]; then exit 0; fi
 if [ "${BENCH_QUICK:-0}" = 1 ]; then size="480 270 64 1"; kreps=100; else size="1920 1080 256 3"; kreps=3000; fi
 echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 echo "== shading: vectorised kernel vs scalar build of the same code (same run)"
 # shellcheck disable=SC2086
-build/bench/bench_shade $size
+"$bin/bench_shade" $size
 echo "== the kernel alone"
-build/bench/bench_kernel $kreps
-if [ -x build/bench/bench_gbuffer ]; then
+"$bin/bench_kernel" $kreps
+if [ -x "$bin/bench_gbuffer" ]; then
   echo "== scene build and G-buffer"
-  build/bench/bench_gbuffer ${BENCH_GBUFFER_ARGS:-}
+  "$bin/bench_gbuffer" ${BENCH_GBUFFER_ARGS:-}
 fi
 echo "== live viewport preview (issue 12 targets), headless"
 py=${BPY_PYTHON:-python3}

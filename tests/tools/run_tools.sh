@@ -102,5 +102,18 @@ print("".join(l for l in open("/proc/self/maps") if "libembree3" in l or "libtbb
   fi
 fi
 
+# make bench's C programs build against the library's current internals
+# (bench_shade did not from 760acca to 2026-12-03, unnoticed: nothing ran it)
+if want bench_builds; then
+  if [ ! -f build/obj/csrc/src/shade/shade.o ]; then
+    bad bench_programs_build "the library's objects are missing: run make first"
+  elif BENCH_BUILD_ONLY=1 BENCH_DIR="$T/bench" tools/bench.sh >"$T/bench.log" 2>&1 &&
+       [ -x "$T/bench/bench_shade" ] && [ -x "$T/bench/bench_kernel" ]; then
+    ok bench_programs_build
+  else
+    bad bench_programs_build "tools/bench.sh (BENCH_BUILD_ONLY=1) failed: $(grep -m3 -E 'error|Error' "$T/bench.log" | tr '\n' '|')"
+  fi
+fi
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
