@@ -295,18 +295,6 @@ static uint64_t lanes_of(size_t n)
     return n < 64 ? ((uint64_t)1 << n) - 1 : ~(uint64_t)0;
 }
 
-/* Visibility of `target` (a VSGL's ray target) from the receivers k <
- * n <= VSGL__KERNEL_BLOCK whose bit is set in `lanes`: one batched
- * occlusion query (an Embree ray stream) of just those, each from the
- * receiver offset along its normal. Returns their visible bits (a blocked
- * ray's bit and every lane outside `lanes` are 0). A receiver within eps
- * of the target traces no ray (visible). With L (the VSGL's kernel light;
- * NULL: every lane traced), no ray for a receiver the VSGL cannot light:
- * behind or within 1e-3 of the behind fade of its plane (VSGL__CLIP_BEHIND
- * sigma) with its emitter clip at >= 0.999 (its light there is at most
- * 0.1 % of the unclipped lobe's: a floor's clusters and the floor's own
- * receivers, a wall's cluster and the wall beside it); visible. */
-_Static_assert(VSGL__KERNEL_BLOCK <= 64, "a block's lanes are kept in 64-bit masks");
 /* Where visibility rays start: receiver k offset along its normal by eps
  * (coordinates by lane). */
 typedef struct ray_origins {
@@ -323,6 +311,18 @@ static void origins_of(const shade_job *j, const receiver *rec, size_t n, ray_or
     }
 }
 
+/* Visibility of `target` (a VSGL's ray target) from the receivers k <
+ * n <= VSGL__KERNEL_BLOCK whose bit is set in `lanes`: one batched
+ * occlusion query (an Embree ray stream) of just those, each from the
+ * receiver's origin in org. Returns their visible bits (a blocked
+ * ray's bit and every lane outside `lanes` are 0). A receiver within eps
+ * of the target traces no ray (visible). With L (the VSGL's kernel light;
+ * NULL: every lane traced), no ray for a receiver the VSGL cannot light:
+ * behind or within 1e-3 of the behind fade of its plane (VSGL__CLIP_BEHIND
+ * sigma) with its emitter clip at >= 0.999 (its light there is at most
+ * 0.1 % of the unclipped lobe's: a floor's clusters and the floor's own
+ * receivers, a wall's cluster and the wall beside it); visible. */
+_Static_assert(VSGL__KERNEL_BLOCK <= 64, "a block's lanes are kept in 64-bit masks");
 static uint64_t visibility_rays(const shade_job *j, v3 target, const vsgl_kernel_light *L, const receiver *rec,
                                 const ray_origins *org, size_t n, uint64_t lanes)
 {
@@ -702,7 +702,7 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
             continue; /* no ray for this VSGL at any receiver of the block */
         uint64_t want = lanes_of(n) & ~sbits, vbits = 0;
         if (v > 0 && j->ray_twin && j->ray_twin[v]) { /* the light before's rays, where it traced them */
-            uint64_t have = want & lanes_of(n) & ~skip[v - 1];
+            uint64_t have = want & ~skip[v - 1];
             vbits = vis[v - 1] & have;
             want &= ~have;
         }
@@ -783,6 +783,11 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
             /* two VSGLs per kernel call, the pairs it interleaves */
             for (size_t v = 0; v < count; v += 2) {
                 size_t m = count - v < 2 ? count - v : 2;
+                uint64_t any = 0; /* a lane that sees either VSGL, or takes the share for it */
+                for (size_t q = 0; q < m; ++q)
+                    any |= bits[count + v + q] | bits[v + q];
+                if (!any)
+                    continue; /* both blocked at every receiver: they add nothing */
                 for (size_t q = 0; q < m; ++q)
                     vsgl__kernel_vis_fill(bits[count + v + q], bits[v + q], share, vis + q * VSGL__KERNEL_BLOCK);
                 kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
