@@ -71,6 +71,20 @@ static double fma_lanes_per_second(void)
     return (double)reps * 10.0 * FMA_LANES / t;
 }
 
+/* The median over reps (<= 16) of the vectorised shade stage with settings rs. */
+static double shade_seconds(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
+                            const vsgl_vsgl_set *set, const vsgl_render_settings *rs, const vsgl_pixel_planes *pl,
+                            int reps, uint64_t *pairs)
+{
+    double tm[16];
+    for (int r = 0; r < reps; ++r) {
+        double t0 = now();
+        vsgl__shade(ctx, scene, g, set, rs, pl, VSGL__SHADE_KERNEL, pairs);
+        tm[r] = now() - t0;
+    }
+    return median(tm, reps);
+}
+
 int main(int argc, char **argv)
 {
     uint32_t W = argc > 1 ? (uint32_t)atoi(argv[1]) : 1920, H = argc > 2 ? (uint32_t)atoi(argv[2]) : 1080;
@@ -134,13 +148,7 @@ int main(int argc, char **argv)
     for (int m = 1; m < 3; ++m) {
         vsgl_render_settings po = rs;
         po.diffuse_mode = m == 1 ? VSGL_COSINE_SG : VSGL_COSINE_PULLED_OUT;
-        double tm[16];
-        for (int r = 0; r < reps; ++r) {
-            double t0 = now();
-            vsgl__shade(ctx, scene, &g, &set, &po, &pl, VSGL__SHADE_KERNEL, &pairs);
-            tm[r] = now() - t0;
-        }
-        double mm = median(tm, reps);
+        double mm = shade_seconds(ctx, scene, &g, &set, &po, &pl, reps, &pairs);
         rate[m] = (double)pairs / mm;
         printf("shade  vectorised kernel, %s cosine + ASG glossy%s: %.3f s  %.3g pairs/s\n", mode_name[m],
                m == 2 ? " (the balanced preset's diffuse form)" : "", mm, rate[m]);
@@ -149,13 +157,7 @@ int main(int argc, char **argv)
         vsgl_render_settings two = rs;
         two.diffuse_mode = VSGL_COSINE_PULLED_OUT;
         two.glossy_mode = VSGL_GLOSSY_ASG2;
-        double tm[16];
-        for (int r = 0; r < reps; ++r) {
-            double t0 = now();
-            vsgl__shade(ctx, scene, &g, &set, &two, &pl, VSGL__SHADE_KERNEL, &pairs);
-            tm[r] = now() - t0;
-        }
-        double mm = median(tm, reps);
+        double mm = shade_seconds(ctx, scene, &g, &set, &two, &pl, reps, &pairs);
         printf("shade  vectorised kernel, pulled-out cosine + two-ASG glossy (the balanced preset's glossy): "
                "%.3f s  %.3g pairs/s\n", mm, (double)pairs / mm);
     }
