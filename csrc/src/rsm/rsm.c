@@ -148,8 +148,10 @@ static int32_t rsm_rows(void *user, size_t chunk, size_t begin, size_t end)
     return 0;
 }
 
+/* The map of `light` over the window (zoom, col0, row0); lout (may be
+ * NULL) receives the light as set up for it. */
 static vsgl_result build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res, uint32_t zoom,
-                         int64_t col0, int64_t row0, vsgl_rsm *out)
+                         int64_t col0, int64_t row0, vsgl_rsm *out, vsgl_rsm_light *lout)
 {
     memset(out, 0, sizeof *out);
     uint32_t nl = 0;
@@ -161,6 +163,8 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t li
     vsgl_rsm_light l;
     vsgl__rsm_light_setup(scene, light, res, &l);
     vsgl__rsm_light_window(&l, zoom, col0, row0);
+    if (lout)
+        *lout = l;
     out->light = light;
     out->zoom = l.type == VSGL_LIGHT_SUN && zoom > 1 ? zoom : 1;
     out->faces = l.faces;
@@ -219,18 +223,14 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t li
 
 vsgl_result vsgl__rsm_build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res, vsgl_rsm *out)
 {
-    return build(ctx, scene, light, res, 1, 0, 0, out);
+    return build(ctx, scene, light, res, 1, 0, 0, out, NULL);
 }
 
-/* The map of a sun built with (zoom, col0, row0): its edges smoothed. */
-static vsgl_result smooth(vsgl_context *ctx, const vsgl_scene *scene, vsgl_rsm *out, uint32_t zoom, int64_t col0,
-                          int64_t row0)
+/* The edges of map `out` smoothed; l: its light as built. */
+static vsgl_result smooth(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm_light *l, vsgl_rsm *out)
 {
-    vsgl_rsm_light l;
-    vsgl__rsm_light_setup(scene, out->light, out->res, &l);
-    vsgl__rsm_light_window(&l, zoom, col0, row0);
     size_t traced;
-    vsgl_result r = vsgl__rsm_smooth_edges(ctx, scene, &l, out, &traced);
+    vsgl_result r = vsgl__rsm_smooth_edges(ctx, scene, l, out, &traced);
     if (r != VSGL_OK)
         vsgl__rsm_free(out);
     else
@@ -242,7 +242,8 @@ static vsgl_result smooth(vsgl_context *ctx, const vsgl_scene *scene, vsgl_rsm *
 vsgl_result vsgl__rsm_build_inward(vsgl_context *ctx, const vsgl_scene *scene, uint32_t light, uint32_t res,
                                    vsgl_rsm *out, double dropped[3])
 {
-    vsgl_result r = build(ctx, scene, light, res, 1, 0, 0, out);
+    vsgl_rsm_light l;
+    vsgl_result r = build(ctx, scene, light, res, 1, 0, 0, out, &l);
     if (r != VSGL_OK)
         return r;
     vsgl__rsm_drop_outward(scene, out, dropped);
@@ -265,13 +266,13 @@ vsgl_result vsgl__rsm_build_inward(vsgl_context *ctx, const vsgl_scene *scene, u
     while (zoom < VSGL__RSM_MAX_ZOOM && side * (int64_t)zoom * 2 <= (int64_t)res)
         zoom *= 2;
     if (zoom == 1)
-        return smooth(ctx, scene, out, 1, 0, 0);
+        return smooth(ctx, scene, &l, out);
     /* the square centred on them, on the grid refined zoom times */
     int64_t pad_c = ((int64_t)res - (c1 - c0 + 3) * (int64_t)zoom) / 2,
             pad_r = ((int64_t)res - (r1 - r0 + 3) * (int64_t)zoom) / 2;
     int64_t col0 = (c0 - 1) * zoom - pad_c, row0 = (r0 - 1) * zoom - pad_r;
     vsgl_rsm fine_map;
-    r = build(ctx, scene, light, res, zoom, col0, row0, &fine_map);
+    r = build(ctx, scene, light, res, zoom, col0, row0, &fine_map, &l);
     if (r != VSGL_OK) {
         vsgl__rsm_free(out);
         return r;
@@ -280,7 +281,7 @@ vsgl_result vsgl__rsm_build_inward(vsgl_context *ctx, const vsgl_scene *scene, u
     *out = fine_map;
     double again[3]; /* the power dropped is the first map's: the same light on the same faces */
     vsgl__rsm_drop_outward(scene, out, again);
-    return smooth(ctx, scene, out, zoom, col0, row0);
+    return smooth(ctx, scene, &l, out);
 }
 
 void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped[3])
@@ -302,7 +303,12 @@ void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped
     }
     if (!(dropped[0] + dropped[1] + dropped[2] > 0.0))
         return; /* nothing dropped: the total as built */
-    for (int k = 0; k < 3; ++k) /* the sum of what is left, not a difference (no rounding residue) */
+    vsgl__rsm_sum_flux(r); /* the sum of what is left, not a difference (no rounding residue) */
+}
+
+void vsgl__rsm_sum_flux(vsgl_rsm *r)
+{
+    for (int k = 0; k < 3; ++k)
         r->total_flux[k] = 0.0;
     for (size_t i = 0; i < r->count; ++i)
         for (int k = 0; k < 3; ++k)

@@ -47,6 +47,8 @@ void vsgl__rsm_free(vsgl_rsm *r);
  * the emitter clip gives them nothing to light, the exact gather no
  * receiver). Sets dropped to their power and total_flux to what is left. */
 void vsgl__rsm_drop_outward(const vsgl_scene *scene, vsgl_rsm *r, double dropped[3]);
+/* total_flux = the sum of the texels' flux, in texel order. */
+void vsgl__rsm_sum_flux(vsgl_rsm *r);
 
 /* Texel helpers shared by the map's builders (rsm.c, rsm_edges.c).
  * faces_out: a surface at p with normal n has every corner of the box

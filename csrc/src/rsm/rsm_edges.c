@@ -134,12 +134,7 @@ vsgl_result vsgl__rsm_smooth_edges(vsgl_context *ctx, const vsgl_scene *scene, c
     free(texels);
     if (rc != VSGL_OK)
         return vsgl__fail(ctx, rc, "rsm: the edges of light %u: %s", r->light, vsgl_result_string(rc));
-    /* the sum of the texels, in texel order: the same for any thread count */
-    for (int k = 0; k < 3; ++k)
-        r->total_flux[k] = 0.0;
-    for (size_t i = 0; i < r->count; ++i)
-        for (int k = 0; k < 3; ++k)
-            r->total_flux[k] += (double)r->flux[k][i];
+    vsgl__rsm_sum_flux(r); /* in texel order: the same for any thread count */
     *traced = n;
     return VSGL_OK;
 }

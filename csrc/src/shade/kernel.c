@@ -93,14 +93,14 @@ static inline void threshold_sums(const float *w, size_t count, const float *thr
     }
 }
 
-/* The first level whose sum fits the budget, searched in two passes: the
+/* The cut at the first level whose sum fits the budget, searched in two passes: the
  * last level of each group of G first, then the levels before it in the
  * first group whose last fits. The sums only fall from level to level (each
  * holds the next one's weights and more, added in the same order), so this
  * is the level a pass over every level finds, from 6 sums per VSGL instead
  * of 12. */
-KERNEL_ATTR void vsgl__kernel_weight_level(const float *w, size_t count, const float *total, float budget,
-                                           int *level)
+KERNEL_ATTR void vsgl__kernel_weight_cut(const float *w, size_t count, const float *total, float budget,
+                                         float *cut)
 {
     enum { B = VSGL__KERNEL_BLOCK, NL = VSGL__VIS_LEVELS, G = 3, NG = NL / G };
     _Static_assert(NL % G == 0, "the levels split into groups of G");
@@ -125,7 +125,7 @@ KERNEL_ATTR void vsgl__kernel_weight_level(const float *w, size_t count, const f
         for (int q = G - 2; q >= 0 && l >= 0; --q)
             if (sums[q * B + k] <= budget * total[k])
                 l = G * group[k] + q;
-        level[k] = l;
+        cut[k] = l >= 0 ? level_threshold(total[k], l) : -1.0f;
     }
 }
 

@@ -171,13 +171,13 @@ void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *li
  * (VSGL-major); total[k] += each receiver's sum. */
 void vsgl__kernel_pair_weights(const vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count, float *w,
                                float *total);
-/* The candidate cuts of the budget: level l is the weights at most
- * total[k] x 2^-(VSGL__VIS_LEVEL0 + l), l < VSGL__VIS_LEVELS. level[k]
- * receives receiver k's first level whose weights sum to at most budget x
- * total[k], or -1 if none does. */
+/* The budget's cut: the candidate cuts are total[k] x 2^-(VSGL__VIS_LEVEL0
+ * + l), l < VSGL__VIS_LEVELS; cut[k] receives receiver k's highest one
+ * whose weights at or below it sum to at most budget x total[k], or -1 if
+ * none does (nothing skipped). */
 #define VSGL__VIS_LEVELS 12
 #define VSGL__VIS_LEVEL0 4
-void vsgl__kernel_weight_level(const float *w, size_t count, const float *total, float budget, int *level);
+void vsgl__kernel_weight_cut(const float *w, size_t count, const float *total, float budget, float *cut);
 
 /* The budget's per-VSGL bookkeeping over a block's VSGL__KERNEL_BLOCK lanes
  * (shade.c), as lane masks (bit k: lane k), vectorised:

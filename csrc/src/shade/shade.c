@@ -680,18 +680,12 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
     float total[VSGL__KERNEL_BLOCK], cut[VSGL__KERNEL_BLOCK];
     double seen[VSGL__KERNEL_BLOCK], lit[VSGL__KERNEL_BLOCK];
     memset(total, 0, sizeof total);
-    for (size_t k = 0; k < B; ++k) {
-        cut[k] = -1.0f; /* nothing skipped */
+    for (size_t k = 0; k < B; ++k)
         seen[k] = lit[k] = 0.0;
-    }
     const float budget = j->s->visibility_budget;
-    if (budget > 0.0f) {
+    if (budget > 0.0f) { /* the highest cut whose pairs' light fits the budget */
         vsgl__kernel_pair_weights(blk, j->klights, count, w, total);
-        int level[VSGL__KERNEL_BLOCK];
-        vsgl__kernel_weight_level(w, count, total, budget, level);
-        for (size_t k = 0; k < n; ++k) /* the highest cut whose pairs' light fits the budget */
-            if (level[k] >= 0)
-                cut[k] = total[k] * (1.0f / (float)(1u << (VSGL__VIS_LEVEL0 + level[k])));
+        vsgl__kernel_weight_cut(w, count, total, budget, cut);
     }
     for (size_t v = 0; v < count; ++v) {
         const float *wv = budget > 0.0f ? w + v * B : NULL; /* weights exist only under a budget */
