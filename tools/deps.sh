@@ -8,7 +8,9 @@ build_pkgs="gcc make pkg-config libembree-dev libopenexr-dev"
 python_pkgs="python3 python3-numpy python3-pytest"
 case "${1:-build}" in
   build) pkgs="$build_pkgs" ;;
-  test)  pkgs="$build_pkgs $python_pkgs blender openimageio-tools python3-openimageio" ;;
+  # xvfb, xauth (xvfb-run) and Mesa's software OpenGL: the add-on's panel and viewport tests
+  # start Blender's real UI on a virtual screen; without them they skip.
+  test)  pkgs="$build_pkgs $python_pkgs blender openimageio-tools python3-openimageio xvfb xauth libgl1-mesa-dri" ;;
   asan)  pkgs="$build_pkgs clang libclang-rt-14-dev" ;;
   demo)  pkgs="$build_pkgs $python_pkgs blender" ;;
   bench) pkgs="$build_pkgs $python_pkgs" ;;

@@ -49,6 +49,7 @@ struct vsgl_shade_plan {
     /* a replay's working memory, kept between renders (no page faults per render) */
     float *pack;                    /* per anchor: 12 floats: light (6), its sum per lobe (2), d2 (4) */
     float *interp;                  /* 6 per sample of a batch */
+    float *blend;                   /* per sample of a batch shaded itself: its t (sparse.h) */
     const float *colours_in;        /* the planes (their diffuse_color) that hold this plan's DiffCol,
                                        GlossCol and coverage of every pixel since its last record or
                                        replay, or NULL; any other render clears it (shade.c) */

@@ -315,30 +315,35 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
                 }
             }
         /* where bilinear interpolation would be off by more than SPARSE_TOL
-         * (a reflection's edge, a shadow's), the sample is shaded itself */
-        int smooth = 1;
+         * (a reflection's edge, a shadow's), the sample is shaded itself;
+         * near that, shaded and blended with its interpolation (SPARSE_BLEND) */
+        float t = 1.0f;
         if (wsum > 0.05f) {
+            t = 0.0f;
             for (int l = 0; l < 2; ++l) {
                 float m = (L[3 * l] + L[3 * l + 1] + L[3 * l + 2]) / wsum;
-                float bound = SPARSE_TOL * m + j->contrast_floor[l];
+                float bound = SPARSE_TOL * m + j->contrast_floor[l], tl;
                 if (dx2[l] < 0.0f && dy2[l] < 0.0f) {
-                    smooth &= !(hi[l] - lo[l] > SPARSE_CONTRAST * (hi[l] + lo[l]) + j->contrast_floor[l]);
-                    continue;
+                    tl = sparse_shade_weight(hi[l] - lo[l], SPARSE_CONTRAST * (hi[l] + lo[l]) + j->contrast_floor[l]);
+                } else {
+                    /* (a missing second difference, -1, counts as 0; a compare, not
+                     * fmaxf, which without -ffinite-math-only is a libm call per sample) */
+                    float ex = dx2[l] > 0.0f ? dx2[l] : 0.0f, ey = dy2[l] > 0.0f ? dy2[l] : 0.0f;
+                    tl = sparse_shade_weight(0.5f * (tx * (1.0f - tx) * ex + ty * (1.0f - ty) * ey), bound);
                 }
-                /* (a missing second difference, -1, counts as 0; a compare, not
-                 * fmaxf, which without -ffinite-math-only is a libm call per sample) */
-                float ex = dx2[l] > 0.0f ? dx2[l] : 0.0f, ey = dy2[l] > 0.0f ? dy2[l] : 0.0f;
-                float e = 0.5f * (tx * (1.0f - tx) * ex + ty * (1.0f - ty) * ey);
-                smooth &= !(e > bound);
+                t = tl > t ? tl : t;
             }
+            if (!(t < 1.0f))
+                t = 1.0f;
         }
-        if (sparse_junction(same, sparse_touching(same, other, ad2)))
-            smooth = 0;
-        if (wsum > 0.05f && smooth) {
+        if (t < 1.0f && sparse_junction(same, sparse_touching(same, other, ad2)))
+            t = 1.0f;
+        if (t < 1.0f)
             for (int c = 0; c < 6; ++c)
                 bt->interp[bi * 6 + c] = L[c] / wsum;
-        } else {
+        if (t > 0.0f) {
             bt->direct_of[bi] = SPARSE_MARK;
+            bt->blend[bi] = t;
         }
     }
     return 0;
@@ -378,6 +383,17 @@ int32_t vsgl__sparse_direct(void *user, size_t chunk, size_t b, size_t e)
     } else {
         bt->dpairs[chunk] = vsgl__shade_list(j, bt->dlist + b, e - b, NULL, bt->dlight + b * 6,
                                              bt->lanes ? bt->lanes + b : NULL);
+    }
+    /* near the test's bound: (1 - t) x the interpolated light + t x the shaded (SPARSE_BLEND) */
+    for (size_t k = b; rc == 0 && k < e; ++k) {
+        const size_t bi = bt->dlist[k] - bt->first;
+        const float t = bt->blend[bi];
+        if (t < 1.0f) {
+            const float *I = bt->interp + bi * 6;
+            float *D = bt->dlight + k * 6;
+            for (int c = 0; c < 6; ++c)
+                D[c] = I[c] + t * (D[c] - I[c]);
+        }
     }
 #if defined(__x86_64__) || defined(__i386__)
     _mm_setcsr(saved_csr);
@@ -538,8 +554,8 @@ static void record_cell4(sparse_batch *bt, size_t px, uint32_t ax, uint32_t ay, 
     _mm_storeu_ps(w4 + 8, r2);
     _mm_storeu_ps(w4 + 12, r3);
     const unsigned near = (unsigned)_mm_movemask_ps(_mm_cmpgt_ps(wsum, _mm_set1_ps(0.05f)));
-    float out[6][4];
-    const unsigned ok = vsgl__sparse_interp4(j, plan->pack, w4, ax, ay, tx, ty, out);
+    float out[6][4], t4[4];
+    const unsigned ok = vsgl__sparse_interp4(j, plan->pack, w4, ax, ay, tx, ty, out, t4);
     /* no anchor of the cell off a lane's surface: no junction (sparse_touching gives 0) in any lane */
     const unsigned any_other = other_bits[0] | other_bits[1] | other_bits[2] | other_bits[3];
     for (unsigned k = 0; k < 4; ++k) {
@@ -556,13 +572,12 @@ static void record_cell4(sparse_batch *bt, size_t px, uint32_t ax, uint32_t ay, 
             junction = sparse_junction(same, sparse_touching(same, other, d2k));
         }
         plan->direct[si] = near >> k & 1u && !junction ? PLAN_NEAR : PLAN_ALONE;
-        if (plan->direct[si] == PLAN_NEAR && ok >> k & 1u) {
-            bt->direct_of[bi] = SIZE_MAX;
+        const float t = plan->direct[si] == PLAN_NEAR && ok >> k & 1u ? t4[k] : 1.0f;
+        bt->direct_of[bi] = t > 0.0f ? SPARSE_MARK : SIZE_MAX;
+        bt->blend[bi] = t;
+        if (t < 1.0f)
             for (int c = 0; c < 6; ++c)
                 bt->interp[bi * 6 + c] = out[c][k];
-        } else {
-            bt->direct_of[bi] = SPARSE_MARK;
-        }
     }
 }
 #endif
@@ -634,9 +649,11 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
                 }
             plan->direct[si] =
                 wsum > 0.05f && !sparse_junction(same, sparse_touching(same, other, ad2)) ? PLAN_NEAR : PLAN_ALONE;
+            float t = 1.0f;
             if (plan->direct[si] == PLAN_ALONE ||
-                !vsgl__sparse_interp(j, plan->pack, w, ax, ay, tx, ty, bt->interp + bi * 6))
+                !vsgl__sparse_interp(j, plan->pack, w, ax, ay, tx, ty, bt->interp + bi * 6, &t) || t > 0.0f)
                 bt->direct_of[bi] = SPARSE_MARK;
+            bt->blend[bi] = t;
         }
         if (++x == W) {
             x = 0;
@@ -658,10 +675,11 @@ vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row
     bt.first = row * W * spp;
     bt.ns = (end - row) * W * spp;
     bt.interp = malloc((bt.ns + 1) * 6 * sizeof *bt.interp);
+    bt.blend = malloc((bt.ns + 1) * sizeof *bt.blend);
     bt.direct_of = malloc((bt.ns + 1) * sizeof *bt.direct_of);
     bt.dlist = malloc((bt.ns + 1) * sizeof *bt.dlist);
     vsgl_result r = VSGL_OK;
-    if (!bt.interp || !bt.direct_of || !bt.dlist ||
+    if (!bt.interp || !bt.blend || !bt.direct_of || !bt.dlist ||
         vsgl__parallel_ctx(ctx, (end - row) * W, W, j->plan ? record_rows : sparse_classify, &bt) != 0) {
         r = VSGL_ERROR_OUT_OF_MEMORY;
         goto done;
@@ -707,6 +725,7 @@ vsgl_result vsgl__shade_sparse_batch(vsgl_context *ctx, shade_job *j, size_t row
         j->pairs[0] += bt.dpairs[c];
 done:
     free(bt.interp);
+    free(bt.blend);
     free(bt.direct_of);
     free(bt.dlist);
     free(bt.dlight);

@@ -32,6 +32,34 @@
 #define SPARSE_TOL 0.04f
 #define SPARSE_CONTRAST 0.1f
 #define SPARSE_FLOOR 0.002f
+/* The verdict is soft: a sample whose estimated error e is up to
+ * SPARSE_BLEND of the bound is interpolated, one beyond the bound shaded,
+ * and one in between shaded too and given (1 - t) x its interpolated light
+ * + t x its shaded light, t rising linearly from 0 to 1 across the band
+ * (sparse_shade_weight). A hard verdict flips wherever the test's inputs
+ * cross the bound, and as the camera moves the anchors slide over a
+ * surface: pixels then jumped between light off by up to SPARSE_TOL and
+ * exact light, speckles inside a glossy cabinet's face (the sun room's
+ * glossy jitter as the camera moves, 0.0118 with a hard verdict, 0.0088
+ * shading every pixel). */
+#ifndef SPARSE_BLEND
+#define SPARSE_BLEND 0.5f
+#endif
+
+/* t for error e against bound (contrast: the anchors' spread against its bound):
+ * 0 interpolated, 1 shaded, between: blended (see SPARSE_BLEND). Each path
+ * computes it with these operations in this order (the SSE forms in
+ * sparse_replay.c), so a render with a plan and one without agree bit for bit. */
+static inline float sparse_shade_weight(float e, float bound)
+{
+    if (e > bound)
+        return 1.0f;
+    const float x = e - SPARSE_BLEND * bound;
+    if (!(x > 0.0f))
+        return 0.0f;
+    const float t = x / ((1.0f - SPARSE_BLEND) * bound);
+    return t < 1.0f ? t : 1.0f;
+}
 
 /* Anchors, and samples shaded themselves, per parallel chunk: four kernel blocks. */
 #define SPARSE_CHUNK (4 * VSGL__KERNEL_BLOCK)
@@ -47,6 +75,7 @@ typedef struct sparse_batch {
     shade_job *j;
     size_t first, ns;        /* the batch's first sample, its sample count */
     float *interp;           /* 6 per sample */
+    float *blend;            /* per sample shaded itself: t (sparse_shade_weight), 1 where it has no interpolation */
     size_t *direct_of;       /* per sample: SIZE_MAX (interpolated or a miss), else its index in dlist */
     size_t *dlist;           /* the samples shaded themselves, in sample order */
     float *dlight;           /* 6 per entry of dlist */
@@ -66,17 +95,19 @@ int32_t vsgl__sparse_direct(void *user, size_t chunk, size_t b, size_t e);
 void vsgl__sparse_anchor_pack(shade_job *j);
 
 /* A sample's light interpolated from the packed anchors of its cell (ax, ay)
- * at (tx, ty) with the weights w (4) into out (6), or 0 where it is to be
- * shaded itself (sparse_replay.c). */
+ * at (tx, ty) with the weights w (4) into out (6) and its t
+ * (sparse_shade_weight) into *t; 0 where it has no interpolation (shaded
+ * itself, t = 1) (sparse_replay.c). */
 int vsgl__sparse_interp(const shade_job *j, const float *pack, const float *w, uint32_t ax, uint32_t ay, float tx,
-                        float ty, float *out);
+                        float ty, float *out, float *t);
 
 #if defined(__SSE2__)
 /* The same for four samples of one row (one per pixel) in one cell, at
  * tx[0..3], ty, with the weights w4 (4 per sample): their light into
- * out[c][k], the samples that pass the test as bits (sparse_replay.c). */
+ * out[c][k] and t into t4[k], the samples that have an interpolation as
+ * bits (sparse_replay.c). */
 unsigned vsgl__sparse_interp4(const shade_job *j, const float *pack, const float *w4, uint32_t ax, uint32_t ay,
-                              const float *tx, float ty, float out[6][4]);
+                              const float *tx, float ty, float out[6][4], float t4[4]);
 #endif
 
 /* vsgl__shade_sparse_batch for a replay (sparse_replay.c). */

@@ -26,6 +26,7 @@ void vsgl__shade_plan_free(vsgl_shade_plan *p)
     free(p->geo);
     free(p->pack);
     free(p->interp);
+    free(p->blend);
     free(p->direct_of);
     free(p->marks);
     free(p);

@@ -16,6 +16,21 @@
 #include <string.h>
 #if defined(__SSE2__)
 #  include <emmintrin.h>
+
+/* sparse_shade_weight (sparse.h) per lane, the same operations */
+static inline __m128 shade_weight4(__m128 e, __m128 bound)
+{
+    const __m128 one = _mm_set1_ps(1.0f), over = _mm_cmpgt_ps(e, bound);
+    const __m128 x = _mm_sub_ps(e, _mm_mul_ps(_mm_set1_ps(SPARSE_BLEND), bound));
+    __m128 t = _mm_min_ps(_mm_div_ps(x, _mm_mul_ps(_mm_set1_ps(1.0f - SPARSE_BLEND), bound)), one);
+    t = _mm_and_ps(_mm_cmpgt_ps(x, _mm_setzero_ps()), t);
+    return _mm_or_ps(_mm_and_ps(over, one), _mm_andnot_ps(over, t));
+}
+
+static inline __m128 select4(__m128 mask, __m128 a, __m128 b)
+{
+    return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
 #endif
 
 /* A replay's anchors: each anchor's light, its sum per lobe and its second
@@ -70,12 +85,13 @@ void vsgl__sparse_anchor_pack(shade_job *j)
 }
 
 /* A replay's sample: its light interpolated from the packed anchors of its
- * cell (ax, ay) at (tx, ty) with the recorded weights w (4), into out (6);
- * 0 where it is to be shaded itself. sparse_classify's arithmetic in its
+ * cell (ax, ay) at (tx, ty) with the recorded weights w (4), into out (6),
+ * and its t (sparse_shade_weight) into *t; 0 where it has no interpolation
+ * (t = 1: shaded itself). sparse_classify's arithmetic in its
  * order: an anchor of weight 0 adds 0 x its light (finite, 0 for a miss)
  * and leaves the bounds and second differences as they are. */
 static inline int replay_sample(const shade_job *j, const float *pack, const float *w, uint32_t ax, uint32_t ay,
-                                float tx, float ty, float *out)
+                                float tx, float ty, float *out, float *t)
 {
     const size_t a0 = (size_t)ay * j->aw + ax;
     const size_t sx = ax + 1 < j->aw ? 1 : 0, sy = ay + 1 < j->ah ? j->aw : 0; /* (off the lattice: weight 0) */
@@ -104,11 +120,13 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
     REPLAY_ANCHOR(2);
     REPLAY_ANCHOR(3);
 #  undef REPLAY_ANCHOR
-    if (!(wsum > 0.05f))
+    if (!(wsum > 0.05f)) {
+        *t = 1.0f;
         return 0;
+    }
     /* the interpolation test below, both lobes at once (lanes 0, 1) */
     {
-        float L[8];
+        float L[8], tl[4];
         _mm_storeu_ps(L, l0);
         _mm_storeu_ps(L + 4, l1);
         const __m128 ws = _mm_set1_ps(wsum), zero = _mm_setzero_ps();
@@ -119,15 +137,17 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
         const __m128 dy2 = _mm_shuffle_ps(vd2, vd2, _MM_SHUFFLE(3, 3, 3, 1));
         const __m128 lo2 = _mm_movehl_ps(vlo, vlo), hi2 = _mm_movehl_ps(vhi, vhi);
         const __m128 contrast = _mm_and_ps(_mm_cmplt_ps(dx2, zero), _mm_cmplt_ps(dy2, zero));
-        const __m128 cfail = _mm_cmpgt_ps(
-            _mm_sub_ps(hi2, lo2), _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_CONTRAST), _mm_add_ps(hi2, lo2)), fl));
         const __m128 e = _mm_mul_ps(_mm_set1_ps(0.5f),
                                     _mm_add_ps(_mm_mul_ps(_mm_set1_ps(tx * (1.0f - tx)), _mm_max_ps(dx2, zero)),
                                                _mm_mul_ps(_mm_set1_ps(ty * (1.0f - ty)), _mm_max_ps(dy2, zero))));
-        const __m128 efail = _mm_cmpgt_ps(e, bound);
-        const __m128 fail = _mm_or_ps(_mm_and_ps(contrast, cfail), _mm_andnot_ps(contrast, efail));
-        if (_mm_movemask_ps(fail) & 3)
+        const __m128 ce = _mm_sub_ps(hi2, lo2),
+                     cb = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_CONTRAST), _mm_add_ps(hi2, lo2)), fl);
+        _mm_storeu_ps(tl, shade_weight4(select4(contrast, ce, e), select4(contrast, cb, bound)));
+        *t = tl[0] > tl[1] ? tl[0] : tl[1];
+        if (!(*t < 1.0f)) {
+            *t = 1.0f;
             return 0;
+        }
         _mm_storeu_ps(out, _mm_div_ps(l0, ws));
         _mm_storel_pi((__m64 *)(void *)(out + 4), _mm_div_ps(l1, ws));
     }
@@ -151,23 +171,28 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
             d2[c] = d > d2[c] ? d : d2[c];
         }
     }
-    if (!(wsum > 0.05f))
+    if (!(wsum > 0.05f)) {
+        *t = 1.0f;
         return 0;
-    int smooth = 1;
+    }
+    float tw = 0.0f;
     for (int l = 0; l < 2; ++l) {
         float m = (L[3 * l] + L[3 * l + 1] + L[3 * l + 2]) / wsum;
         float bound = SPARSE_TOL * m + j->contrast_floor[l];
-        float dx2 = d2[2 * l], dy2 = d2[2 * l + 1];
+        float dx2 = d2[2 * l], dy2 = d2[2 * l + 1], tl;
         if (dx2 < 0.0f && dy2 < 0.0f) {
-            smooth &= !(hi[l] - lo[l] > SPARSE_CONTRAST * (hi[l] + lo[l]) + j->contrast_floor[l]);
-            continue;
+            tl = sparse_shade_weight(hi[l] - lo[l], SPARSE_CONTRAST * (hi[l] + lo[l]) + j->contrast_floor[l]);
+        } else {
+            float ex = dx2 > 0.0f ? dx2 : 0.0f, ey = dy2 > 0.0f ? dy2 : 0.0f;
+            tl = sparse_shade_weight(0.5f * (tx * (1.0f - tx) * ex + ty * (1.0f - ty) * ey), bound);
         }
-        float ex = dx2 > 0.0f ? dx2 : 0.0f, ey = dy2 > 0.0f ? dy2 : 0.0f;
-        float e = 0.5f * (tx * (1.0f - tx) * ex + ty * (1.0f - ty) * ey);
-        smooth &= !(e > bound);
+        tw = tl > tw ? tl : tw;
     }
-    if (!smooth)
+    *t = tw;
+    if (!(tw < 1.0f)) {
+        *t = 1.0f;
         return 0;
+    }
     for (int c = 0; c < 6; ++c)
         out[c] = L[c] / wsum;
 #endif
@@ -175,9 +200,9 @@ static inline int replay_sample(const shade_job *j, const float *pack, const flo
 }
 
 int vsgl__sparse_interp(const shade_job *j, const float *pack, const float *w, uint32_t ax, uint32_t ay, float tx,
-                        float ty, float *out)
+                        float ty, float *out, float *t)
 {
-    return replay_sample(j, pack, w, ax, ay, tx, ty, out);
+    return replay_sample(j, pack, w, ax, ay, tx, ty, out, t);
 }
 
 /* Pixel px of a replay from its samples' light: sparse_resolve's sums. */
@@ -238,10 +263,10 @@ static inline void replay_pixel1(const shade_job *j, size_t px, const float *L)
 /* Four samples of one row (one per pixel) interpolated from the same cell
  * (ax, ay), at tx[0..3], ty, with the weights w4 (4 per sample):
  * replay_sample with the four samples in the lanes, the same operations per
- * lane. Their light into out[c][k] for the samples that pass the
- * interpolation test, returned as bits. */
+ * lane. Their light into out[c][k] and t into t4[k] (1 where a sample has
+ * no interpolation); the samples that have one, returned as bits. */
 static inline unsigned interp4(const shade_job *j, const float *pack, const float *w4, uint32_t ax, uint32_t ay,
-                               const float *tx, float ty, float out[6][4])
+                               const float *tx, float ty, float out[6][4], float t4[4])
 {
     const size_t a0 = (size_t)ay * j->aw + ax;
     const size_t sx = ax + 1 < j->aw ? 1 : 0, sy = ay + 1 < j->ah ? j->aw : 0;
@@ -280,9 +305,10 @@ static inline unsigned interp4(const shade_job *j, const float *pack, const floa
         for (int c = 0; c < 4; ++c)
             d2[c] = _mm_max_ps(_mm_or_ps(_mm_and_ps(on, _mm_set1_ps(A[8 + c])), _mm_andnot_ps(on, neg1)), d2[c]);
     }
-    __m128 ok = _mm_cmpgt_ps(wsum, _mm_set1_ps(0.05f));
+    const __m128 near = _mm_cmpgt_ps(wsum, _mm_set1_ps(0.05f));
     const __m128 vtx = _mm_loadu_ps(tx);
     const __m128 ftx = _mm_mul_ps(vtx, _mm_sub_ps(_mm_set1_ps(1.0f), vtx)), fty = _mm_set1_ps(ty * (1.0f - ty));
+    __m128 tw = zero;
     _Pragma("GCC unroll 8")
     for (int l = 0; l < 2; ++l) {
         const __m128 fl = _mm_set1_ps(j->contrast_floor[l]);
@@ -290,13 +316,15 @@ static inline unsigned interp4(const shade_job *j, const float *pack, const floa
         const __m128 bound = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_TOL), m), fl);
         const __m128 dx2 = d2[2 * l], dy2 = d2[2 * l + 1];
         const __m128 contrast = _mm_and_ps(_mm_cmplt_ps(dx2, zero), _mm_cmplt_ps(dy2, zero));
-        const __m128 cfail = _mm_cmpgt_ps(_mm_sub_ps(hi[l], lo[l]),
-                                          _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_CONTRAST), _mm_add_ps(hi[l], lo[l])), fl));
+        const __m128 ce = _mm_sub_ps(hi[l], lo[l]),
+                     cb = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(SPARSE_CONTRAST), _mm_add_ps(hi[l], lo[l])), fl);
         const __m128 e = _mm_mul_ps(_mm_set1_ps(0.5f), _mm_add_ps(_mm_mul_ps(ftx, _mm_max_ps(dx2, zero)),
                                                                     _mm_mul_ps(fty, _mm_max_ps(dy2, zero))));
-        const __m128 fail = _mm_or_ps(_mm_and_ps(contrast, cfail), _mm_andnot_ps(contrast, _mm_cmpgt_ps(e, bound)));
-        ok = _mm_andnot_ps(fail, ok);
+        const __m128 tl = shade_weight4(select4(contrast, ce, e), select4(contrast, cb, bound));
+        tw = select4(_mm_cmpgt_ps(tl, tw), tl, tw); /* the scalar form's max, not _mm_max_ps */
     }
+    const __m128 one = _mm_set1_ps(1.0f), ok = _mm_and_ps(near, _mm_cmplt_ps(tw, one));
+    _mm_storeu_ps(t4, select4(ok, tw, one));
     const unsigned bits = (unsigned)_mm_movemask_ps(ok);
     if (!bits)
         return 0;
@@ -307,28 +335,35 @@ static inline unsigned interp4(const shade_job *j, const float *pack, const floa
 }
 
 unsigned vsgl__sparse_interp4(const shade_job *j, const float *pack, const float *w4, uint32_t ax, uint32_t ay,
-                              const float *tx, float ty, float out[6][4])
+                              const float *tx, float ty, float out[6][4], float t4[4])
 {
-    return interp4(j, pack, w4, ax, ay, tx, ty, out);
+    return interp4(j, pack, w4, ax, ay, tx, ty, out, t4);
 }
 
 /* Four pixels px..px+3 of one row (one sample each, interpolated from the
  * same cell (ax, ay), at tx[0..3], ty): interp4 and replay_pixel1. Writes
- * the pixels whose samples pass the interpolation test; returns them as
- * bits. */
+ * the pixels whose samples are interpolated alone (t = 0) and returns them
+ * as bits; the others are to be shaded, with t and any interpolated light
+ * kept for the blend (plan->blend, plan->interp, at batch index bi0 + k). */
 static unsigned replay_cell4(const shade_job *j, const float *pack, size_t px, uint32_t ax, uint32_t ay,
-                             const float *tx, float ty)
+                             const float *tx, float ty, size_t bi0)
 {
-    float out[6][4];
-    const unsigned bits = interp4(j, pack, j->plan->w4 + px * 4, ax, ay, tx, ty, out);
-    if (!bits)
-        return 0;
-    for (unsigned k = 0; k < 4; ++k)
-        if (bits >> k & 1u) {
-            const float light[6] = {out[0][k], out[1][k], out[2][k], out[3][k], out[4][k], out[5][k]};
+    const vsgl_shade_plan *plan = j->plan;
+    float out[6][4], t4[4];
+    const unsigned bits = interp4(j, pack, plan->w4 + px * 4, ax, ay, tx, ty, out, t4);
+    unsigned done = 0;
+    for (unsigned k = 0; k < 4; ++k) {
+        const float light[6] = {out[0][k], out[1][k], out[2][k], out[3][k], out[4][k], out[5][k]};
+        if (bits >> k & 1u && t4[k] == 0.0f) {
             replay_pixel1(j, px + k, light);
+            done |= 1u << k;
+            continue;
         }
-    return bits;
+        plan->blend[bi0 + k] = t4[k];
+        if (bits >> k & 1u)
+            memcpy(plan->interp + (bi0 + k) * 6, light, sizeof light);
+    }
+    return done;
 }
 #endif
 
@@ -359,7 +394,7 @@ static int32_t replay_rows(void *user, size_t chunk, size_t b0, size_t e0)
                 plan->direct[px] == PLAN_NEAR && plan->direct[px + 1] == PLAN_NEAR &&
                 plan->direct[px + 2] == PLAN_NEAR && plan->direct[px + 3] == PLAN_NEAR) {
                 unsigned ok = replay_cell4(j, pack, px, plan->cell_x[x], plan->cell_y[y], plan->cell_tx + x,
-                                           plan->cell_ty[y]);
+                                           plan->cell_ty[y], px - bt->first);
                 for (unsigned k = 0; k < 4; ++k)
                     if (!(ok >> k & 1u))
                         marks[nm++] = (uint32_t)(px + k - bt->first);
@@ -369,14 +404,19 @@ static int32_t replay_rows(void *user, size_t chunk, size_t b0, size_t e0)
             }
 #endif
             const int32_t code = plan->direct[px];
+            float t = 1.0f;
             if (code == PLAN_MISS) {
                 replay_pixel1(j, px, NULL);
-            } else if (code == PLAN_ALONE || !replay_sample(j, pack, plan->w4 + px * 4, plan->cell_x[x],
-                                                             plan->cell_y[y], plan->cell_tx[x], plan->cell_ty[y],
-                                                             light)) {
-                marks[nm++] = (uint32_t)(px - bt->first);
-            } else {
+            } else if (code == PLAN_NEAR && replay_sample(j, pack, plan->w4 + px * 4, plan->cell_x[x], plan->cell_y[y],
+                                                          plan->cell_tx[x], plan->cell_ty[y], light, &t) &&
+                       t == 0.0f) {
                 replay_pixel1(j, px, light);
+            } else { /* shaded, and blended with its interpolation where t < 1 */
+                const size_t bi = px - bt->first;
+                marks[nm++] = (uint32_t)bi;
+                plan->blend[bi] = t;
+                if (t < 1.0f)
+                    memcpy(plan->interp + bi * 6, light, 6 * sizeof *light);
             }
         }
         bt->nmarks[chunk] = nm;
@@ -391,12 +431,14 @@ static int32_t replay_rows(void *user, size_t chunk, size_t b0, size_t e0)
                 Ls[k] = NULL;
                 continue;
             }
-            float *o = light + k * 6;
+            float *o = light + k * 6, t = 1.0f;
             Ls[k] = o;
             if (code == PLAN_ALONE ||
                 !replay_sample(j, pack, plan->w4 + si * 4, plan->cell_x[x * spp + k], plan->cell_y[y * spp + k],
-                               plan->cell_tx[x * spp + k], plan->cell_ty[y * spp + k], o)) {
+                               plan->cell_tx[x * spp + k], plan->cell_ty[y * spp + k], o, &t) ||
+                t > 0.0f) { /* shaded, and blended with its interpolation (o) where t < 1 */
                 marks[nm++] = (uint32_t)bi;
+                plan->blend[bi] = t;
                 marked = 1;
             }
         }
@@ -467,17 +509,21 @@ vsgl_result vsgl__sparse_replay_batch(vsgl_context *ctx, shade_job *j, size_t ro
     vsgl_result r = VSGL_OK;
     if (plan->scratch_ns < bt.ns) {
         free(plan->interp);
+        free(plan->blend);
         free(plan->direct_of);
         free(plan->marks);
         plan->interp = malloc((bt.ns + 1) * 6 * sizeof *plan->interp);
+        plan->blend = malloc((bt.ns + 1) * sizeof *plan->blend);
         plan->direct_of = malloc((bt.ns + 1) * sizeof *plan->direct_of);
         plan->marks = malloc((bt.ns + 1) * sizeof *plan->marks);
-        plan->scratch_ns = plan->interp && plan->direct_of && plan->marks ? bt.ns : 0;
+        plan->scratch_ns = plan->interp && plan->blend && plan->direct_of && plan->marks ? bt.ns : 0;
         if (!plan->scratch_ns) {
             r = VSGL_ERROR_OUT_OF_MEMORY;
             goto done;
         }
     }
+    bt.interp = plan->interp; /* the blend's inputs (vsgl__sparse_direct) */
+    bt.blend = plan->blend;
     bt.nmarks = malloc((rows + 1) * sizeof *bt.nmarks);
     if (!bt.nmarks || vsgl__parallel_ctx(ctx, rows * W, W, replay_rows, &bt) != 0) {
         r = VSGL_ERROR_OUT_OF_MEMORY;
