@@ -2,7 +2,7 @@
 
     blender -b --factory-startup --python-exit-code 1 --python tests/quality/render_refs.py -- \
         [--size test|bench|WxH[xSPP]] [--scenes a,b,...] [--seeds 1,2] [--out build/quality/refs] \
-        [--anim light|camera --frame N] [--check-builder] [--force]
+        [--anim light|camera --frame N[,N...]] [--check-builder] [--force]
 
 Builds each scene with tests/blender/cycles_ref.py's build_blender and renders
 it with its render_cycles (max_bounces 1, no clamps, blur_glossy 0, box pixel
@@ -13,7 +13,8 @@ under --out (refs.py names and keys them; existing ones are kept unless
 --force).
 
 --anim/--frame: render frame N of that animation (scenes.animate) instead
-of the still (evaluate.py --motion-truth: the motion's own change).
+of the still (evaluate.py --motion-truth: the motion's own change); N may
+be a comma-separated list of frames, rendered in one Blender session.
 
 --check-builder: compares the pure-Python builder (scenes.library_arrays)
 with the arrays cycles_ref.library_arrays reads back from the bpy-built scene
@@ -131,8 +132,8 @@ def main():
         version = bpy.app.version_string
         code = refs.code_digest()
         w, h, spp = scenes.size_of(args["--size"])
-        anim, frame = args["--anim"], int(args["--frame"])
-        for n in names:
+        anim = args["--anim"]
+        for n, frame in [(n, int(f)) for n in names for f in args["--frame"].split(",")]:
             c = scenes.animate(scenes.case(n, (w, h)), anim, frame)
             built = False
             for seed in [int(s) for s in args["--seeds"].split(",")]:
