@@ -274,6 +274,7 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
             stepped = steps is True or kind in (steps or ())
             if stepped:
                 n = min(frames, steps_frames) if steps_frames else max(frames, MOTION_STEPS + 1)
+                refs.ensure_frames([name], asz, kind, list(range(n)), refdir)
                 anim_seeds[kind] = [[M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, f, refdir)[name]]
                                     for f in range(n)]
             if stepped and not steps_frames:

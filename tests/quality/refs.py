@@ -155,6 +155,19 @@ def ensure(names, size, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=
     return ensure_frame(names, size, "light", 0, refdir, seeds, log, quiet)
 
 
+def ensure_frames(names, size, anim, frames, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=False):
+    """Render the missing references of frames `frames` of animation `anim`,
+    every scene's in one Blender session (a session's start and scene build
+    cost about twice a frame's render at 80 x 60). Loads nothing."""
+    version = blender_version(refdir)
+    code = code_digest()
+    for n in names:
+        need = [f for f in frames for s in seeds if version is None
+                or not os.path.exists(path_frame(refdir, n, size, s, version, anim, f, code))]
+        if need:
+            _render(sorted(set(need)), [n], size, anim, refdir, seeds, version, log, quiet)
+
+
 def ensure_frame(names, size, anim, frame, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=False):
     """ensure() for frame `frame` of animation `anim` (0: the still, the
     same files as ensure()'s)."""
@@ -163,25 +176,7 @@ def ensure_frame(names, size, anim, frame, refdir=DEFAULT_DIR, seeds=scenes.SEED
     need = sorted({n for n in names for s in seeds if version is None
                    or not os.path.exists(path_frame(refdir, n, size, s, version, anim, frame, code))})
     if need:
-        if version is None:
-            raise RuntimeError("references missing and no Blender found ($BLENDER=%s)" % blender_binary())
-        sz = size if isinstance(size, str) else "x".join(str(v) for v in scenes.size_of(size))
-        cmd = [blender_binary(), "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-               os.path.join(HERE, "render_refs.py"), "--", "--size", sz, "--scenes", ",".join(need),
-               "--seeds", ",".join(str(s) for s in seeds), "--out", refdir]
-        what = "reference(s)"
-        if frame:
-            cmd += ["--anim", anim, "--frame", str(frame)]
-            what = "frame %d of the %s animation" % (frame, anim)
-        if not quiet:
-            print("rendering Cycles %s (%d seeds) in Blender %s: %s" % (what, len(seeds), version, " ".join(need)),
-                  flush=True)
-        log = log or os.path.join(refdir, "render_refs.log")
-        os.makedirs(refdir, exist_ok=True)
-        with open(log, "a") as fh:
-            rc = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, env=blender_env()).returncode
-        if rc != 0:
-            raise RuntimeError("render_refs.py failed (exit %d); see %s" % (rc, log))
+        _render([frame], need, size, anim, refdir, seeds, version, log, quiet)
     out = {}
     for n in names:
         out[n] = []
@@ -191,3 +186,26 @@ def ensure_frame(names, size, anim, frame, refdir=DEFAULT_DIR, seeds=scenes.SEED
                 raise RuntimeError("reference %s was not written" % p)
             out[n].append(load(p))
     return out
+
+
+def _render(frames, need, size, anim, refdir, seeds, version, log, quiet):
+    """Render frames `frames` of scenes `need` in one Blender session."""
+    if version is None:
+        raise RuntimeError("references missing and no Blender found ($BLENDER=%s)" % blender_binary())
+    sz = size if isinstance(size, str) else "x".join(str(v) for v in scenes.size_of(size))
+    cmd = [blender_binary(), "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+           os.path.join(HERE, "render_refs.py"), "--", "--size", sz, "--scenes", ",".join(need),
+           "--seeds", ",".join(str(s) for s in seeds), "--out", refdir]
+    what = "reference(s)"
+    if frames != [0]:
+        cmd += ["--anim", anim, "--frame", ",".join(str(f) for f in frames)]
+        what = "frame(s) %s of the %s animation" % (",".join(str(f) for f in frames), anim)
+    if not quiet:
+        print("rendering Cycles %s (%d seeds) in Blender %s: %s" % (what, len(seeds), version, " ".join(need)),
+              flush=True)
+    log = log or os.path.join(refdir, "render_refs.log")
+    os.makedirs(refdir, exist_ok=True)
+    with open(log, "a") as fh:
+        rc = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, env=blender_env()).returncode
+    if rc != 0:
+        raise RuntimeError("render_refs.py failed (exit %d); see %s" % (rc, log))
