@@ -413,7 +413,8 @@ VT_TEST(gbuffer_edge_slot_takes_its_surfaces_mean_normal)
     VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 2, 16, &fine) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
     VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 16, 0, &dense) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
     size_t checked = 0;
-    double worst = 0.0, spread = 0.0;
+    double worst = 0.0, spread = 0.0, worst_spread = 0.0, max_spread = 0.0;
+    size_t spread_px = 0;
     for (size_t px = 0; px < (size_t)64 * 48; ++px) {
         size_t base = px * 4, hit_slot = 4;
         int hits = 0;
@@ -436,6 +437,15 @@ VT_TEST(gbuffer_edge_slot_takes_its_surfaces_mean_normal)
         for (int c = 0; c < 3; ++c)
             dot += m[c] / len * fine.nrm[c][hit_slot];
         worst = fmax(worst, acos(fmin(1.0, dot)));
+        size_t nh = 0; /* the spread: 1 - the mean resultant length of the rays' normals */
+        for (size_t j = px * 256; j < px * 256 + 256; ++j)
+            nh += dense.material[j] != VSGL__GBUFFER_MISS;
+        double want = 1.0 - len / (double)nh, got = 1.0 - (double)fine.spread[hit_slot];
+        if (want > 1e-5) { /* (below, float rounding of the sum) */
+            worst_spread = fmax(worst_spread, fabs(got - want) / want);
+            ++spread_px;
+        }
+        max_spread = fmax(max_spread, want);
         for (size_t j = px * 256; j < px * 256 + 256; ++j) /* how far one ray's normal is from the mean */
             if (dense.material[j] != VSGL__GBUFFER_MISS) {
                 double d = 0.0;
@@ -451,6 +461,69 @@ VT_TEST(gbuffer_edge_slot_takes_its_surfaces_mean_normal)
     VT_CHECK(spread > 0.02, "the normal turns by %.3g rad within a pixel: the test cannot tell a ray from the mean",
              spread);
     VT_CHECK(worst < 5e-4, "an edge slot's normal is %.3g rad off its surface's mean normal", worst);
+    /* ... and the normals' spread (gbuffer.h spread), which widens its glossy lobe */
+    printf("    %zu of them with 1 - R > 1e-5 (at most %.2g): 1 - spread off the rays' own by %.2g (relative) at worst\n",
+           spread_px, max_spread, worst_spread);
+    VT_CHECK(spread_px >= 4, "%zu edge pixels whose normals spread measurably", spread_px);
+    VT_CHECK(worst_spread < 0.05, "an edge slot's spread is %.3g (relative) off its rays' own", worst_spread);
+    vsgl__gbuffer_free(&fine);
+    vsgl__gbuffer_free(&dense);
+    vsgl_scene_destroy(s);
+    vsgl_context_destroy(ctx);
+}
+
+/* On a flat surface (one normal) an edge slot stands at the mean point of
+ * its share's rays (edges.c mean_surface), not at its representative ray:
+ * the coverage test's slanted plane, against the same pixels traced with 16
+ * x 16 samples (the edge rays' own grid). */
+VT_TEST(gbuffer_edge_slot_on_a_flat_surface_takes_its_mean_point)
+{
+    plane_scene p;
+    slanted_plane(&p, -5.0f, 0.3f, 0.37f, 2.0f);
+    vsgl_context *ctx = make_ctx(2);
+    vsgl_scene *s = NULL;
+    VT_REQUIRE(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    vsgl_gbuffer fine, dense;
+    VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 2, 16, &fine) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 16, 0, &dense) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    size_t checked = 0;
+    double worst = 0.0, ray = 0.0;
+    for (size_t px = 0; px < (size_t)64 * 48; ++px) {
+        size_t base = px * 4, hit_slot = 4;
+        int hits = 0;
+        for (int q = 0; q < 4; ++q)
+            if (fine.material[base + q] != VSGL__GBUFFER_MISS && fine.weight[base + q] > 0.0f) {
+                ++hits;
+                hit_slot = base + (size_t)q;
+            }
+        if (hits != 1 || fine.weight[hit_slot] > 0.99f || fine.weight[hit_slot] < 0.1f)
+            continue; /* not an edge pixel with one surface */
+        double m[3] = {0, 0, 0};
+        size_t nh = 0;
+        for (size_t j = px * 256; j < px * 256 + 256; ++j)
+            if (dense.material[j] != VSGL__GBUFFER_MISS) {
+                for (int c = 0; c < 3; ++c)
+                    m[c] += dense.pos[c][j];
+                ++nh;
+            }
+        double d2 = 0.0, far2 = 0.0;
+        for (int c = 0; c < 3; ++c)
+            d2 += pow(m[c] / (double)nh - fine.pos[c][hit_slot], 2.0);
+        for (size_t j = px * 256; j < px * 256 + 256; ++j) /* how far one ray's hit is from the mean */
+            if (dense.material[j] != VSGL__GBUFFER_MISS) {
+                double r2 = 0.0;
+                for (int c = 0; c < 3; ++c)
+                    r2 += pow(m[c] / (double)nh - dense.pos[c][j], 2.0);
+                far2 = fmax(far2, r2);
+            }
+        worst = fmax(worst, sqrt(d2 / far2));
+        ray = fmax(ray, far2);
+        ++checked;
+    }
+    printf("    %zu edge pixels: slot point off its rays' mean by %.2g of their spread at worst\n", checked, worst);
+    VT_CHECK(checked >= 16, "%zu edge pixels with one surface", checked);
+    VT_CHECK(ray > 0.0, "the rays of a pixel hit one point: the test cannot tell a ray from the mean");
+    VT_CHECK(worst < 1e-3, "an edge slot's point is %.3g of its rays' spread off their mean", worst);
     vsgl__gbuffer_free(&fine);
     vsgl__gbuffer_free(&dense);
     vsgl_scene_destroy(s);

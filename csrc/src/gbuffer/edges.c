@@ -159,6 +159,7 @@ static void mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, co
     if (!(len > 0.0f) || !(vlen > 0.0f) || count < 2)
         return;
     v3 m = v3_scale(sum, 1.0f / len), t = at3(g->tan, to);
+    g->spread[to] = len / (float)count < 1.0f ? len / (float)count : 1.0f;
     t = v3_sub(t, v3_scale(m, v3_dot(m, t)));
     float tl = v3_length(t);
     if (!(tl > 1e-6f))
@@ -248,6 +249,7 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint3
         }
         copy_sample(g, base + q, sub, rep);
         g->weight[base + q] = (float)count[q] / (float)n;
+        g->spread[base + q] = 1.0f;
         if (sub->material[rep] != VSGL__GBUFFER_MISS && count[q] > 1)
             mean_surface(g, base + q, sub, group, q, n);
     }

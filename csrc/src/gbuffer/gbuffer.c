@@ -165,6 +165,7 @@ void vsgl__gbuffer_free(vsgl_gbuffer *g)
     }
     free(g->material);
     free(g->weight);
+    free(g->spread);
     for (int k = 0; k < VSGL__SURF_N; ++k)
         free(g->surf[k]);
     memset(g, 0, sizeof *g);
@@ -180,8 +181,10 @@ int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted)
         ok &= (g->tan[k] = malloc((n + 1) * sizeof(float))) != NULL;
     }
     ok &= (g->material = malloc((n + 1) * sizeof(uint32_t))) != NULL;
-    if (weighted)
+    if (weighted) {
         ok &= (g->weight = malloc((n + 1) * sizeof(float))) != NULL;
+        ok &= (g->spread = malloc((n + 1) * sizeof(float))) != NULL;
+    }
     if (textured)
         for (int k = 0; k < VSGL__SURF_N; ++k)
             ok &= (g->surf[k] = malloc((n + 1) * sizeof(float))) != NULL;
@@ -260,8 +263,10 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
     if (r != VSGL_OK)
         return r;
     if (refine) {
-        for (size_t i = 0; i < out->count; ++i)
+        for (size_t i = 0; i < out->count; ++i) {
             out->weight[i] = i % spp < aa * aa ? 1.0f / (float)(aa * aa) : 0.0f;
+            out->spread[i] = 1.0f;
+        }
         job.edge = calloc((size_t)out->width * out->height + 1, 1);
         if (!job.edge) {
             vsgl__gbuffer_free(out);

@@ -32,6 +32,10 @@ typedef struct vsgl_gbuffer {
                                       pixel's slots hold one sample per surface it sees, weighted by
                                       the fraction of edge_aa x edge_aa rays that saw it (0 for unused
                                       slots, which are misses) */
+    float *spread;                 /* with weight: the length of the mean of the unit shading normals a
+                                      sample stands for, in (0, 1]: 1 for one ray; an edge slot's
+                                      group of rays on a curved surface, less (edges.c). The shade
+                                      stage widens its glossy lobe by the spread (shade.c) */
     size_t edge_pixels;            /* pixels refined */
 } vsgl_gbuffer;
 

@@ -41,8 +41,10 @@ static inline void vsgl__gbuffer_clear_slot(vsgl_gbuffer *g, size_t i, size_t li
     if (g->surf[0])
         for (int t = 0; t < VSGL__SURF_N; ++t)
             g->surf[t][i] = 0.0f;
-    if (g->weight)
+    if (g->weight) {
         g->weight[i] = 0.0f;
+        g->spread[i] = 1.0f;
+    }
 }
 
 /* Edge pixels (edges.c): mark then refine, rows [begin, end) of the job. */

@@ -111,7 +111,7 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
     memset(e, 0, sizeof *e);
     const vsgl_camera *cam = vsgl__scene_camera(scene);
     uint64_t pixels = (uint64_t)cam->width * cam->height;
-    /* edge refinement: a weight per sample, an edge mask per pixel, and a
+    /* edge refinement: a weight and a normal spread per sample, an edge mask per pixel, and a
      * second slot per pixel at one sample per pixel */
     int refined = s->edge_samples > s->aa_samples;
     uint64_t spp = (uint64_t)s->aa_samples * s->aa_samples;
@@ -120,7 +120,7 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
     uint64_t samples = mul(pixels, spp);
     uint64_t threads = vsgl_context_thread_count(ctx);
     e->output = output_bytes;
-    e->gbuffer = add(mul(samples, GBUFFER_BYTES_PER_SAMPLE + (refined ? 4u : 0u)), refined ? pixels : 0);
+    e->gbuffer = add(mul(samples, GBUFFER_BYTES_PER_SAMPLE + (refined ? 8u : 0u)), refined ? pixels : 0);
     e->planes = mul(pixels, PLANE_BYTES_PER_PIXEL);
 
     uint32_t light_count = 0;

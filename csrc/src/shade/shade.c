@@ -235,6 +235,27 @@ static void sample_params(const shade_job *j, size_t i, vsgl_brdf_params *bp)
     vsgl__material_params(&m, bp);
 }
 
+/* A sample that stands for normals of mean resultant length R < 1 (an
+ * edge slot on a curved surface, gbuffer.h spread): its GGX lobe convolved
+ * with their spread, as filtered glossy lighting does. As SGs, GGX of alpha
+ * is about sharpness 2 / alpha^2, and normals of resultant length R are
+ * about a vMF of sharpness 1 / (1 - R); sharpnesses of a convolution add
+ * as reciprocals: alpha'^2 = alpha^2 + 2 (1 - R). A glossy sphere's rim,
+ * whose reflection turns across a pixel, is otherwise shaded at one normal
+ * per surface, and that normal's sharp reflection changes from frame to
+ * frame as the camera moves: the sphere room's camera Gloss jitter (80 x
+ * 60, balanced) 0.0359 -> 0.0307 (0.0285 shading 8 x 8 samples), its
+ * frame-to-frame change 0.0499 -> 0.0447 (Cycles' own 0.0396); its still's
+ * Gloss structured error 0.00034 -> 0.00036. (4 (1 - R) gave 0.0285 /
+ * 0.0417 and 0.00039.) */
+static void widen_by_spread(vsgl_brdf_params *bp, float R)
+{
+    const float k = 2.0f * (1.0f - R);
+    float ax = sqrtf(bp->alpha_x * bp->alpha_x + k), ay = sqrtf(bp->alpha_y * bp->alpha_y + k);
+    bp->alpha_x = ax < 1.0f ? ax : 1.0f;
+    bp->alpha_y = ay < 1.0f ? ay : 1.0f;
+}
+
 static void setup_receiver(const shade_job *j, size_t i, receiver *r)
 {
     const vsgl_gbuffer *g = j->g;
@@ -242,6 +263,8 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->n = v3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
     r->o = v3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
     sample_params(j, i, &r->bp);
+    if (g->spread && g->spread[i] < 1.0f)
+        widen_by_spread(&r->bp, g->spread[i]);
     r->alpha = sqrtf(r->bp.alpha_x * r->bp.alpha_y);
     r->glossy = r->bp.glossy && v3_dot(r->n, r->o) > 0.0f;
     if (!r->glossy)
