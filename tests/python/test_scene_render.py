@@ -274,7 +274,7 @@ def test_render_estimate_and_memory_limit(lib):
         try:
             est = L.render_estimate(ctx, scene, L.render_settings_preset("balanced"), planes=("combined", "alpha"))
             assert est["output"] == 640 * 480 * 4 * 4
-            assert est["gbuffer"] == 640 * 480 * (4 * (52 + 4) + 1)  # + edge weights and mask
+            assert est["gbuffer"] == 640 * 480 * (4 * (52 + 8) + 1)  # + edge weights, normal spreads and mask
             assert est["total"] == sum(est[k] for k in ("output", "gbuffer", "planes", "rsm", "fit", "shade"))
             assert est["limit"] > est["total"]
             with pytest.raises(L.VsglError) as e:
