@@ -385,6 +385,32 @@ VT_TEST(gbuffer_edge_refinement_resolves_coverage)
     vsgl_context_destroy(ctx);
 }
 
+/* The edge slot tests' G-buffers of plane p: 2 x 2 samples with 16 x 16
+ * edge rays (fine), and 16 x 16 samples in every pixel (dense, the edge
+ * rays' own grid); 0 on failure (the context says why). */
+static int fine_and_dense(vsgl_context *ctx, const plane_scene *p, vsgl_scene **s, vsgl_gbuffer *fine,
+                          vsgl_gbuffer *dense)
+{
+    return vsgl_scene_create(ctx, &p->desc, s) == VSGL_OK && vsgl__gbuffer_build(ctx, *s, 2, 16, fine) == VSGL_OK &&
+           vsgl__gbuffer_build(ctx, *s, 16, 0, dense) == VSGL_OK;
+}
+
+/* The one slot of pixel px (4 slots) that holds a surface, where px is an
+ * edge pixel with one surface covering more than min_weight of it; else SIZE_MAX. */
+static size_t one_surface_slot(const vsgl_gbuffer *g, size_t px, float min_weight)
+{
+    size_t base = px * 4, hit_slot = SIZE_MAX;
+    int hits = 0;
+    for (int q = 0; q < 4; ++q)
+        if (g->material[base + q] != VSGL__GBUFFER_MISS && g->weight[base + q] > 0.0f) {
+            ++hits;
+            hit_slot = base + (size_t)q;
+        }
+    if (hits != 1 || g->weight[hit_slot] > 0.99f || g->weight[hit_slot] < min_weight)
+        return SIZE_MAX;
+    return hit_slot;
+}
+
 /* An edge pixel's slot stands for its surface's share of the pixel with
  * the mean of that share's shading normals (edges.c mean_normal), not the
  * one ray that represents it: on a smooth-shaded surface whose normal turns
@@ -408,22 +434,14 @@ VT_TEST(gbuffer_edge_slot_takes_its_surfaces_mean_normal)
     p.desc.corner_normals = cn;
     vsgl_context *ctx = make_ctx(2);
     vsgl_scene *s = NULL;
-    VT_REQUIRE(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
     vsgl_gbuffer fine, dense;
-    VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 2, 16, &fine) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
-    VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 16, 0, &dense) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    VT_REQUIRE(fine_and_dense(ctx, &p, &s, &fine, &dense), "'%s'", vsgl_context_last_error(ctx));
     size_t checked = 0;
     double worst = 0.0, spread = 0.0, worst_spread = 0.0, max_spread = 0.0;
     size_t spread_px = 0;
     for (size_t px = 0; px < (size_t)64 * 48; ++px) {
-        size_t base = px * 4, hit_slot = 4;
-        int hits = 0;
-        for (int q = 0; q < 4; ++q)
-            if (fine.material[base + q] != VSGL__GBUFFER_MISS && fine.weight[base + q] > 0.0f) {
-                ++hits;
-                hit_slot = base + (size_t)q;
-            }
-        if (hits != 1 || fine.weight[hit_slot] > 0.99f)
+        const size_t hit_slot = one_surface_slot(&fine, px, 0.0f);
+        if (hit_slot == SIZE_MAX)
             continue; /* not an edge pixel with one surface */
         double m[3] = {0, 0, 0};
         for (size_t j = px * 256; j < px * 256 + 256; ++j)
@@ -482,22 +500,14 @@ VT_TEST(gbuffer_edge_slot_on_a_flat_surface_takes_its_mean_point)
     slanted_plane(&p, -5.0f, 0.3f, 0.37f, 2.0f);
     vsgl_context *ctx = make_ctx(2);
     vsgl_scene *s = NULL;
-    VT_REQUIRE(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
     vsgl_gbuffer fine, dense;
-    VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 2, 16, &fine) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
-    VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 16, 0, &dense) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+    VT_REQUIRE(fine_and_dense(ctx, &p, &s, &fine, &dense), "'%s'", vsgl_context_last_error(ctx));
     size_t checked = 0;
     double worst = 0.0, ray = 0.0;
     for (size_t px = 0; px < (size_t)64 * 48; ++px) {
-        size_t base = px * 4, hit_slot = 4;
-        int hits = 0;
-        for (int q = 0; q < 4; ++q)
-            if (fine.material[base + q] != VSGL__GBUFFER_MISS && fine.weight[base + q] > 0.0f) {
-                ++hits;
-                hit_slot = base + (size_t)q;
-            }
-        if (hits != 1 || fine.weight[hit_slot] > 0.99f || fine.weight[hit_slot] < 0.1f)
-            continue; /* not an edge pixel with one surface */
+        const size_t hit_slot = one_surface_slot(&fine, px, 0.1f);
+        if (hit_slot == SIZE_MAX)
+            continue; /* not an edge pixel with one surface (of at least a tenth of it) */
         double m[3] = {0, 0, 0};
         size_t nh = 0;
         for (size_t j = px * 256; j < px * 256 + 256; ++j)
