@@ -71,8 +71,10 @@ if want install_bpy_pin; then
 fi
 
 # No script hands PIP_PYTHON to a child any more (pip would take it as --python).
+# Allowed: removing it (`unset PIP_PYTHON`, `env -u PIP_PYTHON`) and comments.
 if want no_pip_python; then
-  hits=$(grep -rn 'PIP_PYTHON' Makefile .ci tools tests/blender tests/cli 2>/dev/null | grep -v 'unset PIP_PYTHON' | grep -v '^tools/install_bpy.sh:.*#')
+  hits=$(grep -rn 'PIP_PYTHON' Makefile .ci tools tests/blender tests/cli 2>/dev/null |
+    grep -v -e 'unset PIP_PYTHON' -e 'env -u PIP_PYTHON' | grep -Ev '^[^:]+:[0-9]+:\s*#')
   if [ -z "$hits" ]; then ok no_pip_python; else bad no_pip_python "$hits"; fi
 fi
 
