@@ -170,9 +170,9 @@ int main(int argc, char **argv)
             all = fnv(all, &h, sizeof h);
             if (!quiet)
                 printf("%s %2d: cpu %.4f wall %.4f (%ux%u stride %u; gbuffer %.4f rsm %.4f fit %.4f shade %.4f) "
-                       "hash %016llx\n", step ? "refine" : "edit  ", e, c1 - c0, w1 - w0, c.width, c.height,
+                       "%u VSGLs, %.3g pairs; hash %016llx\n", step ? "refine" : "edit  ", e, c1 - c0, w1 - w0, c.width, c.height,
                        coarse_step ? moving.shade_stride : s.shade_stride, st.seconds_gbuffer, st.seconds_rsm,
-                       st.seconds_fit, st.seconds_shade, (unsigned long long)h);
+                       st.seconds_fit, st.seconds_shade, st.vsgl_count, (double)st.shading_pairs, (unsigned long long)h);
             if (e >= 0 && step == 0) {
                 cpu[e] = c1 - c0;
                 wall[e] = w1 - w0;

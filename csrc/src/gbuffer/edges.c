@@ -11,10 +11,12 @@
  *     surfaces (hit vs miss, another material, normals more than ~25
  *     degrees apart, or off each other's tangent plane);
  *  2. refine: an edge pixel is traced again with edge_aa x edge_aa rays,
- *     the rays are grouped by surface (at most spp groups; a further
- *     surface joins its most similar group), and slot q of the pixel holds
- *     the ray nearest the centre of group q, weighted by the group's share
- *     of the rays. Unused slots are misses of weight 0.
+ *     the rays are grouped by surface (neighbouring rays on one surface
+ *     chain into one piece, so a curved rim is one group; at most spp
+ *     groups, a further surface joins its most similar group; group_rays),
+ *     and slot q of the pixel holds the ray nearest the centre of group q,
+ *     weighted by the group's share of the rays. Unused slots are misses
+ *     of weight 0.
  * The shade stage still shades at most spp samples per pixel; only the
  * coverage is resolved finer. Every pixel is decided from its own and its
  * neighbours' first-pass samples, and refined in place: the result does
@@ -141,7 +143,12 @@ static uint32_t nearest_group(const vsgl_gbuffer *sub, const size_t *founder, ui
  *    moves 0.0109 -> 0.0089 at 80 x 60). On a curved surface the mean point
  *    lies off the surface, where a pixel at a sphere's rim spans much of
  *    it: the sphere room's camera flicker rose 0.023 -> 0.037 (Diff) with
- *    it, so a curved group keeps its representative's point. */
+ *    it, so a curved group takes the point (and view) of its ray whose
+ *    normal is nearest the mean: a point of the surface where it has about
+ *    that normal. (The ray nearest the group's centre did, while a rim
+ *    was two groups; as one, that point's own normal is far from the
+ *    mean's, and visibility rays leaving along the mean normal grazed the
+ *    sphere there.) */
 #define MEAN_FLAT 1e-3f
 static void mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, const uint8_t *group, uint32_t q,
                          uint32_t n)
@@ -168,17 +175,22 @@ static void mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, co
     v3 p = v3_scale(psum, 1.0f / (float)count), v = v3_scale(vsum, 1.0f / vlen);
     /* the mean point where the rays' hits lie on one plane (within MEAN_FLAT
      * of their spread), else the representative's */
-    float hmax = 0.0f, r2max = 0.0f;
+    float hmax = 0.0f, r2max = 0.0f, best = -2.0f;
+    uint32_t along = n;
     for (uint32_t s = 0; s < n; ++s)
         if (group[s] == q && sub->material[s] == g->material[to]) {
             v3 d = v3_sub(at3(sub->pos, s), p);
-            float h = fabsf(v3_dot(d, m)), r2 = v3_dot(d, d);
+            float h = fabsf(v3_dot(d, m)), r2 = v3_dot(d, d), c = v3_dot(at3(sub->nrm, s), m);
             hmax = h > hmax ? h : hmax;
             r2max = r2 > r2max ? r2 : r2max;
+            if (c > best) {
+                best = c;
+                along = s;
+            }
         }
-    if (!(hmax <= MEAN_FLAT * sqrtf(r2max))) {
-        p = at3(g->pos, to);
-        v = at3(g->view, to);
+    if (!(hmax <= MEAN_FLAT * sqrtf(r2max)) && along < n) {
+        p = at3(sub->pos, along);
+        v = at3(sub->view, along);
     }
     const float mv[3] = {m.x, m.y, m.z}, tv[3] = {t.x, t.y, t.z}, pv[3] = {p.x, p.y, p.z}, vv[3] = {v.x, v.y, v.z};
     for (int k = 0; k < 3; ++k) {
@@ -187,6 +199,67 @@ static void mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, co
         g->pos[k][to] = pv[k];
         g->view[k][to] = vv[k];
     }
+}
+
+static uint32_t find_root(uint16_t *parent, uint32_t s)
+{
+    while (parent[s] != s) {
+        parent[s] = parent[parent[s]];
+        s = parent[s];
+    }
+    return s;
+}
+
+/* Group the E x E rays of an edge pixel (in `sub`) by surface, at most spp
+ * groups; returns their number, group[s] for each ray and each group's
+ * founder (its first ray). Rays joined by a chain of neighbours on one
+ * surface are one piece first: a glossy sphere's rim, whose normal turns
+ * by more than EDGE_NORMAL_COS across a pixel but little from a ray to the
+ * next, stays one piece. Compared ray by ray with each group's first ray
+ * (as before), the rim split where the first ray happened to fall, and
+ * the split moved from frame to frame as the camera moved. Then each
+ * piece, in the order of its first ray, joins the first group whose
+ * founder lies on its first ray's surface (two parts of a floor on either
+ * side of a pole), else founds a group, else (all slots taken) joins the
+ * most similar group. */
+static uint32_t group_rays(const gb_job *job, const vsgl_gbuffer *sub, size_t *founder, uint8_t *group)
+{
+    const uint32_t E = job->edge_aa, n = E * E, spp = job->g->spp;
+    uint16_t parent[VSGL__GBUFFER_MAX_SPP];
+    int16_t piece_group[VSGL__GBUFFER_MAX_SPP];
+    for (uint32_t s = 0; s < n; ++s) {
+        parent[s] = (uint16_t)s;
+        piece_group[s] = -1;
+    }
+    for (uint32_t s = 0; s < n; ++s) {
+        uint32_t nb[2] = {s % E + 1 < E ? s + 1 : s, s + E < n ? s + E : s};
+        for (int k = 0; k < 2; ++k) {
+            if (nb[k] == s || !same_surface(sub, s, nb[k], job->plane_tol))
+                continue;
+            uint32_t a = find_root(parent, s), b = find_root(parent, nb[k]);
+            if (a != b)
+                parent[a > b ? a : b] = (uint16_t)(a < b ? a : b); /* the smaller index is the root */
+        }
+    }
+    uint32_t groups = 0;
+    for (uint32_t s = 0; s < n; ++s) {
+        uint32_t r = find_root(parent, s);
+        if (piece_group[r] < 0) {
+            uint32_t q = groups;
+            for (uint32_t t = 0; t < groups && q == groups; ++t)
+                if (same_surface(sub, founder[t], s, job->plane_tol))
+                    q = t;
+            if (q == groups) {
+                if (groups < spp)
+                    founder[groups++] = s;
+                else
+                    q = nearest_group(sub, founder, groups, s);
+            }
+            piece_group[r] = (int16_t)q;
+        }
+        group[s] = (uint8_t)piece_group[r];
+    }
+    return groups;
 }
 
 /* Refine pixel (x, y): trace E x E rays into `sub` and rewrite its slots. */
@@ -212,23 +285,13 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint3
     uint32_t count[VSGL__GBUFFER_MAX_SPP];
     float cx[VSGL__GBUFFER_MAX_SPP], cy[VSGL__GBUFFER_MAX_SPP];
     uint8_t group[VSGL__GBUFFER_MAX_SPP];
-    uint32_t groups = 0;
+    uint32_t groups = group_rays(job, sub, founder, group);
+    for (uint32_t q = 0; q < groups; ++q) {
+        count[q] = 0;
+        cx[q] = cy[q] = 0.0f;
+    }
     for (uint32_t s = 0; s < n; ++s) {
-        uint32_t q = groups;
-        for (uint32_t t = 0; t < groups && q == groups; ++t)
-            if (same_surface(sub, founder[t], s, job->plane_tol))
-                q = t;
-        if (q == groups) {
-            if (groups < spp) {
-                founder[groups] = s;
-                count[groups] = 0;
-                cx[groups] = cy[groups] = 0.0f;
-                ++groups;
-            } else {
-                q = nearest_group(sub, founder, groups, s);
-            }
-        }
-        group[s] = (uint8_t)q;
+        uint32_t q = group[s];
         count[q] += 1;
         cx[q] += (float)(s % E);
         cy[q] += (float)(s / E);

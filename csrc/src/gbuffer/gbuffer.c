@@ -36,7 +36,9 @@ static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_sur
                       const vsgl_hit *hit, const v3 *fr)
 {
     store3(g->view, i, v3_neg(dir));
-    store3(g->pos, i, sf->position);
+    /* on the smooth surface the normals describe: where visibility rays
+     * start, a smooth-shaded mesh's facet would shadow its own neighbours */
+    store3(g->pos, i, vsgl__scene_smooth_point(j->scene, hit, sf));
     store3(g->nrm, i, sf->normal);
     store3(g->tan, i, sf->tangent);
     g->material[i] = sf->material;

@@ -184,6 +184,23 @@ static v3 orthogonalize(v3 t, v3 n)
     return v3_normalize(v3_sub(t, v3_scale(n, v3_dot(n, t))));
 }
 
+v3 vsgl__scene_smooth_point(const vsgl_scene *scene, const vsgl_hit *hit, const vsgl_surface *sf)
+{
+    uint32_t tri = hit->triangle;
+    const uint32_t *ix = scene->indices + (size_t)tri * 3;
+    const float *cn = scene->corner_normals + (size_t)tri * 9;
+    const float b[3] = {1.0f - hit->u - hit->v, hit->u, hit->v};
+    const float side = v3_dot(load3(scene->face_normals + (size_t)tri * 3), sf->geometric_normal) < 0.0f ? -1.0f : 1.0f;
+    v3 p = sf->position, lift = v3_make(0.0f, 0.0f, 0.0f);
+    for (int k = 0; k < 3; ++k) {
+        v3 n = v3_scale(load3(cn + 3 * k), side);
+        float below = v3_dot(v3_sub(p, load3(scene->positions + (size_t)ix[k] * 3)), n);
+        if (below < 0.0f)
+            lift = v3_sub(lift, v3_scale(n, b[k] * below));
+    }
+    return v3_add(p, lift);
+}
+
 void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, vsgl_surface *out)
 {
     uint32_t tri = hit->triangle;

@@ -57,6 +57,14 @@ void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, v
 void vsgl__scene_surface4(const vsgl_scene *scene, const vsgl_hit hit[4], const v3 dir[4], vsgl_surface out[4]);
 #endif
 
+/* Hit point sf->position of `hit` lifted from its flat triangle onto the
+ * smooth surface its corner normals describe, on the side the ray came
+ * from (sf->geometric_normal's): p - sum_i b_i min(0, (p - v_i).n_i) n_i,
+ * the shadow-terminator offset of Hanika, Droske and Fascione (2021), as
+ * Cycles starts its shadow rays. On a flat face (corner normals = the face
+ * normal) it is p. */
+v3 vsgl__scene_smooth_point(const vsgl_scene *scene, const vsgl_hit *hit, const vsgl_surface *sf);
+
 /* Textures (scene/texture.h). A scene whose materials read textures or
  * corner colours is "textured": the stages then evaluate the material
  * inputs per point (G-buffer sample, RSM texel) instead of per material. */
