@@ -104,6 +104,9 @@ static void copy_sample(vsgl_gbuffer *dst, size_t to, const vsgl_gbuffer *src, s
         dst->tan[k][to] = src->tan[k][from];
     }
     dst->material[to] = src->material[from];
+    if (dst->lift[0])
+        for (int k = 0; k < 3; ++k)
+            dst->lift[k][to] = src->lift[k][from];
     if (dst->surf[0])
         for (int q = 0; q < VSGL__SURF_N; ++q)
             dst->surf[q][to] = src->surf[q][from];
@@ -191,6 +194,12 @@ static void mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, co
     if (!(hmax <= MEAN_FLAT * sqrtf(r2max)) && along < n) {
         p = at3(sub->pos, along);
         v = at3(sub->view, along);
+        if (g->lift[0])
+            for (int k = 0; k < 3; ++k)
+                g->lift[k][to] = sub->lift[k][along];
+    } else if (g->lift[0]) {
+        for (int k = 0; k < 3; ++k)
+            g->lift[k][to] = 0.0f; /* on one plane */
     }
     const float mv[3] = {m.x, m.y, m.z}, tv[3] = {t.x, t.y, t.z}, pv[3] = {p.x, p.y, p.z}, vv[3] = {v.x, v.y, v.z};
     for (int k = 0; k < 3; ++k) {
@@ -327,7 +336,7 @@ int32_t vsgl__gbuffer_refine_edges(void *user, size_t chunk, size_t begin, size_
     const uint32_t W = job->g->width;
     vsgl_gbuffer sub;
     memset(&sub, 0, sizeof sub);
-    if (!vsgl__gbuffer_alloc(&sub, (size_t)job->edge_aa * job->edge_aa, job->g->surf[0] != NULL, 0))
+    if (!vsgl__gbuffer_alloc(&sub, (size_t)job->edge_aa * job->edge_aa, job->g->surf[0] != NULL, 0, job->g->lift[0] != NULL))
         return VSGL_ERROR_OUT_OF_MEMORY;
     for (size_t r = begin; r < end; ++r) {
         uint32_t y = job->row0 + (uint32_t)r;

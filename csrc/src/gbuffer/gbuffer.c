@@ -36,9 +36,9 @@ static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_sur
                       const vsgl_hit *hit, const v3 *fr)
 {
     store3(g->view, i, v3_neg(dir));
-    /* on the smooth surface the normals describe: where visibility rays
-     * start, a smooth-shaded mesh's facet would shadow its own neighbours */
-    store3(g->pos, i, vsgl__scene_smooth_point(j->scene, hit, sf));
+    store3(g->pos, i, sf->position);
+    if (g->lift[0])
+        store3(g->lift, i, v3_sub(vsgl__scene_smooth_point(j->scene, hit, sf), sf->position));
     store3(g->nrm, i, sf->normal);
     store3(g->tan, i, sf->tangent);
     g->material[i] = sf->material;
@@ -105,6 +105,8 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
             store3(g->nrm, i, zero);
             store3(g->tan, i, zero);
             g->material[i] = VSGL__GBUFFER_MISS;
+            if (g->lift[0])
+                store3(g->lift, i, zero);
             if (g->surf[0])
                 for (int q = 0; q < VSGL__SURF_N; ++q)
                     g->surf[q][i] = 0.0f;
@@ -164,6 +166,7 @@ void vsgl__gbuffer_free(vsgl_gbuffer *g)
         free(g->nrm[k]);
         free(g->view[k]);
         free(g->tan[k]);
+        free(g->lift[k]);
     }
     free(g->material);
     free(g->weight);
@@ -173,7 +176,7 @@ void vsgl__gbuffer_free(vsgl_gbuffer *g)
     memset(g, 0, sizeof *g);
 }
 
-int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted)
+int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted, int smooth)
 {
     int ok = 1;
     for (int k = 0; k < 3; ++k) {
@@ -187,6 +190,9 @@ int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted)
         ok &= (g->weight = malloc((n + 1) * sizeof(float))) != NULL;
         ok &= (g->spread = malloc((n + 1) * sizeof(float))) != NULL;
     }
+    if (smooth)
+        for (int k = 0; k < 3; ++k)
+            ok &= (g->lift[k] = malloc((n + 1) * sizeof(float))) != NULL;
     if (textured)
         for (int k = 0; k < VSGL__SURF_N; ++k)
             ok &= (g->surf[k] = malloc((n + 1) * sizeof(float))) != NULL;
@@ -253,7 +259,8 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
     v3 lo, hi;
     vsgl__scene_bounds(scene, &lo, &hi);
     job.plane_tol = 1e-3f * v3_length(v3_sub(hi, lo));
-    if (!vsgl__gbuffer_alloc(out, (size_t)cam->width * cam->height * spp, vsgl__scene_textured(scene), refine))
+    if (!vsgl__gbuffer_alloc(out, (size_t)cam->width * cam->height * spp, vsgl__scene_textured(scene), refine,
+                              vsgl__scene_smooth(scene)))
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "gbuffer: out of memory for %ux%u pixels x %u samples",
                           (unsigned)cam->width, (unsigned)cam->height, (unsigned)spp);
     out->width = cam->width;

@@ -36,6 +36,11 @@ typedef struct vsgl_gbuffer {
                                       sample stands for, in (0, 1]: 1 for one ray; an edge slot's
                                       group of rays on a curved surface, less (edges.c). The shade
                                       stage widens its glossy lobe by the spread (shade.c) */
+    float *lift[3];                /* NULL unless the scene has smooth-shaded triangles; else per sample
+                                      the step from its point (on its flat triangle, where Cycles
+                                      shades it too) up to the smooth surface its normals describe
+                                      (vsgl__scene_smooth_point), where its visibility rays start:
+                                      from the triangle they would hit the sample's own mesh */
     size_t edge_pixels;            /* pixels refined */
 } vsgl_gbuffer;
 

@@ -27,8 +27,9 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
                          const size_t *dst, float foot);
 
 /* Allocate g's per-sample arrays for n samples (surf too when textured,
- * weight when weighted); 0 when out of memory (then g is freed). */
-int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted);
+ * weight and spread when weighted, lift when smooth); 0 when out of memory
+ * (then g is freed). */
+int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted, int smooth);
 
 /* Empty slot i (a miss that weighs nothing); its view is slot `like`'s. */
 static inline void vsgl__gbuffer_clear_slot(vsgl_gbuffer *g, size_t i, size_t like)
@@ -45,6 +46,9 @@ static inline void vsgl__gbuffer_clear_slot(vsgl_gbuffer *g, size_t i, size_t li
         g->weight[i] = 0.0f;
         g->spread[i] = 1.0f;
     }
+    if (g->lift[0])
+        for (int k = 0; k < 3; ++k)
+            g->lift[k][i] = 0.0f;
 }
 
 /* Edge pixels (edges.c): mark then refine, rows [begin, end) of the job. */

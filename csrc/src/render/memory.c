@@ -120,7 +120,9 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
     uint64_t samples = mul(pixels, spp);
     uint64_t threads = vsgl_context_thread_count(ctx);
     e->output = output_bytes;
-    e->gbuffer = add(mul(samples, GBUFFER_BYTES_PER_SAMPLE + (refined ? 8u : 0u)), refined ? pixels : 0);
+    /* + the lift on scenes with smooth-shaded meshes (gbuffer.h) */
+    const uint32_t extra = (refined ? 8u : 0u) + (vsgl__scene_smooth(scene) ? 12u : 0u);
+    e->gbuffer = add(mul(samples, GBUFFER_BYTES_PER_SAMPLE + extra), refined ? pixels : 0);
     e->planes = mul(pixels, PLANE_BYTES_PER_PIXEL);
 
     uint32_t light_count = 0;

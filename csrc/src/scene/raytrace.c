@@ -201,6 +201,11 @@ v3 vsgl__scene_smooth_point(const vsgl_scene *scene, const vsgl_hit *hit, const 
     return v3_add(p, lift);
 }
 
+int vsgl__scene_smooth(const vsgl_scene *scene)
+{
+    return scene->smooth;
+}
+
 void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, vsgl_surface *out)
 {
     uint32_t tri = hit->triangle;

@@ -230,6 +230,7 @@ static void copy_triangle(const vsgl_scene_desc *d, vsgl_scene *s, uint32_t *ib,
         cn[c * 3 + 0] = (float)(n.x / l);
         cn[c * 3 + 1] = (float)(n.y / l);
         cn[c * 3 + 2] = (float)(n.z / l);
+        s->smooth |= cn[c * 3] * fn[0] + cn[c * 3 + 1] * fn[1] + cn[c * 3 + 2] * fn[2] < 1.0f - 1e-6f;
     }
     if (s->corner_uvs)
         memcpy(s->corner_uvs + (size_t)o * 6, d->corner_uvs + (size_t)t * 6, 6 * sizeof(float));

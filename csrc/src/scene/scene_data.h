@@ -38,6 +38,7 @@ struct vsgl_scene {
     float *corner_colors;        /* triangle_count * 9 or NULL */
     float *uv_density;           /* triangle_count: UV area / world area (0 without UVs); NULL if untextured */
     int textured;                /* some material reads a texture or corner colours */
+    int smooth;                  /* some corner normal is not its face's normal (vsgl__scene_smooth) */
     v3 lo, hi;                   /* bounds of the valid triangles (0,0,0 when empty) */
     v3 occ_inner_lo, occ_inner_hi; /* scene/occluders.c: segments strictly inside meet no face triangle */
     uint32_t occ_count;          /* boxes around the triangles off the bounds' faces */

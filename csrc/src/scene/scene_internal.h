@@ -64,6 +64,9 @@ void vsgl__scene_surface4(const vsgl_scene *scene, const vsgl_hit hit[4], const 
  * Cycles starts its shadow rays. On a flat face (corner normals = the face
  * normal) it is p. */
 v3 vsgl__scene_smooth_point(const vsgl_scene *scene, const vsgl_hit *hit, const vsgl_surface *sf);
+/* 1 if some triangle's corner normals are not its face normal (a smooth-
+ * shaded mesh), where vsgl__scene_smooth_point moves points. */
+int vsgl__scene_smooth(const vsgl_scene *scene);
 
 /* Textures (scene/texture.h). A scene whose materials read textures or
  * corner colours is "textured": the stages then evaluate the material

@@ -60,6 +60,8 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 P = &own;
             }
             v3 x = load(g->pos, s), n = load(g->nrm, s), v = load(g->view, s), t = load(g->tan, s);
+            /* visibility rays from the smooth surface (gbuffer.h lift) */
+            const v3 xo = g->lift[0] ? v3_add(x, load(g->lift, s)) : x;
             memcpy(dcol, P->diffuse, sizeof dcol);
             float ms[3]; /* the receiver's glossy compensation towards the viewer */
             for (int c = 0; c < 3; ++c)
@@ -92,7 +94,7 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 if (!(rd[0] + rd[1] + rd[2] + rg[0] + rg[1] + rg[2] > 0.0f))
                     continue;
                 if (j->visibility &&
-                    vsgl__scene_occluded(j->scene, x, w, j->eps, dist * (1.0f - 1e-4f) - j->eps))
+                    vsgl__scene_occluded(j->scene, xo, w, j->eps, dist * (1.0f - 1e-4f) - j->eps))
                     continue;
                 double inv = 1.0 / ((double)d2 + (double)q->area * (1.0 / VSGL__PI_D));
                 for (int c = 0; c < 3; ++c) {

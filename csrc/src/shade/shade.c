@@ -262,6 +262,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->x = v3_make(g->pos[0][i], g->pos[1][i], g->pos[2][i]);
     r->n = v3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
     r->o = v3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
+    r->lift = g->lift[0] ? v3_make(g->lift[0][i], g->lift[1][i], g->lift[2][i]) : v3_make(0.0f, 0.0f, 0.0f);
     sample_params(j, i, &r->bp);
     if (g->spread && g->spread[i] < 1.0f)
         widen_by_spread(&r->bp, g->spread[i]);
@@ -327,7 +328,7 @@ typedef struct ray_origins {
 static void origins_of(const shade_job *j, const receiver *rec, size_t n, ray_origins *o)
 {
     for (size_t k = 0; k < n; ++k) {
-        v3 p = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
+        v3 p = v3_add(v3_add(rec[k].x, rec[k].lift), v3_scale(rec[k].n, j->eps));
         o->x[k] = p.x;
         o->y[k] = p.y;
         o->z[k] = p.z;

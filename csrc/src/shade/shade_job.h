@@ -95,6 +95,7 @@ typedef struct shade_job {
 /* Receiver lobe of one sample, set up once and used for every VSGL. */
 typedef struct receiver {
     v3 x, n, o;
+    v3 lift;             /* visibility rays start at x + lift (gbuffer.h lift) */
     vsgl_brdf_params bp;
     float alpha;
     int glossy;
