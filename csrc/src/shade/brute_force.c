@@ -1,5 +1,6 @@
 /* Brute-force VPL gathering with the exact BRDF (see brute_force.h). */
 #include "shade/brute_force.h"
+#include "shade/shade.h"
 #include "math/constants.h"
 
 #include "core/context.h"
@@ -33,6 +34,20 @@ typedef struct bf_job {
 
 static v3 load(float *const a[3], size_t i) { return v3_make(a[0][i], a[1][i], a[2][i]); }
 
+/* Is VPL point p hidden from ray origin o (a receiver, lifted onto its
+ * smooth surface: gbuffer.h lift)? The segment stops short of p, measured
+ * from o: from the receiver's own point it overshot p by the lift and hit
+ * the VPL's own surface behind it (the sphere room's brute force lost a
+ * quarter of its glossy light). */
+static int occluded_from(const bf_job *j, v3 o, v3 p)
+{
+    v3 d = v3_sub(p, o);
+    float len = v3_length(d);
+    if (!(len > j->eps))
+        return 0;
+    return vsgl__scene_occluded(j->scene, o, v3_scale(d, 1.0f / len), j->eps, len * (1.0f - 1e-4f) - j->eps);
+}
+
 static void put3(float *plane, size_t i, const float v[3])
 {
     if (plane) {
@@ -60,8 +75,8 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 P = &own;
             }
             v3 x = load(g->pos, s), n = load(g->nrm, s), v = load(g->view, s), t = load(g->tan, s);
-            /* visibility rays from the smooth surface (gbuffer.h lift) */
-            const v3 xo = g->lift[0] ? v3_add(x, load(g->lift, s)) : x;
+            /* grazing visibility rays from the smooth surface (gbuffer.h lift) */
+            const v3 lift = g->lift[0] ? load(g->lift, s) : v3_make(0.0f, 0.0f, 0.0f);
             memcpy(dcol, P->diffuse, sizeof dcol);
             float ms[3]; /* the receiver's glossy compensation towards the viewer */
             for (int c = 0; c < 3; ++c)
@@ -93,8 +108,7 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 vsgl__brdf_eval(P, n, t, w, v, rd, rg);
                 if (!(rd[0] + rd[1] + rd[2] + rg[0] + rg[1] + rg[2] > 0.0f))
                     continue;
-                if (j->visibility &&
-                    vsgl__scene_occluded(j->scene, xo, w, j->eps, dist * (1.0f - 1e-4f) - j->eps))
+                if (j->visibility && occluded_from(j, v3_add(x, v3_scale(lift, vsgl__lift_share(v3_dot(n, w)))), q->p))
                     continue;
                 double inv = 1.0 / ((double)d2 + (double)q->area * (1.0 / VSGL__PI_D));
                 for (int c = 0; c < 3; ++c) {

@@ -320,7 +320,7 @@ static uint64_t lanes_of(size_t n)
 }
 
 /* Where visibility rays start: receiver k offset along its normal by eps
- * (coordinates by lane). */
+ * (coordinates by lane); visibility_rays lifts the grazing ones. */
 typedef struct ray_origins {
     float x[VSGL__KERNEL_BLOCK], y[VSGL__KERNEL_BLOCK], z[VSGL__KERNEL_BLOCK];
 } ray_origins;
@@ -328,11 +328,50 @@ typedef struct ray_origins {
 static void origins_of(const shade_job *j, const receiver *rec, size_t n, ray_origins *o)
 {
     for (size_t k = 0; k < n; ++k) {
-        v3 p = v3_add(v3_add(rec[k].x, rec[k].lift), v3_scale(rec[k].n, j->eps));
+        v3 p = v3_add(rec[k].x, v3_scale(rec[k].n, j->eps));
         o->x[k] = p.x;
         o->y[k] = p.y;
         o->z[k] = p.z;
     }
+}
+
+/* How much of a smooth-shaded receiver's lift (gbuffer.h) a visibility
+ * ray takes, by the cosine c of its direction to the receiver's normal:
+ * all of it up to VSGL__LIFT_FULL, none from VSGL__LIFT_NONE (as Cycles
+ * offsets only its shadow rays near the horizon). A ray near the horizon
+ * may leave below the receiver's flat triangle and hit its own mesh (the
+ * shadow terminator); a steep one does not, and starting it off the
+ * surface would let it pass under an occluder that touches the surface
+ * (a low-poly smooth-shaded mesh's lift reaches centimetres). */
+#define VSGL__LIFT_FULL 0.25f
+#define VSGL__LIFT_NONE 0.5f
+float vsgl__lift_share(float c)
+{
+    float a = (VSGL__LIFT_NONE - c) * (1.0f / (VSGL__LIFT_NONE - VSGL__LIFT_FULL));
+    return a < 0.0f ? 0.0f : (a > 1.0f ? 1.0f : a);
+}
+
+/* The origins of lanes idx[0..m) towards `target`, lifted by their share
+ * (vsgl__lift_share) into *lifted; org itself where no receiver is lifted. */
+static const ray_origins *lift_grazing(const receiver *rec, const ray_origins *org, const uint32_t *idx, uint32_t m,
+                                       v3 target, ray_origins *lifted)
+{
+    int any = 0;
+    for (uint32_t i = 0; i < m; ++i) {
+        uint32_t k = idx[i];
+        v3 o = v3_make(org->x[k], org->y[k], org->z[k]);
+        if (rec[k].lift.x != 0.0f || rec[k].lift.y != 0.0f || rec[k].lift.z != 0.0f) {
+            v3 d = v3_sub(target, rec[k].x);
+            float len = v3_length(d);
+            float share = len > 0.0f ? vsgl__lift_share(v3_dot(rec[k].n, d) / len) : 0.0f;
+            o = v3_add(o, v3_scale(rec[k].lift, share));
+            any |= share > 0.0f;
+        }
+        lifted->x[k] = o.x;
+        lifted->y[k] = o.y;
+        lifted->z[k] = o.z;
+    }
+    return any ? lifted : org;
 }
 
 /* Visibility of `target` (a VSGL's ray target) from the receivers k <
@@ -365,8 +404,11 @@ static uint64_t visibility_rays(const shade_job *j, v3 target, const vsgl_kernel
         }
         idx[m++] = k;
     }
-    if (m)
-        vsgl__scene_occluded_towards(j->scene, m, idx, org->x, org->y, org->z, target, j->eps, blocked);
+    if (m) {
+        ray_origins lifted;
+        const ray_origins *from = lift_grazing(rec, org, idx, m, target, &lifted);
+        vsgl__scene_occluded_towards(j->scene, m, idx, from->x, from->y, from->z, target, j->eps, blocked);
+    }
     for (uint32_t i = 0; i < m; ++i)
         visible |= (uint64_t)!blocked[i] << idx[i];
     return visible;

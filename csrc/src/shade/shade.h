@@ -57,6 +57,10 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
  * (the kernel computes the same inline); `on` selects the clip. */
 float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
 
+/* The share of a smooth-shaded receiver's lift (gbuffer.h) that a
+ * visibility ray leaving at cosine c to its normal starts from (shade.c). */
+float vsgl__lift_share(float c);
+
 /* Glossy light of a planar, Lambertian cluster (the lattice's diffuse
  * VSGLs) through a receiver lobe (ASG, amplitude included), per watt: the
  * cluster's plane has radiance N(y)/pi, N its 2-D Gaussian of variance
