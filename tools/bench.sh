@@ -44,9 +44,18 @@ fi
 echo "== EXR writing: every compression, float and half"
 tools/bench_exr.sh
 echo "== the trade: error against whole-frame time, library vs Cycles and Cycles + OIDN (issue 11)"
-if "$py" -c 'import numpy, matplotlib, flip_evaluator, bpy' >/dev/null 2>&1; then
+# the modules the trade needs that $py cannot import, by their PyPI names
+lacks=$("$py" -c '
+import importlib
+for mod, pkg in (("numpy", "numpy"), ("matplotlib", "matplotlib"), ("flip_evaluator", "flip-evaluator"), ("bpy", "bpy")):
+    try:
+        importlib.import_module(mod)
+    except Exception:
+        print(pkg, end=" ")' 2>/dev/null || echo "numpy matplotlib flip-evaluator bpy")
+if [ -z "$lacks" ]; then
   # Cycles references and sweeps are rendered (niced) when missing, then cached
   if [ "${BENCH_QUICK:-0}" = 1 ]; then "$py" tools/trade.py --quick; else "$py" tools/trade.py --docs; fi
 else
-  echo "trade: skipped: $py lacks numpy, matplotlib, flip-evaluator or bpy (OIDN)"
+  echo "trade: skipped: $py ($("$py" -c 'import sys; print(sys.executable)' 2>/dev/null)) lacks: ${lacks% }" \
+    "(pip install them into it; bpy, with OIDN: tools/install_bpy.sh)"
 fi
