@@ -36,9 +36,8 @@ PY=${BPY_PYTHON:-python3}
 # FLIP (the perceptual error) needs the reference implementation from PyPI.
 if ! "$PY" -c "import flip_evaluator" >/dev/null 2>&1; then
   echo "run_quality.sh: installing flip-evaluator into $("$PY" -c 'import sys; print(sys.executable)')"
-  # (without PIP_PYTHON: pip reads it as its own --python option, tools/install_bpy.sh)
-  env -u PIP_PYTHON "$PY" -m pip install -q --disable-pip-version-check flip-evaluator >"$OUT/pip_flip.log" 2>&1 ||
-    echo "run_quality.sh: could not install flip-evaluator (pip failed: $(tail -1 "$OUT/pip_flip.log")): FLIP is skipped"
+  tools/pip_install.sh "$PY" "$OUT/pip_flip.log" flip-evaluator 2>"$OUT/pip_flip.err" ||
+    echo "run_quality.sh: could not install flip-evaluator ($(cat "$OUT/pip_flip.err")): FLIP is skipped"
 fi
 VSGL_QUALITY_FRAMES=${VSGL_QUALITY_FRAMES:-6} "$PY" tests/quality/check.py --out "$OUT" >"$OUT/check.log" 2>&1
 rc2=$?

@@ -78,6 +78,27 @@ if want no_pip_python; then
   if [ -z "$hits" ]; then ok no_pip_python; else bad no_pip_python "$hits"; fi
 fi
 
+# run_quality.sh installs flip-evaluator through tools/pip_install.sh: with
+# PIP_PYTHON=python3 exported, plain pip failed and FLIP was skipped (a
+# fresh venv, 2026-12-03); pip must not see it, and a failure says pip's error.
+if want pip_install; then
+  make_stub
+  PIP_PYTHON=python3 tools/pip_install.sh "$T/bin/stubpy" "$T/pip_out.log" flip-evaluator 2>"$T/pip_err.log"; rc=$?
+  if [ $rc -eq 0 ] && grep -q "PIP_PYTHON=<unset> args: install .*flip-evaluator" "$T/bin/pip.log"; then
+    ok pip_install_without_pip_python
+  else
+    bad pip_install_without_pip_python "exit $rc, pip calls: $(cat "$T/bin/pip.log" 2>/dev/null)"
+  fi
+  printf '#!/usr/bin/env bash\necho "ERROR: No matching distribution found for flip-evaluator" >&2; exit 1\n' >"$T/bin/failpy"
+  chmod +x "$T/bin/failpy"
+  tools/pip_install.sh "$T/bin/failpy" "$T/pip_out2.log" flip-evaluator 2>"$T/pip_err2.log"; rc=$?
+  if [ $rc -eq 1 ] && grep -q "pip failed: ERROR: No matching distribution" "$T/pip_err2.log"; then
+    ok pip_install_says_pips_error
+  else
+    bad pip_install_says_pips_error "exit $rc, stderr: $(cat "$T/pip_err2.log")"
+  fi
+fi
+
 # Issue 10: the add-on zip carried libvsgl.so but not libembree3,
 # libOpenEXRCore or libtbb. Now they are inside, and the loader takes them
 # from there (not from the system) through libvsgl's $ORIGIN rpath.
