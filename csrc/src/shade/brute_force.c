@@ -108,7 +108,7 @@ static int32_t bf_chunk(void *user, size_t chunk, size_t begin, size_t end)
                 vsgl__brdf_eval(P, n, t, w, v, rd, rg);
                 if (!(rd[0] + rd[1] + rd[2] + rg[0] + rg[1] + rg[2] > 0.0f))
                     continue;
-                if (j->visibility && occluded_from(j, v3_add(x, v3_scale(lift, vsgl__lift_share(v3_dot(n, w)))), q->p))
+                if (j->visibility && occluded_from(j, vsgl__lifted_origin(x, x, n, lift, q->p), q->p))
                     continue;
                 double inv = 1.0 / ((double)d2 + (double)q->area * (1.0 / VSGL__PI_D));
                 for (int c = 0; c < 3; ++c) {

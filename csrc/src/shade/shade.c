@@ -345,33 +345,34 @@ static void origins_of(const shade_job *j, const receiver *rec, size_t n, ray_or
  * (a low-poly smooth-shaded mesh's lift reaches centimetres). */
 #define VSGL__LIFT_FULL 0.25f
 #define VSGL__LIFT_NONE 0.5f
-float vsgl__lift_share(float c)
+static float lift_share(float c)
 {
     float a = (VSGL__LIFT_NONE - c) * (1.0f / (VSGL__LIFT_NONE - VSGL__LIFT_FULL));
     return a < 0.0f ? 0.0f : (a > 1.0f ? 1.0f : a);
 }
 
-/* The origins of lanes idx[0..m) towards `target`, lifted by their share
- * (vsgl__lift_share) into *lifted; org itself where no receiver is lifted. */
+v3 vsgl__lifted_origin(v3 o, v3 x, v3 n, v3 lift, v3 target)
+{
+    if (lift.x == 0.0f && lift.y == 0.0f && lift.z == 0.0f)
+        return o;
+    v3 d = v3_sub(target, x);
+    float len = v3_length(d);
+    return len > 0.0f ? v3_add(o, v3_scale(lift, lift_share(v3_dot(n, d) / len))) : o;
+}
+
+/* The origins of lanes idx[0..m) towards `target`, lifted
+ * (vsgl__lifted_origin) into *lifted. */
 static const ray_origins *lift_grazing(const receiver *rec, const ray_origins *org, const uint32_t *idx, uint32_t m,
                                        v3 target, ray_origins *lifted)
 {
-    int any = 0;
     for (uint32_t i = 0; i < m; ++i) {
         uint32_t k = idx[i];
-        v3 o = v3_make(org->x[k], org->y[k], org->z[k]);
-        if (rec[k].lift.x != 0.0f || rec[k].lift.y != 0.0f || rec[k].lift.z != 0.0f) {
-            v3 d = v3_sub(target, rec[k].x);
-            float len = v3_length(d);
-            float share = len > 0.0f ? vsgl__lift_share(v3_dot(rec[k].n, d) / len) : 0.0f;
-            o = v3_add(o, v3_scale(rec[k].lift, share));
-            any |= share > 0.0f;
-        }
+        v3 o = vsgl__lifted_origin(v3_make(org->x[k], org->y[k], org->z[k]), rec[k].x, rec[k].n, rec[k].lift, target);
         lifted->x[k] = o.x;
         lifted->y[k] = o.y;
         lifted->z[k] = o.z;
     }
-    return any ? lifted : org;
+    return lifted;
 }
 
 /* Visibility of `target` (a VSGL's ray target) from the receivers k <
@@ -406,7 +407,8 @@ static uint64_t visibility_rays(const shade_job *j, v3 target, const vsgl_kernel
     }
     if (m) {
         ray_origins lifted;
-        const ray_origins *from = lift_grazing(rec, org, idx, m, target, &lifted);
+        /* only scenes with smooth-shaded meshes have a lift to apply */
+        const ray_origins *from = j->g->lift[0] ? lift_grazing(rec, org, idx, m, target, &lifted) : org;
         vsgl__scene_occluded_towards(j->scene, m, idx, from->x, from->y, from->z, target, j->eps, blocked);
     }
     for (uint32_t i = 0; i < m; ++i)

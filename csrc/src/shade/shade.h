@@ -57,9 +57,10 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
  * (the kernel computes the same inline); `on` selects the clip. */
 float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
 
-/* The share of a smooth-shaded receiver's lift (gbuffer.h) that a
- * visibility ray leaving at cosine c to its normal starts from (shade.c). */
-float vsgl__lift_share(float c);
+/* Where a visibility ray from receiver x (normal n, lift: gbuffer.h) to
+ * `target` starts: o (x offset off its surface) plus the share of the lift
+ * its direction takes (shade.c: near the horizon only). */
+v3 vsgl__lifted_origin(v3 o, v3 x, v3 n, v3 lift, v3 target);
 
 /* Glossy light of a planar, Lambertian cluster (the lattice's diffuse
  * VSGLs) through a receiver lobe (ASG, amplitude included), per watt: the
