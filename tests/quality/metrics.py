@@ -239,6 +239,41 @@ def motion_steps(seq_a, seq_b):
     return [_rel_cross(a[t + 1] - a[t], b[t + 1] - b[t], 0.5 * (a[t] + b[t])) for t in range(len(a) - 1)]
 
 
+def firefly_mask(seq_a, seq_b, share=0.02):
+    """Pixels (H x W bool) whose change over an animation Cycles' two seeds
+    disagree about: sum_t |d_a - d_b|^2 > sum_t (|d_a|^2 + |d_b|^2) / 2, d
+    = f[t+1] - f[t] per seed, and that carry more than `share` of both
+    seeds' step energy. With a fixed seed per frame a path that one seed
+    finds (a caustic's firefly: a sun glinting off a metal cabinet onto the
+    floor) stays from frame to frame, so one seed's pixel jumps and keeps
+    its value while the other's does not: that change is neither the
+    motion (the product of the seeds' steps leaves it out) nor noise that
+    averages away over the frames, and a smooth render of the same light
+    changing there is charged as flicker beyond Cycles' own. Seeds that
+    agree about a step (an edge crossing a pixel) are not flagged, nor is
+    independent noise on pixels that barely change (their share)."""
+    a = np.asarray([np.asarray(x, np.float64) for x in seq_a])
+    b = np.asarray([np.asarray(x, np.float64) for x in seq_b])
+    if a.shape != b.shape or len(a) < 2:
+        raise ValueError("firefly_mask: %s frames against %s" % (a.shape, b.shape))
+    da, db = np.diff(a, axis=0), np.diff(b, axis=0)
+    axes = (0,) + tuple(range(3, a.ndim))
+    dis = ((da - db) ** 2).sum(axis=axes)
+    energy = 0.5 * (da ** 2 + db ** 2).sum(axis=axes)
+    return (dis > energy) & (energy > share * energy.sum())
+
+
+def masked(frames, mask):
+    """The frames with the pixels of `mask` set to 0 (flicker() and
+    motion_steps() on the rest of the image)."""
+    out = []
+    for f in frames:
+        f = np.array(f, np.float64)
+        f[mask] = 0.0
+        out.append(f)
+    return out
+
+
 def excess_over_seeds(frames, seq_a, seq_b):
     """Median over steps of how much a sequence changes beyond the motion
     rendered by two independent seeds of every frame: sqrt(max(0, (df - d_a)

@@ -179,6 +179,27 @@ def test_motion_steps_keep_an_edges_jumps_and_remove_noise():
         M.motion_steps(seeds[0], seeds[1][:-1])
 
 
+def test_firefly_mask_finds_a_kept_firefly_and_not_an_edge_or_noise():
+    truth = _edge_sequence()
+    rng = np.random.default_rng(13)
+    seeds = [[f + rng.normal(0, 0.01, f.shape) for f in truth] for _ in range(2)]
+    assert not M.firefly_mask(seeds[0], seeds[1]).any()  # the seeds agree about the edge's steps
+    # seed 2 finds a firefly at (5, 3) in frame 4 and keeps it (a fixed seed per frame)
+    for t in range(4, len(truth)):
+        seeds[1][t][5, 3] += 6.0
+    m = M.firefly_mask(seeds[0], seeds[1])
+    assert m[5, 3] and m.sum() == 1
+    # the same jump in both seeds is the motion, not a firefly
+    for t in range(4, len(truth)):
+        seeds[0][t][5, 3] += 6.0
+    assert not M.firefly_mask(seeds[0], seeds[1]).any()
+    # masked: the pixel no longer counts in either sequence's steps
+    clean = M.masked(seeds[1], m)
+    assert clean[6][5, 3, 0] == 0.0 and clean[6][5, 4, 0] == seeds[1][6][5, 4, 0]
+    with pytest.raises(ValueError):
+        M.firefly_mask(seeds[0], seeds[1][:-1])
+
+
 def test_excess_over_seeds_is_zero_for_the_truth_and_sees_a_jittering_edge():
     truth = _edge_sequence()
     rng = np.random.default_rng(12)
