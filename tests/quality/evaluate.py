@@ -654,6 +654,14 @@ def markdown(results, args, img_rel):
                          "|frame t+1 - frame t|; mean |second difference|; false colour (blue 0, green 1 %%, red >= "
                          "2 %% of the reference's 99th-percentile luminance per frame; a smooth 1/1000 step changes "
                          "a pixel by well under that)." % ", ".join(anim_labels), ""]
+            if img_rel == "img/quality" and os.path.exists(os.path.join(ROOT, "docs", img_rel, name + "_glint.png")):
+                body += ["![%s: Cycles without kept fireflies](%s/%s_glint.png)" % (name, img_rel, name), "",
+                         "Where Cycles' kept fireflies are (above), rendered again with a new seed per frame at 65536 "
+                         "spp (tests/quality/border_ref.py and border_cmp.py, commands in tests/quality/README.md; "
+                         "not rerun by this command): rows frames 0, 6 and 11; columns Cycles, balanced, quality, "
+                         "the brute force at RSM 512. The sun glinting off the cabinet's face onto the floor "
+                         "brightens smoothly from frame to frame in Cycles too; the fixed-seed references show it "
+                         "as fireflies that appear and stay.", ""]
     return "\n".join(lines + summary + [""] + body) + "\n"
 
 
