@@ -6,10 +6,9 @@
 #
 # The variable is not called PIP_PYTHON: pip reads every PIP_<OPTION>
 # environment variable as its own option, and PIP_PYTHON is `pip --python`
-# ("Could not locate Python interpreter python3"). It is unset below so that
-# a caller's environment cannot change what pip does either.
+# ("Could not locate Python interpreter python3"). pip runs through
+# tools/pip_install.sh, which removes it from pip's environment.
 set -euo pipefail
-unset PIP_PYTHON
 BPY_PYTHON=${BPY_PYTHON:-python3}
 spec=bpy
 [ -n "${BPY_VERSION:-}" ] && spec="bpy==$BPY_VERSION"
@@ -19,5 +18,9 @@ where=$("$BPY_PYTHON" -c 'import sys; print(sys.executable, "(Python %d.%d)" % s
 echo "install_bpy.sh: installing $spec, numpy, pytest, OpenImageIO into $where (a large wheel: a few minutes)" >&2
 # OpenImageIO reads the tests' EXRs (tests/blender/addon/exr_read.py); 3.1 and
 # later require numpy >= 2, which bpy (numpy < 2) does not allow.
-"$BPY_PYTHON" -m pip install -q --disable-pip-version-check "$spec" numpy pytest "OpenImageIO<3.1"
+# (tools/pip_install.sh: pip without PIP_PYTHON, its output in a log)
+log="${TMPDIR:-/tmp}/install_bpy.$$.pip.log"
+"$(dirname "$0")/pip_install.sh" "$BPY_PYTHON" "$log" "$spec" numpy pytest "OpenImageIO<3.1" || {
+  echo "install_bpy.sh: could not install $spec into $where (pip's output: $log)" >&2; exit 1; }
+rm -f "$log"
 "$BPY_PYTHON" -c 'import bpy; print("install_bpy.sh: bpy", bpy.app.version_string)' 2>/dev/null | tail -1 >&2

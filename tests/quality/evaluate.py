@@ -279,20 +279,17 @@ def evaluate_scene(name, cfgs, size, anim_size, frames, anims, refdir, rend, bru
                 anim_seeds[kind] = [[M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, f, refdir)[name]]
                                     for f in range(n)]
             if stepped and not steps_frames:
-                seq = anim_seeds[kind]
-                st = {p: M.motion_steps([x[0][p] for x in seq[:MOTION_STEPS + 1]],
-                                        [x[1][p] for x in seq[:MOTION_STEPS + 1]]) for p in PASSES}
-                motion_steps[kind] = {p: [round(v, 5) for v in st[p]] for p in PASSES}
-                motion[kind] = {p: float(np.median(st[p])) for p in PASSES}
-                # pixels whose change the seeds disagree about (a caustic's kept firefly): the motion and each
-                # configuration's flicker again without them (metrics.firefly_mask)
-                fireflies[kind], motion_clean[kind] = {}, {}
+                seq = anim_seeds[kind][:MOTION_STEPS + 1]
+                motion_steps[kind], motion[kind], fireflies[kind], motion_clean[kind] = {}, {}, {}, {}
                 for p in PASSES:
-                    a = [x[0][p] for x in seq[:MOTION_STEPS + 1]]
-                    b = [x[1][p] for x in seq[:MOTION_STEPS + 1]]
-                    fireflies[kind][p] = M.firefly_mask(a, b)
-                    motion_clean[kind][p] = float(np.median(M.motion_steps(M.masked(a, fireflies[kind][p]),
-                                                                           M.masked(b, fireflies[kind][p]))))
+                    a, b = [x[0][p] for x in seq], [x[1][p] for x in seq]
+                    st = M.motion_steps(a, b)
+                    motion_steps[kind][p] = [round(v, 5) for v in st]
+                    motion[kind][p] = float(np.median(st))
+                    # pixels whose change the seeds disagree about (a caustic's kept firefly): the motion and
+                    # each configuration's flicker again without them (metrics.firefly_mask)
+                    mask = fireflies[kind][p] = M.firefly_mask(a, b)
+                    motion_clean[kind][p] = float(np.median(M.motion_steps(M.masked(a, mask), M.masked(b, mask))))
                 continue
             f0 = [M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, 0, refdir)[name]]
             f1 = [M.coloured(p) for p, _ in refs.ensure_frame([name], asz, kind, MOTION_STEPS, refdir)[name]]
