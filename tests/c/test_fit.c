@@ -4,6 +4,8 @@
 #include "scene_fixture.h"
 #include "fit/grid.h"
 #include "scene/material.h"
+#include "math/sg_internal.h"
+#include "vsgl/lobes.h"
 
 #include <stdlib.h>
 
@@ -87,13 +89,19 @@ static void reference_two(const vsgl_scene *scene, const vsgl_rsm *r, int32_t es
             } else {
                 if (!bp.glossy || cosi <= 0)
                     continue;
+                /* the emitted lobe: the warped NDF cut at the horizon (tested against
+                 * quadrature in test_lobes.c) */
+                vsgl_vec3 nf = {(float)n[0], (float)n[1], (float)n[2]}, wf = {(float)wi[0], (float)wi[1], (float)wi[2]};
+                vsgl_sg ndf, em;
+                vsgl_ndf_to_sg(&nf, sqrtf(bp.alpha_x * bp.alpha_y), VSGL_NDF_GGX, &ndf);
+                vsgl__warp_ndf_sg_emitted(&ndf, &wf, &em);
+                double ea[3] = {em.axis.x, em.axis.y, em.axis.z};
                 for (int c = 0; c < 3; ++c) {
                     /* R_s: the lobe's directional albedo (its table is tested in test_material.c) */
                     pw[c] = r->flux[c][t] * vsgl__glossy_albedo(vsgl__scene_glossy_albedo(scene, r->material[t]), c, (float)cosi);
-                    axis[c] = 2.0 * cosi * n[c] - wi[c];
+                    axis[c] = ea[c];
                 }
-                double a = sqrt((double)bp.alpha_x * bp.alpha_y);
-                lambda = (2.0 / (a * a)) / (4.0 * fabs(cosi));
+                lambda = em.sharpness;
             }
             double w = pw[0] + pw[1] + pw[2];
             double mlen = vsgl_mean_length_from_sharpness((float)lambda, est);

@@ -3,6 +3,7 @@
  * *filtered* directions). */
 #include "fit/vsgl_set.h"
 #include "scene/material.h"
+#include "math/sg_internal.h"
 #include "vsgl/lobes.h"
 
 #include <stdlib.h>
@@ -113,7 +114,10 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
         fill(&out[VSGL__LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel, n, foot);
         any = 1;
     }
-    /* Specular lobe: Phi R_s G(w; reflect(wi, n), l_h / (4 |wi.n|)) / A(.), with
+    /* Specular lobe: Phi R_s G(w; axis, l) / A(.), with axis and l the
+     * in-plane mean and spread of the warped NDF cut at the horizon
+     * (vsgl__warp_ndf_sg_emitted; the poster's reflect(wi, n) and
+     * l_h / (4 |wi.n|) are several times too sharp at grazing incidence), and
      * R_s the lobe's directional albedo at the incident angle (Fresnel,
      * shadowing and the lobe's spread; the poster's R_s is the Fresnel term
      * alone, which overstates rough lobes: 0.8 against 0.44 for a metal of
@@ -128,7 +132,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
             float alpha = sqrtf(bp.alpha_x * bp.alpha_y);
             vsgl_sg ndf, warped;
             vsgl_ndf_to_sg(&n, alpha, VSGL_NDF_GGX, &ndf);
-            vsgl_warp_ndf_sg(&ndf, &wi, &warped);
+            vsgl__warp_ndf_sg_emitted(&ndf, &wi, &warped);
             fill(&out[VSGL__LOBE_SPECULAR], ps, warped.axis,
                  vsgl_mean_length_from_sharpness(warped.sharpness, estimator), rel, n, foot);
             any = 1;

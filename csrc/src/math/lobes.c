@@ -2,6 +2,7 @@
  * ASG, the ASG Hessian derived in docs/math.md), the smooth microfacet
  * factor, Ward and Ashikhmin-Shirley. */
 #include "vsgl/lobes.h"
+#include "math/normal.h"
 #include "math/sg_internal.h"
 
 #include <float.h>
@@ -110,6 +111,51 @@ void vsgl_warp_ndf_sg(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_sg *out)
     r.sharpness = clamp_band(vsgl__sg_clamp_sharpness(ndf->sharpness) / (4.0f * d));
     r.log_amplitude = ndf->log_amplitude;
     *out = r;
+}
+
+/* The light a mirror-like VPL sends out, as one isotropic SG (docs/math.md
+ * §5.4.1). In the plane of incidence a tilt d of the half vector turns the
+ * reflection by exactly 2 d, so the outgoing elevation phi above the
+ * surface is Gaussian about phi0 = asin(o.n) with twice the NDF's spread;
+ * the intensity per solid angle carries the warp's Jacobian o.h =
+ * sin(phi0 + s / 2) (s = phi - phi0), taken to first order in s, and stops
+ * at the horizon. The SG takes that profile's mean elevation and its
+ * variance: the lobe's wider axis. The plain warp (vsgl_warp_ndf_sg) keeps
+ * the reflection as the axis and the geometric mean of the two axes'
+ * widths, which at grazing incidence is several times too narrow in
+ * elevation and points into the horizon. */
+void vsgl__warp_ndf_sg_emitted(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_sg *out)
+{
+    vsgl_warp_ndf_sg(ndf, view, out);
+    v3 n = v3_normalize(ndf->axis);
+    float lam = vsgl__sg_clamp_sharpness(ndf->sharpness);
+    if (is_zero(n) || !(lam > 0.0f))
+        return;
+    float c = fminf(fabsf(v3_dot(out->axis, n)), 1.0f); /* = |o.n| */
+    float var = 4.0f / lam, se = sqrtf(var);
+    float phi0 = asinf(c), a = -phi0 / se;
+    if (v3_dot(out->axis, n) < 0.0f)
+        n = v3_neg(n);
+    v3 u = v3_sub(out->axis, v3_scale(n, c));
+    float ul = v3_length(u);
+    if (!(ul > 1e-6f)) { /* normal incidence: any tangent (phi stays at the normal) */
+        v3 u2;
+        v3_basis(n, &u, &u2);
+        ul = 1.0f;
+    }
+    if (a > -5.0f) {
+        /* standard-normal moments over x > a, weighted by 1 + k x */
+        float e = expf(-0.5f * a * a), pdf = 0.39894228f * e;
+        float z = 1.0f - vsgl__normal_cdf_e(a, e);
+        float k = 0.5f * se * sqrtf(fmaxf(1.0f - c * c, 0.0f)) / fmaxf(c, 1e-6f);
+        float m1 = pdf, m2 = z + a * pdf, m3 = (a * a + 2.0f) * pdf;
+        float w0 = z + k * m1, w1 = m1 + k * m2, w2 = m2 + k * m3;
+        float mu = w1 / w0;
+        var *= fmaxf(w2 / w0 - mu * mu, 1e-4f);
+        float phi = fminf(phi0 + se * mu, 1.5707963f);
+        out->axis = v3_add(v3_scale(u, cosf(phi) / ul), v3_scale(n, sinf(phi)));
+    }
+    out->sharpness = clamp_band(1.0f / var);
 }
 
 /* Double-precision helpers for the warp (2x2 eigen-problem). */

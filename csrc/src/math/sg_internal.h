@@ -43,4 +43,10 @@ float vsgl__sg_mean_length(float l);
  * [-1, 1]: the ACCURATE mode of vsgl_sg_cosine_integral. */
 float vsgl__sg_cosine_accurate(float lambda, float c);
 
+/* The SG of the light reflected by an NDF SG from `view` (the direction to
+ * the light): the in-plane profile of the warp with its Jacobian, cut at
+ * the horizon (lobes.c, docs/math.md §5.4.1). Same amplitude as
+ * vsgl_warp_ndf_sg. */
+void vsgl__warp_ndf_sg_emitted(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_sg *out);
+
 #endif
