@@ -293,7 +293,7 @@ VT_TEST(budget_negligible_specular_vsgls_are_dropped_and_said)
     double pct = -1.0, saved = -1.0;
     const char *line = strstr(st.skipped, "light 0: ");
     while (line && sscanf(line, "light 0: %u of its %u specular VSGLs under 1 %% of its mean VSGL peak intensity "
-                          "(%lf %% of its light): %lf %%", &dropped, &spec_all, &pct, &saved) != 4)
+                          "(%lf %% of its light, with the fade of those under twice that): %lf %%", &dropped, &spec_all, &pct, &saved) != 4)
         line = strstr(line + 1, "light 0: ");
     VT_CHECK(line && dropped > 0 && pct >= 0.0 && pct < 0.1, "skipped: %s", st.skipped);
     /* peak intensity relative to a diffuse lobe's: power x max(1, sharpness / 2) */
@@ -311,8 +311,10 @@ VT_TEST(budget_negligible_specular_vsgls_are_dropped_and_said)
     VT_CHECK(spec + dropped == spec_all, "kept %zu + dropped %u != %u", spec, dropped, spec_all);
     /* the light's mean before the drop is at least (kept peaks) / (kept + dropped count) */
     double mean_all = peaks / (double)(n + dropped);
-    VT_CHECK(min_spec >= 0.01 * mean_all * (1.0 - 1e-4), "a kept specular VSGL of peak %g < 1 %% of %g", min_spec,
-             mean_all);
+    /* kept: peak p >= 1 % of the mean; those under 2 % are faded to w p with w = smoothstep(p / limit
+     * - 1), anywhere in (0, 2 %): only that none is kept at zero power can be checked here
+     * (tests/python/test_fit_stability.py sees a pop if the fade is missing) */
+    VT_CHECK(min_spec > 0.0, "a kept specular VSGL of peak %g (mean %g)", min_spec, mean_all);
     VT_CHECK(fabs(saved - 100.0 * dropped / (double)(n + dropped)) < 0.06, "saved %g %% of %zu", saved, n + dropped);
     vsgl_scene_destroy(scene);
     vsgl_context_destroy(ctx);

@@ -53,8 +53,8 @@ def test_lattice_light_motion_is_smooth_and_importance_fits_are_not():
     first, second = _flicker(L.FitMode.LATTICE)
     # a 2 mm step in a 4 m room: the light itself changes by well under 1 %
     assert first < 0.01, first
-    # smooth motion: second differences far below first differences (measured 0.005x; jitter makes
-    # them comparable or larger)
+    # smooth motion: second differences far below first differences (measured 0.0085x; jitter makes
+    # them comparable or larger; 0.034x while negligible specular VSGLs were dropped without a fade)
     assert second < 0.02 * first, (first, second)
     # k-means centres drawn from the light's power reshuffle: the same check fails for it (0.06x here)
     km_first, km_second = _flicker(L.FitMode.KMEANS)

@@ -131,30 +131,33 @@ void vsgl__warp_ndf_sg_emitted(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_s
     float lam = vsgl__sg_clamp_sharpness(ndf->sharpness);
     if (is_zero(n) || !(lam > 0.0f))
         return;
-    float c = fminf(fabsf(v3_dot(out->axis, n)), 1.0f); /* = |o.n| */
-    float var = 4.0f / lam, se = sqrtf(var);
-    float phi0 = asinf(c), a = -phi0 / se;
-    if (v3_dot(out->axis, n) < 0.0f)
+    float cn = v3_dot(out->axis, n);
+    if (cn < 0.0f) {
         n = v3_neg(n);
-    v3 u = v3_sub(out->axis, v3_scale(n, c));
+        cn = -cn;
+    }
+    /* the elevation from the tangent part, not asin(o.n): asin loses the
+     * angle near normal incidence in float and would jitter as a light moves */
+    v3 u = v3_sub(out->axis, v3_scale(n, cn));
     float ul = v3_length(u);
+    float var = 4.0f / lam, se = sqrtf(var);
+    float phi0 = atan2f(cn, ul), a = -phi0 / se;
+    float k = 0.5f * se * fminf(ul, 1.0f) / fmaxf(cn, 1e-6f);
     if (!(ul > 1e-6f)) { /* normal incidence: any tangent (phi stays at the normal) */
         v3 u2;
         v3_basis(n, &u, &u2);
         ul = 1.0f;
     }
-    if (a > -5.0f) {
-        /* standard-normal moments over x > a, weighted by 1 + k x */
-        float e = expf(-0.5f * a * a), pdf = 0.39894228f * e;
-        float z = 1.0f - vsgl__normal_cdf_e(a, e);
-        float k = 0.5f * se * sqrtf(fmaxf(1.0f - c * c, 0.0f)) / fmaxf(c, 1e-6f);
-        float m1 = pdf, m2 = z + a * pdf, m3 = (a * a + 2.0f) * pdf;
-        float w0 = z + k * m1, w1 = m1 + k * m2, w2 = m2 + k * m3;
-        float mu = w1 / w0;
-        var *= fmaxf(w2 / w0 - mu * mu, 1e-4f);
-        float phi = fminf(phi0 + se * mu, 1.5707963f);
-        out->axis = v3_add(v3_scale(u, cosf(phi) / ul), v3_scale(n, sinf(phi)));
-    }
+    /* standard-normal moments over x > a, weighted by 1 + k x (far from the
+     * horizon e underflows to 0: the Jacobian's shift k alone) */
+    float e = expf(-0.5f * a * a), pdf = 0.39894228f * e;
+    float z = 1.0f - vsgl__normal_cdf_e(a, e);
+    float m1 = pdf, m2 = z + a * pdf, m3 = (a * a + 2.0f) * pdf;
+    float w0 = z + k * m1, w1 = m1 + k * m2, w2 = m2 + k * m3;
+    float mu = w1 / w0;
+    var *= fmaxf(w2 / w0 - mu * mu, 1e-4f);
+    float phi = fminf(phi0 + se * mu, 1.5707963f);
+    out->axis = v3_normalize(v3_add(v3_scale(u, cosf(phi) / ul), v3_scale(n, sinf(phi))));
     out->sharpness = clamp_band(1.0f / var);
 }
 
