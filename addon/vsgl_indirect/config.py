@@ -39,7 +39,7 @@ _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", 
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
                diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4, visibility_budget=0.02)
 PRESET_VALUES = {
-    "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="NONE",
+    "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="RAY",
                     shade_stride=2, edge_samples=8),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
                      shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
