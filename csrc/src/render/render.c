@@ -184,10 +184,10 @@ static vsgl_result light_budget(vsgl_context *ctx, const vsgl_scene *scene, cons
 }
 
 /* Specular VSGLs whose peak intensity is below this fraction of their
- * light's mean VSGL's are dropped, and faded in up to twice it (a hard
- * cut popped lobes in and out as a light moved: second differences 0.034x
- * the first in test_fit_stability.py, 0.0085x with the fade): slivers of lattice tents and grazing
- * texels of glossy emitters. The peak, not the power: a sharp lobe of
+ * light's mean VSGL's are dropped, and faded in up to twice it (a hard cut
+ * popped lobes in and out as a light moved: second differences 0.034x the
+ * first in test_fit_stability.py, 0.0085x with the fade): slivers of
+ * lattice tents and grazing texels of glossy emitters. The peak, not the power: a sharp lobe of
  * little power still lights a spot (a power rule dropped the fill light's
  * sharp metal-floor lobes in spot_fill_metal_floor: relMSE 0.0070 ->
  * 0.0073). Peak intensity relative to a diffuse lobe's: power x max(1,
@@ -307,7 +307,8 @@ vsgl_result vsgl__fit_lights_mrp(vsgl_context *ctx, const vsgl_scene *scene, con
         size_t dropped = spec ? drop_negligible_specular(set, before, &dropped_power, &light_power) : 0;
         if (dropped)
             note_skip(ctx, st, "light %u: %zu of its %zu specular VSGLs under %g %% of its mean VSGL peak intensity "
-                      "(%.2g %% of its light, with the fade of those under twice that): %.1f %% of its VSGLs and shading pairs saved", l, dropped, spec,
+                      "(%.2g %% of its light, with the fade of those under twice that): "
+                      "%.1f %% of its VSGLs and shading pairs saved", l, dropped, spec,
                       100.0 * VSGL__SPECULAR_NEGLIGIBLE, 100.0 * dropped_power / light_power,
                       100.0 * (double)dropped / (double)fitted);
         if (set->count == before) {
