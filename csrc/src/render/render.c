@@ -222,21 +222,17 @@ static size_t drop_negligible_specular(vsgl_vsgl_set *set, size_t first, double 
     size_t out = first;
     for (size_t k = first; k < set->count; ++k) {
         const vsgl_vsgl *v = &set->items[k];
+        /* faded in from the limit to twice it: a lobe near the limit does
+         * not pop in and out as a light moves */
         double pk = v->lobe == VSGL__LOBE_SPECULAR ? peak_weight(v) : INFINITY;
+        float w = pk >= 2.0 * limit ? 1.0f : pk > limit ? smoothstep01f((float)(pk / limit - 1.0)) : 0.0f;
+        for (int c = 0; c < 3; ++c)
+            *dropped_power += (double)v->power[c] * (1.0 - w);
+        if (!(w > 0.0f))
+            continue;
         set->items[out] = *v;
-        if (pk < 2.0 * limit) {
-            if (!(pk > limit)) { /* faded to nothing */
-                *dropped_power += (double)v->power[0] + v->power[1] + v->power[2];
-                continue;
-            }
-            /* faded in from the limit to twice it: a lobe near the limit
-             * does not pop in and out as a light moves */
-            float w = smoothstep01f((float)(pk / limit - 1.0));
-            for (int c = 0; c < 3; ++c) {
-                *dropped_power += (double)v->power[c] * (1.0 - w);
-                set->items[out].power[c] *= w;
-            }
-        }
+        for (int c = 0; w < 1.0f && c < 3; ++c)
+            set->items[out].power[c] *= w;
         ++out;
     }
     size_t dropped = set->count - out;
