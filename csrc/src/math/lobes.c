@@ -4,6 +4,7 @@
 #include "vsgl/lobes.h"
 #include "math/normal.h"
 #include "math/sg_internal.h"
+#include "math/asg_internal.h"
 
 #include <float.h>
 
@@ -238,6 +239,73 @@ void vsgl_warp_ndf_asg(const vsgl_asg *ndf, const vsgl_vec3 *view, vsgl_asg *out
     r.mu = clamp_band((float)(e2 > 0.0 ? e2 : 0.0));
     r.log_amplitude = ndf->log_amplitude;
     *out = r;
+}
+
+/* A receiver's reflection lobe cut at its surface's horizon (docs/math.md
+ * §5.4.2). In the gnomonic coordinates of the lobe's frame, (a, b) =
+ * (i.x, i.y) / (i.z), the ASG is about a Gaussian of variances 1 / (2
+ * lambda), 1 / (2 mu), and the horizon n.i > 0 is exactly the half-plane
+ * n.z + a n.x + b n.y > 0. Where the lobe reaches below it (a grazing view:
+ * a glossy sphere's rim, whose reflection points along its tangent plane),
+ * the Gaussian is replaced by the moments of its part above: the mean moves
+ * up, the spread across the horizon shrinks, and the amplitude keeps the
+ * part's integral. Without it, half of a grazing lobe gathers light from
+ * below the surface: a ring along a glossy sphere's silhouette lit by the
+ * sphere's own clusters, which no path can reach. */
+void vsgl__asg_cut_at_horizon(vsgl_asg *a, const vsgl_vec3 *normal)
+{
+    v3 n = v3_normalize(*normal);
+    float lam = clamp_band(a->lambda), mu = clamp_band(a->mu);
+    if (is_zero(n) || !(lam > 0.0f) || !(mu > 0.0f) || !(a->log_amplitude > -INFINITY))
+        return;
+    float c = v3_dot(n, a->z), gx = v3_dot(n, a->x), gy = v3_dot(n, a->y);
+    float va = 0.5f / lam, vb = 0.5f / mu;
+    float vs = gx * gx * va + gy * gy * vb; /* variance of s = a n.x + b n.y */
+    if (!(vs > 1e-12f))
+        return;
+    float sd = sqrtf(vs), t = -c / sd; /* the cut at s > -c, in sds */
+    if (t < -4.0f) /* less than 3e-5 of the lobe below the horizon */
+        return;
+    t = fminf(t, 4.0f);
+    float e = expf(-0.5f * t * t), pdf = 0.39894228f * e;
+    float w0 = fmaxf(1.0f - vsgl__normal_cdf_e(t, e), 1e-6f);
+    float r = pdf / w0;                            /* inverse Mills ratio */
+    float ms = sd * r;                             /* E[s | s > -c] */
+    float shrink = fminf(fmaxf(r * (r - t), 0.0f), 0.999f); /* 1 - Var[s | cut] / Var[s] */
+    /* the conditional mean and covariance of (a, b): Sigma g carries them */
+    float ka = gx * va / vs, kb = gy * vb / vs;
+    float da = ka * ms, db = kb * ms;
+    float s11 = va - gx * va * ka * shrink, s22 = vb - gy * vb * kb * shrink, s12 = -gx * va * kb * shrink;
+    float det = s11 * s22 - s12 * s12;
+    if (!(det > 0.0f))
+        return;
+    v3 z = v3_normalize(v3_add(a->z, v3_add(v3_scale(a->x, da), v3_scale(a->y, db))));
+    /* eigenvectors of the new covariance: x takes the smaller variance (the larger bandwidth) */
+    float th = 0.5f * atan2f(2.0f * s12, s11 - s22);
+    float cs = cosf(th), sn = sinf(th);
+    float mean = 0.5f * (s11 + s22), rad = sqrtf(0.25f * (s11 - s22) * (s11 - s22) + s12 * s12);
+    float v1 = mean + rad, v2 = fmaxf(mean - rad, 1e-12f); /* along (cs, sn) and (-sn, cs) */
+    v3 e1 = v3_add(v3_scale(a->x, cs), v3_scale(a->y, sn)), e2 = v3_add(v3_scale(a->x, -sn), v3_scale(a->y, cs));
+    v3 xs = v2 <= v1 ? e2 : e1, ys = v2 <= v1 ? e1 : e2;
+    float vx = fminf(v1, v2), vy = fmaxf(v1, v2);
+    /* the frame made orthogonal to the moved axis */
+    xs = v3_normalize(v3_sub(xs, v3_scale(z, v3_dot(xs, z))));
+    ys = v3_cross(z, xs);
+    if (v3_dot(ys, e1) * v3_dot(ys, e1) + v3_dot(ys, e2) * v3_dot(ys, e2) < 0.5f)
+        return; /* degenerate: keep the lobe as it is */
+    a->z = z;
+    a->x = xs;
+    a->y = ys;
+    float l0 = a->lambda, m0 = a->mu;
+    a->lambda = clamp_band(0.5f / vx);
+    a->mu = clamp_band(0.5f / vy);
+    /* the part's integral: w0 of the whole lobe's */
+#ifdef VSGL_CUT_GAUSS
+    (void)l0; (void)m0;
+    a->log_amplitude += logf(w0) + 0.5f * logf(va * vb / det);
+#else
+    a->log_amplitude += logf(w0) + (float)log(vsgl__asg_integral_unit(l0, m0) / vsgl__asg_integral_unit(a->lambda, a->mu));
+#endif
 }
 
 float vsgl_specular_factor(const vsgl_vec3 *n, const vsgl_vec3 *view,

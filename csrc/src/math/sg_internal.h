@@ -4,6 +4,7 @@
 #define VSGL_MATH_SG_INTERNAL_H
 
 #include "vsgl/sg.h"
+#include "vsgl/asg.h"
 #include "math/constants.h"
 #include "math/vec.h"
 
@@ -48,5 +49,10 @@ float vsgl__sg_cosine_accurate(float lambda, float c);
  * the horizon (lobes.c, docs/math.md §5.4.1). Same amplitude as
  * vsgl_warp_ndf_sg. */
 void vsgl__warp_ndf_sg_emitted(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_sg *out);
+
+/* A receiver's reflection ASG cut at the horizon of `normal`: its part
+ * above n.i > 0 as one ASG of the same moments and integral (lobes.c,
+ * docs/math.md §5.4.2). Unchanged where under 3e-5 of it lies below. */
+void vsgl__asg_cut_at_horizon(vsgl_asg *a, const vsgl_vec3 *normal);
 
 #endif
