@@ -265,10 +265,8 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->o = v3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
     r->lift = g->lift[0] ? v3_make(g->lift[0][i], g->lift[1][i], g->lift[2][i]) : v3_make(0.0f, 0.0f, 0.0f);
     sample_params(j, i, &r->bp);
-#ifndef VSGL_NO_SPREAD
     if (g->spread && g->spread[i] < 1.0f)
         widen_by_spread(&r->bp, g->spread[i]);
-#endif
     r->alpha = sqrtf(r->bp.alpha_x * r->bp.alpha_y);
     r->glossy = r->bp.glossy && v3_dot(r->n, r->o) > 0.0f;
     if (!r->glossy)
