@@ -15,7 +15,7 @@ KNOBS = {
     "method": (("VSGL", "BRUTE_FORCE"), "VSGL"),
     "aa_samples": (None, 2),
     "shade_stride": (None, 2),
-    "edge_samples": (None, 8),
+    "edge_samples": (None, 12),
     "sample_merging": (("AUTO", "OFF"), "AUTO"),
     "visibility": (("NONE", "RAY"), "RAY"),
     "visibility_budget": (None, 0.02),
@@ -42,9 +42,9 @@ PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="RAY",
                     shade_stride=2, edge_samples=8),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
-                     shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
+                     shade_stride=2, edge_samples=12, glossy_mode="ASG2"),
     "QUALITY": dict(_COMMON, aa_samples=3, rsm_resolution=512, vsgl_count=256, visibility="RAY",
-                    shade_stride=2, edge_samples=8, glossy_mode="ASG2", glossy_lobes=5),
+                    shade_stride=2, edge_samples=12, glossy_mode="ASG2", glossy_lobes=5),
 }
 # AUTO: balanced's knobs as ceilings; the library chooses within them (auto_target, render.h)
 PRESET_VALUES["AUTO"] = dict(PRESET_VALUES["BALANCED"])
@@ -121,7 +121,7 @@ class Options:
     method: str = "VSGL"
     aa_samples: int = 2
     shade_stride: int = 2
-    edge_samples: int = 8
+    edge_samples: int = 12
     rsm_resolution: int = 256
     fit_mode: str = "LATTICE"
     vsgl_count: int = 192
