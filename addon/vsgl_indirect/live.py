@@ -28,13 +28,15 @@ COARSE_DEFAULT = 2
 COARSE_MAX = 4
 
 #: The panel's "Live" quality: the preview preset without edge rays and
-#: without visibility rays, shading one pixel in 4 x 4 (not 2 x 2). On the
-#: live room its Combined pass is within relMSE ~1e-4 / mean FLIP 0.02-0.04
-#: of the preview preset's without rays (docs/performance.md, "Live
-#: viewport"); with them the preview also draws indirect shadows (a sun-lit
-#: cabinet's on the wall behind it) at 1.5-1.8x the time. F12 keeps the
-#: scene's preset.
-LIVE_OVERRIDES = {"shade_stride": 4, "edge_samples": 0, "visibility": 0}
+#: without visibility rays, shading one pixel in 4 x 4 (not 2 x 2), with
+#: GGX as one lobe (glossy_mode 0, ASG). On the live room its Combined pass
+#: is within relMSE ~1e-4 / mean FLIP 0.02-0.04 of the preview preset's
+#: without rays and with one lobe (docs/performance.md, "Live viewport");
+#: with rays the preview also draws indirect shadows (a sun-lit cabinet's
+#: on the wall behind it) at 1.5-1.8x the time, and with two lobes a glossy
+#: surface's glint holds still as a light moves, at 1.2-1.45x. F12 keeps
+#: the scene's preset.
+LIVE_OVERRIDES = {"shade_stride": 4, "edge_samples": 0, "visibility": 0, "glossy_mode": 0}
 
 
 def render_settings(lib, quality, pixels=0):

@@ -314,6 +314,7 @@ VT_TEST(render_cache_refine_after_coarse_views_equals_a_plain_render)
     vsgl_render_settings_preset(VSGL_PRESET_PREVIEW, &live); /* the add-on's Live quality */
     live.shade_stride = 4;
     live.edge_samples = 0;
+    live.glossy_mode = VSGL_GLOSSY_ASG;
     vsgl_render_settings coarse_stride = live;
     coarse_stride.shade_stride = 8;
     for (uint32_t threads = 1; threads <= 2; ++threads) {

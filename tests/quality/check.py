@@ -53,10 +53,10 @@ TOL_BRUTE = 0.06
 # itself, unevenly (an edge of the patch crossing a junction), so a bound on the raw change would be
 # either too loose for the small lights or fail a renderer that follows the motion. Balanced and quality:
 # the issue's 0.01 (measured at 12 frames, before a sun's RSM covered only what it lights: 0.0101 /
-# 0.0108 in sun_opening_thick; after: 0.0024 / 0.0071). The preview: its one-ASG glossy lobe on a
-# lattice of 32 jumps as the sun's patch slides over a glossy cabinet (Gloss 0.024 in the sun rooms,
-# 0.013 at the old RSM window; the two-ASG lobes give 0.009-0.011 there but 0.013 on the sphere at 1.6 x
-# the time at 960x540), so its bound is the issue's tolerance for a preview, 3 x.
+# 0.0108 in sun_opening_thick; after: 0.0024 / 0.0071). The preview: with one ASG for GGX on a
+# lattice of 32 its glint jumped as the sun's patch slid over a glossy cabinet (Gloss 0.024 in the sun
+# rooms); with two (since 2026-12-03) 0.007-0.009, but a visibility ray to one of its few clusters can
+# flip (the sphere room's 0.011), so its bound is the issue's tolerance for a preview, 3 x.
 MAX_EXCESS_LIGHT = dict(preview=0.03, balanced=0.01, quality=0.01)
 # The camera animation, where a moving view's own change stays below 0.01 a frame at 80x60 (the
 # sphere's rim and the sun rooms' sunlit patch change more than that by themselves: INFO there):

@@ -29,7 +29,7 @@ extern "C" {
 #define VSGL_FIT_LATTICE 3 /**< world-space lattice with tent weights, one cluster per surface orientation:
                                 continuous in the light's motion (no flicker), overlapping (no blotches) */
 
-#define VSGL_GLOSSY_ASG  0 /**< receiver lobe as a warped ASG (the zero default; the preview preset) */
+#define VSGL_GLOSSY_ASG  0 /**< receiver lobe as a warped ASG (the zero default; the viewport's Live quality) */
 #define VSGL_GLOSSY_SG   1 /**< receiver lobe as a warped SG (reference path) */
 #define VSGL_GLOSSY_ASG2 2 /**< receiver lobe as two warped ASGs, GGX's core and tail (balanced, quality):
                                one Gaussian puts the 40 % of GGX's energy that is in its tail into its

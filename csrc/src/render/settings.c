@@ -41,12 +41,23 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
      * take 12 x 12 (below). */
     out->edge_samples = 8;
     out->diffuse_mode = VSGL_COSINE_PULLED_OUT;
-    /* Balanced and quality take GGX as two lobes (VSGL_GLOSSY_ASG2): with one,
-     * a metal floor's reflection of a lit wall was too bright in its middle
+    /* Every preset takes GGX as two lobes (VSGL_GLOSSY_ASG2): with one, a
+     * metal floor's reflection of a lit wall was too bright in its middle
      * and too dark around it, which no VSGL count fixed (the spot room's
      * glossy structured error 0.0049 at lattice 192, 0.0058 at 1024; 0.0004
-     * with two lobes). The preview keeps one: at lattice 32 its clusters, not
-     * the lobe, set its error. */
+     * with two lobes). The preview took one until its sun rooms' glint on
+     * the cabinet was seen to shimmer as the sun moved: with one lobe, a
+     * small lit patch of floor seen in a glossy surface changes by +-8 % a
+     * frame as the lattice's clusters drift under the lobe (light-motion
+     * Gloss 0.0162 / 0.0212 a frame, Cycles' own 0.011); with two, and the
+     * half-vector model they bring, 0.0074 / 0.0091. At 80 x 60 the
+     * preview's FLIP falls in every room (spot room 0.141 -> 0.088, red wall
+     * 0.138 -> 0.112, sun rooms 0.083 / 0.088 -> 0.078 / 0.082; the sphere's
+     * the same), its glossy structured error 2.5-3.5x, and its Gloss bias
+     * moves to within 1-3 % of Cycles' but in the sphere room (0.966 ->
+     * 0.950). It costs the preview 1.2-1.45x its time at 960 x 540. The
+     * viewport's Live quality keeps one lobe (addon/vsgl_indirect/live.py),
+     * for its time. */
     switch (preset) {
     case VSGL_PRESET_PREVIEW: /* within +-21 % of Cycles per pass on the bundled scenes */
         out->aa_samples = 1;
@@ -63,6 +74,7 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
          * time in the rooms that are not convex. The viewport's Live quality
          * leaves them out (addon/vsgl_indirect/live.py). */
         out->visibility = VSGL_VISIBILITY_RAY;
+        out->glossy_mode = VSGL_GLOSSY_ASG2;
         break;
     case VSGL_PRESET_QUALITY: /* finer cells, RSMs, samples and GGX lobes than balanced: lower
                                  structured error in every pass of the bundled rooms but the sun
