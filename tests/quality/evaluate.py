@@ -821,8 +821,14 @@ def main(argv=None):
         md_path = os.path.join(args.out, "report_%s.md" % size_key)
         img_rel = "img_%s" % size_key
     w, h, spp = scenes.size_of(args.size)
-    results = dict(command="python3 tests/quality/evaluate.py " + " ".join(argv if argv is not None else sys.argv[1:]),
-                   library=L.version_string(), commit=git_commit(), blender=refs.blender_version(args.refs),
+    # another library (VSGL_LIBRARY, e.g. an earlier commit's build for --before): its path in the
+    # command, and the commit not the checkout's (which built a different library)
+    other = os.environ.get("VSGL_LIBRARY")
+    results = dict(command=("VSGL_LIBRARY=%s " % other if other else "") + "python3 tests/quality/evaluate.py " +
+                   " ".join(argv if argv is not None else sys.argv[1:]),
+                   library=L.version_string(),
+                   commit=("checkout %s, library from VSGL_LIBRARY" % git_commit()) if other else git_commit(),
+                   blender=refs.blender_version(args.refs),
                    spp=spp, size=[w, h], anim_size=list(anim_size), frames=args.frames, flip_error=M.FLIP_ERROR,
                    repeat=max(1, args.repeat), scenes={})
     if M.FLIP_ERROR:
