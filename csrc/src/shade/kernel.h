@@ -63,7 +63,8 @@ typedef struct vsgl_kernel_light {
      * (low: the surface above the cut, high: below) the cut from the mean
      * in units of sqrt(pvar) and its weight (0: not cut there) */
     float fold, fb[2][2], fa[2][2];
-    float freach; /* (sqrt(50) + 2 |farthest cut|)^2 / 2: where the fold can matter (k_shade) */
+    float fs[2];  /* per axis, the mean the images are built on (shade.c, fold_mean) from the mean, same units */
+    float freach; /* (sqrt(50) + 2 |farthest cut| + |fs|)^2 / 2: where the fold can matter (k_shade) */
 } vsgl_kernel_light;
 
 /* The planar model's receiver horizon (shade.h, vsgl__planar_glossy): where

@@ -564,8 +564,9 @@ static inline __attribute__((always_inline)) void k_hv_rest(size_t i, k_scratch 
 }
 
 /* Along one axis of a cut cell (sigma units, the cluster's mean at 0 and
- * its variance 1): the weight of the image of mean m (0: the cluster's,
- * 2 lo: mirrored across the low cut lo, 2 hi: across the high cut hi,
+ * its variance 1): the weight of the image of mean m (fs: the mean the
+ * images are built on, 2 lo - fs: mirrored across the low cut lo, 2 hi -
+ * fs: across the high cut hi,
  * `which` 0, 1, 2), its footprint-blurred density's share on the
  * surface's side of each cut, weighted by the cuts' weights al, ah
  * (shade.c, fold_image: the product of the cluster's Gaussian and the
@@ -595,8 +596,8 @@ k_fold(size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
     f2 = f2 > 1e-12f ? f2 : 1e-12f;
     const float i1 = 1.0f / (1.0f + f1), i2 = 1.0f / (1.0f + f2);
     const float isp1 = k_rsqrt_fine(f1 * i1), isp2 = k_rsqrt_fine(f2 * i2);
-    const float m1[3] = {0.0f, 2.0f * L->fb[0][0], 2.0f * L->fb[0][1]};
-    const float m2[3] = {0.0f, 2.0f * L->fb[1][0], 2.0f * L->fb[1][1]};
+    const float m1[3] = {L->fs[0], 2.0f * L->fb[0][0] - L->fs[0], 2.0f * L->fb[0][1] - L->fs[0]};
+    const float m2[3] = {L->fs[1], 2.0f * L->fb[1][0] - L->fs[1], 2.0f * L->fb[1][1] - L->fs[1]};
     float w1[3], w2[3];
     w1[0] = k_fold_weight(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], m1[0], 0, d1, f1, i1, isp1);
     w1[1] = k_fold_weight(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], m1[1], 1, d1, f1, i1, isp1);
@@ -732,9 +733,9 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
                 else
                     K_FORN(k_planar(b, i, L + j, t + j, kb, kc, 0));
                 /* the fold only where some lane sees the cell: an image lies
-                 * at most 2 |b| (sigma units) from the mean, so where every
-                 * lane's planar exponent is below -freach = -(sqrt(50) + 2
-                 * |b|)^2 / 2, every image's is below -25 (nil) */
+                 * at most 2 |b| + |fs| (sigma units) from the mean, so where
+                 * every lane's planar exponent is below -freach = -(sqrt(50)
+                 * + 2 |b| + |fs|)^2 / 2, every image's is below -25 (nil) */
                 for (int j = 0; j < NL; ++j) {
                     if (!(L[j].fold > 0.0f))
                         continue;
