@@ -69,14 +69,16 @@ def main(argv=None):
             b = min(t_b) if t_b else None
             a = min(t_a)
             rows.append(dict(scene=name, preset=preset, before=b, after=a))
-            print("%-28s %-9s %s %.3f s%s" % (name, preset, "" if b is None else "%.3f s ->" % b, a,
-                                               "" if b is None else "  x%.2f" % (a / b)), file=sys.stderr)
+            before = "" if b is None else "%.3f s ->" % b
+            ratio = "" if b is None else "  x%.2f" % (a / b)
+            print("%-28s %-9s %s %.3f s%s" % (name, preset, before, a, ratio), file=sys.stderr)
     print("| scene | preset | before s | after s | after / before |")
     print("|---|---|---|---|---|")
     for r in rows:
         b = r["before"]
-        print("| %s | %s | %s | %.3f | %s |" % (r["scene"], r["preset"], "-" if b is None else "%.3f" % b, r["after"],
-                                               "-" if b is None else "%.2f" % (r["after"] / b)))
+        before = "-" if b is None else "%.3f" % b
+        ratio = "-" if b is None else "%.2f" % (r["after"] / b)
+        print("| %s | %s | %s | %.3f | %s |" % (r["scene"], r["preset"], before, r["after"], ratio))
     if os.environ.get("PRESET_TIMES_JSON"):
         with open(os.environ["PRESET_TIMES_JSON"], "w") as f:
             json.dump(rows, f, indent=1)
