@@ -707,6 +707,11 @@ def main():
                          "renders always are)")
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
+    try:  # the plot comes last: say what is missing before the hour of renders, not after it
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise SystemExit("trade.py needs matplotlib for the plot in %s: pip install matplotlib into %s"
+                         % ("docs/trade.png" if args.docs else "its report", sys.executable))
     args.size = tuple(int(v) for v in args.size.lower().split("x"))
     args.time_size = None if args.quick or args.time_size == "none" else tuple(
         int(v) for v in args.time_size.lower().split("x"))
