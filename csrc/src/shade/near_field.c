@@ -30,10 +30,6 @@
  * (times coherence: a sphere's cells are not planes) ... */
 #define VSGL__NEAR_FACING_LO 0.98f
 #define VSGL__NEAR_FACING_HI 0.995f
-/* ... and to uniform radiosity: the steps' centroid within this many
- * spacings of the VPLs' mean, none from three times it (a shadow or a
- * spot's edge crossing the cell moves the mean; the steps cannot). */
-#define VSGL__NEAR_UNIFORM 0.05f
 /* A specular cell's lobe leaves its plane at this cosine at least (the
  * footprint's linearisation grows with 1 / cos). */
 #define VSGL__NEAR_SPECULAR_COS 0.1f
@@ -107,7 +103,7 @@ static float polygon_form_factor(v3 x, v3 n, const v3 *p, int m)
 }
 
 /* The tent 1 - |x - c| / h over [lo, hi]: its mass, mean and variance. */
-static void tent_moments(double lo, double hi, double c, double h, double *mass, double *mean, double *var)
+void vsgl__tent_moments(double lo, double hi, double c, double h, double *mass, double *mean, double *var)
 {
     double m0 = 0.0, m1 = 0.0, m2 = 0.0;
     double a = fmin(hi, c) - c, b = lo - c; /* the rising side, y = x - c in [b, a] */
@@ -191,7 +187,7 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
             double lo = fmax((double)v->cell_lo[k] - ck, -(double)h), hi = fmin((double)v->cell_hi[k] - ck, (double)h);
             c->tlo[k] = (float)lo;
             c->thi[k] = (float)hi;
-            tent_moments(lo, hi, 0.0, h, &mass[k], &mean[k], &var[k]);
+            vsgl__tent_moments(lo, hi, 0.0, h, &mass[k], &mean[k], &var[k]);
             g[k] = var[k] > 1e-12 * (double)h * h ? ((double)mv[k] - ck - mean[k]) / var[k] : 0.0;
             c->centroid[k] = (float)mean[k];
         }

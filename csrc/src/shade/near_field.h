@@ -37,6 +37,15 @@ typedef struct vsgl_near_cell {
     float tlo[2], thi[2];  /* its tent's support (u, v) truncated to the VPLs' extent, from the lattice point */
 } vsgl_near_cell;
 
+/* The model applies to uniform radiosity: the steps' centroid within this
+ * many spacings of the VPLs' mean, none from three times it (a shadow or a
+ * spot's edge crossing the cell moves the mean; the steps cannot). The
+ * planar glossy fold (shade.c, fold_mean) uses the same test. */
+#define VSGL__NEAR_UNIFORM 0.05f
+
+/* The tent 1 - |x - c| / h over [lo, hi]: its mass, mean and variance. */
+void vsgl__tent_moments(double lo, double hi, double c, double h, double *mass, double *mean, double *var);
+
 /* The cell of v; 0 if the model does not apply to v (not a lattice
  * cluster, no power, a curved surface, radiosity far from uniform, or a
  * specular lobe that does not leave its plane's front). */

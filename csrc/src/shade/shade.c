@@ -134,25 +134,18 @@ static float fold_mean(const vsgl_vsgl *v, const cell_cuts *c, int k, float m0)
     const float h = v->cell_h, cc = v->cell_centre[k];
     if (!(w > 0.0f) || !(h > 0.0f))
         return m0;
-    /* the uniformly lit tent 1 - |t| (t = (u - cc) / h) over the VPLs'
-     * extent [tl, th]: its mass and first moment, G0 and G1 antiderivatives */
-    float tl = fmaxf((v->cell_lo[k] - cc) / h, -1.0f), th = fminf((v->cell_hi[k] - cc) / h, 1.0f);
-    if (!(th > tl))
+    /* the mean of a uniformly lit tent over the VPLs' extent */
+    double mass, unif, var;
+    vsgl__tent_moments(fmax(v->cell_lo[k], cc - h), fmin(v->cell_hi[k], cc + h), cc, h, &mass, &unif, &var);
+    if (!(mass > 1e-6 * h))
         return m0;
-#define G0(t) ((t) - copysignf(0.5f * (t) * (t), (t)))
-#define G1(t) (0.5f * (t) * (t) - fabsf((t) * (t) * (t)) / 3.0f)
-    float mass = G0(th) - G0(tl), mom = G1(th) - G1(tl);
-#undef G0
-#undef G1
-    if (!(mass > 1e-6f))
-        return m0;
-    float unif = cc + h * mom / mass;
-    /* uniform radiosity only, as the near field's steps (near_field.c): a
-     * spot's edge or a shadow crossing the cell moves its VPLs' mean off a
-     * uniformly lit cut tent's, and the whole tent would then carry its
-     * light into the dark */
-    w *= 1.0f - smoothstep01f((fabsf(m0 - unif) / h - 0.05f) / 0.1f);
-    return m0 + w * (cc - unif);
+    /* uniform radiosity only, as the near field's steps: a spot's edge or
+     * a shadow crossing the cell moves its VPLs' mean off a uniformly lit
+     * cut tent's, and the whole tent would then carry its light into the
+     * dark */
+    float off = fabsf(m0 - (float)unif) / h;
+    w *= 1.0f - smoothstep01f((off - VSGL__NEAR_UNIFORM) / (2.0f * VSGL__NEAR_UNIFORM));
+    return m0 + w * (cc - (float)unif);
 }
 
 /* The cell's in-plane axes u = axis + 1, v = axis + 2 (mod 3). */
@@ -1176,9 +1169,9 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             o->conv = v->lobe == VSGL__LOBE_DIFFUSE ? 1.0f : 0.0f;
             o->ibehind = 1.0f / (VSGL__CLIP_BEHIND * sqrtf(v->variance) + VSGL__TINY);
             o->planar = leak && v->lobe == VSGL__LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
+            o->pvar = v->variance + v->widen;
             v3 u1, u2;
             cell_cuts cuts;
-            o->pvar = v->variance + v->widen;
             o->fold = o->planar > 0.0f ? fold_weight(v, &cuts) : 0.0f;
             memset(o->fb, 0, sizeof o->fb);
             memset(o->fa, 0, sizeof o->fa);
