@@ -427,3 +427,58 @@ VT_TEST(fit_lattice_marks_where_the_surface_ends)
     free_plane_rsm(&h);
     lroom_close(&rm);
 }
+
+/* A specular cell's cut where a wall rises moves to the wall's face (its
+ * near field then reaches the junction, the wall's foot beside a metal
+ * floor): the glossy floor of the fixture room lit up to 3 cm short of the
+ * wall x = -1 (the VPLs' extent stops there, as an RSM's texels do up to
+ * half a texel short). Its specular cells at that wall end at x = -1 with
+ * every preset's receivers; the rim cuts elsewhere stay where the VPLs
+ * stop. */
+VT_TEST(fit_lattice_specular_cut_moves_to_the_wall)
+{
+    static lroom rm;
+    if (!lroom_open(&rm))
+        return;
+    plane_rsm h;
+    make_plane_rsm(&h, 256, 0, 0.0f, 0); /* material 0: the glossy floor (GGX, roughness 0.3) */
+    for (size_t t = 0; t < h.r.count; ++t)
+        if (h.r.pos[0][t] < -0.99f || h.r.pos[0][t] > 0.13f) {
+            h.r.material[t] = VSGL__RSM_EMPTY;
+            for (int c = 0; c < 3; ++c) {
+                h.r.total_flux[c] -= h.r.flux[c][t];
+                h.r.flux[c][t] = 0.0f;
+            }
+        }
+    const int presets[3] = {VSGL_PRESET_PREVIEW, VSGL_PRESET_BALANCED, VSGL_PRESET_QUALITY};
+    for (int p = 0; p < 3; ++p) {
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(presets[p], &s);
+        vsgl_vsgl_set lat = {0};
+        VT_REQUIRE(vsgl__fit_lattice(rm.ctx, rm.scene, &h.r, &s, &lat) == VSGL_OK, "lattice");
+        int wall = 0, at_wall = 0, rim = 0, at_rim = 0;
+        float worst = 0.0f;
+        for (size_t k = 0; k < lat.count; ++k) {
+            const vsgl_vsgl *v = &lat.items[k];
+            if (v->lobe != VSGL__LOBE_SPECULAR || v->cell_axis != 2)
+                continue;
+            const float hh = v->cell_h;
+            if (v->cell_centre[0] - hh < -0.99f) { /* the tent crosses the lit floor's end by the wall */
+                ++wall;
+                at_wall += fabsf(v->cell_lo[0] + 1.0f) < 1e-4f;
+                worst = fmaxf(worst, fabsf(v->cell_lo[0] + 1.0f));
+            }
+            if (v->cell_centre[0] + hh > 0.14f) { /* ... and its end at the rim, x = 0.13 */
+                ++rim;
+                at_rim += fabsf(v->cell_hi[0] - 0.13f) < 0.01f;
+            }
+        }
+        VT_CHECK(wall > 0 && at_wall == wall, "preset %d: %d of %d specular cells by the wall end at it (worst %.4f m off)",
+                 presets[p], at_wall, wall, (double)worst);
+        VT_CHECK(rim > 0 && at_rim == rim, "preset %d: %d of %d specular cells at the rim end there", presets[p], at_rim,
+                 rim);
+        vsgl__vsgl_set_free(&lat);
+    }
+    free_plane_rsm(&h);
+    lroom_close(&rm);
+}

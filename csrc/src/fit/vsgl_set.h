@@ -30,7 +30,9 @@ typedef struct vsgl_vsgl {
      * plane x[axis] = mean[axis], facing +axis (side 0) or -axis (side 1),
      * with tent weights around (centre[0], centre[1]) in the axes u = axis
      * + 1, v = axis + 2 (mod 3), spacing cell_h, within [lo, hi] there
-     * (the VPLs' extent, padded by half a texel). */
+     * (the VPLs' extent, padded by half a texel; where a wall rises at a
+     * cut, the wall's face: fit/lattice.c surface_ends, for every specular
+     * cell and the diffuse ones of one-lobe receivers). */
     float cell_h;
     float cell_centre[2], cell_lo[2], cell_hi[2];
     uint32_t cell_axis, cell_side;
