@@ -107,3 +107,43 @@ def test_hv_lobes_minimise_the_stated_objective(prefix, count):
     k, c = header_hv_constants(prefix)
     assert len(k) == count
     assert_objective_minimum(k, c)
+
+
+def header_emitter_constants():
+    text = open(os.path.join(ROOT, "csrc", "src", "shade", "kernel.h")).read()
+    get = lambda name: float(re.search(r"#define VSGL__GGX_EMIT_%s ([0-9.e+-]+)f" % name, text).group(1))  # noqa: E731
+    k1, c1, _, _ = header_constants()
+    return np.array([k1, get("TAIL_K"), get("FAR_K")]), np.array([c1, get("TAIL_C"), get("FAR_C")])
+
+
+def test_emitter_lobes_keep_ggx_integral_and_follow_it_to_six_alphas():
+    """A specular lattice cluster's three lobes (VSGL__GGX_EMIT_*, fit/lattice.c
+    split_specular): the receivers' core, GGX's integral, within 17 % of GGX
+    up to six alphas, where the two receiver lobes fall to 0.39 at four."""
+    k, c = header_emitter_constants()
+    assert abs(float(np.sum(c / k)) - 1.0) < 1e-3
+    x = np.linspace(0.0, 6.0, 601)
+    ratio = F.model_n(k, c, x) / F.ggx(x)
+    assert np.all(np.abs(ratio - 1.0) < 0.17), float(np.max(np.abs(ratio - 1.0)))
+    k1, c1, k2, c2 = header_constants()
+    two = F.model(k1, c1, k2, c2, x) / F.ggx(x)
+    assert two[x >= 4.0][0] < 0.45
+    # the energy beyond three alphas: GGX's 1 / (1 + 9) = 0.10, the three lobes' 0.084, the two's 0.034
+    beyond = float(np.sum(c / k * np.exp(-k * 9.0)))
+    assert 0.08 < beyond < 0.105, beyond
+    assert c1 / k1 * np.exp(-k1 * 9.0) + c2 / k2 * np.exp(-k2 * 9.0) < 0.04
+
+
+def test_emitter_constants_minimise_the_stated_objective():
+    k, c = header_emitter_constants()
+    base = F.objective_n(k, c, x_max=F.EMIT_X_MAX)
+    rest = 1.0 - c[0] / k[0]
+    far = c[2] / k[2]
+    for d2, d3, ds in [(1.03, 1, 0), (0.97, 1, 0), (1, 1.03, 0), (1, 0.97, 0), (1, 1, 0.01), (1, 1, -0.01)]:
+        k2, k3, s3 = k[1] * d2, k[2] * d3, far + ds
+        kk = np.array([k[0], k2, k3])
+        cc = np.array([c[0], (rest - s3) * k2, s3 * k3])
+        assert F.objective_n(kk, cc, x_max=F.EMIT_X_MAX) > base, (d2, d3, ds)
+    # and it beats the two receiver lobes over the same range by far
+    k1, c1, k2, c2 = header_constants()
+    assert base < 0.05 * F.objective_n(np.array([k1, k2]), np.array([c1, c2]), x_max=F.EMIT_X_MAX)

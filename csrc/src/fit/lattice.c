@@ -163,24 +163,30 @@ static void map_free(cell_map *m)
     memset(m, 0, sizeof *m);
 }
 
-/* Split specular cluster v into GGX's core (v, sharper, less power) and
- * tail (pushed to out, power fraction C/K of the tail ASG) as far as v is
- * planar: the powers sum to v's and both change continuously with it. */
+/* Split specular cluster v into GGX's core (v, sharper, less power), tail
+ * and far tail (pushed to out, power fractions C/K of theirs:
+ * VSGL__GGX_EMIT_*) as far as v is planar: the powers sum to v's and all
+ * change continuously with it. */
 static vsgl_result split_specular(vsgl_vsgl *v, vsgl_vsgl_set *out)
 {
     float f = (v->coherence - VSGL__LATTICE_SPLIT_LO) / (VSGL__LATTICE_SPLIT_HI - VSGL__LATTICE_SPLIT_LO);
     f = f < 0.0f ? 0.0f : f > 1.0f ? 1.0f : f * f * (3.0f - 2.0f * f);
     if (!(f > 0.0f))
         return VSGL_OK;
-    const float tail = f * (VSGL__GGX_TAIL_C / VSGL__GGX_TAIL_K); /* the tail's share of the energy */
-    vsgl_vsgl t = *v;
-    t.sharpness *= VSGL__GGX_TAIL_K;
-    v->sharpness *= 1.0f + f * (VSGL__GGX_CORE_K - 1.0f);
-    for (int c = 0; c < 3; ++c) {
-        t.power[c] = v->power[c] * tail;
-        v->power[c] -= t.power[c];
+    static const float sharp[2] = {VSGL__GGX_EMIT_TAIL_K, VSGL__GGX_EMIT_FAR_K};
+    static const float share[2] = {VSGL__GGX_EMIT_TAIL_C / VSGL__GGX_EMIT_TAIL_K,
+                                   VSGL__GGX_EMIT_FAR_C / VSGL__GGX_EMIT_FAR_K};
+    vsgl_vsgl t[2] = {*v, *v};
+    for (int k = 0; k < 2; ++k) {
+        t[k].sharpness *= sharp[k];
+        for (int c = 0; c < 3; ++c)
+            t[k].power[c] = v->power[c] * f * share[k];
     }
-    return vsgl__vsgl_set_push(out, &t);
+    v->sharpness *= 1.0f + f * (VSGL__GGX_CORE_K - 1.0f);
+    for (int c = 0; c < 3; ++c)
+        v->power[c] -= t[0].power[c] + t[1].power[c];
+    vsgl_result r = vsgl__vsgl_set_push(out, &t[0]);
+    return r == VSGL_OK ? vsgl__vsgl_set_push(out, &t[1]) : r;
 }
 
 /* The lattice spacing for about n clusters over the light's lit area. */
