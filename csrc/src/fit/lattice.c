@@ -25,7 +25,7 @@
  * a sharp glossy lobe, the sum of Gaussians of the tents' own variance
  * (h^2 / 6 per axis) still ripples by ~7 % (stripes in a metal floor's
  * reflection of a lit wall); the planar glossy model widens each by
- * VSGL__LATTICE_OVERLAP h^2 (ripple ~0.3 %). The diffuse light is not
+ * VSGL__LATTICE_OVERLAP h^2 (fit/vsgl_set.h: ripple ~0.6 %). The diffuse light is not
  * widened: wider Gaussians spill light past a junction, where the wall
  * beside the floor cannot see it (-4 % of the diffuse light in a box). */
 #include "fit/grid.h"
@@ -39,9 +39,6 @@
 
 /* Slab thickness along a bin's axis, in units of h. */
 #define VSGL__LATTICE_SLAB 1.0
-/* Extra positional variance of a VSGL seen through a glossy lobe, in
- * units of h^2 (vsgl_vsgl.widen). */
-#define VSGL__LATTICE_OVERLAP (1.0 / 6.0)
 /* A planar cluster's specular lobe as GGX's core and tail (the two ASGs of
  * the receivers' two-lobe mode, shade/kernel.h): one SG of the cluster's
  * sharpness has no tail, so a metal floor's reflection of a lit patch was
