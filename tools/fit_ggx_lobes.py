@@ -62,15 +62,20 @@ def objective(k1, c1, k2, c2, x_max=X_MAX, n=6001):
     return float(np.sum((e[1:] + e[:-1]) * 0.5 * np.diff(x)))
 
 
-def fit():
+def best_minimum(f, starts, **options):
+    """scipy's Nelder-Mead from every start: the lowest result."""
     from scipy.optimize import minimize
     best = None
-    for k1 in (1.0, 2.0, 3.0):
-        for k2 in (0.1, 0.3, 0.6):
-            r = minimize(lambda p: objective(*lobes(p)), [np.log(k1), np.log(k2), 0.0], method="Nelder-Mead",
-                         options=dict(maxiter=5000, xatol=1e-9, fatol=1e-14))
-            if best is None or r.fun < best.fun:
-                best = r
+    for p0 in starts:
+        r = minimize(f, p0, method="Nelder-Mead", options=options)
+        if best is None or r.fun < best.fun:
+            best = r
+    return best
+
+
+def fit():
+    starts = [[np.log(k1), np.log(k2), 0.0] for k1 in (1.0, 2.0, 3.0) for k2 in (0.1, 0.3, 0.6)]
+    best = best_minimum(lambda p: objective(*lobes(p)), starts, maxiter=5000, xatol=1e-9, fatol=1e-14)
     return lobes(best.x)
 
 
@@ -93,16 +98,13 @@ def lobes_n(params, n):
 
 
 def fit_n(n=4, x_max=10.0, starts=40):
-    from scipy.optimize import minimize
     rng = np.random.default_rng(1)
-    best = None
+    p0s = []
     for _ in range(starts):
         k0 = np.sort(np.exp(rng.uniform(np.log(0.005), np.log(3.0), n)))[::-1]
-        p0 = np.concatenate([np.log(k0), rng.normal(0.0, 1.0, n - 1)])
-        r = minimize(lambda p: objective_n(*lobes_n(p, n), x_max=x_max), p0, method="Nelder-Mead",
-                     options=dict(maxiter=40000, xatol=1e-10, fatol=1e-16))
-        if best is None or r.fun < best.fun:
-            best = r
+        p0s.append(np.concatenate([np.log(k0), rng.normal(0.0, 1.0, n - 1)]))
+    best = best_minimum(lambda p: objective_n(*lobes_n(p, n), x_max=x_max), p0s,
+                        maxiter=40000, xatol=1e-10, fatol=1e-16)
     k, c = lobes_n(best.x, n)
     order = np.argsort(-k)
     return k[order], c[order]
@@ -136,15 +138,9 @@ def emitter_lobes(params, k1, c1):
 
 
 def fit_emitter(k1, c1):
-    from scipy.optimize import minimize
-    best = None
-    for k2 in (0.2, 0.3, 0.5):
-        for k3 in (0.02, 0.06, 0.15):
-            r = minimize(lambda p: objective_n(*emitter_lobes(p, k1, c1), x_max=EMIT_X_MAX),
-                         [np.log(k2), np.log(k3), 0.0], method="Nelder-Mead",
-                         options=dict(maxiter=20000, xatol=1e-10, fatol=1e-14))
-            if best is None or r.fun < best.fun:
-                best = r
+    starts = [[np.log(k2), np.log(k3), 0.0] for k2 in (0.2, 0.3, 0.5) for k3 in (0.02, 0.06, 0.15)]
+    best = best_minimum(lambda p: objective_n(*emitter_lobes(p, k1, c1), x_max=EMIT_X_MAX), starts,
+                        maxiter=20000, xatol=1e-10, fatol=1e-14)
     return emitter_lobes(best.x, k1, c1)
 
 

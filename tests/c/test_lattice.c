@@ -430,9 +430,9 @@ VT_TEST(fit_lattice_marks_where_the_surface_ends)
 
 /* A specular cell's cut where a wall rises moves to the wall's face (its
  * near field then reaches the junction, the wall's foot beside a metal
- * floor): the glossy floor of the fixture room lit up to 3 cm short of the
- * wall x = -1 (the VPLs' extent stops there, as an RSM's texels do up to
- * half a texel short). Its specular cells at that wall end at x = -1 with
+ * floor): the glossy floor of the fixture room lit up to one texel (7.8
+ * mm) short of the wall x = -1 (the VPLs' extent stops there, as an RSM's
+ * does up to half a texel short). Its specular cells at that wall end at x = -1 with
  * every preset's receivers; the rim cuts elsewhere stay where the VPLs
  * stop. */
 VT_TEST(fit_lattice_specular_cut_moves_to_the_wall)

@@ -153,9 +153,9 @@ VT_TEST(planar_glossy_fold_holds_a_half_plane_up_to_its_edge)
      * the footprint 5 mm inside it; 0.092 with the lattice's overlap
      * h^2 / 6 before 2026-12-04, h^2 / 8 now: fit/vsgl_set.h); 5 cm back
      * with the edge on a lattice line, as a floor beside a room's wall,
-     * -4.8 % at 5 mm (-8.0 % with h^2 / 6). Folding the cut cell's Gaussian about its VPLs' mean
-     * instead of its tent's centre (shade.c, fold_mean) gave -21.5 %
-     * there. Without the fold 0.504 (-50 %). */
+     * -4.8 % at 5 mm (-8.0 % with h^2 / 6). Folding the cut cell's
+     * Gaussian about its VPLs' mean instead of its tent's centre (shade.c,
+     * fold_mean) gave -21.5 % there. Without the fold 0.504 (-50 %). */
     VT_CHECK(worst_fold < 0.11, "the fold's worst relative error %.3f", worst_fold);
     /* the test can fail: without the fold the edge sags, deep inside both agree */
     VT_CHECK(worst_edge_nofold > 0.2, "without the fold the edge is off by %.3f only", worst_edge_nofold);

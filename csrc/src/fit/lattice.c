@@ -25,9 +25,10 @@
  * a sharp glossy lobe, the sum of Gaussians of the tents' own variance
  * (h^2 / 6 per axis) still ripples by ~7 % (stripes in a metal floor's
  * reflection of a lit wall); the planar glossy model widens each by
- * VSGL__LATTICE_OVERLAP h^2 (fit/vsgl_set.h: ripple ~0.6 %). The diffuse light is not
- * widened: wider Gaussians spill light past a junction, where the wall
- * beside the floor cannot see it (-4 % of the diffuse light in a box). */
+ * VSGL__LATTICE_OVERLAP h^2 (fit/vsgl_set.h: ripple ~0.6 %). The diffuse
+ * light is not widened: wider Gaussians spill light past a junction, where
+ * the wall beside the floor cannot see it (-4 % of the diffuse light in a
+ * box). */
 #include "fit/grid.h"
 #include "core/context.h"
 #include "scene/scene_internal.h"
@@ -39,18 +40,18 @@
 
 /* Slab thickness along a bin's axis, in units of h. */
 #define VSGL__LATTICE_SLAB 1.0
-/* A planar cluster's specular lobe as GGX's core and tail (the two ASGs of
- * the receivers' two-lobe mode, shade/kernel.h): one SG of the cluster's
- * sharpness has no tail, so a metal floor's reflection of a lit patch was
- * too bright in the middle and missing around it (round blobs on the wall
- * it lights: the red-wall room's diffuse structured error 0.00289 ->
+/* A planar cluster's specular lobe as GGX's core, tail and far tail (the
+ * receivers' core, VSGL__GGX_EMIT_* in shade/kernel.h): one SG of the
+ * cluster's sharpness has no tail, so a metal floor's reflection of a lit
+ * patch was too bright in the middle and missing around it (round blobs on
+ * the wall it lights: the red-wall room's diffuse structured error 0.00289 ->
  * 0.00210, FLIP 0.138 -> 0.126 at 80x60). The split applies to planar
  * clusters only, faded in over coherence 0.990-0.995: a curved surface's
  * cluster's sharpness is mostly the spread of its VPLs' mirror directions,
  * which the split would sharpen (the sphere room's diffuse error 0.00140 ->
  * 0.00164 split everywhere). Not with one-lobe receivers (glossy mode ASG
- * or SG; MRP and hybrid take ASG2's diffuse): the preview keeps one VSGL per cluster,
- * and the live viewport its cost (the spot room's Live light edit had 212
+ * or SG; MRP and hybrid take ASG2's diffuse): the live viewport keeps one
+ * VSGL per cluster and its cost (the spot room's Live light edit had 212
  * VSGLs, 317 with the split). */
 #define VSGL__LATTICE_SPLIT_LO 0.990f
 #define VSGL__LATTICE_SPLIT_HI 0.995f
@@ -390,31 +391,28 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
                 for (int k = 0; k < 2; ++k) {
                     const double short_by[2] = {fmax(e[2 * k], cc[1 + k] - 1.0) - (cc[1 + k] - 1.0),
                                                 (cc[1 + k] + 1.0) - fmin(e[2 * k + 1], cc[1 + k] + 1.0)};
+                    /* The probe also moves a cut to the wall's face where a
+                     * wall rises. A specular cell's cut is always probed:
+                     * its near field then reaches the junction (the VPLs'
+                     * extent stopped up to half a texel short, and a wall's
+                     * foot beside a metal floor lost the floor's reflection
+                     * there: the red wall room's diffuse structured error
+                     * 0.00035 -> 0.00030 in balanced, docs/pipeline.md). A
+                     * diffuse cell's only where the fold needs the verdict
+                     * (one-lobe receivers): with two lobes, a cut that moves
+                     * (the sun's patch by the cabinet) snapped to the
+                     * cabinet and the sun rooms' glossy light flickered
+                     * 0.009 -> 0.013 a frame. */
+                    const int probe = lobe == VSGL__LOBE_SPECULAR || !fold_moving;
                     for (int sd = 0; sd < 2; ++sd) {
                         if (!(short_by[sd] > 0.02))
                             continue;
-                        if (lobe == VSGL__LOBE_DIFFUSE) {
-                            if (fold_moving || surface_ends(scene, &v, k, sd))
-                                v.cell_ends |= 1u << (2 * k + sd);
-                        } else {
-                            /* a specular cell's cut is always probed: where
-                             * a wall rises the probe moves it from the VPLs'
-                             * extent to the wall's face, and its near field
-                             * reaches the junction (the extent stopped up to
-                             * half a texel short, and a wall's foot beside a
-                             * metal floor lost the floor's reflection there:
-                             * diffuse structured error of the red wall room
-                             * 0.00035 -> 0.00030, balanced, docs/pipeline.md).
-                             * Not the diffuse cells' with two-lobe
-                             * receivers (fold_moving): snapped at a cut
-                             * that moves (the sun's patch by the cabinet),
-                             * the sun rooms' glossy light flickered 0.009 ->
-                             * 0.013 a frame. */
-                            (void)surface_ends(scene, &v, k, sd);
-                        }
+                        const int ends = probe && surface_ends(scene, &v, k, sd);
+                        if (lobe == VSGL__LOBE_DIFFUSE && (fold_moving || ends))
+                            v.cell_ends |= 1u << (2 * k + sd);
                     }
                 }
-                /* not with one-lobe receivers (ASG, SG: the preview); the
+                /* not with one-lobe receivers (ASG, SG: the live viewport); the
                  * tail keeps the cell (the near field of specular emitters) */
                 if (lobe == VSGL__LOBE_SPECULAR && s->glossy_mode != VSGL_GLOSSY_ASG &&
                     s->glossy_mode != VSGL_GLOSSY_SG) {
