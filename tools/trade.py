@@ -64,12 +64,14 @@ SPP = [1, 2, 4, 8, 16, 64, 256, 1024]
 QUICK_SPP = [1, 4, 16]
 PRESETS = ["preview", "balanced", "quality", "auto"]
 KNOBS = ["lattice 64:vsgl_count=64", "lattice 512:vsgl_count=512", "RSM 128:rsm_resolution=128",
-         "RSM 512:rsm_resolution=512", "aa 1:aa_samples=1", "aa 4:aa_samples=4",
+         # balanced takes 1 sample per pixel from 320 x 240 up (aa_pixel_limit): "aa 2" is its 2 x 2 at
+         # every size, "aa 4" 4 x 4
+         "RSM 512:rsm_resolution=512", "aa 2:aa_pixel_limit=0", "aa 4:aa_samples=4,aa_pixel_limit=0",
          "quality aa 4:preset=quality,aa_samples=4",
          # the glossy modes of issue 14 (docs/mrp.md) beside the k-means fit they are measured against
          "k-means 256:fit_mode=kmeans,vsgl_count=256", "MRP:glossy_mode=3", "hybrid:glossy_mode=4",
          # the auto preset with every RSM at 128 (a footprint of 1 at its 85 texels per VSGL): against auto,
-         # what sizing each light's RSM from its footprint buys; "aa 1" is auto's other knobs at a uniform 256
+         # what sizing each light's RSM from its footprint buys; balanced is auto's other knobs at a uniform 256
          "auto RSM 128:preset=auto,rsm_resolution=128"]
 BRUTE = ["brute RSM 64:preset=brute,rsm_resolution=64", "brute RSM 128:preset=brute,rsm_resolution=128"]
 # scenes with more triangles: one library run per point, no brute force (dense_floor: balanced
@@ -503,20 +505,21 @@ def auto_choice(budget):
 def auto_section(results, meta):
     lines = ["", "## The auto preset", "",
              "`auto` (VSGL_PRESET_AUTO) is balanced's knobs as ceilings; at render time the library chooses, by "
-             "rules measured on these scenes: 1 sample per pixel from 320 x 240 pixels (the `aa 1` knob was as "
-             "accurate as balanced's 2 x 2 there), one ASG glossy lobe where the camera's probe rays see nothing "
+             "rules measured on these scenes: one ASG glossy lobe where the camera's probe rays see nothing "
              "sharper than roughness 0.5 (every bundled scene has a sharper one: asg2 stays), and each light's RSM "
              "side from its footprint, 128^2 / 192 = 85 texels per VSGL on the part of its lit texels that "
              "lights what the camera sees (`RSM 128` was as accurate as 256 where that is all of them). "
              "Verdict: *gain* when auto's combined relMSE is within %d %% and its FLIP within %d %% of balanced's "
-             "in less time, or both lower in no more time. `aa 1` isolates the footprint (auto's other choices at a "
-             "uniform RSM 256), `auto RSM 128` what the footprint keeps where a light lights mostly what the "
-             "camera does not see (a uniform 128). Times: whole frames at the references' size (the fastest of %d "
+             "in less time, or both lower in no more time; auto takes balanced's 1 sample per pixel from 320 x 240 "
+             "pixels up (`aa_pixel_limit`), so against balanced it isolates the footprint and the glossy choice. "
+             "`auto RSM 128` shows what the footprint keeps where a light lights mostly what the camera does not "
+             "see (a uniform 128); the last but one column is balanced's pixel limit against `aa 2`, balanced's "
+             "2 x 2 samples at every size. Times: whole frames at the references' size (the fastest of %d "
              "runs for the presets, one for the knobs)%s." % (
                  round(100 * (AUTO_SAME["relmse"] - 1)), round(100 * (AUTO_SAME["flip"] - 1)), meta["repeat"],
                  " and at %s (one run each)" % "x".join(map(str, meta["time_size"])) if meta["time_size"] else ""),
-             "", "| scene | auto chose | auto vs balanced: time, relMSE, FLIP | verdict | footprint: auto vs aa 1 "
-             "(RSM 256) | footprint: auto vs auto RSM 128 | %s |" % (
+             "", "| scene | auto chose | auto vs balanced: time, relMSE, FLIP | verdict | footprint: auto vs auto "
+             "RSM 128 | pixel limit: balanced vs aa 2 | %s |" % (
                  "auto / balanced at %s" % "x".join(map(str, meta["time_size"])) if meta["time_size"] else "-"),
              "|---|---|---|---|---|---|---|"]
     gains = 0
@@ -539,7 +542,7 @@ def auto_section(results, meta):
         lines.append("| %s | %s | %.3f vs %.3f s (%.2fx), %.5f vs %.5f, %.4f vs %.4f | %s | %s | %s | %s |" % (
             name, auto_choice(a.get("budget", "")), a["seconds"], b["seconds"], a["seconds"] / b["seconds"],
             a["Combined"]["relmse"], b["Combined"]["relmse"], a["flip"] or 0, b["flip"] or 0, verdict,
-            vs(a, point(res, "aa 1")), vs(a, point(res, "auto RSM 128")), big))
+            vs(a, point(res, "auto RSM 128")), vs(b, point(res, "aa 2")), big))
     lines += ["", "auto gains on %d of %d scenes." % (gains, sum(1 for r in results.values() if point(r, "auto")))]
     timed = [(n, r["time_at"]) for n, r in results.items() if r.get("time_at", {}).get("auto budget")]
     if timed:

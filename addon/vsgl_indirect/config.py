@@ -14,6 +14,7 @@ DEFAULT_TEMPLATE = "{render_dir}/vsgl/{scene}_{view_layer}_####.exr"
 KNOBS = {
     "method": (("VSGL", "BRUTE_FORCE"), "VSGL"),
     "aa_samples": (None, 2),
+    "aa_pixel_limit": (None, 76800),
     "shade_stride": (None, 2),
     "edge_samples": (None, 12),
     "sample_merging": (("AUTO", "OFF"), "AUTO"),
@@ -37,12 +38,13 @@ KNOBS = {
 # tests/blender/addon/test_addon_ui.py checks the two agree.
 _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", fis_iterations=8,
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
-               diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4, visibility_budget=0.02)
+               diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4, visibility_budget=0.02,
+               aa_pixel_limit=0)
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="RAY",
                     shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
-                     shade_stride=2, edge_samples=12, glossy_mode="ASG2"),
+                     shade_stride=2, edge_samples=12, glossy_mode="ASG2", aa_pixel_limit=76800),
     "QUALITY": dict(_COMMON, aa_samples=3, rsm_resolution=512, vsgl_count=256, visibility="RAY",
                     shade_stride=2, edge_samples=12, glossy_mode="ASG2", glossy_lobes=5),
 }
@@ -102,7 +104,7 @@ def inactive_knobs(obj):
     elif obj.fit_mode == "KMEANS":
         out |= {"fis_iterations"}
     if obj.aa_samples <= 1:
-        out.add("sample_merging")
+        out |= {"sample_merging", "aa_pixel_limit"}
     if obj.glossy_mode not in ("MRP", "HYBRID") or obj.method == "BRUTE_FORCE":
         out.add("mrp_min_area")
     if obj.glossy_mode != "ASG2" or obj.method == "BRUTE_FORCE":
@@ -120,6 +122,7 @@ class Options:
     use_advanced: bool = False
     method: str = "VSGL"
     aa_samples: int = 2
+    aa_pixel_limit: int = 76800
     shade_stride: int = 2
     edge_samples: int = 12
     rsm_resolution: int = 256

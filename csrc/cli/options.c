@@ -19,6 +19,8 @@ const char cli_usage[] =
     "  --preset NAME         preview | balanced | quality | auto   (auto: balanced's knobs as ceilings;\n"
     "                        aa, the glossy model and each light's RSM chosen for the scene; -v says what)\n"
     "  --aa N                N x N camera samples per pixel (1..16)\n"
+    "  --aa-pixel-limit N    from N pixels up, one sample per pixel whatever --aa says (edge pixels keep\n"
+    "                        their edge rays); 0 = no limit (balanced, auto: 76800 = 320 x 240)\n"
     "  --rsm N               reflective shadow map side in texels (2..8192)\n"
     "  --fit NAME            two | fis | kmeans | lattice   (VSGL fit)\n"
     "  --vsgls N             VSGLs per light (fis, kmeans; 1..65536)\n"
@@ -160,6 +162,7 @@ static const enum_opt enum_opts[] = {
 
 static const num_opt num_opts[] = {
     {"--aa", 1, offsetof(cli_options, aa)},
+    {"--aa-pixel-limit", 0, offsetof(cli_options, aa_limit)},
     {"--rsm", 1, offsetof(cli_options, rsm)},
     {"--vsgls", 1, offsetof(cli_options, vsgls)},
     {"--shade-stride", 1, offsetof(cli_options, stride)},
@@ -344,6 +347,7 @@ void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_r
         *s = *base;
     s->size = sizeof *s;
     if (o->aa.set) s->aa_samples = o->aa.value;
+    if (o->aa_limit.set) s->aa_pixel_limit = o->aa_limit.value;
     if (o->rsm.set) s->rsm_resolution = o->rsm.value;
     if (o->vsgls.set) s->vsgl_count = o->vsgls.value;
     if (o->stride.set) s->shade_stride = o->stride.value;
@@ -371,11 +375,11 @@ static const char *name_of(const char *const *names, const int *values, int v)
 
 void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size)
 {
-    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u mrp_min_area=%g glossy_lobes=%u",
+    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u mrp_min_area=%g glossy_lobes=%u aa_pixel_limit=%u",
              name_of(method_names, method_values, s->method), s->aa_samples, s->rsm_resolution,
              name_of(fit_names, fit_values, s->fit_mode), s->vsgl_count, s->fis_iterations,
              name_of(sharp_names, sharp_values, s->sharpness_estimator), name_of(diffuse_names, diffuse_values, s->diffuse_mode),
              name_of(glossy_names, glossy_values, s->glossy_mode), name_of(vis_names, vis_values, s->visibility), s->seed,
              name_of(leak_names, leak_values, s->leak_correction), name_of(merge_names, merge_values, s->sample_merging), s->shade_stride, s->edge_samples,
-             (double)s->mrp_min_area, s->glossy_lobes);
+             (double)s->mrp_min_area, s->glossy_lobes, s->aa_pixel_limit);
 }

@@ -411,7 +411,7 @@ VT_TEST(budget_auto_renders_what_it_says)
     const struct {
         uint32_t w, h;
         float floor_roughness;
-        unsigned aa; /* below VSGL__AUTO_AA1_PIXELS: balanced's 2 */
+        unsigned aa; /* below balanced's aa_pixel_limit: its 2 */
         const char *glossy;
     } cases[3] = {{BW, BH, 0.3f, 2, "glossy asg2: roughness 0.30 seen"},
                   {BW * 4, BH * 4, 0.3f, 2, "glossy asg2"},
@@ -460,5 +460,54 @@ VT_TEST(budget_auto_renders_what_it_says)
     VT_CHECK(render_with(ctx, &big, &s, comb, NULL) == VSGL_ERROR_INVALID_ARGUMENT &&
              strstr(vsgl_context_last_error(ctx), "auto_target is 7"), "bad auto_target: %s",
              vsgl_context_last_error(ctx));
+    vsgl_context_destroy(ctx);
+}
+
+/* aa_pixel_limit (balanced's 320 x 240): from that many pixels a render
+ * takes one sample per pixel, says so in `skipped`, and gives the pixels
+ * of aa_samples 1 set by hand; one pixel fewer keeps 2 x 2; the memory
+ * estimate follows. */
+VT_TEST(budget_aa_pixel_limit_takes_one_sample_and_says_so)
+{
+    static float lim[320 * 240 * 3], hand[320 * 240 * 3], full[320 * 240 * 3];
+    vsgl_context *ctx = fx_context(2);
+    VT_REQUIRE(ctx, "context");
+    const uint32_t widths[2] = {320, 319};
+    for (int c = 0; c < 2; ++c) {
+        fx_scene fx;
+        fx_room(&fx, widths[c], 240, 0.3f, 150.0f);
+        vsgl_render_settings s, h, f;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        VT_CHECK(s.aa_samples == 2 && s.aa_pixel_limit == VSGL_AA_PIXEL_LIMIT_BALANCED && s.aa_pixel_limit == 76800u,
+                 "balanced: aa %u, limit %u", s.aa_samples, s.aa_pixel_limit);
+        h = s;
+        h.aa_samples = 1;
+        h.aa_pixel_limit = 0;
+        f = s;
+        f.aa_pixel_limit = 0;
+        vsgl_render_stats st = {.size = sizeof st};
+        VT_REQUIRE(render_with(ctx, &fx, &s, lim, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_REQUIRE(render_with(ctx, &fx, &h, hand, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_REQUIRE(render_with(ctx, &fx, &f, full, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        size_t n = (size_t)widths[c] * 240 * 3 * sizeof(float);
+        int said = strstr(st.skipped, "anti-aliasing: 1 sample per pixel, not 2 x 2: 320 x 240 is at least "
+                                      "aa_pixel_limit (76800 pixels); edge pixels keep their edge rays") != NULL;
+        int as_hand = memcmp(lim, hand, n) == 0, as_full = memcmp(lim, full, n) == 0;
+        vsgl_scene *scene = NULL;
+        VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        vsgl_memory_estimate es, eh, ef;
+        VT_CHECK(vsgl_render_estimate(ctx, scene, &s, 22, &es) == VSGL_OK &&
+                 vsgl_render_estimate(ctx, scene, &h, 22, &eh) == VSGL_OK &&
+                 vsgl_render_estimate(ctx, scene, &f, 22, &ef) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        vsgl_scene_destroy(scene);
+        if (c == 0)
+            VT_CHECK(said && as_hand && !as_full && es.gbuffer == eh.gbuffer && es.gbuffer < ef.gbuffer,
+                     "320 x 240: said %d, as aa 1 by hand %d, as 2 x 2 %d, G-buffer estimate %llu (aa 1: %llu, "
+                     "2 x 2: %llu); skipped: %s", said, as_hand, as_full, (unsigned long long)es.gbuffer,
+                     (unsigned long long)eh.gbuffer, (unsigned long long)ef.gbuffer, st.skipped);
+        else
+            VT_CHECK(!strstr(st.skipped, "anti-aliasing") && !as_hand && as_full && es.gbuffer == ef.gbuffer,
+                     "319 x 240: said %d, as aa 1 %d, as 2 x 2 %d", said, as_hand, as_full);
+    }
     vsgl_context_destroy(ctx);
 }

@@ -126,6 +126,7 @@ static void make_scene(test_scene *s, unsigned seed)
     s->settings.mrp_min_area = 1.5f;               /* format 1.5 */
     s->settings.glossy_lobes = 5;                  /* format 1.6 */
     s->settings.visibility_budget = 0.1f;          /* format 1.7 */
+    s->settings.aa_pixel_limit = 1000u;            /* format 1.8 */
 }
 
 static int same_bytes(const void *a, const void *b, size_t n)
@@ -180,7 +181,7 @@ VT_TEST(bundle_roundtrip_memory_is_bit_exact)
     VT_CHECK(b != NULL, "write: %s", vsgl_context_last_error(ctx));
     /* Documented size: 40 + sum over sections of 24 + bytes padded to 8. */
     size_t want = 40 + (24 + 88) + (24 + 64) + (24 + 184) + (24 + 120) + (24 + 240) + (24 + 24) + (24 + 80) + (24 + 312) +
-                  (24 + 104) + (24 + 80) + (24 + 32) + (24 + 8); /* settings: 76 bytes, padded to 80 */
+                  (24 + 104) + (24 + 80) + (24 + 32) + (24 + 8); /* settings: 80 bytes */
     VT_CHECK(n == want, "bundle size %zu, documented layout gives %zu", n, want);
     vsgl_bundle *bd = NULL;
     vsgl_result r = vsgl_bundle_read_memory(ctx, b, n, &bd);
@@ -192,7 +193,7 @@ VT_TEST(bundle_roundtrip_memory_is_bit_exact)
                  st->seed, st->aa_samples, st->shade_stride, st->edge_samples, st->auto_target, (double)st->mrp_min_area);
         vsgl_bundle_info info = {.size = sizeof info};
         VT_CHECK(vsgl_bundle_get_info(bd, &info) == VSGL_OK, "info");
-        VT_CHECK(info.version_major == 1 && info.version_minor == 7 && info.has_frame && info.frame == -42 && info.has_settings &&
+        VT_CHECK(info.version_major == 1 && info.version_minor == VSGL_BUNDLE_VERSION_MINOR && info.has_frame && info.frame == -42 && info.has_settings &&
                      strcmp(info.output_path, "/tmp/out dir/frame_0042.exr") == 0,
                  "info %u.%u frame %d/%d settings %u path '%s'", info.version_major, info.version_minor, info.has_frame,
                  info.frame, info.has_settings, info.output_path);
@@ -278,7 +279,7 @@ VT_TEST(bundle_file_matches_independent_python_reader)
     snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s '%s'", script, path);
     int rc = run_capture(cmd, out, sizeof out);
     VT_CHECK(rc == 0 && strstr(out, "\nok\n"), "reference reader exit %d:\n%s", rc, out);
-    VT_CHECK(strstr(out, "version 1.7\n") && strstr(out, "section POS  esize 12 count 7 crc ok") &&
+    VT_CHECK(strstr(out, "version 1.8\n") && strstr(out, "section POS  esize 12 count 7 crc ok") &&
                  strstr(out, "section IDX  esize 12 count 5 crc ok") && strstr(out, "section LGHT esize 104 count 3 crc ok") &&
                  strstr(out, "camera type 0 fit 0 lens 50 size 320x240") && strstr(out, "light 2 type 2 power 300") &&
                  strstr(out, "output out.exr") && strstr(out, "frame 12") && strstr(out, "seed 1234567"),
@@ -374,9 +375,9 @@ VT_TEST(bundle_bad_headers_give_clear_errors)
 
     memcpy(t, b, n);
     wr32(t + 8, 2);
-    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 2.7, this library reads 1.x", "major 2");
+    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 2.8, this library reads 1.x", "major 2");
     wr32(t + 8, 0);
-    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 0.7", "major 0");
+    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 0.8", "major 0");
 
     memcpy(t, b, n);
     memset(t + n, 0, 16);

@@ -267,7 +267,8 @@ def test_render_estimate_and_memory_limit(lib):
             with pytest.raises(L.VsglError) as e:
                 L.render(small, scene, L.render_settings_preset("balanced"))
             assert e.value.code == L.Result.ERROR_OUT_OF_MEMORY
-            assert "render: 640x480 with aa 2 and RSM 256 needs about" in e.value.message
+            # balanced's 2 x 2 samples: 1 from 320 x 240 pixels up (aa_pixel_limit)
+            assert "render: 640x480 with aa 1 and RSM 256 needs about" in e.value.message
             assert "more than the memory limit of 1.0 MiB (max_memory)" in e.value.message
         finally:
             scene.close()
@@ -276,7 +277,13 @@ def test_render_estimate_and_memory_limit(lib):
         try:
             est = L.render_estimate(ctx, scene, L.render_settings_preset("balanced"), planes=("combined", "alpha"))
             assert est["output"] == 640 * 480 * 4 * 4
-            assert est["gbuffer"] == 640 * 480 * (4 * (52 + 8) + 1)  # + edge weights, normal spreads and mask
+            # one sample per pixel (aa_pixel_limit) with a second slot for edges, each + edge weight and
+            # normal spread, and the edge mask; 2 x 2 samples without the limit
+            assert est["gbuffer"] == 640 * 480 * (2 * (52 + 8) + 1)
+            unlimited = L.render_settings_preset("balanced")
+            unlimited.aa_pixel_limit = 0
+            full = L.render_estimate(ctx, scene, unlimited, planes=("combined", "alpha"))
+            assert full["gbuffer"] == 640 * 480 * (4 * (52 + 8) + 1)
             assert est["total"] == sum(est[k] for k in ("output", "gbuffer", "planes", "rsm", "fit", "shade"))
             assert est["limit"] > est["total"]
             with pytest.raises(L.VsglError) as e:

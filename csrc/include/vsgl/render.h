@@ -95,10 +95,12 @@ extern "C" {
  * the bundled scenes (docs/trade.md, "The auto preset"), from what the
  * per-light budget's probe sees (a 32-wide grid of camera rays, each
  * light's 16^2 probe RSM): the glossy lobe model from the sharpest glossy
- * material the camera sees, anti-aliasing from the image size, and each
+ * material the camera sees, and each
  * light's RSM side from its footprint (the probe texels whose light
- * reaches what the camera sees). Never more than the knobs as set. The
- * stats' `budget` text and the log say what it chose and why. */
+ * reaches what the camera sees); anti-aliasing follows the image size as
+ * in every render (aa_pixel_limit, which the auto preset takes from
+ * balanced). Never more than the knobs as set. The stats' `budget` text
+ * and the log say what it chose and why. */
 #define VSGL_AUTO_OFF      0 /**< the knobs as set (the default) */
 #define VSGL_AUTO_BALANCED 1 /**< the error of the balanced preset, at less cost where the scene allows */
 
@@ -144,8 +146,9 @@ typedef struct vsgl_render_settings {
                                       aa_samples, is off (the default) */
     int32_t auto_target;         /**< VSGL_AUTO_*: OFF (the default) renders with the knobs as set;
                                       BALANCED aims at the balanced preset's error at less cost:
-                                      aa_samples, rsm_resolution and glossy_mode are chosen for the
-                                      scene, at most as set; the other knobs are taken as set */
+                                      rsm_resolution and glossy_mode are chosen for the scene, at
+                                      most as set; the other knobs are taken as set (aa_samples
+                                      follows aa_pixel_limit, as in every render) */
     float mrp_min_area;          /**< glossy_mode MRP and HYBRID: the smallest planar face (m^2, the area of
                                       the rectangle fitted to its coplanar triangles) made a rectangle
                                       proxy. Larger: fewer proxies, less time, fewer surfaces reflected;
@@ -163,7 +166,16 @@ typedef struct vsgl_render_settings {
                                       at most the fraction times how unevenly the VSGLs are shadowed. 0 means
                                       VSGL_VISIBILITY_BUDGET_DEFAULT; negative: a ray for every pair; at most
                                       0.5 */
+    uint32_t aa_pixel_limit;     /**< an image of at least this many pixels takes one sample per pixel
+                                      whatever aa_samples says (edge pixels keep their edge_samples rays):
+                                      there a pixel is small against how fast indirect light changes, and
+                                      aa x aa samples buy little for their time (the balanced preset:
+                                      VSGL_AA_PIXEL_LIMIT_BALANCED). The log and the stats' `skipped` say
+                                      when it applied. 0: no limit (the default) */
 } vsgl_render_settings;
+
+/** vsgl_render_settings.aa_pixel_limit of the balanced and auto presets: 320 x 240. */
+#define VSGL_AA_PIXEL_LIMIT_BALANCED (320u * 240u)
 
 /** vsgl_render_settings.visibility_budget when it is 0. */
 #define VSGL_VISIBILITY_BUDGET_DEFAULT 0.02f

@@ -43,9 +43,6 @@
 /* Glossy receivers sharper than this roughness (sqrt of the GGX alpha)
  * keep the two-lobe GGX (asg2); otherwise one ASG lobe. */
 #define VSGL__AUTO_SHARP_ROUGHNESS 0.5f
-/* From this many pixels, one sample per pixel (edges still get their
- * edge rays). */
-#define VSGL__AUTO_AA1_PIXELS (320u * 240u)
 
 typedef struct vsgl_light_share {
     double weight;           /* in: the probe's light on what the camera sees; 0: contributes nothing */
@@ -89,14 +86,15 @@ typedef struct vsgl_budget_view {
                                   among the glossy ones (textures read); 1 if none */
 } vsgl_budget_view;
 
-/* The camera probe alone (the auto budget's glossy and anti-aliasing choice). */
+/* The camera probe alone (the auto budget's glossy choice). */
 vsgl_result vsgl__budget_view(vsgl_context *ctx, const vsgl_scene *scene, vsgl_budget_view *view);
 
-/* The auto budget (budget_auto.c): chooses aa_samples and glossy_mode of
- * *s for the scene (at most as set) when s->auto_target is set, and says
- * what and why in st->budget and the log. */
-vsgl_result vsgl__auto_choose(vsgl_context *ctx, const vsgl_scene *scene, vsgl_render_settings *s,
-                              vsgl_render_stats *st);
+/* The auto budget (budget_auto.c): chooses glossy_mode of *s for the
+ * scene (at most as set) when s->auto_target is set, and says what and
+ * why in st->budget and the log, with the anti-aliasing aa_pixel_limit
+ * gave (aa_asked: the aa_samples it lowered to 1, else 0). */
+vsgl_result vsgl__auto_choose(vsgl_context *ctx, const vsgl_scene *scene, uint32_t aa_asked,
+                              vsgl_render_settings *s, vsgl_render_stats *st);
 
 /* Each light's weight (render/budget_probe.c): the light its probe RSM's
  * VPLs send, unshadowed, onto what a sparse grid of camera rays sees (the

@@ -26,8 +26,8 @@ static void say(vsgl_context *ctx, vsgl_render_stats *st, const char *fmt, ...)
         snprintf(st->budget + used, sizeof st->budget - used, "auto: %s\n", line);
 }
 
-vsgl_result vsgl__auto_choose(vsgl_context *ctx, const vsgl_scene *scene, vsgl_render_settings *s,
-                              vsgl_render_stats *st)
+vsgl_result vsgl__auto_choose(vsgl_context *ctx, const vsgl_scene *scene, uint32_t aa_asked,
+                              vsgl_render_settings *s, vsgl_render_stats *st)
 {
     if (s->auto_target == VSGL_AUTO_OFF || s->method != VSGL_METHOD_VSGL)
         return VSGL_OK;
@@ -38,14 +38,13 @@ vsgl_result vsgl__auto_choose(vsgl_context *ctx, const vsgl_scene *scene, vsgl_r
     const vsgl_camera *cam = vsgl__scene_camera(scene);
     uint64_t pixels = (uint64_t)cam->width * cam->height;
 
-    /* anti-aliasing: from the image size (edges keep their edge rays) */
-    if (s->aa_samples > 1 && pixels >= VSGL__AUTO_AA1_PIXELS) {
-        say(ctx, st, "aa 1 (not %u): %ux%u, >= %u pixels", s->aa_samples, cam->width, cam->height,
-            VSGL__AUTO_AA1_PIXELS);
-        s->aa_samples = 1;
-    } else {
-        say(ctx, st, "aa %u: %ux%u, < %u pixels", s->aa_samples, cam->width, cam->height, VSGL__AUTO_AA1_PIXELS);
-    }
+    /* anti-aliasing: from the image size, as every render (aa_pixel_limit, render.c) */
+    if (aa_asked)
+        say(ctx, st, "aa 1 (not %u): %ux%u, >= %u pixels", aa_asked, cam->width, cam->height, s->aa_pixel_limit);
+    else if (s->aa_pixel_limit && s->aa_samples > 1 && pixels < s->aa_pixel_limit)
+        say(ctx, st, "aa %u: %ux%u, < %u pixels", s->aa_samples, cam->width, cam->height, s->aa_pixel_limit);
+    else
+        say(ctx, st, "aa %u: as set", s->aa_samples);
     /* the glossy lobe model: two ASGs only where a sharp glossy surface is seen */
     if (s->glossy_mode == VSGL_GLOSSY_ASG2) {
         if (v.glossy == 0 || v.sharpest_roughness >= VSGL__AUTO_SHARP_ROUGHNESS) {

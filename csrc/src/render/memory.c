@@ -213,6 +213,7 @@ vsgl_result vsgl_render_estimate(vsgl_context *ctx, const vsgl_scene *scene, con
     if (r != VSGL_OK)
         return r;
     const vsgl_camera *cam = vsgl__scene_camera(scene);
+    (void)vsgl__settings_fit_image(&s, cam->width, cam->height);
     vsgl_memory_estimate e;
     r = vsgl__memory_estimate(ctx, scene, &s,
                               mul((uint64_t)cam->width * cam->height, (uint64_t)output_floats_per_pixel * sizeof(float)), &e);

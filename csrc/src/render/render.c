@@ -512,7 +512,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
                           !ctx ? "context" : (!scene ? "scene" : "output"));
     vsgl_render_output o; /* the caller's, an older one's missing planes NULL */
     const vsgl_render_output *out = &o;
-    vsgl_render_settings s;
+    vsgl_render_settings s = {0}; /* (filled by vsgl__settings_resolve) */
     size_t stats_bytes = 0;
     vsgl_result r = vsgl__copy_versioned(ctx, &o, sizeof o, caller_out, "vsgl_render_output");
     if (r == VSGL_OK && stats)
@@ -521,6 +521,8 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
         r = vsgl__settings_resolve(ctx, settings, &s);
     if (r == VSGL_OK)
         r = check_output(ctx, scene, out);
+    /* one sample per pixel from aa_pixel_limit pixels up (said at the end) */
+    uint32_t aa_asked = r == VSGL_OK ? vsgl__settings_fit_image(&s, out->width, out->height) : 0;
     if (r == VSGL_OK) { /* refuse what cannot fit before allocating (render/memory.c) */
         const float *const rgb[7] = {out->diffuse_light, out->glossy_light, out->diffuse_color, out->glossy_color,
                                      out->diffuse, out->glossy, out->combined};
@@ -536,7 +538,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     vsgl_render_stats st;
     memset(&st, 0, sizeof st);
     /* the auto budget: anti-aliasing and the glossy model for this scene (budget_auto.c) */
-    if (s.auto_target != VSGL_AUTO_OFF && (r = vsgl__auto_choose(ctx, scene, &s, &st)) != VSGL_OK)
+    if (s.auto_target != VSGL_AUTO_OFF && (r = vsgl__auto_choose(ctx, scene, aa_asked, &s, &st)) != VSGL_OK)
         return r;
     /* a convex shell (an empty closed room): visibility rays cannot find anything */
     int rays_skipped = 0;
@@ -654,6 +656,10 @@ done:
         note_skip(ctx, &st, "visibility rays: every surface lies on the scene's convex hull (an empty closed "
                   "room), so nothing can block light between two surfaces: %llu rays saved",
                   (unsigned long long)st.shading_pairs);
+    if (r == VSGL_OK && aa_asked)
+        note_skip(ctx, &st, "anti-aliasing: 1 sample per pixel, not %u x %u: %u x %u is at least aa_pixel_limit "
+                  "(%u pixels)%s", aa_asked, aa_asked, out->width, out->height, s.aa_pixel_limit,
+                  s.edge_samples > 1 ? "; edge pixels keep their edge rays" : "");
     vsgl__shade_plan_free(plan);
     vsgl__vsgl_set_free(&set);
     vsgl__gbuffer_free(&g);
