@@ -64,10 +64,10 @@ SPP = [1, 2, 4, 8, 16, 64, 256, 1024]
 QUICK_SPP = [1, 4, 16]
 PRESETS = ["preview", "balanced", "quality", "auto"]
 KNOBS = ["lattice 64:vsgl_count=64", "lattice 512:vsgl_count=512", "RSM 128:rsm_resolution=128",
-         # balanced takes 1 sample per pixel from 320 x 240 up (aa_pixel_limit): "aa 2" is its 2 x 2 at
-         # every size, "aa 4" 4 x 4
+         # every preset takes 1 sample per pixel from 320 x 240 up (aa_pixel_limit): "aa 2" is balanced's
+         # 2 x 2 at every size, "aa 4" 4 x 4
          "RSM 512:rsm_resolution=512", "aa 2:aa_pixel_limit=0", "aa 4:aa_samples=4,aa_pixel_limit=0",
-         "quality aa 4:preset=quality,aa_samples=4",
+         "quality aa 4:preset=quality,aa_samples=4,aa_pixel_limit=0",
          # the glossy modes of issue 14 (docs/mrp.md) beside the k-means fit they are measured against
          "k-means 256:fit_mode=kmeans,vsgl_count=256", "MRP:glossy_mode=3", "hybrid:glossy_mode=4",
          # the auto preset with every RSM at 128 (a footprint of 1 at its 85 texels per VSGL): against auto,

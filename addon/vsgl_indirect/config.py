@@ -39,12 +39,12 @@ KNOBS = {
 _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", fis_iterations=8,
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
                diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4, visibility_budget=0.02,
-               aa_pixel_limit=0)
+               aa_pixel_limit=76800)
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="RAY",
                     shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
-                     shade_stride=2, edge_samples=12, glossy_mode="ASG2", aa_pixel_limit=76800),
+                     shade_stride=2, edge_samples=12, glossy_mode="ASG2"),
     "QUALITY": dict(_COMMON, aa_samples=3, rsm_resolution=512, vsgl_count=256, visibility="RAY",
                     shade_stride=2, edge_samples=12, glossy_mode="ASG2", glossy_lobes=5),
 }

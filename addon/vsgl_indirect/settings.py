@@ -239,15 +239,16 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
     method: _enum("method", "Method", "How the light of each reflective shadow map is gathered")
     aa_samples: IntProperty(
         name="AA Samples", default=config.KNOBS["aa_samples"][1], min=1, max=AA_SAMPLES_MAX,
-        description="N x N camera samples per pixel: anti-aliased edges in the AOV. G-buffer cost "
+        description="N x N camera samples per pixel (1 from AA Pixel Limit pixels up): anti-aliased edges "
+                    "in the AOV. G-buffer cost "
                     "x N^2 (shading less with sample merging); the gather room's relMSE 0.0088 "
                     "-> 0.0057 from 1 to 2 (lattice 128, rays), 0.21 s -> 0.32 s")
     aa_pixel_limit: IntProperty(
         name="AA Pixel Limit", default=config.KNOBS["aa_pixel_limit"][1], min=0,
         description="From this many pixels up, one sample per pixel whatever AA Samples says (edge "
-                    "pixels keep their Edge Samples rays); 0: no limit. Balanced: 76800 (320 x 240): "
-                    "at 960 x 540 a frame takes 0.67-0.88x the time of 2 x 2 samples at about the "
-                    "same error against Cycles (docs/trade.md)")
+                    "pixels keep their Edge Samples rays); 0: no limit. Every preset: 76800 (320 x 240): "
+                    "at 960 x 540 a Balanced frame takes 0.64-0.91x the time of 2 x 2 samples at about "
+                    "the same error against Cycles (docs/pipeline.md)")
     shade_stride: IntProperty(
         name="Shade Stride", default=config.KNOBS["shade_stride"][1], min=1, max=SHADE_STRIDE_MAX,
         description="Shade one pixel in S x S and interpolate between them where neighbours "

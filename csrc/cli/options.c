@@ -20,7 +20,7 @@ const char cli_usage[] =
     "                        aa, the glossy model and each light's RSM chosen for the scene; -v says what)\n"
     "  --aa N                N x N camera samples per pixel (1..16)\n"
     "  --aa-pixel-limit N    from N pixels up, one sample per pixel whatever --aa says (edge pixels keep\n"
-    "                        their edge rays); 0 = no limit (balanced, auto: 76800 = 320 x 240)\n"
+    "                        their edge rays); 0 = no limit (every preset: 76800 = 320 x 240)\n"
     "  --rsm N               reflective shadow map side in texels (2..8192)\n"
     "  --fit NAME            two | fis | kmeans | lattice   (VSGL fit)\n"
     "  --vsgls N             VSGLs per light (fis, kmeans; 1..65536)\n"

@@ -478,7 +478,7 @@ VT_TEST(budget_aa_pixel_limit_takes_one_sample_and_says_so)
         fx_room(&fx, widths[c], 240, 0.3f, 150.0f);
         vsgl_render_settings s, h, f;
         vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
-        VT_CHECK(s.aa_samples == 2 && s.aa_pixel_limit == VSGL_AA_PIXEL_LIMIT_BALANCED && s.aa_pixel_limit == 76800u,
+        VT_CHECK(s.aa_samples == 2 && s.aa_pixel_limit == VSGL_AA_PIXEL_LIMIT_PRESETS && s.aa_pixel_limit == 76800u,
                  "balanced: aa %u, limit %u", s.aa_samples, s.aa_pixel_limit);
         h = s;
         h.aa_samples = 1;

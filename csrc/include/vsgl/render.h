@@ -169,13 +169,13 @@ typedef struct vsgl_render_settings {
     uint32_t aa_pixel_limit;     /**< an image of at least this many pixels takes one sample per pixel
                                       whatever aa_samples says (edge pixels keep their edge_samples rays):
                                       there a pixel is small against how fast indirect light changes, and
-                                      aa x aa samples buy little for their time (the balanced preset:
-                                      VSGL_AA_PIXEL_LIMIT_BALANCED). The log and the stats' `skipped` say
+                                      aa x aa samples buy little for their time (every preset:
+                                      VSGL_AA_PIXEL_LIMIT_PRESETS). The log and the stats' `skipped` say
                                       when it applied. 0: no limit (the default) */
 } vsgl_render_settings;
 
-/** vsgl_render_settings.aa_pixel_limit of the balanced and auto presets: 320 x 240. */
-#define VSGL_AA_PIXEL_LIMIT_BALANCED (320u * 240u)
+/** vsgl_render_settings.aa_pixel_limit of every preset: 320 x 240. */
+#define VSGL_AA_PIXEL_LIMIT_PRESETS (320u * 240u)
 
 /** vsgl_render_settings.visibility_budget when it is 0. */
 #define VSGL_VISIBILITY_BUDGET_DEFAULT 0.02f

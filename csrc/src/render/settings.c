@@ -40,6 +40,17 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
      * 2 x 2 samples for it, at about the same flicker. Balanced and quality
      * take 12 x 12 (below). */
     out->edge_samples = 8;
+    /* Every preset takes one sample per pixel from 320 x 240 up (edges keep
+     * their edge rays; docs/pipeline.md, "Anti-aliasing by image size"): at
+     * 320 x 240 against Cycles the combined relMSE of the six quality rooms
+     * is 0.99-1.06x that of balanced's 2 x 2 samples and 0.98-1.07x that of
+     * quality's 3 x 3 (the sun rooms the +5-7 %), FLIP within 0.3 %, and
+     * quality stays more accurate than balanced in every room; balanced
+     * takes 0.64-0.91x the time at 960 x 540, quality 0.44-0.99x at 320 x
+     * 240. At 80 x 60 a pixel is large against the light's changes (the box
+     * room's relMSE 0.00468 with one sample against 0.00416 with 2 x 2), so
+     * the test rooms of docs/quality.md keep their aa x aa. */
+    out->aa_pixel_limit = VSGL_AA_PIXEL_LIMIT_PRESETS;
     out->diffuse_mode = VSGL_COSINE_PULLED_OUT;
     /* Every preset takes GGX as two lobes (VSGL_GLOSSY_ASG2): with one, a
      * metal floor's reflection of a lit wall was too bright in its middle
@@ -98,15 +109,6 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
                 Diff 0.943, sphere Gloss 0.942, sun room Gloss 0.947 of Cycles); at 192
                 every pass of the six is within 5 % (0.951-1.032) */
         out->aa_samples = 2;
-        /* From 320 x 240 up, one sample per pixel (edges keep their 12 x 12
-         * rays; docs/pipeline.md, "Anti-aliasing by image size"): at 320 x
-         * 240 against Cycles, the combined relMSE of the six quality rooms
-         * 0.99-1.06x that of 2 x 2 samples (the sun rooms 1.05-1.06x), FLIP
-         * within 0.3 %, and a 960 x 540 render takes 0.64-0.91x the time.
-         * At 80 x 60 a pixel is large against the light's changes (the box
-         * room's relMSE 0.00468 with one sample against 0.00416), so the
-         * test rooms keep 2 x 2. */
-        out->aa_pixel_limit = VSGL_AA_PIXEL_LIMIT_BALANCED;
         out->rsm_resolution = 256;
         out->vsgl_count = 192;
         out->visibility = VSGL_VISIBILITY_RAY;
