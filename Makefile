@@ -11,9 +11,12 @@ CC      ?= cc
 PYTHON  ?= /usr/bin/python3
 BPY_PYTHON ?= python3
 BUILD   := build
-INCLUDES := -Icsrc/include -Icsrc/src $(shell pkg-config --cflags-only-I OpenEXR 2>/dev/null)
+# `=`, not `:=`: OpenEXR's include path is asked for when a recipe runs, after the
+# `deps` prerequisite has installed libopenexr-dev on a fresh machine (asked at
+# parse time it was empty there, and the first `make` failed on io/exr.c)
+INCLUDES = -Icsrc/include -Icsrc/src $(shell pkg-config --cflags-only-I OpenEXR 2>/dev/null)
 WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes -Wmissing-prototypes
-CFLAGS_COMMON := -std=c11 -D_POSIX_C_SOURCE=200809L -DVSGL_BUILDING -fPIC -fvisibility=hidden $(WARN) $(INCLUDES)
+CFLAGS_COMMON = -std=c11 -D_POSIX_C_SOURCE=200809L -DVSGL_BUILDING -fPIC -fvisibility=hidden $(WARN) $(INCLUDES)
 OPT     ?= -O2 -g
 LDLIBS  := -lembree3 -lOpenEXRCore-3_1 -lpthread -lm
 
