@@ -411,7 +411,7 @@ VT_TEST(budget_auto_renders_what_it_says)
     const struct {
         uint32_t w, h;
         float floor_roughness;
-        unsigned aa; /* below balanced's aa_pixel_limit: its 2 */
+        unsigned aa; /* below the preset's aa_pixel_limit: balanced's 2 */
         const char *glossy;
     } cases[3] = {{BW, BH, 0.3f, 2, "glossy asg2: roughness 0.30 seen"},
                   {BW * 4, BH * 4, 0.3f, 2, "glossy asg2"},
@@ -463,7 +463,7 @@ VT_TEST(budget_auto_renders_what_it_says)
     vsgl_context_destroy(ctx);
 }
 
-/* aa_pixel_limit (balanced's 320 x 240): from that many pixels a render
+/* aa_pixel_limit (every preset's 320 x 240): from that many pixels a render
  * takes one sample per pixel, says so in `skipped`, and gives the pixels
  * of aa_samples 1 set by hand; one pixel fewer keeps 2 x 2; the memory
  * estimate follows. */

@@ -130,7 +130,7 @@ static const field settings_fields[] = {
     F(vsgl_render_settings, glossy_lobes, 'u', 1),
     /* format 1.7: the visibility rays' budget */
     F(vsgl_render_settings, visibility_budget, 'f', 1),
-    /* format 1.8: one sample per pixel from this many pixels up (the balanced preset's) */
+    /* format 1.8: one sample per pixel from this many pixels up (every preset's 76800) */
     F(vsgl_render_settings, aa_pixel_limit, 'u', 1),
 };
 #define SLOT(m) F(vsgl_material_textures, m.texture, 'u', 1), F(vsgl_material_textures, m.filter, 'i', 1), \

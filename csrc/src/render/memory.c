@@ -209,11 +209,11 @@ vsgl_result vsgl_render_estimate(vsgl_context *ctx, const vsgl_scene *scene, con
     if (!ctx || !scene)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "render estimate: %s is NULL", !ctx ? "context" : "scene");
     vsgl_render_settings s;
-    vsgl_result r = vsgl__settings_resolve(ctx, settings, &s);
+    uint32_t aa_asked;
+    vsgl_result r = vsgl__settings_resolve_for(ctx, settings, scene, &s, &aa_asked);
     if (r != VSGL_OK)
         return r;
     const vsgl_camera *cam = vsgl__scene_camera(scene);
-    (void)vsgl__settings_fit_image(&s, cam->width, cam->height);
     vsgl_memory_estimate e;
     r = vsgl__memory_estimate(ctx, scene, &s,
                               mul((uint64_t)cam->width * cam->height, (uint64_t)output_floats_per_pixel * sizeof(float)), &e);

@@ -512,17 +512,16 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
                           !ctx ? "context" : (!scene ? "scene" : "output"));
     vsgl_render_output o; /* the caller's, an older one's missing planes NULL */
     const vsgl_render_output *out = &o;
-    vsgl_render_settings s = {0}; /* (filled by vsgl__settings_resolve) */
+    vsgl_render_settings s;
     size_t stats_bytes = 0;
     vsgl_result r = vsgl__copy_versioned(ctx, &o, sizeof o, caller_out, "vsgl_render_output");
     if (r == VSGL_OK && stats)
         r = vsgl__versioned_size(ctx, stats, sizeof *stats, &stats_bytes, "vsgl_render_stats");
+    uint32_t aa_asked = 0; /* aa_samples that aa_pixel_limit lowered to 1 (said at the end) */
     if (r == VSGL_OK)
-        r = vsgl__settings_resolve(ctx, settings, &s);
+        r = vsgl__settings_resolve_for(ctx, settings, scene, &s, &aa_asked);
     if (r == VSGL_OK)
         r = check_output(ctx, scene, out);
-    /* one sample per pixel from aa_pixel_limit pixels up (said at the end) */
-    uint32_t aa_asked = r == VSGL_OK ? vsgl__settings_fit_image(&s, out->width, out->height) : 0;
     if (r == VSGL_OK) { /* refuse what cannot fit before allocating (render/memory.c) */
         const float *const rgb[7] = {out->diffuse_light, out->glossy_light, out->diffuse_color, out->glossy_color,
                                      out->diffuse, out->glossy, out->combined};

@@ -11,10 +11,12 @@
  * validate; the error names the field. */
 vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings *in,
                                    vsgl_render_settings *s);
-/* aa_pixel_limit on resolved settings `s` for a width x height image: one
- * sample per pixel from that many pixels up. Returns the aa_samples it
- * lowered (to 1), else 0. */
-uint32_t vsgl__settings_fit_image(vsgl_render_settings *s, uint32_t width, uint32_t height);
+/* vsgl__settings_resolve, then aa_pixel_limit for the scene camera's
+ * image: one sample per pixel from that many pixels up. *aa_asked: the
+ * aa_samples it lowered to 1, else 0. What a render and its memory
+ * estimate both start from. */
+vsgl_result vsgl__settings_resolve_for(vsgl_context *ctx, const vsgl_render_settings *in, const vsgl_scene *scene,
+                                       vsgl_render_settings *s, uint32_t *aa_asked);
 
 /* Estimate what a render of `scene` with resolved settings `s` allocates
  * (plus `output_bytes` of caller planes) into `e`, and fail with

@@ -198,12 +198,17 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
     return VSGL_OK;
 }
 
-uint32_t vsgl__settings_fit_image(vsgl_render_settings *s, uint32_t width, uint32_t height)
+vsgl_result vsgl__settings_resolve_for(vsgl_context *ctx, const vsgl_render_settings *in, const vsgl_scene *scene,
+                                       vsgl_render_settings *s, uint32_t *aa_asked)
 {
-    uint32_t asked = s->aa_samples;
-    if (s->aa_pixel_limit && asked > 1 && (uint64_t)width * height >= s->aa_pixel_limit) {
+    *aa_asked = 0;
+    vsgl_result r = vsgl__settings_resolve(ctx, in, s);
+    if (r != VSGL_OK)
+        return r;
+    const vsgl_camera *cam = vsgl__scene_camera(scene);
+    if (s->aa_pixel_limit && s->aa_samples > 1 && (uint64_t)cam->width * cam->height >= s->aa_pixel_limit) {
+        *aa_asked = s->aa_samples;
         s->aa_samples = 1;
-        return asked;
     }
-    return 0;
+    return VSGL_OK;
 }
