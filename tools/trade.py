@@ -68,6 +68,9 @@ KNOBS = ["lattice 64:vsgl_count=64", "lattice 512:vsgl_count=512", "RSM 128:rsm_
          # 2 x 2 at every size, "aa 4" 4 x 4
          "RSM 512:rsm_resolution=512", "aa 2:aa_pixel_limit=0", "aa 4:aa_samples=4,aa_pixel_limit=0",
          "quality aa 4:preset=quality,aa_samples=4,aa_pixel_limit=0",
+         # every preset's stride (2) grows with the image's side above 320 x 240 (stride_pixels): the same
+         # pixels at the references' 320 x 240, so "stride 2" (2 at every size) differs in its 960 x 540 time
+         "stride 2:stride_pixels=0",
          # the glossy modes of issue 14 (docs/mrp.md) beside the k-means fit they are measured against
          "k-means 256:fit_mode=kmeans,vsgl_count=256", "MRP:glossy_mode=3", "hybrid:glossy_mode=4",
          # the auto preset with every RSM at 128 (a footprint of 1 at its 85 texels per VSGL): against auto,

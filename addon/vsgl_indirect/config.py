@@ -16,6 +16,7 @@ KNOBS = {
     "aa_samples": (None, 2),
     "aa_pixel_limit": (None, 76800),
     "shade_stride": (None, 2),
+    "stride_pixels": (None, 76800),
     "edge_samples": (None, 12),
     "sample_merging": (("AUTO", "OFF"), "AUTO"),
     "visibility": (("NONE", "RAY"), "RAY"),
@@ -39,7 +40,7 @@ KNOBS = {
 _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", fis_iterations=8,
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
                diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4, visibility_budget=0.02,
-               aa_pixel_limit=76800)
+               aa_pixel_limit=76800, stride_pixels=76800)
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="RAY",
                     shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
@@ -105,6 +106,8 @@ def inactive_knobs(obj):
         out |= {"fis_iterations"}
     if obj.aa_samples <= 1:
         out |= {"sample_merging", "aa_pixel_limit"}
+    if obj.shade_stride <= 1 or obj.method == "BRUTE_FORCE":  # every pixel at every size
+        out.add("stride_pixels")
     if obj.glossy_mode not in ("MRP", "HYBRID") or obj.method == "BRUTE_FORCE":
         out.add("mrp_min_area")
     if obj.glossy_mode != "ASG2" or obj.method == "BRUTE_FORCE":
@@ -124,6 +127,7 @@ class Options:
     aa_samples: int = 2
     aa_pixel_limit: int = 76800
     shade_stride: int = 2
+    stride_pixels: int = 76800
     edge_samples: int = 12
     rsm_resolution: int = 256
     fit_mode: str = "LATTICE"

@@ -36,6 +36,9 @@ const char cli_usage[] =
     "  --leak NAME           auto | off | on | clip   (emitter clip and near field; clip: without the near field)\n"
     "  --merge NAME          auto | off        (share light between a pixel's samples on one surface)\n"
     "  --shade-stride N      1..8              (shade one pixel in N x N, interpolate the rest)\n"
+    "  --stride-pixels N     the image size (pixels) --shade-stride is meant for: larger images scale the\n"
+    "                        stride by sqrt(pixels / N), up to 8; 0 = the stride at every size (the\n"
+    "                        presets: 76800 = 320 x 240)\n"
     "  --edge-samples N      0..16             (N x N rays in pixels a geometric edge crosses; 0 = off)\n"
     "  --method NAME         vsgl | brute-force   (brute-force: every RSM texel, the reference)\n"
     "  --threads N           worker threads (0 = all cores)\n"
@@ -166,6 +169,7 @@ static const num_opt num_opts[] = {
     {"--rsm", 1, offsetof(cli_options, rsm)},
     {"--vsgls", 1, offsetof(cli_options, vsgls)},
     {"--shade-stride", 1, offsetof(cli_options, stride)},
+    {"--stride-pixels", 0, offsetof(cli_options, stride_pixels)},
     {"--edge-samples", 0, offsetof(cli_options, edge)},
     {"--glossy-lobes", 0, offsetof(cli_options, lobes)},
     {"--threads", 0, offsetof(cli_options, threads)},
@@ -348,6 +352,7 @@ void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_r
     s->size = sizeof *s;
     if (o->aa.set) s->aa_samples = o->aa.value;
     if (o->aa_limit.set) s->aa_pixel_limit = o->aa_limit.value;
+    if (o->stride_pixels.set) s->stride_pixels = o->stride_pixels.value;
     if (o->rsm.set) s->rsm_resolution = o->rsm.value;
     if (o->vsgls.set) s->vsgl_count = o->vsgls.value;
     if (o->stride.set) s->shade_stride = o->stride.value;
@@ -375,11 +380,11 @@ static const char *name_of(const char *const *names, const int *values, int v)
 
 void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size)
 {
-    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u mrp_min_area=%g glossy_lobes=%u aa_pixel_limit=%u",
+    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u mrp_min_area=%g glossy_lobes=%u aa_pixel_limit=%u stride_pixels=%u",
              name_of(method_names, method_values, s->method), s->aa_samples, s->rsm_resolution,
              name_of(fit_names, fit_values, s->fit_mode), s->vsgl_count, s->fis_iterations,
              name_of(sharp_names, sharp_values, s->sharpness_estimator), name_of(diffuse_names, diffuse_values, s->diffuse_mode),
              name_of(glossy_names, glossy_values, s->glossy_mode), name_of(vis_names, vis_values, s->visibility), s->seed,
              name_of(leak_names, leak_values, s->leak_correction), name_of(merge_names, merge_values, s->sample_merging), s->shade_stride, s->edge_samples,
-             (double)s->mrp_min_area, s->glossy_lobes, s->aa_pixel_limit);
+             (double)s->mrp_min_area, s->glossy_lobes, s->aa_pixel_limit, s->stride_pixels);
 }

@@ -4,6 +4,7 @@
 #include "harness.h"
 #include "scene_fixture.h"
 #include "render/budget.h"
+#include "render/render_internal.h"
 #include "vsgl/debug.h"
 
 #include <math.h>
@@ -509,5 +510,70 @@ VT_TEST(budget_aa_pixel_limit_takes_one_sample_and_says_so)
             VT_CHECK(!strstr(st.skipped, "anti-aliasing") && !as_hand && as_full && es.gbuffer == ef.gbuffer,
                      "319 x 240: said %d, as aa 1 %d, as 2 x 2 %d", said, as_hand, as_full);
     }
+    vsgl_context_destroy(ctx);
+}
+
+/* stride_pixels (every preset's 320 x 240): above that many pixels the
+ * stride grows with the image's side, S sqrt(P / P0) rounded down, at
+ * most VSGL_SHADE_STRIDE_MAX; a render says so in `skipped` and gives the
+ * pixels of that stride set by hand; stride 1 is never scaled. 480 x 360
+ * is 2.25 x 76800 (2 -> exactly 3), 479 x 360 just under (2). */
+VT_TEST(budget_stride_pixels_scales_the_stride_and_says_so)
+{
+    vsgl_render_settings p;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &p);
+    VT_CHECK(p.shade_stride == 2 && p.stride_pixels == VSGL_STRIDE_PIXELS_PRESETS && p.stride_pixels == 76800u,
+             "balanced: stride %u, stride_pixels %u", p.shade_stride, p.stride_pixels);
+    const struct {
+        uint32_t w, h, stride, want;
+    } rule[] = {{320, 240, 2, 2}, {479, 360, 2, 2}, {480, 360, 2, 3}, {960, 540, 2, 5}, {1280, 720, 2, 6},
+                {1920, 1080, 2, 8}, {7680, 4320, 2, 8}, {1920, 1080, 1, 1}, {80, 60, 2, 2}, {960, 540, 3, 7}};
+    for (size_t i = 0; i < sizeof rule / sizeof rule[0]; ++i) {
+        vsgl_render_settings q = p;
+        q.shade_stride = rule[i].stride;
+        uint32_t got = vsgl__stride_for_image(&q, rule[i].w, rule[i].h);
+        VT_CHECK(got == rule[i].want, "%u x %u, stride %u: %u, want %u", rule[i].w, rule[i].h, rule[i].stride, got,
+                 rule[i].want);
+        q.stride_pixels = 0;
+        VT_CHECK(vsgl__stride_for_image(&q, rule[i].w, rule[i].h) == rule[i].stride, "stride_pixels 0 scales");
+    }
+
+    static float lim[480 * 360 * 3], hand[480 * 360 * 3], two[480 * 360 * 3];
+    vsgl_context *ctx = fx_context(2);
+    VT_REQUIRE(ctx, "context");
+    const uint32_t widths[2] = {480, 479};
+    for (int c = 0; c < 2; ++c) {
+        fx_scene fx;
+        fx_room(&fx, widths[c], 360, 0.3f, 150.0f);
+        vsgl_render_settings s = p, h = p, f = p;
+        h.shade_stride = 3;
+        h.stride_pixels = 0;
+        f.stride_pixels = 0;
+        vsgl_render_stats st = {.size = sizeof st};
+        VT_REQUIRE(render_with(ctx, &fx, &s, lim, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_REQUIRE(render_with(ctx, &fx, &h, hand, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_REQUIRE(render_with(ctx, &fx, &f, two, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        size_t n = (size_t)widths[c] * 360 * 3 * sizeof(float);
+        int said = strstr(st.skipped, "shading: one pixel in 3 x 3 shaded, not 2 x 2: 480 x 360 is 2.2x "
+                                      "stride_pixels (76800 pixels)") != NULL;
+        int as_hand = memcmp(lim, hand, n) == 0, as_two = memcmp(lim, two, n) == 0;
+        if (c == 0)
+            VT_CHECK(said && as_hand && !as_two, "480 x 360: said %d, as stride 3 by hand %d, as stride 2 %d; "
+                     "skipped: %s", said, as_hand, as_two, st.skipped);
+        else
+            VT_CHECK(!strstr(st.skipped, "shading: one pixel in") && !as_hand && as_two,
+                     "479 x 360: said %d, as stride 3 %d, as stride 2 %d", said, as_hand, as_two);
+    }
+    /* stride 1: every pixel, whatever the size */
+    fx_scene fx;
+    fx_room(&fx, 480, 360, 0.3f, 150.0f);
+    vsgl_render_settings s = p, f = p;
+    s.shade_stride = f.shade_stride = 1;
+    f.stride_pixels = 0;
+    vsgl_render_stats st = {.size = sizeof st};
+    VT_REQUIRE(render_with(ctx, &fx, &s, lim, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_REQUIRE(render_with(ctx, &fx, &f, two, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(memcmp(lim, two, sizeof lim) == 0 && !strstr(st.skipped, "shading: one pixel in"),
+             "stride 1 was scaled: %s", st.skipped);
     vsgl_context_destroy(ctx);
 }

@@ -323,6 +323,26 @@ expect_fail args_bad_glossy_lobes 1 "settings: glossy_lobes is 3 (valid 4 or 5; 
 expect_fail args_bad_compression 2 "'lzma' is not one of zip|zips|piz|none|rle|pxr24|b44|b44a" "$VSGL" render "$SCENE" \
   --compression lzma
 
+# --stride-pixels: the image size --shade-stride is meant for (vsgl_render_settings.stride_pixels); every
+# preset's 76800 makes balanced's stride 2 a 3 at 480 x 360, and the render says so
+if want args_stride_pixels && expect_ok "args_stride_pixels" "$VSGL" render "$SCENE" -o "$T/sp.exr" --preset balanced \
+    --stride-pixels 0 --dry-run; then
+  if grep -q "stride=2 .*stride_pixels=0" "$T/out"; then ok "args_stride_pixels"
+  else bad "args_stride_pixels" "$(head -3 "$T/out" | tr '\n' '|')"; fi
+fi
+if want render_stride_pixels; then
+  "$PY" tests/cli/make_scene.py "$T/sp.vsglb" --width 480 --height 360
+  if expect_ok render_stride_pixels "$VSGL" render "$T/sp.vsglb" -o "$T/sp.exr" --preset balanced; then
+    if grep -q "skipped: shading: one pixel in 3 x 3 shaded, not 2 x 2: 480 x 360 is 2.2x stride_pixels (76800 pixels)" \
+        "$T/err"; then ok "render_stride_pixels"; else bad "render_stride_pixels" "$(tr '\n' '|' < "$T/err" | head -c 600)"; fi
+  fi
+  if expect_ok render_stride_pixels_off "$VSGL" render "$T/sp.vsglb" -o "$T/sp0.exr" --preset balanced --stride-pixels 0
+  then
+    if grep -q "shading: one pixel in" "$T/err"; then bad "render_stride_pixels_off" "the stride was scaled"
+    else ok "render_stride_pixels_off"; fi
+  fi
+fi
+
 # What the renderer skipped is printed once, with or without -v.
 if want render_skipped; then
   "$PY" tests/cli/make_scene.py "$T/up.vsglb" --light-up

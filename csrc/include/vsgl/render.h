@@ -172,10 +172,22 @@ typedef struct vsgl_render_settings {
                                       aa x aa samples buy little for their time (every preset:
                                       VSGL_AA_PIXEL_LIMIT_PRESETS). The log and the stats' `skipped` say
                                       when it applied. 0: no limit (the default) */
+    uint32_t stride_pixels;      /**< the image size, in pixels, that shade_stride is meant for: an image of
+                                      P > stride_pixels pixels shades one pixel in S' x S', S' = shade_stride
+                                      x sqrt(P / stride_pixels) rounded down, at most VSGL_SHADE_STRIDE_MAX,
+                                      so the shaded pixels lie as far apart across the image as at
+                                      stride_pixels (indirect light is no less smooth in a larger image;
+                                      the interpolation test still shades every pixel where the light
+                                      between shaded ones is not smooth). Every preset:
+                                      VSGL_STRIDE_PIXELS_PRESETS. The log and the stats' `skipped` say when
+                                      it applied. shade_stride 1 (every pixel) is never scaled. 0:
+                                      shade_stride at every size (the default) */
 } vsgl_render_settings;
 
 /** vsgl_render_settings.aa_pixel_limit of every preset: 320 x 240. */
 #define VSGL_AA_PIXEL_LIMIT_PRESETS (320u * 240u)
+/** vsgl_render_settings.stride_pixels of every preset: 320 x 240 (960 x 540: 2 -> 5, 1920 x 1080: 2 -> 8). */
+#define VSGL_STRIDE_PIXELS_PRESETS (320u * 240u)
 
 /** vsgl_render_settings.visibility_budget when it is 0. */
 #define VSGL_VISIBILITY_BUDGET_DEFAULT 0.02f

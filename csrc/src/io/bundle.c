@@ -132,6 +132,8 @@ static const field settings_fields[] = {
     F(vsgl_render_settings, visibility_budget, 'f', 1),
     /* format 1.8: one sample per pixel from this many pixels up (every preset's 76800) */
     F(vsgl_render_settings, aa_pixel_limit, 'u', 1),
+    /* format 1.9: the image size shade_stride is meant for (every preset's 320 x 240) */
+    F(vsgl_render_settings, stride_pixels, 'u', 1),
 };
 #define SLOT(m) F(vsgl_material_textures, m.texture, 'u', 1), F(vsgl_material_textures, m.filter, 'i', 1), \
     F(vsgl_material_textures, m.wrap, 'i', 1), F(vsgl_material_textures, m.channel, 'i', 1), \
@@ -246,7 +248,7 @@ static const section_kind kinds[S_COUNT] = {
     {"MATL", "materials", "material", 40, 1, 0, 0},
     {"LGHT", "lights", "light", 104, 1, 0, 0},
     {"CAM ", "camera", "camera", 104, 1, 0, 0},
-    {"RSET", "render settings", "settings", 80, 1, 0, 44},
+    {"RSET", "render settings", "settings", 84, 1, 0, 44},
     {"OUTP", "output path", "byte", 1, 0, 0, 0},
     {"FRME", "frame", "frame", 4, 0, 0, 0},
     /* format 1.2: textures */

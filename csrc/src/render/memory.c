@@ -209,8 +209,8 @@ vsgl_result vsgl_render_estimate(vsgl_context *ctx, const vsgl_scene *scene, con
     if (!ctx || !scene)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "render estimate: %s is NULL", !ctx ? "context" : "scene");
     vsgl_render_settings s;
-    uint32_t aa_asked;
-    vsgl_result r = vsgl__settings_resolve_for(ctx, settings, scene, &s, &aa_asked);
+    vsgl__image_rules rules;
+    vsgl_result r = vsgl__settings_resolve_for(ctx, settings, scene, &s, &rules);
     if (r != VSGL_OK)
         return r;
     const vsgl_camera *cam = vsgl__scene_camera(scene);

@@ -517,9 +517,9 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     vsgl_result r = vsgl__copy_versioned(ctx, &o, sizeof o, caller_out, "vsgl_render_output");
     if (r == VSGL_OK && stats)
         r = vsgl__versioned_size(ctx, stats, sizeof *stats, &stats_bytes, "vsgl_render_stats");
-    uint32_t aa_asked = 0; /* aa_samples that aa_pixel_limit lowered to 1 (said at the end) */
+    vsgl__image_rules rules = {0}; /* what the image-size rules changed (said at the end) */
     if (r == VSGL_OK)
-        r = vsgl__settings_resolve_for(ctx, settings, scene, &s, &aa_asked);
+        r = vsgl__settings_resolve_for(ctx, settings, scene, &s, &rules);
     if (r == VSGL_OK)
         r = check_output(ctx, scene, out);
     if (r == VSGL_OK) { /* refuse what cannot fit before allocating (render/memory.c) */
@@ -537,7 +537,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     vsgl_render_stats st;
     memset(&st, 0, sizeof st);
     /* the auto budget: anti-aliasing and the glossy model for this scene (budget_auto.c) */
-    if (s.auto_target != VSGL_AUTO_OFF && (r = vsgl__auto_choose(ctx, scene, aa_asked, &s, &st)) != VSGL_OK)
+    if (s.auto_target != VSGL_AUTO_OFF && (r = vsgl__auto_choose(ctx, scene, rules.aa_asked, &s, &st)) != VSGL_OK)
         return r;
     /* a convex shell (an empty closed room): visibility rays cannot find anything */
     int rays_skipped = 0;
@@ -655,10 +655,15 @@ done:
         note_skip(ctx, &st, "visibility rays: every surface lies on the scene's convex hull (an empty closed "
                   "room), so nothing can block light between two surfaces: %llu rays saved",
                   (unsigned long long)st.shading_pairs);
-    if (r == VSGL_OK && aa_asked)
+    if (r == VSGL_OK && rules.aa_asked)
         note_skip(ctx, &st, "anti-aliasing: 1 sample per pixel, not %u x %u: %u x %u is at least aa_pixel_limit "
-                  "(%u pixels)%s", aa_asked, aa_asked, out->width, out->height, s.aa_pixel_limit,
+                  "(%u pixels)%s", rules.aa_asked, rules.aa_asked, out->width, out->height, s.aa_pixel_limit,
                   s.edge_samples > 1 ? "; edge pixels keep their edge rays" : "");
+    if (r == VSGL_OK && rules.stride_asked)
+        note_skip(ctx, &st, "shading: one pixel in %u x %u shaded, not %u x %u: %u x %u is %.1fx stride_pixels "
+                  "(%u pixels), so the stride grows with the image's side; the others interpolated where the "
+                  "light is smooth", s.shade_stride, s.shade_stride, rules.stride_asked, rules.stride_asked,
+                  out->width, out->height, (double)out->width * out->height / s.stride_pixels, s.stride_pixels);
     vsgl__shade_plan_free(plan);
     vsgl__vsgl_set_free(&set);
     vsgl__gbuffer_free(&g);

@@ -11,12 +11,22 @@
  * validate; the error names the field. */
 vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings *in,
                                    vsgl_render_settings *s);
-/* vsgl__settings_resolve, then aa_pixel_limit for the scene camera's
- * image: one sample per pixel from that many pixels up. *aa_asked: the
- * aa_samples it lowered to 1, else 0. What a render and its memory
- * estimate both start from. */
+/* What the image-size rules changed (vsgl__settings_resolve_for): the
+ * settings as asked where a rule changed them, else 0. */
+typedef struct vsgl__image_rules {
+    uint32_t aa_asked;     /* aa_samples that aa_pixel_limit lowered to 1 */
+    uint32_t stride_asked; /* shade_stride that stride_pixels raised */
+} vsgl__image_rules;
+
+/* vsgl__settings_resolve, then the rules for the scene camera's image:
+ * aa_pixel_limit (one sample per pixel from that many pixels up) and
+ * stride_pixels (the stride scaled with the image's side). What a render
+ * and its memory estimate both start from. */
 vsgl_result vsgl__settings_resolve_for(vsgl_context *ctx, const vsgl_render_settings *in, const vsgl_scene *scene,
-                                       vsgl_render_settings *s, uint32_t *aa_asked);
+                                       vsgl_render_settings *s, vsgl__image_rules *rules);
+
+/* The stride stride_pixels gives a width x height image (settings resolved). */
+uint32_t vsgl__stride_for_image(const vsgl_render_settings *s, uint32_t width, uint32_t height);
 
 /* Estimate what a render of `scene` with resolved settings `s` allocates
  * (plus `output_bytes` of caller planes) into `e`, and fail with

@@ -179,8 +179,11 @@ def test_live_quality_is_the_preview_preset_sparser():
     lib = engine._binding()
     prev = lib.render_settings_preset(lib.Preset.PREVIEW)
     lv = live.render_settings(lib, "LIVE", 960 * 540)
-    assert live.LIVE_OVERRIDES == {"shade_stride": 4, "edge_samples": 0, "visibility": 0, "glossy_mode": 0}
-    assert (lv.shade_stride, lv.edge_samples, lv.visibility, lv.glossy_mode) == (4, 0, 0, lib.GlossyMode.ASG)
+    assert live.LIVE_OVERRIDES == {"shade_stride": 4, "stride_pixels": 0, "edge_samples": 0, "visibility": 0,
+                                   "glossy_mode": 0}
+    assert (lv.shade_stride, lv.stride_pixels, lv.edge_samples, lv.visibility, lv.glossy_mode) == \
+        (4, 0, 0, 0, lib.GlossyMode.ASG)
+    assert prev.stride_pixels == 320 * 240  # the presets' stride grows above 320 x 240; Live's stays 4
     assert prev.visibility == lib.Visibility.RAY and prev.glossy_mode == lib.GlossyMode.ASG2
     for name, _ in lv._fields_:
         if name not in live.LIVE_OVERRIDES:
