@@ -464,6 +464,21 @@ VT_TEST(budget_auto_renders_what_it_says)
     vsgl_context_destroy(ctx);
 }
 
+/* An image-size rule's three renders of fx: `s` with the rule (its stats
+ * into *st), `h` its result set by hand and `f` without the rule, into
+ * out[0..2]; whether s's first n bytes equal h's (*as_hand) and f's
+ * (*as_off). */
+static void rule_renders(vsgl_context *ctx, fx_scene *fx, const vsgl_render_settings *s,
+                         const vsgl_render_settings *h, const vsgl_render_settings *f, float *const out[3], size_t n,
+                         vsgl_render_stats *st, int *as_hand, int *as_off)
+{
+    VT_REQUIRE(render_with(ctx, fx, s, out[0], st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_REQUIRE(render_with(ctx, fx, h, out[1], NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_REQUIRE(render_with(ctx, fx, f, out[2], NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    *as_hand = memcmp(out[0], out[1], n) == 0;
+    *as_off = memcmp(out[0], out[2], n) == 0;
+}
+
 /* aa_pixel_limit (every preset's 320 x 240): from that many pixels a render
  * takes one sample per pixel, says so in `skipped`, and gives the pixels
  * of aa_samples 1 set by hand; one pixel fewer keeps 2 x 2; the memory
@@ -487,13 +502,11 @@ VT_TEST(budget_aa_pixel_limit_takes_one_sample_and_says_so)
         f = s;
         f.aa_pixel_limit = 0;
         vsgl_render_stats st = {.size = sizeof st};
-        VT_REQUIRE(render_with(ctx, &fx, &s, lim, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
-        VT_REQUIRE(render_with(ctx, &fx, &h, hand, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
-        VT_REQUIRE(render_with(ctx, &fx, &f, full, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
-        size_t n = (size_t)widths[c] * 240 * 3 * sizeof(float);
+        float *const out[3] = {lim, hand, full};
+        int as_hand, as_full;
+        rule_renders(ctx, &fx, &s, &h, &f, out, (size_t)widths[c] * 240 * 3 * sizeof(float), &st, &as_hand, &as_full);
         int said = strstr(st.skipped, "anti-aliasing: 1 sample per pixel, not 2 x 2: 320 x 240 is at least "
                                       "aa_pixel_limit (76800 pixels); edge pixels keep their edge rays") != NULL;
-        int as_hand = memcmp(lim, hand, n) == 0, as_full = memcmp(lim, full, n) == 0;
         vsgl_scene *scene = NULL;
         VT_REQUIRE(vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
         vsgl_memory_estimate es, eh, ef;
@@ -550,13 +563,11 @@ VT_TEST(budget_stride_pixels_scales_the_stride_and_says_so)
         h.stride_pixels = 0;
         f.stride_pixels = 0;
         vsgl_render_stats st = {.size = sizeof st};
-        VT_REQUIRE(render_with(ctx, &fx, &s, lim, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
-        VT_REQUIRE(render_with(ctx, &fx, &h, hand, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
-        VT_REQUIRE(render_with(ctx, &fx, &f, two, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
-        size_t n = (size_t)widths[c] * 360 * 3 * sizeof(float);
+        float *const out[3] = {lim, hand, two};
+        int as_hand, as_two;
+        rule_renders(ctx, &fx, &s, &h, &f, out, (size_t)widths[c] * 360 * 3 * sizeof(float), &st, &as_hand, &as_two);
         int said = strstr(st.skipped, "shading: one pixel in 3 x 3 shaded, not 2 x 2: 480 x 360 is 2.2x "
                                       "stride_pixels (76800 pixels)") != NULL;
-        int as_hand = memcmp(lim, hand, n) == 0, as_two = memcmp(lim, two, n) == 0;
         if (c == 0)
             VT_CHECK(said && as_hand && !as_two, "480 x 360: said %d, as stride 3 by hand %d, as stride 2 %d; "
                      "skipped: %s", said, as_hand, as_two, st.skipped);
