@@ -214,6 +214,7 @@ REUSED_GBUFFER = 1
 REUSED_FIT = 2
 EXR_COMPRESSION_COUNT = 8
 EXR_MAX_CHANNELS = 4
+EXR_ZIP_LEVEL_DEFAULT = 2
 
 
 # --------------------------------------------------------------------------
@@ -485,6 +486,7 @@ class vsgl_exr_options(_Struct):
         ("compression", c_int32),
         ("metadata_count", c_uint32),
         ("metadata", POINTER(vsgl_exr_metadata)),
+        ("zip_level", c_int32),
     ]
     _enums = {"pixel_type": ExrPixelType, "compression": ExrCompression}
 
@@ -657,9 +659,10 @@ __all__ = [
     "LIGHT_FLAGS_KNOWN", "AUTO_OFF", "AUTO_BALANCED", "AA_SAMPLES_MAX", "RSM_RESOLUTION_MIN",
     "RSM_RESOLUTION_MAX", "VSGL_COUNT_MAX", "FIS_ITERATIONS_MAX", "SHADE_STRIDE_MAX",
     "AA_PIXEL_LIMIT_PRESETS", "STRIDE_PIXELS_PRESETS", "VISIBILITY_BUDGET_DEFAULT", "MRP_MIN_AREA_DEFAULT",
-    "REUSED_GBUFFER", "REUSED_FIT", "EXR_COMPRESSION_COUNT", "EXR_MAX_CHANNELS", "vsgl_log_fn",
-    "vsgl_progress_fn", "vsgl_vec3", "vsgl_context_desc", "vsgl_sg", "vsgl_asg", "vsgl_material",
-    "vsgl_texture", "vsgl_texture_slot", "vsgl_material_textures", "vsgl_light", "vsgl_camera",
-    "vsgl_scene_desc", "vsgl_scene_info", "vsgl_render_settings", "vsgl_render_output", "vsgl_render_stats",
-    "vsgl_memory_estimate", "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options", "vsgl_bundle_options",
-    "vsgl_bundle_info", "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS", "FIELD_C_NAMES", "PROTOTYPES"]
+    "REUSED_GBUFFER", "REUSED_FIT", "EXR_COMPRESSION_COUNT", "EXR_MAX_CHANNELS", "EXR_ZIP_LEVEL_DEFAULT",
+    "vsgl_log_fn", "vsgl_progress_fn", "vsgl_vec3", "vsgl_context_desc", "vsgl_sg", "vsgl_asg",
+    "vsgl_material", "vsgl_texture", "vsgl_texture_slot", "vsgl_material_textures", "vsgl_light",
+    "vsgl_camera", "vsgl_scene_desc", "vsgl_scene_info", "vsgl_render_settings", "vsgl_render_output",
+    "vsgl_render_stats", "vsgl_memory_estimate", "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options",
+    "vsgl_bundle_options", "vsgl_bundle_info", "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS",
+    "FIELD_C_NAMES", "PROTOTYPES"]

@@ -978,9 +978,9 @@ def check_output_path(ctx, path):
 
 
 def _exr_options(layer=None, pixel_type=ExrPixelType.FLOAT, compression=ExrCompression.ZIP,
-                 metadata=None):
+                 metadata=None, zip_level=0):
     keep = []
-    opt = vsgl_exr_options(pixel_type=pixel_type, compression=compression)
+    opt = vsgl_exr_options(pixel_type=pixel_type, compression=compression, zip_level=int(zip_level))
     if layer is not None:
         opt.layer = layer.encode()
     if metadata:
@@ -994,11 +994,13 @@ def _exr_options(layer=None, pixel_type=ExrPixelType.FLOAT, compression=ExrCompr
 
 
 def exr_write(ctx, path, passes, layer=None, pixel_type="float", compression="zip",
-              metadata=None):
+              metadata=None, zip_level=0):
     """Write a multilayer EXR. ``passes`` maps pass name -> float32 array of
     shape (H, W, C) with C in 1..4 (or (H, W) for one channel), or to a
     tuple (array, channels) such as (a, "RGBA"). Default channel letters:
-    "V", "??", "RGB", "RGBA" for 1..4 channels (2 needs explicit names)."""
+    "V", "??", "RGB", "RGBA" for 1..4 channels (2 needs explicit names).
+    ``zip_level``: zlib level 1..9 of ZIP / ZIPS, 0 = the library's default
+    (EXR_ZIP_LEVEL_DEFAULT)."""
     passes = dict(passes)
     if not passes:
         raise ValueError("exr_write needs at least one pass")
@@ -1034,7 +1036,7 @@ def exr_write(ctx, path, passes, layer=None, pixel_type="float", compression="zi
         arrays.append(arr)
         c_passes.append(p)
     parr = (vsgl_exr_pass * len(c_passes))(*c_passes)
-    opt, keep = _exr_options(layer, pixel_type, compression, metadata)
+    opt, keep = _exr_options(layer, pixel_type, compression, metadata, zip_level)
     rc = ctx._lib.vsgl_exr_write(ctx.handle, _path(path), W, H, parr, len(c_passes),
                                  ctypes.byref(opt))
     del arrays, keep
@@ -1042,7 +1044,7 @@ def exr_write(ctx, path, passes, layer=None, pixel_type="float", compression="zi
 
 
 def exr_write_render(ctx, path, images, layer=None, pixel_type="float", compression="zip",
-                     metadata=None):
+                     metadata=None, zip_level=0):
     """Write the planes returned by :func:`render` with the standard pass names."""
     H = W = None
     out = vsgl_render_output()
@@ -1061,7 +1063,7 @@ def exr_write_render(ctx, path, images, layer=None, pixel_type="float", compress
     if H is None:
         raise ValueError("exr_write_render needs at least one plane")
     out.width, out.height = W, H
-    opt, keep = _exr_options(layer, pixel_type, compression, metadata)
+    opt, keep = _exr_options(layer, pixel_type, compression, metadata, zip_level)
     rc = ctx._lib.vsgl_exr_write_render(ctx.handle, _path(path), ctypes.byref(out),
                                         ctypes.byref(opt))
     del kept, keep

@@ -49,6 +49,8 @@ const char cli_usage[] =
     "  --float               32-bit float EXR samples\n"
     "  --compression NAME    zip | zips | piz | none | rle | pxr24 | b44 | b44a\n"
     "                        (EXR compression, default zip; pxr24 and b44* are lossy)\n"
+    "  --zip-level N         zlib level 1..9 of zip and zips (lossless: higher is smaller and slower;\n"
+    "                        default 2)\n"
     "  --dry-run             read and validate the scene and settings, estimate the\n"
     "                        memory, check the output path; do not render\n"
     "  -v, --verbose         per-stage timings and statistics on stderr\n"
@@ -170,6 +172,7 @@ static const num_opt num_opts[] = {
     {"--vsgls", 1, offsetof(cli_options, vsgls)},
     {"--shade-stride", 1, offsetof(cli_options, stride)},
     {"--stride-pixels", 0, offsetof(cli_options, stride_pixels)},
+    {"--zip-level", 1, offsetof(cli_options, zip_level)},
     {"--edge-samples", 0, offsetof(cli_options, edge)},
     {"--glossy-lobes", 0, offsetof(cli_options, lobes)},
     {"--threads", 0, offsetof(cli_options, threads)},
@@ -335,6 +338,10 @@ static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t e
                 return 2;
             }
         }
+    }
+    if (o->zip_level.set && o->zip_level.value > 9) { /* refused before a render is spent on it */
+        snprintf(err, err_size, "option --zip-level: '%u' is not a zlib level 1..9", o->zip_level.value);
+        return 2;
     }
     if (!o->scene_path)
         return set_err(err, err_size, "%s: no scene bundle given%s (see vsgl --help)", cmd, "");

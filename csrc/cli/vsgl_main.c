@@ -282,6 +282,7 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
     eo.size = sizeof eo;
     eo.pixel_type = o->half ? VSGL_EXR_HALF : VSGL_EXR_FLOAT;
     eo.compression = o->compression;
+    eo.zip_level = o->zip_level.set ? (int32_t)o->zip_level.value : 0; /* 0: the library's default */
     eo.metadata = md;
     eo.metadata_count = sizeof md / sizeof md[0];
     r = vsgl_exr_write_render(ctx, out_path, &out, &eo); /* SIGINT/SIGTERM cancel it too */

@@ -886,3 +886,76 @@ VT_TEST(exr_render_combined_alpha_cases)
     vsgl_context_destroy(ctx);
     remove_tree(dir);
 }
+
+/* vsgl_exr_options.zip_level: lossless at every level (the pixels read back
+ * by OpenEXR are the same), the default level's file of a smooth image is
+ * no larger than level 1's and larger than 6's and 9's, 0 is the documented default
+ * (the same bytes as VSGL_EXR_ZIP_LEVEL_DEFAULT), and 10 is refused by name. */
+VT_TEST(exr_zip_level_is_lossless_and_trades_size)
+{
+    enum { ZW = 64, ZH = 96 };
+    static float px[ZW * ZH * 3];
+    for (int y = 0; y < ZH; ++y) /* smooth, with a little structure: what deflate's levels differ on */
+        for (int x = 0; x < ZW; ++x)
+            for (int c = 0; c < 3; ++c)
+                px[(y * ZW + x) * 3 + c] = 0.2f + 0.5f * sinf(0.07f * (float)(x + 2 * c)) * cosf(0.05f * (float)y) +
+                                           0.01f * (float)((x * 7 + y * 13) % 5);
+    char dir[64];
+    make_temp_dir(dir, sizeof dir);
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = ZW;
+    o.height = ZH;
+    o.diffuse_light = px;
+    const int32_t levels[5] = {1, VSGL_EXR_ZIP_LEVEL_DEFAULT, 6, 9, 0};
+    size_t sizes[5] = {0};
+    unsigned char *bytes[5] = {NULL};
+    static decoded dec[5];
+    for (int k = 0; k < 5; ++k) {
+        vsgl_exr_options opt;
+        memset(&opt, 0, sizeof opt);
+        opt.size = sizeof opt;
+        opt.pixel_type = VSGL_EXR_HALF;
+        opt.compression = VSGL_EXR_ZIP;
+        opt.zip_level = levels[k];
+        char path[128];
+        snprintf(path, sizeof path, "%s/z%d.exr", dir, k);
+        VT_REQUIRE(vsgl_exr_write_render(ctx, path, &o, &opt) == VSGL_OK, "level %d: %s", levels[k],
+                   vsgl_context_last_error(ctx));
+        decoded *d = &dec[k];
+        VT_REQUIRE(decode_exr(path, d) == 0 && d->count == 3, "decode level %d", levels[k]);
+        int bad = 0; /* half precision of what was written, and bit for bit level 1's pixels */
+        for (int c = 0; c < d->count; ++c) {
+            const char last = d->names[c][strlen(d->names[c]) - 1];
+            const int ch = last == 'R' ? 0 : last == 'G' ? 1 : 2;
+            for (int i = 0; i < ZW * ZH && !bad; ++i)
+                bad = fabsf(d->planes[c][i] - px[i * 3 + ch]) > 1e-3f * fabsf(px[i * 3 + ch]) + 1e-6f ||
+                      d->planes[c][i] != dec[0].planes[c][i];
+        }
+        VT_CHECK(!bad, "level %d: pixels differ from the half values written or from level 1's", levels[k]);
+        read_file(path, &bytes[k], &sizes[k]);
+    }
+    /* (deflate's levels are not strictly ordered: 9 may write a byte more than 6) */
+    VT_CHECK(sizes[1] <= sizes[0] && sizes[2] < sizes[1] && sizes[3] < sizes[1],
+             "file sizes by level 1 / %d / 6 / 9: %zu / %zu / %zu / %zu", VSGL_EXR_ZIP_LEVEL_DEFAULT, sizes[0], sizes[1],
+             sizes[2], sizes[3]);
+    VT_CHECK(sizes[4] == sizes[1] && bytes[4] && bytes[1] && memcmp(bytes[4], bytes[1], sizes[1]) == 0,
+             "level 0 is not the default level %d (%zu vs %zu bytes)", VSGL_EXR_ZIP_LEVEL_DEFAULT, sizes[4], sizes[1]);
+    for (int k = 0; k < 5; ++k) {
+        free(bytes[k]);
+        free_decoded(&dec[k]);
+    }
+    vsgl_exr_options bad;
+    memset(&bad, 0, sizeof bad);
+    bad.size = sizeof bad;
+    bad.zip_level = 10;
+    char path[128];
+    snprintf(path, sizeof path, "%s/bad.exr", dir);
+    VT_CHECK(vsgl_exr_write_render(ctx, path, &o, &bad) == VSGL_ERROR_INVALID_ARGUMENT &&
+                 strstr(vsgl_context_last_error(ctx), "EXR zip level 10 is not 1..9 (0 = 2)"),
+             "zip level 10: %s", vsgl_context_last_error(ctx));
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}

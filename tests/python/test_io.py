@@ -35,6 +35,25 @@ def test_exr_write_passes(lib, ctx, tmp_path):
         L.exr_write(ctx, str(path), {"A": rgb.astype(np.float64)})
 
 
+def test_exr_write_zip_level(lib, ctx, tmp_path):
+    """zip_level reaches the writer: lossless at 1 and 9 (OpenImageIO reads the same pixels), 9's file
+    of a smooth image smaller, 0 the default level's bytes, 10 refused by name."""
+    require(lib, "vsgl_exr_write")
+    y, x = np.mgrid[0:64, 0:96].astype(np.float32)
+    rgb = np.dstack([0.3 + 0.2 * np.sin(0.07 * x + c) * np.cos(0.05 * y) for c in range(3)]).astype(np.float32)
+    paths = {}
+    for level in (1, 9, 0, L.EXR_ZIP_LEVEL_DEFAULT):
+        paths[level] = tmp_path / ("z%d.exr" % level)
+        L.exr_write(ctx, str(paths[level]), {"DiffInd": rgb}, pixel_type="half", zip_level=level)
+    a, b = _exr(paths[1])[0], _exr(paths[9])[0]
+    assert all(np.array_equal(a[c], b[c]) for c in a), "zip levels 1 and 9 read back differently"
+    assert paths[9].stat().st_size < paths[1].stat().st_size
+    assert paths[0].read_bytes() == paths[L.EXR_ZIP_LEVEL_DEFAULT].read_bytes()
+    with pytest.raises(L.VsglError) as e:
+        L.exr_write(ctx, str(tmp_path / "z10.exr"), {"DiffInd": rgb}, zip_level=10)
+    assert "EXR zip level 10 is not 1..9" in e.value.message, e.value.message
+
+
 def test_exr_write_nan_is_refused_with_message(lib, ctx, tmp_path):
     require(lib, "vsgl_exr_write")
     rgb = np.zeros((4, 4, 3), np.float32)

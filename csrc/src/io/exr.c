@@ -112,6 +112,9 @@ static vsgl_result check_args(vsgl_context *ctx, uint32_t width, uint32_t height
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR pixel type %d is not VSGL_EXR_FLOAT or VSGL_EXR_HALF", o->pixel_type);
     if (o->compression < VSGL_EXR_ZIP || o->compression >= VSGL_EXR_COMPRESSION_COUNT)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR compression %d is unknown", o->compression);
+    if (o->zip_level < 0 || o->zip_level > 9)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR zip level %d is not 1..9 (0 = %d)", o->zip_level,
+                          VSGL_EXR_ZIP_LEVEL_DEFAULT);
     if (o->metadata_count && !o->metadata)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "EXR metadata: %u entries but NULL array", o->metadata_count);
     for (uint32_t i = 0; i < o->metadata_count; ++i) {
@@ -286,6 +289,7 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
     init.error_handler_fn = sink_error;
     init.user_data = sink;
     init.write_fn = sink_write;
+    init.zip_level = o->zip_level ? o->zip_level : VSGL_EXR_ZIP_LEVEL_DEFAULT; /* ZIP, ZIPS: not in the file */
     exr_context_t e = NULL;
     exr_result_t rv = exr_start_write(&e, path, EXR_WRITE_FILE_DIRECTLY, &init);
     if (rv != EXR_ERR_SUCCESS)
