@@ -2,6 +2,7 @@
  * of the writer's packing code), with OpenImageIO's oiiotool, and with
  * Blender 3.4; atomicity and failure cases. */
 #include "harness.h"
+#include "io/half.h"
 #include "vsgl.h"
 #include "io/atomic.h"
 
@@ -958,4 +959,82 @@ VT_TEST(exr_zip_level_is_lossless_and_trades_size)
              "zip level 10: %s", vsgl_context_last_error(ctx));
     vsgl_context_destroy(ctx);
     remove_tree(dir);
+}
+
+/* An exact reference for the writer's float -> half packing: the finite
+ * half nearest to v (ties to the even code), from every half's exact value
+ * (decoded here by its definition), clamped to +/-65504. */
+static double half_value(uint16_t h)
+{
+    int e = (h >> 10) & 31, m = h & 1023;
+    double v = e ? ldexp(1.0 + m / 1024.0, e - 15) : ldexp(m / 1024.0, -14);
+    return h & 0x8000u ? -v : v;
+}
+
+static uint16_t half_nearest(float v)
+{
+    /* the positive finite codes 0 .. 0x7bff increase with their value: the
+     * largest code at or below |v|, then it or the next, whichever is
+     * nearer, the even one on a tie */
+    const double a = fabs((double)v);
+    uint16_t lo = 0, hi = 0x7bff;
+    if (a >= half_value(hi)) {
+        lo = hi;
+    } else {
+        while (hi - lo > 1) { /* half_value(lo) <= a < half_value(hi) */
+            uint16_t mid = (uint16_t)((lo + hi) / 2);
+            if (half_value(mid) <= a)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        double dl = a - half_value(lo), dh = half_value(hi) - a;
+        if (dh < dl || (dh == dl && (hi & 1u) == 0))
+            lo = hi;
+    }
+    return (uint16_t)(lo | (signbit(v) ? 0x8000u : 0u));
+}
+
+/* vsgl__exr_row_to_half: the F16C form (where the CPU has it) and the
+ * scalar one give the same bits, the nearest half (ties to even), across
+ * the range: normals, subnormals, ties, signed zeros, values past 65504,
+ * strided rows and a tail that is not a multiple of 8. */
+VT_TEST(exr_half_conversion_matches_exact_rounding)
+{
+    enum { NV = 1003 };
+    static float v[NV * 3];
+    vt_rng rng = {7};
+    for (int i = 0; i < NV; ++i) {
+        double u = vt_uniform(&rng);
+        float x;
+        if (i % 7 == 0) /* an exact tie between two halves of magnitude ~2^k */
+            x = (float)((1.0 + (2.0 * (i % 1024) + 1.0) / 2048.0) * ldexp(1.0, i % 30 - 15));
+        else
+            x = (float)(exp(-30.0 + 43.0 * u)); /* 1e-13 .. 5e5 */
+        v[i * 3] = i % 2 ? -x : x;
+        v[i * 3 + 1] = i % 11 == 0 ? (i % 2 ? -0.0f : 0.0f) : (float)(u * 70000.0 - 35000.0);
+        v[i * 3 + 2] = (float)ldexp(u, -20); /* subnormal halves */
+    }
+    static unsigned char vec[NV * 2], sca[NV * 2];
+    int bad = 0;
+    for (int c = 0; c < 3 && bad < 5; ++c) {
+        vsgl__exr_row_to_half(v + c, 3, NV, vec, 1);
+        vsgl__exr_row_to_half(v + c, 3, NV, sca, 0);
+        for (int i = 0; i < NV && bad < 5; ++i) {
+            uint16_t a, b, want = half_nearest(v[i * 3 + c]);
+            memcpy(&a, vec + 2 * i, 2);
+            memcpy(&b, sca + 2 * i, 2);
+            if (a != want || b != want) {
+                ++bad;
+                VT_CHECK(0, "%.9g: vector 0x%04x, scalar 0x%04x, nearest 0x%04x", (double)v[i * 3 + c], a, b, want);
+            }
+        }
+    }
+    /* contiguous rows take the vector form's unit-stride load */
+    static float flat[NV];
+    for (int i = 0; i < NV; ++i)
+        flat[i] = v[i * 3];
+    vsgl__exr_row_to_half(flat, 1, NV, vec, 1);
+    vsgl__exr_row_to_half(v, 3, NV, sca, 1);
+    VT_CHECK(memcmp(vec, sca, sizeof vec) == 0, "a unit-stride row packs differently from the same values strided");
 }

@@ -1,0 +1,15 @@
+/* Internal: the EXR writer's float -> half packing (exr.c). */
+#ifndef VSGL_IO_HALF_H
+#define VSGL_IO_HALF_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* w finite samples, `stride` floats apart from row, to half floats (2
+ * bytes each, native order) at d: rounded to nearest even, beyond +/-65504
+ * clamped to it. With the F16C instruction where the CPU has it and
+ * `vector` is non-zero, else one sample at a time; both give the same bits
+ * (tests/c/test_exr.c compares them with an exact reference). */
+void vsgl__exr_row_to_half(const float *row, size_t stride, uint32_t w, unsigned char *d, int vector);
+
+#endif
