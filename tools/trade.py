@@ -342,8 +342,9 @@ def time_at_size(name, args, ctx, version, export, exr_dir):
     case = scenes.case(name, (w, h))
     arrays = scenes.library_arrays(case, L)
     for label in ("balanced", "quality", "auto") + TIME_KNOBS:  # the fastest of --repeat runs, as at the refs' size
-        out[label.split(":")[0]] = export + min(sum(run_library(ctx, arrays, case, parse(label), exr_dir)[1].values())
-                                                for _ in range(max(1, args.repeat)))
+        cfg = parse(label)
+        out[cfg.label] = export + min(sum(run_library(ctx, arrays, case, cfg, exr_dir)[1].values())
+                                      for _ in range(max(1, args.repeat)))
     out["auto budget"] = LAST_BUDGET.get("auto", "")
     times = ", ".join("%s %.2f s" % (k, v) for k, v in out.items() if k not in ("size", "auto budget"))
     log("%-28s at %dx%d: %s" % (name, w, h, times))
@@ -628,7 +629,7 @@ def markdown(results, meta, img_rel, png_rel):
     if timed:
         w, h = timed[0][1]["size"]
         cols = ["1 spp", "1 spp + OIDN", "4 spp", "4 spp + OIDN", "balanced", "quality", "auto"] + [
-            k.split(":")[0] for k in TIME_KNOBS]
+            parse(k).label for k in TIME_KNOBS]
         lines += ["", "### Whole-frame seconds at %dx%d" % (w, h), "",
                   "| scene | " + " | ".join(cols) + " | balanced <= 1/5 of 1 spp + OIDN | quality < 4 spp + OIDN |",
                   "|---|" + "---|" * (len(cols) + 2)]

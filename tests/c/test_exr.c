@@ -177,6 +177,13 @@ static void free_decoded(decoded *d)
         free(d->planes[c]);
 }
 
+/* 0, 1, 2 for a channel name ending in R, G, B (the last letter; B for any other). */
+static int rgb_index(const char *name)
+{
+    const char last = name[strlen(name) - 1];
+    return last == 'R' ? 0 : last == 'G' ? 1 : 2;
+}
+
 static int channel_index(const decoded *d, const char *name)
 {
     for (int c = 0; c < d->count; ++c)
@@ -820,7 +827,7 @@ VT_TEST(exr_parallel_encoding_is_identical_for_any_thread_count)
         VT_CHECK(decode_exr(path, &d) == 0 && d.count == 3, "decode threads %u", threads);
         int bad = 0;
         for (int c = 0; c < d.count; ++c) {
-            int ch = d.names[c][strlen(d.names[c]) - 1] == 'R' ? 0 : d.names[c][strlen(d.names[c]) - 1] == 'G' ? 1 : 2;
+            int ch = rgb_index(d.names[c]);
             for (int i = 0; i < PW * PH && bad < 3; ++i)
                 if (d.planes[c][i] != px[i * 3 + ch]) {
                     ++bad;
@@ -929,8 +936,7 @@ VT_TEST(exr_zip_level_is_lossless_and_trades_size)
         VT_REQUIRE(decode_exr(path, d) == 0 && d->count == 3, "decode level %d", levels[k]);
         int bad = 0; /* half precision of what was written, and bit for bit level 1's pixels */
         for (int c = 0; c < d->count; ++c) {
-            const char last = d->names[c][strlen(d->names[c]) - 1];
-            const int ch = last == 'R' ? 0 : last == 'G' ? 1 : 2;
+            const int ch = rgb_index(d->names[c]);
             for (int i = 0; i < ZW * ZH && !bad; ++i)
                 bad = fabsf(d->planes[c][i] - px[i * 3 + ch]) > 1e-3f * fabsf(px[i * 3 + ch]) + 1e-6f ||
                       d->planes[c][i] != dec[0].planes[c][i];
