@@ -1022,9 +1022,10 @@ VT_TEST(exr_half_conversion_matches_exact_rounding)
         v[i * 3 + 2] = (float)ldexp(u, -20); /* subnormal halves */
     }
     static unsigned char vec[NV * 2], sca[NV * 2];
+    const int f16c = vsgl__exr_cpu_has_f16c();
     int bad = 0;
     for (int c = 0; c < 3 && bad < 5; ++c) {
-        vsgl__exr_row_to_half(v + c, 3, NV, vec, 1);
+        vsgl__exr_row_to_half(v + c, 3, NV, vec, f16c);
         vsgl__exr_row_to_half(v + c, 3, NV, sca, 0);
         for (int i = 0; i < NV && bad < 5; ++i) {
             uint16_t a, b, want = half_nearest(v[i * 3 + c]);
@@ -1040,7 +1041,7 @@ VT_TEST(exr_half_conversion_matches_exact_rounding)
     static float flat[NV];
     for (int i = 0; i < NV; ++i)
         flat[i] = v[i * 3];
-    vsgl__exr_row_to_half(flat, 1, NV, vec, 1);
-    vsgl__exr_row_to_half(v, 3, NV, sca, 1);
+    vsgl__exr_row_to_half(flat, 1, NV, vec, f16c);
+    vsgl__exr_row_to_half(v, 3, NV, sca, f16c);
     VT_CHECK(memcmp(vec, sca, sizeof vec) == 0, "a unit-stride row packs differently from the same values strided");
 }

@@ -50,7 +50,27 @@ static void row_to_half_scalar(const float *row, size_t stride, uint32_t w, unsi
 }
 
 #if defined(__x86_64__) && defined(__GNUC__)
+#include <cpuid.h>
 #include <immintrin.h>
+
+/* CPUID's F16C and AVX bits, and the OS saving the AVX registers (XCR0
+ * bits 1-2): the VEX-encoded conversion needs all three. Read through
+ * <cpuid.h>, which gcc and clang both have (clang 14's
+ * __builtin_cpu_supports does not know "f16c"). CPUID may trap to a
+ * hypervisor, so a write asks once, not per row. */
+int vsgl__exr_cpu_has_f16c(void)
+{
+    unsigned a, b, c, d;
+    if (!__get_cpuid(1, &a, &b, &c, &d))
+        return 0;
+    if (!(c & bit_F16C) || !(c & bit_AVX) || !(c & bit_OSXSAVE))
+        return 0;
+    unsigned lo, hi;
+    __asm__ volatile("xgetbv" : "=a"(lo), "=d"(hi) : "c"(0));
+    (void)hi;
+    return (lo & 6u) == 6u;
+}
+
 /* The same with the F16C instruction, 8 samples at a time: clamped to
  * +/-65504 first, then rounded to nearest even, which is float_to_half's
  * result bit for bit (subnormals and signed zeros included; the writer has
@@ -72,17 +92,22 @@ __attribute__((target("avx,f16c"))) static void row_to_half_f16c(const float *ro
     }
     row_to_half_scalar(row + (size_t)x * stride, stride, w - x, d + 2 * (size_t)x);
 }
+#else
+int vsgl__exr_cpu_has_f16c(void)
+{
+    return 0;
+}
 #endif
 
-void vsgl__exr_row_to_half(const float *row, size_t stride, uint32_t w, unsigned char *d, int vector)
+void vsgl__exr_row_to_half(const float *row, size_t stride, uint32_t w, unsigned char *d, int f16c)
 {
 #if defined(__x86_64__) && defined(__GNUC__)
-    if (vector && __builtin_cpu_supports("f16c")) {
+    if (f16c) {
         row_to_half_f16c(row, stride, w, d);
         return;
     }
 #endif
-    (void)vector;
+    (void)f16c;
     row_to_half_scalar(row, stride, w, d);
 }
 
@@ -238,6 +263,7 @@ typedef struct encode_job {
     const exr_chunk_info_t *infos; /* every chunk */
     chunk_out *outs;               /* the current batch */
     size_t batch_begin;
+    int f16c; /* vsgl__exr_cpu_has_f16c(), asked once per write */
 } encode_job;
 
 /* The pipeline's last step: keep the compressed bytes instead of writing. */
@@ -298,7 +324,7 @@ static int32_t encode_chunks(void *user, size_t chunk, size_t begin, size_t end)
                 const float *row = s->data + (size_t)(y0 + r) * j->width * s->stride;
                 unsigned char *d = dst + (size_t)r * j->width * j->bpe;
                 if (j->bpe == 2) {
-                    vsgl__exr_row_to_half(row, s->stride, j->width, d, 1);
+                    vsgl__exr_row_to_half(row, s->stride, j->width, d, j->f16c);
                 } else {
                     for (uint32_t x = 0; x < j->width; ++x)
                         memcpy(d + 4 * (size_t)x, &row[(size_t)x * s->stride], 4);
@@ -399,7 +425,8 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
         if (rv)
             goto exr_error;
     }
-    encode_job job = {e, part, width, ptype == EXR_PIXEL_HALF ? 2u : 4u, ptype, chans, n, infos, outs, 0};
+    encode_job job = {e, part, width, ptype == EXR_PIXEL_HALF ? 2u : 4u, ptype, chans, n, infos, outs, 0,
+                      vsgl__exr_cpu_has_f16c()};
     for (size_t b0 = 0; b0 < nchunks; b0 += batch) {
         size_t b1 = b0 + batch < nchunks ? b0 + batch : nchunks;
         /* SIGINT in the CLI, Esc in the add-on: stop between batches (a 4K
