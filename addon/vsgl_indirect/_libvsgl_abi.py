@@ -21,7 +21,7 @@ else:  # a top-level module (the tests, tools/)
 # --------------------------------------------------------------------------
 
 BINDING_VERSION = (0, 3)
-BUNDLE_VERSION = (1, 9)
+BUNDLE_VERSION = (1, 10)
 
 
 class Result(enum.IntEnum):
@@ -208,6 +208,8 @@ FIS_ITERATIONS_MAX = 32
 SHADE_STRIDE_MAX = 8
 AA_PIXEL_LIMIT_PRESETS = 76800
 STRIDE_PIXELS_PRESETS = 76800
+VISIBILITY_SPREAD_DEFAULT = 2.0
+VISIBILITY_SPREAD_MAX = 4.0
 VISIBILITY_BUDGET_DEFAULT = 0.02
 MRP_MIN_AREA_DEFAULT = 0.25
 REUSED_GBUFFER = 1
@@ -407,6 +409,7 @@ class vsgl_render_settings(_Struct):
         ("visibility_budget", c_float),
         ("aa_pixel_limit", c_uint32),
         ("stride_pixels", c_uint32),
+        ("visibility_spread", c_float),
     ]
     _enums = {
         "method": Method, "fit_mode": FitMode, "sharpness_estimator": SharpnessEstimator,
@@ -658,11 +661,11 @@ __all__ = [
     "MATERIAL_TEXTURES_VERTEX_COLOR", "MATERIAL_TEXTURES_FLAGS_KNOWN", "LIGHT_FLAG_BLENDER_4",
     "LIGHT_FLAGS_KNOWN", "AUTO_OFF", "AUTO_BALANCED", "AA_SAMPLES_MAX", "RSM_RESOLUTION_MIN",
     "RSM_RESOLUTION_MAX", "VSGL_COUNT_MAX", "FIS_ITERATIONS_MAX", "SHADE_STRIDE_MAX",
-    "AA_PIXEL_LIMIT_PRESETS", "STRIDE_PIXELS_PRESETS", "VISIBILITY_BUDGET_DEFAULT", "MRP_MIN_AREA_DEFAULT",
-    "REUSED_GBUFFER", "REUSED_FIT", "EXR_COMPRESSION_COUNT", "EXR_MAX_CHANNELS", "EXR_ZIP_LEVEL_DEFAULT",
-    "vsgl_log_fn", "vsgl_progress_fn", "vsgl_vec3", "vsgl_context_desc", "vsgl_sg", "vsgl_asg",
-    "vsgl_material", "vsgl_texture", "vsgl_texture_slot", "vsgl_material_textures", "vsgl_light",
-    "vsgl_camera", "vsgl_scene_desc", "vsgl_scene_info", "vsgl_render_settings", "vsgl_render_output",
-    "vsgl_render_stats", "vsgl_memory_estimate", "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options",
-    "vsgl_bundle_options", "vsgl_bundle_info", "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS",
-    "FIELD_C_NAMES", "PROTOTYPES"]
+    "AA_PIXEL_LIMIT_PRESETS", "STRIDE_PIXELS_PRESETS", "VISIBILITY_SPREAD_DEFAULT", "VISIBILITY_SPREAD_MAX",
+    "VISIBILITY_BUDGET_DEFAULT", "MRP_MIN_AREA_DEFAULT", "REUSED_GBUFFER", "REUSED_FIT",
+    "EXR_COMPRESSION_COUNT", "EXR_MAX_CHANNELS", "EXR_ZIP_LEVEL_DEFAULT", "vsgl_log_fn", "vsgl_progress_fn",
+    "vsgl_vec3", "vsgl_context_desc", "vsgl_sg", "vsgl_asg", "vsgl_material", "vsgl_texture",
+    "vsgl_texture_slot", "vsgl_material_textures", "vsgl_light", "vsgl_camera", "vsgl_scene_desc",
+    "vsgl_scene_info", "vsgl_render_settings", "vsgl_render_output", "vsgl_render_stats",
+    "vsgl_memory_estimate", "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options", "vsgl_bundle_options",
+    "vsgl_bundle_info", "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS", "FIELD_C_NAMES", "PROTOTYPES"]

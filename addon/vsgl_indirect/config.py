@@ -21,6 +21,7 @@ KNOBS = {
     "sample_merging": (("AUTO", "OFF"), "AUTO"),
     "visibility": (("NONE", "RAY"), "RAY"),
     "visibility_budget": (None, 0.02),
+    "visibility_spread": (None, 2.0),
     "seed": (None, 0),
     "rsm_resolution": (None, 256),
     "fit_mode": (("TWO", "FIS", "KMEANS", "LATTICE"), "LATTICE"),
@@ -40,6 +41,7 @@ KNOBS = {
 _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", fis_iterations=8,
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
                diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4, visibility_budget=0.02,
+               visibility_spread=2.0,
                aa_pixel_limit=76800, stride_pixels=76800)
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="RAY",
@@ -113,7 +115,7 @@ def inactive_knobs(obj):
     if obj.glossy_mode != "ASG2" or obj.method == "BRUTE_FORCE":
         out.add("glossy_lobes")
     if obj.visibility != "RAY" or obj.method == "BRUTE_FORCE":
-        out.add("visibility_budget")
+        out |= {"visibility_budget", "visibility_spread"}
     return out
 
 
@@ -140,6 +142,7 @@ class Options:
     glossy_lobes: int = 4           # GGX's lobes in the half-vector model (ASG2): 4 or 5
     visibility: str = "RAY"
     visibility_budget: float = 0.02  # Visibility Rays: the weakest VSGLs' share of a receiver's light without a ray
+    visibility_spread: float = 2.0  # Visibility Rays: the disk each VSGL's rays aim over, in its sigmas
     seed: int = 0
     leak_correction: str = "AUTO"
     sample_merging: str = "AUTO"

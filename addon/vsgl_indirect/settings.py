@@ -317,6 +317,13 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "most this fraction of all of theirs, trace no ray and take the others' visibility. "
                     "0.02 in every preset (the sphere room: 5.8x fewer rays, the same image within "
                     "0.001 FLIP); 0 = 0.02; negative: a ray for every VSGL")
+    visibility_spread: FloatProperty(
+        name="Ray Spread", default=config.KNOBS["visibility_spread"][1], min=-1.0, max=4.0, soft_min=0.0,
+        description="Visibility Rays only: each VSGL's rays aim over a disk of this many of its cluster's "
+                    "sigmas (each pixel at one of 16 points), so a shadow edge is a soft ramp as wide as "
+                    "the lit patch's penumbra instead of one hard edge per VSGL (stripes where many "
+                    "VSGLs stand behind one object). 2 in every preset (a disk with the cluster's own "
+                    "spread); 0 = 2; negative: rays at each cluster's centre (hard edges)")
     seed: IntProperty(
         name="Seed", default=0, min=0,
         description="Seed of the FIS and k-means cluster draws: moves where their clusters fall, "

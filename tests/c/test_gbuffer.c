@@ -617,7 +617,9 @@ static size_t self_shadowed(const vsgl_scene *s, const vsgl_gbuffer *g, int lift
                 o = v3_add(o, v3_make(g->lift[0][i], g->lift[1][i], g->lift[2][i]));
             const uint32_t lane = 0;
             unsigned char b = 0;
-            vsgl__scene_occluded_towards(s, 1, &lane, &o.x, &o.y, &o.z, v3_add(o, v3_scale(d, 10.0f)), 1e-4f, &b);
+            v3 t = v3_add(o, v3_scale(d, 10.0f));
+            const float *const tgt[3] = {&t.x, &t.y, &t.z};
+            vsgl__scene_occluded_towards_each(s, 1, &lane, &o.x, &o.y, &o.z, tgt, 1e-4f, &b);
             blocked += b != 0;
             ++*rays;
         }

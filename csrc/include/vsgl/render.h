@@ -182,12 +182,26 @@ typedef struct vsgl_render_settings {
                                       VSGL_STRIDE_PIXELS_PRESETS. The log and the stats' `skipped` say when
                                       it applied. shade_stride 1 (every pixel) is never scaled. 0:
                                       shade_stride at every size (the default) */
+    float visibility_spread;     /**< visibility RAY: where a VSGL's rays aim. Its cluster is a lit patch, not a
+                                      point: 16 points over a disk of radius spread x the cluster's in-plane
+                                      sigma (2: a uniform disk with the cluster's own variance), pulled in
+                                      where a surface is in the way, and each receiver aims at one of them,
+                                      picked by a hash of its position. A shadow edge then becomes a dithered
+                                      ramp as wide as the cluster's penumbra instead of one hard edge per
+                                      VSGL (parallel stripes where many clusters stand behind one
+                                      occluder), at one ray per pair as before. 0 means
+                                      VSGL_VISIBILITY_SPREAD_DEFAULT; negative: every ray aims at the
+                                      cluster's centre (hard edges); at most VSGL_VISIBILITY_SPREAD_MAX */
 } vsgl_render_settings;
 
 /** vsgl_render_settings.aa_pixel_limit of every preset: 320 x 240. */
 #define VSGL_AA_PIXEL_LIMIT_PRESETS (320u * 240u)
 /** vsgl_render_settings.stride_pixels of every preset: 320 x 240 (960 x 540: 2 -> 5, 1920 x 1080: 2 -> 8). */
 #define VSGL_STRIDE_PIXELS_PRESETS (320u * 240u)
+
+/** vsgl_render_settings.visibility_spread when it is 0, and its largest value. */
+#define VSGL_VISIBILITY_SPREAD_DEFAULT 2.0f
+#define VSGL_VISIBILITY_SPREAD_MAX 4.0f
 
 /** vsgl_render_settings.visibility_budget when it is 0. */
 #define VSGL_VISIBILITY_BUDGET_DEFAULT 0.02f

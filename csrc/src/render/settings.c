@@ -20,6 +20,7 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
     out->mrp_min_area = VSGL_MRP_MIN_AREA_DEFAULT; /* what 0 means, spelled out (the add-on's panel shows it) */
     out->glossy_lobes = 4;                         /* the same */
     out->visibility_budget = VSGL_VISIBILITY_BUDGET_DEFAULT; /* the same */
+    out->visibility_spread = VSGL_VISIBILITY_SPREAD_DEFAULT; /* the same */
     /* Every preset fits on the lattice: the importance-drawn fits flicker
      * as a light moves (0.1-0.75 of the AOV per 1/1000-extent step, docs/
      * quality.md) and break a reflection into blotches; with the emitter
@@ -203,6 +204,14 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
         s->visibility_budget = VSGL_VISIBILITY_BUDGET_DEFAULT;
     else if (s->visibility_budget < 0.0f)
         s->visibility_budget = -1.0f; /* off */
+    if (!(s->visibility_spread <= VSGL_VISIBILITY_SPREAD_MAX) || s->visibility_spread != s->visibility_spread)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: visibility_spread is %g (valid: at most "
+                          "%g; 0 = %g, negative = rays at each cluster's centre)", (double)s->visibility_spread,
+                          (double)VSGL_VISIBILITY_SPREAD_MAX, (double)VSGL_VISIBILITY_SPREAD_DEFAULT);
+    if (s->visibility_spread == 0.0f)
+        s->visibility_spread = VSGL_VISIBILITY_SPREAD_DEFAULT;
+    else if (s->visibility_spread < 0.0f)
+        s->visibility_spread = -1.0f; /* the centre */
     if (s->fis_iterations > VSGL_FIS_ITERATIONS_MAX)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: fis_iterations is %u (valid 1..%d)",
                           s->fis_iterations, VSGL_FIS_ITERATIONS_MAX);

@@ -135,8 +135,9 @@ void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *or
     }
 }
 
-void vsgl__scene_occluded_towards(const vsgl_scene *scene, uint32_t n, const uint32_t *lane, const float *ox,
-                                  const float *oy, const float *oz, v3 target, float eps, unsigned char *blocked)
+void vsgl__scene_occluded_towards_each(const vsgl_scene *scene, uint32_t n, const uint32_t *lane, const float *ox,
+                                       const float *oy, const float *oz, const float *const tgt[3], float eps,
+                                       unsigned char *blocked)
 {
     enum { BATCH = 64 };
     float rx[BATCH], ry[BATCH], rz[BATCH], dx[BATCH], dy[BATCH], dz[BATCH], t0[BATCH], t1[BATCH], tm[BATCH];
@@ -151,7 +152,7 @@ void vsgl__scene_occluded_towards(const vsgl_scene *scene, uint32_t n, const uin
         /* the segments longer than eps, packed to the front */
         for (uint32_t i = 0; i < c; ++i) {
             uint32_t k = lane[b + i];
-            float ex = target.x - ox[k], ey = target.y - oy[k], ez = target.z - oz[k];
+            float ex = tgt[0][k] - ox[k], ey = tgt[1][k] - oy[k], ez = tgt[2][k] - oz[k];
             float dist = sqrtf(ex * ex + ey * ey + ez * ez), inv = 1.0f / dist;
             blocked[b + i] = 0;
             if (scene->triangle_count == 0 || !(dist > eps))

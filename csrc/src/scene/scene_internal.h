@@ -42,10 +42,12 @@ void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *or
                                const float *tmin, const float *tmax, int coherent, unsigned char *blocked);
 
 /* vsgl__scene_occluded_many for the segments from origin lane[i] (ox, oy,
- * oz: coordinates indexed by lane) to `target`, short of it by eps (a
- * segment of eps or less: unblocked, no ray); blocked[i], i < n. Thread-safe. */
-void vsgl__scene_occluded_towards(const vsgl_scene *scene, uint32_t n, const uint32_t *lane, const float *ox,
-                                  const float *oy, const float *oz, v3 target, float eps, unsigned char *blocked);
+ * oz: coordinates indexed by lane) to target lane[i] (tgt[0..2], the same
+ * indexing), short of it by eps (a segment of eps or less: unblocked, no
+ * ray); blocked[i], i < n. Thread-safe. */
+void vsgl__scene_occluded_towards_each(const vsgl_scene *scene, uint32_t n, const uint32_t *lane, const float *ox,
+                                       const float *oy, const float *oz, const float *const tgt[3], float eps,
+                                       unsigned char *blocked);
 
 /* Index in the caller's triangle array of validated triangle `triangle`. */
 uint32_t vsgl__scene_source_triangle(const vsgl_scene *scene, uint32_t triangle);

@@ -7,6 +7,7 @@
 
 #include "shade/shade.h"
 #include "shade/kernel.h"
+#include "shade/ray_targets.h"
 #include "shade/near_field.h"
 #include "scene/material.h"
 
@@ -90,6 +91,7 @@ typedef struct shade_job {
     const unsigned char *ray_twin;  /* NULL, or per kernel light: 1 if its visibility rays are those of the
                                        light before it (a glossy cluster's core and tail: the same target
                                        and skip test), which block_visibility then does not trace again */
+    const vsgl_ray_targets *targets; /* visibility rays: each VSGL's points (ray_targets.h); NULL without rays */
 } shade_job;
 
 /* Receiver lobe of one sample, set up once and used for every VSGL. */

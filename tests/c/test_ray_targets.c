@@ -1,0 +1,167 @@
+/* Where visibility rays aim (shade/ray_targets.c): points over a disk with
+ * the cluster's own spread, pulled in before a wall, and a receiver's pick
+ * among them; through an occluder's straight edge the share of receivers
+ * that see the cluster must follow a uniform disk's penumbra (the area of
+ * the disk beyond the edge's shadow line), not one hard step. */
+#include "harness.h"
+#include "scene_fixture.h"
+#include "shade/ray_targets.h"
+
+#include <math.h>
+#include <string.h>
+
+/* The fixture room with a horizontal plate at height z_plate over
+ * x in [-0.9, 0], y in [-0.9, 0.9]: its edge is the line x = 0. */
+static vsgl_scene *room_with_plate(vsgl_context *ctx, fx_scene *fx, float z_plate)
+{
+    fx_room(fx, 8, 6, 0.5f, 100.0f);
+    const float plate[4][3] = {{-0.9f, -0.9f, z_plate}, {0.0f, -0.9f, z_plate}, {0.0f, 0.9f, z_plate},
+                               {-0.9f, 0.9f, z_plate}};
+    fx_quad(fx, plate, 3);
+    vsgl_scene *sc = NULL;
+    return vsgl_scene_create(ctx, fx_desc(fx), &sc) == VSGL_OK ? sc : NULL;
+}
+
+static vsgl_vsgl floor_cluster(float x, float y, float sigma)
+{
+    vsgl_vsgl v;
+    memset(&v, 0, sizeof v);
+    v.mean = v3_make(x, y, 0.0f);
+    v.normal = v3_make(0.0f, 0.0f, 1.0f);
+    v.coherence = 1.0f;
+    v.variance = sigma * sigma;
+    return v;
+}
+
+/* The share of a uniform disk of radius 1 on the side x >= -u of a line. */
+static double disk_share_beyond(double u)
+{
+    if (u <= -1.0)
+        return 0.0;
+    if (u >= 1.0)
+        return 1.0;
+    return 1.0 - (acos(u) - u * sqrt(1.0 - u * u)) / 3.14159265358979;
+}
+
+VT_TEST(ray_targets_spread_over_the_cluster_and_stop_before_a_wall)
+{
+    vsgl_context *ctx = fx_context(1);
+    VT_REQUIRE(ctx, "context");
+    fx_scene fx;
+    vsgl_scene *sc = room_with_plate(ctx, &fx, 0.525f);
+    VT_REQUIRE(sc, "%s", vsgl_context_last_error(ctx));
+    const float sigma = 0.05f;
+    vsgl_vsgl items[2] = {floor_cluster(0.0f, 0.0f, sigma), floor_cluster(0.95f, 0.0f, sigma)};
+    vsgl_vsgl_set set = {items, 2, 2};
+    vsgl_ray_targets t;
+    VT_REQUIRE(vsgl__ray_targets_build(sc, &set, 2.0f, 0.25f, &t) == VSGL_OK, "build");
+    const float R = 2.0f * sqrtf(1.5f) * sigma; /* a uniform disk with the cluster's in-plane variance */
+    for (int i = 0; i < 2; ++i) {
+        v3 c = vsgl__ray_centre(&items[i]);
+        VT_CHECK(fabsf(c.z - sigma) < 1e-6f, "cluster %d: centre pushed off the floor to %g, want sigma %g", i,
+                 (double)c.z, (double)sigma);
+        double m2 = 0.0, mx = 0.0, my = 0.0;
+        int pulled = 0;
+        for (unsigned k = 0; k < VSGL__RAY_TARGETS; ++k) {
+            const float *p = t.xyz + (i * VSGL__RAY_TARGETS + k) * 3;
+            v3 d = v3_sub(v3_make(p[0], p[1], p[2]), c);
+            const float rk = R * sqrtf(((float)k + 0.5f) / VSGL__RAY_TARGETS), len = v3_length(d);
+            VT_CHECK(fabsf(d.z) < 1e-6f, "cluster %d point %u off the cluster's plane by %g", i, k, (double)d.z);
+            VT_CHECK(len <= rk * 1.0001f, "cluster %d point %u at %g, past its radius %g", i, k, (double)len,
+                     (double)rk);
+            if (len < rk * 0.999f) { /* pulled in: halfway to the wall x = 1 */
+                ++pulled;
+                VT_CHECK(fabsf(c.x + 2.0f * d.x - 1.0f) < 1e-4f, "cluster %d point %u pulled in to %g, but the "
+                         "wall is not at twice that (%g)", i, k, (double)len, (double)(c.x + 2.0f * d.x));
+            } else {
+                VT_CHECK(p[0] < 1.0f, "cluster %d point %u at x = %g, behind the wall", i, k, (double)p[0]);
+            }
+            m2 += (double)v3_dot(d, d) / VSGL__RAY_TARGETS;
+            mx += (double)d.x / VSGL__RAY_TARGETS;
+            my += (double)d.y / VSGL__RAY_TARGETS;
+        }
+        if (i == 0) { /* nothing in the way: the disk's second moment, R^2 / 2 = 3 sigma^2 */
+            VT_CHECK(pulled == 0, "%d points pulled in with nothing in the way", pulled);
+            VT_CHECK(fabs(m2 / (3.0 * sigma * sigma) - 1.0) < 1e-3, "second moment %g sigma^2, want 3",
+                     m2 / (sigma * sigma));
+            VT_CHECK(fabs(mx) < 0.25 * sigma && fabs(my) < 0.25 * sigma, "points centred off by (%g, %g) sigma",
+                     mx / sigma, my / sigma);
+        } else { /* 5 cm from the wall, the disk 12 cm wide: some points reach it */
+            VT_CHECK(pulled >= 2, "%d points pulled in before the wall 5 cm away", pulled);
+        }
+    }
+    vsgl__ray_targets_free(&t);
+    /* spread 0: every point is the centre */
+    VT_REQUIRE(vsgl__ray_targets_build(sc, &set, 0.0f, 0.25f, &t) == VSGL_OK, "build");
+    v3 c = vsgl__ray_centre(&items[1]);
+    for (unsigned k = 0; k < VSGL__RAY_TARGETS; ++k) {
+        const float *p = t.xyz + (VSGL__RAY_TARGETS + k) * 3;
+        VT_CHECK(p[0] == c.x && p[1] == c.y && p[2] == c.z, "spread 0: point %u is not the centre", k);
+    }
+    vsgl__ray_targets_free(&t);
+    vsgl_scene_destroy(sc);
+    vsgl_context_destroy(ctx);
+}
+
+/* A cluster on the floor under the plate's edge, receivers in lines above
+ * the plate at x = u R (R: the disk's radius), the plate halfway up: a
+ * receiver's ray to point p of the disk passes the plate's plane at
+ * x = (u R + p.x) / 2, so the share that gets through is the disk's share
+ * beyond x = -u R. Measured over 1024 receivers a line: within binomial
+ * noise of the 16 points' share, which is within 0.1 of the disk's. With
+ * every ray at the centre, the share is 0 or 1: the hard step. */
+VT_TEST(ray_targets_give_an_edge_the_cluster_penumbra)
+{
+    vsgl_context *ctx = fx_context(1);
+    VT_REQUIRE(ctx, "context");
+    fx_scene fx;
+    const float sigma = 0.05f, zr = 1.0f;
+    vsgl_vsgl items[1] = {floor_cluster(0.0f, 0.0f, sigma)};
+    const v3 c = vsgl__ray_centre(&items[0]);
+    vsgl_scene *sc = room_with_plate(ctx, &fx, 0.5f * (c.z + zr));
+    VT_REQUIRE(sc, "%s", vsgl_context_last_error(ctx));
+    vsgl_vsgl_set set = {items, 1, 1};
+    const float R = 2.0f * sqrtf(1.5f) * sigma;
+    enum { N = 1024 };
+    static float ox[N], oy[N], oz[N], tx[N], ty[N], tz[N];
+    static uint32_t lane[N];
+    static unsigned char blocked[N];
+    const float *const tgt[3] = {tx, ty, tz};
+    for (int spread = 0; spread < 2; ++spread) {
+        vsgl_ray_targets t;
+        VT_REQUIRE(vsgl__ray_targets_build(sc, &set, spread ? 2.0f : 0.0f, 0.25f, &t) == VSGL_OK, "build");
+        const double us[] = {-0.8, -0.5, -0.2, 0.2, 0.5, 0.8};
+        double prev = -1.0;
+        for (size_t q = 0; q < sizeof us / sizeof us[0]; ++q) {
+            double points = 0.0; /* the share of the 16 points beyond the line */
+            for (unsigned k = 0; k < VSGL__RAY_TARGETS; ++k)
+                points += t.xyz[3 * k] >= c.x - (float)us[q] * R ? 1.0 / VSGL__RAY_TARGETS : 0.0;
+            for (int i = 0; i < N; ++i) {
+                v3 x = v3_make((float)us[q] * R, -0.5f + (float)i / N, zr);
+                const float *p = vsgl__ray_target_for(&t, 0, vsgl__ray_key(x));
+                ox[i] = x.x, oy[i] = x.y, oz[i] = x.z;
+                tx[i] = p[0], ty[i] = p[1], tz[i] = p[2];
+                lane[i] = (uint32_t)i;
+            }
+            vsgl__scene_occluded_towards_each(sc, N, lane, ox, oy, oz, tgt, 1e-4f, blocked);
+            double seen = 0.0;
+            for (int i = 0; i < N; ++i)
+                seen += blocked[i] ? 0.0 : 1.0 / N;
+            if (spread) {
+                double disk = disk_share_beyond(us[q]);
+                VT_CHECK(fabs(seen - points) < 0.05, "u %.1f: %.3f of the receivers see the cluster, its points "
+                         "give %.3f (the picks are not uniform)", us[q], seen, points);
+                VT_CHECK(fabs(points - disk) < 0.1, "u %.1f: the points give %.3f, a uniform disk %.3f", us[q],
+                         points, disk);
+                VT_CHECK(seen > prev, "u %.1f: %.3f, not more than the line before (%.3f)", us[q], seen, prev);
+                prev = seen;
+            } else {
+                VT_CHECK(seen == (us[q] > 0.0 ? 1.0 : 0.0), "spread 0, u %.1f: %.3f see the centre, want a hard "
+                         "step", us[q], seen);
+            }
+        }
+        vsgl__ray_targets_free(&t);
+    }
+    vsgl_scene_destroy(sc);
+    vsgl_context_destroy(ctx);
+}
