@@ -4,9 +4,11 @@ pays for itself": at most 2x the shading time without them, with a measured
 error gain on a scene with indirect shadows).
 
 On the bundled rooms that have indirect shadows (tests/quality/scenes.py:
-a sphere over a floor, the two sun rooms), the balanced preset three ways:
+a sphere over a floor, the two sun rooms), the balanced preset four ways:
 without visibility, with the ray budget (vsgl_render_settings.
-visibility_budget, the default) and with a ray for every pair. Times: the
+visibility_budget, the default), the same with every ray at its VSGL's
+centre (visibility_spread -1: hard edges, the penumbra's samples left to
+the sparse interpolation) and with a ray for every pair. Times: the
 shade stage (the fastest of --repeat renders) at --size, with the ratio to
 the shade stage without visibility against the target 2; errors: against
 the cached Cycles references at 80 x 60 (tests/quality/refs.py; skipped
@@ -25,7 +27,8 @@ import refs  # noqa: E402
 import scenes  # noqa: E402
 
 SCENES = ("glossy_sphere_floor", "sun_opening", "sun_opening_thick")
-WAYS = (("no visibility", dict(visibility=0)), ("ray budget", dict()), ("every pair", dict(visibility_budget=-1.0)))
+WAYS = (("no visibility", dict(visibility=0)), ("ray budget", dict()),
+        ("rays at centres", dict(visibility_spread=-1.0)), ("every pair", dict(visibility_budget=-1.0)))
 TARGET = 2.0
 
 
@@ -55,7 +58,7 @@ def main(argv=None):
     rend = E.Renderer()
     have_refs = refs.blender_version(refs.DEFAULT_DIR) is not None and not refs.missing(
         args.scenes.split(","), scenes.size_of("test"), refs.DEFAULT_DIR)
-    print("visibility: balanced at %dx%d (shade stage, best of %d rounds, the three in turn) on %d cores; "
+    print("visibility: balanced at %dx%d (shade stage, best of %d rounds, the ways in turn) on %d cores; "
           "errors against Cycles at 80x60%s"
           % (w, h, args.repeat, os.cpu_count() or 0, "" if have_refs else " skipped (no cached references)"))
     for name in args.scenes.split(","):
