@@ -25,9 +25,10 @@ def image_node_name(view_layer):
     return IMAGE_NODE % view_layer
 
 
-def placeholder(path, width, height, exclusive=False):
-    """Write a black EXR with every pass so the Image node gets its sockets
-    before the real file exists. ``exclusive``: never replace an existing
+def placeholder(path, width, height, exclusive=False, options=None):
+    """Write a black EXR with the passes a render with ``options`` (default:
+    the defaults) writes, so the Image node gets its sockets before the real
+    file exists. ``exclusive``: never replace an existing
     file (another process may have written that frame's real AOV
     meanwhile): returns the placeholder's inode (for
     ``handlers.remove_if_inode``), or None if a file was there."""
@@ -36,12 +37,13 @@ def placeholder(path, width, height, exclusive=False):
     planes = {p: z for p in engine.PASS_NAMES}
     planes["alpha"] = np.zeros(z.shape[:2], np.float32)
     from .config import Options
+    options = options or Options()
     if not exclusive:
-        engine.write_exr(path, planes, Options())
+        engine.write_exr(path, planes, options)
         return True
     d, name = os.path.split(path)
     tmp = os.path.join(d, ".%s.setup-%d" % (name, os.getpid()))
-    engine.write_exr(tmp, planes, Options())
+    engine.write_exr(tmp, planes, options)
     try:
         os.link(tmp, path)      # atomic, fails if the file exists
         return os.stat(tmp).st_ino

@@ -150,6 +150,7 @@ class Options:
     threads: int = 0
     max_memory_gb: float = 0.0      # 0 = the memory the machine has available
     half_float: bool = True         # Blender's own EXR default; 2x smaller, faster to write
+    color_passes: bool = False      # EXR: also DiffCol and GlossCol (the compositor setup reads neither)
     fail_render: bool = False       # farms: a frame without its AOV fails the render
     strength: float = 1.0           # compositor: factor of the added indirect light
     use_diffuse: bool = True        # compositor: add the Diff pass

@@ -187,11 +187,18 @@ def check_output_path(path):
                        % (path, e.strerror or e))
 
 
-def exr_passes(planes):
-    """EXR passes (name -> HxWxC float32) from library planes."""
+#: The library's colour passes: written only with Options.color_passes (the
+#: compositor setup reads Diff and Gloss, or DiffInd and GlossInd times
+#: Cycles' own colours; Diff = DiffInd x DiffCol already holds them).
+COLOR_PASSES = ("DiffCol", "GlossCol")
+
+
+def exr_passes(planes, color_passes=True):
+    """EXR passes (name -> HxWxC float32) from library planes; without
+    ``color_passes``, not DiffCol and GlossCol."""
     out = {}
     for p, name in PASS_NAMES.items():
-        if p in planes and p != "combined":
+        if p in planes and p != "combined" and (color_passes or name not in COLOR_PASSES):
             out[name] = np.asarray(planes[p], np.float32)
     if "combined" in planes:
         c = np.asarray(planes["combined"], np.float32)
@@ -204,7 +211,7 @@ def exr_passes(planes):
 def write_exr(path, planes, options, metadata=None, warnings=None):
     """Write the planes as a multilayer EXR with libvsgl's writer (atomic, chunks
     compressed in parallel); any failure is an AovError naming the path."""
-    passes = exr_passes(planes)
+    passes = exr_passes(planes, options.color_passes)
     bad = [n for n, a in passes.items() if not np.all(np.isfinite(a))]
     if bad:
         raise AovError("the AOV has non-finite values in pass(es) %s; not written" % ", ".join(bad))

@@ -154,7 +154,7 @@ def _setup_layer(scene, layer, path, w, h, add, options=None, attempts=6):
     for attempt in range(attempts):
         # Blender creates the pass sockets from a real file; never replace
         # one (a parallel process may have rendered this frame).
-        inode = None if os.path.exists(path) else compositor.placeholder(path, w, h, exclusive=True)
+        inode = None if os.path.exists(path) else compositor.placeholder(path, w, h, exclusive=True, options=options)
         try:
             # One composite output: only the first rendered view layer's AOV is
             # added onto it; the others get their Image node to wire by hand.

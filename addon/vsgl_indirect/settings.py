@@ -355,6 +355,12 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "faster writes (a 1080p AOV of the test room: 1.6 MB in 2-3 s instead of "
                     "33 MB in 6 s; noise that does not compress: 38 MB instead of 157 MB) with "
                     "3 significant digits, plenty for light added in the compositor")
+    color_passes: BoolProperty(
+        name="Colour Passes", default=False, **_UPDATE,
+        description="Also write the library's DiffCol and GlossCol (the receivers' Principled "
+                    "colours) into the AOV EXR. Off: DiffInd, GlossInd, Diff, Gloss and Combined, "
+                    "all the compositor setup reads (Diff = DiffInd x DiffCol; Cycles Colours uses "
+                    "Cycles' own), 16 channels instead of 22 and a write about a quarter shorter")
     fail_render: BoolProperty(
         name="Fail Render Without AOV", default=False,
         description="For farms: when a frame's AOV cannot be computed, stop the render. "

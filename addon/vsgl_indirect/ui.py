@@ -195,6 +195,7 @@ class VSGL_PT_output(_Sub, bpy.types.Panel):
             if warn:
                 wrapped(col, context, warn, icon="ERROR")
         layout.prop(props, "half_float")
+        layout.prop(props, "color_passes")
         layout.prop(props, "fail_render")
         col = layout.column(align=True)
         col.prop(props, "threads")

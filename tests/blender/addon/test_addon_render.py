@@ -54,6 +54,27 @@ def test_handler_fake_renderer_two_frames_composited(scene, tmp_path):
         assert np.allclose(out[..., :3], (0.1 * f, 0.2, 0.3), atol=1e-3), (f, out[0, 0])
 
 
+def test_aov_passes_default_and_colour_passes(scene, tmp_path):
+    """The AOV holds what the compositor setup reads, 16 half channels
+    (DiffInd, GlossInd, Diff, Gloss, Combined + alpha); Colour Passes adds
+    the library's DiffCol and GlossCol (22). The compositor wiring works
+    either way (the Image node's sockets come from the same pass set)."""
+    path = setup_blend(scene, tmp_path)
+    scene.objects["Spot"].data.energy = 1e-9   # beauty ~ black (world is None)
+    want = {"VSGL.%s.%s" % (p, c) for p in ("DiffInd", "GlossInd", "Diff", "Gloss") for c in "RGB"}
+    want |= {"VSGL.Combined.%s" % c for c in "RGBA"}
+    for colour in (False, True):
+        scene.vsgl_indirect.color_passes = colour
+        save(path)
+        r = render(path, 1, env={"VSGL_TEST_FAKE_RENDER": "1"})
+        assert r.returncode == 0 and "VSGL ERROR" not in r.stdout, r.stdout
+        ch, _ = read_exr(aov(tmp_path, 1))
+        extra = {"VSGL.%s.%s" % (p, c) for p in ("DiffCol", "GlossCol") for c in "RGB"} if colour else set()
+        assert set(ch) == want | extra, sorted(set(ch) ^ (want | extra))
+        out = image(str(tmp_path / "out" / "beauty_0001.exr"))
+        assert np.allclose(out[..., :3], (0.1, 0.2, 0.3), atol=1e-3), (colour, out[0, 0])
+
+
 def test_real_render_composite_is_render_plus_aov(scene, tmp_path):
     real_render_or_skip()
     path = setup_blend(scene, tmp_path)
@@ -235,7 +256,7 @@ def test_compositor_setup_idempotent_and_removable(scene, tmp_path):
     out = compat.compositor_output_socket(tree)
     assert out.links[0].from_node.name == "VSGL Add Glossy [ViewLayer]"
     node = tree.nodes["VSGL Indirect [ViewLayer]"]
-    assert {"DiffInd", "GlossInd", "DiffCol", "GlossCol"} <= set(node.outputs.keys())
+    assert {"DiffInd", "GlossInd", "Diff", "Gloss", "Combined"} <= set(node.outputs.keys())
     assert node.image.source == "SEQUENCE"
     # Explained, not shown: the frame numbers are hidden with the options.
     assert not node.show_options and "file number = frame" in node.label
@@ -490,6 +511,7 @@ def test_aov_diffcol_aligns_with_cycles_diffcol(scene, tmp_path, fit, shift, cty
     light(scene, "POINT", "Lamp", 300.0, (0, -1, 3))
     scene.vsgl_indirect.output_path = str(tmp_path / "aov" / "a_####.exr")
     scene.vsgl_indirect.add_to_render = False
+    scene.vsgl_indirect.color_passes = True   # the library's DiffCol, not written by default
     scene.vsgl_indirect.enabled = True
     # The compositor routes Cycles' DiffCol pass to the saved image.
     tree = compat.compositor_tree(scene, create=True)
