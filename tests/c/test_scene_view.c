@@ -248,6 +248,73 @@ VT_TEST(render_cache_shading_plan_replays_bit_identically)
     }
 }
 
+/* The same in a smooth-shaded scene, where visibility rays start from the
+ * smooth surface the corner normals describe (the G-buffer's lift): the
+ * floor's corner normals lean outwards, so its samples lie under their
+ * smooth surface. The replay rebuilt its receivers from the plan's lanes
+ * without the lift and traced from uninitialised origins (Embree's
+ * assertion aborted the process); the lanes now carry it. */
+VT_TEST(render_cache_replay_keeps_the_smooth_surface_lift)
+{
+    static planes8 cached, plain;
+    static float corner_normals[FX_MAX_TRIS * 9];
+    fx_scene fx;
+    fx_room(&fx, W, H, 0.25f, 200.0f);
+    /* a low block on the floor: something for the rays to meet (an empty
+     * box room is a convex shell and traces none) */
+    const float lo[3] = {-0.5f, -0.3f, 0.0f}, hi[3] = {0.3f, 0.3f, 0.25f};
+    const float top[4][3] = {{lo[0], lo[1], hi[2]}, {hi[0], lo[1], hi[2]}, {hi[0], hi[1], hi[2]}, {lo[0], hi[1], hi[2]}};
+    const float front[4][3] = {{lo[0], lo[1], lo[2]}, {hi[0], lo[1], lo[2]}, {hi[0], lo[1], hi[2]}, {lo[0], lo[1], hi[2]}};
+    const float back[4][3] = {{hi[0], hi[1], lo[2]}, {lo[0], hi[1], lo[2]}, {lo[0], hi[1], hi[2]}, {hi[0], hi[1], hi[2]}};
+    const float left[4][3] = {{lo[0], hi[1], lo[2]}, {lo[0], lo[1], lo[2]}, {lo[0], lo[1], hi[2]}, {lo[0], hi[1], hi[2]}};
+    const float right[4][3] = {{hi[0], lo[1], lo[2]}, {hi[0], hi[1], lo[2]}, {hi[0], hi[1], hi[2]}, {hi[0], lo[1], hi[2]}};
+    fx_quad(&fx, top, 3);
+    fx_quad(&fx, front, 3);
+    fx_quad(&fx, back, 3);
+    fx_quad(&fx, left, 3);
+    fx_quad(&fx, right, 3);
+    for (uint32_t t = 0; t < fx.triangle_count; ++t) {
+        const float *p[3];
+        for (int k = 0; k < 3; ++k)
+            p[k] = fx.positions + 3 * fx.indices[3 * t + (uint32_t)k];
+        v3 e1 = v3_make(p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]);
+        v3 e2 = v3_make(p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]);
+        v3 n = v3_normalize(v3_cross(e1, e2));
+        for (int k = 0; k < 3; ++k) {
+            v3 c = n;
+            if (t < 2) /* the floor (fx_room's first quad): lean out from its middle */
+                c = v3_normalize(v3_add(n, v3_make(0.4f * p[k][0], 0.4f * p[k][1], 0.0f)));
+            corner_normals[9 * t + 3 * (uint32_t)k] = c.x;
+            corner_normals[9 * t + 3 * (uint32_t)k + 1] = c.y;
+            corner_normals[9 * t + 3 * (uint32_t)k + 2] = c.z;
+        }
+    }
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s); /* stride 2, visibility rays */
+    s.vsgl_count = 32;
+    vsgl_context *ctx = fx_context(2);
+    VT_REQUIRE(ctx != NULL, "context");
+    vsgl_scene_desc d = *fx_desc(&fx);
+    d.corner_normals = corner_normals;
+    vsgl_scene *scene = NULL;
+    vsgl_render_cache *cache = NULL;
+    VT_REQUIRE(vsgl_render_cache_create(ctx, &cache) == VSGL_OK, "cache");
+    VT_REQUIRE(vsgl_scene_create(ctx, &d, &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    for (int edit = 0; edit < 3; ++edit) {
+        vsgl_render_stats st = {.size = sizeof st};
+        fx.lights[0].world_from_light[3] += 0.05f;
+        VT_CHECK(vsgl_scene_set_view(ctx, scene, &fx.camera, fx.lights, fx.light_count) == VSGL_OK, "set_view");
+        VT_CHECK(render_planes(ctx, scene, &s, cache, &cached, &st) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        VT_CHECK(edit == 0 || st.reused == VSGL_REUSED_GBUFFER, "edit %d: reused %u", edit, st.reused);
+        VT_CHECK(render_planes(ctx, scene, &s, NULL, &plain, NULL) == VSGL_OK, "uncached");
+        VT_CHECK(memcmp(&cached, &plain, sizeof plain) == 0, "edit %d: the replay differs from an uncached render",
+                 edit);
+    }
+    vsgl_render_cache_destroy(cache);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+}
+
 /* A replay leaves DiffCol, GlossCol and coverage in the cache's planes as
  * its record or last replay wrote them (sparse_replay.c); a render between
  * them that wrote the planes otherwise (here every pixel shaded, then the

@@ -733,6 +733,13 @@ static void lane_get(const vsgl_kernel_block *b, size_t k, vsgl__plan_lane *o)
     *v++ = b->f0r[k]; *v++ = b->f0g[k]; *v = b->f0b[k];
 }
 
+static void lane_set_lift(vsgl__plan_lane *o, v3 lift)
+{
+    o->lift[0] = lift.x;
+    o->lift[1] = lift.y;
+    o->lift[2] = lift.z;
+}
+
 static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o)
 {
     const float *v = o->v;
@@ -969,8 +976,10 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
                 blk.y[k] = rec[k].x.y;
                 blk.z[k] = rec[k].x.z;
             }
-            if (lanes)
+            if (lanes) {
                 lane_get(&blk, k, &lanes[s0 + k]);
+                lane_set_lift(&lanes[s0 + k], rec[k].lift);
+            }
         }
         pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
     }
@@ -985,6 +994,7 @@ void vsgl__sample_lane(const shade_job *j, size_t i, vsgl__plan_lane *lane)
     receiver r;
     fill_lane(j, i, &blk, 0, &r);
     lane_get(&blk, 0, lane);
+    lane_set_lift(lane, r.lift);
 }
 
 /* The same from recorded lanes (a shading plan's replay): bit-identical
@@ -1002,6 +1012,10 @@ uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lan
             lane_put(&blk, k, lanes[s0 + k]);
             rec[k].x = v3_make(blk.x[k], blk.y[k], blk.z[k]);
             rec[k].n = v3_make(blk.nx[k], blk.ny[k], blk.nz[k]);
+            /* the lift its visibility rays start from (it was left unset:
+             * a replay's rays in a smooth-shaded scene started at garbage,
+             * and Embree's assertion aborted the process) */
+            rec[k].lift = v3_make(lanes[s0 + k]->lift[0], lanes[s0 + k]->lift[1], lanes[s0 + k]->lift[2]);
         }
         pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
     }

@@ -11,9 +11,12 @@
 #include "shade/near_field.h"
 #include "scene/material.h"
 
-/* A kernel lane's receiver fields (26 floats, shade.c: lane_get/lane_put). */
+/* A kernel lane's receiver fields (26 floats, shade.c: lane_get/lane_put)
+ * and the receiver's lift for visibility rays (3 floats: a replay has no
+ * G-buffer sample to read it from). */
 typedef struct vsgl__plan_lane {
     float v[26];
+    float lift[3];
 } vsgl__plan_lane;
 
 /* A shading plan (shade_stride > 1): what shading a G-buffer needs that no
