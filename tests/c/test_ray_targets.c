@@ -138,7 +138,7 @@ VT_TEST(ray_targets_give_an_edge_the_cluster_penumbra)
                 points += t.xyz[3 * k] >= c.x - (float)us[q] * R ? 1.0 / VSGL__RAY_TARGETS : 0.0;
             for (int i = 0; i < N; ++i) {
                 v3 x = v3_make((float)us[q] * R, -0.5f + (float)i / N, zr);
-                const float *p = vsgl__ray_target_for(&t, 0, vsgl__ray_key(x));
+                const float *p = vsgl__ray_target_for(&t, 0, vsgl__hash32((uint32_t)(q * N + i)));
                 ox[i] = x.x, oy[i] = x.y, oz[i] = x.z;
                 tx[i] = p[0], ty[i] = p[1], tz[i] = p[2];
                 lane[i] = (uint32_t)i;

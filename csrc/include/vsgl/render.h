@@ -186,7 +186,7 @@ typedef struct vsgl_render_settings {
                                       point: 16 points over a disk of radius spread x the cluster's in-plane
                                       sigma (2: a uniform disk with the cluster's own variance), pulled in
                                       where a surface is in the way, and each receiver aims at one of them,
-                                      picked by a hash of its position. A shadow edge then becomes a dithered
+                                      picked by a hash of its pixel. A shadow edge then becomes a dithered
                                       ramp as wide as the cluster's penumbra instead of one hard edge per
                                       VSGL (parallel stripes where many clusters stand behind one
                                       occluder), at one ray per pair as before. 0 means

@@ -297,6 +297,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->n = v3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
     r->o = v3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
     r->lift = g->lift[0] ? v3_make(g->lift[0][i], g->lift[1][i], g->lift[2][i]) : v3_make(0.0f, 0.0f, 0.0f);
+    r->key = vsgl__hash32((uint32_t)i ^ vsgl__hash32((uint32_t)((uint64_t)i >> 32)));
     sample_params(j, i, &r->bp);
     if (g->spread && g->spread[i] < 1.0f)
         widen_by_spread(&r->bp, g->spread[i]);
@@ -354,7 +355,7 @@ static uint64_t lanes_of(size_t n)
 
 /* Where visibility rays start: receiver k offset along its normal by eps
  * (coordinates by lane; visibility_rays lifts the grazing ones), and the
- * key that picks its point of each cluster (vsgl__ray_key). */
+ * key that picks its point of each cluster (receiver.key). */
 typedef struct ray_origins {
     float x[VSGL__KERNEL_BLOCK], y[VSGL__KERNEL_BLOCK], z[VSGL__KERNEL_BLOCK];
     uint32_t key[VSGL__KERNEL_BLOCK];
@@ -367,7 +368,7 @@ static void origins_of(const shade_job *j, const receiver *rec, size_t n, ray_or
         o->x[k] = p.x;
         o->y[k] = p.y;
         o->z[k] = p.z;
-        o->key[k] = vsgl__ray_key(rec[k].x);
+        o->key[k] = rec[k].key;
     }
 }
 
@@ -733,11 +734,12 @@ static void lane_get(const vsgl_kernel_block *b, size_t k, vsgl__plan_lane *o)
     *v++ = b->f0r[k]; *v++ = b->f0g[k]; *v = b->f0b[k];
 }
 
-static void lane_set_lift(vsgl__plan_lane *o, v3 lift)
+static void lane_set_lift(vsgl__plan_lane *o, const receiver *r)
 {
-    o->lift[0] = lift.x;
-    o->lift[1] = lift.y;
-    o->lift[2] = lift.z;
+    o->lift[0] = r->lift.x;
+    o->lift[1] = r->lift.y;
+    o->lift[2] = r->lift.z;
+    o->key = r->key;
 }
 
 static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o)
@@ -978,7 +980,7 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
             }
             if (lanes) {
                 lane_get(&blk, k, &lanes[s0 + k]);
-                lane_set_lift(&lanes[s0 + k], rec[k].lift);
+                lane_set_lift(&lanes[s0 + k], &rec[k]);
             }
         }
         pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
@@ -994,7 +996,7 @@ void vsgl__sample_lane(const shade_job *j, size_t i, vsgl__plan_lane *lane)
     receiver r;
     fill_lane(j, i, &blk, 0, &r);
     lane_get(&blk, 0, lane);
-    lane_set_lift(lane, r.lift);
+    lane_set_lift(lane, &r);
 }
 
 /* The same from recorded lanes (a shading plan's replay): bit-identical
@@ -1016,6 +1018,7 @@ uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lan
              * a replay's rays in a smooth-shaded scene started at garbage,
              * and Embree's assertion aborted the process) */
             rec[k].lift = v3_make(lanes[s0 + k]->lift[0], lanes[s0 + k]->lift[1], lanes[s0 + k]->lift[2]);
+            rec[k].key = lanes[s0 + k]->key;
         }
         pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
     }

@@ -17,6 +17,7 @@
 typedef struct vsgl__plan_lane {
     float v[26];
     float lift[3];
+    uint32_t key;
 } vsgl__plan_lane;
 
 /* A shading plan (shade_stride > 1): what shading a G-buffer needs that no
@@ -101,6 +102,7 @@ typedef struct shade_job {
 typedef struct receiver {
     v3 x, n, o;
     v3 lift;             /* visibility rays start at x + lift (gbuffer.h lift) */
+    uint32_t key;        /* picks its visibility rays' points (ray_targets.h): a hash of its G-buffer sample */
     vsgl_brdf_params bp;
     float alpha;
     int glossy;
