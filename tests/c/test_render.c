@@ -136,6 +136,9 @@ VT_TEST(render_rejects_bad_settings_and_sizes_without_touching_output)
         {"glossy_lobes", 3, "settings: glossy_lobes is 3 (valid 4 or 5; 0 = 4)"},
         {"visibility_budget", 1, "settings: visibility_budget is 0.6 (valid: at most 0.5"},
         {"visibility_budget", 2, "settings: visibility_budget is nan (valid: at most 0.5"},
+        {"visibility_spread", 1, "settings: visibility_spread is 4.5 (valid: at most 4; 0 = 2, negative = rays"},
+        {"visibility_spread", 2, "settings: visibility_spread is inf (valid: at most 4"},
+        {"visibility_spread", 3, "settings: visibility_spread is nan (valid: at most 4"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         vsgl_render_settings bad = s;
@@ -146,6 +149,9 @@ VT_TEST(render_rejects_bad_settings_and_sizes_without_touching_output)
         if (i == 4) bad.glossy_lobes = (uint32_t)cases[i].value;
         if (i == 5) bad.visibility_budget = 0.6f;
         if (i == 6) bad.visibility_budget = NAN;
+        if (i == 7) bad.visibility_spread = 4.5f;
+        if (i == 8) bad.visibility_spread = INFINITY;
+        if (i == 9) bad.visibility_spread = NAN;
         memset(&p, 0x7f, sizeof p);
         err[0] = 0;
         VT_CHECK(render_room(0, &bad, &p, NULL, err, sizeof err) == VSGL_ERROR_INVALID_ARGUMENT, "%s", cases[i].field);
