@@ -12,8 +12,9 @@ const char cli_usage[] =
     "       vsgl --version | --help\n"
     "\n"
     "Renders one-bounce diffuse + glossy indirect light of a scene bundle into a\n"
-    "multilayer EXR (layer VSGL; passes DiffInd GlossInd DiffCol GlossCol Diff Gloss\n"
-    "Combined). Settings: the bundle's (or --preset), then the options below.\n"
+    "multilayer EXR (layer VSGL; passes DiffInd GlossInd Diff Gloss Combined, and\n"
+    "DiffCol GlossCol with --passes). Settings: the bundle's (or --preset), then the\n"
+    "options below.\n"
     "\n"
     "  -o, --output PATH     EXR to write (default: the bundle's output path)\n"
     "  --preset NAME         preview | balanced | quality | auto   (auto: balanced's knobs as ceilings;\n"
@@ -51,6 +52,9 @@ const char cli_usage[] =
     "                        (EXR compression, default zip; pxr24 and b44* are lossy)\n"
     "  --zip-level N         zlib level 1..9 of zip and zips (lossless: higher is smaller and slower;\n"
     "                        default 2)\n"
+    "  --passes LIST         the EXR's passes, comma-separated: DiffInd GlossInd DiffCol GlossCol Diff\n"
+    "                        Gloss Combined, or all (default: DiffInd,GlossInd,Diff,Gloss,Combined,\n"
+    "                        what the add-on's compositor setup reads)\n"
     "  --dry-run             read and validate the scene and settings, estimate the\n"
     "                        memory, check the output path; do not render\n"
     "  -v, --verbose         per-stage timings and statistics on stderr\n"
@@ -200,6 +204,32 @@ int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
     return rc;
 }
 
+const char *const cli_pass_names[7] = {"DiffInd", "GlossInd", "DiffCol", "GlossCol", "Diff", "Gloss", "Combined"};
+
+/* "Diff,Gloss" or "all" -> CLI_PASS_* bits; 0 if a name is unknown or the
+ * list is empty (bad: the first unknown name, up to its comma). */
+static uint32_t parse_passes(const char *value, char *bad, size_t bad_size)
+{
+    if (!strcmp(value, "all"))
+        return CLI_PASSES_ALL;
+    uint32_t mask = 0;
+    for (const char *p = value;;) {
+        const char *comma = strchr(p, ',');
+        size_t n = comma ? (size_t)(comma - p) : strlen(p);
+        int k = 0;
+        while (k < 7 && !(strlen(cli_pass_names[k]) == n && !strncmp(p, cli_pass_names[k], n)))
+            ++k;
+        if (k == 7) {
+            snprintf(bad, bad_size, "%.*s", (int)(n < 40 ? n : 40), p);
+            return 0;
+        }
+        mask |= 1u << k;
+        if (!comma)
+            return mask;
+        p = comma + 1;
+    }
+}
+
 static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t err_size)
 {
     memset(o, 0, sizeof *o);
@@ -208,6 +238,7 @@ static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t e
      * (tools/bench_exr.sh, docs/performance.md). */
     o->compression = VSGL_EXR_ZIP;
     o->half = 1;
+    o->passes = CLI_PASSES_COMPOSITOR;
     o->command = CLI_HELP;
     o->preset = o->fit = o->sharpness = o->diffuse = o->glossy = o->visibility = o->method = o->leak = o->merge = -1;
     err[0] = '\0';
@@ -280,7 +311,7 @@ static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t e
         }
         /* Options with a value. */
         int known = !strcmp(name, "-o") || !strcmp(name, "--output") || !strcmp(name, "--max-memory") ||
-                    !strcmp(name, "--mrp-min-area");
+                    !strcmp(name, "--mrp-min-area") || !strcmp(name, "--passes");
         for (size_t k = 0; k < sizeof enum_opts / sizeof enum_opts[0]; ++k)
             known |= !strcmp(name, enum_opts[k].name);
         for (size_t k = 0; k < sizeof num_opts / sizeof num_opts[0]; ++k)
@@ -306,6 +337,14 @@ static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t e
                 return set_err(err, err_size, "option --mrp-min-area: '%s' is not an area in m^2 >= 0%s", value, "");
             o->mrp_min_area_set = 1;
             o->mrp_min_area = area;
+            continue;
+        }
+        if (!strcmp(name, "--passes")) {
+            char bad[48];
+            bad[0] = '\0';
+            if (!(o->passes = parse_passes(value, bad, sizeof bad)))
+                return set_err(err, err_size, "option --passes: '%s' is not a pass (DiffInd GlossInd DiffCol GlossCol "
+                               "Diff Gloss Combined, comma-separated, or all)%s", bad, "");
             continue;
         }
         if (!strcmp(name, "--max-memory")) {

@@ -9,6 +9,15 @@
 #define CLI_RENDER  2
 #define CLI_INFO    3
 
+/* The EXR's passes (--passes), in vsgl_exr_write_render's order. */
+enum { CLI_PASS_DIFFIND = 1, CLI_PASS_GLOSSIND = 2, CLI_PASS_DIFFCOL = 4, CLI_PASS_GLOSSCOL = 8, CLI_PASS_DIFF = 16,
+       CLI_PASS_GLOSS = 32, CLI_PASS_COMBINED = 64, CLI_PASSES_ALL = 127 };
+/* The default: what the add-on's compositor setup reads (and writes itself),
+ * DiffInd GlossInd Diff Gloss Combined. */
+#define CLI_PASSES_COMPOSITOR (CLI_PASS_DIFFIND | CLI_PASS_GLOSSIND | CLI_PASS_DIFF | CLI_PASS_GLOSS | CLI_PASS_COMBINED)
+/* The pass names, bit k = 1 << k. */
+extern const char *const cli_pass_names[7];
+
 /* An optional unsigned number given on the command line. */
 typedef struct cli_u32 { int set; uint32_t value; } cli_u32;
 
@@ -24,6 +33,7 @@ typedef struct cli_options {
     int half, verbose, dry_run;
     int pixel_type_given;   /* --half or --float was given */
     uint64_t max_memory;      /* --max-memory in bytes; 0 = what the machine has available */
+    uint32_t passes;          /* CLI_PASS_* bits of the EXR's passes; default CLI_PASSES_COMPOSITOR */
     int mrp_min_area_set;     /* --mrp-min-area was given */
     double mrp_min_area;      /* its value (m^2, finite, >= 0) */
 } cli_options;

@@ -285,6 +285,14 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
     eo.zip_level = o->zip_level.set ? (int32_t)o->zip_level.value : 0; /* 0: the library's default */
     eo.metadata = md;
     eo.metadata_count = sizeof md / sizeof md[0];
+    /* only the passes asked for (--passes): vsgl_exr_write_render writes the planes that are set */
+    float **wanted[7] = {&out.diffuse_light, &out.glossy_light, &out.diffuse_color, &out.glossy_color,
+                         &out.diffuse, &out.glossy, &out.combined};
+    for (int k = 0; k < 7; ++k)
+        if (!(o->passes & (1u << k)))
+            *wanted[k] = NULL;
+    if (!(o->passes & CLI_PASS_COMBINED))
+        out.alpha = NULL;
     r = vsgl_exr_write_render(ctx, out_path, &out, &eo); /* SIGINT/SIGTERM cancel it too */
     progress_end(progress);
     if (r) {

@@ -225,7 +225,8 @@ fi
 
 # ---- renders ----------------------------------------------------------------------
 PASSES="DiffInd GlossInd DiffCol GlossCol Diff Gloss Combined"
-if want render_float && expect_ok render_float "$VSGL" render "$SCENE" -o "$T/out.exr" --preset preview --float; then
+if want render_float && expect_ok render_float "$VSGL" render "$SCENE" -o "$T/out.exr" --preset preview --float \
+    --passes all; then
   errs=""
   [ -s "$T/out.exr" ] || errs="$errs [no file]"
   grep -q $'\r' "$T/err" && errs="$errs [carriage return on a non-terminal]"
@@ -253,7 +254,9 @@ if want render_half_verbose && expect_ok render_half_verbose "$VSGL" render "$SC
   for l in "vsgl: settings: method=vsgl" "vsgl: render " "gbuffer " "rsm " "fit " "shade " "vsgl: lights used 1, skipped 0" "(64x48, half, zip)"; do
     grep -qF "$l" "$T/err" || errs="$errs [stderr lacks '$l']"
   done
-  oiiotool --info "$T/from_bundle.exr" 2>&1 | grep -q "22 channel, half openexr" || errs="$errs [not half: $(oiiotool --info "$T/from_bundle.exr" 2>&1)]"
+  # the default passes: what the add-on's compositor setup reads (no DiffCol, GlossCol)
+  oiiotool --info "$T/from_bundle.exr" 2>&1 | grep -q "16 channel, half openexr" || errs="$errs [not 16 half channels: $(oiiotool --info "$T/from_bundle.exr" 2>&1)]"
+  oiiotool --info -v "$T/from_bundle.exr" 2>&1 | grep -q "VSGL.DiffCol" && errs="$errs [DiffCol written by default]"
   if [ -z "$errs" ]; then ok render_half_verbose; else bad render_half_verbose "$errs"; fi
 fi
 
@@ -333,6 +336,20 @@ expect_fail args_bad_zip_level 2 "option --zip-level: '10' is not a zlib level 1
   -o "$T/z10.exr" --zip-level 10
 expect_fail args_bad_zip_level_0 2 "option --zip-level: '0' is not a whole number >= 1" "$VSGL" render "$SCENE" \
   -o "$T/z0.exr" --zip-level 0
+
+# --passes: only the passes asked for, by name; a wrong name is refused before rendering
+if want args_passes && expect_ok args_passes "$VSGL" render "$SCENE" -o "$T/p2.exr" --passes Gloss,Diff &&
+    expect_ok args_passes "$VSGL" render "$SCENE" -o "$T/p1.exr" --passes=Combined; then
+  c2=$(oiiotool --info -v "$T/p2.exr" 2>&1 | grep -o "channel list: .*")
+  c1=$(oiiotool --info -v "$T/p1.exr" 2>&1 | grep -o "channel list: .*")
+  if [ "$c2" = "channel list: VSGL.Diff.R, VSGL.Diff.G, VSGL.Diff.B, VSGL.Gloss.R, VSGL.Gloss.G, VSGL.Gloss.B" ] &&
+      [ "$c1" = "channel list: VSGL.Combined.R, VSGL.Combined.G, VSGL.Combined.B, VSGL.Combined.A" ]; then
+    ok args_passes
+  else bad args_passes "Gloss,Diff: '$c2'; Combined: '$c1'"; fi
+fi
+expect_fail args_bad_passes 2 "option --passes: 'Foo' is not a pass (DiffInd GlossInd DiffCol GlossCol Diff Gloss Combined" \
+  "$VSGL" render "$SCENE" -o "$T/pf.exr" --passes Diff,Foo
+expect_fail args_bad_passes_empty 2 "option --passes: '' is not a pass" "$VSGL" render "$SCENE" -o "$T/pe.exr" --passes ""
 
 # --stride-pixels: the image size --shade-stride is meant for (vsgl_render_settings.stride_pixels); every
 # preset's 76800 makes balanced's stride 2 a 3 at 480 x 360, and the render says so
