@@ -29,11 +29,16 @@ vsgl_result vsgl__ray_targets_build(const vsgl_scene *scene, const vsgl_vsgl_set
     for (size_t i = 0; i < count; ++i) {
         const vsgl_vsgl *v = &set->items[i];
         const v3 c = vsgl__ray_centre(v);
-        /* from the cell of the centre alone: a glossy core and tail get the
-         * same points, and a cluster that moves a little with its light
-         * keeps them (a new pattern every frame flickers) */
+        /* from the cell of the centre and the facing of the cluster: a
+         * glossy core and tail get the same points, a cluster that moves a
+         * little with its light keeps them (a new pattern every frame
+         * flickers), and a wall's clusters pick apart from the floor's in
+         * the same cell */
+        const uint32_t facing = cell_of(4.0f * v->normal.x + 4.5f) | cell_of(4.0f * v->normal.y + 4.5f) << 4 |
+                                cell_of(4.0f * v->normal.z + 4.5f) << 8;
         const uint32_t seed = vsgl__hash32(cell_of(c.x * inv_cell) ^
-                                           vsgl__hash32(cell_of(c.y * inv_cell) ^ vsgl__hash32(cell_of(c.z * inv_cell))));
+                                           vsgl__hash32(cell_of(c.y * inv_cell) ^
+                                                        vsgl__hash32(cell_of(c.z * inv_cell) ^ vsgl__hash32(facing))));
         out->seed[i] = seed;
         /* variance is per axis; a flat cluster's 3 sigma^2 lie in its plane */
         const float radius = spread * sqrtf(1.5f * fmaxf(v->variance, 0.0f));
