@@ -92,9 +92,9 @@ BRUTE_DIR = os.path.join(ROOT, "build", "trade", "brute")
 BRUTE_CODE = ["csrc/include", "csrc/src/core", "csrc/src/math", "csrc/src/scene", "csrc/src/gbuffer",
               "csrc/src/rsm", "csrc/src/shade/brute_force.c", "csrc/src/shade/brute_force.h",
               "csrc/src/shade/reference.c"]
-# the passes the add-on writes by default (addon/vsgl_indirect/engine.py: what the compositor setup
-# reads), with Combined + alpha below
-EXR_PASSES = {"diffuse_light": "DiffInd", "glossy_light": "GlossInd", "diffuse": "Diff", "glossy": "Gloss"}
+# the planes of the passes the add-on writes by default (addon/vsgl_indirect/engine.py: what the
+# compositor setup reads; Combined takes alpha as its A)
+EXR_PLANES = ("diffuse_light", "glossy_light", "diffuse", "glossy", "combined", "alpha")
 
 
 def log(*a):
@@ -222,13 +222,10 @@ def run_library(ctx, arrays, case, cfg, exr_dir):
             vsgls = int(st["vsgl_count"])
             LAST_BUDGET[cfg.label] = st.get("budget", "")
         t2 = time.perf_counter()
-    passes = {EXR_PASSES[p]: np.asarray(a, np.float32) for p, a in planes.items() if p in EXR_PASSES}
-    if "combined" in planes:
-        c = np.asarray(planes["combined"], np.float32)
-        alpha = np.asarray(planes["alpha"], np.float32) if "alpha" in planes else np.ones(c.shape[:2], np.float32)
-        passes["Combined"] = np.ascontiguousarray(np.dstack([c, alpha[:, :, None]]))
     # half + ZIP and the add-on's 16 channels, as it writes by default (docs/performance.md, "EXR writing")
-    L.exr_write(ctx, os.path.join(exr_dir, "frame.exr"), passes, layer="VSGL", pixel_type="half")
+    L.exr_write_render(ctx, os.path.join(exr_dir, "frame.exr"),
+                       {p: np.ascontiguousarray(planes[p], np.float32) for p in EXR_PLANES if p in planes},
+                       layer="VSGL", pixel_type="half")
     t3 = time.perf_counter()
     out = M.coloured(dict(DiffInd=planes["diffuse_light"], GlossInd=planes["glossy_light"],
                           DiffCol=planes["diffuse_color"], GlossCol=planes["glossy_color"]))

@@ -28,6 +28,16 @@ static void make_temp_dir(char *dir, size_t cap)
         dir[0] = '\0';
 }
 
+/* A render output of w x h with no planes set. */
+static vsgl_render_output blank_output(uint32_t w, uint32_t h)
+{
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = w;
+    o.height = h;
+    return o;
+}
+
 static void remove_tree(const char *dir)
 {
     char cmd[512];
@@ -108,10 +118,7 @@ static void fill(image *im)
 
 static vsgl_render_output output_of(image *im)
 {
-    vsgl_render_output o;
-    memset(&o, 0, sizeof o);
-    o.width = W;
-    o.height = H;
+    vsgl_render_output o = blank_output(W, H);
     o.diffuse_light = im->rgb[0];
     o.glossy_light = im->rgb[1];
     o.combined = im->combined;
@@ -760,10 +767,7 @@ VT_TEST(exr_write_is_cancelled_by_the_progress_callback)
     snprintf(path, sizeof path, "%s/big.exr", dir);
     enum { BW = 256, BH = 512 };
     float *plane = calloc((size_t)BW * BH * 3, sizeof(float));
-    vsgl_render_output o;
-    memset(&o, 0, sizeof o);
-    o.width = BW;
-    o.height = BH;
+    vsgl_render_output o = blank_output(BW, BH);
     o.diffuse_light = o.glossy_light = o.combined = plane;
     vsgl_context *ctx = NULL;
     vsgl_context_create(NULL, &ctx);
@@ -815,10 +819,7 @@ VT_TEST(exr_parallel_encoding_is_identical_for_any_thread_count)
         cd.thread_count = threads;
         vsgl_context *ctx = NULL;
         vsgl_context_create(&cd, &ctx);
-        vsgl_render_output o;
-        memset(&o, 0, sizeof o);
-        o.width = PW;
-        o.height = PH;
+        vsgl_render_output o = blank_output(PW, PH);
         o.glossy_light = px;
         char path[128];
         snprintf(path, sizeof path, "%s/t%u.exr", dir, threads);
@@ -865,10 +866,7 @@ VT_TEST(exr_render_combined_alpha_cases)
     snprintf(path, sizeof path, "%s/c.exr", dir);
     vsgl_context *ctx = NULL;
     vsgl_context_create(NULL, &ctx);
-    vsgl_render_output o;
-    memset(&o, 0, sizeof o);
-    o.width = CW;
-    o.height = CH;
+    vsgl_render_output o = blank_output(CW, CH);
     VT_CHECK(vsgl_exr_write_render(ctx, path, &o, NULL) == VSGL_ERROR_INVALID_ARGUMENT &&
                  strstr(vsgl_context_last_error(ctx), "no planes"), "no planes: '%s'", vsgl_context_last_error(ctx));
     /* Combined without alpha: A = 1. */
@@ -912,10 +910,7 @@ VT_TEST(exr_zip_level_is_lossless_and_trades_size)
     make_temp_dir(dir, sizeof dir);
     vsgl_context *ctx = NULL;
     vsgl_context_create(NULL, &ctx);
-    vsgl_render_output o;
-    memset(&o, 0, sizeof o);
-    o.width = ZW;
-    o.height = ZH;
+    vsgl_render_output o = blank_output(ZW, ZH);
     o.diffuse_light = px;
     const int32_t levels[5] = {1, VSGL_EXR_ZIP_LEVEL_DEFAULT, 6, 9, 0};
     size_t sizes[5] = {0};

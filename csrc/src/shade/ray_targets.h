@@ -25,7 +25,6 @@
 #include "scene/scene_internal.h"
 
 #include <stdint.h>
-#include <string.h>
 
 /* Points per cluster (a power of two: a receiver's pick is a mask). */
 #define VSGL__RAY_TARGETS 16u
@@ -64,13 +63,6 @@ static inline uint32_t vsgl__hash32(uint32_t x)
     x *= 0x846ca68bu;
     x ^= x >> 16;
     return x;
-}
-
-static inline uint32_t vsgl__float_bits(float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return u;
 }
 
 /* The point of VSGL `item` that the receiver with key `key` (a hash of its

@@ -719,9 +719,14 @@ static int same_surface(const vsgl_gbuffer *g, const vsgl_material *materials, s
 }
 
 /* A kernel lane's receiver fields (vsgl_kernel_block without the
- * accumulators), as a shading plan keeps them (shade_job.h). */
-static void lane_get(const vsgl_kernel_block *b, size_t k, vsgl__plan_lane *o)
+ * accumulators) and its receiver's lift and key, as a shading plan keeps
+ * them (shade_job.h). */
+static void lane_get(const vsgl_kernel_block *b, size_t k, const receiver *r, vsgl__plan_lane *o)
 {
+    o->lift[0] = r->lift.x;
+    o->lift[1] = r->lift.y;
+    o->lift[2] = r->lift.z;
+    o->key = r->key;
     float *v = o->v;
     *v++ = b->x[k]; *v++ = b->y[k]; *v++ = b->z[k];
     *v++ = b->nx[k]; *v++ = b->ny[k]; *v++ = b->nz[k];
@@ -734,16 +739,14 @@ static void lane_get(const vsgl_kernel_block *b, size_t k, vsgl__plan_lane *o)
     *v++ = b->f0r[k]; *v++ = b->f0g[k]; *v = b->f0b[k];
 }
 
-static void lane_set_lift(vsgl__plan_lane *o, const receiver *r)
+/* The inverse, and the receiver fields visibility rays read (position,
+ * normal, lift, key; a replay has no G-buffer sample to read them from). */
+static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, receiver *r)
 {
-    o->lift[0] = r->lift.x;
-    o->lift[1] = r->lift.y;
-    o->lift[2] = r->lift.z;
-    o->key = r->key;
-}
-
-static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o)
-{
+    r->x = v3_make(o->v[0], o->v[1], o->v[2]);
+    r->n = v3_make(o->v[3], o->v[4], o->v[5]);
+    r->lift = v3_make(o->lift[0], o->lift[1], o->lift[2]);
+    r->key = o->key;
     const float *v = o->v;
     b->x[k] = *v++; b->y[k] = *v++; b->z[k] = *v++;
     b->nx[k] = *v++; b->ny[k] = *v++; b->nz[k] = *v++;
@@ -978,10 +981,8 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
                 blk.y[k] = rec[k].x.y;
                 blk.z[k] = rec[k].x.z;
             }
-            if (lanes) {
-                lane_get(&blk, k, &lanes[s0 + k]);
-                lane_set_lift(&lanes[s0 + k], &rec[k]);
-            }
+            if (lanes)
+                lane_get(&blk, k, &rec[k], &lanes[s0 + k]);
         }
         pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
     }
@@ -995,8 +996,7 @@ void vsgl__sample_lane(const shade_job *j, size_t i, vsgl__plan_lane *lane)
     vsgl_kernel_block blk;
     receiver r;
     fill_lane(j, i, &blk, 0, &r);
-    lane_get(&blk, 0, lane);
-    lane_set_lift(lane, &r);
+    lane_get(&blk, 0, &r, lane);
 }
 
 /* The same from recorded lanes (a shading plan's replay): bit-identical
@@ -1011,14 +1011,7 @@ uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lan
     for (size_t s0 = 0; s0 < n_total; s0 += VSGL__KERNEL_BLOCK) {
         size_t n = n_total - s0 < VSGL__KERNEL_BLOCK ? n_total - s0 : VSGL__KERNEL_BLOCK;
         for (size_t k = 0; k < n; ++k) {
-            lane_put(&blk, k, lanes[s0 + k]);
-            rec[k].x = v3_make(blk.x[k], blk.y[k], blk.z[k]);
-            rec[k].n = v3_make(blk.nx[k], blk.ny[k], blk.nz[k]);
-            /* the lift its visibility rays start from (it was left unset:
-             * a replay's rays in a smooth-shaded scene started at garbage,
-             * and Embree's assertion aborted the process) */
-            rec[k].lift = v3_make(lanes[s0 + k]->lift[0], lanes[s0 + k]->lift[1], lanes[s0 + k]->lift[2]);
-            rec[k].key = lanes[s0 + k]->key;
+            lane_put(&blk, k, lanes[s0 + k], &rec[k]);
         }
         pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
     }
@@ -1272,7 +1265,8 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
         twin[k] = same_rays(&set->items[korder[k]], &kl[k], &set->items[korder[k - 1]], &kl[k - 1]);
     vsgl_ray_targets targets = {NULL, NULL};
     if (s->visibility == VSGL_VISIBILITY_RAY &&
-        vsgl__ray_targets_build(scene, set, fmaxf(s->visibility_spread, 0.0f), (extent > 0.0f ? extent : 1.0f) * VSGL__RAY_SEED_CELL, &targets) != VSGL_OK) {
+        vsgl__ray_targets_build(scene, set, fmaxf(s->visibility_spread, 0.0f),
+                                (extent > 0.0f ? extent : 1.0f) * VSGL__RAY_SEED_CELL, &targets) != VSGL_OK) {
         free(twin);
         free(korder);
         free(kl);

@@ -12,8 +12,9 @@
 #include "scene/material.h"
 
 /* A kernel lane's receiver fields (26 floats, shade.c: lane_get/lane_put)
- * and the receiver's lift for visibility rays (3 floats: a replay has no
- * G-buffer sample to read it from). */
+ * and what its visibility rays need beside them, the lift and the pick key
+ * (a replay has no G-buffer sample to read them from: without the lift its
+ * rays in a smooth-shaded scene started from uninitialised memory). */
 typedef struct vsgl__plan_lane {
     float v[26];
     float lift[3];
