@@ -176,3 +176,49 @@ def test_emissive_faces_become_area_lights_of_the_emitted_power():
     L = export.emissive_lights(P, I, M, {0: ((1.0, 1.0, 1.0), 1.0)})
     assert len(L) == 2 and L[0]["area_shape"] == 2
     assert abs(np.pi * (L[0]["size_x"] / 2) ** 2 - 0.5) < 1e-5
+
+
+def test_degenerate_mask_matches_the_librarys_double_precision_test():
+    from vsgl_indirect import export
+    # zero area in double from float32 corners (as vsgl_scene_create's
+    # face_normal), and zero-length corner normals; against a per-triangle
+    # loop in Python floats (doubles)
+    rng = np.random.RandomState(11)
+    pos = (rng.randn(40, 3) * 10.0 ** rng.randint(-6, 6, (40, 1))).astype(np.float32)
+    pos[5] = pos[4]                                   # coincident corners
+    pos[8] = pos[6] + np.float32(0.5) * (pos[7] - pos[6])  # collinear (to float rounding)
+    pos[9] = (np.inf, 0, 0)
+    pos[10:13] = [(1e30, 1e30, 1e30), (1e30, -1e30, 0), (0, 1e30, 1e30)]  # an area beyond float's range, not double's
+    tris = rng.randint(0, 40, (400, 3))
+    tris[:6] = [[4, 5, 1], [6, 7, 8], [9, 1, 2], [10, 11, 12], [3, 3, 3], [0, 1, 2]]
+    nrm = rng.randn(400, 3, 3).astype(np.float32)
+    nrm[7, 1] = 0.0
+    nrm[11, 2] = 1e-11
+    want = []
+    for t, (a, b, c) in enumerate(tris):
+        p0, p1, p2 = (tuple(float(v) for v in pos[i]) for i in (a, b, c))
+        e1 = [p1[k] - p0[k] for k in range(3)]
+        e2 = [p2[k] - p0[k] for k in range(3)]
+        cr = (e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
+        a2 = sum(v * v for v in cr)
+        zero_n = any(sum(float(v) ** 2 for v in nrm[t, q]) <= 1e-20 for q in range(3))
+        want.append(not (a2 > 0) or not np.isfinite(a2) or zero_n)
+    with np.errstate(all="ignore"):
+        got = export.degenerate_mask(pos, tris, nrm)
+        got_pos = export.degenerate_mask(pos, tris)
+    assert got.tolist() == want
+    assert got[[0, 2, 4, 7, 11]].all() and not got[3] and not got[5]
+    assert got_pos[7] == False and got_pos[0] == True  # noqa: E712
+
+
+def test_cross_and_rows_equal_numpy():
+    from vsgl_indirect import export
+    rng = np.random.RandomState(2)
+    a, b = rng.randn(50, 3), rng.randn(50, 3)
+    assert np.array_equal(export._cross(a, b), np.cross(a, b))
+    idx = rng.randint(0, 50, (7, 3))
+    assert np.array_equal(export._rows(a, idx), a[idx])
+    k = rng.randn(2, 50, 3)
+    idx2 = rng.randint(0, 50, (2, 9, 3))
+    assert np.array_equal(export._per_instance(k, idx2), np.stack([k[0][idx2[0]], k[1][idx2[1]]]))
+    assert np.array_equal(export._per_instance(k[:1], idx2[:1]), k[:1][0][idx2[0]][None])

@@ -399,3 +399,58 @@ def test_frame_above_max_memory_is_refused_with_its_size(scene, tmp_path):
     assert "needs about" in str(e.value) and "memory limit of 0.1 MiB (max_memory)" in str(e.value), str(e.value)
     res = engine.compute(sd, Options(preset="PREVIEW"), os.path.join(str(tmp_path), "m.exr"))
     assert engine.memory_summary(res.stats).startswith("about ")
+
+
+def _slow_reads(me):
+    """The mesh's triangles, face materials, smoothness and UVs through the
+    per-element collections with signed buffers (what the export read
+    before it took Blender's one-copy paths)."""
+    me.calc_loop_triangles()
+    lt = me.loop_triangles
+    nt = len(lt)
+    tv, tl, mi = np.empty(nt * 3, np.int32), np.empty(nt * 3, np.int32), np.empty(nt, np.int32)
+    lt.foreach_get("vertices", tv)
+    lt.foreach_get("loops", tl)
+    lt.foreach_get("material_index", mi)
+    sm = np.empty(nt, bool)
+    lt.foreach_get("use_smooth", sm)
+    uvs = {}
+    for layer in me.uv_layers:
+        a = np.empty(len(me.loops) * 2, np.float32)
+        layer.data.foreach_get("uv", a)
+        uvs[layer.name] = a.reshape(-1, 2)
+    return tv.reshape(-1, 3), tl.reshape(-1, 3), mi, sm, uvs
+
+
+@pytest.mark.parametrize("mixed", [True, False])
+def test_mesh_reads_equal_the_per_element_collections(scene, mixed):
+    # export._mesh_arrays reads indices into unsigned buffers and, from 4.1,
+    # face materials, smoothness and UVs as generic attributes (absent
+    # attributes: slot 0, smooth). mixed: faces of two slots, every third
+    # flat, two UV maps; else one slot, all smooth (no attributes to read).
+    from vsgl_indirect import compat
+    basic(scene)
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8)
+    ob = bpy.context.object
+    me = ob.data
+    me.materials.append(principled("M0"))
+    me.materials.append(principled("M1"))
+    me.uv_layers.new(name="Second")
+    for i, p in enumerate(me.polygons):
+        p.material_index = (i % 2) if mixed else 0
+        p.use_smooth = (i % 3 != 0) if mixed else True
+    rng = np.random.RandomState(5)
+    second = rng.rand(len(me.loops) * 2).astype(np.float32)
+    me.uv_layers["Second"].data.foreach_set("uv", second)
+    bpy.context.view_layer.update()
+    tv, tl, mi, sm, uvs = _slow_reads(me)
+    arr = export._mesh_arrays(me, compat)
+    assert np.array_equal(arr.tri_verts, tv) and np.array_equal(arr.tri_loops, tl)
+    assert np.array_equal(arr.tri_material, mi)
+    assert mi.max() == (1 if mixed else 0)
+    flat = arr.tri_flat if arr.tri_flat is not None else np.zeros(len(tv), bool)
+    assert np.array_equal(flat, ~sm) and flat.any() == mixed
+    assert sorted(arr.uv_layers) == sorted(uvs)
+    for name, a in uvs.items():
+        assert np.array_equal(arr.uv_layers[name], a)
+    assert np.array_equal(arr.uv_layers["Second"].reshape(-1), second)
