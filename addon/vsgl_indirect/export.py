@@ -222,8 +222,13 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None, uv_map_o
             gz = ~(gl > 0)
             gl[gz] = 1.0
             g32 = (g / gl[..., None]).astype(np.float32)
-            n32[:, arr.tri_flat] = g32[:, arr.tri_flat][:, :, None, :]
-            zero[:, arr.tri_flat] = gz[:, arr.tri_flat][:, :, None]
+            if arr.tri_flat.all():  # a flat-shaded mesh (Blender's default): every corner its face's
+                n32 = np.repeat(g32[:, :, None, :], 3, axis=2)
+                zero = np.repeat(gz[:, :, None], 3, axis=2)
+            else:
+                fi = np.nonzero(arr.tri_flat)[0]
+                n32[:, fi] = g32[:, fi, None, :]
+                zero[:, fi] = gz[:, fi, None]
         p32 = p.reshape(-1, 3).astype(np.float32)
         tri = (tv + (np.arange(k) * V)[:, None, None]).reshape(-1, 3)
         n32 = n32.reshape(-1, 3, 3)
@@ -396,8 +401,9 @@ def _mesh_arrays(mesh, compat, want_undeformed=False, color_names=()):
     # any other element by element (1M triangles: the triangles' loops
     # 0.14-0.28 s as int32, 0.002-0.04 s as uint32). Material and smoothness
     # per face, then per triangle through its face: cheaper than per triangle.
-    tv = _foreach_u32(lt, "vertices", nt * 3)
     tl = _foreach_u32(lt, "loops", nt * 3)
+    corner_vert = _attribute(mesh, compat, ".corner_vert", "CORNER", "value", np.int32, len(mesh.loops))
+    tv = _rows(corner_vert, tl) if corner_vert is not None else _foreach_u32(lt, "vertices", nt * 3)
     face = _triangle_faces(mesh, lt, nt)
     mi = _face_material(mesh, compat)[face]
     ln = compat.corner_normals(mesh) if nt else np.zeros((0, 3), np.float32)
