@@ -169,6 +169,7 @@ def _rel_l1(d, f):
 
 def flicker(frames):
     """dict(first=[per pair], second=[per triple], median, median_second,
+    mean (over pairs: the sequence's change spread evenly over its frames),
     ratio = median_second / median, l1 = median over pairs of
     sum|f[t+1] - f[t]| / sum|f[t]|) of a frame sequence (>= 3 frames for the
     ratio). The RMS form (the issue's) is dominated by a few hot pixels when
@@ -181,6 +182,7 @@ def flicker(frames):
     med = float(np.median(first)) if first else float("nan")
     med2 = float(np.median(second)) if second else float("nan")
     return dict(first=first, second=second, median=med, median_second=med2,
+                mean=float(np.mean(first)) if first else float("nan"),
                 ratio=med2 / med if med > 0 else float("nan"), l1=float(np.median(l1)) if l1 else float("nan"))
 
 

@@ -83,6 +83,20 @@ def test_flicker_of_a_linear_ramp():
     assert abs(f["median"] - np.median(want)) < 1e-12
     assert f["median_second"] < 1e-12 and f["ratio"] < 1e-9      # smooth: no second difference
     assert abs(f["l1"] - np.median(want)) < 1e-12                  # uniform scaling: L1 = RMS
+    assert abs(f["mean"] - np.mean(want)) < 1e-12
+
+
+def test_flicker_mean_step_of_a_burst_and_of_its_smooth_spread():
+    # the truth moves in a burst (two big steps), a smooth render spreads the
+    # same total change over every frame: its median step is the larger, its
+    # mean the same (the acceptance's "Cycles' mean step")
+    x = _img(3)
+    burst = np.cumsum([0.0, 0.005, 0.005, 0.005, 0.04, 0.04, 0.005, 0.005])
+    smooth = np.linspace(0.0, burst[-1], len(burst))
+    fb = M.flicker([(1 + 0.0 * b) * x + b for b in burst])
+    fs = M.flicker([(1 + 0.0 * b) * x + b for b in smooth])
+    assert fs["median"] > fb["median"] * 1.5
+    assert abs(fs["mean"] - fb["mean"]) < 0.1 * fb["mean"]
 
 
 def test_flicker_l1_is_not_dominated_by_one_hot_pixel():
