@@ -367,6 +367,14 @@ def ref_noise_entry(seeds, p):
 # acceptance (issue 9), as a report column
 # ---------------------------------------------------------------------------
 
+def _flicker_under(fl, own):
+    """PASS, or FAIL naming the passes, for flicker fl (Diff, Gloss) against
+    max(the issue's 0.01, own[pass]) per pass."""
+    over = [(fl[i], max(ACCEPT["flicker"], own[p])) for i, p in enumerate(("Diff", "Gloss"))]
+    return ("PASS" if all(f <= lim for f, lim in over) else
+            "FAIL (%s)" % ", ".join("%.3f > %.3f" % (f, lim) for f, lim in over if f > lim))
+
+
 def acceptance(res):
     """{config label: {criterion: "PASS" / "FAIL" / "WARN ..."}} for the presets of one scene."""
     out = {}
@@ -385,27 +393,19 @@ def acceptance(res):
                                                                 else "FAIL (%.3f)" % max(fl))
             mo = (res.get("motion") or {}).get(k)
             if mo:
-                over = [(fl[i], max(ACCEPT["flicker"], mo[p])) for i, p in enumerate(("Diff", "Gloss"))]
-                a["flicker %s <= max(%.2f, Cycles' own)" % (k, ACCEPT["flicker"])] = (
-                    "PASS" if all(f <= lim for f, lim in over) else
-                    "FAIL (%s)" % ", ".join("%.3f > %.3f" % (f, lim) for f, lim in over if f > lim))
+                a["flicker %s <= max(%.2f, Cycles' own)" % (k, ACCEPT["flicker"])] = _flicker_under(fl, mo)
             mm = (res.get("motion_mean") or {}).get(k)
             if mm:
                 # the motion's change per frame as its mean step: a sun's patch edge crossing pixels moves
                 # the truth in bursts (sun_opening's light steps 0.007-0.037, median 0.0099, mean 0.0149),
                 # which a smooth render spreads over every frame, so its median exceeds the truth's
                 # median while its mean stays under the truth's
-                over = [(fl[i], max(ACCEPT["flicker"], mm[p])) for i, p in enumerate(("Diff", "Gloss"))]
-                a["flicker %s <= max(%.2f, Cycles' mean step)" % (k, ACCEPT["flicker"])] = (
-                    "PASS" if all(f <= lim for f, lim in over) else
-                    "FAIL (%s)" % ", ".join("%.3f > %.3f" % (f, lim) for f, lim in over if f > lim))
+                a["flicker %s <= max(%.2f, Cycles' mean step)" % (k, ACCEPT["flicker"])] = _flicker_under(fl, mm)
             mc = (res.get("motion_clean") or {}).get(k)
             cl = [e["flicker"][k][p].get("clean") for p in ("Diff", "Gloss")]
             if mc and None not in cl:
-                over = [(cl[i], max(ACCEPT["flicker"], mc[p])) for i, p in enumerate(("Diff", "Gloss"))]
-                a["flicker %s <= max(%.2f, Cycles' own), without Cycles' kept fireflies" % (k, ACCEPT["flicker"])] = (
-                    "PASS" if all(f <= lim for f, lim in over) else
-                    "FAIL (%s)" % ", ".join("%.3f > %.3f" % (f, lim) for f, lim in over if f > lim))
+                a["flicker %s <= max(%.2f, Cycles' own), without Cycles' kept fireflies" % (
+                    k, ACCEPT["flicker"])] = _flicker_under(cl, mc)
             exc = [e["flicker"][k][p].get("excess_cycles") for p in ("Diff", "Gloss")]
             if None not in exc:
                 a["%s flicker above Cycles' own motion <= %.2f" % (k, ACCEPT["flicker"])] = (
