@@ -120,9 +120,8 @@ def degenerate_mask(positions, indices, corner_normals=None):
     """Triangles libvsgl would drop: zero area (in the float32 positions it is
     given, computed in double as the library does) or a corner normal of
     (near) zero length (as vsgl_scene_create; corner_normals None: none is)."""
-    q = _rows(np.asarray(positions, np.float32), np.asarray(indices, np.int64)).astype(np.float64)
-    c = _cross(q[:, 1] - q[:, 0], q[:, 2] - q[:, 0])
-    area2 = np.einsum("ti,ti->t", c, c)
+    cx, cy, cz = _triangle_cross(positions, indices)
+    area2 = cx * cx + cy * cy + cz * cz
     bad = ~(area2 > 0) | ~np.isfinite(area2)
     if corner_normals is not None:
         n = np.asarray(corner_normals, np.float32).astype(np.float64)
@@ -130,19 +129,27 @@ def degenerate_mask(positions, indices, corner_normals=None):
     return bad
 
 
+def _triangle_cross(positions, indices):
+    """The cross product (e1 x e2 per coordinate, float64) of each
+    triangle's edges from its first corner, its corners' float32 positions
+    taken to double first (as the library's face_normal). A coordinate at
+    a time: contiguous arrays, 2-4x faster than rows of three."""
+    P = np.asarray(positions, np.float32)
+    idx = np.asarray(indices, np.int64)
+    i0, i1, i2 = idx[:, 0], idx[:, 1], idx[:, 2]
+    e1, e2 = [], []
+    for a in range(3):
+        col = P[:, a].astype(np.float64)
+        x0 = col[i0]
+        e1.append(col[i1] - x0)
+        e2.append(col[i2] - x0)
+    return (e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
+
+
 def _rows(a, idx):
     """a[idx] for row indices idx (any shape): np.take, several times faster
     than fancy indexing on arrays of a million rows."""
     return np.take(a, idx, axis=0)
-
-
-def _cross(a, b):
-    """Row-wise cross product of (..., 3) arrays (np.cross is ~7x slower)."""
-    c = np.empty(np.broadcast_shapes(a.shape, b.shape), np.result_type(a, b))
-    c[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
-    c[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
-    c[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-    return c
 
 
 def _per_instance(a, idx):
@@ -435,8 +442,7 @@ def _mesh_arrays(mesh, compat, want_undeformed=False, color_names=()):
                 arr.loop_colors[name] = c
     if nt and not smooth.all():
         cand = np.nonzero(~smooth)[0]                                       # flat-shaded faces' triangles
-        p = _rows(arr.positions, arr.tri_verts[cand]).astype(np.float64)    # (F,3,3)
-        gn = _cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        gn = np.stack(_triangle_cross(arr.positions, arr.tri_verts[cand]), axis=1)   # (F,3)
         length = np.linalg.norm(gn, axis=1, keepdims=True)
         # zero-area ones keep a zero normal: assemble drops them (as the library would for their area)
         length[length == 0] = 1.0

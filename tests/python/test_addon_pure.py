@@ -211,11 +211,15 @@ def test_degenerate_mask_matches_the_librarys_double_precision_test():
     assert got_pos[7] == False and got_pos[0] == True  # noqa: E712
 
 
-def test_cross_and_rows_equal_numpy():
+def test_triangle_cross_and_rows_equal_numpy():
     from vsgl_indirect import export
     rng = np.random.RandomState(2)
-    a, b = rng.randn(50, 3), rng.randn(50, 3)
-    assert np.array_equal(export._cross(a, b), np.cross(a, b))
+    a = rng.randn(50, 3)
+    pos = rng.randn(30, 3).astype(np.float32)
+    tri = rng.randint(0, 30, (40, 3))
+    q = pos.astype(np.float64)[tri]
+    want = np.cross(q[:, 1] - q[:, 0], q[:, 2] - q[:, 0])
+    assert np.array_equal(np.stack(export._triangle_cross(pos, tri), axis=1), want)
     idx = rng.randint(0, 50, (7, 3))
     assert np.array_equal(export._rows(a, idx), a[idx])
     k = rng.randn(2, 50, 3)
