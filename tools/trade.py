@@ -49,6 +49,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, ".."))
 sys.path.insert(0, os.path.join(ROOT, "tests", "quality"))
 sys.path.insert(0, os.path.join(ROOT, "addon", "vsgl_indirect"))
+sys.path.insert(0, os.path.join(ROOT, "addon"))
 import evaluate  # noqa: E402  (configurations)
 import imgutil  # noqa: E402
 import libvsgl as L  # noqa: E402
@@ -56,6 +57,7 @@ import metrics as M  # noqa: E402
 import oidn  # noqa: E402
 import refs  # noqa: E402
 import scenes  # noqa: E402
+from vsgl_indirect import engine  # noqa: E402  (the add-on's EXR passes)
 
 SCENES = ["spot_metal_floor", "sun_opening", "box_point_area_glossy_green", "glossy_sphere_floor",
           "brushed_metal_floor", "dense_floor"]
@@ -92,9 +94,6 @@ BRUTE_DIR = os.path.join(ROOT, "build", "trade", "brute")
 BRUTE_CODE = ["csrc/include", "csrc/src/core", "csrc/src/math", "csrc/src/scene", "csrc/src/gbuffer",
               "csrc/src/rsm", "csrc/src/shade/brute_force.c", "csrc/src/shade/brute_force.h",
               "csrc/src/shade/reference.c"]
-# the planes of the passes the add-on writes by default (addon/vsgl_indirect/engine.py: what the
-# compositor setup reads; Combined takes alpha as its A)
-EXR_PLANES = ("diffuse_light", "glossy_light", "diffuse", "glossy", "combined", "alpha")
 
 
 def log(*a):
@@ -222,10 +221,10 @@ def run_library(ctx, arrays, case, cfg, exr_dir):
             vsgls = int(st["vsgl_count"])
             LAST_BUDGET[cfg.label] = st.get("budget", "")
         t2 = time.perf_counter()
-    # half + ZIP and the add-on's 16 channels, as it writes by default (docs/performance.md, "EXR writing")
-    L.exr_write_render(ctx, os.path.join(exr_dir, "frame.exr"),
-                       {p: np.ascontiguousarray(planes[p], np.float32) for p in EXR_PLANES if p in planes},
-                       layer="VSGL", pixel_type="half")
+    # half + ZIP and the add-on's passes, as it writes by default (engine.exr_passes, the passes the
+    # compositor setup reads: docs/performance.md, "EXR writing")
+    L.exr_write(ctx, os.path.join(exr_dir, "frame.exr"), engine.exr_passes(planes, color_passes=False),
+                layer=engine.LAYER, pixel_type="half")
     t3 = time.perf_counter()
     out = M.coloured(dict(DiffInd=planes["diffuse_light"], GlossInd=planes["glossy_light"],
                           DiffCol=planes["diffuse_color"], GlossCol=planes["glossy_color"]))

@@ -159,6 +159,25 @@ def _per_instance(a, idx):
     return a[np.arange(a.shape[0]).reshape((-1,) + (1,) * (idx.ndim - 1)), idx]
 
 
+def _corner_values(out, gm, tl, layer_of):
+    """Fill ``out`` (k, T, 3, C) with per-loop values through the triangles'
+    loops ``tl`` (k, T, 3): for the triangles of global material g (``gm``,
+    (k, T)), the (L, C) array ``layer_of(g)`` (None: left as it is). One
+    gather per distinct array, whichever materials share it."""
+    by_layer = {}   # id(array) -> (array, its materials)
+    for g in np.unique(gm):
+        layer = layer_of(int(g))
+        if layer is not None:
+            by_layer.setdefault(id(layer), (layer, []))[1].append(g)
+    for layer, gs in by_layer.values():
+        m = np.isin(gm, gs)
+        if m.all():
+            out[:] = _rows(layer, tl)
+        else:
+            out[m] = layer[tl[m]]
+    return out
+
+
 def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None, uv_map_of=None, color_of=None):
     """Concatenate ``chunks`` = [(MeshArrays, matrix 4x4, slot_to_global list)]
     into world-space (positions, indices, corner_normals, corner_uvs,
@@ -252,7 +271,7 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None, uv_map_o
         nrm.append(n32[keep])
         if want_tangents:
             tw = np.einsum("kij,vj->kvi", nm, default_tangents_local(arr))     # (k, V, 3)
-            tc = tw[np.arange(k)[:, None, None], tv]                            # (k, T, 3, 3)
+            tc = _per_instance(tw, tv)                                           # (k, T, 3, 3)
             t4 = np.ones((k, T, 3, 4), np.float32)
             t4[..., :3] = tc
             tan.append(t4.reshape(-1, 3, 4)[keep])
@@ -262,30 +281,17 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None, uv_map_o
         last = np.array([len(sm) - 1 for sm in smaps])[:, None]
         gm = table[np.arange(k)[:, None], np.minimum(slot, last)]                 # (k, T)
         if want_uvs:
-            uv = np.zeros((k, T, 3, 2), np.float32)
-            by_layer = {}   # id(layer) -> (layer, its global materials): one gather per UV map
-            for g in np.unique(gm):
-                name = uv_map_of(int(g)) if uv_map_of else ""
+            def uv_layer(g):
+                name = uv_map_of(g) if uv_map_of else ""
                 layer = arr.uv_layers.get(name) if name else None
-                if layer is None and not (name and arr.uv_layers):
-                    layer = arr.loop_uvs
-                if layer is not None:
-                    by_layer.setdefault(id(layer), (layer, []))[1].append(g)
-            for layer, gs in by_layer.values():
-                m = np.isin(gm, gs)
-                if m.all():
-                    uv[:] = _rows(layer, tl)
-                else:
-                    uv[m] = layer[tl[m]]
+                return arr.loop_uvs if layer is None and not (name and arr.uv_layers) else layer
+            uv = _corner_values(np.zeros((k, T, 3, 2), np.float32), gm, tl, uv_layer)
             uvs.append(uv.reshape(-1, 3, 2)[keep])
         if color_of is not None:
-            col = np.ones((k, T, 3, 3), np.float32)
-            for g in np.unique(gm):
-                name = color_of(int(g))
-                layer = arr.loop_colors.get(name) if name is not None else None
-                if layer is not None:
-                    m = gm == g
-                    col[m] = layer[tl[m]]
+            def color_layer(g):
+                name = color_of(g)
+                return arr.loop_colors.get(name) if name is not None else None
+            col = _corner_values(np.ones((k, T, 3, 3), np.float32), gm, tl, color_layer)
             cols.append(col.reshape(-1, 3, 3)[keep])
         mats.append(gm.reshape(-1)[keep])
         base += k * V

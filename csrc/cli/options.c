@@ -204,7 +204,7 @@ int cli_parse(int argc, char **argv, cli_options *o, char *err, size_t err_size)
     return rc;
 }
 
-const char *const cli_pass_names[7] = {"DiffInd", "GlossInd", "DiffCol", "GlossCol", "Diff", "Gloss", "Combined"};
+const char *const cli_pass_names[CLI_PASS_COUNT] = {"DiffInd", "GlossInd", "DiffCol", "GlossCol", "Diff", "Gloss", "Combined"};
 
 /* "Diff,Gloss" or "all" -> CLI_PASS_* bits; 0 if a name is unknown or the
  * list is empty (bad: the first unknown name, up to its comma). */
@@ -217,9 +217,9 @@ static uint32_t parse_passes(const char *value, char *bad, size_t bad_size)
         const char *comma = strchr(p, ',');
         size_t n = comma ? (size_t)(comma - p) : strlen(p);
         int k = 0;
-        while (k < 7 && !(strlen(cli_pass_names[k]) == n && !strncmp(p, cli_pass_names[k], n)))
+        while (k < CLI_PASS_COUNT && !(strlen(cli_pass_names[k]) == n && !strncmp(p, cli_pass_names[k], n)))
             ++k;
-        if (k == 7) {
+        if (k == CLI_PASS_COUNT) {
             snprintf(bad, bad_size, "%.*s", (int)(n < 40 ? n : 40), p);
             return 0;
         }

@@ -16,7 +16,8 @@ enum { CLI_PASS_DIFFIND = 1, CLI_PASS_GLOSSIND = 2, CLI_PASS_DIFFCOL = 4, CLI_PA
  * DiffInd GlossInd Diff Gloss Combined. */
 #define CLI_PASSES_COMPOSITOR (CLI_PASS_DIFFIND | CLI_PASS_GLOSSIND | CLI_PASS_DIFF | CLI_PASS_GLOSS | CLI_PASS_COMBINED)
 /* The pass names, bit k = 1 << k. */
-extern const char *const cli_pass_names[7];
+#define CLI_PASS_COUNT 7
+extern const char *const cli_pass_names[CLI_PASS_COUNT];
 
 /* An optional unsigned number given on the command line. */
 typedef struct cli_u32 { int set; uint32_t value; } cli_u32;

@@ -286,9 +286,9 @@ static int cmd_render(vsgl_context *ctx, const cli_options *o, progress_state *p
     eo.metadata = md;
     eo.metadata_count = sizeof md / sizeof md[0];
     /* only the passes asked for (--passes): vsgl_exr_write_render writes the planes that are set */
-    float **wanted[7] = {&out.diffuse_light, &out.glossy_light, &out.diffuse_color, &out.glossy_color,
+    float **wanted[CLI_PASS_COUNT] = {&out.diffuse_light, &out.glossy_light, &out.diffuse_color, &out.glossy_color,
                          &out.diffuse, &out.glossy, &out.combined};
-    for (int k = 0; k < 7; ++k)
+    for (int k = 0; k < CLI_PASS_COUNT; ++k)
         if (!(o->passes & (1u << k)))
             *wanted[k] = NULL;
     if (!(o->passes & CLI_PASS_COMBINED))
