@@ -59,3 +59,28 @@ def test_lattice_light_motion_is_smooth_and_importance_fits_are_not():
     # k-means centres drawn from the light's power reshuffle: the same check fails for it (0.06x here)
     km_first, km_second = _flicker(L.FitMode.KMEANS)
     assert km_second > 0.02 * km_first, (km_first, km_second)
+
+
+def _tilted_floor(ctx, deg):
+    """scenes.floor_and_wall with its floor tilted by `deg` about y (the wall
+    lit by it sees the light the floor reflects)."""
+    d = scenes.floor_and_wall(wall=True, width=40, height=30)
+    d["positions"] = d["positions"].copy()
+    d["positions"][:4, 2] = d["positions"][:4, 0] * np.tan(np.radians(deg))
+    return L.Scene(ctx, **d)
+
+
+def test_lattice_keeps_a_slightly_tilted_floor_in_one_orientation_bin():
+    """A floor 8 deg off the horizontal is fitted with as many clusters as a
+    flat one: with orientation weights n_a^2 and no dead zone its 2 % along
+    x filled a second bin at the full lattice density (about twice the
+    floor's VSGLs, each of the second bin's with ~1/50 of the light)."""
+    counts = {}
+    with L.Context() as ctx:
+        for deg in (0.0, 8.0, 30.0):
+            v = L.debug_vsgls(ctx, _tilted_floor(ctx, deg), _settings(L.FitMode.LATTICE))
+            counts[deg] = int((v["normal"][:, 2] > 0.5).sum())  # the floor's
+    assert counts[0.0] > 16
+    assert counts[8.0] <= 1.2 * counts[0.0], counts
+    # past the dead zone the second bin takes its share: the count grows
+    assert counts[30.0] > 1.5 * counts[0.0], counts

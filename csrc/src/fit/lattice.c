@@ -5,10 +5,15 @@
  * reshuffles every cluster (flicker), and clusters of random size and
  * shape sum to blotches. Here the clusters are fixed in the world:
  *
- *  - orientation: a VPL of normal n belongs to the six signed-axis bins
- *    with weights max(+-n_a, 0)^2 (they sum to 1, smooth in n), so a
- *    cluster never mixes a floor with a wall: its VPLs face one way, which
- *    is what lets the shading clip its emission to its own hemisphere;
+ *  - orientation: a VPL of normal n belongs to the signed-axis bin of
+ *    each axis a it faces, with weights max(n_a^2 - d^2, 0) over their sum
+ *    (they sum to 1, continuous in n), so a cluster never mixes a floor
+ *    with a wall: its VPLs face one way, which is what lets the shading
+ *    clip its emission to its own hemisphere. The dead zone d
+ *    (VSGL__LATTICE_BIN_DEAD) keeps a surface tilted a little off an axis
+ *    in that axis's bin alone: with d = 0 a bumpy floor also filled the
+ *    four side bins, each with a few % of its light, at the full lattice
+ *    density (dense_floor: 1930 clusters for 192 asked);
  *  - position: within bin b (axis a), lattice points h apart in the two
  *    axes across a, with tent (bilinear) weights, which sum to 1 and are
  *    continuous in the VPL's position; along a, slabs h thick (surfaces of
@@ -38,6 +43,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The orientation bins' dead zone: a normal's component along an axis
+ * must exceed this (sin 14.5 deg) to put any weight in that axis's bin.
+ * Measured (tests/quality/evaluate.py, balanced): dense_floor at 320 x 240
+ * 3421 -> ~1450 VSGLs, its render 2.2 -> 1.1 s at the same error (relMSE
+ * 0.0068 -> 0.0067, FLIP 0.1920 -> 0.1920); the sphere room's FLIP 0.1075
+ * -> 0.1083 (its side bins' clusters hold more tilted texels) for 6 % fewer
+ * VSGLs; rooms of axis-aligned walls unchanged (a weight of 1 stays 1). */
+#define VSGL__LATTICE_BIN_DEAD 0.25
 /* Slab thickness along a bin's axis, in units of h. */
 #define VSGL__LATTICE_SLAB 1.0
 /* A planar cluster's specular lobe as GGX's core, tail and far tail (the
@@ -241,12 +254,18 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl
         double q[3];
         for (int a = 0; a < 3; ++a)
             q[a] = (p[a] - anchor[a]) * inv_h;
+        /* orientation weights max(n_a^2 - d^2, 0) over their sum */
+        double ew[3], norm = 0.0;
+        for (int a = 0; a < 3; ++a) {
+            ew[a] = nrm[a] * nrm[a] - VSGL__LATTICE_BIN_DEAD * VSGL__LATTICE_BIN_DEAD;
+            norm += ew[a] > 0.0 ? ew[a] : 0.0;
+        }
         for (uint32_t bin = 0; bin < 6 && r == VSGL_OK; ++bin) {
             int a = (int)(bin >> 1);
             double na = (bin & 1) ? -nrm[a] : nrm[a];
-            if (!(na > 0.0))
+            if (!(na > 0.0) || !(ew[a] > 0.0) || !(norm > 0.0))
                 continue;
-            double wb = na * na;
+            double wb = ew[a] / norm;
             int u = (a + 1) % 3, v = (a + 2) % 3;
             int32_t k = (int32_t)floor(q[a] * (1.0 / VSGL__LATTICE_SLAB));
             double fu = floor(q[u]), fv = floor(q[v]);
