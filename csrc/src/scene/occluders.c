@@ -55,6 +55,17 @@ static int on_box_face(const vsgl_scene *s, uint32_t t, float tol)
     return 0;
 }
 
+/* Positions are finite (validated): plain compares, no libm calls */
+static inline float min_f(float a, float b)
+{
+    return a < b ? a : b;
+}
+
+static inline float max_f(float a, float b)
+{
+    return a > b ? a : b;
+}
+
 static void tri_bounds(const vsgl_scene *s, uint32_t t, float b[6])
 {
     b[0] = b[1] = b[2] = INFINITY;
@@ -62,27 +73,27 @@ static void tri_bounds(const vsgl_scene *s, uint32_t t, float b[6])
     for (int k = 0; k < 3; ++k) {
         const float *p = s->positions + 3 * (size_t)s->indices[3 * (size_t)t + k];
         for (int a = 0; a < 3; ++a) {
-            b[a] = fminf(b[a], p[a]);
-            b[3 + a] = fmaxf(b[3 + a], p[a]);
+            b[a] = min_f(b[a], p[a]);
+            b[3 + a] = max_f(b[3 + a], p[a]);
         }
     }
 }
 
-/* Boxes of tri[0..n) into s->occ_boxes, split at the midpoint of their
+/* Boxes of the triangles tri[0..n) (indices into bounds, 6 floats each:
+ * lo xyz, hi xyz) into s->occ_boxes, split at the midpoint of their
  * centroids' extent along its longest axis. */
-static void split(vsgl_scene *s, uint32_t *tri, uint32_t n, int depth, float pad)
+static void split(vsgl_scene *s, const float *bounds, uint32_t *tri, uint32_t n, int depth, float pad)
 {
     float c_lo[3] = {INFINITY, INFINITY, INFINITY}, c_hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     float box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (uint32_t i = 0; i < n; ++i) {
-        float b[6];
-        tri_bounds(s, tri[i], b);
+        const float *b = bounds + 6 * (size_t)tri[i];
         for (int a = 0; a < 3; ++a) {
             float c = 0.5f * (b[a] + b[3 + a]);
-            c_lo[a] = fminf(c_lo[a], c);
-            c_hi[a] = fmaxf(c_hi[a], c);
-            box[a] = fminf(box[a], b[a]);
-            box[3 + a] = fmaxf(box[3 + a], b[3 + a]);
+            c_lo[a] = min_f(c_lo[a], c);
+            c_hi[a] = max_f(c_hi[a], c);
+            box[a] = min_f(box[a], b[a]);
+            box[3 + a] = max_f(box[3 + a], b[3 + a]);
         }
     }
     int axis = 0;
@@ -93,8 +104,7 @@ static void split(vsgl_scene *s, uint32_t *tri, uint32_t n, int depth, float pad
     uint32_t m = 0;
     if (depth < VSGL__OCC_DEPTH && n >= 2 * VSGL__OCC_LEAF && c_hi[axis] > c_lo[axis]) {
         for (uint32_t i = 0; i < n; ++i) { /* partition: centroid below mid first */
-            float b[6];
-            tri_bounds(s, tri[i], b);
+            const float *b = bounds + 6 * (size_t)tri[i];
             if (0.5f * (b[axis] + b[3 + axis]) < mid) {
                 uint32_t x = tri[i];
                 tri[i] = tri[m];
@@ -103,8 +113,8 @@ static void split(vsgl_scene *s, uint32_t *tri, uint32_t n, int depth, float pad
         }
     }
     if (m > 0 && m < n) {
-        split(s, tri, m, depth + 1, pad);
-        split(s, tri + m, n - m, depth + 1, pad);
+        split(s, bounds, tri, m, depth + 1, pad);
+        split(s, bounds, tri + m, n - m, depth + 1, pad);
         return;
     }
     float *o = s->occ_boxes + 6 * (size_t)s->occ_count++;
@@ -133,18 +143,29 @@ vsgl_result vsgl__scene_build_occluders(vsgl_context *ctx, vsgl_scene *s)
     if (!tri)
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: no memory for the occluders' list (%u triangles)",
                           s->triangle_count);
+    /* the occluders' bounds, once (the split reads them at every level) */
+    float *bounds = malloc((size_t)s->triangle_count * 6 * sizeof *bounds);
+    if (!bounds) {
+        free(tri);
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: no memory for the occluders' bounds (%u triangles)",
+                          s->triangle_count);
+    }
     uint32_t n = 0;
     for (uint32_t t = 0; t < s->triangle_count; ++t)
-        if (!on_box_face(s, t, tol))
-            tri[n++] = t;
+        if (!on_box_face(s, t, tol)) {
+            tri_bounds(s, t, bounds + 6 * (size_t)n);
+            tri[n] = n;
+            ++n;
+        }
     if (n > 0) {
         s->occ_boxes = malloc(sizeof(float) * 6 * ((size_t)1 << VSGL__OCC_DEPTH));
         if (!s->occ_boxes) {
             free(tri);
+            free(bounds);
             return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: no memory for the occluders' boxes");
         }
         /* padded by far more than the rounding of a segment's end points */
-        split(s, tri, n, 0, 4.0f * tol + 1e-5f * size);
+        split(s, bounds, tri, n, 0, 4.0f * tol + 1e-5f * size);
         for (int a = 0; a < 3; ++a) {
             s->occ_union[a] = INFINITY;
             s->occ_union[3 + a] = -INFINITY;
@@ -167,6 +188,7 @@ vsgl_result vsgl__scene_build_occluders(vsgl_context *ctx, vsgl_scene *s)
         }
     }
     free(tri);
+    free(bounds);
     /* twice the tolerance: a segment's end points are rounded too */
     s->occ_inner_lo = v3_make(s->lo.x + 2.0f * tol, s->lo.y + 2.0f * tol, s->lo.z + 2.0f * tol);
     s->occ_inner_hi = v3_make(s->hi.x - 2.0f * tol, s->hi.y - 2.0f * tol, s->hi.z - 2.0f * tol);
