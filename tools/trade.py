@@ -80,8 +80,9 @@ KNOBS = ["lattice 64:vsgl_count=64", "lattice 512:vsgl_count=512", "RSM 128:rsm_
 # every size
 TIME_KNOBS = ("stride 2:stride_pixels=0",)
 BRUTE = ["brute RSM 64:preset=brute,rsm_resolution=64", "brute RSM 128:preset=brute,rsm_resolution=128"]
-# scenes with more triangles: one library run per point, no brute force (dense_floor: balanced
-# ~20 s, brute force RSM 64 ~280 s at 320x240 here)
+# scenes with more triangles: one library run per point (dense_floor at 320x240: balanced ~1 s,
+# brute force RSM 64 ~35 s here since the lattice's orientation dead zone and the occluders' bounds
+# computed once, 2026-12-04; ~20 s and ~280 s before, when it ran the presets only)
 DENSE = 100000
 SWEEP_SEED = 7
 TIME_SPP = [1, 4]  # Cycles at --time-size (times only)
@@ -280,11 +281,8 @@ def measure_scene(name, args, ctx, version, exr_dir):
     res["triangles"], res["library_repeat"], res["skipped"] = len(arrays["indices"]), repeat, []
     for spec in args.configs:
         cfg = parse(spec)
-        if cfg.brute and (dense or (cfg.brute_params()["rsm_resolution"] > 64 and not case.get("convex"))):
+        if cfg.brute and cfg.brute_params()["rsm_resolution"] > 64 and not case.get("convex"):
             res["skipped"].append(cfg.label)  # shadow rays for every pixel x texel: minutes
-            continue
-        if dense and cfg.label not in PRESETS:
-            res["skipped"].append(cfg.label)  # ~20-40 s a frame here: the presets only
             continue
         kind = "brute" if cfg.brute else ("preset" if cfg.label in PRESETS else "knob")
         if cfg.brute and args.brute_cached_only and not os.path.exists(brute_path(arrays, case, cfg, name)):
@@ -305,7 +303,7 @@ def measure_scene(name, args, ctx, version, exr_dir):
                                   parts=parts, vsgls=vsgls, budget=LAST_BUDGET.get(cfg.label, ""),
                                   **score(img, ref)))
         images[cfg.label] = img["Combined"]
-    if args.flicker_frames and not dense:
+    if args.flicker_frames:
         small = scenes.case(name, FLICKER_SIZE)
         for p in res["points"]:
             if p["kind"] != "preset":
@@ -318,7 +316,7 @@ def measure_scene(name, args, ctx, version, exr_dir):
                 seq.append(im["diffuse"].astype(np.float64) + im["glossy"])
             fl = M.flicker(seq)
             p["flicker"] = dict(rms=fl["median"], l1=fl["l1"], ratio=fl["ratio"])
-    if args.time_size and not dense:
+    if args.time_size:
         res["time_at"] = time_at_size(name, args, ctx, version, export, exr_dir)
     for p in res["points"]:
         log("%-28s %-20s %8.3f s  relMSE %.5f  FLIP %.4f  bias %.3f" % (
