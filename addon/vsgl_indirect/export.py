@@ -146,6 +146,15 @@ def _triangle_cross(positions, indices):
     return (e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
 
 
+def _unit32(v):
+    """(v / |v| as float32, |v| == 0 or NaN) of float64 vectors v (..., 3);
+    a zero vector stays zero."""
+    length = np.sqrt(np.einsum("...i,...i->...", v, v))
+    zero = ~(length > 0)
+    length[zero] = 1.0
+    return (v / length[..., None]).astype(np.float32), zero
+
+
 def _rows(a, idx):
     """a[idx] for row indices idx (any shape): np.take, several times faster
     than fancy indexing on arrays of a million rows."""
@@ -237,19 +246,12 @@ def assemble(chunks, want_uvs=False, want_tangents=False, dropped=None, uv_map_o
         # transformed and normalised there, then gathered to the corners
         fi = np.nonzero(arr.tri_flat)[0] if arr.tri_flat is not None else None
         if fi is None or len(fi) < T:
-            nl = np.matmul(arr.loop_normals.astype(np.float64)[None], nm.transpose(0, 2, 1))    # (k, L, 3)
-            ln = np.sqrt(np.einsum("kli,kli->kl", nl, nl))
-            zero_l = ~(ln > 0)
-            ln[zero_l] = 1.0
-            n32l = (nl / ln[..., None]).astype(np.float32)
+            n32l, zero_l = _unit32(np.matmul(arr.loop_normals.astype(np.float64)[None],
+                                             nm.transpose(0, 2, 1)))                    # (k, L, 3)
             n32 = _per_instance(n32l, tl)                                               # (k, T, 3, 3)
             zero = _per_instance(zero_l, tl)
         if fi is not None:
-            g = np.matmul(arr.flat_normals[None], nm.transpose(0, 2, 1))                 # (k, F, 3)
-            gl = np.sqrt(np.einsum("kti,kti->kt", g, g))
-            gz = ~(gl > 0)
-            gl[gz] = 1.0
-            g32 = (g / gl[..., None]).astype(np.float32)
+            g32, gz = _unit32(np.matmul(arr.flat_normals[None], nm.transpose(0, 2, 1)))  # (k, F, 3)
             if len(fi) == T:  # a flat-shaded mesh (Blender's default): every corner its face's
                 n32 = np.repeat(g32[:, :, None, :], 3, axis=2)
                 zero = np.repeat(gz[:, :, None], 3, axis=2)
