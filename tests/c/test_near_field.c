@@ -241,7 +241,9 @@ static float *render_diffuse(vsgl_context *ctx, vsgl_scene *scene, uint32_t W, u
 
 /* A room lit by a spot (the fixture): with the near field the lattice's
  * diffuse light beside the junctions moves to the brute force's over the
- * same RSMs, where the far-field model alone is dark. */
+ * same RSMs, where the far-field model alone is dark. (relMSE with / without
+ * it: 4.1e-5 / 1.0e-4 with the round spread, 3.2e-5 / 4.5e-5 since the
+ * far field foreshortens a plane's spread, shade.h.) */
 VT_TEST(near_field_junctions_against_brute_force)
 {
     const uint32_t W = 64, H = 48;
@@ -269,7 +271,7 @@ VT_TEST(near_field_junctions_against_brute_force)
     if (getenv("VSGL_TEST_VERBOSE"))
         printf("    diffuse relMSE against the brute force: %.4g with the near field, %.4g without; sums %.3f / %.3f\n",
                e_near, e_far, s1 / s0, s2 / s0);
-    VT_CHECK(e_near < 0.7 * e_far, "relMSE %.4g with the near field, %.4g without", e_near, e_far);
+    VT_CHECK(e_near < 0.8 * e_far, "relMSE %.4g with the near field, %.4g without", e_near, e_far);
     VT_CHECK(fabs(s1 / s0 - 1.0) < fabs(s2 / s0 - 1.0), "sum ratio %.4f with, %.4f without", s1 / s0, s2 / s0);
     for (int k = 0; k < 3; ++k)
         free(img[k]);

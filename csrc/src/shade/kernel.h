@@ -7,10 +7,49 @@
 #ifndef VSGL_SHADE_KERNEL_H
 #define VSGL_SHADE_KERNEL_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #define VSGL__KERNEL_BLOCK 64
+
+/* A planar cluster seen obliquely (shade.h, vsgl__vsgl_incident_sg): the
+ * factor on its spread's sharpness. au = a.u, un = u.n_v, an = a.n_v for
+ * the emission axis a (as an incident direction), the unit direction u to
+ * the cluster's mean and its mean normal n_v; fore = its weight
+ * (vsgl__foreshortening_weight). Along the tangent t at u towards a (where
+ * the emission lobe pulls the product's axis), the plane's Gaussian spans
+ * sqrt(1 - (t.n_v)^2) of its round angular width: the factor is
+ * 1 / (1 - fore (t.n_v)^2), at most 1 / VSGL__FORESHORTEN_MIN. */
+#define VSGL__FORESHORTEN_MIN 1e-3f
+static inline float vsgl__foreshortening(float au, float un, float an, float fore)
+{
+    float at2 = 1.0f - au * au;
+    at2 = at2 > 1e-6f ? at2 : 1e-6f;
+    float tn = an - au * un;
+    float den = at2 - fore * tn * tn, lo = VSGL__FORESHORTEN_MIN * at2;
+    return at2 / (den > lo ? den : lo);
+}
+
+/* The same cluster's distance lobe (shade.h): the sharpness of an SG
+ * about -n_v, of value 1 at u, for a receiver in front of the plane at
+ * cosine ce = -u.n_v. 1 / d^2 over a plane at height h is cos^2(psi) / h^2
+ * as a function of the direction (psi from -n_v): its peak is 1 / ce^2
+ * times its value at u, and the SG of sharpness 2 ln(1 / ce) / (1 - ce)
+ * has that peak ratio (and the slope of cos^2 at u as ce -> 1; a slope
+ * fitted at u instead, 2 / ce, has a peak of e^{2 (1 - ce) / ce}: e^38 at
+ * ce = 0.05, and the near field's wide spreads found it). ln(1/c)/(1 - c)
+ * on [0.05, 1] from a fit in c, c^2, c^{-1/2} and c^{1/2}, within 0.35 %;
+ * cut at ce = 0.05 and faded in from ce = 0 (continuous across the
+ * plane). */
+static inline float vsgl__distance_sharpness(float ce, float fore)
+{
+    float c = ce < 0.05f ? 0.05f : (ce > 1.0f ? 1.0f : ce);
+    float is = 1.0f / sqrtf(c);
+    float g = 2.58785576f + c * (2.00836341f - 0.29538491f * c) + (0.28599766f - 3.58783291f * c) * is;
+    float fade = ce < 0.05f ? (ce > 0.0f ? 20.0f * ce : 0.0f) : 1.0f;
+    return 2.0f * fore * g * fade;
+}
 
 /* The emitter-hemisphere clip's constants (shade.h explains the clip). */
 #define VSGL__CLIP_BEHIND 0.02f   /* the behind fade, in units of sigma */
@@ -54,6 +93,7 @@ typedef struct vsgl_kernel_light {
     float nx, ny, nz;        /* mean surface normal of the cluster */
     float clip;              /* emitter-hemisphere clip: coherence^2 of the normals, 0 = off (shade.h) */
     float conv;              /* 1 for a diffuse lobe: clamped-cosine emission in the far field */
+    float fore, an;          /* vsgl__foreshortening_weight and -axis . normal (vsgl__foreshortening) */
     float ibehind;           /* 1 / (VSGL__CLIP_BEHIND sigma) */
     float planar;            /* weight of the planar glossy model (coherence^2 of a diffuse lobe, clip on), else 0 */
     float pvar;              /* its positional variance (var + the fit's overlap widening) */

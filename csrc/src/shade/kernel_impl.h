@@ -215,6 +215,7 @@ typedef struct k_scratch {
     float expo[VSGL__KERNEL_BLOCK];                                            /* an exp's argument */
     float gpre[VSGL__KERNEL_BLOCK];                                            /* the glossy integral's factor */
     float r[VSGL__KERNEL_BLOCK], d2[VSGL__KERNEL_BLOCK], ls[VSGL__KERNEL_BLOCK];
+    float lden[VSGL__KERNEL_BLOCK], xnum[VSGL__KERNEL_BLOCK]; /* the exponent's denominator, its distance-lobe terms */
     /* the accurate cosine's part that depends on lin alone (k_cos_l) */
     float low[VSGL__KERNEL_BLOCK], u[VSGL__KERNEL_BLOCK], t[VSGL__KERNEL_BLOCK], it[VSGL__KERNEL_BLOCK];
     float h[VSGL__KERNEL_BLOCK];                                               /* height above the cluster's plane */
@@ -278,12 +279,30 @@ k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
     float ls = d2 * ivar;
     float w = ls * r; /* |d| / var' */
     float mx = w * dx + L->lax, my = w * dy + L->lay, mz = w * dz + L->laz;
-    t->amp[i] *= ivar;
-    t->ls[i] = ls;
-    t->mx[i] = mx; t->my[i] = my; t->mz[i] = mz;
     float lin2 = mx * mx + my * my + mz * mz;
     float ilin = lin2 > VSGL__TINY ? k_rsqrt(lin2 > VSGL__TINY ? lin2 : 1.0f) : 0.0f;
-    t->lin[i] = lin2 * ilin; t->ilin[i] = ilin;
+    float lin = lin2 * ilin;
+    /* the product with the spread foreshortened and the distance lobe
+     * (shade.h, vsgl__vsgl_incident_sg): m' = lf u + lv a - kd n_v; m
+     * keeps m''s direction and the round |m|. Its amplitude's exponent
+     * |m'| - lf - lv - kd ce in the stable form
+     * (kd^2 (1 - ce^2) - 2 lv kd (an + ce) - lf lv |a - u|^2) / (|m'| + lf + lv + kd ce) */
+    float au = (L->ax * dx + L->ay * dy + L->az * dz) * r;
+    float un = (dx * L->nx + dy * L->ny + dz * L->nz) * r;
+    float lf = ls * vsgl__foreshortening(au, un, L->an, L->fore);
+    float wf = lf * r;
+    float ce = -un;
+    float kd = vsgl__distance_sharpness(ce, L->fore);
+    float fx = wf * dx + L->lax - kd * L->nx, fy = wf * dy + L->lay - kd * L->ny, fz = wf * dz + L->laz - kd * L->nz;
+    float lf2 = fx * fx + fy * fy + fz * fz;
+    float ilf = lf2 > VSGL__TINY ? k_rsqrt(lf2 > VSGL__TINY ? lf2 : 1.0f) : 0.0f;
+    float sc = lin * ilf;
+    t->amp[i] *= ivar;
+    t->ls[i] = lf;
+    t->lden[i] = lf2 * ilf + L->lv + lf + kd * ce;
+    t->xnum[i] = kd * (kd * (1.0f - ce * ce) - 2.0f * L->lv * (L->an + ce));
+    t->mx[i] = fx * sc; t->my[i] = fy * sc; t->mz[i] = fz * sc;
+    t->lin[i] = lin; t->ilin[i] = ilin;
 }
 
 static inline __attribute__((always_inline)) void
@@ -293,7 +312,7 @@ k_exponent(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
     float r = t->r[i], ls = t->ls[i];
     float ddx = L->ax - dx * r, ddy = L->ay - dy * r, ddz = L->az - dz * r;
     float diff2 = ddx * ddx + ddy * ddy + ddz * ddz;
-    t->expo[i] = -L->lv * ls * diff2 / (t->lin[i] + L->lv + ls + VSGL__TINY);
+    t->expo[i] = (t->xnum[i] - L->lv * ls * diff2) / (t->lden[i] + VSGL__TINY);
 }
 
 /* Stage 2: the amplitude's exp. */
