@@ -288,6 +288,13 @@ VT_TEST(shade_clipped_lattice_lights_like_the_exact_plane)
         {1.0f, 0.0f, 0.3f, -1, 0, 0, 0.05, "wall at the edge, 30 cm up"},
         {0.3f, 0.2f, 0.05f, 0, 0, -1, 0.05, "facing, 5 cm"},
         {0.9f, 0.9f, 0.1f, -0.7071f, -0.7071f, 0, 0.05, "a corner's diagonal, 10 cm up"},
+        /* a slope beside the square, facing it (a bump beside a lit
+         * floor), where the round spread's product put the light below
+         * the square's plane: -9.8 % and -9.4 % with it, -4.9 % and
+         * -0.2 % with the foreshortened spread (shade.h) */
+        {1.3f, 0.0f, 0.05f, -0.5f, 0, 0.866f, 0.06, "slope 30 deg, 30 cm off, 5 cm up"},
+        {1.6f, 0.3f, 0.1f, -0.2588f, 0, 0.9659f, 0.06, "slope 15 deg, 60 cm off, 10 cm up"},
+        {2.0f, 0.0f, 0.05f, -0.7071f, 0, 0.7071f, 0.05, "slope 45 deg, 1 m off, 5 cm up"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         v3 x = v3_make(cases[i].x, cases[i].y, cases[i].z), n = v3_normalize(v3_make(cases[i].nx, cases[i].ny, cases[i].nz));
