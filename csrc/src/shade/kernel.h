@@ -13,42 +13,34 @@
 
 #define VSGL__KERNEL_BLOCK 64
 
-/* A planar cluster seen obliquely (shade.h, vsgl__vsgl_incident_sg): the
- * factor on its spread's sharpness. au = a.u, un = u.n_v, an = a.n_v for
- * the emission axis a (as an incident direction), the unit direction u to
- * the cluster's mean and its mean normal n_v; fore = its weight
- * (vsgl__foreshortening_weight). Along the tangent t at u towards a (where
- * the emission lobe pulls the product's axis), the plane's Gaussian spans
- * sqrt(1 - (t.n_v)^2) of its round angular width: the factor is
- * 1 / (1 - fore (t.n_v)^2), at most 1 / VSGL__FORESHORTEN_MIN. */
+/* A diffuse cluster seen from x as a patch of its plane, not a round blob
+ * (shade.h, vsgl__vsgl_incident_sg), at cosine ce = -u.n_v (u the unit
+ * direction from x to the mean, n_v the mean normal, which is a diffuse
+ * lobe's axis) and weight fore (vsgl__foreshortening_weight). Returns the
+ * factor on the spread's sharpness; *kd gets the distance lobe's.
+ *  - Foreshortening: the emission lobe pulls the product's axis along the
+ *    tangent t towards -n_v, where the plane's Gaussian spans
+ *    sqrt(1 - (t.n_v)^2) = ce of its round angular width: the factor is
+ *    1 / (1 - fore (1 - ce^2)), at most 1 / VSGL__FORESHORTEN_MIN.
+ *  - Distance: 1 / d^2 over a plane at height h is cos^2(psi) / h^2 as a
+ *    function of the direction (psi from -n_v), 1 / ce^2 times its value
+ *    at u at its peak: an SG about -n_v, of value 1 at u, of sharpness
+ *    2 ln(1 / ce) / (1 - ce) has that peak ratio (and the slope of cos^2 at
+ *    u as ce -> 1; one fitted to the slope at u instead, 2 / ce, peaks at
+ *    e^{2 (1 - ce) / ce}: e^38 at ce = 0.05, and the near field's wide
+ *    spreads found it). ln(1/c) / (1 - c) on [0.05, 1] as a rational fit
+ *    within 1.7 %, cut at ce = 0.05 and faded in from ce = 0.
+ * Branch-free, one reciprocal for both: the kernel runs it per pair. */
 #define VSGL__FORESHORTEN_MIN 1e-3f
-static inline float vsgl__foreshortening(float au, float un, float an, float fore)
+static inline __attribute__((always_inline)) float vsgl__plane_spread(float ce, float fore, float *kd)
 {
-    float at2 = 1.0f - au * au;
-    at2 = at2 > 1e-6f ? at2 : 1e-6f;
-    float tn = an - au * un;
-    float den = at2 - fore * tn * tn, lo = VSGL__FORESHORTEN_MIN * at2;
-    return at2 / (den > lo ? den : lo);
-}
-
-/* The same cluster's distance lobe (shade.h): the sharpness of an SG
- * about -n_v, of value 1 at u, for a receiver in front of the plane at
- * cosine ce = -u.n_v. 1 / d^2 over a plane at height h is cos^2(psi) / h^2
- * as a function of the direction (psi from -n_v): its peak is 1 / ce^2
- * times its value at u, and the SG of sharpness 2 ln(1 / ce) / (1 - ce)
- * has that peak ratio (and the slope of cos^2 at u as ce -> 1; a slope
- * fitted at u instead, 2 / ce, has a peak of e^{2 (1 - ce) / ce}: e^38 at
- * ce = 0.05, and the near field's wide spreads found it). ln(1/c)/(1 - c)
- * on [0.05, 1] from a fit in c, c^2, c^{-1/2} and c^{1/2}, within 0.35 %;
- * cut at ce = 0.05 and faded in from ce = 0 (continuous across the
- * plane). */
-static inline float vsgl__distance_sharpness(float ce, float fore)
-{
-    float c = ce < 0.05f ? 0.05f : (ce > 1.0f ? 1.0f : ce);
-    float is = 1.0f / sqrtf(c);
-    float g = 2.58785576f + c * (2.00836341f - 0.29538491f * c) + (0.28599766f - 3.58783291f * c) * is;
-    float fade = ce < 0.05f ? (ce > 0.0f ? 20.0f * ce : 0.0f) : 1.0f;
-    return 2.0f * fore * g * fade;
+    float D = fmaxf(1.0f - fore * (1.0f - ce * ce), VSGL__FORESHORTEN_MIN);
+    float c = fminf(fmaxf(ce, 0.05f), 1.0f);
+    float q = c + 0.10887257f;
+    float r = 1.0f / (D * q);
+    float g = (0.44659993f + c * (0.93112012f - 0.27423752f * c)) * (D * r);
+    *kd = 2.0f * fore * g * fminf(fmaxf(20.0f * ce, 0.0f), 1.0f);
+    return q * r;
 }
 
 /* The emitter-hemisphere clip's constants (shade.h explains the clip). */
@@ -93,7 +85,7 @@ typedef struct vsgl_kernel_light {
     float nx, ny, nz;        /* mean surface normal of the cluster */
     float clip;              /* emitter-hemisphere clip: coherence^2 of the normals, 0 = off (shade.h) */
     float conv;              /* 1 for a diffuse lobe: clamped-cosine emission in the far field */
-    float fore, an;          /* vsgl__foreshortening_weight and -axis . normal (vsgl__foreshortening) */
+    float fore;              /* vsgl__foreshortening_weight (vsgl__plane_spread) */
     float ibehind;           /* 1 / (VSGL__CLIP_BEHIND sigma) */
     float planar;            /* weight of the planar glossy model (coherence^2 of a diffuse lobe, clip on), else 0 */
     float pvar;              /* its positional variance (var + the fit's overlap widening) */

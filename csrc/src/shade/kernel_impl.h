@@ -283,16 +283,14 @@ k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
     float ilin = lin2 > VSGL__TINY ? k_rsqrt(lin2 > VSGL__TINY ? lin2 : 1.0f) : 0.0f;
     float lin = lin2 * ilin;
     /* the product with the spread foreshortened and the distance lobe
-     * (shade.h, vsgl__vsgl_incident_sg): m' = lf u + lv a - kd n_v; m
-     * keeps m''s direction and the round |m|. Its amplitude's exponent
-     * |m'| - lf - lv - kd ce in the stable form
-     * (kd^2 (1 - ce^2) - 2 lv kd (an + ce) - lf lv |a - u|^2) / (|m'| + lf + lv + kd ce) */
-    float au = (L->ax * dx + L->ay * dy + L->az * dz) * r;
-    float un = (dx * L->nx + dy * L->ny + dz * L->nz) * r;
-    float lf = ls * vsgl__foreshortening(au, un, L->an, L->fore);
+     * (kernel.h, vsgl__plane_spread): m' = lf u + lv a - kd n_v; m keeps
+     * m''s direction and the round |m|. The amplitude's exponent
+     * |m'| - lf - lv - kd ce in the stable form (a = -n_v where kd > 0)
+     * (kd^2 (1 - ce^2) + 2 lv kd (1 - ce) - lf lv |a - u|^2) / (|m'| + lf + lv + kd ce) */
+    float ce = -(dx * L->nx + dy * L->ny + dz * L->nz) * r;
+    float kd;
+    float lf = ls * vsgl__plane_spread(ce, L->fore, &kd);
     float wf = lf * r;
-    float ce = -un;
-    float kd = vsgl__distance_sharpness(ce, L->fore);
     float fx = wf * dx + L->lax - kd * L->nx, fy = wf * dy + L->lay - kd * L->ny, fz = wf * dz + L->laz - kd * L->nz;
     float lf2 = fx * fx + fy * fy + fz * fz;
     float ilf = lf2 > VSGL__TINY ? k_rsqrt(lf2 > VSGL__TINY ? lf2 : 1.0f) : 0.0f;
@@ -300,7 +298,7 @@ k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
     t->amp[i] *= ivar;
     t->ls[i] = lf;
     t->lden[i] = lf2 * ilf + L->lv + lf + kd * ce;
-    t->xnum[i] = kd * (kd * (1.0f - ce * ce) - 2.0f * L->lv * (L->an + ce));
+    t->xnum[i] = kd * (kd * (1.0f - ce * ce) + 2.0f * L->lv * (1.0f - ce));
     t->mx[i] = fx * sc; t->my[i] = fy * sc; t->mz[i] = fz * sc;
     t->lin[i] = lin; t->ilin[i] = ilin;
 }

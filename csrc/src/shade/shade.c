@@ -45,15 +45,12 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
     spread.sharpness = dist2 / var;
     spread.log_amplitude = 0.0f;
     /* the product with the spread foreshortened and the distance lobe
-     * (shade.h); its sharpness the round product's */
+     * (shade.h, kernel.h vsgl__plane_spread); its sharpness the round product's */
     float round = v3_length(v3_add(v3_scale(light_lobe.axis, light_lobe.sharpness),
                                    v3_scale(spread.axis, spread.sharpness)));
-    float fore = vsgl__foreshortening_weight(v);
-    spread.sharpness *= vsgl__foreshortening(v3_dot(light_lobe.axis, spread.axis), v3_dot(spread.axis, v->normal),
-                                             v3_dot(light_lobe.axis, v->normal), fore);
+    float ce = -v3_dot(spread.axis, v->normal), kd;
+    spread.sharpness *= vsgl__plane_spread(ce, vsgl__foreshortening_weight(v), &kd);
     vsgl_sg_product(&light_lobe, &spread, sg);
-    float ce = -v3_dot(spread.axis, v->normal);
-    float kd = vsgl__distance_sharpness(ce, fore);
     if (kd > 0.0f) {
         vsgl_sg dist = {v3_neg(v->normal), kd, kd * (1.0f - ce)};
         vsgl_sg_product(sg, &dist, sg);
@@ -1220,7 +1217,6 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             o->clip = leak ? v->coherence * v->coherence : 0.0f;
             o->conv = v->lobe == VSGL__LOBE_DIFFUSE ? 1.0f : 0.0f;
             o->fore = vsgl__foreshortening_weight(v);
-            o->an = o->ax * o->nx + o->ay * o->ny + o->az * o->nz;
             o->ibehind = 1.0f / (VSGL__CLIP_BEHIND * sqrtf(v->variance) + VSGL__TINY);
             o->planar = leak && v->lobe == VSGL__LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
             o->pvar = v->variance + v->widen;
