@@ -64,6 +64,7 @@ int main(int argc, char **argv)
         l->nz = 1.0f;
         l->clip = 0.5f;
         l->conv = 1.0f;
+        l->fore = 1.0f; /* their plane spread (kernel.h, vsgl__plane_spread) */
         l->ibehind = 1.0f / (0.02f * sqrtf(l->var));
     }
     for (int i = 0; i < VSGL__KERNEL_BLOCK; ++i) {

@@ -269,8 +269,11 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
     t->amp[i] = valid * L->c0 * (1.0f - L->clip * (1.0f - e));
 }
 
+/* plane: a constant, 0 where no light of the call has a plane spread
+ * (fore 0: specular lobes), which then take the round product alone */
 static inline __attribute__((always_inline)) void
-k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
+k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t,
+       const int plane)
 {
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
     float r = t->r[i], d2 = t->d2[i];
@@ -282,6 +285,15 @@ k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
     float lin2 = mx * mx + my * my + mz * mz;
     float ilin = lin2 > VSGL__TINY ? k_rsqrt(lin2 > VSGL__TINY ? lin2 : 1.0f) : 0.0f;
     float lin = lin2 * ilin;
+    t->amp[i] *= ivar;
+    t->lin[i] = lin; t->ilin[i] = ilin;
+    if (!plane) {
+        t->ls[i] = ls;
+        t->lden[i] = lin + L->lv + ls;
+        t->xnum[i] = 0.0f;
+        t->mx[i] = mx; t->my[i] = my; t->mz[i] = mz;
+        return;
+    }
     /* the product with the spread foreshortened and the distance lobe
      * (kernel.h, vsgl__plane_spread): m' = lf u + lv a - kd n_v; m keeps
      * m''s direction and the round |m|. The amplitude's exponent
@@ -295,12 +307,10 @@ k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
     float lf2 = fx * fx + fy * fy + fz * fz;
     float ilf = lf2 > VSGL__TINY ? k_rsqrt(lf2 > VSGL__TINY ? lf2 : 1.0f) : 0.0f;
     float sc = lin * ilf;
-    t->amp[i] *= ivar;
     t->ls[i] = lf;
     t->lden[i] = lf2 * ilf + L->lv + lf + kd * ce;
     t->xnum[i] = kd * (kd * (1.0f - ce * ce) + 2.0f * L->lv * (1.0f - ce));
     t->mx[i] = fx * sc; t->my[i] = fy * sc; t->mz[i] = fz * sc;
-    t->lin[i] = lin; t->ilin[i] = ilin;
 }
 
 static inline __attribute__((always_inline)) void
@@ -684,7 +694,13 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j));
     else
         K_FORN(k_geometry(b, i, L + j, 1.0f, t + j));
-    K_FORN(k_axis(b, i, L + j, t + j));
+    int plane = 0;
+    for (int j = 0; j < NL; ++j)
+        plane |= L[j].fore > 0.0f;
+    if (plane)
+        K_FORN(k_axis(b, i, L + j, t + j, 1));
+    else
+        K_FORN(k_axis(b, i, L + j, t + j, 0));
     K_FORN(k_exponent(b, i, L + j, t + j));
     K_FORN(k_amplitude(i, t + j));
     if (lobes & VSGL__KERNEL_DIFFUSE) {
