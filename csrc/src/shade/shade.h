@@ -38,10 +38,10 @@ typedef struct vsgl_pixel_planes {
  *    slope received light from the slope facing it at the cosine of a
  *    direction under the horizon (dense_floor: 0.41 of the brute force's
  *    floor-to-floor light in the image's middle rows). The spread's
- *    sharpness along that pull is scaled by vsgl__foreshortening (kernel.h);
+ *    sharpness along that pull is scaled (kernel.h, vsgl__plane_spread);
  *  - distance: the plane's VPLs nearer x's foot on it are nearer x, and
  *    1 / d^2 over the plane pulls the light towards the foot (-n_v): a
- *    third lobe, vsgl__distance_sharpness (kernel.h). Without it the
+ *    third lobe (the same function's *kd). Without it the
  *    foreshortened model lost 1-5 % of a lit plane's light beside a
  *    junction (the round spread's pull towards a had stood in for it).
  * The product's axis and amplitude are those of the three lobes; its
@@ -50,8 +50,11 @@ typedef struct vsgl_pixel_planes {
  * (tests/c/test_lattice.c): far field within -1.5..+0.5 % (before:
  * -1.5..+0.1 %), a wall at its edge 30 cm up -2.0 % (-4.3 %), 10 cm up
  * -4.0 % (-3.2 %). */
-float vsgl__foreshortening_weight(const vsgl_vsgl *v);
 int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
+
+/* The weight of v's plane spread above: coherence^2 of a diffuse lobe, 0
+ * for a specular one (kernel.h vsgl__plane_spread's fore). */
+float vsgl__foreshortening_weight(const vsgl_vsgl *v);
 
 /* Shading paths: the vectorised kernel (default), the same kernel built
  * scalar (benchmark baseline), and the reference path through the public
