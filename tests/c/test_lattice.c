@@ -138,7 +138,7 @@ VT_TEST(fit_lattice_conserves_power_and_keeps_orientations_apart)
 
 /* Light at receiver x (normal n) from a set, through the reference path's
  * formulas (the kernel is checked against them in test_kernel.c). */
-/* clip: 0 the papers' model, 1 the emitter clip, 2 the clip and the near
+/* clip: 0 no clip (the papers' model but for the plane spread, shade.h), 1 the emitter clip, 2 the clip and the near
  * field (shade/near_field.h), blended in as the shading does */
 static double diffuse_at(const vsgl_vsgl_set *set, v3 x, v3 n, int clip)
 {
@@ -301,7 +301,7 @@ VT_TEST(shade_clipped_lattice_lights_like_the_exact_plane)
         double want = polygon_irradiance(x, n, M) / PI_D, got = diffuse_at(&set, x, n, 2),
                clipped = diffuse_at(&set, x, n, 1), paper = diffuse_at(&set, x, n, 0);
         if (getenv("VSGL_TEST_VERBOSE"))
-            printf("    %-32s exact %.5f near field %.5f (%+.1f %%) clip only %.5f (%+.1f %%) papers' SG %.5f (%+.1f %%)\n",
+            printf("    %-32s exact %.5f near field %.5f (%+.1f %%) clip only %.5f (%+.1f %%) no clip %.5f (%+.1f %%)\n",
                    cases[i].what, want, got, 100 * (got / want - 1), clipped, 100 * (clipped / want - 1), paper,
                    100 * (paper / want - 1));
         VT_CHECK_REL(got, want, cases[i].tol, "%s", cases[i].what);
