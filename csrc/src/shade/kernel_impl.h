@@ -299,7 +299,7 @@ k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
      * m''s direction and the round |m|. The amplitude's exponent
      * |m'| - lf - lv - kd ce in the stable form (a = -n_v where kd > 0)
      * (kd^2 (1 - ce^2) + 2 lv kd (1 - ce) - lf lv |a - u|^2) / (|m'| + lf + lv + kd ce) */
-    float ce = -(dx * L->nx + dy * L->ny + dz * L->nz) * r;
+    float ce = t->h[i] * r; /* k_geometry's height over the cluster's plane, h = -d.n_v */
     float kd;
     float lf = ls * vsgl__plane_spread(ce, L->fore, &kd);
     float wf = lf * r;
