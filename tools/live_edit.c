@@ -11,7 +11,8 @@
  * hash (FNV-1a over the 64-bit words of all eight planes; --no-hash: none,
  * and only Combined is asked for, as the live viewport does) of every frame: two
  * builds that print the same hashes rendered the same pixels bit for bit.
- * Ends with the medians. --settings K replaces the bundle's knobs:
+ * --dump FILE writes the last frame's 22 planes as raw float32 (with
+ * --no-hash only Combined, planes 18-20, is filled). Ends with the medians. --settings K replaces the bundle's knobs:
  * 0 as saved, 1 stride 2 + 2x2 AA + 8x8 edge rays, 2 stride 3 + 2x2 AA,
  * 3 stride 2 + 8x8 edge rays, 4 stride 1 (every pixel shaded).
  *
@@ -49,9 +50,9 @@ static uint64_t fnv(uint64_t h, const void *p, size_t n)
 
 int main(int argc, char **argv)
 {
-    const char *path = NULL;
+    const char *path = NULL, *dump = NULL;
     int edits = 9, camera = 0, knobs = 0, quiet = 0, hash = 1;
-    uint32_t threads = 0, coarse = 1, coarse_stride = 0;
+    uint32_t threads = 0, coarse = 1, coarse_stride = 0, stride = 0;
     int refine_every = 1;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--edits") && i + 1 < argc)
@@ -60,6 +61,10 @@ int main(int argc, char **argv)
             threads = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--settings") && i + 1 < argc)
             knobs = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--dump") && i + 1 < argc)
+            dump = argv[++i];
+        else if (!strcmp(argv[i], "--stride") && i + 1 < argc)
+            stride = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--coarse") && i + 1 < argc)
             coarse = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--coarse-stride") && i + 1 < argc)
@@ -78,7 +83,7 @@ int main(int argc, char **argv)
     const int navigating = coarse > 1 || coarse_stride > 0;
     if (!path || edits < 1 || edits > 1000 || coarse < 1 || coarse > 16 || coarse_stride > 8 || refine_every < 1) {
         fprintf(stderr, "usage: live_edit BUNDLE [--edits N] [--threads T] [--camera] [--settings K] [--quiet] "
-                        "[--no-hash] [--coarse N | --coarse-stride S] [--refine K]\n");
+                        "[--no-hash] [--coarse N | --coarse-stride S] [--refine K] [--stride S] [--dump FILE]\n");
         return 2;
     }
     vsgl_context_desc cd;
@@ -104,6 +109,8 @@ int main(int argc, char **argv)
     } else if (knobs == 4) {
         s.shade_stride = 1;
     }
+    if (stride)
+        s.shade_stride = stride;
     if (vsgl_scene_create(ctx, desc, &scene) != VSGL_OK || vsgl_render_cache_create(ctx, &cache) != VSGL_OK) {
         fprintf(stderr, "scene: %s\n", vsgl_context_last_error(ctx));
         return 1;
@@ -180,6 +187,13 @@ int main(int argc, char **argv)
                 rcpu[refines] = c1 - c0;
                 rwall[refines++] = w1 - w0;
             }
+        }
+    }
+    if (dump) { /* the last frame's planes, raw float32 (22 x pixels) */
+        FILE *f = fopen(dump, "wb");
+        if (!f || fwrite(planes, sizeof(float), px * 22, f) != px * 22 || fclose(f) != 0) {
+            fprintf(stderr, "cannot write %s\n", dump);
+            return 1;
         }
     }
     printf("%s edit%s, %ux%u, %d edits, threads %u: median cpu %.4f s, wall %.4f s; frames hash %016llx\n",

@@ -612,43 +612,70 @@ static inline __attribute__((always_inline)) float k_fold_weight(float lo, float
  * planar model's density with the cluster's Gaussian folded back at each
  * cut (an image mirrored across it), every image kept to the surface's
  * side (shade.c, vsgl__planar_glossy), blended in by L->fold; into ppre,
- * with pexpo 0. Images of a side without a cut have weight 0. */
+ * with pexpo 0. Images of a side without a cut have weight 0.
+ * cuts: the light's cut sides as bits (1, 2: axis u1's low and high side,
+ * 4, 8: u2's; k_fold_cuts), a constant in each caller's loop: a side
+ * without a cut has al or ah 0, so its image's weight is 0 and the others'
+ * factor for it 1, and neither is computed (a junction's cell is cut on
+ * one side: 2 images of 9, 4 exps of 21). */
+#define K_FOLD_ALL 15
+
+static inline __attribute__((always_inline)) int k_fold_cuts(const vsgl_kernel_light *L)
+{
+    return (L->fa[0][0] > 0.0f ? 1 : 0) | (L->fa[0][1] > 0.0f ? 2 : 0) | (L->fa[1][0] > 0.0f ? 4 : 0) |
+           (L->fa[1][1] > 0.0f ? 8 : 0);
+}
+
+/* Along one axis (ax) with cut sides lo, hi (constants): the images'
+ * weights w[3] (k_fold_weight), those of an uncut side's image 0. */
 static inline __attribute__((always_inline)) void
-k_fold(size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
+k_fold_axis(const vsgl_kernel_light *restrict L, int ax, int lo, int hi, float y, float f, float *m, float *w)
+{
+    m[0] = L->fs[ax];
+    m[1] = 2.0f * L->fb[ax][0] - L->fs[ax];
+    m[2] = 2.0f * L->fb[ax][1] - L->fs[ax];
+    w[0] = 1.0f;
+    w[1] = w[2] = 0.0f;
+    if (!lo && !hi)
+        return;
+    const float i1 = 1.0f / (1.0f + f), isp = k_rsqrt_fine(f * i1);
+    const float bl = L->fb[ax][0], bh = L->fb[ax][1], al = L->fa[ax][0], ah = L->fa[ax][1];
+    if (lo && hi) {
+        for (int q = 0; q < 3; ++q)
+            w[q] = k_fold_weight(bl, bh, al, ah, m[q], q, y, f, i1, isp);
+    } else if (lo) { /* ah = 0: wh = 1 */
+        float tl0 = k_ncdf(((m[0] * f + y) * i1 - bl) * isp), tl1 = k_ncdf(((m[1] * f + y) * i1 - bl) * isp);
+        w[0] = 1.0f - al + al * tl0;
+        w[1] = al * tl1;
+    } else { /* al = 0: wl = 1 */
+        float th0 = k_ncdf((bh - (m[0] * f + y) * i1) * isp), th2 = k_ncdf((bh - (m[2] * f + y) * i1) * isp);
+        w[0] = 1.0f - ah + ah * th0;
+        w[2] = ah * th2;
+    }
+}
+
+static inline __attribute__((always_inline)) void
+k_fold(size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t, const int cuts)
 {
     const float d1 = t->pd1[i], d2 = t->pd2[i], s11 = t->ps11[i], s22 = t->ps22[i], s12 = t->ps12[i];
     const float idet = t->pidet[i];
     float f1 = s11 - 1.0f, f2 = s22 - 1.0f;
     f1 = f1 > 1e-12f ? f1 : 1e-12f;
     f2 = f2 > 1e-12f ? f2 : 1e-12f;
-    const float i1 = 1.0f / (1.0f + f1), i2 = 1.0f / (1.0f + f2);
-    const float isp1 = k_rsqrt_fine(f1 * i1), isp2 = k_rsqrt_fine(f2 * i2);
-    const float m1[3] = {L->fs[0], 2.0f * L->fb[0][0] - L->fs[0], 2.0f * L->fb[0][1] - L->fs[0]};
-    const float m2[3] = {L->fs[1], 2.0f * L->fb[1][0] - L->fs[1], 2.0f * L->fb[1][1] - L->fs[1]};
-    float w1[3], w2[3];
-    w1[0] = k_fold_weight(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], m1[0], 0, d1, f1, i1, isp1);
-    w1[1] = k_fold_weight(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], m1[1], 1, d1, f1, i1, isp1);
-    w1[2] = k_fold_weight(L->fb[0][0], L->fb[0][1], L->fa[0][0], L->fa[0][1], m1[2], 2, d1, f1, i1, isp1);
-    w2[0] = k_fold_weight(L->fb[1][0], L->fb[1][1], L->fa[1][0], L->fa[1][1], m2[0], 0, d2, f2, i2, isp2);
-    w2[1] = k_fold_weight(L->fb[1][0], L->fb[1][1], L->fa[1][0], L->fa[1][1], m2[1], 1, d2, f2, i2, isp2);
-    w2[2] = k_fold_weight(L->fb[1][0], L->fb[1][1], L->fa[1][0], L->fa[1][1], m2[2], 2, d2, f2, i2, isp2);
+    float m1[3], m2[3], w1[3], w2[3];
+    k_fold_axis(L, 0, cuts & 1, cuts & 2, d1, f1, m1, w1);
+    k_fold_axis(L, 1, cuts & 4, cuts & 8, d2, f2, m2, w2);
+    /* the images of a side with a cut: 0 always, 1 below a low cut, 2 above a high one */
+    const int on1[3] = {1, cuts & 1, cuts & 2}, on2[3] = {1, cuts & 4, cuts & 8};
     float sum = 0.0f;
-#define K_FOLD_TERM(a, c)                                                                                       \
-    do {                                                                                                        \
-        float e1 = d1 - m1[a], e2 = d2 - m2[c];                                                                 \
-        float q = (s22 * e1 * e1 - 2.0f * s12 * e1 * e2 + s11 * e2 * e2) * idet;                                \
-        sum += w1[a] * w2[c] * k_exp(q > 0.0f ? -0.5f * q : 0.0f);                                             \
-    } while (0)
-    K_FOLD_TERM(0, 0);
-    K_FOLD_TERM(1, 0);
-    K_FOLD_TERM(2, 0);
-    K_FOLD_TERM(0, 1);
-    K_FOLD_TERM(1, 1);
-    K_FOLD_TERM(2, 1);
-    K_FOLD_TERM(0, 2);
-    K_FOLD_TERM(1, 2);
-    K_FOLD_TERM(2, 2);
-#undef K_FOLD_TERM
+    for (int c = 0; c < 3; ++c)
+        for (int a = 0; a < 3; ++a) {
+            if (!on1[a] || !on2[c])
+                continue;
+            float e1 = d1 - m1[a], e2 = d2 - m2[c];
+            float q = (s22 * e1 * e1 - 2.0f * s12 * e1 * e2 + s11 * e2 * e2) * idet;
+            sum += w1[a] * w2[c] * k_exp(q > 0.0f ? -0.5f * q : 0.0f);
+        }
     t->ppre[i] *= (1.0f - L->fold) * k_exp(t->pexpo[i]) + L->fold * sum;
     t->pexpo[i] = 0.0f;
 }
@@ -777,9 +804,22 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
                         float e = t[j].ppre[i] > 0.0f ? t[j].pexpo[i] : -1e30f;
                         near = e > near ? e : near;
                     }
-                    if (near >= -L[j].freach)
-                        for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
-                            k_fold(i, L + j, t + j);
+                    if (!(near >= -L[j].freach))
+                        continue;
+                    /* one loop per kind of cut, the cuts a constant in each */
+#define K_FOLD(CUTS)                                          \
+    for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)           \
+        k_fold(i, L + j, t + j, (CUTS))
+                    switch (k_fold_cuts(L + j)) {
+                    case 1: K_FOLD(1); break;
+                    case 2: K_FOLD(2); break;
+                    case 4: K_FOLD(4); break;
+                    case 8: K_FOLD(8); break;
+                    case 3: K_FOLD(3); break;
+                    case 12: K_FOLD(12); break;
+                    default: K_FOLD(K_FOLD_ALL); break;
+                    }
+#undef K_FOLD
                 }
                 if (hv)
                     K_FORN(k_hv_rest(i, t + j));

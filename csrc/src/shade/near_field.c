@@ -208,14 +208,26 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
     return c->fit > 0.0f;
 }
 
-/* The integral of (al + be v) (v - o)^j N(v; m, s^2) over [lo, hi], j = 0
- * (out[0]) and 1 (out[1]), from the CDF and density at the bounds. */
-static void lin_gauss(float al, float be, float o, float m, float s, float lo, float hi, float *out)
+/* N(v; m, s^2) at a bound lo: its CDF and its density times s. */
+typedef struct gauss_at {
+    float cdf, ps;
+} gauss_at;
+
+static gauss_at gauss_bound(float m, float is, float lo)
 {
-    float is = 1.0f / s, za = (lo - m) * is, zb = (hi - m) * is;
-    float ea = expf(-0.5f * za * za), eb = expf(-0.5f * zb * zb);
-    float d0 = vsgl__normal_cdf_e(zb, eb) - vsgl__normal_cdf_e(za, ea);
-    float pa = 0.3989422804f * ea, pb = 0.3989422804f * eb;
+    float z = (lo - m) * is, e = expf(-0.5f * z * z);
+    gauss_at g = {vsgl__normal_cdf_e(z, e), 0.3989422804f * e};
+    return g;
+}
+
+/* The integral of (al + be v) (v - o)^j N(v; m, s^2) over [lo, hi], j = 0
+ * (out[0]) and 1 (out[1]), from the CDF and density at the bounds (ga at
+ * lo, gb at hi: gauss_bound). */
+static void lin_gauss(float al, float be, float o, float m, float s, float lo, float hi, gauss_at ga, gauss_at gb,
+                      float *out)
+{
+    float d0 = gb.cdf - ga.cdf;
+    float pa = ga.ps, pb = gb.ps;
     float d1 = m * d0 - s * (pb - pa);                                   /* int v N */
     float d2 = (m * m + s * s) * d0 - s * ((m + hi) * pb - (m + lo) * pa); /* int v^2 N */
     out[0] = al * d0 + be * d1;
@@ -241,6 +253,10 @@ static float tent_mass(const vsgl_near_cell *c, float pu, float pv, float cuu, f
     float slope = cuv / cuu, sv = sqrtf(fmaxf(cvv - cuv * slope, 1e-12f * cvv));
     const float ubreak[3] = {c->tlo[0], fminf(fmaxf(0.0f, c->tlo[0]), c->thi[0]), c->thi[0]};
     const float vbreak[3] = {c->tlo[1], fminf(fmaxf(0.0f, c->tlo[1]), c->thi[1]), c->thi[1]};
+    /* the bounds some side of the tent in v uses */
+    const int side0 = vbreak[1] > vbreak[0], side1 = vbreak[2] > vbreak[1];
+    const int has[3] = {side0, side0 || side1, side1};
+    const float isv = 1.0f / sv;
     float sum = 0.0f;
     for (int side = 0; side < 2; ++side) {
         float u0 = fmaxf(ubreak[side], pu - 6.0f * su), u1 = fminf(ubreak[side + 1], pu + 6.0f * su);
@@ -253,12 +269,17 @@ static float tent_mass(const vsgl_near_cell *c, float pu, float pv, float cuu, f
         for (int k = 0; k < nodes; ++k) {
             float u = mid + (k & 1 ? -half : half) * xs[k >> 1], du = (u - pu) / su;
             float tu = 1.0f - fabsf(u) * ih, mvu = pv + slope * (u - pu), in[2] = {0.0f, 0.0f};
+            /* the sides share the bound at the peak: each bound's exp once */
+            gauss_at gb[3];
+            for (int q = 0; q < 3; ++q)
+                if (has[q])
+                    gb[q] = gauss_bound(mvu, isv, vbreak[q]);
             for (int vs = 0; vs < 2; ++vs) {
                 if (!(vbreak[vs + 1] > vbreak[vs]))
                     continue;
                 /* the tent in v on this side: 1 -+ (v - cv) / h = al + be v */
                 float be = vs ? -ih : ih, al = 1.0f, o[2];
-                lin_gauss(al, be, c->centroid[1], mvu, sv, vbreak[vs], vbreak[vs + 1], o);
+                lin_gauss(al, be, c->centroid[1], mvu, sv, vbreak[vs], vbreak[vs + 1], gb[vs], gb[vs + 1], o);
                 in[0] += o[0];
                 in[1] += o[1];
             }
