@@ -186,3 +186,17 @@ KERNEL_ATTR void vsgl__kernel_vis_fill(uint64_t skipped, uint64_t visible, const
     for (size_t k = 0; k < B; ++k)
         out[k] = s[k] ? share[k] : (float)v[k];
 }
+
+/* The near field's specular footprint (near_field.c, tent_mass): e^{-z^2/2}
+ * and Phi(z) for n values, vectorised (libm's expf is not). z must be
+ * finite (the caller clamps it). */
+KERNEL_ATTR void vsgl__kernel_normal_cdf(const float *restrict z, float *restrict e, float *restrict cdf, size_t n)
+{
+    for (size_t i = 0; i < n; ++i) {
+        float x = z[i];
+        float ex = k_exp(-0.5f * x * x);
+        float tail = 0.5f * ex * k_erfc_poly(fabsf(x) * 0.70710678f);
+        e[i] = ex;
+        cdf[i] = x < 0.0f ? tail : 1.0f - tail;
+    }
+}

@@ -234,4 +234,8 @@ uint64_t vsgl__kernel_lanes_within(const float *w, const float *cut);
 void vsgl__kernel_vis_accumulate(const float *w, uint64_t traced, uint64_t visible, double *seen, double *lit);
 void vsgl__kernel_vis_fill(uint64_t skipped, uint64_t visible, const float *share, float *out);
 
+/* e[i] = e^{-z[i]^2 / 2} and cdf[i] = Phi(z[i]), i < n, vectorised (the
+ * near field's specular footprint, near_field.c). z finite. */
+void vsgl__kernel_normal_cdf(const float *z, float *e, float *cdf, size_t n);
+
 #endif

@@ -238,9 +238,11 @@ typedef struct k_scratch {
  *   r = 1/|d|, var' = max(var, d^2 2^-41) so 1/var' = min(1/var, 2^41 r^2),
  *   ls = d^2 / var', the product axis m = ls u + lv a = (|d|/var') d + lv a,
  *   lin = |m|, and the amplitude's exponent -lv ls |a - u|^2 / (lin + lv + ls). */
+/* conv: a constant, 0 where no light of the call has the far-field
+ * falloff (L->conv 0: specular lobes), which then leave its exp out */
 static inline __attribute__((always_inline)) void
 k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, float vis,
-           k_scratch *restrict t)
+           k_scratch *restrict t, const int conv)
 {
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
     float d2 = dx * dx + dy * dy + dz * dz;
@@ -256,14 +258,18 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
     sb = sb < 0.0f ? 0.0f : (sb > 1.0f ? 1.0f : sb);
     float sp = (1.0f - (b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz)) * (1.0f / VSGL__CLIP_PARALLEL);
     sp = sp > 1.0f ? 1.0f : sp;
-    float c = h * r;
-    c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
-    float rho = K_CLIP_RHO * c * k_exp(VSGL__COSINE_SHARPNESS * (1.0f - c));
     float s = d2 * L->ivar;
-    float wn = s / (s + VSGL__CLIP_NEAR), w = wn * L->conv;
+    float wn = s / (s + VSGL__CLIP_NEAR);
     /* the parallel clip in the near field only: far away the receiver's own cosine does it */
     float par = 1.0f - (1.0f - sp * sp * (3.0f - 2.0f * sp)) * (1.0f - wn);
-    float e = sb * sb * (3.0f - 2.0f * sb) * par * ((1.0f - w) + w * rho);
+    float e = sb * sb * (3.0f - 2.0f * sb) * par;
+    if (conv) {
+        float c = h * r;
+        c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
+        float rho = K_CLIP_RHO * c * k_exp(VSGL__COSINE_SHARPNESS * (1.0f - c));
+        float w = wn * L->conv;
+        e *= (1.0f - w) + w * rho;
+    }
     float valid = (d2 > 0.0f ? 1.0f : L->valid) * vis;
     t->vis[i] = valid;
     t->amp[i] = valid * L->c0 * (1.0f - L->clip * (1.0f - e));
@@ -717,13 +723,19 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
     /* the poster's SG-cosine lobe: constants (no call on the hot path) */
     const float ld_sharp = VSGL__COSINE_SHARPNESS;
     const float ld_norm = VSGL__PI / k_sg_integral(VSGL__COSINE_SHARPNESS);
-    if (visibility)
-        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j));
-    else
-        K_FORN(k_geometry(b, i, L + j, 1.0f, t + j));
-    int plane = 0;
-    for (int j = 0; j < NL; ++j)
+    int plane = 0, conv = 0;
+    for (int j = 0; j < NL; ++j) {
         plane |= L[j].fore > 0.0f;
+        conv |= L[j].conv > 0.0f;
+    }
+    if (visibility && conv)
+        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 1));
+    else if (visibility)
+        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 0));
+    else if (conv)
+        K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 1));
+    else
+        K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 0));
     if (plane)
         K_FORN(k_axis(b, i, L + j, t + j, 1));
     else

@@ -5,6 +5,7 @@
  * truncated to the VPLs' extent, the cells at a junction end where the
  * surface ends, where the Gaussians' tails spill past it. */
 #include "shade/near_field.h"
+#include "shade/kernel.h"
 #include "math/constants.h"
 #include "math/normal.h"
 
@@ -208,17 +209,10 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
     return c->fit > 0.0f;
 }
 
-/* N(v; m, s^2) at a bound lo: its CDF and its density times s. */
+/* N(v; m, s^2) at a bound: its CDF and its density times s. */
 typedef struct gauss_at {
     float cdf, ps;
 } gauss_at;
-
-static gauss_at gauss_bound(float m, float is, float lo)
-{
-    float z = (lo - m) * is, e = expf(-0.5f * z * z);
-    gauss_at g = {vsgl__normal_cdf_e(z, e), 0.3989422804f * e};
-    return g;
-}
 
 /* The integral of (al + be v) (v - o)^j N(v; m, s^2) over [lo, hi], j = 0
  * (out[0]) and 1 (out[1]), from the CDF and density at the bounds (ga at
@@ -253,9 +247,6 @@ static float tent_mass(const vsgl_near_cell *c, float pu, float pv, float cuu, f
     float slope = cuv / cuu, sv = sqrtf(fmaxf(cvv - cuv * slope, 1e-12f * cvv));
     const float ubreak[3] = {c->tlo[0], fminf(fmaxf(0.0f, c->tlo[0]), c->thi[0]), c->thi[0]};
     const float vbreak[3] = {c->tlo[1], fminf(fmaxf(0.0f, c->tlo[1]), c->thi[1]), c->thi[1]};
-    /* the bounds some side of the tent in v uses */
-    const int side0 = vbreak[1] > vbreak[0], side1 = vbreak[2] > vbreak[1];
-    const int has[3] = {side0, side0 || side1, side1};
     const float isv = 1.0f / sv;
     float sum = 0.0f;
     for (int side = 0; side < 2; ++side) {
@@ -266,14 +257,28 @@ static float tent_mass(const vsgl_near_cell *c, float pu, float pv, float cuu, f
         /* 4 nodes where the piece spans at most 3 sigma, 8 where it holds the peak and tails */
         const int nodes = u1 - u0 <= 3.0f * su ? 4 : VSGL__NEAR_GL;
         const float *xs = nodes == 4 ? gx4 : gx, *ws = nodes == 4 ? gw4 : gw;
-        for (int k = 0; k < nodes; ++k) {
-            float u = mid + (k & 1 ? -half : half) * xs[k >> 1], du = (u - pu) / su;
-            float tu = 1.0f - fabsf(u) * ih, mvu = pv + slope * (u - pu), in[2] = {0.0f, 0.0f};
-            /* the sides share the bound at the peak: each bound's exp once */
-            gauss_at gb[3];
+        /* every node's bounds in v and its own offset in u, standardised,
+         * through one vectorised pass of exps (kernel.c): row q < 3 the
+         * bound vbreak[q], row 3 the node's du; 8 columns, one per node */
+        float z[4 * VSGL__NEAR_GL], ez[4 * VSGL__NEAR_GL], cz[4 * VSGL__NEAR_GL], us[VSGL__NEAR_GL],
+            mv[VSGL__NEAR_GL];
+        for (int k = 0; k < VSGL__NEAR_GL; ++k) {
+            float u = k < nodes ? mid + (k & 1 ? -half : half) * xs[k >> 1] : mid;
+            us[k] = u;
+            mv[k] = pv + slope * (u - pu);
             for (int q = 0; q < 3; ++q)
-                if (has[q])
-                    gb[q] = gauss_bound(mvu, isv, vbreak[q]);
+                z[q * VSGL__NEAR_GL + k] = fminf(fmaxf((vbreak[q] - mv[k]) * isv, -40.0f), 40.0f);
+            z[3 * VSGL__NEAR_GL + k] = fminf(fmaxf((u - pu) / su, -40.0f), 40.0f);
+        }
+        vsgl__kernel_normal_cdf(z, ez, cz, 4 * VSGL__NEAR_GL);
+        for (int k = 0; k < nodes; ++k) {
+            float u = us[k], mvu = mv[k];
+            float tu = 1.0f - fabsf(u) * ih, in[2] = {0.0f, 0.0f};
+            gauss_at gb[3];
+            for (int q = 0; q < 3; ++q) {
+                gb[q].cdf = cz[q * VSGL__NEAR_GL + k];
+                gb[q].ps = 0.3989422804f * ez[q * VSGL__NEAR_GL + k];
+            }
             for (int vs = 0; vs < 2; ++vs) {
                 if (!(vbreak[vs + 1] > vbreak[vs]))
                     continue;
@@ -283,7 +288,7 @@ static float tent_mass(const vsgl_near_cell *c, float pu, float pv, float cuu, f
                 in[0] += o[0];
                 in[1] += o[1];
             }
-            part += ws[k >> 1] * expf(-0.5f * du * du) * tu *
+            part += ws[k >> 1] * ez[3 * VSGL__NEAR_GL + k] * tu *
                     ((1.0f + c->grad[0] * (u - c->centroid[0])) * in[0] + c->grad[1] * in[1]);
         }
         sum += part * half;
