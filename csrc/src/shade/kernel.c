@@ -187,16 +187,49 @@ KERNEL_ATTR void vsgl__kernel_vis_fill(uint64_t skipped, uint64_t visible, const
         out[k] = s[k] ? share[k] : (float)v[k];
 }
 
-/* The near field's specular footprint (near_field.c, tent_mass): e^{-z^2/2}
- * and Phi(z) for n values, vectorised (libm's expf is not). z must be
- * finite (the caller clamps it). */
-KERNEL_ATTR void vsgl__kernel_normal_cdf(const float *restrict z, float *restrict e, float *restrict cdf, size_t n)
+/* The near field's specular footprint (near_field.c, tent_mass): one side
+ * of the tent in u, its VSGL__TENT_NODES Gauss-Legendre nodes at once
+ * (vectorised: libm's expf is not). Per node u, the Gaussian's conditional
+ * in v has mean pv + slope (u - pu) and sd sv; its integral against the
+ * tent in v (1 -+ v / h on each side of 0, over [vb0, vb1] and [vb1, vb2])
+ * times the linear irradiance 1 + grad . (y - centroid), in closed form
+ * from the normal CDF and density at the three bounds. */
+static inline __attribute__((always_inline)) void
+k_lin_gauss(float al, float be, float o, float m, float s, float lo, float hi, float ca, float pa, float cb,
+            float pb, float *o0, float *o1)
 {
-    for (size_t i = 0; i < n; ++i) {
-        float x = z[i];
-        float ex = k_exp(-0.5f * x * x);
-        float tail = 0.5f * ex * k_erfc_poly(fabsf(x) * 0.70710678f);
-        e[i] = ex;
-        cdf[i] = x < 0.0f ? tail : 1.0f - tail;
+    float d0 = cb - ca;
+    float d1 = m * d0 - s * (pb - pa);
+    float d2 = (m * m + s * s) * d0 - s * ((m + hi) * pb - (m + lo) * pa);
+    *o0 = al * d0 + be * d1;
+    *o1 = (al - be * o) * d1 + be * d2 - al * o * d0;
+}
+
+KERNEL_ATTR float vsgl__kernel_tent_nodes(const vsgl_tent_nodes *restrict t)
+{
+    float sum = 0.0f;
+    const float ih = t->ih, isv = t->isv, is_u = t->isu;
+    const float side0 = t->side[0], side1 = t->side[1];
+    for (int k = 0; k < VSGL__TENT_NODES; ++k) {
+        const float u = t->u[k];
+        const float mvu = t->pv + t->slope * (u - t->pu);
+        float cdf[3], ps[3];
+        for (int q = 0; q < 3; ++q) {
+            float z = (t->vb[q] - mvu) * isv;
+            z = z < -40.0f ? -40.0f : (z > 40.0f ? 40.0f : z);
+            float e = k_exp(-0.5f * z * z);
+            float tail = 0.5f * e * k_erfc_poly(fabsf(z) * 0.70710678f);
+            cdf[q] = z < 0.0f ? tail : 1.0f - tail;
+            ps[q] = 0.3989422804f * e;
+        }
+        float a0, a1, b0, b1;
+        k_lin_gauss(1.0f, ih, t->cv, mvu, t->sv, t->vb[0], t->vb[1], cdf[0], ps[0], cdf[1], ps[1], &a0, &a1);
+        k_lin_gauss(1.0f, -ih, t->cv, mvu, t->sv, t->vb[1], t->vb[2], cdf[1], ps[1], cdf[2], ps[2], &b0, &b1);
+        const float in0 = side0 * a0 + side1 * b0, in1 = side0 * a1 + side1 * b1;
+        float du = (u - t->pu) * is_u;
+        du = du < -40.0f ? -40.0f : (du > 40.0f ? 40.0f : du);
+        const float tu = 1.0f - fabsf(u) * ih;
+        sum += t->w[k] * k_exp(-0.5f * du * du) * tu * ((1.0f + t->g[0] * (u - t->cu)) * in0 + t->g[1] * in1);
     }
+    return sum;
 }

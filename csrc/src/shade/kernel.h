@@ -234,8 +234,19 @@ uint64_t vsgl__kernel_lanes_within(const float *w, const float *cut);
 void vsgl__kernel_vis_accumulate(const float *w, uint64_t traced, uint64_t visible, double *seen, double *lit);
 void vsgl__kernel_vis_fill(uint64_t skipped, uint64_t visible, const float *share, float *out);
 
-/* e[i] = e^{-z[i]^2 / 2} and cdf[i] = Phi(z[i]), i < n, vectorised (the
- * near field's specular footprint, near_field.c). z finite. */
-void vsgl__kernel_normal_cdf(const float *z, float *e, float *cdf, size_t n);
+/* One side of the near field's specular footprint (near_field.c,
+ * tent_mass): its Gauss-Legendre nodes u (weights w, 0 for unused ones)
+ * and what they share; vsgl__kernel_tent_nodes returns sum_k w_k x the
+ * integrand at u_k, vectorised. */
+#define VSGL__TENT_NODES 8
+typedef struct vsgl_tent_nodes {
+    float u[VSGL__TENT_NODES], w[VSGL__TENT_NODES];
+    float pu, pv, isu, slope, sv, isv; /* the footprint: mean, 1 / sd in u, v's regression on u, v's sd */
+    float ih;                          /* 1 / the lattice spacing */
+    float vb[3];                       /* the tent's support in v: low end, peak (clamped), high end */
+    float side[2];                     /* 1 where the tent in v has that side ([vb0, vb1], [vb1, vb2]), else 0 */
+    float cu, cv, g[2];                /* the irradiance's centroid and gradient */
+} vsgl_tent_nodes;
+float vsgl__kernel_tent_nodes(const vsgl_tent_nodes *t);
 
 #endif

@@ -7,7 +7,6 @@
 #include "shade/near_field.h"
 #include "shade/kernel.h"
 #include "math/constants.h"
-#include "math/normal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -209,25 +208,6 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
     return c->fit > 0.0f;
 }
 
-/* N(v; m, s^2) at a bound: its CDF and its density times s. */
-typedef struct gauss_at {
-    float cdf, ps;
-} gauss_at;
-
-/* The integral of (al + be v) (v - o)^j N(v; m, s^2) over [lo, hi], j = 0
- * (out[0]) and 1 (out[1]), from the CDF and density at the bounds (ga at
- * lo, gb at hi: gauss_bound). */
-static void lin_gauss(float al, float be, float o, float m, float s, float lo, float hi, gauss_at ga, gauss_at gb,
-                      float *out)
-{
-    float d0 = gb.cdf - ga.cdf;
-    float pa = ga.ps, pb = gb.ps;
-    float d1 = m * d0 - s * (pb - pa);                                   /* int v N */
-    float d2 = (m * m + s * s) * d0 - s * ((m + hi) * pb - (m + lo) * pa); /* int v^2 N */
-    out[0] = al * d0 + be * d1;
-    out[1] = (al - be * o) * d1 + be * d2 - al * o * d0;
-}
-
 /* A specular cell's footprint mass: the 2-D Gaussian of mean (pu, pv) and
  * covariance (cuu, cuv; cuv, cvv) over the cell's truncated tent times its
  * linear irradiance, 1 + grad . (y - centroid): Gauss-Legendre over u on
@@ -238,60 +218,38 @@ static float tent_mass(const vsgl_near_cell *c, float pu, float pv, float cuu, f
     static const float gx[VSGL__NEAR_GL / 2] = {0.1834346425f, 0.5255324099f, 0.7966664774f, 0.9602898565f};
     static const float gw[VSGL__NEAR_GL / 2] = {0.3626837834f, 0.3137066459f, 0.2223810345f, 0.1012285363f};
     static const float gx4[2] = {0.3399810436f, 0.8611363116f}, gw4[2] = {0.6521451549f, 0.3478548451f};
+    _Static_assert(VSGL__TENT_NODES == VSGL__NEAR_GL, "one kernel pass per side");
     /* (pu, pv), the tent's support and the centroid are relative to the
      * lattice point: a scene 100 km from the origin keeps its digits */
-    const float h = c->h, ih = 1.0f / h;
+    const float h = c->h;
     float su = sqrtf(cuu);
     if (!(su > 0.0f))
         return 0.0f;
     float slope = cuv / cuu, sv = sqrtf(fmaxf(cvv - cuv * slope, 1e-12f * cvv));
     const float ubreak[3] = {c->tlo[0], fminf(fmaxf(0.0f, c->tlo[0]), c->thi[0]), c->thi[0]};
-    const float vbreak[3] = {c->tlo[1], fminf(fmaxf(0.0f, c->tlo[1]), c->thi[1]), c->thi[1]};
-    const float isv = 1.0f / sv;
+    vsgl_tent_nodes t = {.pu = pu, .pv = pv, .isu = 1.0f / su, .slope = slope, .sv = sv, .isv = 1.0f / sv,
+                         .ih = 1.0f / h, .cu = c->centroid[0], .cv = c->centroid[1]};
+    t.vb[0] = c->tlo[1];
+    t.vb[1] = fminf(fmaxf(0.0f, c->tlo[1]), c->thi[1]);
+    t.vb[2] = c->thi[1];
+    t.side[0] = t.vb[1] > t.vb[0] ? 1.0f : 0.0f;
+    t.side[1] = t.vb[2] > t.vb[1] ? 1.0f : 0.0f;
+    t.g[0] = c->grad[0];
+    t.g[1] = c->grad[1];
     float sum = 0.0f;
     for (int side = 0; side < 2; ++side) {
         float u0 = fmaxf(ubreak[side], pu - 6.0f * su), u1 = fminf(ubreak[side + 1], pu + 6.0f * su);
         if (!(u1 > u0))
             continue;
-        float mid = 0.5f * (u0 + u1), half = 0.5f * (u1 - u0), part = 0.0f;
+        float mid = 0.5f * (u0 + u1), half = 0.5f * (u1 - u0);
         /* 4 nodes where the piece spans at most 3 sigma, 8 where it holds the peak and tails */
         const int nodes = u1 - u0 <= 3.0f * su ? 4 : VSGL__NEAR_GL;
         const float *xs = nodes == 4 ? gx4 : gx, *ws = nodes == 4 ? gw4 : gw;
-        /* every node's bounds in v and its own offset in u, standardised,
-         * through one vectorised pass of exps (kernel.c): row q < 3 the
-         * bound vbreak[q], row 3 the node's du; 8 columns, one per node */
-        float z[4 * VSGL__NEAR_GL], ez[4 * VSGL__NEAR_GL], cz[4 * VSGL__NEAR_GL], us[VSGL__NEAR_GL],
-            mv[VSGL__NEAR_GL];
         for (int k = 0; k < VSGL__NEAR_GL; ++k) {
-            float u = k < nodes ? mid + (k & 1 ? -half : half) * xs[k >> 1] : mid;
-            us[k] = u;
-            mv[k] = pv + slope * (u - pu);
-            for (int q = 0; q < 3; ++q)
-                z[q * VSGL__NEAR_GL + k] = fminf(fmaxf((vbreak[q] - mv[k]) * isv, -40.0f), 40.0f);
-            z[3 * VSGL__NEAR_GL + k] = fminf(fmaxf((u - pu) / su, -40.0f), 40.0f);
+            t.u[k] = k < nodes ? mid + (k & 1 ? -half : half) * xs[k >> 1] : mid;
+            t.w[k] = k < nodes ? ws[k >> 1] : 0.0f;
         }
-        vsgl__kernel_normal_cdf(z, ez, cz, 4 * VSGL__NEAR_GL);
-        for (int k = 0; k < nodes; ++k) {
-            float u = us[k], mvu = mv[k];
-            float tu = 1.0f - fabsf(u) * ih, in[2] = {0.0f, 0.0f};
-            gauss_at gb[3];
-            for (int q = 0; q < 3; ++q) {
-                gb[q].cdf = cz[q * VSGL__NEAR_GL + k];
-                gb[q].ps = 0.3989422804f * ez[q * VSGL__NEAR_GL + k];
-            }
-            for (int vs = 0; vs < 2; ++vs) {
-                if (!(vbreak[vs + 1] > vbreak[vs]))
-                    continue;
-                /* the tent in v on this side: 1 -+ (v - cv) / h = al + be v */
-                float be = vs ? -ih : ih, al = 1.0f, o[2];
-                lin_gauss(al, be, c->centroid[1], mvu, sv, vbreak[vs], vbreak[vs + 1], gb[vs], gb[vs + 1], o);
-                in[0] += o[0];
-                in[1] += o[1];
-            }
-            part += ws[k >> 1] * ez[3 * VSGL__NEAR_GL + k] * tu *
-                    ((1.0f + c->grad[0] * (u - c->centroid[0])) * in[0] + c->grad[1] * in[1]);
-        }
-        sum += part * half;
+        sum += vsgl__kernel_tent_nodes(&t) * half;
     }
     return sum / (su * 2.5066282746f);
 }
