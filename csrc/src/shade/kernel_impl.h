@@ -646,9 +646,10 @@ k_fold_axis(const vsgl_kernel_light *restrict L, int ax, int lo, int hi, float y
         return;
     const float i1 = 1.0f / (1.0f + f), isp = k_rsqrt_fine(f * i1);
     const float bl = L->fb[ax][0], bh = L->fb[ax][1], al = L->fa[ax][0], ah = L->fa[ax][1];
-    if (lo && hi) {
-        for (int q = 0; q < 3; ++q)
-            w[q] = k_fold_weight(bl, bh, al, ah, m[q], q, y, f, i1, isp);
+    if (lo && hi) { /* (no loop: a loop inside the lanes' loop stops its vectorisation) */
+        w[0] = k_fold_weight(bl, bh, al, ah, m[0], 0, y, f, i1, isp);
+        w[1] = k_fold_weight(bl, bh, al, ah, m[1], 1, y, f, i1, isp);
+        w[2] = k_fold_weight(bl, bh, al, ah, m[2], 2, y, f, i1, isp);
     } else if (lo) { /* ah = 0: wh = 1 */
         float tl0 = k_ncdf(((m[0] * f + y) * i1 - bl) * isp), tl1 = k_ncdf(((m[1] * f + y) * i1 - bl) * isp);
         w[0] = 1.0f - al + al * tl0;
@@ -671,17 +672,29 @@ k_fold(size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t, con
     float m1[3], m2[3], w1[3], w2[3];
     k_fold_axis(L, 0, cuts & 1, cuts & 2, d1, f1, m1, w1);
     k_fold_axis(L, 1, cuts & 4, cuts & 8, d2, f2, m2, w2);
-    /* the images of a side with a cut: 0 always, 1 below a low cut, 2 above a high one */
-    const int on1[3] = {1, cuts & 1, cuts & 2}, on2[3] = {1, cuts & 4, cuts & 8};
+    /* the images of a side with a cut: 0 always, 1 below a low cut, 2 above
+     * a high one; the terms unrolled, each under a constant condition */
     float sum = 0.0f;
-    for (int c = 0; c < 3; ++c)
-        for (int a = 0; a < 3; ++a) {
-            if (!on1[a] || !on2[c])
-                continue;
-            float e1 = d1 - m1[a], e2 = d2 - m2[c];
-            float q = (s22 * e1 * e1 - 2.0f * s12 * e1 * e2 + s11 * e2 * e2) * idet;
-            sum += w1[a] * w2[c] * k_exp(q > 0.0f ? -0.5f * q : 0.0f);
-        }
+#define K_FOLD_ON(ax, a) ((a) == 0 || (cuts & (1 << (2 * (ax) + (a) - 1))))
+#define K_FOLD_TERM(a, c)                                                                                       \
+    do {                                                                                                        \
+        if (K_FOLD_ON(0, a) && K_FOLD_ON(1, c)) {                                                               \
+            float e1 = d1 - m1[a], e2 = d2 - m2[c];                                                             \
+            float q = (s22 * e1 * e1 - 2.0f * s12 * e1 * e2 + s11 * e2 * e2) * idet;                            \
+            sum += w1[a] * w2[c] * k_exp(q > 0.0f ? -0.5f * q : 0.0f);                                         \
+        }                                                                                                       \
+    } while (0)
+    K_FOLD_TERM(0, 0);
+    K_FOLD_TERM(1, 0);
+    K_FOLD_TERM(2, 0);
+    K_FOLD_TERM(0, 1);
+    K_FOLD_TERM(1, 1);
+    K_FOLD_TERM(2, 1);
+    K_FOLD_TERM(0, 2);
+    K_FOLD_TERM(1, 2);
+    K_FOLD_TERM(2, 2);
+#undef K_FOLD_TERM
+#undef K_FOLD_ON
     t->ppre[i] *= (1.0f - L->fold) * k_exp(t->pexpo[i]) + L->fold * sum;
     t->pexpo[i] = 0.0f;
 }
