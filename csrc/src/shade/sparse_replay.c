@@ -494,6 +494,40 @@ static int32_t replay_direct1(void *user, size_t chunk, size_t b, size_t e)
     return r != 0 ? r : replay_fixup(user, chunk, b, e);
 }
 
+/* The lanes this replay made from the G-buffer (samples the record did
+ * not shade itself: a light edit moves the test's verdict along a shadow
+ * or a lit patch's edge), kept in the plan for the next replays: the
+ * next light edit shades mostly the same samples, and a lane's setup (the
+ * receiver's lobes, their horizon cut) is ~1 us. The same lane a fresh
+ * render would make, so the planes stay bit-identical. Up to
+ * PLAN_LANES_MAX_BYTES of lanes in all; past it, lanes are made per
+ * replay as before. */
+#define PLAN_LANES_MAX_BYTES ((size_t)64 << 20)
+static void keep_new_lanes(vsgl_shade_plan *plan, const sparse_batch *bt, size_t nd)
+{
+    size_t made = 0;
+    for (size_t k = 0; k < nd; ++k)
+        made += plan->dlane_of[bt->dlist[k]] < 0;
+    if (!made || (plan->ndlanes + made) * sizeof *plan->dlanes > PLAN_LANES_MAX_BYTES ||
+        plan->ndlanes + made >= (size_t)INT32_MAX)
+        return;
+    if (plan->ndlanes + made > plan->dlanes_cap) {
+        size_t cap = 2 * (plan->ndlanes + made) + 64;
+        vsgl__plan_lane *grown = realloc(plan->dlanes, cap * sizeof *grown);
+        if (!grown)
+            return; /* no memory: the next replay makes them again */
+        plan->dlanes = grown;
+        plan->dlanes_cap = cap;
+    }
+    for (size_t k = 0; k < nd; ++k) {
+        int32_t *d = &plan->dlane_of[bt->dlist[k]];
+        if (*d < 0) {
+            *d = (int32_t)plan->ndlanes;
+            plan->dlanes[plan->ndlanes++] = bt->lanes[k];
+        }
+    }
+}
+
 /* vsgl__shade_sparse_batch for a replay: interpolate and write what can be
  * (replay_rows), shade the rest in full kernel blocks (vsgl__sparse_direct), then
  * write their pixels (replay_fixup). */
@@ -557,6 +591,7 @@ vsgl_result vsgl__sparse_replay_batch(vsgl_context *ctx, shade_job *j, size_t ro
     }
     for (size_t c = 0; c < nd / SPARSE_CHUNK + 2; ++c)
         j->pairs[0] += bt.dpairs[c];
+    keep_new_lanes(plan, &bt, nd);
 done:
     free(bt.nmarks);
     free(bt.dlist);
