@@ -41,7 +41,7 @@ help:
 	@echo "make asan       C tests under AddressSanitizer + UBSan (clang)"
 	@echo "make bench      speed/memory benchmarks, reported as ratios"
 	@echo "make screenshots  the add-on's panels in Blender's UI under Xvfb -> docs/img/"
-	@echo "make lint       flake8 (setup.cfg) and cppcheck over the sources"
+	@echo "make lint       flake8 (setup.cfg), cppcheck over the sources, the kernel's loops vectorised"
 	@echo "make abi        regenerate the binding's ABI mirror (addon/vsgl_indirect/_libvsgl_abi.py) from the headers"
 
 deps:
@@ -121,6 +121,7 @@ lint:
 	/usr/bin/python3 -m flake8 addon tests tools
 	cppcheck --quiet --error-exitcode=1 --std=c11 --enable=warning,portability,performance --inline-suppr \
 	  -D__GNUC__ -I csrc/include -I csrc/src csrc/src csrc/cli
+	$(PYTHON) tools/check_vectorised.py --cc $(CC)
 
 # The binding's ABI mirror (enums, constants, structs, prototypes) from the
 # public headers; tests/python/test_layout.py fails when it is not current.

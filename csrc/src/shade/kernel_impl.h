@@ -675,7 +675,7 @@ k_fold(size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t, con
     /* the images of a side with a cut: 0 always, 1 below a low cut, 2 above
      * a high one; the terms unrolled, each under a constant condition */
     float sum = 0.0f;
-#define K_FOLD_ON(ax, a) ((a) == 0 || (cuts & (1 << (2 * (ax) + (a) - 1))))
+#define K_FOLD_ON(ax, a) ((a) == 0 || (cuts & (((a) == 1 ? 1 : 2) << (2 * (ax)))))
 #define K_FOLD_TERM(a, c)                                                                                       \
     do {                                                                                                        \
         if (K_FOLD_ON(0, a) && K_FOLD_ON(1, c)) {                                                               \
