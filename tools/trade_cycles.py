@@ -26,6 +26,7 @@ ROOT = os.path.normpath(os.path.join(HERE, ".."))
 for d in (os.path.join(ROOT, "tests", "quality"), os.path.join(ROOT, "tests", "blender"), os.path.join(ROOT, "addon")):
     sys.path.insert(0, d)
 import cycles_ref  # noqa: E402
+import cycles_textures  # noqa: E402
 import gbuffer_ref  # noqa: E402
 import refs  # noqa: E402
 import scenes  # noqa: E402
@@ -93,7 +94,7 @@ def main():
         if not todo:
             continue
         t0 = time.perf_counter()
-        cycles_ref.build_blender(c)
+        cycles_textures.apply_textures(c, cycles_ref.build_blender(c)[0])
         build = time.perf_counter() - t0
         exp = export_seconds()
         print("%s: built in %.1f s, add-on export %.3f s" % (name, build, exp), flush=True)

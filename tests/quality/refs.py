@@ -8,7 +8,8 @@ with the passes DiffInd, GlossInd, DiffCol, GlossCol (float32 (H, W, 3), row
 key = sha1 of (the scene as Blender renders it, resolution, samples, seed,
 Blender's version, the source of the functions that build and render it:
 cycles_ref.py's build_blender / blender_material / render_cycles / ... and
-render_refs.py's render_passes). Anything else in those files can change
+render_refs.py's render_passes; for a textured scene also those that make
+its textures, TEXTURE_CODE). Anything else in those files can change
 without re-rendering.
 
 `ensure(names, size)` renders what is missing by running
@@ -35,6 +36,13 @@ CODE = {
     os.path.join("tests", "blender", "cycles_ref.py"): ("_principled_defaults", "blender_material", "build_blender",
                                                         "render_cycles", "load_exr_rgb", "read_passes_exr"),
     os.path.join("tests", "quality", "render_refs.py"): ("render_passes",),
+}
+
+# the code that only textured scenes' renders run (their keys hash it too;
+# the others' keys do not, so adding textures re-rendered none of them)
+TEXTURE_CODE = {
+    os.path.join("tests", "blender", "cycles_textures.py"): ("apply_textures",),
+    os.path.join("tests", "quality", "scenes.py"): ("texture_pixels",),
 }
 
 
@@ -104,8 +112,11 @@ def blender_version(refdir=DEFAULT_DIR):
 
 def key(case, spp, seed, version, code=None):
     """The cache key of one reference render (case: scenes.case(...))."""
-    blob = json.dumps(dict(case=scenes.blender_case(case), spp=int(spp), seed=int(seed), version=version,
-                           code=code or code_digest()), sort_keys=True)
+    d = dict(case=scenes.blender_case(case), spp=int(spp), seed=int(seed), version=version,
+             code=code or code_digest())
+    if case.get("images"):
+        d["textures"] = code_digest(TEXTURE_CODE)
+    blob = json.dumps(d, sort_keys=True)
     return hashlib.sha1(blob.encode()).hexdigest()[:16]
 
 

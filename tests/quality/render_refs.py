@@ -37,6 +37,7 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "blender"))
 sys.path.insert(0, os.path.join(ROOT, "addon", "vsgl_indirect"))
 import cycles_ref  # noqa: E402  (guarded main: importing renders nothing)
 import libvsgl  # noqa: E402
+import cycles_textures  # noqa: E402
 import refs  # noqa: E402
 import scenes  # noqa: E402
 
@@ -80,6 +81,7 @@ def check_builder(name):
     a list of differences (empty: equal)."""
     c = scenes.case(name, "test")
     ob, lights, co, mats = cycles_ref.build_blender(c)
+    cycles_textures.apply_textures(c, ob)
     want = cycles_ref.library_arrays(ob, lights, co, mats, c["materials"])
     got = scenes.library_arrays(c, libvsgl)
     bad = []
@@ -142,7 +144,7 @@ def main():
                     print("cached %s" % os.path.basename(p), flush=True)
                     continue
                 if not built:
-                    cycles_ref.build_blender(c)
+                    cycles_textures.apply_textures(c, cycles_ref.build_blender(c)[0])
                     built = True
                 tmp = os.path.join(out, "tmp_%d" % os.getpid())
                 t0 = time.time()

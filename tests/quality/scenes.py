@@ -6,7 +6,10 @@ builds in Blender (`build_blender`):
     geometry:  list of dict(quad=[4 points], mat=name) or
                dict(tris=[[3 points], ...], normals=[[3 normals], ...] or None, mat=name)
                (normals: per-corner shading normals; the entry is smooth-shaded)
-    materials: {name: dict(kind=diffuse|glossy|metal|principled|lambert_spec, color, roughness, ...)}
+    materials: {name: dict(kind=diffuse|glossy|metal|principled|lambert_spec, color, roughness, ...,
+               texture=image name: the image's RGB multiplies `color` (linear, bilinear, repeat))}
+    images:    {name: dict(kind=planks|stripes|checker, size=(W, H), ...)} (optional): generated
+               by texture_pixels; quads of a textured material carry uv=[4 (u, v)]
     lights:    list of dict(type=POINT|SPOT|SUN|AREA, energy, loc, rot (Euler XYZ degrees), ...)
     camera:    dict(type=PERSP|ORTHO, lens | ortho_scale, loc, rot, res=(W, H))
 
@@ -58,8 +61,55 @@ def look_rot(eye, target):
     return _r((a, 0.0, c), 4)
 
 
-def quad(p0, p1, p2, p3, mat):
-    return dict(quad=[_r(p0), _r(p1), _r(p2), _r(p3)], mat=mat)
+def quad(p0, p1, p2, p3, mat, uv=None):
+    q = dict(quad=[_r(p0), _r(p1), _r(p2), _r(p3)], mat=mat)
+    if uv is not None:
+        q["uv"] = [_r(t) for t in uv]
+    return q
+
+
+def quad_uv(q, tile):
+    """Quad q with UVs of `tile` m per repeat along its first and last edges (p0 -> p1, p0 -> p3)."""
+    P = np.asarray(q["quad"], np.float64)
+    a, b = np.linalg.norm(P[1] - P[0]) / tile, np.linalg.norm(P[3] - P[0]) / tile
+    return dict(q, uv=[_r(t) for t in ((0.0, 0.0), (a, 0.0), (a, b), (0.0, b))])
+
+
+def texture_pixels(spec):
+    """An image of the scene's `images` table as (H, W, 4) float32 linear RGBA,
+    rows bottom to top (Blender's Image.pixels order, the library's too):
+    deterministic, from the spec alone (the cache key hashes the spec).
+    planks: boards along u of `boards` per image, each its own tone of
+    `color` times 0.7-1.3 (a fixed sequence) with dark seams; stripes:
+    vertical bands alternating `colors` (`bands` per image); checker:
+    `cells` x `cells` squares of the two `colors`."""
+    w, h = spec["size"]
+    u = (np.arange(w) + 0.5) / w
+    v = (np.arange(h) + 0.5) / h
+    U, V = np.meshgrid(u, v)
+    k = spec["kind"]
+    if k == "planks":
+        n = spec["boards"]
+        board = np.minimum((V * n).astype(int), n - 1)
+        tone = 0.7 + 0.6 * ((np.arange(n) * 0.618034) % 1.0)
+        grain = 0.92 + 0.08 * np.sin(U * 2 * np.pi * 7 + board * 1.7)
+        seam = (np.abs((V * n) - np.round(V * n)) < 0.04).astype(np.float64)
+        f = tone[board] * grain * (1.0 - 0.6 * seam)
+        rgb = f[..., None] * np.asarray(spec["color"], np.float64)
+    elif k == "stripes":
+        c = np.asarray(spec["colors"], np.float64)
+        idx = np.minimum((U * spec["bands"]).astype(int), spec["bands"] - 1) % len(c)
+        rgb = c[idx]
+    elif k == "checker":
+        c = np.asarray(spec["colors"], np.float64)
+        n = spec["cells"]
+        idx = ((U * n).astype(int) + (V * n).astype(int)) % 2
+        rgb = c[idx]
+    else:
+        raise ValueError("unknown image kind %r" % k)
+    out = np.ones((h, w, 4), np.float32)
+    out[..., :3] = np.clip(rgb, 0.0, 1.0)
+    return out
 
 
 def box_room(x0, x1, y0, y1, z0, z1, mats):
@@ -382,12 +432,48 @@ def _dense_floor():
     )
 
 
+def _textured_interior():
+    # 4 x 5 x 2.8 m room: a spot aimed at the back wall's striped wallpaper,
+    # a blue-and-yellow checker on the left wall, a varnished plank floor
+    # (textured diffuse + a GGX specular layer, roughness 0.3) that reflects
+    # them; the patterns bleed onto the floor and ceiling
+    mats = dict(floor="planks", ceiling="ceiling", left="checker", right="wall", back="wallpaper", front="wall")
+    geo = box_room(-2, 2, -2.5, 2.5, 0, 2.8, mats)
+    tiles = dict(planks=1.0, checker=1.4, wallpaper=0.9)
+    geo = [quad_uv(q, tiles[q["mat"]]) if q["mat"] in tiles else q for q in geo]
+    spot_loc, spot_target = (0.6, -0.8, 2.6), (-0.2, 2.5, 1.3)
+    cam_loc, cam_target = (0.5137, -2.3, 1.5), (-0.3, 2.5, 0.8)
+    return dict(
+        name="textured_interior",
+        feature="a textured interior: a spot lights a striped wallpaper (red / cream) that bleeds its mean "
+                "colour onto a varnished plank floor (textured base colour, GGX specular, roughness 0.3), "
+                "which reflects it; a blue / yellow checker wall (issue 11: a textured interior)",
+        images=dict(planks=dict(kind="planks", size=(64, 64), boards=6, color=(0.55, 0.36, 0.2)),
+                    stripes=dict(kind="stripes", size=(64, 8), bands=8,
+                                 colors=((0.75, 0.12, 0.1), (0.85, 0.8, 0.65))),
+                    checker=dict(kind="checker", size=(32, 32), cells=4,
+                                 colors=((0.1, 0.2, 0.7), (0.85, 0.75, 0.15)))),
+        materials=dict(planks=dict(kind="lambert_spec", color=(1.0, 1.0, 1.0), roughness=0.3, texture="planks"),
+                       wallpaper=dict(kind="diffuse", color=(1.0, 1.0, 1.0), texture="stripes"),
+                       checker=dict(kind="diffuse", color=(1.0, 1.0, 1.0), texture="checker"),
+                       wall=WHITE, ceiling=WHITE),
+        geometry=geo,
+        lights=[dict(type="SPOT", energy=2000.0, loc=spot_loc, rot=look_rot(spot_loc, spot_target),
+                     spot_size=55.0, spot_blend=0.3)],
+        camera=dict(type="PERSP", lens=18.0, loc=cam_loc, rot=look_rot(cam_loc, cam_target)),
+        convex=True,  # an empty closed box: every surface sees every other
+        extent=5.0,
+        light_motion=dict(light=0, loc=(1.0, 0.0, 0.0)),
+        camera_motion=dict(loc=(1.0, 0.0, 0.0)),
+    )
+
+
 _BUILDERS = [_spot_metal_floor, _metal_floor_red_wall, _box_point_area_glossy_green, _glossy_sphere_floor,
              _sun_opening, _sun_opening_thick]
 NAMES = [b.__name__[1:] for b in _BUILDERS]
 # scenes of the trade measurement only (tools/trade.py, issue 11): not in the
 # quality suite (NAMES), which `make test` runs
-_TRADE_BUILDERS = [_brushed_metal_floor, _dense_floor]
+_TRADE_BUILDERS = [_brushed_metal_floor, _dense_floor, _textured_interior]
 # several lights (issue 11's per-light budget; with box_point_area_glossy_green)
 _MULTI_LIGHT_BUILDERS = [_spot_fill_metal_floor, _sun_lamp_opening, _red_wall_two_spots]
 _TRADE_BUILDERS = _TRADE_BUILDERS + _MULTI_LIGHT_BUILDERS
@@ -427,7 +513,10 @@ def case(name, size="test"):
 
 def blender_case(s):
     """Only what Blender renders (the cache key hashes this)."""
-    return {k: s[k] for k in ("geometry", "materials", "lights", "camera")}
+    out = {k: s[k] for k in ("geometry", "materials", "lights", "camera")}
+    if s.get("images"):  # only textured scenes: the others' keys stay as they were
+        out["images"] = s["images"]
+    return out
 
 
 # ---------------------------------------------------------------------------
@@ -601,7 +690,37 @@ def library_arrays(s, L):
                camera=library_camera(L, s["camera"]))
     if any(m.get("anisotropy", 0.0) for m in s["materials"].values()):
         out["corner_tangents"] = radial_tangents(out["positions"], out["indices"])
+    if s.get("images"):
+        out.update(library_textures(L, s, order))
     return out
+
+
+def library_textures(L, s, order):
+    """corner_uvs, textures and material_textures of a textured scene: each
+    textured material's base colour reads its image (linear, bilinear,
+    repeat), as an Image Texture node linked straight into the colour input
+    (tests/blender/cycles_textures.py) with the input's constant 1."""
+    names = sorted(s["images"])
+    uvs = []
+    for g in s["geometry"]:
+        polys = [g["quad"]] if "quad" in g else g["tris"]
+        uv = g.get("uv")
+        for poly in polys:
+            t = uv if uv is not None else [(0.0, 0.0)] * len(poly)
+            for j in range(1, len(poly) - 1):
+                uvs.append([t[0], t[j], t[j + 1]])
+    mts = []
+    for n in order:
+        mt = L.MaterialTextures()
+        img = s["materials"][n].get("texture")
+        if img is not None:
+            mt.base_color.texture = names.index(img) + 1
+            mt.base_color.filter = L.FILTER_LINEAR
+            mt.base_color.wrap = L.WRAP_REPEAT
+        mts.append(mt)
+    return dict(corner_uvs=np.ascontiguousarray(uvs, np.float32),
+                textures=[texture_pixels(s["images"][k]) for k in names],
+                material_textures=mts)
 
 
 def radial_tangents(positions, indices):
