@@ -60,7 +60,7 @@ import scenes  # noqa: E402
 from vsgl_indirect import engine  # noqa: E402  (the add-on's EXR passes)
 
 SCENES = ["spot_metal_floor", "sun_opening", "box_point_area_glossy_green", "glossy_sphere_floor",
-          "brushed_metal_floor", "dense_floor"]
+          "brushed_metal_floor", "dense_floor", "textured_interior"]
 QUICK_SCENES = ["spot_metal_floor", "box_point_area_glossy_green"]
 SPP = [1, 2, 4, 8, 16, 64, 256, 1024]
 QUICK_SPP = [1, 4, 16]
