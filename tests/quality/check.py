@@ -163,6 +163,20 @@ def feature_checks(name, ref, cnt):
         cnt.check(inside > 0.01 and ceil > 0.01,
                   "feature %s: the sun enters through the window (%.1f %% of its RSM flux lands on the floor inside, "
                   "> 1 %%) and lights the room (ceiling Diff %.3f, > 0.01)" % (name, 100 * inside, ceil))
+    elif name == "textured_interior":
+        d = ref["Diff"]
+        cl, fl, wp = m == idx["ceiling"], m == idx["planks"], m == idx["wallpaper"]
+        ce = float(d[cl][:, 0].mean() / max(d[cl][:, 1].mean(), 1e-9))
+        fg = ref["Gloss"][fl]
+        rg = float(fg[:, 0].sum() / max(fg[:, 1].sum(), 1e-9))
+        gl = float(fg.sum() / max(d[fl].sum(), 1e-9))
+        gr = d[wp][:, 1] / np.maximum(d[wp][:, 0], 1e-9)
+        spread = float(np.percentile(gr, 95) - np.percentile(gr, 5))
+        cnt.check(spread > 0.3 and ce > 1.3 and rg > 1.3 and gl > 0.2,
+                  "feature %s: the wallpaper's stripes are in view (its Diff G/R spans %.2f between the 5th and "
+                  "95th percentiles, > 0.3), its red bleeds onto the white ceiling (Diff R/G %.2f, > 1.3) and the "
+                  "varnished planks reflect it (floor Gloss R/G %.2f, > 1.3; Gloss %.2f x the floor's Diff, > 0.2)"
+                  % (name, spread, ce, rg, gl))
     print("INFO %s: %d wall/ceiling and %d wall/floor junction pixels in view" % (name, junction_ceiling,
                                                                                   junction_floor))
 
