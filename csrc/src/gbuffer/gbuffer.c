@@ -147,7 +147,7 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
                 ry[k] = (float)row + ((float)(s / aa) + 0.5f) * inv;
                 dst[k] = base + (size_t)col * spp + s;
             }
-            vsgl__gbuffer_trace(j, g, m, rx, ry, dst, inv);
+            vsgl__gbuffer_trace(j, g, m, rx, ry, dst, vsgl__texture_footprint(inv));
         }
         /* slots beyond the grid (one sample per pixel, refined): empty until an edge fills them */
         for (uint32_t col = 0; spp > grid && col < width; ++col)
