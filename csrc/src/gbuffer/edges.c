@@ -287,7 +287,7 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint3
             ry[k] = (float)y + ((float)(s / E) + 0.5f) * inv;
             dst[k] = s;
         }
-        /* the texture footprint of a first-pass sample (gbuffer_internal.h) */
+        /* the texture footprint of a first-pass sample (gbuffer/trace.h) */
         vsgl__gbuffer_trace(job, sub, m, rx, ry, dst, vsgl__texture_footprint(1.0f / (float)job->aa));
     }
     size_t founder[VSGL__GBUFFER_MAX_SPP];
