@@ -30,12 +30,7 @@ def apply_textures(case, ob):
         return
     me = ob.data
     layer = me.uv_layers.new(name="UVMap")
-    uv = []
-    for g in case["geometry"]:
-        polys = [g["quad"]] if "quad" in g else g["tris"]
-        t = g.get("uv")
-        for poly in polys:
-            uv += [tuple(map(float, p)) for p in (t if t is not None else [(0.0, 0.0)] * len(poly))]
+    uv = [p for t in scenes.polygon_uvs(case) for p in t]
     layer.data.foreach_set("uv", np.asarray(uv, np.float32).reshape(-1))
     images = {}
     for name, spec in sorted(case["images"].items()):

@@ -42,7 +42,7 @@ CODE = {
 # the others' keys do not, so adding textures re-rendered none of them)
 TEXTURE_CODE = {
     os.path.join("tests", "blender", "cycles_textures.py"): ("apply_textures",),
-    os.path.join("tests", "quality", "scenes.py"): ("texture_pixels",),
+    os.path.join("tests", "quality", "scenes.py"): ("texture_pixels", "polygon_uvs"),
 }
 
 

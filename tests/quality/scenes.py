@@ -695,20 +695,25 @@ def library_arrays(s, L):
     return out
 
 
+def polygon_uvs(s):
+    """Each polygon's corner UVs, in the order build_blender makes the
+    polygons ((0, 0) where an entry has none): the library fans them into
+    triangles (library_textures), Blender takes them per loop
+    (tests/blender/cycles_textures.py)."""
+    for g in s["geometry"]:
+        polys = [g["quad"]] if "quad" in g else g["tris"]
+        uv = g.get("uv")
+        for poly in polys:
+            yield uv if uv is not None else [(0.0, 0.0)] * len(poly)
+
+
 def library_textures(L, s, order):
     """corner_uvs, textures and material_textures of a textured scene: each
     textured material's base colour reads its image (linear, bilinear,
     repeat), as an Image Texture node linked straight into the colour input
     (tests/blender/cycles_textures.py) with the input's constant 1."""
     names = sorted(s["images"])
-    uvs = []
-    for g in s["geometry"]:
-        polys = [g["quad"]] if "quad" in g else g["tris"]
-        uv = g.get("uv")
-        for poly in polys:
-            t = uv if uv is not None else [(0.0, 0.0)] * len(poly)
-            for j in range(1, len(poly) - 1):
-                uvs.append([t[0], t[j], t[j + 1]])
+    uvs = [[t[0], t[j], t[j + 1]] for t in polygon_uvs(s) for j in range(1, len(t) - 1)]
     mts = []
     for n in order:
         mt = L.MaterialTextures()
