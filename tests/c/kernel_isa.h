@@ -7,12 +7,12 @@
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #  define KERNEL_ISA_CLONES 1
-void test_kernel_isa_v4(vsgl_kernel_block *b, const vsgl_kernel_light *L, size_t count, const float *visibility,
-                        int32_t diffuse_mode, int32_t lobes);
-void test_kernel_isa_v3(vsgl_kernel_block *b, const vsgl_kernel_light *L, size_t count, const float *visibility,
-                        int32_t diffuse_mode, int32_t lobes);
-void test_kernel_isa_base(vsgl_kernel_block *b, const vsgl_kernel_light *L, size_t count, const float *visibility,
-                          int32_t diffuse_mode, int32_t lobes);
+size_t test_kernel_isa_v4(vsgl_kernel_block *b, const vsgl_kernel_light *L, size_t count, const float *visibility,
+                          int32_t diffuse_mode, int32_t lobes, float faint);
+size_t test_kernel_isa_v3(vsgl_kernel_block *b, const vsgl_kernel_light *L, size_t count, const float *visibility,
+                          int32_t diffuse_mode, int32_t lobes, float faint);
+size_t test_kernel_isa_base(vsgl_kernel_block *b, const vsgl_kernel_light *L, size_t count, const float *visibility,
+                            int32_t diffuse_mode, int32_t lobes, float faint);
 #else
 #  define KERNEL_ISA_CLONES 0
 #endif

@@ -222,7 +222,8 @@ static void random_light(vt_rng *r, vsgl_kernel_light *o, int sharp)
 VT_TEST(kernel_isa_clones_agree_with_scalar_build)
 {
 #if KERNEL_ISA_CLONES
-    typedef void (*kfn)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t);
+    typedef size_t (*kfn)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t,
+                           float);
     kfn fns[3] = {test_kernel_isa_base, test_kernel_isa_v3, test_kernel_isa_v4};
     const char *names[3] = {"x86-64", "x86-64-v3", "x86-64-v4"};
     int have[3] = {1, __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"),
@@ -254,7 +255,7 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
             for (int withvis = 0; withvis < 2; ++withvis) {
                 ref = base;
                 for (int k = 0; k < 8; ++k) /* one at a time */
-                    vsgl__kernel_shade_scalar(&ref, &L[k], 1, withvis ? vis + k * VSGL__KERNEL_BLOCK : NULL, mode, lob);
+                    vsgl__kernel_shade_scalar(&ref, &L[k], 1, withvis ? vis + k * VSGL__KERNEL_BLOCK : NULL, mode, lob, 0.0f);
                 double scale = 0.0;
                 for (int c = 0; c < 3; ++c)
                     for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k)
@@ -263,8 +264,8 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
                     if (!have[f])
                         continue;
                     got = base;
-                    fns[f](&got, L, 7, withvis ? vis : NULL, mode, lob); /* in pairs, one left over */
-                    fns[f](&got, L + 7, 1, withvis ? vis + 7 * VSGL__KERNEL_BLOCK : NULL, mode, lob);
+                    fns[f](&got, L, 7, withvis ? vis : NULL, mode, lob, 0.0f); /* in pairs, one left over */
+                    fns[f](&got, L + 7, 1, withvis ? vis + 7 * VSGL__KERNEL_BLOCK : NULL, mode, lob, 0.0f);
                     for (int c = 0; c < 3; ++c)
                         for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k) {
                             double ed = fabs((double)got.ld[c][k] - ref.ld[c][k]) / (fabs(ref.ld[c][k]) + 1e-6 * scale);
@@ -332,8 +333,8 @@ VT_TEST(kernel_receiver_at_a_planar_clusters_mean_is_finite)
     }
     const int32_t lob = VSGL__KERNEL_DIFFUSE | VSGL__KERNEL_GLOSSY | VSGL__KERNEL_GGX_TAIL;
     ref = b;
-    vsgl__kernel_shade(&b, &L, 1, NULL, VSGL_COSINE_PULLED_OUT, lob);
-    vsgl__kernel_shade_scalar(&ref, &L, 1, NULL, VSGL_COSINE_PULLED_OUT, lob);
+    vsgl__kernel_shade(&b, &L, 1, NULL, VSGL_COSINE_PULLED_OUT, lob, 0.0f);
+    vsgl__kernel_shade_scalar(&ref, &L, 1, NULL, VSGL_COSINE_PULLED_OUT, lob, 0.0f);
     int bad = 0, lit = 0;
     for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k)
         for (int c = 0; c < 3; ++c) {
@@ -342,4 +343,90 @@ VT_TEST(kernel_receiver_at_a_planar_clusters_mean_is_finite)
         }
     VT_CHECK(bad == 0, "%d non-finite outputs (lane 0 glossy %g, scalar build %g)", bad, b.ls[0][0], ref.ls[0][0]);
     VT_CHECK(lit > 0, "no lane got glossy light: the block does not reach the half-vector model");
+}
+
+/* The faint skip (VSGL__FAINT, kernel_impl.h k_faint): a small specular
+ * cluster with a sharp lobe aimed away from a block of diffuse receivers
+ * that face it is skipped there, and what it skips is at most about that
+ * share of what it gives each receiver when aimed at it; aimed at the
+ * block it is shaded exactly as without the skip; a planar cluster is never
+ * skipped. Far receivers of a small cluster (ls >> lv): the incident lobe's
+ * sharpness is the same whichever way the lobe points, so the amplitude's
+ * share is the light's. */
+VT_TEST(kernel_faint_vsgls_skip_at_most_their_share)
+{
+    static vsgl_kernel_block base, b, off, peak;
+    vsgl_kernel_light L;
+    memset(&L, 0, sizeof L);
+    L.mx = 0.0f; L.my = 0.0f; L.mz = 2.0f;
+    L.var = 1e-6f; L.pvar = L.var; L.var2 = 2.0f * L.var; L.ivar = 1.0f / L.var; L.valid = 1.0f;
+    L.nz = -1.0f; L.u1x = 1.0f; L.u2y = 1.0f;
+    L.lv = 500.0f;
+    L.c0 = 1.0f / (6.2831853f * vsgl_sg_integral(L.lv));
+    L.pr = L.pg = L.pb = 1.0f;
+    L.ibehind = 1.0f / (0.02f * sqrtf(L.var));
+    memset(&base, 0, sizeof base);
+    vt_rng r = {5};
+    for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k) { /* a patch of floor below it, facing up */
+        base.x[k] = (float)(0.4 * vt_uniform(&r) - 0.2);
+        base.y[k] = (float)(0.4 * vt_uniform(&r) - 0.2);
+        base.nz[k] = 1.0f;
+        base.diffuse[k] = 1.0f;
+        base.Xx[k] = 1.0f; base.Yy[k] = 1.0f; base.Zz[k] = 1.0f;
+    }
+    const int32_t lob = VSGL__KERNEL_DIFFUSE;
+    int checked = 0;
+    for (int aim = 0; aim < 8; ++aim) {
+        /* the lobe tilted off the block's centre by 10..45 degrees */
+        double th = (10.0 + 5.0 * aim) * 3.14159265 / 180.0;
+        vsgl_kernel_light A = L;
+        A.ax = (float)sin(th); A.az = (float)cos(th); /* -axis: the block sees the lobe's axis at th */
+        A.lax = A.lv * A.ax; A.laz = A.lv * A.az;
+        b = base; off = base;
+        size_t sk = vsgl__kernel_shade(&b, &A, 1, NULL, VSGL_COSINE_PULLED_OUT, lob, VSGL__FAINT);
+        size_t sk0 = vsgl__kernel_shade(&off, &A, 1, NULL, VSGL_COSINE_PULLED_OUT, lob, 0.0f);
+        VT_CHECK(sk0 == 0, "faint 0 skipped %zu VSGLs", sk0);
+        /* the largest share over the lanes, each against the lobe aimed at it */
+        double share = 0.0;
+        for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k) {
+            vsgl_kernel_light P = L;
+            float dx = L.mx - base.x[k], dy = L.my - base.y[k], dz = L.mz - base.z[k];
+            float dn = sqrtf(dx * dx + dy * dy + dz * dz);
+            P.ax = dx / dn; P.ay = dy / dn; P.az = dz / dn;
+            P.lax = P.lv * P.ax; P.lay = P.lv * P.ay; P.laz = P.lv * P.az;
+            peak = base;
+            vsgl__kernel_shade(&peak, &P, 1, NULL, VSGL_COSINE_PULLED_OUT, lob, 0.0f);
+            share = fmax(share, off.ld[0][k] / peak.ld[0][k]);
+        }
+        if (share < 0.5 * VSGL__FAINT) {
+            VT_CHECK(sk == 1, "aim %d: the lobe gives at most %.3g of its peak at every lane, not skipped", aim, share);
+        }
+        if (sk == 1) {
+            ++checked;
+            VT_CHECK(share <= 1.05 * VSGL__FAINT, "aim %d: skipped, yet a lane gets %.3g of its peak (> %g)", aim,
+                     share, (double)VSGL__FAINT);
+            double sum = 0.0;
+            for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k)
+                sum += b.ld[0][k] + b.ld[1][k] + b.ld[2][k];
+            VT_CHECK(sum == 0.0, "aim %d: skipped, yet the block got light %g", aim, sum);
+        } else {
+            VT_CHECK(memcmp(&b, &off, sizeof b) == 0, "aim %d: not skipped, yet the block differs from faint 0", aim);
+        }
+    }
+    VT_CHECK(checked >= 3, "only %d of the 8 aims were skipped: the test no longer reaches the skip", checked);
+    /* aimed at the block: shaded, bit for bit as without the skip */
+    vsgl_kernel_light A = L;
+    A.az = 1.0f; A.laz = A.lv;
+    b = base; off = base;
+    VT_CHECK(vsgl__kernel_shade(&b, &A, 1, NULL, VSGL_COSINE_PULLED_OUT, lob, VSGL__FAINT) == 0,
+             "a lobe aimed at the block was skipped");
+    vsgl__kernel_shade(&off, &A, 1, NULL, VSGL_COSINE_PULLED_OUT, lob, 0.0f);
+    VT_CHECK(memcmp(&b, &off, sizeof b) == 0, "aimed at the block: the skip changed the light");
+    /* a planar cluster aimed away: never skipped (its planar model does not scale with the amplitude) */
+    A = L;
+    A.ax = 1.0f; A.lax = A.lv;
+    A.planar = 1.0f; A.clip = 1.0f; A.conv = 1.0f;
+    b = base;
+    VT_CHECK(vsgl__kernel_shade(&b, &A, 1, NULL, VSGL_COSINE_PULLED_OUT, lob | VSGL__KERNEL_GLOSSY, VSGL__FAINT) == 0,
+             "a planar cluster was skipped");
 }

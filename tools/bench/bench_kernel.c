@@ -90,7 +90,7 @@ int main(int argc, char **argv)
                 memset(b.ls, 0, sizeof b.ls);
                 double t0 = now();
                 for (int r = 0; r < reps; ++r)
-                    vsgl__kernel_shade(&b, L, NL, NULL, mode, lobes);
+                    vsgl__kernel_shade(&b, L, NL, NULL, mode, lobes, 0.0f);
                 double dt = now() - t0;
                 best = dt < best ? dt : best;
             }

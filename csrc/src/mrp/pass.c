@@ -101,7 +101,7 @@ vsgl_result vsgl__mrp_hybrid_pass(vsgl_context *ctx, const vsgl_scene *scene, co
     vsgl_pixel_planes pq = {buf, buf + 3 * pixels, buf + 6 * pixels, buf + 9 * pixels, buf + 12 * pixels};
     if (r == VSGL_OK && q.count) {
         uint64_t pairs = 0;
-        r = vsgl__shade_planned(ctx, scene, g, &q, s, &pq, VSGL__SHADE_KERNEL, &pairs, NULL);
+        r = vsgl__shade_planned(ctx, scene, g, &q, s, &pq, VSGL__SHADE_KERNEL, &pairs, NULL, NULL);
     }
     if (r == VSGL_OK)
         r = run_pass(ctx, scene, s->rsm_resolution, sp, g, planes, pq.glossy, lit != NULL);

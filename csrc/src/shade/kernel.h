@@ -198,11 +198,18 @@ static inline int vsgl__hv_lobe_set(int count, const float **k, const float **c)
  * receiver and ignores their sums), in that order. Diffuse modes as in
  * vsgl/sg.h (VSGL_COSINE_*); the glossy lobe is the block's ASG.
  * visibility: NULL or count x VSGL__KERNEL_BLOCK factors in [0, 1]
- * (VSGL-major). */
-void vsgl__kernel_shade(vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count,
-                        const float *visibility, int32_t diffuse_mode, int32_t lobes);
-void vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count,
-                               const float *visibility, int32_t diffuse_mode, int32_t lobes);
+ * (VSGL-major). faint in (0, 1): a VSGL (not a planar cluster) whose
+ * radiant intensity towards every lane is below that share of its peak
+ * adds nothing to the block (kernel_impl.h, k_faint); 0: every pair is
+ * shaded. Returns how many of the VSGLs were faint. The renderer passes
+ * VSGL__FAINT: in the bundled rooms at 960 x 540 it skips most of the
+ * specular VSGLs' pairs and changes the image by a relative RMS of
+ * ~4e-6 (docs/pipeline.md, "Faint pairs"). */
+#define VSGL__FAINT 1e-4f
+size_t vsgl__kernel_shade(vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count,
+                          const float *visibility, int32_t diffuse_mode, int32_t lobes, float faint);
+size_t vsgl__kernel_shade_scalar(vsgl_kernel_block *b, const vsgl_kernel_light *lights, size_t count,
+                                 const float *visibility, int32_t diffuse_mode, int32_t lobes, float faint);
 
 /* The visibility budget's order of importance (shade.c): the light of each
  * of lights[0, count) at the block's receivers (every lane; padding lanes

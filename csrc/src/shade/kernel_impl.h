@@ -729,13 +729,152 @@ k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
         for (int j = 0; j < NL; ++j)                   \
             STMT
 
+/* A VSGL that is faint at every lane of the block: its radiant intensity
+ * towards each lane (the amplitude's exponent, k_exponent) below e^lcut of
+ * its peak. The stages after the amplitude then add less than that share
+ * of what it would add in its lobe's direction, and are skipped: an SG's
+ * light beyond where it falls to e^lcut is about that share of all of it
+ * (docs/pipeline.md, "Faint pairs"). Only where every term scales with
+ * the amplitude: not for planar clusters (L->planar > 0), whose planar
+ * and half-vector models take the cluster's plane. */
+static inline __attribute__((always_inline)) int k_faint(const vsgl_kernel_light *restrict L,
+                                                         const k_scratch *restrict t, float lcut)
+{
+    if (L->planar > 0.0f)
+        return 0;
+    float m = -1e30f;
+    for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
+        m = t->expo[i] > m ? t->expo[i] : m;
+    return m < lcut;
+}
+
+/* The diffuse stages of VSGLs L[0, NL) (k_shade). */
 static inline __attribute__((always_inline)) void
-k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, const int NL,
-        const float *restrict visibility, int32_t mode, int32_t lobes, k_scratch *restrict t)
+k_diffuse_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, const int NL, int32_t mode,
+                 k_scratch *restrict t)
 {
     /* the poster's SG-cosine lobe: constants (no call on the hot path) */
     const float ld_sharp = VSGL__COSINE_SHARPNESS;
     const float ld_norm = VSGL__PI / k_sg_integral(VSGL__COSINE_SHARPNESS);
+    /* blocks where every incident lobe is sharp take short forms */
+    float lmin = K_SHARP_MAX;
+    K_FORN(lmin = t[j].lin[i] < lmin ? t[j].lin[i] : lmin);
+    int sharp = lmin >= K_SHARP_COSINE;
+    /* one loop per form, the form a constant in each */
+#define K_DIFFUSE(FORM) K_FORN(k_diffuse(b, i, L + j, (FORM), t + j, ld_sharp, ld_norm))
+    switch (mode) {
+    case VSGL_COSINE_SG:
+        if (sharp) K_DIFFUSE(K_COSINE_SG_SHARP); else K_DIFFUSE(VSGL_COSINE_SG);
+        break;
+    case VSGL_COSINE_PULLED_OUT:
+        if (sharp) K_DIFFUSE(K_COSINE_PULLED_OUT_SHARP); else K_DIFFUSE(VSGL_COSINE_PULLED_OUT);
+        break;
+    default:
+        if (sharp) {
+            K_FORN(k_cosine_stage_sharp(i, t + j));
+            K_DIFFUSE(K_COSINE_ACCURATE_SHARP);
+        } else {
+            K_FORN(k_cosine_stage(i, t + j));
+            K_DIFFUSE(VSGL_COSINE_ACCURATE);
+        }
+        break;
+    }
+#undef K_DIFFUSE
+}
+
+/* The glossy stages of VSGLs L[0, NL) (k_shade). */
+static inline __attribute__((always_inline)) void
+k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, const int NL, int32_t lobes,
+                k_scratch *restrict t)
+{
+    /* the SG model, the planar one (coherent diffuse clusters) or a blend */
+    int all_planar = 1, none_planar = 1;
+    for (int j = 0; j < NL; ++j) {
+        all_planar &= L[j].planar == 1.0f;
+        none_planar &= L[j].planar == 0.0f;
+    }
+    /* one ASG, or GGX's core and tail as two (kernel.h, VSGL__KERNEL_GGX_TAIL) */
+    const int two = (lobes & VSGL__KERNEL_GGX_TAIL) != 0;
+    /* with GGX as lobes, planar clusters that subtend little are taken
+     * by the half-vector model (kernel.h VSGL__HV_*) */
+    int hv = 0, hv_all = 1;
+    if (two && !none_planar) {
+        K_FORN(k_hv_shared(b, i, L + j, t + j));
+        for (int j = 0; j < NL; ++j)
+            for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) {
+                hv |= t[j].hvw[i] > 0.0f;
+                hv_all &= t[j].hvw[i] == 1.0f;
+            }
+    }
+    /* planar clusters that every lane sees through the half-vector
+     * model alone: the lobes' pass would add zeros */
+    const int skip_lobes = hv && hv_all && all_planar;
+    /* the receiver's horizon only in blocks where some lane's lobe grazes it */
+    const int graze = (lobes & VSGL__KERNEL_GRAZE) != 0;
+    for (int q = 0; q < (skip_lobes ? 0 : 1 + two); ++q) {
+        const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
+        const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
+        const int sg_only = none_planar;
+        if (!all_planar)
+            K_FORN(k_glossy(b, i, t + j, kb, kc));
+        if (!sg_only) {
+            if (graze)
+                K_FORN(k_planar(b, i, L + j, t + j, kb, kc, 1));
+            else
+                K_FORN(k_planar(b, i, L + j, t + j, kb, kc, 0));
+            /* the fold only where some lane sees the cell: an image lies
+             * at most 2 |b| + |fs| (sigma units) from the mean, so where
+             * every lane's planar exponent is below -freach = -(sqrt(50)
+             * + 2 |b| + |fs|)^2 / 2, every image's is below -25 (nil) */
+            for (int j = 0; j < NL; ++j) {
+                if (!(L[j].fold > 0.0f))
+                    continue;
+                float near = -1e30f;
+                for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) {
+                    float e = t[j].ppre[i] > 0.0f ? t[j].pexpo[i] : -1e30f;
+                    near = e > near ? e : near;
+                }
+                if (!(near >= -L[j].freach))
+                    continue;
+                /* one loop per kind of cut, the cuts a constant in each */
+#define K_FOLD(CUTS)                                          \
+for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)           \
+    k_fold(i, L + j, t + j, (CUTS))
+                switch (k_fold_cuts(L + j)) {
+                case 1: K_FOLD(1); break;
+                case 2: K_FOLD(2); break;
+                case 4: K_FOLD(4); break;
+                case 8: K_FOLD(8); break;
+                case 3: K_FOLD(3); break;
+                case 12: K_FOLD(12); break;
+                default: K_FOLD(K_FOLD_ALL); break;
+                }
+#undef K_FOLD
+            }
+            if (hv)
+                K_FORN(k_hv_rest(i, t + j));
+        }
+        if (sg_only)
+            K_FORN(k_glossy_sum(b, i, L + j, t + j, 0));
+        else if (all_planar)
+            K_FORN(k_glossy_sum(b, i, L + j, t + j, 1));
+        else
+            K_FORN(k_glossy_sum(b, i, L + j, t + j, 2));
+    }
+    if (hv) {
+        const float *hk, *hc;
+        const int nhv = vsgl__hv_lobe_set(lobes & VSGL__KERNEL_HV5 ? VSGL__HV5_LOBES : VSGL__HV_LOBES, &hk, &hc);
+        for (int q = 0; q < nhv; ++q) {
+            K_FORN(k_hv_lobe(b, i, t + j, hk[q], hc[q]));
+            K_FORN(k_glossy_sum(b, i, L + j, t + j, 3));
+        }
+    }
+}
+
+static inline __attribute__((always_inline)) int
+k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, const int NL,
+        const float *restrict visibility, int32_t mode, int32_t lobes, float lcut, k_scratch *restrict t)
+{
     int plane = 0, conv = 0;
     for (int j = 0; j < NL; ++j) {
         plane |= L[j].fore > 0.0f;
@@ -755,131 +894,48 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         K_FORN(k_axis(b, i, L + j, t + j, 0));
     K_FORN(k_exponent(b, i, L + j, t + j));
     K_FORN(k_amplitude(i, t + j));
-    if (lobes & VSGL__KERNEL_DIFFUSE) {
-        /* blocks where every incident lobe is sharp take short forms */
-        float lmin = K_SHARP_MAX;
-        K_FORN(lmin = t[j].lin[i] < lmin ? t[j].lin[i] : lmin);
-        int sharp = lmin >= K_SHARP_COSINE;
-        /* one loop per form, the form a constant in each */
-#define K_DIFFUSE(FORM) K_FORN(k_diffuse(b, i, L + j, (FORM), t + j, ld_sharp, ld_norm))
-        switch (mode) {
-        case VSGL_COSINE_SG:
-            if (sharp) K_DIFFUSE(K_COSINE_SG_SHARP); else K_DIFFUSE(VSGL_COSINE_SG);
-            break;
-        case VSGL_COSINE_PULLED_OUT:
-            if (sharp) K_DIFFUSE(K_COSINE_PULLED_OUT_SHARP); else K_DIFFUSE(VSGL_COSINE_PULLED_OUT);
-            break;
-        default:
-            if (sharp) {
-                K_FORN(k_cosine_stage_sharp(i, t + j));
-                K_DIFFUSE(K_COSINE_ACCURATE_SHARP);
-            } else {
-                K_FORN(k_cosine_stage(i, t + j));
-                K_DIFFUSE(VSGL_COSINE_ACCURATE);
-            }
-            break;
-        }
-#undef K_DIFFUSE
+    /* VSGLs whose light is negligible at every lane of the block (k_faint)
+     * skip the stages after this; the others take them one or two at a
+     * time, as they come */
+    int live = 0;
+    for (int j = 0; j < NL; ++j)
+        live |= !(lcut < 0.0f && k_faint(L + j, t + j, lcut)) << j;
+    const int nlive = (live & 1) + (live >> 1);
+    if (nlive == 0)
+        return NL;
+    const int off = live == 2; /* the one live VSGL of a pass */
+    if (nlive == 2) {
+        if (lobes & VSGL__KERNEL_DIFFUSE)
+            k_diffuse_lights(b, L, 2, mode, t);
+        if (lobes & VSGL__KERNEL_GLOSSY)
+            k_glossy_lights(b, L, 2, lobes, t);
+    } else {
+        if (lobes & VSGL__KERNEL_DIFFUSE)
+            k_diffuse_lights(b, L + off, 1, mode, t + off);
+        if (lobes & VSGL__KERNEL_GLOSSY)
+            k_glossy_lights(b, L + off, 1, lobes, t + off);
     }
-    if (lobes & VSGL__KERNEL_GLOSSY) {
-        /* the SG model, the planar one (coherent diffuse clusters) or a blend */
-        int all_planar = 1, none_planar = 1;
-        for (int j = 0; j < NL; ++j) {
-            all_planar &= L[j].planar == 1.0f;
-            none_planar &= L[j].planar == 0.0f;
-        }
-        /* one ASG, or GGX's core and tail as two (kernel.h, VSGL__KERNEL_GGX_TAIL) */
-        const int two = (lobes & VSGL__KERNEL_GGX_TAIL) != 0;
-        /* with GGX as lobes, planar clusters that subtend little are taken
-         * by the half-vector model (kernel.h VSGL__HV_*) */
-        int hv = 0, hv_all = 1;
-        if (two && !none_planar) {
-            K_FORN(k_hv_shared(b, i, L + j, t + j));
-            for (int j = 0; j < NL; ++j)
-                for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) {
-                    hv |= t[j].hvw[i] > 0.0f;
-                    hv_all &= t[j].hvw[i] == 1.0f;
-                }
-        }
-        /* planar clusters that every lane sees through the half-vector
-         * model alone: the lobes' pass would add zeros */
-        const int skip_lobes = hv && hv_all && all_planar;
-        /* the receiver's horizon only in blocks where some lane's lobe grazes it */
-        const int graze = (lobes & VSGL__KERNEL_GRAZE) != 0;
-        for (int q = 0; q < (skip_lobes ? 0 : 1 + two); ++q) {
-            const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
-            const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
-            const int sg_only = none_planar;
-            if (!all_planar)
-                K_FORN(k_glossy(b, i, t + j, kb, kc));
-            if (!sg_only) {
-                if (graze)
-                    K_FORN(k_planar(b, i, L + j, t + j, kb, kc, 1));
-                else
-                    K_FORN(k_planar(b, i, L + j, t + j, kb, kc, 0));
-                /* the fold only where some lane sees the cell: an image lies
-                 * at most 2 |b| + |fs| (sigma units) from the mean, so where
-                 * every lane's planar exponent is below -freach = -(sqrt(50)
-                 * + 2 |b| + |fs|)^2 / 2, every image's is below -25 (nil) */
-                for (int j = 0; j < NL; ++j) {
-                    if (!(L[j].fold > 0.0f))
-                        continue;
-                    float near = -1e30f;
-                    for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) {
-                        float e = t[j].ppre[i] > 0.0f ? t[j].pexpo[i] : -1e30f;
-                        near = e > near ? e : near;
-                    }
-                    if (!(near >= -L[j].freach))
-                        continue;
-                    /* one loop per kind of cut, the cuts a constant in each */
-#define K_FOLD(CUTS)                                          \
-    for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)           \
-        k_fold(i, L + j, t + j, (CUTS))
-                    switch (k_fold_cuts(L + j)) {
-                    case 1: K_FOLD(1); break;
-                    case 2: K_FOLD(2); break;
-                    case 4: K_FOLD(4); break;
-                    case 8: K_FOLD(8); break;
-                    case 3: K_FOLD(3); break;
-                    case 12: K_FOLD(12); break;
-                    default: K_FOLD(K_FOLD_ALL); break;
-                    }
-#undef K_FOLD
-                }
-                if (hv)
-                    K_FORN(k_hv_rest(i, t + j));
-            }
-            if (sg_only)
-                K_FORN(k_glossy_sum(b, i, L + j, t + j, 0));
-            else if (all_planar)
-                K_FORN(k_glossy_sum(b, i, L + j, t + j, 1));
-            else
-                K_FORN(k_glossy_sum(b, i, L + j, t + j, 2));
-        }
-        if (hv) {
-            const float *hk, *hc;
-            const int nhv = vsgl__hv_lobe_set(lobes & VSGL__KERNEL_HV5 ? VSGL__HV5_LOBES : VSGL__HV_LOBES, &hk, &hc);
-            for (int q = 0; q < nhv; ++q) {
-                K_FORN(k_hv_lobe(b, i, t + j, hk[q], hc[q]));
-                K_FORN(k_glossy_sum(b, i, L + j, t + j, 3));
-            }
-        }
-    }
+    return NL - nlive;
 }
 
-KERNEL_ATTR void KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_light *lights, size_t count,
-                             const float *restrict visibility, int32_t mode, int32_t lobes)
+KERNEL_ATTR size_t KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_light *lights, size_t count,
+                               const float *restrict visibility, int32_t mode, int32_t lobes, float faint)
 {
+    const float lcut = faint > 0.0f ? logf(faint) : 0.0f;
+    size_t skipped = 0;
     k_scratch t[2];
     vsgl_kernel_light local[2]; /* copies: no aliasing with the block */
     size_t v = 0;
     for (; v + 2 <= count; v += 2) {
         local[0] = lights[v];
         local[1] = lights[v + 1];
-        k_shade(b, local, 2, visibility ? visibility + v * VSGL__KERNEL_BLOCK : NULL, mode, lobes, t);
+        skipped += (size_t)k_shade(b, local, 2, visibility ? visibility + v * VSGL__KERNEL_BLOCK : NULL, mode, lobes,
+                                      lcut, t);
     }
     if (v < count) {
         local[0] = lights[v];
-        k_shade(b, local, 1, visibility ? visibility + v * VSGL__KERNEL_BLOCK : NULL, mode, lobes, t);
+        skipped += (size_t)k_shade(b, local, 1, visibility ? visibility + v * VSGL__KERNEL_BLOCK : NULL, mode, lobes,
+                                      lcut, t);
     }
+    return skipped;
 }

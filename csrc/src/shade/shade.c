@@ -921,9 +921,10 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
     memset(blk->ld, 0, sizeof blk->ld);
     memset(blk->ls, 0, sizeof blk->ls);
     if (lobes) {
-        void (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t) =
+        size_t (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t, float) =
             j->path == VSGL__SHADE_KERNEL_SCALAR ? vsgl__kernel_shade_scalar : vsgl__kernel_shade;
         const size_t count = j->set->count;
+        size_t faint = 0;
         if (vs->bits) {
             uint64_t *bits = vs->bits;
             float share[VSGL__KERNEL_BLOCK];
@@ -938,7 +939,7 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
                     continue; /* both blocked at every receiver: they add nothing */
                 for (size_t q = 0; q < m; ++q)
                     vsgl__kernel_vis_fill(bits[count + v + q], bits[v + q], share, vis + q * VSGL__KERNEL_BLOCK);
-                kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
+                faint += kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes, VSGL__FAINT);
             }
         } else if (j->s->visibility == VSGL_VISIBILITY_RAY) { /* no memory for it: a ray for every pair */
             ray_origins org;
@@ -951,12 +952,14 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
                     for (size_t k = 0; k < n; ++k)
                         vis[q * VSGL__KERNEL_BLOCK + k] = (float)((bits >> k) & 1u);
                 }
-                kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes);
+                faint += kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes, VSGL__FAINT);
             }
         } else {
-            kernel(blk, j->klights, count, NULL, j->s->diffuse_mode, lobes);
+            faint += kernel(blk, j->klights, count, NULL, j->s->diffuse_mode, lobes, VSGL__FAINT);
         }
         pairs += (uint64_t)n * j->set->count;
+        if (faint)
+            __atomic_fetch_add(j->faint, (uint64_t)n * faint, __ATOMIC_RELAXED);
         if ((lobes & VSGL__KERNEL_DIFFUSE) && j->near->start)
             for (size_t k = 0; k < n; ++k)
                 if (blk->diffuse[k] > 0.0f)
@@ -1157,12 +1160,12 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
                         const vsgl_vsgl_set *set, const vsgl_render_settings *s,
                         const vsgl_pixel_planes *planes, int path, uint64_t *pairs)
 {
-    return vsgl__shade_planned(ctx, scene, g, set, s, planes, path, pairs, NULL);
+    return vsgl__shade_planned(ctx, scene, g, set, s, planes, path, pairs, NULL, NULL);
 }
 
 vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
                                 const vsgl_vsgl_set *set, const vsgl_render_settings *s,
-                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs,
+                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs, uint64_t *faint,
                                 vsgl_shade_plan **plan)
 {
     size_t pixels = (size_t)g->width * g->height;
@@ -1290,8 +1293,9 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
         free(per_chunk);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
     }
+    uint64_t faint_total = 0;
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
-                   eps, 0, per_chunk, kl, korder, path, leak,
+                   eps, 0, per_chunk, &faint_total, kl, korder, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
                    0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL, twin, &targets};
     /* untextured: each material's BRDF parameters once, not once per sample */
@@ -1384,5 +1388,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     }
     if (pairs)
         *pairs = total;
+    if (faint)
+        *faint = faint_total;
     return r;
 }

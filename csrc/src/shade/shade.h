@@ -133,10 +133,11 @@ void vsgl__shade_plan_free(vsgl_shade_plan *plan);
  * the G-buffer changes). With shade_stride > 1 it replays a plan made
  * with the same stride and glossy mode, else records one into `*plan`
  * (replacing the old one; left as it was if memory is short). The planes
- * are bit-identical to vsgl__shade's either way. */
+ * are bit-identical to vsgl__shade's either way. `faint` (NULL or) receives
+ * how many of the pairs were faint (vsgl__kernel_shade, VSGL__FAINT). */
 vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
                                 const vsgl_vsgl_set *set, const vsgl_render_settings *s,
-                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs,
+                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs, uint64_t *faint,
                                 vsgl_shade_plan **plan);
 
 #endif

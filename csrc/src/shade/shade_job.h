@@ -74,6 +74,8 @@ typedef struct shade_job {
     float eps;            /* ray offset, metres */
     size_t base;          /* first pixel of the current batch */
     uint64_t *pairs;      /* per chunk of the current batch */
+    uint64_t *faint;      /* pairs whose VSGL was faint at every receiver of their block (k_faint), summed
+                             atomically by every thread */
     const vsgl_kernel_light *klights; /* the VSGLs, kernel layout, in kernel order */
     const size_t *korder;             /* per kernel light: its index in set->items */
     int path;             /* VSGL_SHADE_* */
