@@ -222,6 +222,10 @@ typedef struct k_scratch {
     float vis[VSGL__KERNEL_BLOCK];                                             /* visibility x validity */
     float pexpo[VSGL__KERNEL_BLOCK], ppre[VSGL__KERNEL_BLOCK];                  /* the planar glossy's exp argument, factor */
     float kappa[VSGL__KERNEL_BLOCK], ct[VSGL__KERNEL_BLOCK];
+    /* the planar glossy's lobe-independent part (k_planar_geom): the footprint's frame on the plane
+     * (sigma units), 1/sigma, and its factor ok x visibility x camp / sigma^2 */
+    float pa1[VSGL__KERNEL_BLOCK], pa2[VSGL__KERNEL_BLOCK], pb1[VSGL__KERNEL_BLOCK], pb2[VSGL__KERNEL_BLOCK];
+    float pis[VSGL__KERNEL_BLOCK], pok[VSGL__KERNEL_BLOCK];
     /* the planar glossy's offsets and covariance (sigma units), for a fold */
     float pd1[VSGL__KERNEL_BLOCK], pd2[VSGL__KERNEL_BLOCK], ps11[VSGL__KERNEL_BLOCK], ps22[VSGL__KERNEL_BLOCK],
         ps12[VSGL__KERNEL_BLOCK], pidet[VSGL__KERNEL_BLOCK];
@@ -437,10 +441,11 @@ k_horizon(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light
 
 /* Stage 4b: glossy light from a planar cluster (shade.h, vsgl__planar_glossy):
  * the radiance of the cluster's plane where the lobe's axis meets it,
- * blurred by the lobe's footprint there: all but the exp. */
+ * blurred by the lobe's footprint there. First what every lobe of the lane
+ * shares (the axis's hit on the plane and the footprint's frame there),
+ * then per lobe (k_planar_lobe) all but the exp. */
 static inline __attribute__((always_inline)) void
-k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t,
-         float kb, float kc, int graze)
+k_planar_geom(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
 {
     /* lengths in units of the cluster's sigma, so that nothing overflows:
      * the axis must meet the plane at t <= 1e4 sigma and >= 0.6 degrees
@@ -465,11 +470,25 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
     float yu1 = b->Yx[i] * L->u1x + b->Yy[i] * L->u1y + b->Yz[i] * L->u1z;
     float yu2 = b->Yx[i] * L->u2x + b->Yy[i] * L->u2y + b->Yz[i] * L->u2z;
     float fx = nxd * inz, fy = nyd * inz;
-    float a1 = tt * (xu1 - zu1 * fx), a2 = tt * (xu2 - zu2 * fx);
-    float b1 = tt * (yu1 - zu1 * fy), b2 = tt * (yu2 - zu2 * fy);
+    t->pa1[i] = tt * (xu1 - zu1 * fx);
+    t->pa2[i] = tt * (xu2 - zu2 * fx);
+    t->pb1[i] = tt * (yu1 - zu1 * fy);
+    t->pb2[i] = tt * (yu2 - zu2 * fy);
     /* the offset from the cluster's mean to where the axis meets its plane: t z - (mean - x) */
     float ox = tt * zx - dx * is, oy = tt * zy - dy * is, oz = tt * zz - dz * is;
-    float d1 = ox * L->u1x + oy * L->u1y + oz * L->u1z, e2 = ox * L->u2x + oy * L->u2y + oz * L->u2z;
+    t->pd1[i] = ox * L->u1x + oy * L->u1y + oz * L->u1z;
+    t->pd2[i] = ox * L->u2x + oy * L->u2y + oz * L->u2z;
+    t->pis[i] = is;
+    t->pok[i] = ok * t->vis[i] * b->camp[i] * (is * is);
+}
+
+/* One lobe (kb, kc) of k_planar_geom's lane: the footprint's covariance,
+ * the density's exponent into pexpo and its factor into ppre. */
+static inline __attribute__((always_inline)) void
+k_planar_lobe(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L,
+              k_scratch *restrict t, float kb, float kc, int graze)
+{
+    const float a1 = t->pa1[i], a2 = t->pa2[i], b1 = t->pb1[i], b2 = t->pb2[i], d1 = t->pd1[i], e2 = t->pd2[i];
     float lam = b->lam[i] * kb, mu = b->mu[i] * kb;
     lam = lam > 0.01f ? lam : 0.01f;
     mu = mu > 0.01f ? mu : 0.01f;
@@ -488,10 +507,13 @@ k_planar(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light 
      * S^-1 d, covariance I - S^-1 in sigma units) above the receiver's
      * tangent plane, along nu, the normal's part in the cluster's plane;
      * `graze` 0 (no lane of the block grazes: VSGL__KERNEL_GRAZE): 1 */
-    float hz = graze ? k_horizon(b, i, L, dx * is, dy * is, dz * is, d1, e2, s11, s22, s12, idet) : 1.0f;
-    t->ppre[i] = ok * hz * t->vis[i] * kc * b->camp[i] * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu) * (is * is);
-    t->pd1[i] = d1;
-    t->pd2[i] = e2;
+    float hz = 1.0f;
+    if (graze) {
+        float is = t->pis[i];
+        float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
+        hz = k_horizon(b, i, L, dx * is, dy * is, dz * is, d1, e2, s11, s22, s12, idet);
+    }
+    t->ppre[i] = t->pok[i] * hz * kc * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu);
     t->ps11[i] = s11;
     t->ps22[i] = s22;
     t->ps12[i] = s12;
@@ -811,6 +833,8 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
     const int skip_lobes = hv && hv_all && all_planar;
     /* the receiver's horizon only in blocks where some lane's lobe grazes it */
     const int graze = (lobes & VSGL__KERNEL_GRAZE) != 0;
+    if (!skip_lobes && !none_planar)
+        K_FORN(k_planar_geom(b, i, L + j, t + j));
     for (int q = 0; q < (skip_lobes ? 0 : 1 + two); ++q) {
         const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
         const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
@@ -819,9 +843,9 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
             K_FORN(k_glossy(b, i, t + j, kb, kc));
         if (!sg_only) {
             if (graze)
-                K_FORN(k_planar(b, i, L + j, t + j, kb, kc, 1));
+                K_FORN(k_planar_lobe(b, i, L + j, t + j, kb, kc, 1));
             else
-                K_FORN(k_planar(b, i, L + j, t + j, kb, kc, 0));
+                K_FORN(k_planar_lobe(b, i, L + j, t + j, kb, kc, 0));
             /* the fold only where some lane sees the cell: an image lies
              * at most 2 |b| + |fs| (sigma units) from the mean, so where
              * every lane's planar exponent is below -freach = -(sqrt(50)
