@@ -570,8 +570,9 @@ def markdown(results, meta, img_rel, png_rel):
                  "the Cycles renders niced (`nice -n 19`), the library and OIDN not (`--no-nice`)"
                  if not meta.get("niced", True) else "every run niced (`nice -n 19`)"), "",
              "**Size** %dx%d pixels. **Truth**: Cycles %s one-bounce references, two seeds of %d spp each (their "
-             "mean, %d spp in all), each pixel the average over its area (a 1-px box filter)%s. **Cycles**: the same settings, one render per spp (seed %d), its time the "
-             "render call as measured when it was rendered (scene sync included). **Cycles + OIDN**: the coloured "
+             "mean, %d spp in all), each pixel the average over its area (a 1-px box filter)%s. **Cycles**: "
+             "the same settings, one render per spp (seed %d), its time the render call as measured when it "
+             "was rendered (scene sync included). **Cycles + OIDN**: the coloured "
              "combined indirect pass (DiffInd x DiffCol + GlossInd x GlossCol) of that render denoised by "
              "OpenImageDenoise %s (the pip `bpy` wheel's library; RT filter, HDR, quality %s, albedo guide "
              "DiffCol + GlossCol, normal guide the Normal pass), its time render + denoise (device, commit, "
