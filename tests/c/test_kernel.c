@@ -255,7 +255,8 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
             for (int withvis = 0; withvis < 2; ++withvis) {
                 ref = base;
                 for (int k = 0; k < 8; ++k) /* one at a time */
-                    vsgl__kernel_shade_scalar(&ref, &L[k], 1, withvis ? vis + k * VSGL__KERNEL_BLOCK : NULL, mode, lob, 0.0f);
+                    vsgl__kernel_shade_scalar(&ref, &L[k], 1, withvis ? vis + k * VSGL__KERNEL_BLOCK : NULL, mode, lob,
+                                              0.0f);
                 double scale = 0.0;
                 for (int c = 0; c < 3; ++c)
                     for (int k = 0; k < VSGL__KERNEL_BLOCK; ++k)

@@ -921,7 +921,8 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
     memset(blk->ld, 0, sizeof blk->ld);
     memset(blk->ls, 0, sizeof blk->ls);
     if (lobes) {
-        size_t (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t, float) =
+        size_t (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t,
+                         float) =
             j->path == VSGL__SHADE_KERNEL_SCALAR ? vsgl__kernel_shade_scalar : vsgl__kernel_shade;
         const size_t count = j->set->count;
         size_t faint = 0;
