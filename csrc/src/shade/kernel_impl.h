@@ -861,9 +861,9 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
                 if (!(near >= -L[j].freach))
                     continue;
                 /* one loop per kind of cut, the cuts a constant in each */
-#define K_FOLD(CUTS)                                          \
-for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)           \
-    k_fold(i, L + j, t + j, (CUTS))
+#define K_FOLD(CUTS)                                      \
+    for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)       \
+        k_fold(i, L + j, t + j, (CUTS))
                 switch (k_fold_cuts(L + j)) {
                 case 1: K_FOLD(1); break;
                 case 2: K_FOLD(2); break;
