@@ -194,6 +194,41 @@ double vsgl__asg_integral_unit(double lambda, double mu)
                                        : vsgl__asg_integral_exact(lambda, mu);
 }
 
+double vsgl__asg_integral_eq10_fast(double lambda, double mu)
+{
+    double hi = lambda >= mu ? lambda : mu, lo = lambda >= mu ? mu : lambda;
+    /* pi / sqrt(hi lo) - e^{-lo} / (2 hi) (F(nu) + nu / lo F(nu + nu / lo)), nu = hi - lo,
+     * F(a) = 2 pi I0e(a / 2) <= 2 pi: the second term is at most e^{-lo} sqrt(hi / lo) of the
+     * first; below 2^-54 it does not change the double (rounding to nearest) */
+    double first = VSGL__PI_D / sqrt(hi * lo), r = exp(-lo) * sqrt(hi / lo);
+    if (r < 0x1p-54)
+        return first;
+    double nu = hi - lo, nl = nu / lo;
+    double second = exp(-lo) / (2.0 * hi) * 2.0 * VSGL__PI_D * (vsgl__i0e_poly(0.5 * nu) + nl * vsgl__i0e_poly(0.5 * (nu + nl)));
+    return first - second;
+}
+
+double vsgl__asg_integral_unit_fast(double lambda, double mu)
+{
+    double hi = lambda >= mu ? lambda : mu, lo = lambda >= mu ? mu : lambda;
+    if (!(lo >= 0.0) || !(hi < INFINITY))
+        return vsgl__asg_integral_unit(lambda, mu); /* NaN, negative or infinite bandwidths */
+    if (lo >= VSGL__ASG_EQ10_MIN_MU)
+        return vsgl__asg_integral_eq10_fast(hi, lo);
+    /* the table's coordinates (tools/gen_asg_table.py): x from 1/sqrt(13) to 1, y from 0 to 1 */
+    const double x0 = 0.27735009811261456; /* 1 / sqrt(1 + VSGL__ASG_EQ10_MIN_MU) */
+    double slo = sqrt(1.0 + lo), shi = sqrt(1.0 + hi);
+    double fx = (1.0 / slo - x0) / (1.0 - x0) * (VSGL__ASG_TABLE_NX - 1);
+    double fy = 1.0 / shi * (VSGL__ASG_TABLE_NY - 1);
+    int ix = (int)fx, iy = (int)fy;
+    ix = ix < 0 ? 0 : (ix > VSGL__ASG_TABLE_NX - 2 ? VSGL__ASG_TABLE_NX - 2 : ix);
+    iy = iy < 0 ? 0 : (iy > VSGL__ASG_TABLE_NY - 2 ? VSGL__ASG_TABLE_NY - 2 : iy);
+    double tx = fx - ix, ty = fy - iy;
+    const float *r0 = vsgl__asg_table[ix], *r1 = vsgl__asg_table[ix + 1];
+    double g = (1.0 - tx) * ((1.0 - ty) * r0[iy] + ty * r0[iy + 1]) + tx * ((1.0 - ty) * r1[iy] + ty * r1[iy + 1]);
+    return VSGL__PI_D * g / (slo * shi);
+}
+
 float vsgl_asg_integral(const vsgl_asg *a)
 {
     vsgl__frame f;

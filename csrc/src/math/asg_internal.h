@@ -37,6 +37,26 @@ double vsgl__asg_integral_exact(double lambda, double mu);
  * min(lambda, mu) >= VSGL__ASG_EQ10_MIN_MU, the exact quadrature below. */
 double vsgl__asg_integral_unit(double lambda, double mu);
 
+/* Eq. 10 for min(lambda, mu) >= VSGL__ASG_EQ10_MIN_MU (both finite) within
+ * 1e-9 of vsgl__asg_integral_unit, faster: its small second term (at most
+ * e^{-min} sqrt(max / min) of the first) with the polynomial I0e
+ * (vsgl__i0e_poly), and none where it is below 2^-54 of the first (the
+ * same double). */
+double vsgl__asg_integral_eq10_fast(double lambda, double mu);
+
+/* vsgl__asg_integral_unit within 5e-5 (relative), for work per receiver
+ * (the horizon cut of a glossy receiver's lobe, lobes.c): below
+ * VSGL__ASG_EQ10_MIN_MU bilinear in vsgl__asg_table (asg_table.c, generated
+ * by tools/gen_asg_table.py; 4.2e-5 at most, tests/c/test_asg.c), above it
+ * vsgl__asg_integral_eq10_fast; NaN, negative or infinite bandwidths take
+ * vsgl__asg_integral_unit. The exact quadrature costs ~1 us per call: two
+ * calls per glossy receiver were a quarter of a live camera edit's CPU
+ * time. */
+#define VSGL__ASG_TABLE_NX 65
+#define VSGL__ASG_TABLE_NY 129
+extern const float vsgl__asg_table[VSGL__ASG_TABLE_NX][VSGL__ASG_TABLE_NY];
+double vsgl__asg_integral_unit_fast(double lambda, double mu);
+
 /* Normalisation of the convolution / ASG x SG product integral:
  * VSGL__CONV_PAPER = pi / sqrt((lambda + nu)(mu + nu)) (Eq. 18 as printed;
  * infinite at lambda + nu = 0), VSGL__CONV_EXACT_INTEGRAL = the ASG integral

@@ -41,3 +41,18 @@ double vsgl__bessel_f(double a)
 {
     return 2.0 * VSGL__PI_D * vsgl__i0e(0.5 * a);
 }
+
+double vsgl__i0e_poly(double x)
+{
+    if (x <= 3.75) {
+        double t = x / 3.75;
+        t *= t;
+        double i0 = 1.0 + t * (3.5156229 + t * (3.0899424 + t * (1.2067492 + t * (0.2659732 + t * (0.0360768 +
+                    t * 0.0045813)))));
+        return i0 * exp(-x);
+    }
+    double t = 3.75 / x;
+    double p = 0.39894228 + t * (0.01328592 + t * (0.00225319 + t * (-0.00157565 + t * (0.00916281 + t * (-0.02057706 +
+               t * (0.02635537 + t * (-0.01647633 + t * 0.00392377)))))));
+    return p / sqrt(x);
+}

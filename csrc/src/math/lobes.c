@@ -301,7 +301,8 @@ void vsgl__asg_cut_at_horizon(vsgl_asg *a, const vsgl_vec3 *normal)
     a->mu = clamp_band(0.5f / vy);
     /* the part's integral: w0 of the whole lobe's (the ASG's own integral:
      * the Gaussians' determinants overshoot it by up to 13 % for wide lobes) */
-    a->log_amplitude += logf(w0) + (float)log(vsgl__asg_integral_unit(l0, m0) / vsgl__asg_integral_unit(a->lambda, a->mu));
+    a->log_amplitude +=
+        logf(w0) + (float)log(vsgl__asg_integral_unit_fast(l0, m0) / vsgl__asg_integral_unit_fast(a->lambda, a->mu));
 }
 
 float vsgl_specular_factor(const vsgl_vec3 *n, const vsgl_vec3 *view,

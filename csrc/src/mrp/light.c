@@ -7,37 +7,12 @@
 #include "math/constants.h"
 #include "vsgl/lobes.h"
 
-/* e^{-x} I0(x), x >= 0, by Abramowitz & Stegun 9.8.1 / 9.8.2 (relative
- * error < 6e-7): only the small second term of Eq. 10 takes it. */
-static double i0e_poly(double x)
-{
-    if (x <= 3.75) {
-        double t = x / 3.75;
-        t *= t;
-        double i0 = 1.0 + t * (3.5156229 + t * (3.0899424 + t * (1.2067492 + t * (0.2659732 + t * (0.0360768 +
-                    t * 0.0045813)))));
-        return i0 * exp(-x);
-    }
-    double t = 3.75 / x;
-    double p = 0.39894228 + t * (0.01328592 + t * (0.00225319 + t * (-0.00157565 + t * (0.00916281 + t * (-0.02057706 +
-               t * (0.02635537 + t * (-0.01647633 + t * 0.00392377)))))));
-    return p / sqrt(x);
-}
-
 double vsgl__mrp_asg_integral_unit(double lambda, double mu)
 {
     double hi = lambda >= mu ? lambda : mu, lo = lambda >= mu ? mu : lambda;
     if (!(lo >= VSGL__ASG_EQ10_MIN_MU) || !(hi < INFINITY))
         return vsgl__asg_integral_unit(lambda, mu); /* NaN, small or infinite bandwidths */
-    /* Eq. 10: pi / sqrt(hi lo) - e^{-lo} / (2 hi) (F(nu) + nu / lo F(nu + nu / lo)), nu = hi - lo,
-     * F(a) = 2 pi I0e(a / 2) <= 2 pi: the second term is at most e^{-lo} sqrt(hi / lo) of the
-     * first; below 2^-54 it does not change the double (rounding to nearest) */
-    double first = VSGL__PI_D / sqrt(hi * lo), r = exp(-lo) * sqrt(hi / lo);
-    if (r < 0x1p-54)
-        return first;
-    double nu = hi - lo, nl = nu / lo;
-    double second = exp(-lo) / (2.0 * hi) * 2.0 * VSGL__PI_D * (i0e_poly(0.5 * nu) + nl * i0e_poly(0.5 * (nu + nl)));
-    return first - second;
+    return vsgl__asg_integral_eq10_fast(hi, lo);
 }
 
 double vsgl__mrp_bandwidth(double l)
