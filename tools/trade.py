@@ -25,7 +25,8 @@ Debian's Blender 3.4 ($BLENDER), run under `nice -n 19`:
 
 The library's whole-frame time: the add-on's export of the scene in Blender
 (measured by trade_cycles.py), scene creation (BVH), vsgl_render of every
-plane, and the multilayer EXR write (float, ZIP, as the add-on writes it):
+plane, and the multilayer EXR write (half floats, ZIP, the add-on's default passes,
+as the add-on writes them):
 the presets the fastest of --repeat runs, the knobs one run. The brute force
 is cached under build/trade/brute/ (like the sweeps, with its time as
 measured when it was computed) by a hash of the scene, its parameters and
@@ -578,7 +579,8 @@ def markdown(results, meta, img_rel, png_rel):
              "DiffCol + GlossCol, normal guide the Normal pass), its time render + denoise (device, commit, "
              "execute). **Library**: whole frame as the add-on runs it: export in Blender (the add-on's "
              "`export.collect`, measured in Blender 3.4) + scene creation (BVH) + `vsgl_render` of every plane + "
-             "the multilayer EXR write (float, ZIP); the presets the fastest of %d runs, the knobs one run. "
+             "the multilayer EXR write (half floats, ZIP, the add-on's default passes); the presets the fastest "
+             "of %d runs, the knobs one run. "
              "**Brute force**: every RSM texel a VPL with the exact BRDF (the RSM's own limit), one run, cached "
              "under build/trade/brute/ by a hash of the scene, its parameters and the sources the brute-force "
              "path runs through, its time as measured when it was computed (like the Cycles sweeps)." % (

@@ -169,6 +169,32 @@ static vsgl_result exr_failed(vsgl_context *ctx, exr_sink *s, const char *path, 
                       s->message[0] ? s->message : exr_get_default_error_message(rv));
 }
 
+/* The rows [b, e) of every channel (row r: channel r / height, y = r % height)
+ * that hold a non-finite sample, flagged in bad[r]. */
+typedef struct finite_job {
+    const src_channel *chans;
+    uint32_t width, height;
+    unsigned char *bad;
+} finite_job;
+
+static int32_t flag_rows(void *user, size_t chunk, size_t b, size_t e)
+{
+    (void)chunk;
+    const finite_job *j = user;
+    for (size_t r = b; r < e; ++r) {
+        const src_channel *s = &j->chans[r / j->height];
+        const float *row = s->data + (r % j->height) * j->width * s->stride;
+        uint32_t any = 0;
+        for (uint32_t x = 0; x < j->width; ++x) {
+            uint32_t bits;
+            memcpy(&bits, &row[(size_t)x * s->stride], sizeof bits);
+            any |= (bits & 0x7f800000u) == 0x7f800000u;
+        }
+        j->bad[r] = (unsigned char)any;
+    }
+    return 0;
+}
+
 static vsgl_result check_args(vsgl_context *ctx, uint32_t width, uint32_t height,
                               const vsgl_exr_pass *passes, uint32_t pass_count,
                               const vsgl_exr_options *o, src_channel *chans, uint32_t *chan_count)
@@ -222,26 +248,31 @@ static vsgl_result check_args(vsgl_context *ctx, uint32_t width, uint32_t height
         }
     }
     *chan_count = n;
-    /* Refuse non-finite samples before any file exists: a row at a time
-     * without a branch (an exponent of all ones), then the first bad one */
-    for (uint32_t i = 0; i < n; ++i) {
-        const src_channel *s = &chans[i];
-        for (uint32_t y = 0; y < height; ++y) {
-            const float *row = s->data + (size_t)y * width * s->stride;
-            uint32_t any = 0;
-            for (uint32_t x = 0; x < width; ++x) {
-                uint32_t b;
-                memcpy(&b, &row[(size_t)x * s->stride], sizeof b);
-                any |= (b & 0x7f800000u) == 0x7f800000u;
-            }
-            for (uint32_t x = 0; any && x < width; ++x) {
-                float v = row[(size_t)x * s->stride];
-                if (!isfinite(v))
-                    return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "pass %s channel %c pixel (%u, %u): %s",
-                                      s->pass, s->letter, x, y, isnan(v) ? "NaN" : (v > 0 ? "+Inf" : "-Inf"));
+    /* Refuse non-finite samples before any file exists: the rows checked
+     * in parallel without a branch (an exponent of all ones), then the
+     * first bad sample of the first flagged row, in order */
+    size_t rows = (size_t)n * height;
+    unsigned char *bad = calloc(rows ? rows : 1, 1);
+    if (!bad)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "out of memory");
+    finite_job fj = {chans, width, height, bad};
+    vsgl__parallel_ctx(ctx, rows, 64, flag_rows, &fj);
+    for (size_t r = 0; r < rows; ++r) {
+        if (!bad[r])
+            continue;
+        const src_channel *s = &chans[r / height];
+        uint32_t y = (uint32_t)(r % height);
+        const float *row = s->data + (size_t)y * width * s->stride;
+        for (uint32_t x = 0; x < width; ++x) {
+            float v = row[(size_t)x * s->stride];
+            if (!isfinite(v)) {
+                free(bad);
+                return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "pass %s channel %c pixel (%u, %u): %s",
+                                  s->pass, s->letter, x, y, isnan(v) ? "NaN" : (v > 0 ? "+Inf" : "-Inf"));
             }
         }
     }
+    free(bad);
     return VSGL_OK;
 }
 
@@ -436,7 +467,7 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
             goto done;
         }
         job.batch_begin = b0;
-        int32_t failed = vsgl__parallel_for(threads, b1 - b0, 1, encode_chunks_batch, &job);
+        int32_t failed = vsgl__parallel_ctx(ctx, b1 - b0, 1, encode_chunks_batch, &job);
         for (size_t k = b0; k < b1 && !rv; ++k) {
             chunk_out *out = &outs[k - b0];
             if (failed && (out->rv || !out->data))
