@@ -18,7 +18,7 @@ INCLUDES = -Icsrc/include -Icsrc/src $(shell pkg-config --cflags-only-I OpenEXR 
 WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes -Wmissing-prototypes
 CFLAGS_COMMON = -std=c11 -D_POSIX_C_SOURCE=200809L -DVSGL_BUILDING -fPIC -fvisibility=hidden $(WARN) $(INCLUDES)
 OPT     ?= -O2 -g
-LDLIBS  := -lembree3 -lOpenEXRCore-3_1 -lpthread -lm
+LDLIBS  := -lembree3 -lOpenEXRCore-3_1 -ldeflate -lpthread -lm
 
 LIB_SRC  := $(sort $(wildcard csrc/src/*/*.c))
 TEST_SRC := $(sort $(wildcard tests/c/*.c))

@@ -6,5 +6,5 @@ cd "$(dirname "$0")/.."
 make --no-print-directory build/libvsgl.so >/dev/null
 mkdir -p build/bench
 cc -O2 -Itests/c -Icsrc/include -Icsrc/src tools/accuracy.c build/obj/csrc/src/*/*.o \
-   -lembree3 -lOpenEXRCore-3_1 -lpthread -lm -o build/bench/accuracy
+   -lembree3 -lOpenEXRCore-3_1 -ldeflate -lpthread -lm -o build/bench/accuracy
 build/bench/accuracy "$@"

@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 # the objects of the current sources (a build dir may still hold those of moved files)
 objs=$(ls csrc/src/*/*.c | sed 's|^|build/obj/|; s|\.c$|.o|')
 flags="-O2 -march=native -Itests/c -Icsrc/include -Icsrc/src"
-libs="-lembree3 -lOpenEXRCore-3_1 -lpthread -lm"
+libs="-lembree3 -lOpenEXRCore-3_1 -ldeflate -lpthread -lm"
 # BENCH_DIR: where the programs go; BENCH_BUILD_ONLY=1: build them and stop
 # (tests/tools/run_tools.sh checks that they still build)
 bin=${BENCH_DIR:-build/bench}

@@ -2,7 +2,7 @@
 # Package the Blender add-on: build/vsgl_indirect.zip with the Python package
 # and the built library in vsgl_indirect/lib/libvsgl.so (where libvsgl.py looks
 # first), self-contained: the libraries it links against that a Linux machine
-# with Blender may lack (Embree 3, OpenEXR Core, oneTBB) are copied beside it,
+# with Blender may lack (Embree 3, OpenEXR Core, oneTBB, libdeflate) are copied beside it,
 # found through its $ORIGIN rpath (Makefile). Not copied: glibc, libstdc++,
 # libgcc_s and zlib, which every Linux that runs Blender has (the zip needs
 # x86-64 Linux with glibc >= 2.34 and libstdc++ of GCC >= 12: Debian 12,
@@ -31,7 +31,7 @@ done
 cat >"$stage/vsgl_indirect/lib/README" <<'TXT'
 libvsgl.so and the libraries it links against, found through its $ORIGIN rpath:
 libembree3 (Intel Embree 3, Apache-2.0), libOpenEXRCore (OpenEXR, BSD-3-Clause),
-libtbb (oneTBB, Apache-2.0), copied from Debian 12. Needs x86-64 Linux with
+libtbb (oneTBB, Apache-2.0), libdeflate (MIT), copied from Debian 12. Needs x86-64 Linux with
 glibc >= 2.34 and libstdc++ from GCC >= 12.
 TXT
 out=$(pwd)/build/vsgl_indirect.zip

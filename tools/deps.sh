@@ -4,7 +4,7 @@
 # Without root it prints the exact apt-get line and exits 1.
 set -euo pipefail
 
-build_pkgs="gcc make pkg-config libembree-dev libopenexr-dev"
+build_pkgs="gcc make pkg-config libembree-dev libopenexr-dev libdeflate-dev"
 python_pkgs="python3 python3-numpy python3-pytest"
 case "${1:-build}" in
   build) pkgs="$build_pkgs" ;;

@@ -216,7 +216,7 @@ REUSED_GBUFFER = 1
 REUSED_FIT = 2
 EXR_COMPRESSION_COUNT = 8
 EXR_MAX_CHANNELS = 4
-EXR_ZIP_LEVEL_DEFAULT = 2
+EXR_ZIP_LEVEL_DEFAULT = 1
 
 
 # --------------------------------------------------------------------------

@@ -162,6 +162,7 @@ DEPENDENCIES = {
     "libembree3.so.3": ("Intel Embree 3", "libembree3-3"),
     "libOpenEXRCore-3_1.so.30": ("OpenEXR Core 3.1", "libopenexr-3-1-30"),
     "libtbb.so.12": ("oneTBB", "libtbb12"),
+    "libdeflate.so.0": ("libdeflate", "libdeflate0"),
     "libstdc++.so.6": ("the GNU C++ runtime", "libstdc++6"),
     "libz.so.1": ("zlib", "zlib1g"),
 }
@@ -999,7 +1000,7 @@ def exr_write(ctx, path, passes, layer=None, pixel_type="float", compression="zi
     shape (H, W, C) with C in 1..4 (or (H, W) for one channel), or to a
     tuple (array, channels) such as (a, "RGBA"). Default channel letters:
     "V", "??", "RGB", "RGBA" for 1..4 channels (2 needs explicit names).
-    ``zip_level``: zlib level 1..9 of ZIP / ZIPS, 0 = the library's default
+    ``zip_level``: deflate level 1..9 of ZIP / ZIPS, 0 = the library's default
     (EXR_ZIP_LEVEL_DEFAULT)."""
     passes = dict(passes)
     if not passes:

@@ -50,8 +50,8 @@ const char cli_usage[] =
     "  --float               32-bit float EXR samples\n"
     "  --compression NAME    zip | zips | piz | none | rle | pxr24 | b44 | b44a\n"
     "                        (EXR compression, default zip; pxr24 and b44* are lossy)\n"
-    "  --zip-level N         zlib level 1..9 of zip and zips (lossless: higher is smaller and slower;\n"
-    "                        default 2)\n"
+    "  --zip-level N         deflate level 1..9 of zip and zips (lossless: higher is smaller and slower;\n"
+    "                        default 1)\n"
     "  --passes LIST         the EXR's passes, comma-separated: DiffInd GlossInd DiffCol GlossCol Diff\n"
     "                        Gloss Combined, or all (default: DiffInd,GlossInd,Diff,Gloss,Combined,\n"
     "                        what the add-on's compositor setup reads)\n"
@@ -379,7 +379,7 @@ static int parse_args(int argc, char **argv, cli_options *o, char *err, size_t e
         }
     }
     if (o->zip_level.set && o->zip_level.value > 9) { /* refused before a render is spent on it */
-        snprintf(err, err_size, "option --zip-level: '%u' is not a zlib level 1..9", o->zip_level.value);
+        snprintf(err, err_size, "option --zip-level: '%u' is not a deflate level 1..9", o->zip_level.value);
         return 2;
     }
     if (!o->scene_path)

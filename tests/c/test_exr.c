@@ -955,9 +955,61 @@ VT_TEST(exr_zip_level_is_lossless_and_trades_size)
     bad.zip_level = 10;
     char path[128];
     snprintf(path, sizeof path, "%s/bad.exr", dir);
+    char want[64];
+    snprintf(want, sizeof want, "EXR zip level 10 is not 1..9 (0 = %d)", VSGL_EXR_ZIP_LEVEL_DEFAULT);
     VT_CHECK(vsgl_exr_write_render(ctx, path, &o, &bad) == VSGL_ERROR_INVALID_ARGUMENT &&
-                 strstr(vsgl_context_last_error(ctx), "EXR zip level 10 is not 1..9 (0 = 2)"),
+                 strstr(vsgl_context_last_error(ctx), want),
              "zip level 10: %s", vsgl_context_last_error(ctx));
+    vsgl_context_destroy(ctx);
+    remove_tree(dir);
+}
+
+/* A chunk deflate cannot shrink (float noise: every mantissa bit random)
+ * is stored as its packed bytes, which OpenEXR reads as uncompressed: the
+ * file is about the raw size and reads back exactly, ZIP and ZIPS alike. */
+VT_TEST(exr_zip_stores_incompressible_chunks_as_packed)
+{
+    enum { NW = 40, NH = 37 }; /* a last ZIP chunk of 5 lines */
+    static float px[NW * NH * 3];
+    uint32_t h = 12345u;
+    for (int i = 0; i < NW * NH * 3; ++i) {
+        h = h * 1664525u + 1013904223u;
+        uint32_t b = 0x3f800000u | (h >> 9); /* [1, 2): 23 random mantissa bits */
+        memcpy(&px[i], &b, sizeof b);
+    }
+    char dir[64];
+    make_temp_dir(dir, sizeof dir);
+    vsgl_context *ctx = NULL;
+    vsgl_context_create(NULL, &ctx);
+    vsgl_render_output o = blank_output(NW, NH);
+    o.diffuse_light = px;
+    const int32_t comp[2] = {VSGL_EXR_ZIP, VSGL_EXR_ZIPS};
+    for (int k = 0; k < 2; ++k) {
+        vsgl_exr_options opt;
+        memset(&opt, 0, sizeof opt);
+        opt.size = sizeof opt;
+        opt.pixel_type = VSGL_EXR_FLOAT;
+        opt.compression = comp[k];
+        char path[128];
+        snprintf(path, sizeof path, "%s/noise%d.exr", dir, k);
+        VT_REQUIRE(vsgl_exr_write_render(ctx, path, &o, &opt) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        unsigned char *bytes = NULL;
+        size_t size = 0;
+        read_file(path, &bytes, &size);
+        VT_CHECK(size >= (size_t)NW * NH * 3 * 4, "compression %d: %zu bytes, below the raw %d", comp[k], size,
+                 NW * NH * 3 * 4);
+        free(bytes);
+        decoded d;
+        VT_REQUIRE(decode_exr(path, &d) == 0 && d.count == 3, "decode compression %d", comp[k]);
+        int bad = 0;
+        for (int c = 0; c < d.count; ++c) {
+            const int ch = rgb_index(d.names[c]);
+            for (int i = 0; i < NW * NH && !bad; ++i)
+                bad = d.planes[c][i] != px[i * 3 + ch];
+        }
+        VT_CHECK(!bad, "compression %d: the pixels read back differ", comp[k]);
+        free_decoded(&d);
+    }
     vsgl_context_destroy(ctx);
     remove_tree(dir);
 }

@@ -325,14 +325,14 @@ expect_fail args_bad_glossy_lobes 1 "settings: glossy_lobes is 3 (valid 4 or 5; 
   --glossy-lobes 3 --dry-run
 expect_fail args_bad_compression 2 "'lzma' is not one of zip|zips|piz|none|rle|pxr24|b44|b44a" "$VSGL" render "$SCENE" \
   --compression lzma
-# --zip-level: zlib's level of zip / zips (vsgl_exr_options.zip_level): 1..9, lossless; the library refuses 10
+# --zip-level: the deflate level of zip / zips (vsgl_exr_options.zip_level): 1..9, lossless; the library refuses 10
 if want args_zip_level && expect_ok args_zip_level "$VSGL" render "$SCENE" -o "$T/z1.exr" --zip-level 1 &&
     expect_ok args_zip_level "$VSGL" render "$SCENE" -o "$T/z9.exr" --zip-level 9; then
   s1=$(stat -c %s "$T/z1.exr"); s9=$(stat -c %s "$T/z9.exr")
   if [ "$s9" -lt "$s1" ] && idiff -q -a "$T/z1.exr" "$T/z9.exr" >/dev/null 2>&1; then ok args_zip_level
   else bad args_zip_level "level 9: $s9 bytes, level 1: $s1 bytes, idiff: $(idiff -a "$T/z1.exr" "$T/z9.exr" 2>&1 | tail -1)"; fi
 fi
-expect_fail args_bad_zip_level 2 "option --zip-level: '10' is not a zlib level 1..9" "$VSGL" render "$SCENE" \
+expect_fail args_bad_zip_level 2 "option --zip-level: '10' is not a deflate level 1..9" "$VSGL" render "$SCENE" \
   -o "$T/z10.exr" --zip-level 10
 expect_fail args_bad_zip_level_0 2 "option --zip-level: '0' is not a whole number >= 1" "$VSGL" render "$SCENE" \
   -o "$T/z0.exr" --zip-level 0

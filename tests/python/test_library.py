@@ -172,7 +172,7 @@ def test_missing_dependency_names_it_and_its_package(tmp_path):
     assert "it needs libvsgl_test_dep.so.1, which is not installed" in msg, msg
     # the sonames libvsgl really needs map to their Debian packages
     for soname, pkg in (("libembree3.so.3", "libembree3-3"), ("libtbb.so.12", "libtbb12"),
-                        ("libOpenEXRCore-3_1.so.30", "libopenexr-3-1-30")):
+                        ("libOpenEXRCore-3_1.so.30", "libopenexr-3-1-30"), ("libdeflate.so.0", "libdeflate0")):
         m = libvsgl.load_error_message("/x/libvsgl.so", "%s: cannot open shared object file: "
                                        "No such file or directory" % soname)
         assert ("it needs %s" % soname) in m and ("apt-get install %s" % pkg) in m, m

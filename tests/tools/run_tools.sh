@@ -107,7 +107,7 @@ if want addon_zip; then
     lib="$T/zip/vsgl_indirect/lib"
     errs=""
     deps=$(ldd "$lib/libvsgl.so")
-    for so in libembree3.so.3 libOpenEXRCore-3_1.so.30 libtbb.so.12; do
+    for so in libembree3.so.3 libOpenEXRCore-3_1.so.30 libtbb.so.12 libdeflate.so.0; do
       grep -q "^\s*$so => $lib/$so " <<<"$deps" || errs="$errs [$so not taken from the zip: $(grep "$so" <<<"$deps" | xargs)]"
     done
     nf=$(grep -c "not found" <<<"$deps")

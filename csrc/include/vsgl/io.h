@@ -93,14 +93,16 @@ typedef struct vsgl_exr_options {
     int32_t compression;     /**< VSGL_EXR_ZIP (default), NONE, ZIPS, PIZ, RLE, PXR24, B44, B44A */
     uint32_t metadata_count;
     const vsgl_exr_metadata *metadata; /**< copied into the header as string attributes */
-    int32_t zip_level;       /**< zlib level 1..9 of ZIP and ZIPS (lossless either way: smaller files, slower
-                                  writes as it rises); 0 = VSGL_EXR_ZIP_LEVEL_DEFAULT */
+    int32_t zip_level;       /**< deflate level 1..9 of ZIP and ZIPS (libdeflate's levels, which zlib's
+                                  names; lossless either way: smaller files, slower writes as it rises);
+                                  0 = VSGL_EXR_ZIP_LEVEL_DEFAULT */
 } vsgl_exr_options;
 
-/** vsgl_exr_options.zip_level when it is 0: zlib's level 2, not its default 6. A 1920 x 1080
- *  balanced frame's 18 half channels (docs/performance.md, "EXR writing"): written in 0.59x / 0.50x
- *  the time of level 6 in two rooms, files 1.7x / 1.4x as large (2.1 / 4.8 MB). */
-#define VSGL_EXR_ZIP_LEVEL_DEFAULT 2
+/** vsgl_exr_options.zip_level when it is 0: level 1 of libdeflate, which writes the ZIP chunks'
+ *  zlib streams since 2026-12-05 (docs/performance.md, "EXR writing"): a 1920 x 1080 balanced
+ *  frame's 16 half channels in 0.23 s, 6.7 MB, where zlib's level 2 (the default before) took
+ *  0.28-0.29 s for 7.1 MB and libdeflate's level 2 0.25-0.28 s for 6.3 MB. */
+#define VSGL_EXR_ZIP_LEVEL_DEFAULT 1
 
 /**
  * @brief Write a single-part scanline multilayer EXR, atomically.

@@ -5,6 +5,7 @@
 #include "io/atomic.h"
 #include "io/half.h"
 #include "core/parallel.h"
+#include "io/exr_zip.h"
 
 #include <openexr.h>
 
@@ -295,6 +296,8 @@ typedef struct encode_job {
     chunk_out *outs;               /* the current batch */
     size_t batch_begin;
     int f16c; /* vsgl__exr_cpu_has_f16c(), asked once per write */
+    int zip_level;         /* ZIP / ZIPS: libdeflate's level (exr_zip.h), else 0 (OpenEXR Core's pipeline) */
+    const uint32_t *order; /* with zip_level: the file's channel k is chans[order[k]] */
 } encode_job;
 
 /* The pipeline's last step: keep the compressed bytes instead of writing. */
@@ -321,10 +324,57 @@ static exr_result_t no_wait(exr_encode_pipeline_t *enc)
     return EXR_ERR_SUCCESS;
 }
 
+/* Chunks [begin, end) packed in the file's line layout (per line, the
+ * channels in file order, each a row of samples) and deflated by libdeflate
+ * (exr_zip.h). */
+static int32_t zip_chunks(encode_job *j, size_t begin, size_t end)
+{
+    vsgl__zip_coder *z = vsgl__zip_coder_new(j->zip_level);
+    unsigned char *packed = NULL;
+    size_t cap = 0;
+    int32_t failed = z ? 0 : 1;
+    for (size_t k = begin; k < end && !failed; ++k) {
+        chunk_out *out = &j->outs[k - j->batch_begin];
+        const exr_chunk_info_t *ci = &j->infos[k];
+        uint32_t rows = (uint32_t)ci->height, y0 = (uint32_t)ci->start_y;
+        size_t line = (size_t)j->width * j->bpe, n = line * j->n * rows;
+        if (n > cap) {
+            unsigned char *p = realloc(packed, n);
+            if (!p) {
+                failed = 1;
+                break;
+            }
+            packed = p;
+            cap = n;
+        }
+        unsigned char *d = packed;
+        for (uint32_t r = 0; r < rows; ++r)
+            for (uint32_t c = 0; c < j->n; ++c, d += line) {
+                const src_channel *s = &j->chans[j->order[c]];
+                const float *row = s->data + (size_t)(y0 + r) * j->width * s->stride;
+                if (j->bpe == 2) {
+                    vsgl__exr_row_to_half(row, s->stride, j->width, d, j->f16c);
+                } else {
+                    for (uint32_t x = 0; x < j->width; ++x)
+                        memcpy(d + 4 * (size_t)x, &row[(size_t)x * s->stride], 4);
+                }
+            }
+        if (vsgl__zip_encode(z, packed, n, &out->data, &out->size) != 0)
+            failed = 1;
+    }
+    if (failed)
+        j->outs[begin - j->batch_begin].rv = EXR_ERR_OUT_OF_MEMORY;
+    free(packed);
+    vsgl__zip_coder_free(z);
+    return failed;
+}
+
 static int32_t encode_chunks(void *user, size_t chunk, size_t begin, size_t end)
 {
     (void)chunk;
     encode_job *j = user;
+    if (j->zip_level)
+        return zip_chunks(j, begin, end);
     for (size_t k = begin; k < end; ++k) {
         chunk_out *out = &j->outs[k - j->batch_begin];
         const exr_chunk_info_t *ci = &j->infos[k];
@@ -456,8 +506,28 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
         if (rv)
             goto exr_error;
     }
+    /* ZIP and ZIPS: libdeflate (exr_zip.h) on the file's channel order */
+    uint32_t order[MAX_CHANNELS_TOTAL];
+    int zip = o->compression == VSGL_EXR_ZIP || o->compression == VSGL_EXR_ZIPS;
+    if (zip) {
+        const exr_attr_chlist_t *cl = NULL;
+        rv = exr_get_channels(e, part, &cl);
+        if (rv)
+            goto exr_error;
+        for (int k = 0; k < cl->num_channels && k < (int)n; ++k) {
+            uint32_t i = 0;
+            while (i < n && strcmp(chans[i].name, cl->entries[k].name.str) != 0)
+                ++i;
+            if (i == n) {
+                rv = EXR_ERR_INVALID_ARGUMENT;
+                goto exr_error;
+            }
+            order[k] = i;
+        }
+    }
     encode_job job = {e, part, width, ptype == EXR_PIXEL_HALF ? 2u : 4u, ptype, chans, n, infos, outs, 0,
-                      vsgl__exr_cpu_has_f16c()};
+                      vsgl__exr_cpu_has_f16c(), zip ? (o->zip_level ? o->zip_level : VSGL_EXR_ZIP_LEVEL_DEFAULT) : 0,
+                      order};
     for (size_t b0 = 0; b0 < nchunks; b0 += batch) {
         size_t b1 = b0 + batch < nchunks ? b0 + batch : nchunks;
         /* SIGINT in the CLI, Esc in the add-on: stop between batches (a 4K
