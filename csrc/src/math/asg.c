@@ -204,7 +204,8 @@ double vsgl__asg_integral_eq10_fast(double lambda, double mu)
     if (r < 0x1p-54)
         return first;
     double nu = hi - lo, nl = nu / lo;
-    double second = exp(-lo) / (2.0 * hi) * 2.0 * VSGL__PI_D * (vsgl__i0e_poly(0.5 * nu) + nl * vsgl__i0e_poly(0.5 * (nu + nl)));
+    double second = exp(-lo) / (2.0 * hi) * 2.0 * VSGL__PI_D *
+                    (vsgl__i0e_poly(0.5 * nu) + nl * vsgl__i0e_poly(0.5 * (nu + nl)));
     return first - second;
 }
 
