@@ -512,9 +512,11 @@ static vsgl_result write_exr(vsgl_context *ctx, exr_sink *sink, const char *path
     if (zip) {
         const exr_attr_chlist_t *cl = NULL;
         rv = exr_get_channels(e, part, &cl);
+        if (!rv && cl->num_channels != (int)n)
+            rv = EXR_ERR_INVALID_ARGUMENT; /* the header holds every channel added above, and no other */
         if (rv)
             goto exr_error;
-        for (int k = 0; k < cl->num_channels && k < (int)n; ++k) {
+        for (int k = 0; k < cl->num_channels; ++k) {
             uint32_t i = 0;
             while (i < n && strcmp(chans[i].name, cl->entries[k].name.str) != 0)
                 ++i;
