@@ -1141,7 +1141,8 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
     const float *Ls[VSGL__GBUFFER_MAX_SPP];
     for (size_t px = j->base + b0; px < j->base + e0; ++px) {
 #if defined(__SSE2__)
-        if (spp == 1 && j->params && px + 4 <= j->base + e0) { /* four pixels' colours at once (pixel4.c), bit for bit */
+        /* four pixels' colours at once (pixel4.c), bit for bit */
+        if (spp == 1 && j->params && px + 4 <= j->base + e0) {
             for (size_t k = 0; k < 4; ++k) {
                 size_t i = px + k - j->base - b0;
                 Ls[k] = slot[i] == UINT32_MAX ? NULL : light + (size_t)slot[i] * 6;
