@@ -893,6 +893,19 @@ VT_TEST(exr_render_combined_alpha_cases)
     remove_tree(dir);
 }
 
+/* The ZIP tests' set-up: a temporary folder, a context and a render
+ * output of w x h whose diffuse light is px. */
+static vsgl_render_output zip_fixture(char *dir, size_t dir_size, vsgl_context **ctx, uint32_t w, uint32_t h,
+                                      float *px)
+{
+    make_temp_dir(dir, dir_size);
+    *ctx = NULL;
+    vsgl_context_create(NULL, ctx);
+    vsgl_render_output o = blank_output(w, h);
+    o.diffuse_light = px;
+    return o;
+}
+
 /* vsgl_exr_options.zip_level: lossless at every level (the pixels read back
  * by OpenEXR are the same), the default level's file of a smooth image is
  * no larger than level 1's and larger than 6's and 9's, 0 is the documented default
@@ -907,11 +920,8 @@ VT_TEST(exr_zip_level_is_lossless_and_trades_size)
                 px[(y * ZW + x) * 3 + c] = 0.2f + 0.5f * sinf(0.07f * (float)(x + 2 * c)) * cosf(0.05f * (float)y) +
                                            0.01f * (float)((x * 7 + y * 13) % 5);
     char dir[64];
-    make_temp_dir(dir, sizeof dir);
-    vsgl_context *ctx = NULL;
-    vsgl_context_create(NULL, &ctx);
-    vsgl_render_output o = blank_output(ZW, ZH);
-    o.diffuse_light = px;
+    vsgl_context *ctx;
+    vsgl_render_output o = zip_fixture(dir, sizeof dir, &ctx, ZW, ZH, px);
     const int32_t levels[5] = {1, VSGL_EXR_ZIP_LEVEL_DEFAULT, 6, 9, 0};
     size_t sizes[5] = {0};
     unsigned char *bytes[5] = {NULL};
@@ -978,11 +988,8 @@ VT_TEST(exr_zip_stores_incompressible_chunks_as_packed)
         memcpy(&px[i], &b, sizeof b);
     }
     char dir[64];
-    make_temp_dir(dir, sizeof dir);
-    vsgl_context *ctx = NULL;
-    vsgl_context_create(NULL, &ctx);
-    vsgl_render_output o = blank_output(NW, NH);
-    o.diffuse_light = px;
+    vsgl_context *ctx;
+    vsgl_render_output o = zip_fixture(dir, sizeof dir, &ctx, NW, NH, px);
     const int32_t comp[2] = {VSGL_EXR_ZIP, VSGL_EXR_ZIPS};
     for (int k = 0; k < 2; ++k) {
         vsgl_exr_options opt;
