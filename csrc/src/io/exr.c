@@ -324,6 +324,18 @@ static exr_result_t no_wait(exr_encode_pipeline_t *enc)
     return EXR_ERR_SUCCESS;
 }
 
+/* Row y of channel s as the file stores it: half or float samples, packed. */
+static void pack_row(const encode_job *j, const src_channel *s, uint32_t y, unsigned char *d)
+{
+    const float *row = s->data + (size_t)y * j->width * s->stride;
+    if (j->bpe == 2) {
+        vsgl__exr_row_to_half(row, s->stride, j->width, d, j->f16c);
+    } else {
+        for (uint32_t x = 0; x < j->width; ++x)
+            memcpy(d + 4 * (size_t)x, &row[(size_t)x * s->stride], 4);
+    }
+}
+
 /* Chunks [begin, end) packed in the file's line layout (per line, the
  * channels in file order, each a row of samples) and deflated by libdeflate
  * (exr_zip.h). */
@@ -349,16 +361,8 @@ static int32_t zip_chunks(encode_job *j, size_t begin, size_t end)
         }
         unsigned char *d = packed;
         for (uint32_t r = 0; r < rows; ++r)
-            for (uint32_t c = 0; c < j->n; ++c, d += line) {
-                const src_channel *s = &j->chans[j->order[c]];
-                const float *row = s->data + (size_t)(y0 + r) * j->width * s->stride;
-                if (j->bpe == 2) {
-                    vsgl__exr_row_to_half(row, s->stride, j->width, d, j->f16c);
-                } else {
-                    for (uint32_t x = 0; x < j->width; ++x)
-                        memcpy(d + 4 * (size_t)x, &row[(size_t)x * s->stride], 4);
-                }
-            }
+            for (uint32_t c = 0; c < j->n; ++c, d += line)
+                pack_row(j, &j->chans[j->order[c]], y0 + r, d);
         if (vsgl__zip_encode(z, packed, n, &out->data, &out->size) != 0)
             failed = 1;
     }
@@ -401,16 +405,8 @@ static int32_t encode_chunks(void *user, size_t chunk, size_t begin, size_t end)
             }
             unsigned char *dst = scratch + (size_t)i * plane;
             const src_channel *s = &j->chans[i];
-            for (uint32_t r = 0; r < rows; ++r) {
-                const float *row = s->data + (size_t)(y0 + r) * j->width * s->stride;
-                unsigned char *d = dst + (size_t)r * j->width * j->bpe;
-                if (j->bpe == 2) {
-                    vsgl__exr_row_to_half(row, s->stride, j->width, d, j->f16c);
-                } else {
-                    for (uint32_t x = 0; x < j->width; ++x)
-                        memcpy(d + 4 * (size_t)x, &row[(size_t)x * s->stride], 4);
-                }
-            }
+            for (uint32_t r = 0; r < rows; ++r)
+                pack_row(j, s, y0 + r, dst + (size_t)r * j->width * j->bpe);
             ch->encode_from_ptr = dst;
             ch->user_pixel_stride = (int32_t)j->bpe;
             ch->user_line_stride = (int32_t)(j->width * j->bpe);
