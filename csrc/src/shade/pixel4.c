@@ -43,12 +43,15 @@ void vsgl__write_pixels4(const shade_job *j, size_t px, const float *const Ls[4]
     const vsgl_gbuffer *g = j->g;
     const vsgl_pixel_planes *pl = j->planes;
     const vsgl_brdf_params *bp[4];
-    float eta[4], dot[4], fd[4], m5[4];
+    float dot[4], fd[4], m5[4];
     for (int k = 0; k < 4; ++k) {
         const uint32_t mat = g->material[px + (size_t)k];
         bp[k] = mat == VSGL__GBUFFER_MISS ? NULL : &j->params[mat];
-        eta[k] = bp[k] ? bp[k]->eta : 1.0f;
     }
+    /* eta's lanes built in registers: four scalar stores read back as one
+     * vector cannot be forwarded, and stalled every call */
+    const __m128 eta = _mm_setr_ps(bp[0] ? bp[0]->eta : 1.0f, bp[1] ? bp[1]->eta : 1.0f, bp[2] ? bp[2]->eta : 1.0f,
+                                   bp[3] ? bp[3]->eta : 1.0f);
     /* v3_dot(n, o), then glossy_color's c = clampf(dot, 0, 1), its dielectric
      * Fresnel at c and (1 - c)^5, for every lane (used where the scalar
      * path would compute them) */
@@ -59,7 +62,7 @@ void vsgl__write_pixels4(const shade_job *j, size_t px, const float *const Ls[4]
     const __m128 c = clamp01_4(d);
     const __m128 m = _mm_sub_ps(_mm_set1_ps(1.0f), c);
     _mm_storeu_ps(dot, d);
-    _mm_storeu_ps(fd, fresnel4(c, _mm_loadu_ps(eta)));
+    _mm_storeu_ps(fd, fresnel4(c, eta));
     _mm_storeu_ps(m5, _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(m, m), m), m), m));
     for (int k = 0; k < 4; ++k) {
         const size_t si = px + (size_t)k;
