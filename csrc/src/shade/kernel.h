@@ -43,6 +43,18 @@ static inline __attribute__((always_inline)) float vsgl__plane_spread(float ce, 
     return q * r;
 }
 
+/* The planar glossy model (shade.h, vsgl__planar_glossy) takes a lobe
+ * whose axis meets the cluster's plane at least VSGL__PLANAR_NZ_MIN (its
+ * cosine to the plane's normal) off it, faded in by a smoothstep over the
+ * next VSGL__PLANAR_NZ_RAMP. A hard bound switched a pair on at full
+ * strength where the receiver lies almost in the cluster's plane (the
+ * axis then meets it within the cluster): on the glossy sphere's rim, a
+ * neighbouring cluster's plane passes next to the receiver, and a pixel
+ * went 0.002 -> 0.062 -> 0.002 in three frames of the camera animation as
+ * the axis crossed the bound. */
+#define VSGL__PLANAR_NZ_MIN 0.01f
+#define VSGL__PLANAR_NZ_RAMP 0.04f
+
 /* The emitter-hemisphere clip's constants (shade.h explains the clip). */
 #define VSGL__CLIP_BEHIND 0.02f   /* the behind fade, in units of sigma */
 #define VSGL__CLIP_PARALLEL 0.3f  /* the parallel fade, in 1 - n.n_v */

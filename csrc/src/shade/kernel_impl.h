@@ -449,7 +449,7 @@ k_planar_geom(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_l
 {
     /* lengths in units of the cluster's sigma, so that nothing overflows:
      * the axis must meet the plane at t <= 1e4 sigma and >= 0.6 degrees
-     * off it (beyond, the footprint's density is ~0 anyway) */
+     * off it, faded in up to 2.9 degrees (kernel.h VSGL__PLANAR_NZ_*) */
     float zx = b->Zx[i], zy = b->Zy[i], zz = b->Zz[i];
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
     float d2 = t->d2[i];
@@ -458,8 +458,10 @@ k_planar_geom(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_l
     float is = k_rsqrt_fine(var); /* the offsets scale with it and q amplifies their error */
     float h = t->h[i] * is;
     float nz = zx * L->nx + zy * L->ny + zz * L->nz;
-    float ok = (h > 0.0f ? 1.0f : 0.0f) * (nz < -0.01f ? 1.0f : 0.0f);
-    float inz = 1.0f / (nz < -0.01f ? nz : -0.01f);
+    float ramp = (-nz - VSGL__PLANAR_NZ_MIN) * (1.0f / VSGL__PLANAR_NZ_RAMP);
+    ramp = ramp < 0.0f ? 0.0f : (ramp > 1.0f ? 1.0f : ramp);
+    float ok = (h > 0.0f ? 1.0f : 0.0f) * ramp * ramp * (3.0f - 2.0f * ramp);
+    float inz = 1.0f / (nz < -VSGL__PLANAR_NZ_MIN ? nz : -VSGL__PLANAR_NZ_MIN);
     float tt = -h * inz;
     tt = tt < 1e4f ? (tt > 0.0f ? tt : 0.0f) : 1e4f;
     float nxd = b->Xx[i] * L->nx + b->Xy[i] * L->ny + b->Xz[i] * L->nz;
