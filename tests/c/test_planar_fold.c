@@ -162,6 +162,20 @@ VT_TEST(planar_glossy_fold_holds_a_half_plane_up_to_its_edge)
     VT_CHECK(worst_inside_nofold < 0.06, "inside, without the fold: %.3f", worst_inside_nofold);
 }
 
+/* An ASG of axis z (unit), its x axis across z and ref, amplitude 1. */
+static vsgl_asg lobe_about(v3 z, v3 ref, float lambda, float mu)
+{
+    v3 xa = v3_normalize(v3_cross(z, ref)), ya = v3_cross(z, xa);
+    vsgl_asg lobe;
+    memset(&lobe, 0, sizeof lobe);
+    lobe.x = (vsgl_vec3){xa.x, xa.y, xa.z};
+    lobe.y = (vsgl_vec3){ya.x, ya.y, ya.z};
+    lobe.z = (vsgl_vec3){z.x, z.y, z.z};
+    lobe.lambda = lambda;
+    lobe.mu = mu;
+    return lobe;
+}
+
 VT_TEST(planar_glossy_grazing_lobe_sees_nothing_below_the_horizon)
 {
     /* a receiver 0.4 m above a lit plane, its normal tilted away from most
@@ -174,14 +188,7 @@ VT_TEST(planar_glossy_grazing_lobe_sees_nothing_below_the_horizon)
     double worst = 0.0, best_nocut = 1e30;
     for (int l = 0; l < 3; ++l) {
         v3 z = v3_normalize(v3_add(t, v3_scale(nr, 0.05f)));
-        v3 xa = v3_normalize(v3_cross(z, v3_make(1.0f, 0.0f, 0.0f))), ya = v3_cross(z, xa);
-        vsgl_asg lobe;
-        memset(&lobe, 0, sizeof lobe);
-        lobe.x = (vsgl_vec3){xa.x, xa.y, xa.z};
-        lobe.y = (vsgl_vec3){ya.x, ya.y, ya.z};
-        lobe.z = (vsgl_vec3){z.x, z.y, z.z};
-        lobe.lambda = bands[l][0];
-        lobe.mu = bands[l][1];
+        vsgl_asg lobe = lobe_about(z, v3_make(1.0f, 0.0f, 0.0f), bands[l][0], bands[l][1]);
         double want = quadrature(x, &nr, &lobe, x, 2.5, getenv("VSGL_TEST_QUICK") ? 0.01 : 0.005);
         double got = 0.0, nocut = 0.0;
         for (int i = -16; i <= 16; ++i)
@@ -228,15 +235,7 @@ VT_TEST(planar_glossy_is_continuous_as_the_axis_leaves_the_plane)
     double prev = -1.0, peak = 0.0, worst = 0.0;
     int steps = 0;
     for (double c = -0.002; c >= -0.08; c -= 0.0005, ++steps) {
-        v3 z = v3_normalize(v3_make(-1.0f, 0.0f, (float)c));
-        v3 xa = v3_normalize(v3_cross(z, v3_make(0.0f, 1.0f, 0.0f))), ya = v3_cross(z, xa);
-        vsgl_asg lobe;
-        memset(&lobe, 0, sizeof lobe);
-        lobe.x = (vsgl_vec3){xa.x, xa.y, xa.z};
-        lobe.y = (vsgl_vec3){ya.x, ya.y, ya.z};
-        lobe.z = (vsgl_vec3){z.x, z.y, z.z};
-        lobe.lambda = 50.0f;
-        lobe.mu = 50.0f;
+        vsgl_asg lobe = lobe_about(v3_normalize(v3_make(-1.0f, 0.0f, (float)c)), v3_make(0.0f, 1.0f, 0.0f), 50.0f, 50.0f);
         double g = vsgl__planar_glossy(&v, x, nr, &lobe);
         VT_CHECK(isfinite(g) && g >= 0.0, "n_v.z %.4f: %g", c, g);
         peak = g > peak ? g : peak;
