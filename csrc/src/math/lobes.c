@@ -31,12 +31,12 @@ static int is_null(v3 a)
     return !(l2 > 0.0f && l2 < INFINITY);
 }
 
-/* v3_normalize(a), with a returned as it is where it is already unit to
- * float precision (a G-buffer normal or view: a few ulps apart). */
-static v3 unit_of(v3 a)
-{
-    return fabsf(v3_dot(a, a) - 1.0f) < 1e-6f ? a : v3_normalize(a);
-}
+/* a is unit to float precision (a G-buffer normal, tangent or view: a few
+ * ulps apart). */
+static int is_unit(v3 a) { return fabsf(v3_dot(a, a) - 1.0f) < 1e-6f; }
+
+/* v3_normalize(a), with a returned as it is where it is already unit. */
+static v3 unit_of(v3 a) { return is_unit(a) ? a : v3_normalize(a); }
 
 /* Right-handed orthonormal frame [x, y, z] with z = normalize(n) and x the
  * tangent made orthogonal to z (any completion if t is degenerate). A zero
@@ -49,8 +49,7 @@ static void make_frame(v3 n, v3 t, v3 *x, v3 *y, v3 *z)
      * such a pair twice (vsgl_ndf_aniso_to_asg, vsgl_warp_ndf_asg), and
      * re-normalising it cost 10 % of a 1080p frame's per-receiver work for
      * a change of a few ulps. */
-    const float n2 = v3_dot(n, n), t2 = v3_dot(t, t), nt = v3_dot(n, t);
-    if (fabsf(n2 - 1.0f) < 1e-6f && fabsf(t2 - 1.0f) < 1e-6f && fabsf(nt) < 1e-6f) {
+    if (is_unit(n) && is_unit(t) && fabsf(v3_dot(n, t)) < 1e-6f) {
         *x = t;
         *y = v3_cross(n, t);
         *z = n;
@@ -260,9 +259,7 @@ void vsgl_warp_ndf_asg(const vsgl_asg *ndf, const vsgl_vec3 *view, vsgl_asg *out
      * cos 2th = half_diff / rad, sin 2th = q12 / rad (th = 0 where the
      * form is round) */
     double c2 = rad > 0.0 ? half_diff / rad : 1.0;
-    double cs = sqrt(fmax(0.5 * (1.0 + c2), 0.0)), sn = sqrt(fmax(0.5 * (1.0 - c2), 0.0));
-    if (q12 < 0.0 || (q12 == 0.0 && signbit(q12) && c2 < 1.0))
-        sn = -sn;
+    double cs = sqrt(fmax(0.5 * (1.0 + c2), 0.0)), sn = copysign(sqrt(fmax(0.5 * (1.0 - c2), 0.0)), q12);
     dv xi = dv_lin(xp, cs, yp, sn);
     dv yi = dv_lin(xp, -sn, yp, cs);
     double e1 = mean + rad, e2 = mean - rad;

@@ -55,6 +55,15 @@ static inline __attribute__((always_inline)) float vsgl__plane_spread(float ce, 
 #define VSGL__PLANAR_NZ_MIN 0.01f
 #define VSGL__PLANAR_NZ_RAMP 0.04f
 
+/* That fade's weight for the cosine nz = n_v.z of the axis to the plane's
+ * normal (the kernel and vsgl__planar_glossy alike). */
+static inline float vsgl__planar_nz_weight(float nz)
+{
+    float r = (-nz - VSGL__PLANAR_NZ_MIN) * (1.0f / VSGL__PLANAR_NZ_RAMP);
+    r = r < 0.0f ? 0.0f : (r > 1.0f ? 1.0f : r);
+    return r * r * (3.0f - 2.0f * r);
+}
+
 /* The emitter-hemisphere clip's constants (shade.h explains the clip). */
 #define VSGL__CLIP_BEHIND 0.02f   /* the behind fade, in units of sigma */
 #define VSGL__CLIP_PARALLEL 0.3f  /* the parallel fade, in 1 - n.n_v */

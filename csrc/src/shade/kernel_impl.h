@@ -458,9 +458,7 @@ k_planar_geom(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_l
     float is = k_rsqrt_fine(var); /* the offsets scale with it and q amplifies their error */
     float h = t->h[i] * is;
     float nz = zx * L->nx + zy * L->ny + zz * L->nz;
-    float ramp = (-nz - VSGL__PLANAR_NZ_MIN) * (1.0f / VSGL__PLANAR_NZ_RAMP);
-    ramp = ramp < 0.0f ? 0.0f : (ramp > 1.0f ? 1.0f : ramp);
-    float ok = (h > 0.0f ? 1.0f : 0.0f) * ramp * ramp * (3.0f - 2.0f * ramp);
+    float ok = (h > 0.0f ? 1.0f : 0.0f) * vsgl__planar_nz_weight(nz);
     float inz = 1.0f / (nz < -VSGL__PLANAR_NZ_MIN ? nz : -VSGL__PLANAR_NZ_MIN);
     float tt = -h * inz;
     tt = tt < 1e4f ? (tt > 0.0f ? tt : 0.0f) : 1e4f;

@@ -216,8 +216,8 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe)
     if (!(h > 0.0f) || !(nz < -1e-6f) || !(lobe->log_amplitude > -INFINITY))
         return 0.0f;
     /* within 0.6 degrees of the plane nothing, faded in up to 2.9 (kernel.h VSGL__PLANAR_NZ_*) */
-    float ramp = clampf((-nz - VSGL__PLANAR_NZ_MIN) * (1.0f / VSGL__PLANAR_NZ_RAMP), 0.0f, 1.0f);
-    if (!(ramp > 0.0f))
+    const float fade = vsgl__planar_nz_weight(nz);
+    if (!(fade > 0.0f))
         return 0.0f;
     float t = h / -nz;
     v3 y0 = v3_add(x, v3_scale(lobe->z, t));
@@ -244,8 +244,7 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe)
         return 0.0f;
     /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
     float scale = expf(lobe->log_amplitude) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
-    scale *= planar_horizon(v, x, nr, lobe->z, var, d1, d2, s11, s22, s12, det, u1, u2) * ramp * ramp *
-             (3.0f - 2.0f * ramp);
+    scale *= planar_horizon(v, x, nr, lobe->z, var, d1, d2, s11, s22, s12, det, u1, u2) * fade;
     float q0 = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
     if (!(wf > 0.0f))
         return scale * expf(-0.5f * q0);
