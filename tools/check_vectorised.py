@@ -3,7 +3,7 @@
 
 The kernel (csrc/src/shade/kernel_impl.h) is branch-free C that GCC
 vectorises over a block's receivers; each stage is one loop, written as a
-macro invocation (K_FORN, K_DIFFUSE, K_FOLD) inside k_shade. A stage that
+macro invocation (K_FORN, K_FORI, K_DIFFUSE, K_FOLD) inside k_shade. A stage that
 stops vectorising still computes the same pixels, only several times
 slower, and no test sees it: a fold rewrite once left five of its seven
 loops scalar and balanced renders 15-40 % slower (docs/performance.md,
@@ -26,7 +26,7 @@ IMPL = os.path.join("csrc", "src", "shade", "kernel_impl.h")
 FLAGS = ["-std=c11", "-D_POSIX_C_SOURCE=200809L", "-DVSGL_BUILDING", "-fPIC", "-Icsrc/include", "-Icsrc/src",
          "-O3", "-fno-math-errno", "-fno-trapping-math", "-funsafe-math-optimizations", "-ffinite-math-only",
          "-mrecip", "-fopt-info-vec-optimized"]
-STAGE = re.compile(r"^\s*(?:if \(.*\)\s*|else\s*|case \d+:\s*|default:\s*)*(K_FORN|K_DIFFUSE|K_FOLD)\(")
+STAGE = re.compile(r"^\s*(?:if \(.*\)\s*|else\s*|case \d+:\s*|default:\s*)*(K_FORN|K_FORI|K_DIFFUSE|K_FOLD)\(")
 
 
 def stage_lines(path):

@@ -251,3 +251,77 @@ VT_TEST(planar_glossy_is_continuous_as_the_axis_leaves_the_plane)
     /* measured: at most 2.0 % of the peak per step; with a hard bound at 0.01, 45 % */
     VT_CHECK(worst < 0.05 * peak, "over %d steps of 0.0005, the largest change is %.3f of the peak", steps, worst / peak);
 }
+
+/* Exitance of the lattice of make_cell (its tents' sum, one row or column
+ * beyond the last cell's centre falling to 0) at (px, py), per unit. */
+static double lattice_exitance(double px, double py)
+{
+    if (py < 0.0)
+        return 0.0;
+    const double xe = 16 * CELL_H, ye = (16 + cell_off) * CELL_H;
+    double fx = fabs(px) <= xe ? 1.0 : fmax(0.0, 1.0 - (fabs(px) - xe) / CELL_H);
+    double fy = py <= ye ? 1.0 : fmax(0.0, 1.0 - (py - ye) / CELL_H);
+    return fx * fy;
+}
+
+VT_TEST(planar_glossy_follows_a_lobe_across_the_plane_horizon)
+{
+    /* a receiver 0.4 m above a lit plane (4 m of it ahead), its lobe's
+     * axis turning from 0.2 rad below the plane's horizon to 0.15 above it
+     * (a glossy sphere's reflection of a floor, from its lower part up
+     * past the floor's far end): the part of the lobe that meets the plane
+     * shrinks smoothly, and so must the light. Quadrature of the same
+     * radiance through the same ASG over the plane is the truth. */
+    const v3 x = v3_make(0.0f, 0.0f, 0.4f);
+    const double step = getenv("VSGL_TEST_QUICK") ? 0.02 : 0.01;
+    const float bands[2][2] = {{50.0f, 50.0f}, {12.0f, 40.0f}};
+    double worst = 0.0, worst_horizon = 0.0;
+    for (int l = 0; l < 2; ++l) {
+        double peak = 0.0, err = 0.0, prev = 1e30;
+        for (int k = 0; k <= 7; ++k) {
+            const double el = 0.2 - 0.05 * k;
+            v3 z = v3_make(0.0f, (float)cos(el), (float)-sin(el));
+            vsgl_asg lobe = lobe_about(z, v3_make(0.0f, 0.0f, 1.0f), bands[l][0], bands[l][1]);
+            double want = 0.0;
+            for (double py = 0.5 * step; py < 4.5; py += step)
+                for (double px = -4.5 + 0.5 * step; px < 4.5; px += step) {
+                    double e = lattice_exitance(px, py);
+                    if (!(e > 0.0))
+                        continue;
+                    double d[3] = {px - x.x, py - x.y, -x.z}, r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2],
+                           r = sqrt(r2);
+                    vsgl_vec3 dir = {(float)(d[0] / r), (float)(d[1] / r), (float)(d[2] / r)};
+                    want += e * vsgl_asg_eval(&lobe, &dir) * (x.z / r) / r2 * step * step;
+                }
+            want /= 3.14159265358979323846;
+            double got = 0.0;
+            for (int i = -16; i <= 16; ++i)
+                for (int j = -2; j <= 16; ++j) {
+                    vsgl_vsgl v;
+                    if (make_cell(i, j, 1, &v))
+                        got += v.power[0] * vsgl__planar_glossy(&v, x, v3_make(z.x, z.y, z.z), &lobe);
+                }
+            VT_CHECK(isfinite(got) && got >= 0.0, "elevation %.2f: %g", el, got);
+            if (getenv("VSGL_TEST_VERBOSE"))
+                printf("    bands %g/%g, axis %+.2f rad into the plane: quadrature %.5f, model %.5f (%+.0f %%)\n",
+                       bands[l][0], bands[l][1], el, want, got, 100.0 * (got / want - 1.0));
+            peak = want > peak ? want : peak;
+            err = fmax(err, fabs(got - want));
+            /* the light falls as the axis leaves the plane, and is there with the axis on the horizon */
+            VT_CHECK(got < prev, "bands %g/%g: at %.2f rad the model does not fall (%g after %g)", bands[l][0],
+                     bands[l][1], el, got, prev);
+            prev = got;
+            if (fabs(el) < 1e-9)
+                worst_horizon = fmax(worst_horizon, fabs(got / want - 1.0));
+        }
+        worst = fmax(worst, err / peak);
+    }
+    if (getenv("VSGL_TEST_VERBOSE"))
+        printf("    largest error %.3f of the peak; on the horizon %.3f\n", worst, worst_horizon);
+    /* measured: 0.120 of the peak (+12 % where the axis meets the plane
+     * 2 m off, the model's error away from the horizon too), on the horizon
+     * -34 %; with the axis followed to the plane alone (before 2026-12-05)
+     * 0.316 of the peak and nothing from the horizon up */
+    VT_CHECK(worst < 0.15, "the largest error is %.3f of the peak", worst);
+    VT_CHECK(worst_horizon < 0.5, "with the axis on the horizon, off by %.3f", worst_horizon);
+}

@@ -7,6 +7,8 @@
 #ifndef VSGL_SHADE_KERNEL_H
 #define VSGL_SHADE_KERNEL_H
 
+#include "math/normal.h"
+
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -43,6 +45,13 @@ static inline __attribute__((always_inline)) float vsgl__plane_spread(float ce, 
     return q * r;
 }
 
+/* smoothstep of r clamped to [0, 1] (branch-free: the kernel's lanes). */
+static inline float vsgl__smooth_ramp(float r)
+{
+    r = r < 0.0f ? 0.0f : (r > 1.0f ? 1.0f : r);
+    return r * r * (3.0f - 2.0f * r);
+}
+
 /* The planar glossy model (shade.h, vsgl__planar_glossy) takes a lobe
  * whose axis meets the cluster's plane at least VSGL__PLANAR_NZ_MIN (its
  * cosine to the plane's normal) off it, faded in by a smoothstep over the
@@ -59,15 +68,123 @@ static inline __attribute__((always_inline)) float vsgl__plane_spread(float ce, 
  * normal (the kernel and vsgl__planar_glossy alike). */
 static inline float vsgl__planar_nz_weight(float nz)
 {
-    float r = (-nz - VSGL__PLANAR_NZ_MIN) * (1.0f / VSGL__PLANAR_NZ_RAMP);
-    r = r < 0.0f ? 0.0f : (r > 1.0f ? 1.0f : r);
-    return r * r * (3.0f - 2.0f * r);
+    return vsgl__smooth_ramp((-nz - VSGL__PLANAR_NZ_MIN) * (1.0f / VSGL__PLANAR_NZ_RAMP));
+}
+
+/* The planar model across the plane's horizon. The model follows the
+ * lobe's axis to the plane and spreads the lobe's whole integral about
+ * that point, which holds while the lobe lies well inside the directions
+ * that meet the plane. Near the horizon it does not: the part of the lobe
+ * that points above the horizon meets the plane nowhere, and with the
+ * axis above it none of the lobe was counted, though its lower part still
+ * meets the plane (a glossy sphere's reflection of a floor ended in a
+ * sharp edge where its axis crossed the floor's horizon: the pixel above
+ * it had 0.14 of Cycles' glossy light, 0.92 with what follows). Along e, the direction from the axis towards -n_v, the lobe's
+ * angular spread is sigma^2 = (n_v.X)^2 / 2 lambda + (n_v.Y)^2 / 2 mu over
+ * 1 - (n_v.z)^2 (an ASG's Gaussian over its tangent plane), and the axis
+ * lies delta = asin(-n_v.z) into the plane: a = delta / sigma. The share
+ * of the lobe that meets the plane is Phi(a), and its directions there
+ * centre on delta + sigma phi(a) / Phi(a) (a truncated Gaussian's mean):
+ * the model takes that share, with the axis tilted by Delta = sigma phi(a)
+ * / Phi(a) towards the plane, z' = (z + Delta e) / sqrt(1 + Delta^2).
+ * Far into the plane Phi = 1 and Delta = 0: the model as before.
+ * `a` is kept at -4 and above (Phi 3e-5; from a = -4.22 the tilted axis
+ * itself leaves the plane, vsgl__planar_nz_weight). A lane's a, Phi and
+ * tilt depend on its lobe and the plane alone: shade.c (tilt_lane) takes
+ * them once per block for each axis plane, and the kernel and
+ * vsgl__planar_glossy apply them per pair (vsgl__planar_tilt). */
+#define VSGL__PLANAR_TILT_A_MIN (-4.0f)
+
+static inline float vsgl__planar_tilt_a(float nz, float nx, float ny, float lam, float mu, float *sigma, float *iw)
+{
+    float w2 = 1.0f - nz * nz;
+    w2 = w2 > 1e-4f ? w2 : 1e-4f;
+    *iw = 1.0f / sqrtf(w2);
+    float s2 = (nx * nx * (0.5f / lam) + ny * ny * (0.5f / mu)) * (*iw * *iw);
+    s2 = s2 > 1e-12f ? s2 : 1e-12f;
+    *sigma = sqrtf(s2);
+    /* asin(-nz) by its series (exact near the horizon, 1.24 for 1.57 at
+     * the pole, where Phi is 1 either way) */
+    float s = -nz, d = s * (1.0f + s * s * (0.16666667f + 0.075f * s * s));
+    float a = d / *sigma;
+    return a > VSGL__PLANAR_TILT_A_MIN ? a : VSGL__PLANAR_TILT_A_MIN;
+}
+
+/* What a lane's tilt needs against a plane (vsgl__planar_tilt_a's a,
+ * sigma, iw and e = exp(-a^2 / 2)): Phi(a) and D = sigma phi(a) / Phi(a),
+ * the tilt at full weight. */
+static inline float vsgl__planar_tilt_pre(float a, float sigma, float e, float *D)
+{
+    float Phi = vsgl__normal_cdf_e(a, e);
+    *D = sigma * (0.39894228f * e) / Phi;
+    return Phi;
+}
+
+/* The share of the lobe that meets the plane, 1 - w (1 - Phi), and the
+ * axis's tilt w D as z' = p z - q n_v (e = (nz z - n_v) / sqrt(1 - nz^2)
+ * towards the plane), at weight w (vsgl__planar_tilt_weight, _gate): w =
+ * 0, or Phi 1 and D 0 (a lane that needs no tilt), give share 1, p 1 and
+ * q 0 exactly. */
+static inline float vsgl__planar_tilt(float nz, float Phi, float D, float w, float *p, float *q)
+{
+    float w2 = 1.0f - nz * nz;
+    float iw = 1.0f / sqrtf(w2 > 1e-4f ? w2 : 1e-4f);
+    float delta = w * D;
+    float c = 1.0f / sqrtf(1.0f + delta * delta);
+    *p = c * (1.0f + delta * nz * iw);
+    *q = c * delta * iw;
+    return 1.0f - w * (1.0f - Phi);
+}
+
+/* How far the horizon's share and tilt apply: to a flat surface's cluster
+ * (coherence k >= 0.995, smoothstep from 0.98) seen from a receiver that
+ * stands off its plane by more than its size (height hs >= 2 sigma,
+ * smoothstep from 0.5). A sphere's cluster stands for a surface that
+ * curves away from its plane, and receivers on the sphere lie behind that
+ * plane or barely in front of it; tilted lobes on the sphere's rim met its
+ * neighbours' planes where the sphere is not (a bright ring, and pixels
+ * of its rim flashing 0.005 -> 0.06 from frame to frame of the camera
+ * animation, where small cells of the sphere are as coherent as a plane). */
+static inline float vsgl__planar_tilt_weight(float k)
+{
+    return vsgl__smooth_ramp((k - 0.98f) * (1.0f / 0.015f));
+}
+
+/* Whether a lane needs the tilt at all: not when the axis lies at least 4
+ * sigma into the plane (-nz >= 4 sigma, -nz <= delta: a >= 4), where Phi >=
+ * 1 - 3e-5 and the tilt is below 1.4e-4 sigma. Those lanes take share 1
+ * and no tilt exactly, and the kernel skips the tilt's arithmetic in
+ * blocks where no lane needs it. nx, ny: n_v.X, n_v.Y. */
+static inline int vsgl__planar_tilt_needed(float nz, float nx, float ny, float lam, float mu)
+{
+    float w2 = 1.0f - nz * nz;
+    return !(nz < 0.0f && nz * nz * w2 >= 16.0f * (nx * nx * (0.5f / lam) + ny * ny * (0.5f / mu)));
+}
+
+/* The table (VSGL__TILT_DIRS) of a cluster's plane normal n: 2 axis +
+ * (n[axis] < 0) where n is an axis (within 1e-5: a flat wall's mean
+ * normal), else -1: no tilt (a plane at an angle keeps the model without
+ * it, as before 2026-12-05). */
+static inline int vsgl__planar_tilt_dir(float nx, float ny, float nz)
+{
+    const float c[3] = {nx, ny, nz};
+    for (int k = 0; k < 3; ++k)
+        if (fabsf(c[k]) > 1.0f - 1e-5f)
+            return 2 * k + (c[k] < 0.0f);
+    return -1;
+}
+
+static inline float vsgl__planar_tilt_gate(float hs)
+{
+    return vsgl__smooth_ramp((hs - 0.5f) * (1.0f / 1.5f));
 }
 
 /* The emitter-hemisphere clip's constants (shade.h explains the clip). */
 #define VSGL__CLIP_BEHIND 0.02f   /* the behind fade, in units of sigma */
 #define VSGL__CLIP_PARALLEL 0.3f  /* the parallel fade, in 1 - n.n_v */
 #define VSGL__CLIP_NEAR 4.0f      /* the spread sharpness where conv is half-way */
+
+#define VSGL__TILT_DIRS 6
 
 /* Receivers of one block. Non-glossy receivers have camp = 0 (and any
  * frame); receivers without a diffuse lobe have diffuse = 0. */
@@ -86,6 +203,13 @@ typedef struct vsgl_kernel_block {
     float alpha[VSGL__KERNEL_BLOCK];
     /* the smooth Fresnel/shadowing factor M(z, o) per channel at the lobe axis */
     float f0r[VSGL__KERNEL_BLOCK], f0g[VSGL__KERNEL_BLOCK], f0b[VSGL__KERNEL_BLOCK];
+    /* the planar model's horizon tilt against the six planes facing +-x,
+     * +-y, +-z (index 2 axis + side; kernel.h, vsgl__planar_tilt), per
+     * lane: Phi and D, 1 and 0 where the lane needs no tilt
+     * (vsgl__planar_tilt_needed); tany[d]: some lane needs it (shade.c,
+     * tilt_table) */
+    float tphi[VSGL__TILT_DIRS][VSGL__KERNEL_BLOCK], td[VSGL__TILT_DIRS][VSGL__KERNEL_BLOCK];
+    int tany[VSGL__TILT_DIRS];
     /* accumulators */
     float ld[3][VSGL__KERNEL_BLOCK];     /* diffuse light: sum power * cosine integral / pi */
     float ls[3][VSGL__KERNEL_BLOCK];     /* glossy radiance */
@@ -117,6 +241,8 @@ typedef struct vsgl_kernel_light {
      * in units of sqrt(pvar) and its weight (0: not cut there) */
     float fold, fb[2][2], fa[2][2];
     float fs[2];  /* per axis, the mean the images are built on (shade.c, fold_mean) from the mean, same units */
+    float tilt;   /* the planar model's horizon share and tilt, vsgl__planar_tilt_weight (0: none) */
+    uint32_t tdir; /* where tilt > 0: the block's table of the axis its normal is (VSGL__TILT_DIRS: 2 axis + side) */
     float freach; /* (sqrt(50) + 2 |farthest cut| + |fs|)^2 / 2: where the fold can matter (k_shade) */
 } vsgl_kernel_light;
 

@@ -445,25 +445,38 @@ k_horizon(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light
  * shares (the axis's hit on the plane and the footprint's frame there),
  * then per lobe (k_planar_lobe) all but the exp. */
 static inline __attribute__((always_inline)) void
-k_planar_geom(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
+k_planar_geom(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t,
+              int tilt, const float *restrict tphi, const float *restrict td)
 {
     /* lengths in units of the cluster's sigma, so that nothing overflows:
      * the axis must meet the plane at t <= 1e4 sigma and >= 0.6 degrees
      * off it, faded in up to 2.9 degrees (kernel.h VSGL__PLANAR_NZ_*) */
-    float zx = b->Zx[i], zy = b->Zy[i], zz = b->Zz[i];
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
     float d2 = t->d2[i];
     float var = L->pvar > d2 * 4.547473508864641e-13f ? L->pvar : d2 * 4.547473508864641e-13f;
     var = var > VSGL__TINY ? var : VSGL__TINY;
     float is = k_rsqrt_fine(var); /* the offsets scale with it and q amplifies their error */
     float h = t->h[i] * is;
-    float nz = zx * L->nx + zy * L->ny + zz * L->nz;
-    float ok = (h > 0.0f ? 1.0f : 0.0f) * vsgl__planar_nz_weight(nz);
+    float nxd = b->Xx[i] * L->nx + b->Xy[i] * L->ny + b->Xz[i] * L->nz;
+    float nyd = b->Yx[i] * L->nx + b->Yy[i] * L->ny + b->Yz[i] * L->nz;
+    /* at the plane's horizon the lobe's share that meets it, about an axis
+     * tilted towards it (kernel.h, vsgl__planar_tilt; the lane's part from
+     * the block's table of the plane's axis); `tilt` 0: no lane of the
+     * block needs it */
+    float nz0 = b->Zx[i] * L->nx + b->Zy[i] * L->ny + b->Zz[i] * L->nz;
+    float zx = b->Zx[i], zy = b->Zy[i], zz = b->Zz[i], nz = nz0, share = 1.0f;
+    if (tilt) {
+        float tp, tq;
+        share = vsgl__planar_tilt(nz0, tphi[i], td[i], L->tilt * vsgl__planar_tilt_gate(h), &tp, &tq);
+        zx = tp * zx - tq * L->nx;
+        zy = tp * zy - tq * L->ny;
+        zz = tp * zz - tq * L->nz;
+        nz = tp * nz0 - tq;
+    }
+    float ok = (h > 0.0f ? 1.0f : 0.0f) * vsgl__planar_nz_weight(nz) * share;
     float inz = 1.0f / (nz < -VSGL__PLANAR_NZ_MIN ? nz : -VSGL__PLANAR_NZ_MIN);
     float tt = -h * inz;
     tt = tt < 1e4f ? (tt > 0.0f ? tt : 0.0f) : 1e4f;
-    float nxd = b->Xx[i] * L->nx + b->Xy[i] * L->ny + b->Xz[i] * L->nz;
-    float nyd = b->Yx[i] * L->nx + b->Yy[i] * L->ny + b->Yz[i] * L->nz;
     float zu1 = zx * L->u1x + zy * L->u1y + zz * L->u1z, zu2 = zx * L->u2x + zy * L->u2y + zz * L->u2z;
     float xu1 = b->Xx[i] * L->u1x + b->Xy[i] * L->u1y + b->Xz[i] * L->u1z;
     float xu2 = b->Xx[i] * L->u2x + b->Xy[i] * L->u2y + b->Xz[i] * L->u2z;
@@ -746,6 +759,11 @@ k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
  * pass (the j loop is unrolled before vectorisation), every loop body holds
  * two independent chains, which the core overlaps. Sums are added in VSGL
  * order, as one VSGL at a time would. */
+/* one VSGL's stage: lanes i */
+#define K_FORI(STMT)                                   \
+    for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) \
+        STMT
+
 #define K_FORN(STMT)                                   \
     for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) \
         for (int j = 0; j < NL; ++j)                   \
@@ -833,8 +851,21 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
     const int skip_lobes = hv && hv_all && all_planar;
     /* the receiver's horizon only in blocks where some lane's lobe grazes it */
     const int graze = (lobes & VSGL__KERNEL_GRAZE) != 0;
-    if (!skip_lobes && !none_planar)
-        K_FORN(k_planar_geom(b, i, L + j, t + j));
+    if (!skip_lobes && !none_planar) {
+        /* the horizon's tilt only in blocks where some lane's lobe nears a
+         * flat cluster's horizon (kernel.h, vsgl__planar_tilt_needed) */
+        int tilt = 0;
+        for (int j = 0; j < NL; ++j)
+            tilt |= L[j].tilt > 0.0f && b->tany[L[j].tdir];
+        if (tilt) {
+            for (int j = 0; j < NL; ++j) { /* each VSGL with the rows of its plane in the block's tables */
+                const float *restrict tphi = b->tphi[L[j].tdir], *restrict td = b->td[L[j].tdir];
+                K_FORI(k_planar_geom(b, i, L + j, t + j, 1, tphi, td));
+            }
+        } else {
+            K_FORN(k_planar_geom(b, i, L + j, t + j, 0, NULL, NULL));
+        }
+    }
     for (int q = 0; q < (skip_lobes ? 0 : 1 + two); ++q) {
         const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
         const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;

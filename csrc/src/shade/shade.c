@@ -209,21 +209,81 @@ static float planar_horizon(const vsgl_vsgl *v, v3 x, v3 nr, vsgl_vec3 z, float 
     return 1.0f - (1.0f - above) * gw;
 }
 
+/* A lane's part of the horizon tilt (kernel.h, vsgl__planar_tilt) against
+ * the plane of table dir (an axis and side) for the lobe of frame (X, Y,
+ * Z) and sharpnesses lam, mu: Phi and D; 1 and 0 where the lane needs
+ * none. The kernel's block tables and the scalar form both take it from
+ * here. */
+static float tilt_lane(vsgl_vec3 X, vsgl_vec3 Y, vsgl_vec3 Z, float lam, float mu, int dir, float *D)
+{
+    const int k = dir >> 1;
+    const float sg = dir & 1 ? -1.0f : 1.0f;
+    const float nz = sg * (k == 0 ? Z.x : k == 1 ? Z.y : Z.z), nx = sg * (k == 0 ? X.x : k == 1 ? X.y : X.z),
+                ny = sg * (k == 0 ? Y.x : k == 1 ? Y.y : Y.z);
+    lam = fmaxf(lam, 0.01f);
+    mu = fmaxf(mu, 0.01f);
+    *D = 0.0f;
+    if (!vsgl__planar_tilt_needed(nz, nx, ny, lam, mu))
+        return 1.0f;
+    float sigma, iw;
+    const float a = vsgl__planar_tilt_a(nz, nx, ny, lam, mu, &sigma, &iw);
+    return vsgl__planar_tilt_pre(a, sigma, expf(-0.5f * a * a), D);
+}
+
+/* The block's tilt tables (vsgl_kernel_block.tphi, td) for its glossy
+ * lanes; the others need none. */
+static void tilt_table(vsgl_kernel_block *b)
+{
+    for (int d = 0; d < VSGL__TILT_DIRS; ++d) {
+        b->tany[d] = 0;
+        for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) {
+            const vsgl_vec3 X = {b->Xx[i], b->Xy[i], b->Xz[i]}, Y = {b->Yx[i], b->Yy[i], b->Yz[i]},
+                            Z = {b->Zx[i], b->Zy[i], b->Zz[i]};
+            b->tphi[d][i] = 1.0f;
+            b->td[d][i] = 0.0f;
+            if (b->camp[i] > 0.0f)
+                b->tphi[d][i] = tilt_lane(X, Y, Z, b->lam[i], b->mu[i], d, &b->td[d][i]);
+            b->tany[d] |= b->td[d][i] > 0.0f;
+        }
+    }
+}
+
 float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe)
 {
+    return vsgl__planar_glossy_part(v, x, nr, lobe, lobe);
+}
+
+float vsgl__planar_glossy_part(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe, const vsgl_asg *whole)
+{
     v3 n = v->normal;
-    float h = v3_dot(n, v3_sub(x, v->mean)), nz = v3_dot(n, lobe->z);
-    if (!(h > 0.0f) || !(nz < -1e-6f) || !(lobe->log_amplitude > -INFINITY))
+    float h = v3_dot(n, v3_sub(x, v->mean));
+    if (!(h > 0.0f) || !(lobe->log_amplitude > -INFINITY))
+        return 0.0f;
+    /* the share of the whole lobe that meets the plane, its axis tilted
+     * towards it by where that share centres (kernel.h, vsgl__planar_tilt;
+     * the kernel's from the block's table, tilt_table) */
+    float var = v->variance + v->widen, share = 1.0f;
+    v3 z = v3_make(lobe->z.x, lobe->z.y, lobe->z.z);
+    const int dir = vsgl__planar_tilt_dir(n.x, n.y, n.z);
+    if (dir >= 0 && v->lobe == VSGL__LOBE_DIFFUSE) {
+        float D, tp, tq;
+        const float Phi = tilt_lane(whole->x, whole->y, whole->z, whole->lambda, whole->mu, dir, &D);
+        const float w = vsgl__planar_tilt_weight(v->coherence) * vsgl__planar_tilt_gate(h / sqrtf(fmaxf(var, VSGL__TINY)));
+        share = vsgl__planar_tilt(v3_dot(n, z), Phi, D, w, &tp, &tq);
+        z = v3_sub(v3_scale(z, tp), v3_scale(n, tq));
+    }
+    float nz = v3_dot(n, z);
+    if (!(nz < -1e-6f))
         return 0.0f;
     /* within 0.6 degrees of the plane nothing, faded in up to 2.9 (kernel.h VSGL__PLANAR_NZ_*) */
-    const float fade = vsgl__planar_nz_weight(nz);
+    const float fade = vsgl__planar_nz_weight(nz) * share;
     if (!(fade > 0.0f))
         return 0.0f;
     float t = h / -nz;
-    v3 y0 = v3_add(x, v3_scale(lobe->z, t));
+    v3 y0 = v3_add(x, v3_scale(z, t));
     v3 dlt = v3_sub(y0, v->mean);
-    v3 ex = v3_scale(v3_sub(lobe->x, v3_scale(lobe->z, v3_dot(n, lobe->x) / nz)), t);
-    v3 ey = v3_scale(v3_sub(lobe->y, v3_scale(lobe->z, v3_dot(n, lobe->y) / nz)), t);
+    v3 ex = v3_scale(v3_sub(lobe->x, v3_scale(z, v3_dot(n, lobe->x) / nz)), t);
+    v3 ey = v3_scale(v3_sub(lobe->y, v3_scale(z, v3_dot(n, lobe->y) / nz)), t);
     v3 u1, u2;
     cell_cuts cuts;
     float wf = fold_weight(v, &cuts);
@@ -234,7 +294,7 @@ float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe)
     float lam = fmaxf(lobe->lambda, 0.01f), mu = fmaxf(lobe->mu, 0.01f);
     float a1 = v3_dot(ex, u1), a2 = v3_dot(ex, u2), b1 = v3_dot(ey, u1), b2 = v3_dot(ey, u2);
     float d1 = v3_dot(dlt, u1), d2 = v3_dot(dlt, u2);
-    float il = 0.5f / lam, im = 0.5f / mu, var = v->variance + v->widen;
+    float il = 0.5f / lam, im = 0.5f / mu;
     float s11 = var + a1 * a1 * il + b1 * b1 * im;
     float s22 = var + a2 * a2 * il + b2 * b2 * im;
     float s12 = a1 * a2 * il + b1 * b2 * im;
@@ -561,10 +621,11 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
             vsgl_asg lobe = r->asg;
             if (j->s->glossy_mode == VSGL_GLOSSY_SG)
                 vsgl_sg_to_asg(&r->sg, &lobe);
-            else if (parts == 2)
+            const vsgl_asg whole = lobe; /* its spread sets the tilt of every part (the kernel's b->lam, b->mu) */
+            if (j->s->glossy_mode != VSGL_GLOSSY_SG && parts == 2)
                 lobe = ggx_part(&r->asg, q);
             float k2 = v->coherence * v->coherence;
-            gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * vsgl__planar_glossy(v, r->x, r->n, &lobe);
+            gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * vsgl__planar_glossy_part(v, r->x, r->n, &lobe, &whole);
         }
         sum += gi;
     }
@@ -922,6 +983,8 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
     }
     memset(blk->ld, 0, sizeof blk->ld);
     memset(blk->ls, 0, sizeof blk->ls);
+    if (lobes & VSGL__KERNEL_GLOSSY)
+        tilt_table(blk);
     if (lobes) {
         size_t (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t,
                          float) =
@@ -1241,6 +1304,9 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             v3 u1, u2;
             cell_cuts cuts;
             o->fold = o->planar > 0.0f ? fold_weight(v, &cuts) : 0.0f;
+            const int tdir = vsgl__planar_tilt_dir(v->normal.x, v->normal.y, v->normal.z);
+            o->tilt = o->planar > 0.0f && tdir >= 0 ? vsgl__planar_tilt_weight(v->coherence) : 0.0f;
+            o->tdir = tdir >= 0 ? (uint32_t)tdir : 0u;
             memset(o->fb, 0, sizeof o->fb);
             memset(o->fa, 0, sizeof o->fa);
             o->fs[0] = o->fs[1] = 0.0f;

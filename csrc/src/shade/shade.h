@@ -115,8 +115,16 @@ v3 vsgl__lifted_origin(v3 o, v3 x, v3 n, v3 lift, v3 target);
  * lattice rows otherwise spill past the junction and the reflection of a
  * lit wall darkened towards its foot (35 % at the junction of the red-wall
  * room's floor; glossy structured error against Cycles 2-6x lower with the
- * fold, docs/quality.md). */
+ * fold, docs/quality.md).
+ * Where the lobe meets the plane's horizon, only its share that points
+ * into the plane counts, about an axis tilted towards the plane (kernel.h,
+ * vsgl__planar_tilt). */
 float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe);
+
+/* The same for one part of a lobe (GGX's core or tail, of the same axes)
+ * whose tilt at the horizon the whole lobe's spread sets, as the kernel's
+ * (vsgl__planar_glossy is this with part = whole). */
+float vsgl__planar_glossy_part(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *part, const vsgl_asg *whole);
 
 /* Shade every G-buffer sample with every VSGL; writes `planes`.
  * `pairs` receives the number of sample x VSGL evaluations. */
