@@ -95,12 +95,11 @@ static inline float vsgl__planar_nz_weight(float nz)
  * vsgl__planar_glossy apply them per pair (vsgl__planar_tilt). */
 #define VSGL__PLANAR_TILT_A_MIN (-4.0f)
 
-static inline float vsgl__planar_tilt_a(float nz, float nx, float ny, float lam, float mu, float *sigma, float *iw)
+static inline float vsgl__planar_tilt_a(float nz, float nx, float ny, float lam, float mu, float *sigma)
 {
     float w2 = 1.0f - nz * nz;
     w2 = w2 > 1e-4f ? w2 : 1e-4f;
-    *iw = 1.0f / sqrtf(w2);
-    float s2 = (nx * nx * (0.5f / lam) + ny * ny * (0.5f / mu)) * (*iw * *iw);
+    float s2 = (nx * nx * (0.5f / lam) + ny * ny * (0.5f / mu)) / w2;
     s2 = s2 > 1e-12f ? s2 : 1e-12f;
     *sigma = sqrtf(s2);
     /* asin(-nz) by its series (exact near the horizon, 1.24 for 1.57 at
@@ -110,8 +109,8 @@ static inline float vsgl__planar_tilt_a(float nz, float nx, float ny, float lam,
     return a > VSGL__PLANAR_TILT_A_MIN ? a : VSGL__PLANAR_TILT_A_MIN;
 }
 
-/* What a lane's tilt needs against a plane (vsgl__planar_tilt_a's a,
- * sigma, iw and e = exp(-a^2 / 2)): Phi(a) and D = sigma phi(a) / Phi(a),
+/* What a lane's tilt needs against a plane (vsgl__planar_tilt_a's a and
+ * sigma, and e = exp(-a^2 / 2)): Phi(a) and D = sigma phi(a) / Phi(a),
  * the tilt at full weight. */
 static inline float vsgl__planar_tilt_pre(float a, float sigma, float e, float *D)
 {

@@ -225,8 +225,8 @@ static float tilt_lane(vsgl_vec3 X, vsgl_vec3 Y, vsgl_vec3 Z, float lam, float m
     *D = 0.0f;
     if (!vsgl__planar_tilt_needed(nz, nx, ny, lam, mu))
         return 1.0f;
-    float sigma, iw;
-    const float a = vsgl__planar_tilt_a(nz, nx, ny, lam, mu, &sigma, &iw);
+    float sigma;
+    const float a = vsgl__planar_tilt_a(nz, nx, ny, lam, mu, &sigma);
     return vsgl__planar_tilt_pre(a, sigma, expf(-0.5f * a * a), D);
 }
 
