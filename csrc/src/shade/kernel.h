@@ -8,6 +8,7 @@
 #define VSGL_SHADE_KERNEL_H
 
 #include "math/normal.h"
+#include "math/vec.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -45,13 +46,6 @@ static inline __attribute__((always_inline)) float vsgl__plane_spread(float ce, 
     return q * r;
 }
 
-/* smoothstep of r clamped to [0, 1] (branch-free: the kernel's lanes). */
-static inline float vsgl__smooth_ramp(float r)
-{
-    r = r < 0.0f ? 0.0f : (r > 1.0f ? 1.0f : r);
-    return r * r * (3.0f - 2.0f * r);
-}
-
 /* The planar glossy model (shade.h, vsgl__planar_glossy) takes a lobe
  * whose axis meets the cluster's plane at least VSGL__PLANAR_NZ_MIN (its
  * cosine to the plane's normal) off it, faded in by a smoothstep over the
@@ -68,7 +62,7 @@ static inline float vsgl__smooth_ramp(float r)
  * normal (the kernel and vsgl__planar_glossy alike). */
 static inline float vsgl__planar_nz_weight(float nz)
 {
-    return vsgl__smooth_ramp((-nz - VSGL__PLANAR_NZ_MIN) * (1.0f / VSGL__PLANAR_NZ_RAMP));
+    return smoothstep01f((-nz - VSGL__PLANAR_NZ_MIN) * (1.0f / VSGL__PLANAR_NZ_RAMP));
 }
 
 /* The planar model across the plane's horizon. The model follows the
@@ -146,7 +140,7 @@ static inline float vsgl__planar_tilt(float nz, float Phi, float D, float w, flo
  * animation, where small cells of the sphere are as coherent as a plane). */
 static inline float vsgl__planar_tilt_weight(float k)
 {
-    return vsgl__smooth_ramp((k - 0.98f) * (1.0f / 0.015f));
+    return smoothstep01f((k - 0.98f) * (1.0f / 0.015f));
 }
 
 /* Whether a lane needs the tilt at all: not when the axis lies at least 4
@@ -175,7 +169,7 @@ static inline int vsgl__planar_tilt_dir(float nx, float ny, float nz)
 
 static inline float vsgl__planar_tilt_gate(float hs)
 {
-    return vsgl__smooth_ramp((hs - 0.5f) * (1.0f / 1.5f));
+    return smoothstep01f((hs - 0.5f) * (1.0f / 1.5f));
 }
 
 /* The emitter-hemisphere clip's constants (shade.h explains the clip). */

@@ -858,9 +858,13 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
         for (int j = 0; j < NL; ++j)
             tilt |= L[j].tilt > 0.0f && b->tany[L[j].tdir];
         if (tilt) {
-            for (int j = 0; j < NL; ++j) { /* each VSGL with the rows of its plane in the block's tables */
-                const float *restrict tphi = b->tphi[L[j].tdir], *restrict td = b->td[L[j].tdir];
-                K_FORI(k_planar_geom(b, i, L + j, t + j, 1, tphi, td));
+            for (int j = 0; j < NL; ++j) { /* each VSGL that tilts with the rows of its plane in the block's tables */
+                if (L[j].tilt > 0.0f && b->tany[L[j].tdir]) {
+                    const float *restrict tphi = b->tphi[L[j].tdir], *restrict td = b->td[L[j].tdir];
+                    K_FORI(k_planar_geom(b, i, L + j, t + j, 1, tphi, td));
+                } else {
+                    K_FORI(k_planar_geom(b, i, L + j, t + j, 0, NULL, NULL));
+                }
             }
         } else {
             K_FORN(k_planar_geom(b, i, L + j, t + j, 0, NULL, NULL));

@@ -231,11 +231,14 @@ static float tilt_lane(vsgl_vec3 X, vsgl_vec3 Y, vsgl_vec3 Z, float lam, float m
 }
 
 /* The block's tilt tables (vsgl_kernel_block.tphi, td) for its glossy
- * lanes; the others need none. */
-static void tilt_table(vsgl_kernel_block *b)
+ * lanes and the planes of `dirs` (bit d: some VSGL faces axis plane d); no
+ * other row is read (tany 0). */
+static void tilt_table(vsgl_kernel_block *b, unsigned dirs)
 {
     for (int d = 0; d < VSGL__TILT_DIRS; ++d) {
         b->tany[d] = 0;
+        if (!(dirs >> d & 1u))
+            continue;
         for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i) {
             const vsgl_vec3 X = {b->Xx[i], b->Xy[i], b->Xz[i]}, Y = {b->Yx[i], b->Yy[i], b->Yz[i]},
                             Z = {b->Zx[i], b->Zy[i], b->Zz[i]};
@@ -983,8 +986,8 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
     }
     memset(blk->ld, 0, sizeof blk->ld);
     memset(blk->ls, 0, sizeof blk->ls);
-    if (lobes & VSGL__KERNEL_GLOSSY)
-        tilt_table(blk);
+    if ((lobes & VSGL__KERNEL_GLOSSY) && j->tilt_dirs)
+        tilt_table(blk, j->tilt_dirs);
     if (lobes) {
         size_t (*kernel)(vsgl_kernel_block *, const vsgl_kernel_light *, size_t, const float *, int32_t, int32_t,
                          float) =
@@ -1378,7 +1381,10 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
                    eps, 0, per_chunk, &faint_total, kl, korder, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
-                   0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL, twin, &targets};
+                   0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL, twin, &targets, 0u};
+    for (size_t k = 0; kl && k < set->count; ++k) /* the axis planes the horizon tilt is taken against */
+        if (kl[k].tilt > 0.0f)
+            j.tilt_dirs |= 1u << kl[k].tdir;
     /* untextured: each material's BRDF parameters once, not once per sample */
     vsgl_brdf_params *params = g->surf[0] ? NULL : malloc(((size_t)material_count + 1) * sizeof *params);
     if (params)

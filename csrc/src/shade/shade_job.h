@@ -99,6 +99,8 @@ typedef struct shade_job {
                                        light before it (a glossy cluster's core and tail: the same target
                                        and skip test), which block_visibility then does not trace again */
     const vsgl_ray_targets *targets; /* visibility rays: each VSGL's points (ray_targets.h); NULL without rays */
+    unsigned tilt_dirs;   /* bit d: some kernel light takes the horizon tilt against axis plane d (kernel.h
+                             VSGL__TILT_DIRS); only those rows of a block's tables are filled */
 } shade_job;
 
 /* Receiver lobe of one sample, set up once and used for every VSGL. */
