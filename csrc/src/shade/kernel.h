@@ -65,6 +65,38 @@ static inline float vsgl__planar_nz_weight(float nz)
     return smoothstep01f((-nz - VSGL__PLANAR_NZ_MIN) * (1.0f / VSGL__PLANAR_NZ_RAMP));
 }
 
+/* The planar model's footprint at the distance where the lobe meets the
+ * cluster. The model maps the lobe's directions to the plane linearly
+ * about the point y0 = x + t z where its axis meets it, so the footprint
+ * is a Gaussian of a size that grows with t. That holds near y0; a
+ * cluster far from y0 (a floor's cell at the foot of a glossy sphere,
+ * whose lobe grazes the floor and meets it metres away) lies in the
+ * footprint's linear tail, which reaches back past the receiver to
+ * directions the lobe does not point at: there the model lit the lower
+ * half of the sphere 4-10x brighter than the brute force. Each pair
+ * linearises instead at ym, the centre of the product of the cluster's
+ * Gaussian and the footprint, with the lobe's argument (X.w, Y.w) taken
+ * at ym's distance d_m = |ym - x| (exact in the direction of ym): the
+ * footprint about y0 scales by k^2 = d_m^2 / t^2 and the result by
+ * (z.w_m) / k, the lobe's cosine and the solid angle there. At ym = y0
+ * this is the old model; for a cluster small against the footprint (ym
+ * at its mean) it is the lobe evaluated towards the cluster, as the
+ * exact integral of a point cluster. With e = ym - y0 (in the plane) and
+ * g = z.e: d_m^2 = t^2 + 2 t g + |e|^2; returns k^2 and in *f the
+ * factor (z.w_m)+ / k = (t (t + g))+ / d_m^2. */
+static inline float vsgl__planar_reach(float t, float e1, float e2, float zu1, float zu2, float *f)
+{
+    const float g = e1 * zu1 + e2 * zu2, tg = t * (t + g);
+    float dm2 = t * t + 2.0f * t * g + e1 * e1 + e2 * e2;
+    dm2 = dm2 > 1e-30f ? dm2 : 1e-30f;
+    *f = tg > 0.0f ? tg / dm2 : 0.0f;
+    /* bounded where the axis meets the plane at the receiver (t -> 0: the
+     * footprint is nil there, and a pair the kernel does not count must
+     * stay finite) */
+    const float t2 = t * t, k2 = dm2 / (t2 > 1e-8f ? t2 : 1e-8f);
+    return k2 < 1e12f ? k2 : 1e12f;
+}
+
 /* The planar model across the plane's horizon. The model follows the
  * lobe's axis to the plane and spreads the lobe's whole integral about
  * that point, which holds while the lobe lies well inside the directions

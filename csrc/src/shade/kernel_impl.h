@@ -226,6 +226,9 @@ typedef struct k_scratch {
      * (sigma units), 1/sigma, and its factor ok x visibility x camp / sigma^2 */
     float pa1[VSGL__KERNEL_BLOCK], pa2[VSGL__KERNEL_BLOCK], pb1[VSGL__KERNEL_BLOCK], pb2[VSGL__KERNEL_BLOCK];
     float pis[VSGL__KERNEL_BLOCK], pok[VSGL__KERNEL_BLOCK];
+    /* where the axis meets the plane (t, sigma units) and the axis's components along u1, u2, for
+     * the footprint's reach (kernel.h, vsgl__planar_reach) */
+    float pt[VSGL__KERNEL_BLOCK], pz1[VSGL__KERNEL_BLOCK], pz2[VSGL__KERNEL_BLOCK];
     /* the planar glossy's offsets and covariance (sigma units), for a fold */
     float pd1[VSGL__KERNEL_BLOCK], pd2[VSGL__KERNEL_BLOCK], ps11[VSGL__KERNEL_BLOCK], ps22[VSGL__KERNEL_BLOCK],
         ps12[VSGL__KERNEL_BLOCK], pidet[VSGL__KERNEL_BLOCK];
@@ -493,6 +496,9 @@ k_planar_geom(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_l
     t->pd2[i] = ox * L->u2x + oy * L->u2y + oz * L->u2z;
     t->pis[i] = is;
     t->pok[i] = ok * t->vis[i] * b->camp[i] * (is * is);
+    t->pt[i] = tt;
+    t->pz1[i] = zu1;
+    t->pz2[i] = zu2;
 }
 
 /* One lobe (kb, kc) of k_planar_geom's lane: the footprint's covariance,
@@ -511,8 +517,21 @@ k_planar_lobe(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_l
     float s12 = a1 * a2 * il + b1 * b2 * im;
     /* det = 1 + tr(A) + det(A), A the footprint: no cancellation */
     float cr = a1 * b2 - a2 * b1;
-    float det = s11 + s22 - 1.0f + cr * cr * il * im;
+    float fd = cr * cr * il * im;
+    float det = s11 + s22 - 1.0f + fd;
     float idet = 1.0f / det;
+    /* the footprint at the distance where the lobe meets the cluster
+     * (kernel.h, vsgl__planar_reach): ym - mean = S^-1 d, e = ym - y0 */
+    float reach;
+    {
+        const float e1 = (s22 * d1 - s12 * e2) * idet - d1, f2 = (s11 * e2 - s12 * d1) * idet - e2;
+        const float k2 = vsgl__planar_reach(t->pt[i], e1, f2, t->pz1[i], t->pz2[i], &reach);
+        s11 = 1.0f + k2 * (s11 - 1.0f);
+        s22 = 1.0f + k2 * (s22 - 1.0f);
+        s12 *= k2;
+        det = s11 + s22 - 1.0f + k2 * k2 * fd;
+        idet = 1.0f / det;
+    }
     float qf = (s22 * d1 * d1 - 2.0f * s12 * d1 * e2 + s11 * e2 * e2) * idet;
     t->pexpo[i] = qf > 0.0f ? -0.5f * qf : 0.0f;
     /* the receiver's horizon where its lobe grazes it (kernel.h,
@@ -526,7 +545,7 @@ k_planar_lobe(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_l
         float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
         hz = k_horizon(b, i, L, dx * is, dy * is, dz * is, d1, e2, s11, s22, s12, idet);
     }
-    t->ppre[i] = t->pok[i] * hz * kc * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu);
+    t->ppre[i] = t->pok[i] * reach * hz * kc * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu);
     t->ps11[i] = s11;
     t->ps22[i] = s22;
     t->ps12[i] = s12;

@@ -305,8 +305,22 @@ float vsgl__planar_glossy_part(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *
     float det = var * (var + (a1 * a1 + a2 * a2) * il + (b1 * b1 + b2 * b2) * im) + cr * cr * il * im;
     if (!(det > 0.0f))
         return 0.0f;
+    /* the footprint at the distance where the lobe meets the cluster
+     * (kernel.h, vsgl__planar_reach): ym - mean = var S^-1 d, e = ym - y0 */
+    float reach;
+    {
+        const float e1 = var * (s22 * d1 - s12 * d2) / det - d1, e2 = var * (s11 * d2 - s12 * d1) / det - d2;
+        const float k2 = vsgl__planar_reach(t, e1, e2, v3_dot(z, u1), v3_dot(z, u2), &reach);
+        const float f11 = s11 - var, f22 = s22 - var;
+        s11 = var + k2 * f11;
+        s22 = var + k2 * f22;
+        s12 *= k2;
+        det = var * (var + k2 * (f11 + f22)) + k2 * k2 * cr * cr * il * im;
+        if (!(det > 0.0f) || !(reach > 0.0f))
+            return 0.0f;
+    }
     /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
-    float scale = expf(lobe->log_amplitude) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
+    float scale = reach * expf(lobe->log_amplitude) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
     scale *= planar_horizon(v, x, nr, lobe->z, var, d1, d2, s11, s22, s12, det, u1, u2) * fade;
     float q0 = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
     if (!(wf > 0.0f))
