@@ -103,6 +103,10 @@ v3 vsgl__lifted_origin(v3 o, v3 x, v3 n, v3 lift, v3 target);
  * radiance blurred by the footprint, N(y0 - mean; variance I + footprint) / pi.
  * Where the lobe grazes the receiver's tangent plane (normal nr), the
  * part below that plane is dropped (kernel.h, VSGL__HORIZON_*).
+ * The footprint is taken at the distance where the lobe meets the
+ * cluster, not where its axis meets the plane (kernel.h,
+ * vsgl__planar_reach): a linear footprint about a far hit reached back
+ * past the receiver.
  * Unlike the round spread SG it sees a plane foreshortened (a cabinet's
  * face reflecting the floor beside it: 0.65 -> 1.08 of the brute force's
  * glossy light in the sun room) and never anything behind the plane.
