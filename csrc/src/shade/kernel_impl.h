@@ -525,7 +525,7 @@ k_planar_lobe(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_l
     float reach;
     {
         const float r1 = (s22 * d1 - s12 * e2) * idet - d1, r2 = (s11 * e2 - s12 * d1) * idet - e2;
-        const float k2 = vsgl__planar_reach(t->pt[i], r1, r2, t->pz1[i], t->pz2[i], &reach);
+        const float k2 = vsgl__planar_reach(t->pt[i], r1, r2, t->pz1[i], t->pz2[i], 1.0f, &reach);
         s11 = 1.0f + k2 * (s11 - 1.0f);
         s22 = 1.0f + k2 * (s22 - 1.0f);
         s12 *= k2;

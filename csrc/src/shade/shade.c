@@ -310,7 +310,7 @@ float vsgl__planar_glossy_part(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *
     float reach;
     {
         const float e1 = var * (s22 * d1 - s12 * d2) / det - d1, e2 = var * (s11 * d2 - s12 * d1) / det - d2;
-        const float k2 = vsgl__planar_reach(t, e1, e2, v3_dot(z, u1), v3_dot(z, u2), &reach);
+        const float k2 = vsgl__planar_reach(t, e1, e2, v3_dot(z, u1), v3_dot(z, u2), var, &reach);
         const float f11 = s11 - var, f22 = s22 - var;
         s11 = var + k2 * f11;
         s22 = var + k2 * f22;
