@@ -83,7 +83,8 @@ static inline float vsgl__planar_nz_weight(float nz)
  * at its mean) it is the lobe evaluated towards the cluster, as the
  * exact integral of a point cluster. With e = ym - y0 (in the plane) and
  * g = z.e: d_m^2 = t^2 + 2 t g + |e|^2; returns k^2 and in *f the
- * factor (z.w_m)+ / k = (t (t + g))+ / d_m^2. */
+ * factor (z.w_m)+ / k = (t (t + g))+ / d_m^2, both faded towards 1 (the
+ * old model) as the cluster's variance `var` nears d_m^2 (below). */
 #define VSGL__PLANAR_REACH_LO 0.25f /* sigma^2 / d_m^2 */
 #define VSGL__PLANAR_REACH_HI 1.0f
 static inline float vsgl__planar_reach(float t, float e1, float e2, float zu1, float zu2, float var, float *f)
@@ -113,8 +114,8 @@ static inline float vsgl__planar_reach(float t, float e1, float e2, float zu1, f
  * axis above it none of the lobe was counted, though its lower part still
  * meets the plane (a glossy sphere's reflection of a floor ended in a
  * sharp edge where its axis crossed the floor's horizon: the pixel above
- * it had 0.14 of Cycles' glossy light, 0.92 with what follows). Along e, the direction from the axis towards -n_v, the lobe's
- * angular spread is sigma^2 = (n_v.X)^2 / 2 lambda + (n_v.Y)^2 / 2 mu over
+ * it had 0.14 of Cycles' glossy light, 0.92 with what follows). Along
+ * e, the direction from the axis towards -n_v, the lobe's angular spread is sigma^2 = (n_v.X)^2 / 2 lambda + (n_v.Y)^2 / 2 mu over
  * 1 - (n_v.z)^2 (an ASG's Gaussian over its tangent plane), and the axis
  * lies delta = asin(-n_v.z) into the plane: a = delta / sigma. The share
  * of the lobe that meets the plane is Phi(a), and its directions there
