@@ -156,6 +156,28 @@ void vsgl__specular_factor(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float al
         out[c] = (p->f0[c] * (1.0f - FH) + FH) * g4;
 }
 
+void vsgl__fresnel_ratio(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float out[3])
+{
+    out[0] = 0.0f;
+    out[1] = 1.0f;
+    out[2] = 0.0f;
+    if (!p->glossy || !(p->eta > 1.0f) || !(v3_dot(n, o) > 0.0f) || !(v3_dot(n, i) > 0.0f))
+        return;
+    float f0 = (p->f0[0] + p->f0[1] + p->f0[2]) * (1.0f / 3.0f);
+    float F0 = fresnel_dielectric(1.0f, p->eta);
+    if (!(F0 < 1.0f))
+        return;
+    v3 h = v3_normalize(v3_add(i, o));
+    float FH = clampf((fresnel_dielectric(v3_dot(i, h), p->eta) - F0) / (1.0f - F0), 0.0f, 1.0f);
+    float fa = f0 * (1.0f - FH) + FH; /* the factor at the axis */
+    if (!(fa > 1e-6f))
+        return;
+    /* f0 (1 - FH(l)) + FH(l) with FH(l) = (F(l.h) - F0) / (1 - F0), over fa */
+    out[0] = p->eta;
+    out[1] = (f0 - (1.0f - f0) * F0 / (1.0f - F0)) / fa;
+    out[2] = (1.0f - f0) / ((1.0f - F0) * fa);
+}
+
 void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3])
 {
     float g = p->glossy ? 1.0f : 0.0f;

@@ -98,4 +98,14 @@ void vsgl__glossy_color(const vsgl_brdf_params *p, v3 n, v3 wo, float out[3]);
  * material's flags say). 0 when either direction is below the surface. */
 void vsgl__specular_factor(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float alpha, float out[3]);
 
+/* The dielectric Fresnel term of vsgl__specular_factor towards light
+ * direction l over its value towards the lobe's axis i (the grey f0, the
+ * mean of p->f0), as A + B F(l.h, eta) with F the exact dielectric
+ * Fresnel: out = {eta, A, B}; {0, 1, 0} (the ratio 1) where the material
+ * has no dielectric Fresnel (eta <= 1: metals, Blender 3.x's plain
+ * specular). The half-vector model (shade/halfvec.h) takes it per
+ * direction: a grazing view's Fresnel at the axis is several times that of
+ * the directions far out in GGX's tail. */
+void vsgl__fresnel_ratio(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float out[3]);
+
 #endif

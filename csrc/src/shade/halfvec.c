@@ -13,7 +13,8 @@ static float smith_term(float ci, float co, float a2)
     return ci / (ci * so + co * si);
 }
 
-float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float alpha, int lobes, float *weight)
+float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float alpha, int lobes,
+                           const float fres[3], float *weight)
 {
     *weight = 0.0f;
     v3 d = v3_sub(v->mean, x);
@@ -62,5 +63,6 @@ float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float 
     float co = fmaxf(v3_dot(o, n), 1e-4f), ci = fmaxf(v3_dot(w, n), 0.0f), ca = fmaxf(v3_dot(axis, n), 1e-4f);
     float g = smith_term(ci, co, a2) / smith_term(ca, co, a2);
     *weight = wgt;
-    return (1.0f / VSGL__PI) * hgt * r * r * r * ed / (hn * hn * hn * hn) * g;
+    return (1.0f / VSGL__PI) * hgt * r * r * r * ed / (hn * hn * hn * hn) * g *
+           (fres[1] + fres[2] * vsgl__fresnel_dielectric_eta(v3_dot(w, h), fres[0]));
 }

@@ -26,11 +26,17 @@
  * expectation is sum c/k N(s; 0, alpha^2/2k I + J C J^T) / h.n^4. The
  * light is then N/pi x the emitter's cos/d^2 x E[D] x G(w)/G(axis) (Smith's
  * height-correlated G over the view term; M carries Fresnel, G(axis) and
- * 1/4 cos o). Unlike the ASG lobes (a warped NDF, exact at its peak only)
+ * 1/4 cos o) x F(w)/F(axis), the dielectric Fresnel ratio fres (scene/
+ * material.h vsgl__fresnel_ratio: {eta, A, B}, the ratio A + B F(w.h, eta);
+ * {0, 1, 0} for none). At a grazing view the Fresnel at the axis is
+ * several times that of the directions out in GGX's tail: without the
+ * ratio, a glossy sphere's lower rim reflected the lit floor beside it 36 %
+ * too brightly. Unlike the ASG lobes (a warped NDF, exact at its peak only)
  * it keeps GGX's tail, where a metal floor shows the haze around a
  * reflected wall. Valid where the cluster subtends little and the half
  * vector stands well above the horizon: the weight blends it out beyond
  * (kernel.h). */
-float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float alpha, int lobes, float *weight);
+float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float alpha, int lobes,
+                           const float fres[3], float *weight);
 
 #endif

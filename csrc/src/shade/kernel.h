@@ -237,6 +237,10 @@ typedef struct vsgl_kernel_block {
     float alpha[VSGL__KERNEL_BLOCK];
     /* the smooth Fresnel/shadowing factor M(z, o) per channel at the lobe axis */
     float f0r[VSGL__KERNEL_BLOCK], f0g[VSGL__KERNEL_BLOCK], f0b[VSGL__KERNEL_BLOCK];
+    /* the half-vector model's Fresnel towards each cluster over M's at the
+     * axis, fa + fb F(l.h, fe) (scene/material.h vsgl__fresnel_ratio;
+     * fe 0: the ratio 1) */
+    float fe[VSGL__KERNEL_BLOCK], fa[VSGL__KERNEL_BLOCK], fb[VSGL__KERNEL_BLOCK];
     /* the planar model's horizon tilt against the six planes facing +-x,
      * +-y, +-z (index 2 axis + side; kernel.h, vsgl__planar_tilt), per
      * lane: Phi and D, 1 and 0 where the lane needs no tilt
@@ -368,6 +372,18 @@ static inline int vsgl__hv_lobe_set(int count, const float **k, const float **c)
     *k = five ? k5 : k4;
     *c = five ? c5 : c4;
     return five ? VSGL__HV5_LOBES : VSGL__HV_LOBES;
+}
+/* The exact dielectric Fresnel at cosine c (0..1) for eta: 1 where eta^2 - 1
+ * + c^2 <= 0 (total reflection, and eta 0: the half-vector model's "no
+ * ratio", A = 1, B = 0). scene/material.c's fresnel_dielectric without
+ * branches, for the kernel's vectorised loops (halfvec.h). */
+static inline float vsgl__fresnel_dielectric_eta(float c, float eta)
+{
+    float g2 = eta * eta - 1.0f + c * c;
+    float g = sqrtf(g2 > 1e-12f ? g2 : 1e-12f);
+    float a = (g - c) / (g + c), b = (c * (g + c) - 1.0f) / (c * (g - c) + 1.0f);
+    float f = 0.5f * a * a * (1.0f + b * b);
+    return g2 > 0.0f ? f : 1.0f;
 }
 #define VSGL__HV_SPREAD_LO 0.003f
 #define VSGL__HV_SPREAD_HI 0.01f

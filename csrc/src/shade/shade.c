@@ -398,6 +398,9 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
         widen_by_spread(&r->bp, g->spread[i]);
     r->alpha = sqrtf(r->bp.alpha_x * r->bp.alpha_y);
     r->glossy = r->bp.glossy && v3_dot(r->n, r->o) > 0.0f;
+    r->fres[0] = 0.0f;
+    r->fres[1] = 1.0f;
+    r->fres[2] = 0.0f;
     if (!r->glossy)
         return;
     vsgl__ms_scale3(&r->bp, v3_dot(r->n, r->o), r->ms);
@@ -411,6 +414,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
         vsgl_ndf_aniso_to_asg(&r->n, &t, r->bp.alpha_x, r->bp.alpha_y, &ndf);
         vsgl_warp_ndf_asg(&ndf, &r->o, &r->asg);
         vsgl__asg_cut_at_horizon(&r->asg, &r->n);
+        vsgl__fresnel_ratio(&r->bp, r->n, r->o, r->asg.z, r->fres);
     }
 }
 
@@ -631,7 +635,7 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
      * half-vector model (halfvec.h), the planar one taking the rest */
     float hw = 0.0f, hv = 0.0f;
     if (parts == 2 && j->leak && v->lobe == VSGL__LOBE_DIFFUSE && v->coherence > 0.0f)
-        hv = vsgl__halfvec_glossy(v, r->x, r->n, r->o, r->asg.z, hv_alpha(r), (int)j->s->glossy_lobes, &hw);
+        hv = vsgl__halfvec_glossy(v, r->x, r->n, r->o, r->asg.z, hv_alpha(r), (int)j->s->glossy_lobes, r->fres, &hw);
     for (int q = 0; q < parts; ++q) {
         float gi = glossy_integral(j, r, in, axis, q);
         if (j->leak && v->lobe == VSGL__LOBE_DIFFUSE) {
@@ -744,6 +748,9 @@ static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z
     b->Zz[k] = 1.0f; b->Zx[k] = b->Zy[k] = 0.0f;
     b->lam[k] = b->mu[k] = b->camp[k] = b->alpha[k] = 0.0f;
     b->f0r[k] = b->f0g[k] = b->f0b[k] = 0.0f;
+    b->fe[k] = 0.0f;
+    b->fa[k] = 1.0f;
+    b->fb[k] = 0.0f;
 }
 
 /* Fill lane `k` of a kernel block from G-buffer sample i; returns 0 for a miss. */
@@ -784,6 +791,9 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     b->f0r[k] = m[0];
     b->f0g[k] = m[1];
     b->f0b[k] = m[2];
+    b->fe[k] = r->fres[0];
+    b->fa[k] = r->fres[1];
+    b->fb[k] = r->fres[2];
     return 1;
 }
 
@@ -832,7 +842,8 @@ static void lane_get(const vsgl_kernel_block *b, size_t k, const receiver *r, vs
     *v++ = b->Yx[k]; *v++ = b->Yy[k]; *v++ = b->Yz[k];
     *v++ = b->Zx[k]; *v++ = b->Zy[k]; *v++ = b->Zz[k];
     *v++ = b->lam[k]; *v++ = b->mu[k]; *v++ = b->camp[k]; *v++ = b->alpha[k];
-    *v++ = b->f0r[k]; *v++ = b->f0g[k]; *v = b->f0b[k];
+    *v++ = b->f0r[k]; *v++ = b->f0g[k]; *v++ = b->f0b[k];
+    *v++ = b->fe[k]; *v++ = b->fa[k]; *v = b->fb[k];
 }
 
 /* The inverse, and the receiver fields visibility rays read (position,
@@ -852,7 +863,8 @@ static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, r
     b->Yx[k] = *v++; b->Yy[k] = *v++; b->Yz[k] = *v++;
     b->Zx[k] = *v++; b->Zy[k] = *v++; b->Zz[k] = *v++;
     b->lam[k] = *v++; b->mu[k] = *v++; b->camp[k] = *v++; b->alpha[k] = *v++;
-    b->f0r[k] = *v++; b->f0g[k] = *v++; b->f0b[k] = *v;
+    b->f0r[k] = *v++; b->f0g[k] = *v++; b->f0b[k] = *v++;
+    b->fe[k] = *v++; b->fa[k] = *v++; b->fb[k] = *v;
 }
 
 /* The far-field diffuse light per watt of VSGL v at (x, n), as the kernel

@@ -16,7 +16,7 @@
  * (a replay has no G-buffer sample to read them from: without the lift its
  * rays in a smooth-shaded scene started from uninitialised memory). */
 typedef struct vsgl__plan_lane {
-    float v[26];
+    float v[29];
     float lift[3];
     uint32_t key;
 } vsgl__plan_lane;
@@ -112,6 +112,7 @@ typedef struct receiver {
     float alpha;
     int glossy;
     float ms[3];         /* multiple-scattering compensation towards o (1 unless 4.x+ Multiscatter GGX) */
+    float fres[3];       /* the half-vector model's Fresnel ratio (material.h vsgl__fresnel_ratio) */
     vsgl_asg asg;        /* warped NDF (ASG mode) */
     vsgl_sg sg;          /* warped NDF (SG mode) */
 } receiver;
