@@ -101,9 +101,9 @@ void vsgl__specular_factor(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float al
 /* The dielectric Fresnel term of vsgl__specular_factor towards light
  * direction l over its value towards the lobe's axis i (the grey f0, the
  * mean of p->f0), as A + B F(l.h, eta) with F the exact dielectric
- * Fresnel: out = {eta, A, B}; {0, 1, 0} (the ratio 1) where the material
- * has no dielectric Fresnel (eta <= 1: metals, Blender 3.x's plain
- * specular). The half-vector model (shade/halfvec.h) takes it per
+ * Fresnel: out = {eta, A, B}; {0, 1, 0} (the ratio 1) where the
+ * material's Fresnel is constant (eta <= 1: f0 alone, as for a metal of
+ * specular 0). The half-vector model (shade/halfvec.h) takes it per
  * direction: a grazing view's Fresnel at the axis is several times that of
  * the directions far out in GGX's tail. */
 void vsgl__fresnel_ratio(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float out[3]);
