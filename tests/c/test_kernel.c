@@ -187,6 +187,15 @@ static void random_block(vt_rng *r, vsgl_kernel_block *b)
             b->mu[k] = (float)pow(10.0, 4.0 * vt_uniform(r) - 0.5);
             b->camp[k] = (float)(1.0 + 100.0 * vt_uniform(r));
             b->f0r[k] = b->f0g[k] = b->f0b[k] = (float)vt_uniform(r);
+            /* the half-vector model's Fresnel ratio (scene/material.h
+             * vsgl__fresnel_ratio): a dielectric's on half the lanes, 1 on
+             * the rest (0, the block's memset, would zero that model) */
+            b->fa[k] = 1.0f;
+            if (vt_uniform(r) < 0.5) {
+                b->fe[k] = 1.5f;
+                b->fa[k] = (float)(0.2 + vt_uniform(r));
+                b->fb[k] = (float)(2.0 * vt_uniform(r));
+            }
         }
     }
 }
@@ -330,6 +339,7 @@ VT_TEST(kernel_receiver_at_a_planar_clusters_mean_is_finite)
         b.camp[k] = 10.0f;
         b.alpha[k] = 0.05f;
         b.f0r[k] = b.f0g[k] = b.f0b[k] = 0.5f;
+        b.fa[k] = 1.0f; /* no Fresnel ratio (scene/material.h vsgl__fresnel_ratio) */
         b.diffuse[k] = 1.0f;
     }
     const int32_t lob = VSGL__KERNEL_DIFFUSE | VSGL__KERNEL_GLOSSY | VSGL__KERNEL_GGX_TAIL;

@@ -76,6 +76,7 @@ int main(int argc, char **argv)
         b.mu[i] = 10.0f + 100.0f * uniform(&s);
         b.camp[i] = 1.0f;
         b.f0r[i] = b.f0g[i] = b.f0b[i] = 0.5f;
+        b.fa[i] = 1.0f; /* no Fresnel ratio (scene/material.h vsgl__fresnel_ratio) */
     }
     const char *mode_name[3] = {"accurate", "SG (poster)", "pulled-out"};
     const char *lobe_name[4] = {"", "diffuse only", "glossy only", "diffuse + glossy"};
