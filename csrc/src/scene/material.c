@@ -23,6 +23,7 @@
  */
 #include "material.h"
 #include "math/constants.h"
+#include "math/fresnel.h"
 
 #include "vsgl/lobes.h"
 
@@ -67,17 +68,21 @@ void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out)
 }
 
 /* Unpolarised Fresnel reflectance of a dielectric interface (Cycles'
- * fresnel_dielectric_cos); 1 under total internal reflection. */
+ * fresnel_dielectric_cos) at cosine |cosi|; 1 under total internal reflection. */
 static float fresnel_dielectric(float cosi, float eta)
 {
-    float c = fabsf(cosi);
-    float g = eta * eta - 1.0f + c * c;
-    if (g <= 0.0f)
-        return 1.0f;
-    g = sqrtf(g);
-    float A = (g - c) / (g + c);
-    float B = (c * (g + c) - 1.0f) / (c * (g - c) + 1.0f);
-    return 0.5f * A * A * (1.0f + B * B);
+    return vsgl__fresnel_dielectric(fabsf(cosi), eta);
+}
+
+/* Cycles 3.x's Fresnel shape between f0 and 1 at i.h = cos_ih: the
+ * dielectric Fresnel normalised, (F(i.h) - F0) / (1 - F0) in [0, 1]; 0 for
+ * eta <= 1 (the constant f0). The glossy factors below blend f0 to 1 by it. */
+static float fresnel_shape(const vsgl_brdf_params *p, float cos_ih)
+{
+    if (!(p->eta > 1.0f))
+        return 0.0f;
+    float F0 = fresnel_dielectric(1.0f, p->eta);
+    return clampf((fresnel_dielectric(cos_ih, p->eta) - F0) / (1.0f - F0), 0.0f, 1.0f);
 }
 
 /* GGX Smith Lambda for direction (x, y, z) in the tangent frame, z > 0;
@@ -124,12 +129,7 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
     float common = D * G / (4.0f * co);
     if (!(common < INFINITY))
         common = 3.0e38f;
-    float FH = 0.0f;
-    if (p->eta > 1.0f) {
-        float F0 = fresnel_dielectric(1.0f, p->eta);
-        FH = (fresnel_dielectric(v3_dot(wi, h), p->eta) - F0) / (1.0f - F0);
-        FH = clampf(FH, 0.0f, 1.0f);
-    }
+    float FH = fresnel_shape(p, v3_dot(wi, h));
     for (int c = 0; c < 3; ++c)
         glossy_out[c] = (p->f0[c] * (1.0f - FH) + FH) * common;
 }
@@ -146,12 +146,7 @@ void vsgl__specular_factor(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float al
     float so = sqrtf(a2 + (1.0f - a2) * co * co), si = sqrtf(a2 + (1.0f - a2) * ci * ci);
     /* G / (4 co): height-correlated 2 ci co / (ci so + co si), separable G1(i) G1(o), G1(c) = 2c / (c + s) */
     float g4 = p->height_correlated ? ci / (2.0f * (ci * so + co * si)) : ci / ((ci + si) * (co + so));
-    float FH = 0.0f;
-    if (p->eta > 1.0f) {
-        v3 h = v3_normalize(v3_add(i, o));
-        float F0 = fresnel_dielectric(1.0f, p->eta);
-        FH = clampf((fresnel_dielectric(v3_dot(i, h), p->eta) - F0) / (1.0f - F0), 0.0f, 1.0f);
-    }
+    float FH = fresnel_shape(p, v3_dot(i, v3_normalize(v3_add(i, o))));
     for (int c = 0; c < 3; ++c)
         out[c] = (p->f0[c] * (1.0f - FH) + FH) * g4;
 }
@@ -167,8 +162,7 @@ void vsgl__fresnel_ratio(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float out[
     float F0 = fresnel_dielectric(1.0f, p->eta);
     if (!(F0 < 1.0f))
         return;
-    v3 h = v3_normalize(v3_add(i, o));
-    float FH = clampf((fresnel_dielectric(v3_dot(i, h), p->eta) - F0) / (1.0f - F0), 0.0f, 1.0f);
+    float FH = fresnel_shape(p, v3_dot(i, v3_normalize(v3_add(i, o))));
     float fa = f0 * (1.0f - FH) + FH; /* the factor at the axis */
     if (!(fa > 1e-6f))
         return;

@@ -64,5 +64,5 @@ float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float 
     float g = smith_term(ci, co, a2) / smith_term(ca, co, a2);
     *weight = wgt;
     return (1.0f / VSGL__PI) * hgt * r * r * r * ed / (hn * hn * hn * hn) * g *
-           (fres[1] + fres[2] * vsgl__fresnel_dielectric_eta(v3_dot(w, h), fres[0]));
+           (fres[1] + fres[2] * vsgl__fresnel_dielectric(v3_dot(w, h), fres[0]));
 }

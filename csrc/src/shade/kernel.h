@@ -7,6 +7,7 @@
 #ifndef VSGL_SHADE_KERNEL_H
 #define VSGL_SHADE_KERNEL_H
 
+#include "math/fresnel.h"
 #include "math/normal.h"
 #include "math/vec.h"
 
@@ -372,18 +373,6 @@ static inline int vsgl__hv_lobe_set(int count, const float **k, const float **c)
     *k = five ? k5 : k4;
     *c = five ? c5 : c4;
     return five ? VSGL__HV5_LOBES : VSGL__HV_LOBES;
-}
-/* The exact dielectric Fresnel at cosine c (0..1) for eta: 1 where eta^2 - 1
- * + c^2 <= 0 (total reflection, and eta 0: the half-vector model's "no
- * ratio", A = 1, B = 0). scene/material.c's fresnel_dielectric without
- * branches, for the kernel's vectorised loops (halfvec.h). */
-static inline float vsgl__fresnel_dielectric_eta(float c, float eta)
-{
-    float g2 = eta * eta - 1.0f + c * c;
-    float g = sqrtf(g2 > 1e-12f ? g2 : 1e-12f);
-    float a = (g - c) / (g + c), b = (c * (g + c) - 1.0f) / (c * (g - c) + 1.0f);
-    float f = 0.5f * a * a * (1.0f + b * b);
-    return g2 > 0.0f ? f : 1.0f;
 }
 #define VSGL__HV_SPREAD_LO 0.003f
 #define VSGL__HV_SPREAD_HI 0.01f

@@ -625,7 +625,7 @@ k_hv_shared(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_lig
     float ih2 = ihn * ihn;
     /* radiance N / pi, the emitter's cos / d^2 = h r^3, and D's 1 / h.n^4 */
     /* the dielectric Fresnel towards the cluster over M's at the axis */
-    float fr = b->fa[i] + b->fb[i] * vsgl__fresnel_dielectric_eta(wx * hx + wy * hy + wz * hz, b->fe[i]);
+    float fr = b->fa[i] + b->fb[i] * vsgl__fresnel_dielectric(wx * hx + wy * hy + wz * hz, b->fe[i]);
     float pre = w * t->vis[i] * h * r * r * r * (1.0f / VSGL__PI) * ih2 * ih2 * (gc / ga) * fr;
     t->hpre[i] = w > 0.0f ? pre : 0.0f; /* a select: r^3 overflows where w is 0 (a receiver at the mean) */
 }
