@@ -278,9 +278,9 @@ def test_render_estimate_and_memory_limit(lib):
         try:
             est = L.render_estimate(ctx, scene, L.render_settings_preset("balanced"), planes=("combined", "alpha"))
             assert est["output"] == 640 * 480 * 4 * 4
-            # one sample per pixel (aa_pixel_limit) with a second slot for edges, each + edge weight and
-            # normal spread, and the edge mask; 2 x 2 samples without the limit
-            assert est["gbuffer"] == 640 * 480 * (2 * (52 + 8) + 1)
+            # one sample per pixel (aa_pixel_limit) with two more slots for edges, each + edge weight
+            # and normal spread, and the edge mask; 2 x 2 samples without the limit
+            assert est["gbuffer"] == 640 * 480 * (3 * (52 + 8) + 1)
             unlimited = L.render_settings_preset("balanced")
             unlimited.aa_pixel_limit = 0
             full = L.render_estimate(ctx, scene, unlimited, planes=("combined", "alpha"))

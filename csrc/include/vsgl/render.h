@@ -142,7 +142,7 @@ typedef struct vsgl_render_settings {
                                       most aa x aa samples, one per surface it sees, each weighted by the
                                       fraction of the E x E rays that saw it, so silhouettes move smoothly
                                       with the camera instead of in steps of 1/aa^2 (with aa_samples 1 a
-                                      pixel gets a second slot for a second surface); 0, or E <=
+                                      pixel gets three slots, for up to three surfaces); 0, or E <=
                                       aa_samples, is off (the default) */
     int32_t auto_target;         /**< VSGL_AUTO_*: OFF (the default) renders with the knobs as set;
                                       BALANCED aims at the balanced preset's error at less cost:

@@ -245,9 +245,8 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
     if (edge_aa > VSGL__GBUFFER_MAX_AA)
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "gbuffer: edge_samples is %u (must be in [0, %d])",
                           (unsigned)edge_aa, VSGL__GBUFFER_MAX_AA);
-    /* one sample per pixel gets a second, empty slot for a second surface */
     int refine = edge_aa > aa;
-    uint32_t spp = refine && aa == 1 ? 2u : aa * aa;
+    uint32_t spp = vsgl__gbuffer_slots(aa, refine);
     const vsgl_camera *cam = vsgl__scene_camera(scene);
     gb_job job;
     memset(&job, 0, sizeof job);

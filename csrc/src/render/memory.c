@@ -10,6 +10,7 @@
 #include "render/budget.h"
 #include "shade/kernel.h"
 #include "fit/grid.h"
+#include "gbuffer/gbuffer.h"
 #include "fit/vsgl_set.h"
 #include "rsm/rsm_light.h"
 #include "core/context.h"
@@ -111,12 +112,10 @@ vsgl_result vsgl__memory_estimate(vsgl_context *ctx, const vsgl_scene *scene, co
     memset(e, 0, sizeof *e);
     const vsgl_camera *cam = vsgl__scene_camera(scene);
     uint64_t pixels = (uint64_t)cam->width * cam->height;
-    /* edge refinement: a weight and a normal spread per sample, an edge mask per pixel, and a
-     * second slot per pixel at one sample per pixel */
+    /* edge refinement: a weight and a normal spread per sample, an edge mask per pixel, and
+     * three slots per pixel at one sample per pixel */
     int refined = s->edge_samples > s->aa_samples;
-    uint64_t spp = (uint64_t)s->aa_samples * s->aa_samples;
-    if (refined && spp == 1)
-        spp = 2;
+    uint64_t spp = vsgl__gbuffer_slots(s->aa_samples, refined);
     uint64_t samples = mul(pixels, spp);
     uint64_t threads = vsgl_context_thread_count(ctx);
     e->output = output_bytes;
