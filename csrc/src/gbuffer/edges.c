@@ -104,10 +104,12 @@ static void copy_sample(vsgl_gbuffer *dst, size_t to, const vsgl_gbuffer *src, s
         dst->tan[k][to] = src->tan[k][from];
     }
     dst->material[to] = src->material[from];
-    if (dst->lift[0])
+    /* (the edge rays' buffer has no lift or textured inputs: refine_pixel
+     * computes them for the rays it keeps) */
+    if (dst->lift[0] && src->lift[0])
         for (int k = 0; k < 3; ++k)
             dst->lift[k][to] = src->lift[k][from];
-    if (dst->surf[0])
+    if (dst->surf[0] && src->surf[0])
         for (int q = 0; q < VSGL__SURF_N; ++q)
             dst->surf[q][to] = src->surf[q][from];
 }
@@ -153,8 +155,10 @@ static uint32_t nearest_group(const vsgl_gbuffer *sub, const size_t *founder, ui
  *    mean's, and visibility rays leaving along the mean normal grazed the
  *    sphere there.) */
 #define MEAN_FLAT 1e-3f
-static void mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, const uint8_t *group, uint32_t q,
-                         uint32_t n)
+/* Returns the ray whose lift the slot takes (n: its representative's, or
+ * none on a plane, where the lift was set to 0). */
+static uint32_t mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, const uint8_t *group, uint32_t q,
+                             uint32_t n)
 {
     v3 sum = v3_make(0.0f, 0.0f, 0.0f), psum = sum, vsum = sum;
     uint32_t count = 0;
@@ -167,13 +171,13 @@ static void mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, co
         }
     float len = v3_length(sum), vlen = v3_length(vsum);
     if (!(len > 0.0f) || !(vlen > 0.0f) || count < 2)
-        return;
+        return n;
     v3 m = v3_scale(sum, 1.0f / len), t = at3(g->tan, to);
     g->spread[to] = len / (float)count < 1.0f ? len / (float)count : 1.0f;
     t = v3_sub(t, v3_scale(m, v3_dot(m, t)));
     float tl = v3_length(t);
     if (!(tl > 1e-6f))
-        return;
+        return n;
     t = v3_scale(t, 1.0f / tl);
     v3 p = v3_scale(psum, 1.0f / (float)count), v = v3_scale(vsum, 1.0f / vlen);
     /* the mean point where the rays' hits lie on one plane (within MEAN_FLAT
@@ -191,12 +195,11 @@ static void mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, co
                 along = s;
             }
         }
+    uint32_t lift_from = n;
     if (!(hmax <= MEAN_FLAT * sqrtf(r2max)) && along < n) {
         p = at3(sub->pos, along);
         v = at3(sub->view, along);
-        if (g->lift[0])
-            for (int k = 0; k < 3; ++k)
-                g->lift[k][to] = sub->lift[k][along];
+        lift_from = along;
     } else if (g->lift[0]) {
         for (int k = 0; k < 3; ++k)
             g->lift[k][to] = 0.0f; /* on one plane */
@@ -208,6 +211,7 @@ static void mean_surface(vsgl_gbuffer *g, size_t to, const vsgl_gbuffer *sub, co
         g->pos[k][to] = pv[k];
         g->view[k][to] = vv[k];
     }
+    return lift_from;
 }
 
 static uint32_t find_root(uint16_t *parent, uint32_t s)
@@ -272,11 +276,13 @@ static uint32_t group_rays(const gb_job *job, const vsgl_gbuffer *sub, size_t *f
 }
 
 /* Refine pixel (x, y): trace E x E rays into `sub` and rewrite its slots. */
-static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint32_t y)
+static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, vsgl_hit *hits, uint32_t x, uint32_t y)
 {
     vsgl_gbuffer *g = job->g;
     const uint32_t E = job->edge_aa, n = E * E, spp = g->spp;
     const float inv = 1.0f / (float)E;
+    /* the texture footprint of a first-pass sample (gbuffer/trace.h) */
+    const float foot = vsgl__texture_footprint(1.0f / (float)job->aa);
     float rx[VSGL__GBUFFER_BATCH], ry[VSGL__GBUFFER_BATCH];
     size_t dst[VSGL__GBUFFER_BATCH];
     for (uint32_t b = 0; b < n; b += VSGL__GBUFFER_BATCH) {
@@ -287,8 +293,7 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint3
             ry[k] = (float)y + ((float)(s / E) + 0.5f) * inv;
             dst[k] = s;
         }
-        /* the texture footprint of a first-pass sample (gbuffer/trace.h) */
-        vsgl__gbuffer_trace(job, sub, m, rx, ry, dst, vsgl__texture_footprint(1.0f / (float)job->aa));
+        vsgl__gbuffer_trace(job, sub, m, rx, ry, dst, foot, hits);
     }
     size_t founder[VSGL__GBUFFER_MAX_SPP];
     uint32_t count[VSGL__GBUFFER_MAX_SPP];
@@ -322,8 +327,14 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, uint32_t x, uint3
         copy_sample(g, base + q, sub, rep);
         g->weight[base + q] = (float)count[q] / (float)n;
         g->spread[base + q] = 1.0f;
-        if (sub->material[rep] != VSGL__GBUFFER_MISS && count[q] > 1)
-            mean_surface(g, base + q, sub, group, q, n);
+        vsgl__gbuffer_store_deferred(job, g, base + q, &hits[rep], (float)x + ((float)(rep % E) + 0.5f) * inv,
+                                     (float)y + ((float)(rep / E) + 0.5f) * inv, foot, 1);
+        if (sub->material[rep] != VSGL__GBUFFER_MISS && count[q] > 1) {
+            uint32_t a = mean_surface(g, base + q, sub, group, q, n);
+            if (a < n && g->lift[0])
+                vsgl__gbuffer_store_deferred(job, g, base + q, &hits[a], (float)x + ((float)(a % E) + 0.5f) * inv,
+                                             (float)y + ((float)(a / E) + 0.5f) * inv, foot, 0);
+        }
     }
     for (uint32_t q = groups; q < spp; ++q)
         vsgl__gbuffer_clear_slot(g, base + q, base);
@@ -336,14 +347,21 @@ int32_t vsgl__gbuffer_refine_edges(void *user, size_t chunk, size_t begin, size_
     const uint32_t W = job->g->width;
     vsgl_gbuffer sub;
     memset(&sub, 0, sizeof sub);
-    if (!vsgl__gbuffer_alloc(&sub, (size_t)job->edge_aa * job->edge_aa, job->g->surf[0] != NULL, 0, job->g->lift[0] != NULL))
+    /* the edge rays' geometry and hits; the lift and textured inputs only
+     * of the rays a slot keeps (vsgl__gbuffer_store_deferred) */
+    const size_t n = (size_t)job->edge_aa * job->edge_aa;
+    vsgl_hit *hits = malloc(n * sizeof *hits);
+    if (!hits || !vsgl__gbuffer_alloc(&sub, n, 0, 0, 0)) {
+        free(hits);
         return VSGL_ERROR_OUT_OF_MEMORY;
+    }
     for (size_t r = begin; r < end; ++r) {
         uint32_t y = job->row0 + (uint32_t)r;
         for (uint32_t x = 0; x < W; ++x)
             if (job->edge[(size_t)y * W + x])
-                refine_pixel(job, &sub, x, y);
+                refine_pixel(job, &sub, hits, x, y);
     }
     vsgl__gbuffer_free(&sub);
+    free(hits);
     return 0;
 }

@@ -32,6 +32,9 @@ static void store3(float *const a[3], size_t i, v3 v)
  * inputs in a textured G-buffer: textures filtered over the sample's
  * footprint at the hit, on the surface, from the rays fr = (o1, d1, o2, d2)
  * one footprint (foot pixels) to the right and down (NULL if untextured). */
+static void store_inputs(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_surface *sf, v3 org, v3 dir,
+                         const vsgl_hit *hit, const v3 *fr);
+
 static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_surface *sf, v3 org, v3 dir,
                       const vsgl_hit *hit, const v3 *fr)
 {
@@ -42,8 +45,15 @@ static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_sur
     store3(g->nrm, i, sf->normal);
     store3(g->tan, i, sf->tangent);
     g->material[i] = sf->material;
-    if (!g->surf[0] || !fr)
-        return;
+    if (g->surf[0] && fr)
+        store_inputs(j, g, i, sf, org, dir, hit, fr);
+}
+
+/* Sample i's textured inputs (g->surf), filtered over the footprint of the
+ * rays fr = (o1, d1, o2, d2). */
+static void store_inputs(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_surface *sf, v3 org, v3 dir,
+                         const vsgl_hit *hit, const v3 *fr)
+{
     const v3 o1 = fr[0], d1 = fr[1], o2 = fr[2], d2 = fr[3];
     float t = hit->t;
     v3 p0 = v3_add(org, v3_scale(dir, t));
@@ -57,8 +67,27 @@ static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_sur
         g->surf[q][i] = in[q];
 }
 
+void vsgl__gbuffer_store_deferred(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_hit *hit, float rx,
+                                  float ry, float foot, int inputs)
+{
+    if (hit->triangle == VSGL__HIT_NONE || (!(inputs && g->surf[0]) && !g->lift[0]))
+        return;
+    v3 org, dir, fr[4];
+    float t0, t1;
+    vsgl__camera_ray(&j->cam, rx, ry, &org, &dir, &t0, &t1);
+    vsgl_surface sf;
+    vsgl__scene_surface(j->scene, hit, dir, &sf);
+    if (g->lift[0])
+        store3(g->lift, i, v3_sub(vsgl__scene_smooth_point(j->scene, hit, &sf), sf.position));
+    if (!inputs || !g->surf[0])
+        return;
+    vsgl__camera_ray(&j->cam, rx + foot, ry, &fr[0], &fr[1], &t0, &t1);
+    vsgl__camera_ray(&j->cam, rx, ry + foot, &fr[2], &fr[3], &t0, &t1);
+    store_inputs(j, g, i, &sf, org, dir, hit, fr);
+}
+
 void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const float *rx, const float *ry,
-                        const size_t *dst, float foot)
+                         const size_t *dst, float foot, vsgl_hit *hits)
 {
     /* not zeroed (2 KB per call): entries [0, m) are written by the camera rays before anything reads them */
     v3 org[VSGL__GBUFFER_BATCH], dir[VSGL__GBUFFER_BATCH];
@@ -75,6 +104,9 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
     for (uint32_t k = k0; k < m; ++k)
         vsgl__camera_ray(&j->cam, rx[k], ry[k], &org[k], &dir[k], &tmin[k], &tmax[k]);
     vsgl__scene_intersect_many(j->scene, m, org, dir, tmin, tmax, 1, hit);
+    if (hits)
+        for (uint32_t k = 0; k < m; ++k)
+            hits[dst[k]] = hit[k];
     for (uint32_t k = 0; k < m; ++k) {
 #if defined(__SSE2__)
         if (k % 4 == 0 && k + 4 <= m && hit[k].triangle != VSGL__HIT_NONE && hit[k + 1].triangle != VSGL__HIT_NONE &&
@@ -147,7 +179,7 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
                 ry[k] = (float)row + ((float)(s / aa) + 0.5f) * inv;
                 dst[k] = base + (size_t)col * spp + s;
             }
-            vsgl__gbuffer_trace(j, g, m, rx, ry, dst, vsgl__texture_footprint(inv));
+            vsgl__gbuffer_trace(j, g, m, rx, ry, dst, vsgl__texture_footprint(inv), NULL);
         }
         /* slots beyond the grid (one sample per pixel, refined): empty until an edge fills them */
         for (uint32_t col = 0; spp > grid && col < width; ++col)
@@ -289,6 +321,9 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
         free(job.edge);
         if (r != VSGL_OK)
             return r;
+        vsgl__log(ctx, VSGL_LOG_INFO, "gbuffer: %zu edge pixels (%.1f %%) traced again with %u x %u rays each",
+                  out->edge_pixels, 100.0 * (double)out->edge_pixels / (double)((size_t)out->width * out->height),
+                  (unsigned)edge_aa, (unsigned)edge_aa);
     }
     if (vsgl__progress(ctx, "gbuffer", 1.0f)) {
         vsgl__gbuffer_free(out);

@@ -37,9 +37,18 @@ static inline float vsgl__texture_footprint(float spacing)
 
 /* Trace m <= VSGL__GBUFFER_BATCH camera rays at raster positions (rx[k],
  * ry[k]) and store what each sees at index dst[k] of g; `foot` is a
- * sample's side in pixels (the texture filter's footprint). */
+ * sample's side in pixels (the texture filter's footprint). With `hits`,
+ * also each ray's hit at hits[dst[k]]: a g without surf and lift arrays
+ * (the edge refinement's rays) skips those, and vsgl__gbuffer_store_deferred
+ * fills them later for the few samples kept. */
 void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const float *rx, const float *ry,
-                         const size_t *dst, float foot);
+                         const size_t *dst, float foot, vsgl_hit *hits);
+
+/* Sample i's lift and (with `inputs`) textured inputs, those of g's arrays
+ * that exist, from the hit of the camera ray at raster (rx, ry): the same
+ * values the trace stores. Nothing for a miss. */
+void vsgl__gbuffer_store_deferred(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_hit *hit, float rx,
+                                  float ry, float foot, int inputs);
 
 /* Allocate g's per-sample arrays for n samples (surf too when textured,
  * weight and spread when weighted, lift when smooth); 0 when out of memory
