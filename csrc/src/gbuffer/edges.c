@@ -59,23 +59,29 @@ static size_t sample_at(const vsgl_gbuffer *g, uint32_t aa, uint32_t x, uint32_t
     return ((size_t)y * g->width + x) * g->spp + (size_t)j * aa + i;
 }
 
-static int is_edge(const gb_job *job, uint32_t x, uint32_t y)
+/* Do two samples of pixel (x, y) lie on different surfaces? */
+static int inside_differs(const gb_job *job, uint32_t x, uint32_t y)
 {
     const vsgl_gbuffer *g = job->g;
-    const uint32_t aa = job->aa, W = g->width, H = g->height;
-    size_t p0 = ((size_t)y * W + x) * g->spp;
+    const uint32_t aa = job->aa;
+    size_t p0 = ((size_t)y * g->width + x) * g->spp;
     for (size_t k = 1; k < (size_t)aa * aa; ++k)
         if (!same_surface(g, p0, p0 + k, job->plane_tol))
             return 1;
-    /* the samples next to each border against the neighbour's across it */
+    return 0;
+}
+
+/* Do pixel (x, y)'s samples next to its right (or lower) border and the
+ * neighbour's across it lie on different surfaces? (same_surface is
+ * symmetric to the bit, so each border is tested once, for both pixels.) */
+static int border_differs(const gb_job *job, uint32_t x, uint32_t y, int lower)
+{
+    const vsgl_gbuffer *g = job->g;
+    const uint32_t aa = job->aa;
     for (uint32_t t = 0; t < aa; ++t) {
-        if (x > 0 && !same_surface(g, sample_at(g, aa, x, y, 0, t), sample_at(g, aa, x - 1, y, aa - 1, t), job->plane_tol))
-            return 1;
-        if (x + 1 < W && !same_surface(g, sample_at(g, aa, x, y, aa - 1, t), sample_at(g, aa, x + 1, y, 0, t), job->plane_tol))
-            return 1;
-        if (y > 0 && !same_surface(g, sample_at(g, aa, x, y, t, 0), sample_at(g, aa, x, y - 1, t, aa - 1), job->plane_tol))
-            return 1;
-        if (y + 1 < H && !same_surface(g, sample_at(g, aa, x, y, t, aa - 1), sample_at(g, aa, x, y + 1, t, 0), job->plane_tol))
+        size_t a = lower ? sample_at(g, aa, x, y, t, aa - 1) : sample_at(g, aa, x, y, aa - 1, t);
+        size_t b = lower ? sample_at(g, aa, x, y + 1, t, 0) : sample_at(g, aa, x + 1, y, 0, t);
+        if (!same_surface(g, a, b, job->plane_tol))
             return 1;
     }
     return 0;
@@ -85,12 +91,28 @@ int32_t vsgl__gbuffer_mark_edges(void *user, size_t chunk, size_t begin, size_t 
 {
     (void)chunk;
     gb_job *job = user;
-    const uint32_t W = job->g->width;
+    const uint32_t W = job->g->width, H = job->g->height;
+    /* the borders above and below the current row, per column */
+    unsigned char *above = malloc(2 * (size_t)W + 1), *below = above + W;
+    if (!above)
+        return VSGL_ERROR_OUT_OF_MEMORY;
+    uint32_t y0 = job->row0 + (uint32_t)begin;
+    for (uint32_t x = 0; x < W; ++x)
+        above[x] = (unsigned char)(y0 > 0 && border_differs(job, x, y0 - 1, 1));
     for (size_t r = begin; r < end; ++r) {
         uint32_t y = job->row0 + (uint32_t)r;
         for (uint32_t x = 0; x < W; ++x)
-            job->edge[(size_t)y * W + x] = (unsigned char)is_edge(job, x, y);
+            below[x] = (unsigned char)(y + 1 < H && border_differs(job, x, y, 1));
+        int left = 0;
+        for (uint32_t x = 0; x < W; ++x) {
+            int right = x + 1 < W && border_differs(job, x, y, 0);
+            int e = left || right || above[x] || below[x] || inside_differs(job, x, y);
+            job->edge[(size_t)y * W + x] = (unsigned char)e;
+            left = right;
+        }
+        memcpy(above, below, W);
     }
+    free(above);
     return 0;
 }
 
