@@ -732,6 +732,52 @@ VT_TEST(gbuffer_smooth_mesh_does_not_shadow_itself)
     vsgl_context_destroy(ctx);
 }
 
+/* An edge slot's lift is its ray's: the edge rays keep only their hits,
+ * and the lift (and textured inputs) of the ray a slot keeps are computed
+ * from its hit afterwards (vsgl__gbuffer_store_deferred). On a smooth
+ * 12-facet cylinder, a rim slot at one sample per pixel (8 x 8 edge rays)
+ * sits at one of its rays' points (the one whose normal is nearest the
+ * group's mean): the ray of the 8 x 8 grid traced plainly at that point
+ * must have the slot's lift, to the bit. A slot of a flat group takes the
+ * mean point and no lift. */
+VT_TEST(gbuffer_edge_slot_lift_is_its_rays)
+{
+    static cylinder_scene cyl;
+    cylinder_init(&cyl, 1.0f, 12);
+    vsgl_context *ctx = make_ctx(2);
+    vsgl_scene *s = NULL;
+    vsgl_gbuffer one, dense;
+    VT_REQUIRE(vsgl_scene_create(ctx, &cyl.p.desc, &s) == VSGL_OK && vsgl__gbuffer_build(ctx, s, 1, 8, &one) == VSGL_OK &&
+                   vsgl__gbuffer_build(ctx, s, 8, 0, &dense) == VSGL_OK,
+               "'%s'", vsgl_context_last_error(ctx));
+    VT_REQUIRE(one.lift[0] != NULL && dense.lift[0] != NULL, "no lift on a smooth-shaded scene");
+    size_t lifted = 0, matched = 0, flat = 0;
+    for (size_t px = 0; px < (size_t)64 * 48; ++px)
+        for (size_t q = px * one.spp; q < px * one.spp + one.spp; ++q) {
+            if (one.material[q] == VSGL__GBUFFER_MISS || one.weight[q] == 1.0f || !(one.weight[q] > 0.0f))
+                continue; /* a miss, an empty slot, or not an edge pixel */
+            if (one.lift[0][q] == 0.0f && one.lift[1][q] == 0.0f && one.lift[2][q] == 0.0f) {
+                ++flat;
+                continue;
+            }
+            ++lifted;
+            for (size_t j = px * 64; j < px * 64 + 64; ++j)
+                if (dense.pos[0][j] == one.pos[0][q] && dense.pos[1][j] == one.pos[1][q] &&
+                    dense.pos[2][j] == one.pos[2][q]) {
+                    matched += dense.lift[0][j] == one.lift[0][q] && dense.lift[1][j] == one.lift[1][q] &&
+                               dense.lift[2][j] == one.lift[2][q];
+                    break;
+                }
+        }
+    printf("    %zu lifted edge slots, %zu with their ray's lift to the bit; %zu without a lift\n", lifted, matched, flat);
+    VT_CHECK(lifted >= 48, "%zu lifted edge slots: the test cannot tell", lifted);
+    VT_CHECK(matched == lifted, "%zu of %zu edge slots lack their ray's lift", lifted - matched, lifted);
+    vsgl__gbuffer_free(&one);
+    vsgl__gbuffer_free(&dense);
+    vsgl_scene_destroy(s);
+    vsgl_context_destroy(ctx);
+}
+
 /* A flat scene has no lift (gbuffer.h: nothing to model). */
 VT_TEST(gbuffer_flat_scene_has_no_lift)
 {
