@@ -93,9 +93,10 @@ int32_t vsgl__gbuffer_mark_edges(void *user, size_t chunk, size_t begin, size_t 
     gb_job *job = user;
     const uint32_t W = job->g->width, H = job->g->height;
     /* the borders above and below the current row, per column */
-    unsigned char *above = malloc(2 * (size_t)W + 1), *below = above + W;
+    unsigned char *above = malloc(2 * (size_t)W + 1);
     if (!above)
         return VSGL_ERROR_OUT_OF_MEMORY;
+    unsigned char *below = above + W;
     uint32_t y0 = job->row0 + (uint32_t)begin;
     for (uint32_t x = 0; x < W; ++x)
         above[x] = (unsigned char)(y0 > 0 && border_differs(job, x, y0 - 1, 1));
