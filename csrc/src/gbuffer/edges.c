@@ -73,7 +73,8 @@ static int inside_differs(const gb_job *job, uint32_t x, uint32_t y)
 
 /* Do pixel (x, y)'s samples next to its right (or lower) border and the
  * neighbour's across it lie on different surfaces? (same_surface is
- * symmetric to the bit, so each border is tested once, for both pixels.) */
+ * symmetric to the bit, so each border is tested once for both pixels;
+ * the upper border of a range's first row once more, by that range.) */
 static int border_differs(const gb_job *job, uint32_t x, uint32_t y, int lower)
 {
     const vsgl_gbuffer *g = job->g;
