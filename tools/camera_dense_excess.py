@@ -101,9 +101,8 @@ def main():
                 import matplotlib.pyplot as plt
                 os.makedirs(a.map, exist_ok=True)
                 for p in PASSES:
-                    f = [x[p].sum(-1) for x in seq]
-                    g = [x[p].sum(-1) for x in dense]
-                    ex = sum(((f[t + 1] - f[t]) - (g[t + 1] - g[t])) ** 2 for t in range(FRAMES - 1))
+                    steps = M.excess_steps([x[p].sum(-1) for x in seq], [x[p].sum(-1) for x in dense])
+                    ex = sum(d ** 2 for d in steps)
                     plt.figure(figsize=(8, 6))
                     plt.imshow(np.sqrt(ex), cmap="magma")
                     plt.colorbar(label="sqrt(summed squared excess)")

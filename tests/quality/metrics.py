@@ -200,15 +200,22 @@ def jitter(frames):
     return float(np.median([_rel((f[t + 1] - f[t]) - trend, f[t]) for t in range(n)]))
 
 
-def excess_flicker(frames, truth):
-    """Median over consecutive pairs of the RMS of (f[t+1] - f[t]) - (g[t+1]
-    - g[t]) relative to the RMS of f[t]: how much a sequence changes beyond
-    the change of `truth` (the same motion rendered densely)."""
+def excess_steps(frames, truth):
+    """Per consecutive pair, (f[t+1] - f[t]) - (g[t+1] - g[t]): a sequence's
+    change beyond that of `truth` (the same motion rendered densely)."""
     f = [np.asarray(x, np.float64) for x in frames]
     g = [np.asarray(x, np.float64) for x in truth]
     if len(f) != len(g) or len(f) < 2:
         raise ValueError("excess_flicker: %d frames against %d truth frames" % (len(f), len(g)))
-    return float(np.median([_rel((f[t + 1] - f[t]) - (g[t + 1] - g[t]), f[t]) for t in range(len(f) - 1)]))
+    return [(f[t + 1] - f[t]) - (g[t + 1] - g[t]) for t in range(len(f) - 1)]
+
+
+def excess_flicker(frames, truth):
+    """Median over consecutive pairs of the RMS of excess_steps relative to
+    the RMS of f[t]: how much a sequence changes beyond the change of
+    `truth` (the same motion rendered densely)."""
+    f = [np.asarray(x, np.float64) for x in frames]
+    return float(np.median([_rel(d, f[t]) for t, d in enumerate(excess_steps(frames, truth))]))
 
 
 def motion_change(first, last, steps):

@@ -299,6 +299,15 @@ static uint32_t group_rays(const gb_job *job, const vsgl_gbuffer *sub, size_t *f
     return groups;
 }
 
+/* Raster position of edge ray s of pixel (x, y) on its E x E grid (inv =
+ * 1 / E): the trace and the deferred inputs of the rays kept must take the
+ * same, to the bit. */
+static inline void edge_ray_at(uint32_t x, uint32_t y, uint32_t s, uint32_t E, float inv, float *rx, float *ry)
+{
+    *rx = (float)x + ((float)(s % E) + 0.5f) * inv;
+    *ry = (float)y + ((float)(s / E) + 0.5f) * inv;
+}
+
 /* Refine pixel (x, y): trace E x E rays into `sub` and rewrite its slots. */
 static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, vsgl_hit *hits, uint32_t x, uint32_t y)
 {
@@ -313,8 +322,7 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, vsgl_hit *hits, u
         uint32_t m = n - b < VSGL__GBUFFER_BATCH ? n - b : VSGL__GBUFFER_BATCH;
         for (uint32_t k = 0; k < m; ++k) {
             uint32_t s = b + k;
-            rx[k] = (float)x + ((float)(s % E) + 0.5f) * inv;
-            ry[k] = (float)y + ((float)(s / E) + 0.5f) * inv;
+            edge_ray_at(x, y, s, E, inv, &rx[k], &ry[k]);
             dst[k] = s;
         }
         vsgl__gbuffer_trace(job, sub, m, rx, ry, dst, foot, hits);
@@ -351,13 +359,15 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, vsgl_hit *hits, u
         copy_sample(g, base + q, sub, rep);
         g->weight[base + q] = (float)count[q] / (float)n;
         g->spread[base + q] = 1.0f;
-        vsgl__gbuffer_store_deferred(job, g, base + q, &hits[rep], (float)x + ((float)(rep % E) + 0.5f) * inv,
-                                     (float)y + ((float)(rep / E) + 0.5f) * inv, foot, 1);
+        float px, py;
+        edge_ray_at(x, y, rep, E, inv, &px, &py);
+        vsgl__gbuffer_store_deferred(job, g, base + q, &hits[rep], px, py, foot, 1);
         if (sub->material[rep] != VSGL__GBUFFER_MISS && count[q] > 1) {
             uint32_t a = mean_surface(g, base + q, sub, group, q, n);
-            if (a < n && g->lift[0])
-                vsgl__gbuffer_store_deferred(job, g, base + q, &hits[a], (float)x + ((float)(a % E) + 0.5f) * inv,
-                                             (float)y + ((float)(a / E) + 0.5f) * inv, foot, 0);
+            if (a < n && g->lift[0]) {
+                edge_ray_at(x, y, a, E, inv, &px, &py);
+                vsgl__gbuffer_store_deferred(job, g, base + q, &hits[a], px, py, foot, 0);
+            }
         }
     }
     for (uint32_t q = groups; q < spp; ++q)

@@ -67,6 +67,15 @@ static void store_inputs(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_
         g->surf[q][i] = in[q];
 }
 
+/* The texture footprint's rays of the sample at raster (rx, ry): `foot`
+ * pixels to the right and down, fr = (o1, d1, o2, d2). */
+static void footprint_rays(const gb_job *j, float rx, float ry, float foot, v3 fr[4])
+{
+    float t0, t1;
+    vsgl__camera_ray(&j->cam, rx + foot, ry, &fr[0], &fr[1], &t0, &t1);
+    vsgl__camera_ray(&j->cam, rx, ry + foot, &fr[2], &fr[3], &t0, &t1);
+}
+
 void vsgl__gbuffer_store_deferred(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_hit *hit, float rx,
                                   float ry, float foot, int inputs)
 {
@@ -81,8 +90,7 @@ void vsgl__gbuffer_store_deferred(const gb_job *j, vsgl_gbuffer *g, size_t i, co
         store3(g->lift, i, v3_sub(vsgl__scene_smooth_point(j->scene, hit, &sf), sf.position));
     if (!inputs || !g->surf[0])
         return;
-    vsgl__camera_ray(&j->cam, rx + foot, ry, &fr[0], &fr[1], &t0, &t1);
-    vsgl__camera_ray(&j->cam, rx, ry + foot, &fr[2], &fr[3], &t0, &t1);
+    footprint_rays(j, rx, ry, foot, fr);
     store_inputs(j, g, i, &sf, org, dir, hit, fr);
 }
 
@@ -147,11 +155,8 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
         vsgl_surface sf;
         vsgl__scene_surface(j->scene, &hit[k], dir[k], &sf);
         v3 fr[4];
-        if (g->surf[0]) { /* the footprint's rays */
-            float t0, t1;
-            vsgl__camera_ray(&j->cam, rx[k] + foot, ry[k], &fr[0], &fr[1], &t0, &t1);
-            vsgl__camera_ray(&j->cam, rx[k], ry[k] + foot, &fr[2], &fr[3], &t0, &t1);
-        }
+        if (g->surf[0])
+            footprint_rays(j, rx[k], ry[k], foot, fr);
         store_hit(j, g, i, &sf, org[k], dir[k], &hit[k], g->surf[0] ? fr : NULL);
     }
 }
