@@ -20,7 +20,7 @@ process (VSGL_LIBRARY), so builds can be compared in one run:
 
 The dense frames are cached under --cache (they take most of the time:
 the box room's ~4 minutes at 320 x 240 on 2 cores). --map writes the
-per-pixel excess of the last library as PNGs (needs matplotlib).
+per-pixel excess of the last library as false-colour PNGs.
 """
 import argparse
 import os
@@ -51,6 +51,17 @@ def render_child(scene, config, size, out):
     base = scenes.case(scene, size)
     seq = [rend.render(scenes.animate(base, "camera", f), cfg)[0] for f in range(FRAMES)]
     np.savez(out, **{"%s%d" % (p, f): seq[f][p] for f in range(FRAMES) for p in PASSES})
+
+
+def save_map(path, err):
+    """err (H, W) as a false-colour PNG (blue 0 .. red at its 99.5th
+    percentile), 4x enlarged when small; the scale goes to stdout."""
+    import imgutil
+    vmax = max(float(np.percentile(err, 99.5)), 1e-30)
+    img = imgutil.false_colour(err, vmax)
+    k = max(1, 640 // img.shape[1])
+    imgutil.save_png(path, np.repeat(np.repeat(img, k, 0), k, 1))
+    print("  %s: red = %.4g (99.5th percentile), max %.4g" % (os.path.basename(path), vmax, float(err.max())))
 
 
 def load(path):
@@ -92,24 +103,17 @@ def main():
         dense = load(dense_path) if os.path.exists(dense_path) else run(scene, "dense", size, dense_path)
         cells = []
         for i, lib in enumerate(libs):
-            seq = run(scene, a.config, size, os.path.join(a.cache, "run%d.npz" % i), lib)
+            seq = run(scene, a.config, size, os.path.join(a.cache, "run%d_%d.npz" % (os.getpid(), i)), lib)
             cells.append(" / ".join("%.4f" % M.excess_flicker([x[p] for x in seq], [x[p] for x in dense])
                                     for p in PASSES))
-            if a.map and i == len(libs) - 1:
-                import matplotlib
-                matplotlib.use("Agg")
-                import matplotlib.pyplot as plt
-                os.makedirs(a.map, exist_ok=True)
-                for p in PASSES:
-                    steps = M.excess_steps([x[p].sum(-1) for x in seq], [x[p].sum(-1) for x in dense])
-                    ex = sum(d ** 2 for d in steps)
-                    plt.figure(figsize=(8, 6))
-                    plt.imshow(np.sqrt(ex), cmap="magma")
-                    plt.colorbar(label="sqrt(summed squared excess)")
-                    plt.title("%s, %s: %s step minus the dense render's" % (scene, a.config, p))
-                    plt.savefig(os.path.join(a.map, "%s_%s.png" % (scene, p)), dpi=80)
-                    plt.close()
         print("%-28s %s" % (scene, "  ->  ".join(cells)), flush=True)
+        if a.map:  # the last library's excess, per pass
+            os.makedirs(a.map, exist_ok=True)
+            for p in PASSES:
+                steps = M.excess_steps([x[p].sum(-1) for x in seq], [x[p].sum(-1) for x in dense])
+                path = os.path.join(a.map, "%s_%s.png" % (scene, p))
+                save_map(path, np.sqrt(sum(d ** 2 for d in steps)))
+                print("  wrote", path)
     return 0
 
 

@@ -17,7 +17,7 @@ over the frames beside Cycles' and writes the excess map as a PNG.
     python3 tools/camera_excess.py balanced --map /tmp/excess.png
 
 Needs the cached 80 x 60 camera references (`make test` renders them with
-Blender 3.4 when they are missing) and numpy; --map needs matplotlib.
+Blender 3.4 when they are missing) and numpy; --map writes a false-colour PNG.
 """
 import argparse
 import os
@@ -106,14 +106,13 @@ def main():
         print("(%d,%d) Cycles %s" % (x, y, " ".join("%.3f" % v for v in cyc)))
         print("(%d,%d) ours   %s" % (x, y, " ".join("%.3f" % o[y, x].sum() for o in ours)))
     if args.map:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(8, 6))
-        im = ax.imshow(np.sqrt(acc), cmap="magma")
-        fig.colorbar(im, label="sqrt(summed excess)")
-        ax.set_title("%s, %s: %s excess over Cycles' camera motion" % (args.scene, cfg.label, p))
-        fig.savefig(args.map, dpi=80)
+        import imgutil
+        err = np.sqrt(acc)
+        vmax = max(float(np.percentile(err, 99.5)), 1e-30)
+        img = imgutil.false_colour(err, vmax)
+        k = max(1, 640 // img.shape[1])
+        imgutil.save_png(args.map, np.repeat(np.repeat(img, k, 0), k, 1))
+        print("map: blue 0 .. red %.4g (99.5th percentile), max %.4g" % (vmax, float(err.max())))
         print("wrote", args.map)
 
 
