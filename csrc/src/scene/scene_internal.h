@@ -54,6 +54,16 @@ uint32_t vsgl__scene_source_triangle(const vsgl_scene *scene, uint32_t triangle)
 
 /* Surface attributes at a hit seen along ray direction dir. */
 void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, vsgl_surface *out);
+/* The shading normal a camera sample is shaded with, as Cycles' BSDF nodes
+ * take it (ensure_valid_reflection): n itself, unless the mirror
+ * reflection of the view i about n dips below the face (ng) by more than
+ * allowed; then the normal nearest n, in the plane of n and ng, whose
+ * reflection of i leaves the face at height min(0.9 ng.i, 0.01). On
+ * smooth-shaded silhouettes, where the interpolated normal faces away from
+ * the camera, it keeps the rim's glossy reflection that Cycles renders.
+ * ng: unit face normal on the camera's side; i: unit direction towards the
+ * camera; n: unit shading normal (scene/shading_normal.c). */
+v3 vsgl__valid_reflection_normal(v3 ng, v3 i, v3 n);
 #if defined(__SSE2__)
 /* The same for four hits (every one a hit), bit for bit (scene/surface4.c). */
 void vsgl__scene_surface4(const vsgl_scene *scene, const vsgl_hit hit[4], const v3 dir[4], vsgl_surface out[4]);
