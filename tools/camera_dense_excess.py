@@ -87,6 +87,7 @@ def main():
     ap.add_argument("--libs", default="", help="comma-separated libvsgl.so paths (default: the one evaluate.py loads)")
     ap.add_argument("--cache", default=os.path.join(ROOT, "build", "camera_dense"))
     ap.add_argument("--map", default="", help="directory for per-pixel excess PNGs")
+    ap.add_argument("--keep-runs", action="store_true", help="keep each library's frames (npz) in --cache")
     ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.child:
@@ -103,7 +104,12 @@ def main():
         dense = load(dense_path) if os.path.exists(dense_path) else run(scene, "dense", size, dense_path)
         cells = []
         for i, lib in enumerate(libs):
-            seq = run(scene, a.config, size, os.path.join(a.cache, "run%d_%d.npz" % (os.getpid(), i)), lib)
+            path = os.path.join(a.cache, "run_%s_%d_%d.npz" % (scene, os.getpid(), i))
+            seq = run(scene, a.config, size, path, lib)
+            if a.keep_runs:
+                print("  frames of %s: %s" % (lib or "default", path))
+            else:
+                os.remove(path)
             cells.append(" / ".join("%.4f" % M.excess_flicker([x[p] for x in seq], [x[p] for x in dense])
                                     for p in PASSES))
         print("%-28s %s" % (scene, "  ->  ".join(cells)), flush=True)

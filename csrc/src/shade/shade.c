@@ -1415,7 +1415,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
                    eps, 0, per_chunk, &faint_total, kl, korder, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
-                   0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL, twin, &targets, 0u};
+                   0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL, twin, &targets, 0u, NULL};
     for (size_t k = 0; kl && k < set->count; ++k) /* the axis planes the horizon tilt is taken against */
         if (kl[k].tilt > 0.0f)
             j.tilt_dirs |= 1u << kl[k].tdir;
@@ -1425,6 +1425,11 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
         for (uint32_t k = 0; k < material_count; ++k)
             vsgl__material_params(&j.materials[k], &params[k]);
     j.params = params;
+    /* sparse interpolation: each material's same-surface normal tolerance (no memory: the loosest) */
+    float *normal_cos = s->shade_stride > 1 ? malloc(((size_t)material_count + 1) * 2 * sizeof *normal_cos) : NULL;
+    if (normal_cos)
+        vsgl__sparse_normal_cos(j.materials, material_count, normal_cos);
+    j.normal_cos = normal_cos;
     vsgl_near_index near;
     memset(&near, 0, sizeof near);
     if (leak && s->leak_correction != VSGL_LEAK_CLIP)
@@ -1496,6 +1501,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     free(j.anchor_pairs);
     free(j.alist);
     free(params);
+    free(normal_cos);
     vsgl__near_index_free(&near);
     if (j.plan && r == VSGL_OK)
         j.plan->colours_in = planes->diffuse_color;

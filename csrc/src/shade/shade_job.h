@@ -101,6 +101,9 @@ typedef struct shade_job {
     const vsgl_ray_targets *targets; /* visibility rays: each VSGL's points (ray_targets.h); NULL without rays */
     unsigned tilt_dirs;   /* bit d: some kernel light takes the horizon tilt against axis plane d (kernel.h
                              VSGL__TILT_DIRS); only those rows of a block's tables are filled */
+    const float *normal_cos; /* NULL, or per material (2 floats): the cosine above which two normals
+                                count as one surface for sparse interpolation, and 1 / (1 - it)
+                                (sparse.h sparse_normal_cos) */
 } shade_job;
 
 /* Receiver lobe of one sample, set up once and used for every VSGL. */
@@ -142,6 +145,8 @@ int vsgl__shade_plan_complete(const vsgl_shade_plan *p);
 /* Shade with shade_stride > 1 (sparse.c): the anchors first, then rows of
  * pixels [b, e) of the current batch, as vsgl__parallel_for's callback. */
 vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j);
+/* j->normal_cos of the count materials: out[2 k], out[2 k + 1] (sparse.h sparse_normal_cos). */
+void vsgl__sparse_normal_cos(const vsgl_material *materials, uint32_t count, float *out);
 /* Rows [row, end) with shade_stride > 1 (j->base = row * width, j->pairs
  * the batch's per-row pair counts): interpolate, shade what cannot be
  * interpolated in full kernel blocks, resolve the pixels. */

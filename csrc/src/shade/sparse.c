@@ -195,10 +195,10 @@ static float same_surface_weight(const shade_job *j, size_t s, size_t a)
         return 0.0f;
     v3 ns = v3_make(g->nrm[0][s], g->nrm[1][s], g->nrm[2][s]);
     v3 na = v3_make(g->nrm[0][a], g->nrm[1][a], g->nrm[2][a]);
-    float c = v3_dot(ns, na);
-    if (!(c > SPARSE_NORMAL_COS))
+    float c = v3_dot(ns, na), inv, cmin = sparse_normal_cos(j, g->material[s], &inv);
+    if (!(c > cmin))
         return 0.0f;
-    float wn = (c - SPARSE_NORMAL_COS) * (1.0f / (1.0f - SPARSE_NORMAL_COS));
+    float wn = (c - cmin) * inv;
     v3 d = v3_make(g->pos[0][a] - g->pos[0][s], g->pos[1][a] - g->pos[1][s], g->pos[2][a] - g->pos[2][s]);
     float off = fabsf(v3_dot(d, ns)), tol = SPARSE_PLANE_REL * v3_length(d) + j->plane_tol;
     float wp = 1.0f - off / tol;
@@ -461,19 +461,20 @@ static int32_t sparse_resolve(void *user, size_t chunk, size_t b0, size_t e0)
 
 /* same_surface_weight of an anchor packed in q (plan->geo) for a sample of
  * normal n, position x and material m: the same operations. */
-static inline float packed_surface_weight(const float *n, const float *x, uint32_t m, const float *q, float plane_tol)
+static inline float packed_surface_weight(const shade_job *j, const float *n, const float *x, uint32_t m,
+                                          const float *q)
 {
     uint32_t qm;
     memcpy(&qm, &q[6], sizeof qm);
     if (qm != m)
         return 0.0f;
-    float c = n[0] * q[0] + n[1] * q[1] + n[2] * q[2];
-    if (!(c > SPARSE_NORMAL_COS))
+    float c = n[0] * q[0] + n[1] * q[1] + n[2] * q[2], inv, cmin = sparse_normal_cos(j, m, &inv);
+    if (!(c > cmin))
         return 0.0f;
-    float wn = (c - SPARSE_NORMAL_COS) * (1.0f / (1.0f - SPARSE_NORMAL_COS));
+    float wn = (c - cmin) * inv;
     float d0 = q[3] - x[0], d1 = q[4] - x[1], d2 = q[5] - x[2];
     float off = fabsf(d0 * n[0] + d1 * n[1] + d2 * n[2]);
-    float tol = SPARSE_PLANE_REL * sqrtf(d0 * d0 + d1 * d1 + d2 * d2) + plane_tol;
+    float tol = SPARSE_PLANE_REL * sqrtf(d0 * d0 + d1 * d1 + d2 * d2) + j->plane_tol;
     float wp = 1.0f - off / tol;
     if (!(wp > 0.0f))
         return 0.0f;
@@ -521,9 +522,9 @@ static void record_cell4(sparse_batch *bt, size_t px, uint32_t ax, uint32_t ay, 
             const __m128 same = _mm_castsi128_ps(_mm_cmpeq_epi32(mat, _mm_set1_epi32((int)qm)));
             const __m128 c = _mm_add_ps(_mm_add_ps(_mm_mul_ps(n0, _mm_set1_ps(q[0])), _mm_mul_ps(n1, _mm_set1_ps(q[1]))),
                                         _mm_mul_ps(n2, _mm_set1_ps(q[2])));
-            const __m128 c_ok = _mm_cmpgt_ps(c, _mm_set1_ps(SPARSE_NORMAL_COS));
-            const __m128 wn = _mm_mul_ps(_mm_sub_ps(c, _mm_set1_ps(SPARSE_NORMAL_COS)),
-                                         _mm_set1_ps(1.0f / (1.0f - SPARSE_NORMAL_COS)));
+            float inv, cmin = sparse_normal_cos(j, qm, &inv); /* (lanes of another material weigh 0) */
+            const __m128 c_ok = _mm_cmpgt_ps(c, _mm_set1_ps(cmin));
+            const __m128 wn = _mm_mul_ps(_mm_sub_ps(c, _mm_set1_ps(cmin)), _mm_set1_ps(inv));
             const __m128 d0 = _mm_sub_ps(_mm_set1_ps(q[3]), x0), d1 = _mm_sub_ps(_mm_set1_ps(q[4]), x1),
                          d2 = _mm_sub_ps(_mm_set1_ps(q[5]), x2);
             const __m128 off = _mm_and_ps(
@@ -635,7 +636,7 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
                     float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
                     if (as == SIZE_MAX || !(wb > 0.0f))
                         continue;
-                    float wa = wb * (as == si ? 1.0f : packed_surface_weight(n, xs, m, plan->geo + a * 8, j->plane_tol));
+                    float wa = wb * (as == si ? 1.0f : packed_surface_weight(j, n, xs, m, plan->geo + a * 8));
                     const float *q = plan->geo + a * 8;
                     const float d0 = q[3] - xs[0], d1 = q[4] - xs[1], d2 = q[5] - xs[2];
                     ad2[dy * 2 + dx] = d0 * d0 + d1 * d1 + d2 * d2;
@@ -732,4 +733,20 @@ done:
     free(bt.dpairs);
     free(bt.lanes);
     return r == VSGL_OK ? VSGL_OK : vsgl__fail(ctx, r, "shade: out of memory");
+}
+
+void vsgl__sparse_normal_cos(const vsgl_material *materials, uint32_t count, float *out)
+{
+    for (uint32_t k = 0; k < count; ++k) {
+        vsgl_brdf_params bp;
+        vsgl__material_params(&materials[k], &bp);
+        float c = SPARSE_NORMAL_COS;
+        if (bp.glossy) {
+            const float turn = SPARSE_GLOSSY_TURN * sqrtf(bp.alpha_x * bp.alpha_y);
+            const float cg = cosf(turn);
+            c = cg > c ? cg : c;
+        }
+        out[2 * (size_t)k] = c;
+        out[2 * (size_t)k + 1] = 1.0f / (1.0f - c);
+    }
 }
