@@ -50,6 +50,17 @@ if "$py" -c 'import numpy' >/dev/null 2>&1; then
 else
   echo "visibility: skipped: $py lacks numpy"
 fi
+echo "== camera flicker at one sample per pixel (320 x 240: every preset), above a dense render (issue 9)"
+if "$py" -c 'import numpy' >/dev/null 2>&1; then
+  # the dense 8 x 8 renders are cached in build/camera_dense (the box room's ~4 minutes, once)
+  if [ "${BENCH_QUICK:-0}" = 1 ]; then
+    "$py" tools/camera_dense_excess.py --scenes glossy_sphere_floor --size 160x120 --config balanced
+  else
+    for preset in preview balanced quality; do "$py" tools/camera_dense_excess.py --config "$preset"; done
+  fi
+else
+  echo "camera flicker: skipped: $py lacks numpy"
+fi
 echo "== EXR writing: every compression, float and half"
 tools/bench_exr.sh
 echo "== the trade: error against whole-frame time, library vs Cycles and Cycles + OIDN (issue 11)"

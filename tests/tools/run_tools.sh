@@ -138,5 +138,30 @@ if want bench_builds; then
   fi
 fi
 
+# tools/camera_dense_excess.py (make bench's camera flicker at one sample per
+# pixel) runs end to end at a tiny size: the same library twice gives the
+# same figures (renders are deterministic), --map writes PNGs, and the
+# per-library frames are removed
+if want camera_dense_excess; then
+  py=${BPY_PYTHON:-python3}
+  if ! "$py" -c 'import numpy' >/dev/null 2>&1; then
+    bad camera_dense_excess "$py lacks numpy"
+  else
+    out=$("$py" tools/camera_dense_excess.py --scenes spot_metal_floor --size 40x30 --config preview \
+          --libs build/libvsgl.so,build/libvsgl.so --cache "$T/dense" --map "$T/map" 2>&1); rc=$?
+    line=$(grep "^spot_metal_floor " <<<"$out")
+    cells=$(sed -E 's/^spot_metal_floor +//' <<<"$line")
+    first=${cells%%  ->  *}; second=${cells##*  ->  }
+    png=$(head -c 8 "$T/map/spot_metal_floor_Gloss.png" 2>/dev/null | od -An -tx1 | tr -d ' \n')
+    if [ $rc -eq 0 ] && [[ "$first" =~ ^[0-9]+\.[0-9]{4}\ /\ [0-9]+\.[0-9]{4}$ ]] && [ "$first" = "$second" ] &&
+       [ "$png" = 89504e470d0a1a0a ] && ! ls "$T/dense"/run_* >/dev/null 2>&1; then
+      ok camera_dense_excess
+    else
+      bad camera_dense_excess "exit $rc; cells '$first' / '$second'; PNG header '$png'; runs left: $(ls "$T/dense" 2>/dev/null | tr '\n' ' ')" \
+          "output: $(tail -5 <<<"$out" | tr '\n' '|')"
+    fi
+  fi
+fi
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
