@@ -483,11 +483,11 @@ VT_TEST(render_sample_merging_cuts_pairs_at_small_error)
 }
 
 /* The combined plane of the room at w x h with settings s and `threads`. */
-static float *render_room_size(uint32_t w, uint32_t h, uint32_t threads, const vsgl_render_settings *s,
-                               vsgl_render_stats *st, float **dc)
+static float *render_room_rough(uint32_t w, uint32_t h, uint32_t threads, const vsgl_render_settings *s,
+                                vsgl_render_stats *st, float **dc, float floor_roughness)
 {
     fx_scene fx;
-    fx_room(&fx, w, h, 0.25f, 200.0f);
+    fx_room(&fx, w, h, floor_roughness, 200.0f);
     vsgl_context *ctx = fx_context(threads);
     vsgl_scene *scene = NULL;
     float *comb = calloc((size_t)w * h * 3, sizeof *comb), *col = calloc((size_t)w * h * 3, sizeof *col);
@@ -504,6 +504,12 @@ static float *render_room_size(uint32_t w, uint32_t h, uint32_t threads, const v
     vsgl_context_destroy(ctx);
     *dc = col;
     return comb;
+}
+
+static float *render_room_size(uint32_t w, uint32_t h, uint32_t threads, const vsgl_render_settings *s,
+                               vsgl_render_stats *st, float **dc)
+{
+    return render_room_rough(w, h, threads, s, st, dc, 0.25f);
 }
 
 /* Shading one pixel in S x S (shade_stride): the shading pairs fall by
@@ -555,6 +561,34 @@ VT_TEST(render_shade_stride_cuts_pairs_at_small_error)
     }
     free(full);
     free(dc_full);
+}
+
+/* A mirror floor (roughness 0, GGX alpha 5e-10) still shares its light
+ * between pixels at shade_stride 2: sparse.c takes two normals of a sharp
+ * glossy material for one surface only within half its alpha, but never
+ * within less than SPARSE_GLOSSY_MIN_TURN; at the alpha itself not even
+ * the floor's own normals were one surface, and every pixel was shaded. */
+VT_TEST(render_shade_stride_interpolates_a_mirror_floor)
+{
+    enum { SW = 120, SH = 90 };
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.visibility = VSGL_VISIBILITY_NONE;
+    s.rsm_resolution = 64;
+    s.aa_samples = 1;
+    s.edge_samples = 0;
+    vsgl_render_stats st[2] = {{.size = sizeof st[0]}, {.size = sizeof st[1]}};
+    float *dc[2], *img[2];
+    for (int k = 0; k < 2; ++k) {
+        s.shade_stride = k ? 2 : 1;
+        img[k] = render_room_rough(SW, SH, 0, &s, &st[k], &dc[k], 0.0f);
+    }
+    VT_CHECK((double)st[1].shading_pairs * 2.0 < (double)st[0].shading_pairs, "stride 2: pairs %llu vs %llu",
+             (unsigned long long)st[1].shading_pairs, (unsigned long long)st[0].shading_pairs);
+    for (int k = 0; k < 2; ++k) {
+        free(img[k]);
+        free(dc[k]);
+    }
 }
 
 /* The same room at very different scales and far from the origin: every

@@ -742,7 +742,8 @@ void vsgl__sparse_normal_cos(const vsgl_material *materials, uint32_t count, flo
         vsgl__material_params(&materials[k], &bp);
         float c = SPARSE_NORMAL_COS;
         if (bp.glossy) {
-            const float turn = SPARSE_GLOSSY_TURN * sqrtf(bp.alpha_x * bp.alpha_y);
+            float turn = SPARSE_GLOSSY_TURN * sqrtf(bp.alpha_x * bp.alpha_y);
+            turn = turn > SPARSE_GLOSSY_MIN_TURN ? turn : SPARSE_GLOSSY_MIN_TURN;
             const float cg = cosf(turn);
             c = cg > c ? cg : c;
         }

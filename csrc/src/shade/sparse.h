@@ -28,6 +28,10 @@
  * above a dense render 0.0260 -> 0.0206, 0.0202 shading every pixel;
  * half as tight, 1 x alpha, 0.0230). */
 #define SPARSE_GLOSSY_TURN 0.5f
+/* ... but never under 0.01 radians (0.6 degrees): a mirror's alpha is
+ * 5e-10, whose cosine is 1 in float, and no two normals, not even a flat
+ * floor's own, would then be one surface. */
+#define SPARSE_GLOSSY_MIN_TURN 0.01f
 
 /* The same-surface cosine of material m and 1 / (1 - it) in *inv. */
 static inline float sparse_normal_cos(const shade_job *j, uint32_t m, float *inv)
