@@ -6,6 +6,7 @@
 #include "harness.h"
 #include "scene_fixture.h"
 #include "shade/ray_targets.h"
+#include "shade/shade.h"
 
 #include <math.h>
 #include <string.h>
@@ -164,4 +165,53 @@ VT_TEST(ray_targets_give_an_edge_the_cluster_penumbra)
     }
     vsgl_scene_destroy(sc);
     vsgl_context_destroy(ctx);
+}
+
+/* A receiver never aims below its own horizon (vsgl__ray_aim): above it a
+ * point is kept as it is; below it, its mirror image through the cluster's
+ * centre, raised to 5 % of its distance above the horizon where it is
+ * lower, so the ray cannot start into the receiver's own surface. The
+ * height above the horizon goes on continuously as the mirror image sinks
+ * (a ray that jumped to the centre below the horizon, blocked by the
+ * receiver itself, took a cluster's whole light for a frame). Random
+ * receivers, normals, clusters and points. */
+VT_TEST(ray_aim_stays_above_the_receivers_horizon)
+{
+    uint64_t st = 0x243F6A8885A308D3ull;
+    size_t kept = 0, mirrored = 0, raised = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        float u[12];
+        for (int k = 0; k < 12; ++k) {
+            st = st * 6364136223846793005ull + 1442695040888963407ull;
+            u[k] = (float)((double)(st >> 11) * (1.0 / 9007199254740992.0)) * 2.0f - 1.0f;
+        }
+        v3 x = v3_make(u[0], u[1], u[2]);
+        v3 n = v3_normalize(v3_make(u[3], u[4], u[5] + 0.01f));
+        v3 c = v3_add(x, v3_scale(v3_make(u[6], u[7], u[8]), 2.0f));
+        v3 t = v3_add(c, v3_scale(v3_make(u[9], u[10], u[11]), 0.5f));
+        v3 a = vsgl__ray_aim(x, n, c, t);
+        float ht = v3_dot(n, v3_sub(t, x));
+        if (ht > 0.0f) {
+            VT_CHECK(a.x == t.x && a.y == t.y && a.z == t.z, "trial %d: a point above the horizon moved", trial);
+            ++kept;
+            continue;
+        }
+        v3 m = v3_sub(v3_scale(c, 2.0f), t), dm = v3_sub(m, x);
+        float hm = v3_dot(n, dm), lm = v3_length(dm);
+        v3 da = v3_sub(a, x);
+        float ha = v3_dot(n, da), la = v3_length(da);
+        if (hm >= 0.05f * lm) {
+            VT_CHECK(a.x == m.x && a.y == m.y && a.z == m.z, "trial %d: not the mirror image", trial);
+            ++mirrored;
+            continue;
+        }
+        /* raised along n to 5 % of the mirror image's distance, nothing else moved */
+        v3 off = v3_sub(a, m);
+        float along = v3_dot(off, n), across = v3_length(v3_sub(off, v3_scale(n, along)));
+        VT_CHECK(fabsf(ha - 0.05f * lm) <= 1e-4f * (1.0f + lm) && across <= 1e-5f * (1.0f + lm) && ha > 0.0f && la > 0.0f,
+                 "trial %d: height %g, want %g; moved across n by %g", trial, ha, 0.05f * lm, across);
+        ++raised;
+    }
+    VT_CHECK(kept > 1000 && mirrored > 1000 && raised > 1000, "cases: %zu kept, %zu mirrored, %zu raised", kept, mirrored,
+             raised);
 }

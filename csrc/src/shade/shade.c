@@ -480,6 +480,7 @@ static void origins_of(const shade_job *j, const receiver *rec, size_t n, ray_or
  * surface would let it pass under an occluder that touches the surface
  * (a low-poly smooth-shaded mesh's lift reaches centimetres). */
 #define VSGL__LIFT_FULL 0.25f
+#define VSGL__RAY_RISE 0.05f /* visibility_rays: a target's least height above the receiver's horizon */
 #define VSGL__LIFT_NONE 0.5f
 static float lift_share(float c)
 {
@@ -519,6 +520,30 @@ static const ray_origins *lift_grazing(const receiver *rec, const ray_origins *o
     return lifted;
 }
 
+/* Where a receiver at x with normal n aims its visibility ray at a
+ * cluster of ray centre c, given its dithered point t of it (ray_targets.h):
+ * t, or for a point below the receiver's horizon, where the kernel sees
+ * the cluster above it (its ray would enter the receiver's own surface: a
+ * sphere's underside and the floor around it, 2 % dark; the kernel's
+ * cosine already counts the part of the cluster that sets), its mirror
+ * image through the centre, raised to VSGL__RAY_RISE of its distance above
+ * the horizon if it is lower. Aimed at the centre where the mirror image
+ * set too, below the horizon as well, the ray entered the receiver's own
+ * surface and took all the cluster's light: a sphere's rim above the
+ * floor behind it lost a quarter of its Gloss until the camera moved the
+ * centre above its horizon (the preview at 80 x 60, pixel (45, 31): 0.91
+ * -> 1.23 in one frame, where Cycles rises smoothly; camera Gloss above
+ * Cycles' motion 0.0236 -> 0.0208, balanced 0.0149 -> 0.0137). */
+v3 vsgl__ray_aim(v3 x, v3 n, v3 c, v3 t)
+{
+    if (v3_dot(n, v3_sub(t, x)) > 0.0f)
+        return t;
+    t = v3_sub(v3_scale(c, 2.0f), t);
+    v3 d = v3_sub(t, x);
+    float h = v3_dot(n, d), rise = VSGL__RAY_RISE * v3_length(d);
+    return h < rise ? v3_add(t, v3_scale(n, rise - h)) : t;
+}
+
 /* Visibility of VSGL `item` (set order; each receiver aims at its own
  * point of the cluster, ray_targets.h) from the receivers k <
  * n <= VSGL__KERNEL_BLOCK whose bit is set in `lanes`: one batched
@@ -556,18 +581,7 @@ static uint64_t visibility_rays(const shade_job *j, size_t item, const vsgl_kern
         for (uint32_t i = 0; i < m; ++i) {
             const receiver *r = &rec[idx[i]];
             const float *p = vsgl__ray_target_for(j->targets, item, org->key[idx[i]]);
-            v3 t = v3_make(p[0], p[1], p[2]);
-            /* a point below the receiver's horizon, where the kernel sees
-             * the cluster above it: its ray would enter the receiver's own
-             * surface (a sphere's underside and the floor around it, 2 %
-             * dark), and the kernel's cosine already counts the part of the
-             * cluster that sets. Its mirror image through the centre, else
-             * the centre. */
-            if (v3_dot(r->n, v3_sub(t, r->x)) <= 0.0f) {
-                t = v3_sub(v3_scale(c, 2.0f), t);
-                if (v3_dot(r->n, v3_sub(t, r->x)) <= 0.0f)
-                    t = c;
-            }
+            v3 t = vsgl__ray_aim(r->x, r->n, c, v3_make(p[0], p[1], p[2]));
             to.x[idx[i]] = t.x;
             to.y[idx[i]] = t.y;
             to.z[idx[i]] = t.z;

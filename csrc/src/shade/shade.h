@@ -91,6 +91,10 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
  * `target` starts: o (x offset off its surface) plus the share of the lift
  * its direction takes (shade.c: near the horizon only). */
 v3 vsgl__lifted_origin(v3 o, v3 x, v3 n, v3 lift, v3 target);
+/* The point a receiver at x (unit normal n) aims its visibility ray at, for
+ * its dithered point t of a cluster whose ray centre is c: never below its
+ * horizon (shade.c). */
+v3 vsgl__ray_aim(v3 x, v3 n, v3 c, v3 t);
 
 /* Glossy light of a planar, Lambertian cluster (the lattice's diffuse
  * VSGLs) through a receiver lobe (ASG, amplitude included), per watt: the
