@@ -33,6 +33,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "quality"))
 sys.path.insert(0, os.path.join(ROOT, "addon"))
 
+import imgutil  # noqa: E402
 import metrics as M  # noqa: E402
 
 PASSES = ("Diff", "Gloss")
@@ -51,17 +52,6 @@ def render_child(scene, config, size, out):
     base = scenes.case(scene, size)
     seq = [rend.render(scenes.animate(base, "camera", f), cfg)[0] for f in range(FRAMES)]
     np.savez(out, **{"%s%d" % (p, f): seq[f][p] for f in range(FRAMES) for p in PASSES})
-
-
-def save_map(path, err):
-    """err (H, W) as a false-colour PNG (blue 0 .. red at its 99.5th
-    percentile), 4x enlarged when small; the scale goes to stdout."""
-    import imgutil
-    vmax = max(float(np.percentile(err, 99.5)), 1e-30)
-    img = imgutil.false_colour(err, vmax)
-    k = max(1, 640 // img.shape[1])
-    imgutil.save_png(path, np.repeat(np.repeat(img, k, 0), k, 1))
-    print("  %s: red = %.4g (99.5th percentile), max %.4g" % (os.path.basename(path), vmax, float(err.max())))
 
 
 def load(path):
@@ -118,8 +108,8 @@ def main():
             for p in PASSES:
                 steps = M.excess_steps([x[p].sum(-1) for x in seq], [x[p].sum(-1) for x in dense])
                 path = os.path.join(a.map, "%s_%s.png" % (scene, p))
-                save_map(path, np.sqrt(sum(d ** 2 for d in steps)))
-                print("  wrote", path)
+                red, top = imgutil.save_error_map(path, np.sqrt(sum(d ** 2 for d in steps)))
+                print("  wrote %s (red = %.4g, the 99.5th percentile; max %.4g)" % (path, red, top))
     return 0
 
 

@@ -107,12 +107,8 @@ def main():
         print("(%d,%d) ours   %s" % (x, y, " ".join("%.3f" % o[y, x].sum() for o in ours)))
     if args.map:
         import imgutil
-        err = np.sqrt(acc)
-        vmax = max(float(np.percentile(err, 99.5)), 1e-30)
-        img = imgutil.false_colour(err, vmax)
-        k = max(1, 640 // img.shape[1])
-        imgutil.save_png(args.map, np.repeat(np.repeat(img, k, 0), k, 1))
-        print("map: blue 0 .. red %.4g (99.5th percentile), max %.4g" % (vmax, float(err.max())))
+        red, top = imgutil.save_error_map(args.map, np.sqrt(acc))
+        print("map: blue 0 .. red %.4g (99.5th percentile), max %.4g" % (red, top))
         print("wrote", args.map)
 
 

@@ -57,6 +57,18 @@ def false_colour(err, vmax):
     return np.stack([np.clip(2 * t - 1, 0, 1), 1 - np.abs(2 * t - 1), np.clip(1 - 2 * t, 0, 1)], -1)
 
 
+def save_error_map(path, err):
+    """A per-pixel error (H, W) as a false-colour PNG, blue 0 .. red at its
+    99.5th percentile, enlarged by whole pixels to about 640 wide. Returns
+    (the red level, the maximum) for the caller to print."""
+    err = np.asarray(err, np.float64)
+    vmax = max(float(np.percentile(err, 99.5)), 1e-30)
+    img = false_colour(err, vmax)
+    k = max(1, 640 // img.shape[1])
+    save_png(path, np.repeat(np.repeat(img, k, 0), k, 1))
+    return vmax, float(err.max())
+
+
 def signed_error(diff, scale):
     """A signed error image: diff * scale (diff: luminance differences), red
     where positive (too bright), blue where negative (too dark), through the
