@@ -45,17 +45,10 @@ static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_sur
     /* shaded with the normal Cycles' BSDF takes: on a smooth-shaded
      * silhouette the interpolated normal can face away from the camera,
      * which left the rim's samples no glossy light (scene_internal.h) */
-    v3 n = vsgl__valid_reflection_normal(sf->geometric_normal, v3_neg(dir), sf->normal), t = sf->tangent;
-    if (n.x != sf->normal.x || n.y != sf->normal.y || n.z != sf->normal.z) {
-        v3 tt = v3_sub(t, v3_scale(n, v3_dot(t, n)));
-        float l = v3_length(tt);
-        if (l > 1e-6f)
-            t = v3_scale(tt, 1.0f / l);
-        else
-            v3_basis(n, &t, &tt);
-    }
-    store3(g->nrm, i, n);
-    store3(g->tan, i, t);
+    vsgl_surface shaded = *sf;
+    vsgl__surface_valid_reflection(&shaded, v3_neg(dir));
+    store3(g->nrm, i, shaded.normal);
+    store3(g->tan, i, shaded.tangent);
     g->material[i] = sf->material;
     if (g->surf[0] && fr)
         store_inputs(j, g, i, sf, org, dir, hit, fr);

@@ -64,6 +64,10 @@ void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, v
  * ng: unit face normal on the camera's side; i: unit direction towards the
  * camera; n: unit shading normal (scene/shading_normal.c). */
 v3 vsgl__valid_reflection_normal(v3 ng, v3 i, v3 n);
+/* sf seen from direction i (unit, towards the viewer) shaded as Cycles'
+ * BSDF nodes shade it: its normal vsgl__valid_reflection_normal, its
+ * tangent made orthogonal to that normal again where it turned. */
+void vsgl__surface_valid_reflection(vsgl_surface *sf, v3 i);
 #if defined(__SSE2__)
 /* The same for four hits (every one a hit), bit for bit (scene/surface4.c). */
 void vsgl__scene_surface4(const vsgl_scene *scene, const vsgl_hit hit[4], const v3 dir[4], vsgl_surface out[4]);

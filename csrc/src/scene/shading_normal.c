@@ -55,3 +55,18 @@ v3 vsgl__valid_reflection_normal(v3 ng, v3 i, v3 n)
         return ng;
     return v3_normalize(v3_add(v3_scale(x, mx), v3_scale(ng, mz)));
 }
+
+void vsgl__surface_valid_reflection(vsgl_surface *sf, v3 i)
+{
+    v3 n = vsgl__valid_reflection_normal(sf->geometric_normal, i, sf->normal), t = sf->tangent;
+    if (n.x == sf->normal.x && n.y == sf->normal.y && n.z == sf->normal.z)
+        return;
+    v3 tt = v3_sub(t, v3_scale(n, v3_dot(t, n)));
+    float l = v3_length(tt);
+    if (l > 1e-6f)
+        t = v3_scale(tt, 1.0f / l);
+    else
+        v3_basis(n, &t, &tt);
+    sf->normal = n;
+    sf->tangent = t;
+}

@@ -480,7 +480,6 @@ static void origins_of(const shade_job *j, const receiver *rec, size_t n, ray_or
  * surface would let it pass under an occluder that touches the surface
  * (a low-poly smooth-shaded mesh's lift reaches centimetres). */
 #define VSGL__LIFT_FULL 0.25f
-#define VSGL__RAY_RISE 0.05f /* visibility_rays: a target's least height above the receiver's horizon */
 #define VSGL__LIFT_NONE 0.5f
 static float lift_share(float c)
 {
@@ -534,6 +533,7 @@ static const ray_origins *lift_grazing(const receiver *rec, const ray_origins *o
  * centre above its horizon (the preview at 80 x 60, pixel (45, 31): 0.91
  * -> 1.23 in one frame, where Cycles rises smoothly; camera Gloss above
  * Cycles' motion 0.0236 -> 0.0208, balanced 0.0149 -> 0.0137). */
+#define VSGL__RAY_RISE 0.05f
 v3 vsgl__ray_aim(v3 x, v3 n, v3 c, v3 t)
 {
     if (v3_dot(n, v3_sub(t, x)) > 0.0f)

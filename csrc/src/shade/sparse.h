@@ -24,9 +24,10 @@
  * degrees a sample on the glossy sphere's rim (alpha 0.09, 5.2 degrees)
  * took the light of an anchor a pixel further inside, whose reflection
  * differed by more than its lobe: pixels lost a fifth of their Gloss for
- * one frame as the camera moved (320 x 240, balanced: camera flicker
- * above a dense render 0.0260 -> 0.0206, 0.0202 shading every pixel;
- * half as tight, 1 x alpha, 0.0230). */
+ * one frame as the camera moved (320 x 240, balanced: Gloss camera
+ * flicker above a dense render 0.0276 -> 0.0206, 0.0202 shading every
+ * pixel; in a build that also shaded samples lacking a second difference,
+ * 0.0260 -> 0.0206 with 0.5 x alpha, 0.0230 with 1 x alpha). */
 #define SPARSE_GLOSSY_TURN 0.5f
 /* ... but never under 0.01 radians (0.6 degrees): a mirror's alpha is
  * 5e-10, whose cosine is 1 in float, and no two normals, not even a flat
