@@ -197,6 +197,9 @@ static void random_block(vt_rng *r, vsgl_kernel_block *b)
                 b->fb[k] = (float)(2.0 * vt_uniform(r));
             }
         }
+        /* convex parts (kernel.h vsgl__part_keep): none, 0 or 1, outside or in */
+        b->part[k] = (float)((int)(3.0 * vt_uniform(r)) - 1);
+        b->pouter[k] = vt_uniform(r) < 0.5 ? 1.0f : 0.0f;
     }
 }
 
@@ -223,6 +226,11 @@ static void random_light(vt_rng *r, vsgl_kernel_light *o, int sharp)
     /* a planar cluster (its normal -z) for half the lights: the planar glossy stage */
     o->planar = vt_uniform(r) < 0.5 ? (vt_uniform(r) < 0.5 ? 1.0f : (float)vt_uniform(r)) : 0.0f;
     o->u1x = 1.0f; o->u2y = 1.0f;
+    /* on convex part 0 or 1 for two thirds of the lights, with shares out and in */
+    int part = (int)(3.0 * vt_uniform(r)) - 1;
+    o->part = part < 0 ? -2.0f : (float)part;
+    o->pout = (float)(0.6 * vt_uniform(r));
+    o->pin = (float)((1.0 - o->pout) * vt_uniform(r));
 }
 
 /* Every ISA copy (AVX-512, AVX2, baseline) and the library's scalar build

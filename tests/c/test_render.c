@@ -321,9 +321,10 @@ VT_TEST(render_refuses_what_exceeds_the_memory_limit_up_front)
     VT_CHECK(r == VSGL_ERROR_OUT_OF_MEMORY, "estimate result %d '%s'", r, msg);
     VT_CHECK(strstr(msg, "render: 48x36 with aa 2 and RSM 256 needs about ") == msg, "'%s'", msg);
     VT_CHECK(strstr(msg, "more than the memory limit of 1.0 MiB (max_memory)") != NULL, "'%s'", msg);
-    /* the parts: 48x36 pixels x 22 output floats; 4 samples x 52 bytes, + 8 for the edge
-     * refinement's weight and normal spread, + a byte of edge mask per pixel; 52 bytes of planes */
-    VT_CHECK(e.output == (uint64_t)W * H * 22 * 4 && e.gbuffer == (uint64_t)W * H * (4 * (52 + 8) + 1) &&
+    /* the parts: 48x36 pixels x 22 output floats; 4 samples x 56 bytes (pos, nrm, view, tan;
+     * material, convex part), + 8 for the edge refinement's weight and normal spread, + a
+     * byte of edge mask per pixel; 52 bytes of planes */
+    VT_CHECK(e.output == (uint64_t)W * H * 22 * 4 && e.gbuffer == (uint64_t)W * H * (4 * (56 + 8) + 1) &&
                  e.planes == (uint64_t)W * H * 52 && e.limit == (1u << 20),
              "output %llu gbuffer %llu planes %llu limit %llu", (unsigned long long)e.output,
              (unsigned long long)e.gbuffer, (unsigned long long)e.planes, (unsigned long long)e.limit);

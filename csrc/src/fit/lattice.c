@@ -82,6 +82,8 @@ typedef struct cell_map {
     double *sums;        /* count * VSGL__GRID_STRIDE */
     double *ext;         /* count * 4: the VPLs' extent in u and v (lattice units) */
     int32_t *cell;       /* count * 3: bin, i, j */
+    uint32_t *part;      /* count: the convex part its shares are of (the smallest seen), VSGL__PART_NONE */
+    double *pw;          /* count * 4: that part's weight outside, inside, for the diffuse then specular lobe */
     size_t sums_cap;
 } cell_map;
 
@@ -151,6 +153,14 @@ static double *map_get(cell_map *m, uint64_t key)
         if (!c)
             return NULL;
         m->cell = c;
+        uint32_t *pt = realloc(m->part, cap * sizeof *pt);
+        if (!pt)
+            return NULL;
+        m->part = pt;
+        double *pw = realloc(m->pw, cap * 4 * sizeof *pw);
+        if (!pw)
+            return NULL;
+        m->pw = pw;
         m->sums_cap = cap;
     }
     m->keys[p] = key;
@@ -160,6 +170,8 @@ static double *map_get(cell_map *m, uint64_t key)
     double *e = m->ext + m->count * 4;
     e[0] = e[2] = INFINITY;
     e[1] = e[3] = -INFINITY;
+    m->part[m->count] = VSGL__PART_NONE;
+    memset(m->pw + m->count * 4, 0, 4 * sizeof *m->pw);
     ++m->count;
     return s;
 }
@@ -171,6 +183,8 @@ static void map_free(cell_map *m)
     free(m->sums);
     free(m->ext);
     free(m->cell);
+    free(m->part);
+    free(m->pw);
     memset(m, 0, sizeof *m);
 }
 
@@ -231,6 +245,27 @@ static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, double n,
     return h > hmin ? h : hmin;
 }
 
+/* A texel on part key `key` (scene_internal.h) with tent weight w and grid
+ * sums m into slot's part shares. A cell keeps the smallest part it has
+ * seen: a cell holding two parts' VPLs (rare: the bins keep surfaces
+ * facing different ways apart, the slabs surfaces at different heights)
+ * drops the light of one of them only. */
+static void add_part(cell_map *map, size_t slot, uint32_t key, double w, const float *m)
+{
+    if (key == VSGL__PART_NONE)
+        return;
+    uint32_t part = key >> 1, inner = key & 1u;
+    double *pw = map->pw + slot * 4;
+    if (map->part[slot] == VSGL__PART_NONE || part < map->part[slot]) {
+        map->part[slot] = part;
+        memset(pw, 0, 4 * sizeof *pw);
+    } else if (part != map->part[slot]) {
+        return;
+    }
+    pw[inner] += w * m[0];
+    pw[2 + inner] += w * m[VSGL__GRID_FIELDS];
+}
+
 /* Every lit texel's moments into the tents of its lattice cells, spacing h. */
 static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl_grid *gp, const double anchor[3],
                               double h, cell_map *out)
@@ -287,6 +322,7 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl
                     cc[0] = (int32_t)bin;
                     cc[1] = (int32_t)fu + du;
                     cc[2] = (int32_t)fv + dv;
+                    add_part(&map, slot, rsm->part ? rsm->part[t] : VSGL__PART_NONE, w, m);
                     double *e = map.ext + slot * 4;
                     double half = 0.5 * sqrt(rsm->area[t] > 0.0f ? (double)rsm->area[t] : 0.0) * inv_h;
                     e[0] = fmin(e[0], q[u] - half);
@@ -394,6 +430,12 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
             vsgl__grid_moments(f, &mo);
             if (vsgl__moments_to_vsgl(&mo, g.origin, s->sharpness_estimator, rsm->light, lobe, &v)) {
                 v.widen = (float)widen;
+                if (map.part[c] != VSGL__PART_NONE) {
+                    const double *pw = map.pw + c * 4 + lobe * 2;
+                    v.part = map.part[c];
+                    v.part_out = (float)fmin(fmax(pw[0] / f[0], 0.0), 1.0);
+                    v.part_in = (float)fmin(fmax(pw[1] / f[0], 0.0), 1.0 - v.part_out);
+                }
                 const int32_t *cc = map.cell + c * 3;
                 const double *e = map.ext + c * 4;
                 int ax = cc[0] >> 1, au = (ax + 1) % 3, av = (ax + 2) % 3;

@@ -172,6 +172,7 @@ int vsgl__moments_to_vsgl(const vsgl_moments *m, v3 origin, int32_t estimator,
     out->coherence = (float)(nl < 1.0 ? nl : 1.0);
     out->normal = nl > 0.0 ? v3_make((float)(nx / nl), (float)(ny / nl), (float)(nz / nl)) : out->axis;
     out->light = light;
+    out->part = VSGL__PART_NONE;
     out->lobe = lobe;
     return 1;
 }

@@ -43,6 +43,14 @@ typedef struct vsgl_vsgl {
      * shadow's edge or a spot's rim where it goes on: the planar glossy
      * model's fold applies there (shade.h, vsgl__planar_glossy). */
     uint32_t cell_ends;
+    /* The convex part (scene_internal.h, VSGL__PART_NONE) most of whose
+     * VPLs lie on it, and the shares of the cluster's weight that lie on
+     * its outside and inside: a receiver on that part keeps 1 - part_out
+     * of the cluster's light, and 1 - part_out - part_in on its outside
+     * (points of a convex surface light each other only inside to inside).
+     * VSGL__PART_NONE (shares 0) for the fits other than the lattice. */
+    uint32_t part;
+    float part_out, part_in;
 } vsgl_vsgl;
 
 /* The lattice's overlap, in units of h^2 (vsgl_vsgl.widen): a sum of the

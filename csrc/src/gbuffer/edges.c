@@ -128,6 +128,8 @@ static void copy_sample(vsgl_gbuffer *dst, size_t to, const vsgl_gbuffer *src, s
         dst->tan[k][to] = src->tan[k][from];
     }
     dst->material[to] = src->material[from];
+    if (dst->part)
+        dst->part[to] = src->part ? src->part[from] : VSGL__PART_NONE;
     /* (the edge rays' buffer has no lift or textured inputs: refine_pixel
      * computes them for the rays it keeps) */
     if (dst->lift[0] && src->lift[0])

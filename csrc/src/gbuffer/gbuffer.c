@@ -50,6 +50,8 @@ static void store_hit(const gb_job *j, vsgl_gbuffer *g, size_t i, const vsgl_sur
     store3(g->nrm, i, shaded.normal);
     store3(g->tan, i, shaded.tangent);
     g->material[i] = sf->material;
+    if (g->part)
+        g->part[i] = sf->part;
     if (g->surf[0] && fr)
         store_inputs(j, g, i, sf, org, dir, hit, fr);
 }
@@ -150,6 +152,8 @@ void vsgl__gbuffer_trace(const gb_job *j, vsgl_gbuffer *g, uint32_t m, const flo
             store3(g->nrm, i, zero);
             store3(g->tan, i, zero);
             g->material[i] = VSGL__GBUFFER_MISS;
+            if (g->part)
+                g->part[i] = VSGL__PART_NONE;
             if (g->lift[0])
                 store3(g->lift, i, zero);
             if (g->surf[0])
@@ -211,6 +215,7 @@ void vsgl__gbuffer_free(vsgl_gbuffer *g)
         free(g->lift[k]);
     }
     free(g->material);
+    free(g->part);
     free(g->weight);
     free(g->spread);
     for (int k = 0; k < VSGL__SURF_N; ++k)
@@ -228,6 +233,7 @@ int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted, i
         ok &= (g->tan[k] = malloc((n + 1) * sizeof(float))) != NULL;
     }
     ok &= (g->material = malloc((n + 1) * sizeof(uint32_t))) != NULL;
+    ok &= (g->part = malloc((n + 1) * sizeof(uint32_t))) != NULL;
     if (weighted) {
         ok &= (g->weight = malloc((n + 1) * sizeof(float))) != NULL;
         ok &= (g->spread = malloc((n + 1) * sizeof(float))) != NULL;

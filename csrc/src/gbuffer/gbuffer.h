@@ -25,6 +25,7 @@ typedef struct vsgl_gbuffer {
     float *tan[3];                 /* unit tangent (anisotropy frame), orthogonal to nrm */
     uint32_t *material;            /* material index, VSGL__GBUFFER_MISS where nothing was hit
                                       (then pos, nrm, tan are 0; view is still set) */
+    uint32_t *part;                /* the convex part key of its surface (vsgl_surface.part); NULL: none */
     float *surf[VSGL__SURF_N];      /* textured scenes only (else NULL): the material inputs at the
                                       sample (scene_internal.h VSGL_SURF_*), textures filtered over the
                                       sample's 1/spp share of its pixel; 0 for misses */

@@ -59,6 +59,8 @@ int vsgl__gbuffer_alloc(vsgl_gbuffer *g, size_t n, int textured, int weighted, i
 static inline void vsgl__gbuffer_clear_slot(vsgl_gbuffer *g, size_t i, size_t like)
 {
     g->material[i] = VSGL__GBUFFER_MISS;
+    if (g->part)
+        g->part[i] = VSGL__PART_NONE;
     for (int k = 0; k < 3; ++k) {
         g->pos[k][i] = g->nrm[k][i] = g->tan[k][i] = 0.0f;
         g->view[k][i] = g->view[k][like];

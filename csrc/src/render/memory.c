@@ -21,9 +21,9 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#define GBUFFER_BYTES_PER_SAMPLE (12u * 4u + 4u)    /* pos, nrm, view, tan; material */
+#define GBUFFER_BYTES_PER_SAMPLE (12u * 4u + 8u)    /* pos, nrm, view, tan; material, part */
 #define PLANE_BYTES_PER_PIXEL (13u * 4u)             /* render.c's accumulation planes */
-#define RSM_BYTES_PER_TEXEL (15u * 4u + 4u + 4u)     /* pos, nrm, tan, wi, flux; material; area */
+#define RSM_BYTES_PER_TEXEL (15u * 4u + 8u + 4u)     /* pos, nrm, tan, wi, flux; material, part; area */
 #define SHADE_BYTES_PER_SAMPLE (8u + 4u + 24u + 16u) /* shade.c's per-row scratch of a worker */
 #define BRUTE_BYTES_PER_SAMPLE (12u * 4u)            /* brute_force's per-sample light/colour */
 #define BRUTE_BYTES_PER_VPL 68u                      /* bf_vpl */

@@ -25,6 +25,7 @@ void vsgl__rsm_free(vsgl_rsm *r)
         free(r->flux[k]);
     }
     free(r->material);
+    free(r->part);
     free(r->area);
     for (int k = 0; k < VSGL__SURF_N; ++k)
         free(r->surf[k]);
@@ -71,6 +72,8 @@ void vsgl__rsm_clear_texel(vsgl_rsm *o, size_t i)
     for (int k = 0; k < 3; ++k)
         o->pos[k][i] = o->nrm[k][i] = o->tan[k][i] = o->wi[k][i] = o->flux[k][i] = 0.0f;
     o->material[i] = VSGL__RSM_EMPTY;
+    if (o->part)
+        o->part[i] = VSGL__PART_NONE;
     o->area[i] = 0.0f;
     if (o->surf[0])
         for (int q = 0; q < VSGL__SURF_N; ++q)
@@ -93,6 +96,8 @@ void vsgl__rsm_fill_texel(const vsgl_scene *scene, vsgl_rsm *o, size_t i, const 
     for (int k = 0; k < 3; ++k)
         o->flux[k][i] = (float)flux[k];
     o->material[i] = sf.material;
+    if (o->part)
+        o->part[i] = sf.part;
     if (o->surf[0]) {
         float in[VSGL__SURF_N];
         vsgl__scene_inputs(scene, hit, o->area[i], in);
@@ -180,6 +185,7 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene *scene, uint32_t li
         ok &= (out->flux[k] = malloc(n * sizeof(float))) != NULL;
     }
     ok &= (out->material = malloc(n * sizeof(uint32_t))) != NULL;
+    ok &= (out->part = malloc(n * sizeof(uint32_t))) != NULL;
     ok &= (out->area = malloc(n * sizeof(float))) != NULL;
     if (vsgl__scene_textured(scene))
         for (int k = 0; k < VSGL__SURF_N; ++k)

@@ -29,6 +29,7 @@ typedef struct vsgl_rsm {
     float *wi[3];                  /* unit direction from the VPL towards the light */
     float *flux[3];                /* incident power on the texel's patch, W (RGB) */
     uint32_t *material;            /* VSGL__RSM_EMPTY where the texel saw nothing */
+    uint32_t *part;                /* the convex part key of its surface (vsgl_surface.part); NULL: none */
     double total_flux[3];          /* sum of flux */
     float *surf[VSGL__SURF_N];      /* textured scenes only (else NULL): the material inputs at the VPL
                                       (VSGL_SURF_*), textures filtered over the texel's patch */

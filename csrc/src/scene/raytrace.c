@@ -223,10 +223,12 @@ void vsgl__scene_surface(const vsgl_scene *scene, const vsgl_hit *hit, v3 dir, v
     if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f)
         n = ng; /* opposite corner normals cancelled: fall back to the face */
     /* back-facing: flip both to the side the ray came from (as Cycles does) */
-    if (v3_dot(ng, dir) > 0.0f) {
+    int back = v3_dot(ng, dir) > 0.0f;
+    if (back) {
         ng = v3_neg(ng);
         n = v3_neg(n);
     }
+    out->part = vsgl__scene_part_key(scene, tri, back);
     out->normal = n;
     out->geometric_normal = ng;
 

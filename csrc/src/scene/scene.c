@@ -58,6 +58,8 @@ void vsgl_scene_destroy(vsgl_scene *s)
     free(s->corner_colors);
     free(s->uv_density);
     free(s->occ_boxes);
+    free(s->tri_part);
+    free(s->tri_side);
     free(s);
 }
 
@@ -294,7 +296,9 @@ static vsgl_result build(vsgl_context *ctx, const vsgl_scene_desc *d, vsgl_scene
         return r;
     s->vertex_count = d->vertex_count;
     s->convex_shell = vsgl__scene_test_convex_shell(s); /* geometry never changes after this */
-    r = vsgl__scene_build_occluders(ctx, s);
+    r = vsgl__scene_build_parts(ctx, s);
+    if (r == VSGL_OK)
+        r = vsgl__scene_build_occluders(ctx, s);
     if (r != VSGL_OK)
         return r;
     rtcCommitScene(s->rtc);

@@ -45,6 +45,10 @@ struct vsgl_scene {
     float *occ_boxes;            /* occ_count * 6 (lo xyz, hi xyz), padded; NULL when occ_count is 0 */
     float occ_union[6];          /* the boxes' union */
     int convex_shell;            /* vsgl__scene_convex_shell, decided once when the scene is built */
+    uint32_t *tri_part;          /* triangle_count: its convex part (scene/convex.c), VSGL__PART_NONE if none */
+    signed char *tri_side;       /* triangle_count: +1 / -1: the face normal / its opposite points out of the
+                                  * part; 0: the part is flat (no inside) */
+    uint32_t part_count;         /* convex parts found */
     uint64_t identity;           /* creation time (CLOCK_MONOTONIC ns): with the address, tells this scene's
                                     geometry and materials from a destroyed one's at the same address;
                                     kept by vsgl_scene_set_view (render caches key on both) */
@@ -61,6 +65,21 @@ void vsgl__scene_desc_normalise(const vsgl_scene_desc *in, vsgl_scene_desc *out)
 vsgl_result vsgl__validate_camera(vsgl_context *ctx, const vsgl_camera *c);
 vsgl_result vsgl__validate_light(vsgl_context *ctx, uint32_t index, const vsgl_light *l);
 vsgl_result vsgl__validate_material(vsgl_context *ctx, uint32_t index, const vsgl_material *m);
+
+/* The convex parts (scene/convex.c), once the triangles are set. */
+vsgl_result vsgl__scene_build_parts(vsgl_context *ctx, vsgl_scene *s);
+/* The part key of a point on triangle tri seen from its back (back = 1:
+ * the ray met the face against its normal's side) or front. */
+static inline uint32_t vsgl__scene_part_key(const vsgl_scene *s, uint32_t tri, int back)
+{
+    uint32_t part = s->tri_part ? s->tri_part[tri] : VSGL__PART_NONE;
+    if (part == VSGL__PART_NONE)
+        return VSGL__PART_NONE;
+    int side = s->tri_side[tri];
+    /* seen from the side the face normal x side points to: the outside */
+    int inner = side != 0 && ((side > 0) == (back != 0));
+    return 2u * part + (uint32_t)inner;
+}
 
 /* Affine 3x4 row-major matrix checks. Returns NULL if fine, else a static reason. */
 const char *vsgl__matrix_problem(const float m[12]);

@@ -21,6 +21,7 @@ typedef struct vsgl_surface {
     v3 geometric_normal; /* unit face normal, same side as `normal` */
     v3 tangent;          /* unit, orthogonal to normal, anisotropic rotation applied */
     uint32_t material;   /* index into the scene's materials */
+    uint32_t part;       /* convex part key (vsgl__scene_part_key below), VSGL__PART_NONE if none */
 } vsgl_surface;
 
 /* Closest hit along org + t*dir for t in (tmin, tmax); dir unit. Returns 1 on hit. Thread-safe. */
@@ -126,5 +127,20 @@ int vsgl__scene_segment_clear(const vsgl_scene *scene, v3 a, v3 b);
 int vsgl__scene_convex_shell(const vsgl_scene *scene);
 /* The test itself (up to triangles x vertices): run once by the scene's build. */
 int vsgl__scene_test_convex_shell(const vsgl_scene *scene);
+
+/* Convex parts (scene/convex.c). A part is a connected set of triangles
+ * (sharing vertices or vertex positions) every one of whose planes has all
+ * of the part's vertices on one side: a sphere, a box, a plane, a room's
+ * closed shell. Two points on the outside of a convex surface each lie
+ * behind the other's tangent plane, so they exchange no light; a point on
+ * the inside and one on the outside neither; two points on the inside
+ * (a closed room seen from within) do. A flat part has no inside: its
+ * points never light each other. A surface point's key is 2 part + inner
+ * (inner: 1 on the part's inside); the shading drops the light a cluster
+ * sends from a part to the same part's receivers except inside to inside
+ * (fit/vsgl_set.h, vsgl_vsgl.part). */
+#define VSGL__PART_NONE 0xFFFFFFFFu
+/* The number of convex parts found when the scene was built. */
+uint32_t vsgl__scene_part_count(const vsgl_scene *scene);
 
 #endif

@@ -136,6 +136,7 @@ void vsgl__scene_surface4(const vsgl_scene *scene, const vsgl_hit hit[4], const 
         t.y = select4(from_edge, t.y, tu.y);
         t.z = select4(from_edge, t.z, tu.z);
     }
+    const unsigned back = (unsigned)_mm_movemask_ps(flip);
     const unsigned scalar = (unsigned)_mm_movemask_ps(is_zero4(t)); /* v3_basis: the scalar function */
     float f[12][4];
     _mm_storeu_ps(f[0], pos.x), _mm_storeu_ps(f[1], pos.y), _mm_storeu_ps(f[2], pos.z);
@@ -153,6 +154,7 @@ void vsgl__scene_surface4(const vsgl_scene *scene, const vsgl_hit hit[4], const 
         out[k].geometric_normal = v3_make(f[6][k], f[7][k], f[8][k]);
         out[k].tangent = v3_make(f[9][k], f[10][k], f[11][k]);
         out[k].material = mat;
+        out[k].part = vsgl__scene_part_key(scene, tri[k], (int)(back >> k & 1u));
     }
 }
 #endif

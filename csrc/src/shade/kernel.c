@@ -44,7 +44,7 @@ static inline float pair_weight(const vsgl_kernel_block *b, const vsgl_kernel_li
                        b->mu[k] * gy * gy / (1.0f + b->mu[k] * spread));
     }
     float df = b->diffuse[k] * ((cr > 0.0f ? cr : 0.0f) + 0.05f) * (1.0f / 3.14159265f);
-    return pw * rough_exp(L->lv * (ce - 1.0f)) * (df + gl) / (d2 + L->var);
+    return pw * vsgl__part_keep(b, k, L) * rough_exp(L->lv * (ce - 1.0f)) * (df + gl) / (d2 + L->var);
 }
 
 KERNEL_ATTR void vsgl__kernel_pair_weights(const vsgl_kernel_block *b, const vsgl_kernel_light *lights,

@@ -228,6 +228,9 @@ typedef struct vsgl_kernel_block {
     float nx[VSGL__KERNEL_BLOCK], ny[VSGL__KERNEL_BLOCK], nz[VSGL__KERNEL_BLOCK];
     float ox[VSGL__KERNEL_BLOCK], oy[VSGL__KERNEL_BLOCK], oz[VSGL__KERNEL_BLOCK];
     float diffuse[VSGL__KERNEL_BLOCK];   /* 1 if the diffuse lobe is shaded, else 0 */
+    /* its convex part (scene_internal.h) as a float, -1 if none, and 1 on
+     * the part's outside, 0 inside (vsgl__part_keep) */
+    float part[VSGL__KERNEL_BLOCK], pouter[VSGL__KERNEL_BLOCK];
     /* warped NDF lobe: ASG frame (X, Y, Z), bandwidths, linear amplitude */
     float Xx[VSGL__KERNEL_BLOCK], Xy[VSGL__KERNEL_BLOCK], Xz[VSGL__KERNEL_BLOCK];
     float Yx[VSGL__KERNEL_BLOCK], Yy[VSGL__KERNEL_BLOCK], Yz[VSGL__KERNEL_BLOCK];
@@ -282,8 +285,20 @@ typedef struct vsgl_kernel_light {
     float fs[2];  /* per axis, the mean the images are built on (shade.c, fold_mean) from the mean, same units */
     float tilt;   /* the planar model's horizon share and tilt, vsgl__planar_tilt_weight (0: none) */
     uint32_t tdir; /* where tilt > 0: the block's table of the axis its normal is (VSGL__TILT_DIRS: 2 axis + side) */
+    /* the cluster's convex part (vsgl_vsgl.part) as a float, -2 if none or
+     * the leak correction is off, and its shares outside and inside */
+    float part, pout, pin;
     float freach; /* (sqrt(50) + 2 |farthest cut| + |fs|)^2 / 2: where the fold can matter (k_shade) */
 } vsgl_kernel_light;
+
+/* The share of VSGL L's light that lane i of block b receives by the
+ * convex parts (fit/vsgl_set.h, vsgl_vsgl.part): a receiver on the
+ * cluster's part gets none of what the cluster sends from its outside,
+ * and none from its inside unless it is inside too. */
+static inline float vsgl__part_keep(const vsgl_kernel_block *b, size_t i, const vsgl_kernel_light *L)
+{
+    return b->part[i] == L->part ? 1.0f - L->pout - b->pouter[i] * L->pin : 1.0f;
+}
 
 /* The planar model's receiver horizon (shade.h, vsgl__planar_glossy): where
  * the lobe's axis is within asin(HI) of the receiver's tangent plane, its

@@ -277,7 +277,7 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
         float w = wn * L->conv;
         e *= (1.0f - w) + w * rho;
     }
-    float valid = (d2 > 0.0f ? 1.0f : L->valid) * vis;
+    float valid = (d2 > 0.0f ? 1.0f : L->valid) * vis * vsgl__part_keep(b, i, L);
     t->vis[i] = valid;
     t->amp[i] = valid * L->c0 * (1.0f - L->clip * (1.0f - e));
 }

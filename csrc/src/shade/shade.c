@@ -61,6 +61,13 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
     return 1;
 }
 
+float vsgl__vsgl_part_keep(const vsgl_vsgl *v, uint32_t part)
+{
+    if (v->part == VSGL__PART_NONE || part == VSGL__PART_NONE || part >> 1 != v->part)
+        return 1.0f;
+    return fmaxf(1.0f - v->part_out - ((part & 1u) ? 0.0f : v->part_in), 0.0f);
+}
+
 float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
 {
     if (!on)
@@ -393,6 +400,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->o = v3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
     r->lift = g->lift[0] ? v3_make(g->lift[0][i], g->lift[1][i], g->lift[2][i]) : v3_make(0.0f, 0.0f, 0.0f);
     r->key = vsgl__hash32((uint32_t)i ^ vsgl__hash32((uint32_t)((uint64_t)i >> 32)));
+    r->part = g->part ? g->part[i] : VSGL__PART_NONE;
     sample_params(j, i, &r->bp);
     if (g->spread && g->spread[i] < 1.0f)
         widen_by_spread(&r->bp, g->spread[i]);
@@ -711,7 +719,8 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 if (!vsgl__vsgl_incident_sg(v, r.x, &in))
                     continue;
                 if (j->leak)
-                    in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1), VSGL__TINY));
+                    in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1) *
+                                                   vsgl__vsgl_part_keep(v, r.part), VSGL__TINY));
                 if (j->s->visibility == VSGL_VISIBILITY_RAY) {
                     if (!visible_from(j, v, &r))
                         continue;
@@ -755,6 +764,13 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
 }
 
 
+/* A lane's fields of a convex part key (scene_internal.h; kernel.h vsgl__part_keep). */
+static void part_lane(uint32_t key, float *part, float *outer)
+{
+    *part = key == VSGL__PART_NONE ? -1.0f : (float)(key >> 1);
+    *outer = key == VSGL__PART_NONE ? 0.0f : (float)(1u - (key & 1u));
+}
+
 /* Lane `k` of a kernel block as a receiver at (x, y, z) with no lobe: finite
  * everywhere, contributes nothing (misses, and the padding of a last block). */
 static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z)
@@ -765,6 +781,8 @@ static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z
     b->ox[k] = b->oy[k] = 0.0f;
     b->oz[k] = 1.0f;
     b->diffuse[k] = 0.0f;
+    b->part[k] = -1.0f;
+    b->pouter[k] = 0.0f;
     b->Xx[k] = 1.0f; b->Xy[k] = b->Xz[k] = 0.0f;
     b->Yy[k] = 1.0f; b->Yx[k] = b->Yz[k] = 0.0f;
     b->Zz[k] = 1.0f; b->Zx[k] = b->Zy[k] = 0.0f;
@@ -780,6 +798,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
 {
     if (j->g->material[i] == VSGL__GBUFFER_MISS) {
         memset(r, 0, sizeof *r);
+        r->part = VSGL__PART_NONE;
         clear_lane(b, k, 0.0f, 0.0f, 0.0f);
         return 0;
     }
@@ -787,6 +806,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     b->x[k] = r->x.x; b->y[k] = r->x.y; b->z[k] = r->x.z;
     b->nx[k] = r->n.x; b->ny[k] = r->n.y; b->nz[k] = r->n.z;
     b->ox[k] = r->o.x; b->oy[k] = r->o.y; b->oz[k] = r->o.z;
+    part_lane(r->part, &b->part[k], &b->pouter[k]);
     b->diffuse[k] = r->bp.diffuse[0] + r->bp.diffuse[1] + r->bp.diffuse[2] > 0.0f ? 1.0f : 0.0f;
     /* VSGL_GLOSSY_MRP replaces the glossy plane (mrp/pass.c): the kernel
      * skips the glossy lobe of lanes with camp 0 */
@@ -855,6 +875,7 @@ static void lane_get(const vsgl_kernel_block *b, size_t k, const receiver *r, vs
     o->lift[1] = r->lift.y;
     o->lift[2] = r->lift.z;
     o->key = r->key;
+    o->part = r->part;
     float *v = o->v;
     *v++ = b->x[k]; *v++ = b->y[k]; *v++ = b->z[k];
     *v++ = b->nx[k]; *v++ = b->ny[k]; *v++ = b->nz[k];
@@ -876,6 +897,7 @@ static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, r
     r->n = v3_make(o->v[3], o->v[4], o->v[5]);
     r->lift = v3_make(o->lift[0], o->lift[1], o->lift[2]);
     r->key = o->key;
+    r->part = o->part;
     const float *v = o->v;
     b->x[k] = *v++; b->y[k] = *v++; b->z[k] = *v++;
     b->nx[k] = *v++; b->ny[k] = *v++; b->nz[k] = *v++;
@@ -887,6 +909,7 @@ static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, r
     b->lam[k] = *v++; b->mu[k] = *v++; b->camp[k] = *v++; b->alpha[k] = *v++;
     b->f0r[k] = *v++; b->f0g[k] = *v++; b->f0b[k] = *v++;
     b->fe[k] = *v++; b->fa[k] = *v++; b->fb[k] = *v;
+    part_lane(o->part, &b->part[k], &b->pouter[k]);
 }
 
 /* The far-field diffuse light per watt of VSGL v at (x, n), as the kernel
@@ -916,7 +939,8 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
         if (!(w > 0.0f))
             continue;
         const vsgl_vsgl *v = &j->set->items[cell->vsgl];
-        float e = w * (q - far_diffuse(j, v, r->x, r->n));
+        /* the kernel's far field took the part's share (vsgl__part_keep): so does the near field */
+        float e = w * (q - far_diffuse(j, v, r->x, r->n)) * (j->leak ? vsgl__vsgl_part_keep(v, r->part) : 1.0f);
         if (e == 0.0f)
             continue;
         if (j->s->visibility == VSGL_VISIBILITY_RAY) {
@@ -1347,6 +1371,9 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             o->pr = v->power[0]; o->pg = v->power[1]; o->pb = v->power[2];
             o->nx = v->normal.x; o->ny = v->normal.y; o->nz = v->normal.z;
             o->clip = leak ? v->coherence * v->coherence : 0.0f;
+            o->part = leak && v->part != VSGL__PART_NONE ? (float)v->part : -2.0f;
+            o->pout = v->part_out;
+            o->pin = v->part_in;
             o->conv = v->lobe == VSGL__LOBE_DIFFUSE ? 1.0f : 0.0f;
             o->fore = vsgl__foreshortening_weight(v);
             o->ibehind = 1.0f / (VSGL__CLIP_BEHIND * sqrtf(v->variance) + VSGL__TINY);

@@ -87,6 +87,10 @@ float vsgl__foreshortening_weight(const vsgl_vsgl *v);
  * (the kernel computes the same inline); `on` selects the clip. */
 float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on);
 
+/* The share of v's light a receiver on convex part key `part` gets
+ * (vsgl_vsgl.part; the kernel's vsgl__part_keep), in [0, 1]. */
+float vsgl__vsgl_part_keep(const vsgl_vsgl *v, uint32_t part);
+
 /* Where a visibility ray from receiver x (normal n, lift: gbuffer.h) to
  * `target` starts: o (x offset off its surface) plus the share of the lift
  * its direction takes (shade.c: near the horizon only). */

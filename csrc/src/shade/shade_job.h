@@ -19,6 +19,7 @@ typedef struct vsgl__plan_lane {
     float v[29];
     float lift[3];
     uint32_t key;
+    uint32_t part;     /* the receiver's convex part key (scene_internal.h) */
 } vsgl__plan_lane;
 
 /* A shading plan (shade_stride > 1): what shading a G-buffer needs that no
@@ -111,6 +112,7 @@ typedef struct receiver {
     v3 x, n, o;
     v3 lift;             /* visibility rays start at x + lift (gbuffer.h lift) */
     uint32_t key;        /* picks its visibility rays' points (ray_targets.h): a hash of its G-buffer sample */
+    uint32_t part;       /* its convex part key (scene_internal.h) */
     vsgl_brdf_params bp;
     float alpha;
     int glossy;
