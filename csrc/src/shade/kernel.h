@@ -295,9 +295,12 @@ typedef struct vsgl_kernel_light {
  * convex parts (fit/vsgl_set.h, vsgl_vsgl.part): a receiver on the
  * cluster's part gets none of what the cluster sends from its outside,
  * and none from its inside unless it is inside too. */
-static inline float vsgl__part_keep(const vsgl_kernel_block *b, size_t i, const vsgl_kernel_light *L)
+static inline __attribute__((always_inline)) float vsgl__part_keep(const vsgl_kernel_block *b, size_t i, const vsgl_kernel_light *L)
 {
-    return b->part[i] == L->part ? 1.0f - L->pout - b->pouter[i] * L->pin : 1.0f;
+    /* branch-free: as a select of two expressions the kernel's loop took
+     * 1.65x the time (the sun room, balanced without rays, 960 x 540) */
+    float same = b->part[i] == L->part ? 1.0f : 0.0f;
+    return 1.0f - same * (L->pout + b->pouter[i] * L->pin);
 }
 
 /* The planar model's receiver horizon (shade.h, vsgl__planar_glossy): where
