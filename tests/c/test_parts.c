@@ -83,6 +83,32 @@ static void mesh_sphere(mesh *m, float cx, float cy, float cz, float r, int seg,
         }
 }
 
+/* Corner normals for triangles [first, m->nt): radial about (cx, cy, cz)
+ * (a smooth-shaded sphere), the face normal elsewhere. malloc'd, nt * 9. */
+static float *mesh_normals(const mesh *m, uint32_t first, float cx, float cy, float cz)
+{
+    float *cn = malloc((size_t)m->nt * 9 * sizeof *cn);
+    if (!cn)
+        return NULL;
+    for (uint32_t t = 0; t < m->nt; ++t) {
+        const float *p[3];
+        for (int k = 0; k < 3; ++k)
+            p[k] = m->pos + 3 * m->idx[3 * t + k];
+        float e1[3], e2[3];
+        for (int a = 0; a < 3; ++a)
+            e1[a] = p[1][a] - p[0][a], e2[a] = p[2][a] - p[0][a];
+        float fn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        for (int k = 0; k < 3; ++k) {
+            float n[3] = {p[k][0] - cx, p[k][1] - cy, p[k][2] - cz};
+            const float *src = t >= first ? n : fn;
+            float l = sqrtf(src[0] * src[0] + src[1] * src[1] + src[2] * src[2]);
+            for (int a = 0; a < 3; ++a)
+                cn[9 * t + 3 * k + a] = src[a] / l;
+        }
+    }
+    return cn;
+}
+
 static void mesh_free(mesh *m)
 {
     free(m->pos), free(m->idx), free(m->mat);
@@ -197,16 +223,8 @@ VT_TEST(render_a_convex_object_alone_receives_no_indirect_light)
     fx_spot(&fx, eye, at, 200.0f, 1.0f, 0.2f);
     const float ceye[3] = {-0.3f, -2.6f, 1.1f}, cat[3] = {0.0f, 0.0f, 0.8f};
     fx_camera(&fx, ceye, cat, 40.0f, 48, 36);
-    /* smooth normals: the sphere's own, radial */
-    float *cn = malloc((size_t)m.nt * 9 * sizeof *cn);
+    float *cn = mesh_normals(&m, 0, 0.0f, 0.0f, 0.8f); /* smooth: radial */
     VT_REQUIRE(cn, "memory");
-    for (uint32_t t = 0; t < m.nt; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const float *p = m.pos + 3 * m.idx[3 * t + k];
-            float n[3] = {p[0], p[1], p[2] - 0.8f}, l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            for (int a = 0; a < 3; ++a)
-                cn[9 * t + 3 * k + a] = n[a] / l;
-        }
     fx_desc(&fx);
     fx.desc.vertex_count = m.nv;
     fx.desc.positions = m.pos;
@@ -247,10 +265,58 @@ VT_TEST(render_a_convex_object_alone_receives_no_indirect_light)
     vsgl_context_destroy(ctx);
 }
 
+/* lattice_clusters_carry_their_parts_shares for the room and sphere of m,
+ * the sphere smooth-shaded where cn is given. */
+static void check_lattice_parts(vsgl_context *ctx, fx_scene *fx, const mesh *m, const float *cn)
+{
+    fx_desc(fx);
+    fx->desc.vertex_count = m->nv;
+    fx->desc.positions = m->pos;
+    fx->desc.triangle_count = m->nt;
+    fx->desc.indices = m->idx;
+    fx->desc.material_indices = m->mat;
+    fx->desc.corner_normals = cn;
+    vsgl_scene *scene = NULL;
+    VT_REQUIRE(vsgl_scene_create(ctx, &fx->desc, &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    const int smooth = cn != NULL;
+    VT_CHECK(vsgl__scene_part_count(scene) == 2, "parts: %u, want 2 (the room, the sphere)",
+             vsgl__scene_part_count(scene));
+    VT_CHECK(!vsgl__scene_part_curved(scene, 0) && vsgl__scene_part_curved(scene, 1) == smooth,
+             "curved: room %d, sphere %d (smooth %d)", vsgl__scene_part_curved(scene, 0),
+             vsgl__scene_part_curved(scene, 1), smooth);
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    vsgl_rsm rsm;
+    VT_REQUIRE(vsgl__rsm_build(ctx, scene, 0, 128, &rsm) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    vsgl_vsgl_set set = {0};
+    VT_REQUIRE(vsgl__fit_lattice(ctx, scene, &rsm, &s, &set) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    int room = 0, sphere = 0, other = 0;
+    float h_room = 0.0f, h_sphere = 0.0f;
+    for (size_t k = 0; k < set.count; ++k) {
+        const vsgl_vsgl *v = &set.items[k];
+        if (v->part == 0 && v->part_out == 0.0f && v->part_in > 0.999f)
+            ++room, h_room = v->cell_h;
+        else if (v->part == 1 && v->part_out > 0.999f && v->part_in == 0.0f)
+            ++sphere, h_sphere = v->cell_h;
+        else
+            ++other;
+    }
+    VT_CHECK(room > 0 && sphere > 0 && other == 0, "smooth %d: clusters: room %d, sphere %d, neither %d", smooth,
+             room, sphere, other);
+    float want = smooth ? (float)(VSGL__LATTICE_CURVED * h_room) : h_room;
+    VT_CHECK(fabsf(h_sphere - want) <= 1e-5f * h_room, "smooth %d: spacing room %g, sphere %g, want %g", smooth,
+             h_room, h_sphere, want);
+    vsgl__vsgl_set_free(&set);
+    vsgl__rsm_free(&rsm);
+    vsgl_scene_destroy(scene);
+}
+
 /* The fit's part shares: in the fixture's open box (one convex part, lit
  * and seen from inside) every cluster is all inside, so nothing of the
  * room's own light is dropped; a sphere standing in it has clusters all
- * outside. */
+ * outside. A smooth-shaded sphere is a curved part and takes the finer
+ * lattice (VSGL__LATTICE_CURVED x the room's spacing); flat-shaded, the
+ * room's. */
 VT_TEST(lattice_clusters_carry_their_parts_shares)
 {
     vsgl_context *ctx = fx_context(1);
@@ -266,31 +332,13 @@ VT_TEST(lattice_clusters_carry_their_parts_shares)
         }
         mesh_tri(&m, v[0], v[1], v[2], fx.material_indices[t]);
     }
+    uint32_t first = m.nt;
     mesh_sphere(&m, -0.5f, -0.1f, 0.4f, 0.3f, 32, 16, 0, 3);
-    vsgl_scene *scene = mesh_scene(ctx, &m, &fx);
-    VT_REQUIRE(scene, "%s", vsgl_context_last_error(ctx));
-    VT_CHECK(vsgl__scene_part_count(scene) == 2, "parts: %u, want 2 (the room, the sphere)",
-             vsgl__scene_part_count(scene));
-    vsgl_render_settings s;
-    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
-    vsgl_rsm rsm;
-    VT_REQUIRE(vsgl__rsm_build(ctx, scene, 0, 128, &rsm) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
-    vsgl_vsgl_set set = {0};
-    VT_REQUIRE(vsgl__fit_lattice(ctx, scene, &rsm, &s, &set) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
-    int room = 0, sphere = 0, other = 0;
-    for (size_t k = 0; k < set.count; ++k) {
-        const vsgl_vsgl *v = &set.items[k];
-        if (v->part == 0 && v->part_out == 0.0f && v->part_in > 0.999f)
-            ++room;
-        else if (v->part == 1 && v->part_out > 0.999f && v->part_in == 0.0f)
-            ++sphere;
-        else
-            ++other;
-    }
-    VT_CHECK(room > 0 && sphere > 0 && other == 0, "clusters: room %d, sphere %d, neither %d", room, sphere, other);
-    vsgl__vsgl_set_free(&set);
-    vsgl__rsm_free(&rsm);
-    vsgl_scene_destroy(scene);
+    float *cn = mesh_normals(&m, first, -0.5f, -0.1f, 0.4f);
+    VT_REQUIRE(cn, "memory");
+    for (int smooth = 0; smooth < 2; ++smooth)
+        check_lattice_parts(ctx, &fx, &m, smooth ? cn : NULL);
+    free(cn);
     mesh_free(&m);
     vsgl_context_destroy(ctx);
 }

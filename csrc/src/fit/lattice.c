@@ -87,11 +87,15 @@ typedef struct cell_map {
     size_t sums_cap;
 } cell_map;
 
+/* Bit 3 of a cell's bin: the fine lattice of a curved part's outside
+ * (VSGL__LATTICE_CURVED). */
+#define VSGL__BIN_FINE 8u
+
 static uint64_t pack_key(uint32_t bin, int32_t k, int32_t i, int32_t j)
 {
-    /* 3 bits of bin + 1, three 20-bit biased coordinates */
+    /* bit 63: the fine lattice; 3 bits of bin + 1; three 20-bit biased coordinates */
     const int32_t bias = 1 << 19;
-    return ((uint64_t)(bin + 1) << 60) | ((uint64_t)(uint32_t)(k + bias) << 40) |
+    return ((uint64_t)(bin >> 3) << 63) | ((uint64_t)((bin & 7u) + 1) << 60) | ((uint64_t)(uint32_t)(k + bias) << 40) |
            ((uint64_t)(uint32_t)(i + bias) << 20) | (uint64_t)(uint32_t)(j + bias);
 }
 
@@ -215,7 +219,8 @@ static vsgl_result split_specular(vsgl_vsgl *v, vsgl_vsgl_set *out)
 }
 
 /* The lattice spacing for about n clusters over the light's lit area. */
-static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, double n, double extent)
+/* texel: the typical texel size, for the fine lattice's floor (NULL: not wanted). */
+static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, double n, double extent, double *texel_out)
 {
     double sw = 0.0, sw2a = 0.0, swa = 0.0;
     size_t per_face = (size_t)rsm->res * rsm->res;
@@ -237,6 +242,8 @@ static double lattice_spacing(const vsgl_rsm *rsm, const vsgl_grid *g, double n,
     double h = sqrt(area / (n >= 1.0 ? n : 1.0));
     /* a cluster should hold a few texels: h >= 1.5 x the typical texel size */
     double texel = sqrt(swa / sw);
+    if (texel_out)
+        *texel_out = texel;
     if (h < 1.5 * texel)
         h = 1.5 * texel;
 
@@ -266,14 +273,15 @@ static void add_part(cell_map *map, size_t slot, uint32_t key, double w, const f
     pw[2 + inner] += w * m[VSGL__GRID_FIELDS];
 }
 
-/* Every lit texel's moments into the tents of its lattice cells, spacing h. */
-static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl_grid *gp, const double anchor[3],
-                              double h, cell_map *out)
+/* Every lit texel's moments into the tents of its lattice cells, spacing h
+ * (h_fine on a curved part's outside, VSGL__LATTICE_CURVED). */
+static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_rsm *rsm, const vsgl_grid *gp,
+                              const double anchor[3], double h, double h_fine, cell_map *out)
 {
     const vsgl_grid g = *gp;
     cell_map map;
     memset(&map, 0, sizeof map);
-    double inv_h = 1.0 / h;
+    const double inv_coarse = 1.0 / h, inv_fine = 1.0 / h_fine;
     vsgl_result r = VSGL_OK;
     size_t per_face = (size_t)rsm->res * rsm->res;
     /* Sequential in texel order: the sums and the VSGLs' order are the same
@@ -286,6 +294,10 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl
             continue;
         const double p[3] = {rsm->pos[0][t], rsm->pos[1][t], rsm->pos[2][t]};
         const double nrm[3] = {rsm->nrm[0][t], rsm->nrm[1][t], rsm->nrm[2][t]};
+        const uint32_t key = rsm->part ? rsm->part[t] : VSGL__PART_NONE;
+        const uint32_t fine = key != VSGL__PART_NONE && !(key & 1u) && vsgl__scene_part_curved(scene, key >> 1)
+                                  ? VSGL__BIN_FINE : 0u;
+        const double inv_h = fine ? inv_fine : inv_coarse;
         double q[3];
         for (int a = 0; a < 3; ++a)
             q[a] = (p[a] - anchor[a]) * inv_h;
@@ -310,7 +322,7 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl
                     double w = wb * (du ? tu : 1.0 - tu) * (dv ? tv : 1.0 - tv);
                     if (!(w > 0.0))
                         continue;
-                    double *dst = map_get(&map, pack_key(bin, k, (int32_t)fu + du, (int32_t)fv + dv));
+                    double *dst = map_get(&map, pack_key(bin | fine, k, (int32_t)fu + du, (int32_t)fv + dv));
                     if (!dst) {
                         r = vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "fit: out of memory for the lattice clusters");
                         break;
@@ -319,10 +331,10 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_rsm *rsm, const vsgl
                         dst[f] += w * m[f];
                     size_t slot = (size_t)(dst - map.sums) / VSGL__GRID_STRIDE;
                     int32_t *cc = map.cell + slot * 3;
-                    cc[0] = (int32_t)bin;
+                    cc[0] = (int32_t)(bin | fine);
                     cc[1] = (int32_t)fu + du;
                     cc[2] = (int32_t)fv + dv;
-                    add_part(&map, slot, rsm->part ? rsm->part[t] : VSGL__PART_NONE, w, m);
+                    add_part(&map, slot, key, w, m);
                     double *e = map.ext + slot * 4;
                     double half = 0.5 * sqrt(rsm->area[t] > 0.0f ? (double)rsm->area[t] : 0.0) * inv_h;
                     e[0] = fmin(e[0], q[u] - half);
@@ -399,12 +411,15 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
     v3 lo, hi;
     vsgl__scene_bounds(scene, &lo, &hi);
     double extent = v3_length(v3_sub(hi, lo));
-    double h = lattice_spacing(rsm, &g, n_clusters, extent);
+    double texel = 0.0;
+    double h = lattice_spacing(rsm, &g, n_clusters, extent, &texel), h_fine = h;
     const double anchor[3] = {lo.x, lo.y, lo.z};
     cell_map map;
     memset(&map, 0, sizeof map);
     for (int attempt = 0;; ++attempt) {
-        r = bin_texels(ctx, rsm, &g, anchor, h, &map);
+        /* a curved part's spacing: finer, but not below the texels' floor (lattice_spacing) */
+        h_fine = fmax(h * VSGL__LATTICE_CURVED, fmin(h, 1.5 * texel));
+        r = bin_texels(ctx, scene, rsm, &g, anchor, h, h_fine, &map);
         double cap = VSGL__LATTICE_MAX_PER_VSGL * n_clusters;
         if (r != VSGL_OK || (double)map.count <= cap || attempt == 3)
             break;
@@ -412,7 +427,6 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
         map_free(&map);
     }
     double total = g.total[0] + g.total[VSGL__GRID_FIELDS];
-    double widen = VSGL__LATTICE_OVERLAP * h * h;
     /* The fold at a cut that moves with the light (a shadow's edge, a
      * spot's rim) only with two-lobe receivers, as the specular split: it
      * moves in texel steps, which a one-lobe preview's sharp core showed as
@@ -428,26 +442,27 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
             vsgl_moments mo;
             vsgl_vsgl v;
             vsgl__grid_moments(f, &mo);
+            const int32_t *cc = map.cell + c * 3;
+            const double hc = (cc[0] & (int32_t)VSGL__BIN_FINE) ? h_fine : h; /* the cell's spacing */
             if (vsgl__moments_to_vsgl(&mo, g.origin, s->sharpness_estimator, rsm->light, lobe, &v)) {
-                v.widen = (float)widen;
+                v.widen = (float)(VSGL__LATTICE_OVERLAP * hc * hc);
                 if (map.part[c] != VSGL__PART_NONE) {
                     const double *pw = map.pw + c * 4 + lobe * 2;
                     v.part = map.part[c];
                     v.part_out = (float)fmin(fmax(pw[0] / f[0], 0.0), 1.0);
                     v.part_in = (float)fmin(fmax(pw[1] / f[0], 0.0), 1.0 - v.part_out);
                 }
-                const int32_t *cc = map.cell + c * 3;
                 const double *e = map.ext + c * 4;
-                int ax = cc[0] >> 1, au = (ax + 1) % 3, av = (ax + 2) % 3;
-                v.cell_h = (float)h;
+                int ax = (cc[0] & 7) >> 1, au = (ax + 1) % 3, av = (ax + 2) % 3;
+                v.cell_h = (float)hc;
                 v.cell_axis = (uint32_t)ax;
                 v.cell_side = (uint32_t)(cc[0] & 1);
-                v.cell_centre[0] = (float)(anchor[au] + cc[1] * h);
-                v.cell_centre[1] = (float)(anchor[av] + cc[2] * h);
-                v.cell_lo[0] = (float)(anchor[au] + fmax(e[0], cc[1] - 1.0) * h);
-                v.cell_hi[0] = (float)(anchor[au] + fmin(e[1], cc[1] + 1.0) * h);
-                v.cell_lo[1] = (float)(anchor[av] + fmax(e[2], cc[2] - 1.0) * h);
-                v.cell_hi[1] = (float)(anchor[av] + fmin(e[3], cc[2] + 1.0) * h);
+                v.cell_centre[0] = (float)(anchor[au] + cc[1] * hc);
+                v.cell_centre[1] = (float)(anchor[av] + cc[2] * hc);
+                v.cell_lo[0] = (float)(anchor[au] + fmax(e[0], cc[1] - 1.0) * hc);
+                v.cell_hi[0] = (float)(anchor[au] + fmin(e[1], cc[1] + 1.0) * hc);
+                v.cell_lo[1] = (float)(anchor[av] + fmax(e[2], cc[2] - 1.0) * hc);
+                v.cell_hi[1] = (float)(anchor[av] + fmin(e[3], cc[2] + 1.0) * hc);
                 v.cell_ends = 0;
                 for (int k = 0; k < 2; ++k) {
                     const double short_by[2] = {fmax(e[2 * k], cc[1 + k] - 1.0) - (cc[1 + k] - 1.0),

@@ -63,6 +63,28 @@ typedef struct vsgl_vsgl {
  * (they are not the lattice's: h^2 / 24 and 0 gave 1.9 %). */
 #define VSGL__LATTICE_OVERLAP (1.0 / 8.0)
 
+/* The outside of a curved convex part (a smooth-shaded sphere, a
+ * cylinder: scene_internal.h vsgl__scene_part_curved) takes a lattice this
+ * much finer (never below the texels' floor, fit/lattice.c). Its clusters
+ * are curved patches whose Gaussians, seen through a sharp glossy lobe,
+ * blur and break up its reflection by their size: the glossy floor under
+ * the sphere room's sphere showed it at 0.47-0.53 where Cycles has
+ * 0.75-0.87 (80 x 60, balanced; the brute force 0.75-0.93), in lumps that
+ * did not look like a sphere. Flat parts keep the spacing: their cells are
+ * planes, which the planar model draws sharply. Measured on the sphere
+ * room at 80 x 60 (tests/quality/evaluate.py), 1 -> 0.7:
+ *  - preview: glossy structured error 0.00154 -> 0.00107, diffuse 0.00347
+ *    -> 0.00266, FLIP 0.167 -> 0.153; its light flicker (Gloss) 0.0098 ->
+ *    0.0104, smaller clusters following the spot's edge;
+ *  - balanced: glossy structured 0.00022 -> 0.00012, FLIP 0.107 -> 0.104;
+ *  - quality: glossy structured 0.00011 -> 0.00011, FLIP 0.104 -> 0.099;
+ *  - time at 960 x 540 (tools/preset_times.py): 1.03x, 1.21x, 1.21x.
+ * 0.5 took balanced to 0.00009 (quality 0.00007) for 1.55x the time; 0.3
+ * made the preview's light flicker 0.025. VSGLs: preview 459 -> 512,
+ * balanced 1719 -> 2082, quality 2159 -> 2857. Rooms without a smooth-shaded convex part are
+ * unchanged. */
+#define VSGL__LATTICE_CURVED 0.7
+
 typedef struct vsgl_vsgl_set {
     vsgl_vsgl *items;
     size_t count, capacity;

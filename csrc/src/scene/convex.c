@@ -228,6 +228,17 @@ vsgl_result vsgl__scene_build_parts(vsgl_context *ctx, vsgl_scene *s)
         s->part_count += (uint32_t)convex;
     }
     free(parent), free(keys), free(comp), free(order), free(start), free(stamp), free(verts);
+    s->part_curved = calloc(s->part_count + 1, 1);
+    if (!s->part_curved)
+        return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "scene: out of memory for the convex parts");
+    for (uint32_t t = 0; t < nt; ++t) {
+        uint32_t p = s->tri_part[t];
+        if (p == VSGL__PART_NONE || s->part_curved[p])
+            continue;
+        const float *cn = s->corner_normals + 9 * (size_t)t, *fn = s->face_normals + 3 * (size_t)t;
+        for (int c = 0; c < 3; ++c)
+            s->part_curved[p] |= fabsf(cn[3 * c] * fn[0] + cn[3 * c + 1] * fn[1] + cn[3 * c + 2] * fn[2]) < 1.0f - 1e-6f;
+    }
     vsgl__log(ctx, VSGL_LOG_DEBUG, "scene: %u convex parts (their clusters do not light their own outside); "
               "%u meshes past the test's budget not tested", s->part_count, untested);
     return VSGL_OK;
@@ -236,4 +247,9 @@ vsgl_result vsgl__scene_build_parts(vsgl_context *ctx, vsgl_scene *s)
 uint32_t vsgl__scene_part_count(const vsgl_scene *scene)
 {
     return scene->part_count;
+}
+
+int vsgl__scene_part_curved(const vsgl_scene *scene, uint32_t part)
+{
+    return part < scene->part_count && scene->part_curved && scene->part_curved[part];
 }

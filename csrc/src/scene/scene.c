@@ -60,6 +60,7 @@ void vsgl_scene_destroy(vsgl_scene *s)
     free(s->occ_boxes);
     free(s->tri_part);
     free(s->tri_side);
+    free(s->part_curved);
     free(s);
 }
 

@@ -49,6 +49,8 @@ struct vsgl_scene {
     signed char *tri_side;       /* triangle_count: +1 / -1: the face normal / its opposite points out of the
                                   * part; 0: the part is flat (no inside) */
     uint32_t part_count;         /* convex parts found */
+    unsigned char *part_curved;  /* part_count: 1 if the part is smooth-shaded (some corner normal is not
+                                  * its face's): a curved surface, vsgl__scene_part_curved */
     uint64_t identity;           /* creation time (CLOCK_MONOTONIC ns): with the address, tells this scene's
                                     geometry and materials from a destroyed one's at the same address;
                                     kept by vsgl_scene_set_view (render caches key on both) */

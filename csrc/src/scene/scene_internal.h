@@ -142,5 +142,8 @@ int vsgl__scene_test_convex_shell(const vsgl_scene *scene);
 #define VSGL__PART_NONE 0xFFFFFFFFu
 /* The number of convex parts found when the scene was built. */
 uint32_t vsgl__scene_part_count(const vsgl_scene *scene);
+/* 1 if convex part `part` is smooth-shaded (a curved surface: a sphere, a
+ * cylinder), 0 if flat-shaded or out of range. */
+int vsgl__scene_part_curved(const vsgl_scene *scene, uint32_t part);
 
 #endif
