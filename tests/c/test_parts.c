@@ -115,7 +115,9 @@ static void mesh_free(mesh *m)
     memset(m, 0, sizeof *m);
 }
 
-static vsgl_scene *mesh_scene(vsgl_context *ctx, const mesh *m, fx_scene *fx)
+/* The scene of m (corner normals cn, or NULL) with fx's materials, light
+ * and camera; NULL on failure (the context says why). */
+static vsgl_scene *mesh_scene(vsgl_context *ctx, const mesh *m, const float *cn, fx_scene *fx)
 {
     fx_desc(fx);
     fx->desc.vertex_count = m->nv;
@@ -123,6 +125,7 @@ static vsgl_scene *mesh_scene(vsgl_context *ctx, const mesh *m, fx_scene *fx)
     fx->desc.triangle_count = m->nt;
     fx->desc.indices = m->idx;
     fx->desc.material_indices = m->mat;
+    fx->desc.corner_normals = cn;
     vsgl_scene *scene = NULL;
     if (vsgl_scene_create(ctx, &fx->desc, &scene) != VSGL_OK)
         return NULL;
@@ -176,7 +179,7 @@ VT_TEST(convex_parts_of_spheres_planes_a_wedge_and_a_step)
     mesh_quad(&m, s1, 3);
     mesh_quad(&m, s2, 3);
     mesh_quad(&m, s3, 3);
-    vsgl_scene *scene = mesh_scene(ctx, &m, &fx);
+    vsgl_scene *scene = mesh_scene(ctx, &m, NULL, &fx);
     VT_REQUIRE(scene, "%s", vsgl_context_last_error(ctx));
     VT_CHECK(vsgl__scene_part_count(scene) == 4, "parts: %u, want 4", vsgl__scene_part_count(scene));
     const uint32_t NONE = VSGL__PART_NONE;
@@ -225,15 +228,8 @@ VT_TEST(render_a_convex_object_alone_receives_no_indirect_light)
     fx_camera(&fx, ceye, cat, 40.0f, 48, 36);
     float *cn = mesh_normals(&m, 0, 0.0f, 0.0f, 0.8f); /* smooth: radial */
     VT_REQUIRE(cn, "memory");
-    fx_desc(&fx);
-    fx.desc.vertex_count = m.nv;
-    fx.desc.positions = m.pos;
-    fx.desc.triangle_count = m.nt;
-    fx.desc.indices = m.idx;
-    fx.desc.material_indices = m.mat;
-    fx.desc.corner_normals = cn;
-    vsgl_scene *scene = NULL;
-    VT_REQUIRE(vsgl_scene_create(ctx, &fx.desc, &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    vsgl_scene *scene = mesh_scene(ctx, &m, cn, &fx);
+    VT_REQUIRE(scene, "%s", vsgl_context_last_error(ctx));
     const size_t n = 48 * 36 * 3;
     float *diff = malloc(n * sizeof *diff), *gl = malloc(n * sizeof *gl);
     VT_REQUIRE(diff && gl, "memory");
@@ -269,15 +265,8 @@ VT_TEST(render_a_convex_object_alone_receives_no_indirect_light)
  * the sphere smooth-shaded where cn is given. */
 static void check_lattice_parts(vsgl_context *ctx, fx_scene *fx, const mesh *m, const float *cn)
 {
-    fx_desc(fx);
-    fx->desc.vertex_count = m->nv;
-    fx->desc.positions = m->pos;
-    fx->desc.triangle_count = m->nt;
-    fx->desc.indices = m->idx;
-    fx->desc.material_indices = m->mat;
-    fx->desc.corner_normals = cn;
-    vsgl_scene *scene = NULL;
-    VT_REQUIRE(vsgl_scene_create(ctx, &fx->desc, &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    vsgl_scene *scene = mesh_scene(ctx, m, cn, fx);
+    VT_REQUIRE(scene, "%s", vsgl_context_last_error(ctx));
     const int smooth = cn != NULL;
     VT_CHECK(vsgl__scene_part_count(scene) == 2, "parts: %u, want 2 (the room, the sphere)",
              vsgl__scene_part_count(scene));

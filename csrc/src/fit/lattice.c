@@ -145,26 +145,20 @@ static double *map_get(cell_map *m, uint64_t key)
         return m->sums + (size_t)m->slot[p] * VSGL__GRID_STRIDE;
     if (m->count == m->sums_cap) {
         size_t cap = m->sums_cap ? m->sums_cap * 2 : 256;
-        double *s = realloc(m->sums, cap * VSGL__GRID_STRIDE * sizeof *s);
-        if (!s)
-            return NULL;
-        m->sums = s;
-        double *e = realloc(m->ext, cap * 4 * sizeof *e);
-        if (!e)
-            return NULL;
-        m->ext = e;
-        int32_t *c = realloc(m->cell, cap * 3 * sizeof *c);
-        if (!c)
-            return NULL;
-        m->cell = c;
-        uint32_t *pt = realloc(m->part, cap * sizeof *pt);
-        if (!pt)
-            return NULL;
-        m->part = pt;
-        double *pw = realloc(m->pw, cap * 4 * sizeof *pw);
-        if (!pw)
-            return NULL;
-        m->pw = pw;
+        /* each per-cell array to n entries per cell (NULL if memory is short) */
+#define MAP_GROW(arr, n)                                            \
+    do {                                                            \
+        void *grown_ = realloc((arr), cap * (n) * sizeof *(arr));   \
+        if (!grown_)                                                \
+            return NULL;                                            \
+        (arr) = grown_;                                             \
+    } while (0)
+        MAP_GROW(m->sums, VSGL__GRID_STRIDE);
+        MAP_GROW(m->ext, 4);
+        MAP_GROW(m->cell, 3);
+        MAP_GROW(m->part, 1);
+        MAP_GROW(m->pw, 4);
+#undef MAP_GROW
         m->sums_cap = cap;
     }
     m->keys[p] = key;
