@@ -175,8 +175,8 @@ if want huge || want dry_run || want memory; then
 fi
 # balanced takes 1 sample per pixel from 320 x 240 up (aa_pixel_limit), and the estimate says so;
 # --aa-pixel-limit 0 keeps its 2 x 2
-expect_fail dry_run_huge 1 "render: 16384x16384 with aa 1 and RSM 256 needs about 80.3 GiB" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --dry-run --preset balanced --max-memory 20G
-expect_fail dry_run_huge_aa2 1 "render: 16384x16384 with aa 2 and RSM 256 needs about 95.3 GiB" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --dry-run --preset balanced --aa-pixel-limit 0 --max-memory 20G
+expect_fail dry_run_huge 1 "render: 16384x16384 with aa 1 and RSM 256 needs about 83.3 GiB" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --dry-run --preset balanced --max-memory 20G
+expect_fail dry_run_huge_aa2 1 "render: 16384x16384 with aa 2 and RSM 256 needs about 99.3 GiB" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --dry-run --preset balanced --aa-pixel-limit 0 --max-memory 20G
 if want render_huge_refused; then
   start=$(date +%s)
   expect_fail render_huge_refused 1 "more than the memory limit of 20.0 GiB (max_memory)" "$VSGL" render "$T/huge.vsglb" -o "$T/huge.exr" --preset balanced --max-memory 20G

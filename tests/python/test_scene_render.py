@@ -280,11 +280,11 @@ def test_render_estimate_and_memory_limit(lib):
             assert est["output"] == 640 * 480 * 4 * 4
             # one sample per pixel (aa_pixel_limit) with two more slots for edges, each + edge weight
             # and normal spread, and the edge mask; 2 x 2 samples without the limit
-            assert est["gbuffer"] == 640 * 480 * (3 * (52 + 8) + 1)
+            assert est["gbuffer"] == 640 * 480 * (3 * (56 + 8) + 1)
             unlimited = L.render_settings_preset("balanced")
             unlimited.aa_pixel_limit = 0
             full = L.render_estimate(ctx, scene, unlimited, planes=("combined", "alpha"))
-            assert full["gbuffer"] == 640 * 480 * (4 * (52 + 8) + 1)
+            assert full["gbuffer"] == 640 * 480 * (4 * (56 + 8) + 1)
             assert est["total"] == sum(est[k] for k in ("output", "gbuffer", "planes", "rsm", "fit", "shade"))
             assert est["limit"] > est["total"]
             with pytest.raises(L.VsglError) as e:
