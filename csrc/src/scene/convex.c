@@ -236,8 +236,10 @@ vsgl_result vsgl__scene_build_parts(vsgl_context *ctx, vsgl_scene *s)
         if (p == VSGL__PART_NONE || s->part_curved[p])
             continue;
         const float *cn = s->corner_normals + 9 * (size_t)t, *fn = s->face_normals + 3 * (size_t)t;
-        for (int c = 0; c < 3; ++c)
-            s->part_curved[p] |= fabsf(cn[3 * c] * fn[0] + cn[3 * c + 1] * fn[1] + cn[3 * c + 2] * fn[2]) < 1.0f - 1e-6f;
+        for (int c = 0; c < 3; ++c) {
+            float d = cn[3 * c] * fn[0] + cn[3 * c + 1] * fn[1] + cn[3 * c + 2] * fn[2];
+            s->part_curved[p] |= fabsf(d) < 1.0f - 1e-6f; /* either winding */
+        }
     }
     vsgl__log(ctx, VSGL_LOG_DEBUG, "scene: %u convex parts (their clusters do not light their own outside); "
               "%u meshes past the test's budget not tested", s->part_count, untested);

@@ -295,7 +295,8 @@ typedef struct vsgl_kernel_light {
  * convex parts (fit/vsgl_set.h, vsgl_vsgl.part): a receiver on the
  * cluster's part gets none of what the cluster sends from its outside,
  * and none from its inside unless it is inside too. */
-static inline __attribute__((always_inline)) float vsgl__part_keep(const vsgl_kernel_block *b, size_t i, const vsgl_kernel_light *L)
+static inline __attribute__((always_inline)) float vsgl__part_keep(const vsgl_kernel_block *b, size_t i,
+                                                                 const vsgl_kernel_light *L)
 {
     /* branch-free: as a select of two expressions the kernel's loop took
      * 1.65x the time (the sun room, balanced without rays, 960 x 540) */
