@@ -16,6 +16,29 @@
  * costs triangles x vertices in the worst case. */
 #define VSGL__CONVEX_MAX_TRIANGLES 2048u
 
+/* Where vertices verts[0, m) (NULL: vertices 0 .. m - 1) lie against the
+ * plane of triangle t: bit 1 some lie in front of its face normal by more
+ * than eps, bit 2 some behind (3: on both sides; the scan stops there).
+ * *tested: how many vertices were tested. The shell and the parts' test. */
+#define SIDE_FRONT 1
+#define SIDE_BEHIND 2
+static int plane_sides(const vsgl_scene *s, uint32_t t, const uint32_t *verts, uint32_t m, double eps,
+                       uint32_t *tested)
+{
+    const float *n = s->face_normals + 3 * (size_t)t;
+    const float *p = s->positions + 3 * (size_t)s->indices[3 * (size_t)t];
+    int sides = 0;
+    uint32_t k = 0;
+    for (; k < m && sides != (SIDE_FRONT | SIDE_BEHIND); ++k) {
+        const float *q = s->positions + 3 * (size_t)(verts ? verts[k] : k);
+        double d = (double)n[0] * ((double)q[0] - p[0]) + (double)n[1] * ((double)q[1] - p[1]) +
+                   (double)n[2] * ((double)q[2] - p[2]);
+        sides |= (d > eps ? SIDE_FRONT : 0) | (d < -eps ? SIDE_BEHIND : 0);
+    }
+    *tested = k;
+    return sides;
+}
+
 int vsgl__scene_test_convex_shell(const vsgl_scene *scene)
 {
     uint32_t t_count = scene->triangle_count, v_count = scene->vertex_count;
@@ -25,20 +48,10 @@ int vsgl__scene_test_convex_shell(const vsgl_scene *scene)
                       (double)(scene->hi.y - scene->lo.y) * (scene->hi.y - scene->lo.y) +
                       (double)(scene->hi.z - scene->lo.z) * (scene->hi.z - scene->lo.z));
     double eps = 1e-5 * (ext > 0.0 ? ext : 1.0);
-    for (uint32_t t = 0; t < t_count; ++t) {
-        const float *n = scene->face_normals + 3 * (size_t)t;
-        const float *p = scene->positions + 3 * (size_t)scene->indices[3 * (size_t)t];
-        int above = 0, below = 0;
-        for (uint32_t v = 0; v < v_count; ++v) {
-            const float *q = scene->positions + 3 * (size_t)v;
-            double d = (double)n[0] * ((double)q[0] - p[0]) + (double)n[1] * ((double)q[1] - p[1]) +
-                       (double)n[2] * ((double)q[2] - p[2]);
-            above |= d > eps;
-            below |= d < -eps;
-            if (above && below)
-                return 0;
-        }
-    }
+    uint32_t tested;
+    for (uint32_t t = 0; t < t_count; ++t)
+        if (plane_sides(scene, t, NULL, v_count, eps, &tested) == (SIDE_FRONT | SIDE_BEHIND))
+            return 0;
     return 1;
 }
 
@@ -120,21 +133,12 @@ static int part_sides(const vsgl_scene *s, const uint32_t *tris, uint32_t n, con
             side[t] = VSGL__SIDE_SLIVER;
             continue;
         }
-        const float *nf = s->face_normals + 3 * (size_t)t;
-        const float *p = s->positions + 3 * (size_t)s->indices[3 * (size_t)t];
-        int above = 0, below = 0;
-        uint32_t k = 0;
-        for (; k < m && !(above && below); ++k) {
-            const float *q = s->positions + 3 * (size_t)verts[k];
-            double d = (double)nf[0] * ((double)q[0] - p[0]) + (double)nf[1] * ((double)q[1] - p[1]) +
-                       (double)nf[2] * ((double)q[2] - p[2]);
-            above |= d > eps;
-            below |= d < -eps;
-        }
-        *work += k;
-        if (above && below)
+        uint32_t tested;
+        int sides = plane_sides(s, t, verts, m, eps, &tested);
+        *work += tested;
+        if (sides == (SIDE_FRONT | SIDE_BEHIND))
             return 0;
-        side[t] = (signed char)(below ? 1 : above ? -1 : 0);
+        side[t] = (signed char)(sides == SIDE_BEHIND ? 1 : sides == SIDE_FRONT ? -1 : 0);
     }
     return 1;
 }
