@@ -188,7 +188,7 @@ static void grazing_case(uint32_t flags, double *worst_out, double *worst_withou
             vsgl_asg ndf, lobe;
             vsgl_ndf_aniso_to_asg(&nn, &t, P.alpha_x, P.alpha_y, &ndf);
             vsgl_warp_ndf_asg(&ndf, &ovv, &lobe);
-            vsgl__asg_cut_at_horizon(&lobe, &nn);
+            vsgl__asg_cut_at_horizon(&lobe, &nn, &ovv);
             v3 axis = v3_make(lobe.z.x, lobe.z.y, lobe.z.z);
             float M[3], fres[3];
             vsgl__specular_factor(&P, n, ov, axis, alpha, M);

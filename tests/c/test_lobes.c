@@ -332,7 +332,7 @@ VT_TEST(lobes_receiver_lobe_cut_at_the_horizon_keeps_the_part_above)
             vsgl_ndf_aniso_to_asg(&nf, &tf, (float)alphas[ia][0], (float)alphas[ia][1], &ndf);
             vsgl_warp_ndf_asg(&ndf, &of, &w);
             cut = w;
-            vsgl__asg_cut_at_horizon(&cut, &nf);
+            vsgl__asg_cut_at_horizon(&cut, &nf, NULL);
             VT_CHECK(asg_ok(&cut), "alpha %g/%g cos %g: a valid ASG", alphas[ia][0],
                      alphas[ia][1], c);
             double mw[7], ma[7], mc[7];

@@ -151,6 +151,18 @@ def feature_checks(name, ref, cnt):
         cnt.check(sp.sum() >= 100 and ratio > 5,
                   "feature %s: the sphere (%d px) is reflected in the floor below it (the floor's Gloss there %.1f x "
                   "its median, > 5)" % (name, sp.sum(), ratio))
+    elif name == "grazing_corridor":
+        fl, ew = m == idx["polished_floor"], m == idx["end_wall"]
+        ys, xs = np.nonzero(ew)
+        # the floor below the end wall in the image (its columns, every row under its lowest pixel)
+        band = np.zeros_like(fl)
+        band[ys.max() + 1:, xs.min():xs.max() + 1] = True
+        band &= fl
+        g = lum["Gloss"]
+        ratio = float(g[band].mean() / max(np.median(g[fl]), 1e-9)) if band.any() else 0.0
+        cnt.check(ew.sum() >= 50 and band.sum() >= 100 and ratio > 20,
+                  "feature %s: the floor reflects the lit end wall (%d px) down %d px below it (the floor's Gloss "
+                  "there %.0f x its median, > 20)" % (name, ew.sum(), band.sum(), ratio))
     elif name.startswith("sun_opening"):
         c = scenes.case(name, "test")
         ctx = L.Context()

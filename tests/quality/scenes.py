@@ -286,6 +286,34 @@ def _glossy_sphere_floor():
     )
 
 
+def _grazing_corridor():
+    # a corridor 3 m wide, 20 m long and 3 m high; a spot at the far end
+    # lights the end wall, and the polished floor (Lambert + GGX layer,
+    # roughness 0.3), seen from 0.6 m above it, reflects the lit wall at
+    # grazing angles (the view's cosine to the floor 0.03-0.2): a wet road's
+    # or a long hall's reflection, where a receiver's lobe reaches below its
+    # horizon (docs/math.md §5.4.3)
+    mats = dict(floor="polished_floor", ceiling="ceiling", left="wall", right="wall", back="end_wall",
+                front="wall")
+    spot_loc, spot_target = (0.0, 13.0, 2.7), (0.0, 18.0, 1.4)
+    cam_loc, cam_target = (0.3137, -1.5, 0.6), (0.0, 18.0, 0.45)
+    return dict(
+        name="grazing_corridor",
+        feature="a spot lights the end wall of a 20 m corridor; the polished floor (Lambert + GGX layer, "
+                "roughness 0.3), seen from 0.6 m above it, reflects the lit wall at grazing angles",
+        materials=dict(polished_floor=dict(kind="lambert_spec", color=(0.4, 0.4, 0.4), roughness=0.3),
+                       end_wall=WHITE, wall=WHITE, ceiling=WHITE),
+        geometry=box_room(-1.5, 1.5, -2.0, 18.0, 0, 3.0, mats),
+        lights=[dict(type="SPOT", energy=4000.0, loc=spot_loc, rot=look_rot(spot_loc, spot_target),
+                     spot_size=50.0, spot_blend=0.3)],
+        camera=dict(type="PERSP", lens=35.0, loc=cam_loc, rot=look_rot(cam_loc, cam_target)),
+        convex=True,  # an empty closed box: every surface sees every other
+        extent=20.0,
+        light_motion=dict(light=0, loc=(1.0, 0.0, 0.0)),
+        camera_motion=dict(loc=(1.0, 0.0, 0.0)),
+    )
+
+
 def _sun_opening():
     # closed 4 x 4 x 2.7 m room with a window (1.2 x 1.1 m) in its left wall;
     # a sun shines through it onto the floor (Diffuse + a Principled specular
@@ -469,7 +497,7 @@ def _textured_interior():
 
 
 _BUILDERS = [_spot_metal_floor, _metal_floor_red_wall, _box_point_area_glossy_green, _glossy_sphere_floor,
-             _sun_opening, _sun_opening_thick, _textured_interior]
+             _sun_opening, _sun_opening_thick, _textured_interior, _grazing_corridor]
 NAMES = [b.__name__[1:] for b in _BUILDERS]
 # scenes of the trade measurement only (tools/trade.py, issue 11): not in the
 # quality suite (NAMES), which `make test` runs

@@ -52,7 +52,9 @@ void vsgl__warp_ndf_sg_emitted(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_s
 
 /* A receiver's reflection ASG cut at the horizon of `normal`: its part
  * above n.i > 0 as one ASG of the same moments and integral (lobes.c,
- * docs/math.md §5.4.2). Unchanged where under 3e-5 of it lies below. */
-void vsgl__asg_cut_at_horizon(vsgl_asg *a, const vsgl_vec3 *normal);
+ * docs/math.md §5.4.2), and with the `view` it reflects (NULL: none) that
+ * part's fan across the plane of incidence (§5.4.3). Unchanged where under
+ * 3e-5 of it lies below. */
+void vsgl__asg_cut_at_horizon(vsgl_asg *a, const vsgl_vec3 *normal, const vsgl_vec3 *view);
 
 #endif

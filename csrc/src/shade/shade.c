@@ -421,7 +421,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
         vsgl_asg ndf;
         vsgl_ndf_aniso_to_asg(&r->n, &t, r->bp.alpha_x, r->bp.alpha_y, &ndf);
         vsgl_warp_ndf_asg(&ndf, &r->o, &r->asg);
-        vsgl__asg_cut_at_horizon(&r->asg, &r->n);
+        vsgl__asg_cut_at_horizon(&r->asg, &r->n, &r->o);
         vsgl__fresnel_ratio(&r->bp, r->n, r->o, r->asg.z, r->fres);
     }
 }
