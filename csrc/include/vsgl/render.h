@@ -275,12 +275,12 @@ typedef struct vsgl_render_stats {
  */
 typedef struct vsgl_memory_estimate {
     uint64_t output;         /**< the caller's output planes (width x height x output floats per pixel) */
-    uint64_t gbuffer;        /**< camera samples: width x height x aa^2 x 52; with edge refinement
-                                  (edge_samples > aa_samples) x 60, + 1 per pixel, and at aa 1 two
+    uint64_t gbuffer;        /**< camera samples: width x height x aa^2 x 56; with edge refinement
+                                  (edge_samples > aa_samples) x 64, + 1 per pixel, and at aa 1 two
                                   slots per pixel; + 12 per sample in a scene with smooth-shaded
                                   triangles (where visibility rays start) */
     uint64_t planes;         /**< the library's own accumulation planes: 52 per pixel */
-    uint64_t rsm;            /**< reflective shadow maps alive at once (one; every light's with brute force), 68 per texel */
+    uint64_t rsm;            /**< reflective shadow maps alive at once (one; every light's with brute force), 72 per texel */
     uint64_t fit;            /**< moment grids and cluster labels of the largest light's fit */
     uint64_t shade;          /**< shading scratch of every worker thread and the VSGL table */
     uint64_t total;          /**< the sum of the fields above */
