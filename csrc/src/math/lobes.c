@@ -275,7 +275,7 @@ void vsgl_warp_ndf_asg(const vsgl_asg *ndf, const vsgl_vec3 *view, vsgl_asg *out
 /* The fan of a reflection lobe about axis z0 seen from view o: the
  * relative growth of c = o.h (h the half vector of o and a direction) from
  * z0 to z1, a direction one sd above it across the horizon; 0 where c does
- * not grow (lobes.c vsgl__asg_cut_at_horizon). */
+ * not grow (vsgl__asg_cut_at_horizon, below). */
 #define VSGL__FAN_MAX 8.0f
 static float asg_fan_slope(v3 z0, v3 z1, v3 view)
 {
