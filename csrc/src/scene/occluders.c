@@ -154,9 +154,20 @@ vsgl_result vsgl__scene_build_occluders(vsgl_context *ctx, vsgl_scene *s)
     for (uint32_t t = 0; t < s->triangle_count; ++t)
         if (!on_box_face(s, t, tol)) {
             tri_bounds(s, t, bounds + 6 * (size_t)n);
-            tri[n] = n;
+            tri[n] = t; /* the occluders' ids first, for occlude_few.c */
             ++n;
         }
+    s->occ_triangles = n;
+    vsgl_result r = VSGL_OK;
+    if (n > 0 && n <= VSGL__OCC_FEW)
+        r = vsgl__scene_build_few(ctx, s, tri, n);
+    if (r != VSGL_OK) {
+        free(tri);
+        free(bounds);
+        return r;
+    }
+    for (uint32_t i = 0; i < n; ++i)
+        tri[i] = i;
     if (n > 0) {
         s->occ_boxes = malloc(sizeof(float) * 6 * ((size_t)1 << VSGL__OCC_DEPTH));
         if (!s->occ_boxes) {

@@ -135,10 +135,59 @@ void vsgl__scene_occluded_many(const vsgl_scene *scene, uint32_t n, const v3 *or
     }
 }
 
+/* Segments strictly inside the bounds of a scene whose occluders are none
+ * or few (occluders.c): those go to the occluders' own test (occlude_few.c),
+ * or are clear when there are none; the rest are traced (blocked[] as
+ * vsgl__scene_occluded_towards_each). */
+static void occluded_few_towards_each(const vsgl_scene *scene, uint32_t n, const uint32_t *lane, const float *ox,
+                                      const float *oy, const float *oz, const float *const tgt[3], float eps,
+                                      unsigned char *blocked)
+{
+    enum { BATCH = VSGL__OCC_STREAM };
+    float sx[BATCH], sy[BATCH], sz[BATCH], ex[BATCH], ey[BATCH], ez[BATCH], inv[BATCH], reach[BATCH];
+    int route[BATCH];
+    unsigned char hit[BATCH];
+    v3 org[BATCH], dir[BATCH];
+    float t0[BATCH], t1[BATCH];
+    uint32_t idx[BATCH];
+    unsigned char traced[BATCH];
+    for (uint32_t b = 0; b < n;) {
+        uint32_t c = n - b < BATCH ? n - b : BATCH, m = 0;
+        for (uint32_t i = 0; i < c; ++i) { /* gather */
+            uint32_t k = lane[b + i];
+            sx[i] = ox[k], sy[i] = oy[k], sz[i] = oz[k];
+            ex[i] = tgt[0][k] - ox[k], ey[i] = tgt[1][k] - oy[k], ez[i] = tgt[2][k] - oz[k];
+        }
+        vsgl__scene_segments_route(scene, c, 1, sx, sy, sz, ex, ey, ez, eps, inv, reach, route);
+        if (scene->occ_few)
+            vsgl__scene_occluded_few(scene, c, sx, sy, sz, ex, ey, ez, reach, hit);
+        for (uint32_t i = 0; i < c; ++i) {
+            blocked[b + i] = route[i] == 2 && scene->occ_few ? hit[i] : 0;
+            if (route[i] == 1) { /* an end at or past the bounds: the whole scene */
+                org[m] = v3_make(sx[i], sy[i], sz[i]);
+                dir[m] = v3_make(ex[i] * inv[i], ey[i] * inv[i], ez[i] * inv[i]);
+                t0[m] = 0.0f;
+                t1[m] = 1.0f / inv[i] - eps;
+                idx[m++] = b + i;
+            }
+        }
+        if (m) {
+            vsgl__scene_occluded_many(scene, m, org, dir, t0, t1, 1, traced);
+            for (uint32_t i = 0; i < m; ++i)
+                blocked[idx[i]] = traced[i];
+        }
+        b += c;
+    }
+}
+
 void vsgl__scene_occluded_towards_each(const vsgl_scene *scene, uint32_t n, const uint32_t *lane, const float *ox,
                                        const float *oy, const float *oz, const float *const tgt[3], float eps,
                                        unsigned char *blocked)
 {
+    if (scene->triangle_count > 0 && (scene->occ_few || scene->occ_triangles == 0)) {
+        occluded_few_towards_each(scene, n, lane, ox, oy, oz, tgt, eps, blocked);
+        return;
+    }
     enum { BATCH = 64 };
     float rx[BATCH], ry[BATCH], rz[BATCH], dx[BATCH], dy[BATCH], dz[BATCH], t0[BATCH], t1[BATCH], tm[BATCH];
     unsigned int mask[BATCH], id[BATCH], flags[BATCH];

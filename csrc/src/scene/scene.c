@@ -58,6 +58,7 @@ void vsgl_scene_destroy(vsgl_scene *s)
     free(s->corner_colors);
     free(s->uv_density);
     free(s->occ_boxes);
+    free(s->occ_few);
     free(s->tri_part);
     free(s->tri_side);
     free(s->part_curved);

@@ -44,6 +44,9 @@ struct vsgl_scene {
     uint32_t occ_count;          /* boxes around the triangles off the bounds' faces */
     float *occ_boxes;            /* occ_count * 6 (lo xyz, hi xyz), padded; NULL when occ_count is 0 */
     float occ_union[6];          /* the boxes' union */
+    uint32_t occ_triangles;      /* triangles off the bounds' faces (the occluders) */
+    float *occ_few;              /* occ_few_count * 12 (v0, e1, e2, e1 x e2) when they are few (occlude_few.c), or NULL */
+    uint32_t occ_few_count;
     int convex_shell;            /* vsgl__scene_convex_shell, decided once when the scene is built */
     uint32_t *tri_part;          /* triangle_count: its convex part (scene/convex.c), VSGL__PART_NONE if none */
     signed char *tri_side;       /* triangle_count: +1 / -1: the face normal / its opposite points out of the
@@ -56,6 +59,19 @@ struct vsgl_scene {
                                     kept by vsgl_scene_set_view (render caches key on both) */
     char embree_message[VSGL__SCENE_EMBREE_MESSAGE]; /* first Embree error seen */
 };
+
+/* Segments per visibility batch (raytrace.c, occlude_few.c). */
+#define VSGL__OCC_STREAM 64
+/* At most this many occluders are tested one by one (occlude_few.c). */
+#define VSGL__OCC_FEW 16u
+/* The few occluders ids[0, n) as vertex, two edges and their cross product (occlude_few.c). */
+vsgl_result vsgl__scene_build_few(vsgl_context *ctx, vsgl_scene *s, const uint32_t *ids, uint32_t n);
+void vsgl__scene_occluded_few(const vsgl_scene *s, uint32_t m, const float *ox, const float *oy, const float *oz,
+                              const float *ex, const float *ey, const float *ez, const float *reach,
+                              unsigned char *hit);
+void vsgl__scene_segments_route(const vsgl_scene *s, uint32_t m, int split, const float *ox, const float *oy,
+                                const float *oz, const float *ex, const float *ey, const float *ez, float eps,
+                                float *inv, float *reach, int *route);
 
 /* The occluders' bounds (occluders.c), once the triangles and bounds are set. */
 vsgl_result vsgl__scene_build_occluders(vsgl_context *ctx, vsgl_scene *s);
