@@ -136,6 +136,51 @@ VT_TEST(fit_lattice_conserves_power_and_keeps_orientations_apart)
     lroom_close(&rm);
 }
 
+/* A room's floor and ceiling lie on the faces of the scene's bounds, and
+ * their VPLs' positions on either side of them by rounding. Every texel
+ * of such a face must fall into one cluster per lattice cell: slabs
+ * starting at a face put the texels a hair below the floor into another
+ * slab than those a hair above, two clusters for one cell whose powers
+ * swung from frame to frame with the rounding (a wall's foot in the sphere
+ * room, docs/accuracy.md). */
+VT_TEST(fit_lattice_keeps_a_face_of_the_bounds_in_one_slab)
+{
+    static lroom rm;
+    if (!lroom_open(&rm))
+        return;
+    for (int ceiling = 0; ceiling < 2; ++ceiling) {
+        plane_rsm h;
+        make_plane_rsm(&h, 64, 0, 0.0f, 3);
+        const float face = ceiling ? 2.0f : 0.0f, ulp = ceiling ? 2.4e-7f : 1e-7f;
+        for (size_t t = 0; t < h.r.count; ++t) { /* the face, each texel a rounding off it */
+            h.r.pos[2][t] = face + ((t * 7u + t / 64u) % 3u == 0 ? -ulp : (t % 3u == 1 ? ulp : 0.0f));
+            h.r.nrm[2][t] = h.r.wi[2][t] = ceiling ? -1.0f : 1.0f;
+        }
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.vsgl_count = 64;
+        vsgl_vsgl_set lat = {0};
+        VT_REQUIRE(vsgl__fit_lattice(rm.ctx, rm.scene, &h.r, &s, &lat) == VSGL_OK, "%s",
+                   vsgl_context_last_error(rm.ctx));
+        int twins = 0;
+        for (size_t a = 0; a < lat.count; ++a)
+            for (size_t b = a + 1; b < lat.count; ++b) {
+                const vsgl_vsgl *x = &lat.items[a], *y = &lat.items[b];
+                if (x->lobe == y->lobe && x->cell_axis == y->cell_axis && x->cell_side == y->cell_side &&
+                    x->cell_centre[0] == y->cell_centre[0] && x->cell_centre[1] == y->cell_centre[1] &&
+                    twins++ < 3)
+                    VT_REPORT("%s: VSGLs %zu and %zu share the cell at (%g, %g), powers %g and %g W",
+                              ceiling ? "ceiling" : "floor", a, b, (double)x->cell_centre[0],
+                              (double)x->cell_centre[1], (double)x->power[0], (double)y->power[0]);
+            }
+        VT_CHECK(twins == 0, "%s: %d pairs of clusters share a lattice cell", ceiling ? "ceiling" : "floor", twins);
+        VT_CHECK(lat.count >= 16, "%s: %zu VSGLs", ceiling ? "ceiling" : "floor", lat.count);
+        vsgl__vsgl_set_free(&lat);
+        free_plane_rsm(&h);
+    }
+    lroom_close(&rm);
+}
+
 /* Light at receiver x (normal n) from a set, through the reference path's
  * formulas (the kernel is checked against them in test_kernel.c). */
 /* clip: 0 no clip (the papers' model but for the plane spread, shade.h), 1 the emitter clip, 2 the clip and the near
