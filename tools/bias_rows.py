@@ -46,8 +46,8 @@ def main(argv=None):
     for y in range(ref.shape[0]):
         share = ref[y].sum() / total
         if share >= args.min_share:
-            print("%3d %5.1f%%  " % (y, 100 * share) + "  ".join("%9.3f" % (o[y].sum() / ref[y].sum())
-                                                                for o in out.values()))
+            ratios = "  ".join("%9.3f" % (o[y].sum() / ref[y].sum()) for o in out.values())
+            print("%3d %5.1f%%  %s" % (y, 100 * share, ratios))
     print("all         " + "  ".join("%9.3f" % (o.sum() / total) for o in out.values()))
     if args.cols:
         y0, y1 = (int(v) for v in args.cols.split(","))

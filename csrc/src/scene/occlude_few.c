@@ -92,11 +92,11 @@ static int inside(float x, float y, float z, v3 lo, v3 hi)
 /* Segments o + t e, t in [0, 1], i < m, shortened by eps at their far end:
  * inv[i] = 1 / |e|, reach[i] = 1 - eps / |e|, route[i] 0 (eps long or
  * less: no ray), 1 (trace against the whole scene) or 2 (both ends strictly
- * inside the bounds: only the occluders can block it), 2 only where
- * `split`. Vectorised as the test above (the batch's set-up was 14 % of the
- * sun room's render in scalar code). */
+ * inside the bounds: only the occluders can block it). Vectorised as the
+ * test above (the batch's set-up was 14 % of the sun room's render in
+ * scalar code). */
 FEW_ATTR
-void vsgl__scene_segments_route(const vsgl_scene *s, uint32_t m, int split, const float *restrict ox,
+void vsgl__scene_segments_route(const vsgl_scene *s, uint32_t m, const float *restrict ox,
                                 const float *restrict oy, const float *restrict oz, const float *restrict ex,
                                 const float *restrict ey, const float *restrict ez, float eps, float *restrict inv,
                                 float *restrict reach, int *restrict route)
@@ -106,7 +106,7 @@ void vsgl__scene_segments_route(const vsgl_scene *s, uint32_t m, int split, cons
         float dist = sqrtf(ex[i] * ex[i] + ey[i] * ey[i] + ez[i] * ez[i]);
         inv[i] = 1.0f / dist;
         reach[i] = 1.0f - eps * inv[i];
-        int in = split & inside(ox[i], oy[i], oz[i], lo, hi) &
+        int in = inside(ox[i], oy[i], oz[i], lo, hi) &
                  inside(ox[i] + ex[i] * reach[i], oy[i] + ey[i] * reach[i], oz[i] + ez[i] * reach[i], lo, hi);
         route[i] = dist > eps ? 1 + in : 0;
     }

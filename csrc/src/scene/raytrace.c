@@ -158,7 +158,7 @@ static void occluded_few_towards_each(const vsgl_scene *scene, uint32_t n, const
             sx[i] = ox[k], sy[i] = oy[k], sz[i] = oz[k];
             ex[i] = tgt[0][k] - ox[k], ey[i] = tgt[1][k] - oy[k], ez[i] = tgt[2][k] - oz[k];
         }
-        vsgl__scene_segments_route(scene, c, 1, sx, sy, sz, ex, ey, ez, eps, inv, reach, route);
+        vsgl__scene_segments_route(scene, c, sx, sy, sz, ex, ey, ez, eps, inv, reach, route);
         if (scene->occ_few)
             vsgl__scene_occluded_few(scene, c, sx, sy, sz, ex, ey, ez, reach, hit);
         for (uint32_t i = 0; i < c; ++i) {

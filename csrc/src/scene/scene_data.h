@@ -69,9 +69,9 @@ vsgl_result vsgl__scene_build_few(vsgl_context *ctx, vsgl_scene *s, const uint32
 void vsgl__scene_occluded_few(const vsgl_scene *s, uint32_t m, const float *ox, const float *oy, const float *oz,
                               const float *ex, const float *ey, const float *ez, const float *reach,
                               unsigned char *hit);
-void vsgl__scene_segments_route(const vsgl_scene *s, uint32_t m, int split, const float *ox, const float *oy,
-                                const float *oz, const float *ex, const float *ey, const float *ez, float eps,
-                                float *inv, float *reach, int *route);
+void vsgl__scene_segments_route(const vsgl_scene *s, uint32_t m, const float *ox, const float *oy, const float *oz,
+                                const float *ex, const float *ey, const float *ez, float eps, float *inv, float *reach,
+                                int *route);
 
 /* The occluders' bounds (occluders.c), once the triangles and bounds are set. */
 vsgl_result vsgl__scene_build_occluders(vsgl_context *ctx, vsgl_scene *s);
