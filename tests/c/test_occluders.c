@@ -93,6 +93,27 @@ static uint32_t copy_with_pieces(const fx_scene *fx, const float (*lo)[3], const
     return t;
 }
 
+/* The fixture room with `blocks` of the two blocks [lo, hi] in it, each
+ * face cut into pieces x pieces quads (copy_with_pieces); NULL (reported)
+ * if the scene is refused. *tris: its triangle count. */
+static vsgl_scene *room_with_blocks(vsgl_context *ctx, const float (*lo)[3], const float (*hi)[3], int blocks,
+                                    int pieces, uint32_t *tris)
+{
+    fx_scene fx;
+    fx_room(&fx, 8, 6, 0.5f, 100.0f);
+    *tris = copy_with_pieces(&fx, lo, hi, blocks, pieces);
+    vsgl_scene_desc d = *fx_desc(&fx);
+    d.vertex_count = 3 * *tris;
+    d.positions = occ_pos;
+    d.triangle_count = *tris;
+    d.indices = occ_idx;
+    d.material_indices = occ_mat;
+    vsgl_scene *sc = NULL;
+    if (vsgl_scene_create(ctx, &d, &sc) != VSGL_OK)
+        VT_REPORT("scene: %s", vsgl_context_last_error(ctx));
+    return sc;
+}
+
 VT_TEST(occluders_never_call_a_blocked_segment_clear)
 {
     vsgl_context *ctx = fx_context(1);
@@ -101,17 +122,9 @@ VT_TEST(occluders_never_call_a_blocked_segment_clear)
     const float lo[2][3] = {{-0.6f, -0.2f, 0.0f}, {0.4f, 0.5f, 1.2f}}, hi[2][3] = {{-0.2f, 0.3f, 0.7f}, {0.8f, 0.9f, 1.5f}};
     int clear_one_box = 0;
     for (int blocks = 0; blocks < 3; ++blocks) { /* none, two of 12 triangles, two of 96 (leaves) */
-        fx_scene fx;
-        fx_room(&fx, 8, 6, 0.5f, 100.0f);
-        uint32_t tris = copy_with_pieces(&fx, lo, hi, blocks ? 2 : 0, blocks == 2 ? 2 : 1);
-        vsgl_scene_desc d = *fx_desc(&fx);
-        d.vertex_count = 3 * tris;
-        d.positions = occ_pos;
-        d.triangle_count = tris;
-        d.indices = occ_idx;
-        d.material_indices = occ_mat;
-        vsgl_scene *sc = NULL;
-        VT_REQUIRE(vsgl_scene_create(ctx, &d, &sc) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        uint32_t tris;
+        vsgl_scene *sc = room_with_blocks(ctx, lo, hi, blocks ? 2 : 0, blocks == 2 ? 2 : 1, &tris);
+        VT_REQUIRE(sc, "blocks %d: no scene", blocks);
         uint32_t rng = 12345u; /* the same segments in each scene */
         int clear = 0, wrong = 0, inside = 0, outside_clear = 0;
         const int n = 20000;
@@ -172,17 +185,9 @@ VT_TEST(visibility_rays_route_inside_segments_to_the_occluders)
     VT_REQUIRE(ctx, "context");
     const float lo[2][3] = {{-0.6f, -0.2f, 0.0f}, {0.4f, 0.5f, 1.2f}}, hi[2][3] = {{-0.2f, 0.3f, 0.7f}, {0.8f, 0.9f, 1.5f}};
     for (int blocks = 0; blocks < 3; ++blocks) { /* none, one, two */
-        fx_scene fx;
-        fx_room(&fx, 8, 6, 0.5f, 100.0f);
-        uint32_t tris = copy_with_pieces(&fx, lo, hi, blocks, 1);
-        vsgl_scene_desc d = *fx_desc(&fx);
-        d.vertex_count = 3 * tris;
-        d.positions = occ_pos;
-        d.triangle_count = tris;
-        d.indices = occ_idx;
-        d.material_indices = occ_mat;
-        vsgl_scene *sc = NULL;
-        VT_REQUIRE(vsgl_scene_create(ctx, &d, &sc) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+        uint32_t tris;
+        vsgl_scene *sc = room_with_blocks(ctx, lo, hi, blocks, 1, &tris);
+        VT_REQUIRE(sc, "blocks %d: no scene", blocks);
         enum { N = 20000, B = 64 };
         static float ox[N], oy[N], oz[N], tx[N], ty[N], tz[N];
         static int want[N];
