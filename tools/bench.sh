@@ -15,6 +15,8 @@ mkdir -p "$bin"
 cc $flags tools/bench/bench_shade.c $objs $libs -o "$bin/bench_shade"
 cc $flags tools/bench/bench_kernel.c $objs $libs -o "$bin/bench_kernel"
 if [ -f tools/bench_gbuffer.c ]; then cc $flags tools/bench_gbuffer.c $objs $libs -o "$bin/bench_gbuffer"; fi
+# not a benchmark: the per-VSGL probe of tools/probe_frames.py, built here against the same objects
+cc $flags tools/probe_vsgls.c $objs $libs -o "$bin/probe_vsgls"
 if [ "${BENCH_BUILD_ONLY:-0}" = 1 ]; then exit 0; fi
 if [ "${BENCH_QUICK:-0}" = 1 ]; then size="480 270 64 1"; kreps=100; else size="1920 1080 256 3"; kreps=3000; fi
 echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
