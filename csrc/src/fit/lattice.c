@@ -18,7 +18,8 @@
  *    axes across a, with tent (bilinear) weights, which sum to 1 and are
  *    continuous in the VPL's position; along a, slabs h thick (surfaces of
  *    one bin at different heights, a floor and a table top, stay apart;
- *    thinner slabs cut a sphere into more clusters for no gain);
+ *    thinner slabs cut a sphere into more clusters for no gain), centred
+ *    on the bounds' faces (bin_texels);
  *  - the lattice is anchored at the scene's bounds, not at the light, and
  *    h follows the light's effective lit area A (the power-weighted
  *    participation area (sum w)^2 / sum(w^2 / a)), h = sqrt(A / N): both
