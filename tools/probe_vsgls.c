@@ -87,9 +87,10 @@ int main(int argc, char **argv)
         const vsgl_vsgl *v = &set.items[k];
         if (!(c >= min))
             continue;
-        printf("%5zu lobe %u light %u  %.5f  mean %.3f %.3f %.3f  power %.4g  coh %.4f  var %.4g", k, v->lobe,
-               v->light, c, v->mean.x, v->mean.y, v->mean.z, v->power[0] + v->power[1] + v->power[2],
-               v->coherence, v->variance);
+        printf("%5zu lobe %u light %u  %.5f  mean %.3f %.3f %.3f  power %.4g  coh %.4f  var %.4g  axis %.3f %.3f %.3f"
+               "  sharpness %.4g", k, v->lobe, v->light, c, v->mean.x, v->mean.y, v->mean.z,
+               v->power[0] + v->power[1] + v->power[2], v->coherence, v->variance, v->axis.x, v->axis.y, v->axis.z,
+               v->sharpness);
         if (v->cell_h > 0.0f) { /* the cell's lattice indices: its centre from the bounds' low corner */
             const float lo3[3] = {lo.x, lo.y, lo.z};
             long ci = lroundf((v->cell_centre[0] - lo3[(v->cell_axis + 1) % 3]) / v->cell_h);
