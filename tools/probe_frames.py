@@ -32,7 +32,7 @@ CELL = re.compile(r"cell axis (\d+) side (\d+) at (-?\d+) (-?\d+)")
 def probe(binary, bundle, x, y, pas):
     out = subprocess.run([binary, bundle, str(x), str(y), pas, "0"], capture_output=True, text=True, check=True)
     lines = out.stdout.splitlines()
-    total, rows = float(lines[0].split()[4]), {}
+    total, rows = float(lines[0].split()[4].rstrip(";")), {}
     for line in lines[1:]:
         m = LINE.match(line)
         c = CELL.search(m.group(5))

@@ -78,8 +78,11 @@ int main(int argc, char **argv)
     const float *plane = diffuse ? pl.diffuse : pl.glossy;
     uint64_t pairs;
     vsgl__shade(ctx, scene, &g, &set, &s, &pl, VSGL__SHADE_KERNEL, &pairs);
-    printf("pixel (%ld, %ld) %s %.5f from %zu VSGLs\n", x, y, diffuse ? "diffuse" : "glossy", pixel_sum(plane, i),
-           set.count);
+    const size_t smp = i * g.spp; /* the pixel's first sample */
+    const v3 rx = v3_make(g.pos[0][smp], g.pos[1][smp], g.pos[2][smp]);
+    printf("pixel (%ld, %ld) %s %.5f from %zu VSGLs; its first sample at %.3f %.3f %.3f, normal %.3f %.3f %.3f\n", x,
+           y, diffuse ? "diffuse" : "glossy", pixel_sum(plane, i), set.count, rx.x, rx.y, rx.z, g.nrm[0][smp],
+           g.nrm[1][smp], g.nrm[2][smp]);
     for (size_t k = 0; k < set.count; ++k) {
         vsgl_vsgl_set one = {&set.items[k], 1, 1};
         vsgl__shade(ctx, scene, &g, &one, &s, &pl, VSGL__SHADE_KERNEL, &pairs);
@@ -91,6 +94,12 @@ int main(int argc, char **argv)
                "  sharpness %.4g", k, v->lobe, v->light, c, v->mean.x, v->mean.y, v->mean.z,
                v->power[0] + v->power[1] + v->power[2], v->coherence, v->variance, v->axis.x, v->axis.y, v->axis.z,
                v->sharpness);
+        { /* the sample seen from the cluster: its height over the cluster's plane, the lobe's value towards it */
+            const v3 d = v3_sub(rx, v->mean);
+            const float len = v3_length(d), cosl = len > 0.0f ? v3_dot(d, v->axis) / len : 1.0f;
+            printf("  sample: %.3f m off the plane, %.3f m away, lobe e^(l(cos-1)) %.3g", v3_dot(d, v->normal), len,
+                   expf(v->sharpness * (cosl - 1.0f)));
+        }
         if (v->cell_h > 0.0f) { /* the cell's lattice indices: its centre from the bounds' low corner */
             const float lo3[3] = {lo.x, lo.y, lo.z};
             long ci = lroundf((v->cell_centre[0] - lo3[(v->cell_axis + 1) % 3]) / v->cell_h);
