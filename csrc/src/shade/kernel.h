@@ -216,6 +216,22 @@ static inline float vsgl__planar_tilt_gate(float hs)
 
 /* The emitter-hemisphere clip's constants (shade.h explains the clip). */
 #define VSGL__CLIP_BEHIND 0.02f   /* the behind fade, in units of sigma */
+/* A curved cluster's behind fade is wider by this many sigma times
+ * sqrt(1 - coherence^2) (the spread of its normals), centred on its plane:
+ * its VPLs lie on both sides of the plane through their mean (a sphere's
+ * cap), and a receiver beside it crossed a 2 mm fade as the cluster's mean
+ * moved 1 cm with the light (the floor under the sphere: 17x in a frame,
+ * docs/accuracy.md). */
+#define VSGL__CLIP_CURVED 1.0f
+/* The behind fade of a cluster of variance var (per axis, m^2) and
+ * coherence c: *width (m) and *start (m behind the plane). */
+static inline void vsgl__clip_fade(float var, float c, float *width, float *start)
+{
+    float sd = sqrtf(var > 0.0f ? var : 0.0f), s = 1.0f - c * c;
+    float curved = VSGL__CLIP_CURVED * (s > 0.0f ? sqrtf(s) : 0.0f) * sd;
+    *width = VSGL__CLIP_BEHIND * sd + curved;
+    *start = 0.5f * curved;
+}
 #define VSGL__CLIP_PARALLEL 0.3f  /* the parallel fade, in 1 - n.n_v */
 #define VSGL__CLIP_NEAR 4.0f      /* the spread sharpness where conv is half-way */
 
@@ -273,7 +289,8 @@ typedef struct vsgl_kernel_light {
     float clip;              /* emitter-hemisphere clip: coherence^2 of the normals, 0 = off (shade.h) */
     float conv;              /* 1 for a diffuse lobe: clamped-cosine emission in the far field */
     float fore;              /* vsgl__foreshortening_weight (vsgl__plane_spread) */
-    float ibehind;           /* 1 / (VSGL__CLIP_BEHIND sigma) */
+    float ibehind;           /* 1 / the behind fade's width (vsgl__clip_fade) */
+    float boff;              /* where it starts, in its widths behind the plane (0 for a planar cluster) */
     float planar;            /* weight of the planar glossy model (coherence^2 of a diffuse lobe, clip on), else 0 */
     float pvar;              /* its positional variance (var + the fit's overlap widening) */
     float u1x, u1y, u1z, u2x, u2y, u2z; /* an orthonormal basis of the cluster's plane */

@@ -261,7 +261,7 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
      * the clamped cosine's far-field falloff for diffuse lobes. */
     float h = -(dx * L->nx + dy * L->ny + dz * L->nz);
     t->h[i] = h;
-    float sb = h * L->ibehind;
+    float sb = h * L->ibehind + L->boff;
     sb = sb < 0.0f ? 0.0f : (sb > 1.0f ? 1.0f : sb);
     float sp = (1.0f - (b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz)) * (1.0f / VSGL__CLIP_PARALLEL);
     sp = sp > 1.0f ? 1.0f : sp;

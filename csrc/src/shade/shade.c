@@ -80,7 +80,9 @@ float vsgl__emitter_clip(const vsgl_vsgl *v, v3 x, v3 n, int on)
     float w = s / (s + VSGL__CLIP_NEAR);
     /* the parallel clip in the near field only: far away the receiver's own cosine does it */
     float par = 1.0f - (1.0f - smoothstep01f((1.0f - v3_dot(n, v->normal)) * (1.0f / VSGL__CLIP_PARALLEL))) * (1.0f - w);
-    float e = smoothstep01f(h / (VSGL__CLIP_BEHIND * sqrtf(var) + VSGL__TINY)) * par;
+    float fw, fs;
+    vsgl__clip_fade(var, v->coherence, &fw, &fs);
+    float e = smoothstep01f((h + fs) / (fw + VSGL__TINY)) * par;
     if (v->lobe == VSGL__LOBE_DIFFUSE) {
         float c = d2 > 0.0f ? clampf(h / sqrtf(d2), 0.0f, 1.0f) : 0.0f;
         float ld = vsgl_sg_cosine_sharpness();
@@ -450,7 +452,7 @@ static int same_rays(const vsgl_vsgl *a, const vsgl_kernel_light *ka, const vsgl
     return a->mean.x == b->mean.x && a->mean.y == b->mean.y && a->mean.z == b->mean.z &&
            a->normal.x == b->normal.x && a->normal.y == b->normal.y && a->normal.z == b->normal.z &&
            a->coherence == b->coherence && a->variance == b->variance && ka->clip == kb->clip &&
-           ka->ibehind == kb->ibehind && ka->mx == kb->mx && ka->my == kb->my && ka->mz == kb->mz &&
+           ka->ibehind == kb->ibehind && ka->boff == kb->boff && ka->mx == kb->mx && ka->my == kb->my && ka->mz == kb->mz &&
            ka->nx == kb->nx && ka->ny == kb->ny && ka->nz == kb->nz;
 }
 
@@ -576,7 +578,7 @@ static uint64_t visibility_rays(const shade_job *j, size_t item, const vsgl_kern
         uint32_t k = (uint32_t)__builtin_ctzll(rest);
         if (may_skip) { /* the kernel's h (kernel_impl.h, k_geometry) */
             float h = -((L->mx - rec[k].x.x) * L->nx + (L->my - rec[k].x.y) * L->ny + (L->mz - rec[k].x.z) * L->nz);
-            if (h * L->ibehind < VSGL__VIS_SKIP_BEHIND) {
+            if (h * L->ibehind + L->boff < VSGL__VIS_SKIP_BEHIND) {
                 visible |= (uint64_t)1 << k; /* not traced */
                 continue;
             }
@@ -1376,7 +1378,10 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             o->pin = v->part_in;
             o->conv = v->lobe == VSGL__LOBE_DIFFUSE ? 1.0f : 0.0f;
             o->fore = vsgl__foreshortening_weight(v);
-            o->ibehind = 1.0f / (VSGL__CLIP_BEHIND * sqrtf(v->variance) + VSGL__TINY);
+            float fw, fs;
+            vsgl__clip_fade(v->variance, v->coherence, &fw, &fs);
+            o->ibehind = 1.0f / (fw + VSGL__TINY);
+            o->boff = fs * o->ibehind;
             o->planar = leak && v->lobe == VSGL__LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
             o->pvar = v->variance + v->widen;
             v3 u1, u2;
