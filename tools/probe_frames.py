@@ -62,10 +62,11 @@ def main(argv=None):
     frames = [int(f) for f in args.frames.split(",")]
     base = scenes.case(args.scene, args.size)
     totals, per = [], []
+    ctx = E.L.Context()
     with tempfile.TemporaryDirectory() as tmp:
         for f in frames:
             path = os.path.join(tmp, "frame%d.vsglb" % f)
-            E.L.bundle_write(E.L.Context(), path, scenes.library_arrays(scenes.animate(base, args.anim, f), E.L),
+            E.L.bundle_write(ctx, path, scenes.library_arrays(scenes.animate(base, args.anim, f), E.L),
                              cfg.settings())
             t, rows = probe(args.probe, path, args.x, args.y, args.pas)
             totals.append(t)

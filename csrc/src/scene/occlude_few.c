@@ -84,11 +84,6 @@ void vsgl__scene_occluded_few(const vsgl_scene *s, uint32_t m, const float *rest
         hit[i] = (unsigned char)h[i];
 }
 
-static int inside(float x, float y, float z, v3 lo, v3 hi)
-{
-    return (x > lo.x) & (y > lo.y) & (z > lo.z) & (x < hi.x) & (y < hi.y) & (z < hi.z);
-}
-
 /* Segments o + t e, t in [0, 1], i < m, shortened by eps at their far end:
  * inv[i] = 1 / |e|, reach[i] = 1 - eps / |e|, route[i] 0 (eps long or
  * less: no ray), 1 (trace against the whole scene) or 2 (both ends strictly
@@ -101,13 +96,13 @@ void vsgl__scene_segments_route(const vsgl_scene *s, uint32_t m, const float *re
                                 const float *restrict ey, const float *restrict ez, float eps, float *restrict inv,
                                 float *restrict reach, int *restrict route)
 {
-    const v3 lo = s->occ_inner_lo, hi = s->occ_inner_hi;
     for (uint32_t i = 0; i < m; ++i) {
         float dist = sqrtf(ex[i] * ex[i] + ey[i] * ey[i] + ez[i] * ez[i]);
         inv[i] = 1.0f / dist;
         reach[i] = 1.0f - eps * inv[i];
-        int in = inside(ox[i], oy[i], oz[i], lo, hi) &
-                 inside(ox[i] + ex[i] * reach[i], oy[i] + ey[i] * reach[i], oz[i] + ez[i] * reach[i], lo, hi);
+        int in = vsgl__scene_strictly_inside(s, ox[i], oy[i], oz[i]) &
+                 vsgl__scene_strictly_inside(s, ox[i] + ex[i] * reach[i], oy[i] + ey[i] * reach[i],
+                                             oz[i] + ez[i] * reach[i]);
         route[i] = dist > eps ? 1 + in : 0;
     }
 }

@@ -206,11 +206,6 @@ vsgl_result vsgl__scene_build_occluders(vsgl_context *ctx, vsgl_scene *s)
     return VSGL_OK;
 }
 
-static int strictly_inside(v3 p, v3 lo, v3 hi)
-{
-    return p.x > lo.x && p.y > lo.y && p.z > lo.z && p.x < hi.x && p.y < hi.y && p.z < hi.z;
-}
-
 /* Does segment p + t d, t in [0, 1], meet box b (lo xyz, hi xyz)? inv =
  * 1 / d per axis (inf where d is 0). */
 static int segment_meets_box(v3 p, v3 d, v3 inv, const float *b)
@@ -233,8 +228,7 @@ static int segment_meets_box(v3 p, v3 d, v3 inv, const float *b)
 
 int vsgl__scene_segment_clear(const vsgl_scene *s, v3 a, v3 b)
 {
-    if (!strictly_inside(a, s->occ_inner_lo, s->occ_inner_hi) ||
-        !strictly_inside(b, s->occ_inner_lo, s->occ_inner_hi))
+    if (!vsgl__scene_strictly_inside(s, a.x, a.y, a.z) || !vsgl__scene_strictly_inside(s, b.x, b.y, b.z))
         return 0;
     if (s->occ_count == 0)
         return 1;

@@ -60,6 +60,16 @@ struct vsgl_scene {
     char embree_message[VSGL__SCENE_EMBREE_MESSAGE]; /* first Embree error seen */
 };
 
+/* 1 if (x, y, z) lies strictly inside the occluders' inner box (occluders.c):
+ * a segment between two such points meets no triangle on the bounds'
+ * faces. Branch-free, so that occlude_few.c's loop over segments
+ * vectorises. */
+static inline int vsgl__scene_strictly_inside(const vsgl_scene *s, float x, float y, float z)
+{
+    const v3 lo = s->occ_inner_lo, hi = s->occ_inner_hi;
+    return (x > lo.x) & (y > lo.y) & (z > lo.z) & (x < hi.x) & (y < hi.y) & (z < hi.z);
+}
+
 /* Segments per visibility batch (raytrace.c, occlude_few.c). */
 #define VSGL__OCC_STREAM 64
 /* At most this many occluders are tested one by one (occlude_few.c). */
