@@ -64,7 +64,8 @@ static vsgl_context *make_ctx(uint32_t threads)
  * a horizontal-fit 36 mm sensor at 50 mm, 64 x 48 pixels. */
 static void analytic_point(double z0, uint32_t col, uint32_t row, uint32_t i, uint32_t j, uint32_t aa, double out[3])
 {
-    double px = col + (i + 0.5) / aa, py = row + (j + 0.5) / aa;
+    /* the sheared aa x aa grid of gbuffer.h (vsgl__gbuffer_pattern) */
+    double px = col + (i + (j + 0.5) / aa) / aa, py = row + (j + (i + 0.5) / aa) / aa;
     double hx = 18.0 / 50.0, hy = hx * 48.0 / 64.0;
     double x = (2.0 * px / 64.0 - 1.0) * hx, y = (1.0 - 2.0 * py / 48.0) * hy;
     out[0] = x * -z0;
@@ -194,7 +195,7 @@ VT_TEST(gbuffer_orthographic_positions)
             for (uint32_t col = 0; col < 64; ++col)
                 for (uint32_t k = 0; k < 4; ++k) {
                     size_t e = ((size_t)row * 64 + col) * 4 + k;
-                    double px = col + (k % 2 + 0.5) / 2, py = row + (k / 2 + 0.5) / 2;
+                    double px = col + (k % 2 + (k / 2 + 0.5) / 2) / 2, py = row + (k / 2 + (k % 2 + 0.5) / 2) / 2;
                     /* 4 m across 64 px; 3 m across 48 px; shift 0.25 * 4 m up */
                     double x = 1.0 + (px / 64.0 - 0.5) * 4.0, y = 2.0 + (0.5 - py / 48.0) * 3.0 + 1.0;
                     double err = fabs(g.pos[0][e] - x) + fabs(g.pos[1][e] - y) + fabs(g.pos[2][e] + 3.0);
@@ -385,6 +386,47 @@ VT_TEST(gbuffer_edge_refinement_resolves_coverage)
     VT_CHECK(filled >= 40 && bad_empty == 0, "%zu filled, %zu bad empty slots", filled, bad_empty);
     vsgl__gbuffer_free(&one);
     vsgl_scene_destroy(s);
+    vsgl_context_destroy(ctx);
+}
+
+/* A vertical edge sliding across a pixel in 1/32 steps, one sample per
+ * pixel and 8 x 8 edge rays: the refined coverage follows it within half
+ * of 1/64 (the sheared pattern, gbuffer.h vsgl__gbuffer_pattern: 64
+ * distinct columns of rays) and never steps backwards. On the square 8 x 8
+ * grid it moved in steps of 1/8, off by up to 1/16 (the corridor's end
+ * wall crept in steps as the camera moved, docs/accuracy.md). */
+VT_TEST(gbuffer_edge_rays_follow_an_axis_aligned_edge)
+{
+    const float z0 = -5.0f;
+    const double hx = 18.0 / 50.0, width = 2.0 * hx * -z0 / 64.0; /* a pixel's width on the plane, m */
+    const uint32_t col = 40, row = 24;
+    vsgl_context *ctx = make_ctx(2);
+    double worst = 0.0, prev = -1.0;
+    size_t backwards = 0, steps = 0;
+    for (int t = 0; t < 32; ++t) {
+        const double f = (t + 0.25) / 32.0; /* the edge's position within the pixel */
+        const float x0 = (float)((2.0 * col / 64.0 - 1.0) * hx * -z0 + f * width);
+        plane_scene p;
+        slanted_plane(&p, z0, x0, 0.0f, 100.0f);
+        vsgl_scene *s = NULL;
+        VT_REQUIRE(vsgl_scene_create(ctx, &p.desc, &s) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+        vsgl_gbuffer g;
+        VT_REQUIRE(vsgl__gbuffer_build(ctx, s, 1, 8, &g) == VSGL_OK, "'%s'", vsgl_context_last_error(ctx));
+        const size_t base = ((size_t)row * 64 + col) * g.spp;
+        double cov = 0.0;
+        for (uint32_t q = 0; q < g.spp; ++q)
+            cov += g.material[base + q] != VSGL__GBUFFER_MISS ? g.weight[base + q] : 0.0;
+        const double want = exact_coverage(col, row, x0, 0.0, z0);
+        worst = fmax(worst, fabs(cov - want));
+        backwards += prev >= 0.0 && cov < prev - 1e-6; /* the plane covers x < x0: more as the edge moves right */
+        steps += prev >= 0.0 && cov > prev + 1e-6;
+        prev = cov;
+        vsgl__gbuffer_free(&g);
+        vsgl_scene_destroy(s);
+    }
+    printf("    32 positions: coverage off by %.4f at worst, %zu steps up, %zu back\n", worst, steps, backwards);
+    VT_CHECK(worst < 0.6 / 64.0 + 1e-4, "coverage off by %.4f (1/64 steps: within %.4f)", worst, 0.6 / 64.0);
+    VT_CHECK(backwards == 0 && steps == 31, "%zu steps up and %zu back over 31 moves", steps, backwards);
     vsgl_context_destroy(ctx);
 }
 

@@ -3,6 +3,7 @@
  * sizes, settings validation and determinism across thread counts. */
 #include "harness.h"
 #include "scene_fixture.h"
+#include "gbuffer/gbuffer.h"
 
 #include <stdlib.h>
 
@@ -562,6 +563,58 @@ VT_TEST(render_shade_stride_cuts_pairs_at_small_error)
     }
     free(full);
     free(dc_full);
+}
+
+/* At shade_stride 2 every pixel that edge refinement rewrote is shaded
+ * itself, as at stride 1: its slots stand for groups of rays anywhere in
+ * the pixel, which no anchor cell describes. Interpolated at its slots'
+ * grid positions, an edge pixel took its light from the anchors in some
+ * frames and its own in others, and the corridor's end-wall edges jumped
+ * as the camera moved (docs/accuracy.md, "Edges that move in steps"). */
+VT_TEST(render_shade_stride_shades_edge_pixels_themselves)
+{
+    enum { SW = 160, SH = 120 };
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.visibility = VSGL_VISIBILITY_NONE;
+    s.rsm_resolution = 64;
+    float *dc[2], *img[2];
+    for (int k = 0; k < 2; ++k) {
+        s.shade_stride = k ? 2 : 1;
+        img[k] = render_room_rough(SW, SH, 0, &s, NULL, &dc[k], 0.25f);
+    }
+    fx_scene fx;
+    fx_room(&fx, SW, SH, 0.25f, 200.0f);
+    vsgl_context *ctx = fx_context(0);
+    vsgl_scene *scene = NULL;
+    vsgl_gbuffer g;
+    memset(&g, 0, sizeof g);
+    VT_REQUIRE(ctx && vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK &&
+                   vsgl__gbuffer_build(ctx, scene, s.aa_samples, s.edge_samples, &g) == VSGL_OK,
+               "G-buffer: %s", ctx ? vsgl_context_last_error(ctx) : "no context");
+    size_t refined = 0, differ = 0;
+    double worst = 0.0;
+    for (size_t px = 0; px < (size_t)SW * SH; ++px) {
+        if (!vsgl__gbuffer_refined(&g, px))
+            continue;
+        ++refined;
+        for (int c = 0; c < 3; ++c) {
+            const double a = img[1][px * 3 + c], b = img[0][px * 3 + c], e = fabs(a - b) / (1e-3 + fabs(b));
+            worst = e > worst ? e : worst;
+            differ += e > 1e-4; /* (float rounding: the blocks differ) */
+        }
+    }
+    printf("    %zu refined pixels: %zu channels differ from every pixel shaded, by %.2g (relative) at worst\n",
+           refined, differ, worst);
+    VT_CHECK(refined >= 100, "%zu refined pixels: the room has no edges", refined);
+    VT_CHECK(differ == 0, "%zu channels of refined pixels interpolated (worst %.3g)", differ, worst);
+    vsgl__gbuffer_free(&g);
+    vsgl_scene_destroy(scene);
+    vsgl_context_destroy(ctx);
+    for (int k = 0; k < 2; ++k) {
+        free(img[k]);
+        free(dc[k]);
+    }
 }
 
 /* A mirror floor (roughness 0, GGX alpha 5e-10) still shares its light

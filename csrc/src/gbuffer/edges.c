@@ -1,6 +1,6 @@
 /* Edge refinement of the camera G-buffer (vsgl_render_settings.edge_samples).
  *
- * With aa x aa samples on a fixed grid, a geometric edge that crosses a
+ * With aa x aa samples on a fixed pattern, a geometric edge that crosses a
  * pixel covers 0, 1/spp, 2/spp ... of it: as the camera moves, the edge
  * pixel jumps in steps of 1/spp, which an animation shows as crawling
  * silhouettes (docs/quality.md, "camera flicker"). Shading more samples
@@ -10,7 +10,9 @@
  *     samples and the nearest sample of a 4-neighbour, lie on different
  *     surfaces (hit vs miss, another material, normals more than ~25
  *     degrees apart, or off each other's tangent plane);
- *  2. refine: an edge pixel is traced again with edge_aa x edge_aa rays,
+ *  2. refine: an edge pixel is traced again with edge_aa x edge_aa rays
+ *     (the sheared pattern of gbuffer.h: edge_aa^2 coverage steps for a
+ *     horizontal or vertical edge, not edge_aa),
  *     the rays are grouped by surface (neighbouring rays on one surface
  *     chain into one piece, so a curved rim is one group; at most spp
  *     groups, a further surface joins its most similar group; group_rays),
@@ -301,13 +303,15 @@ static uint32_t group_rays(const gb_job *job, const vsgl_gbuffer *sub, size_t *f
     return groups;
 }
 
-/* Raster position of edge ray s of pixel (x, y) on its E x E grid (inv =
- * 1 / E): the trace and the deferred inputs of the rays kept must take the
- * same, to the bit. */
+/* Raster position of edge ray s of pixel (x, y) on its E x E pattern (inv
+ * = 1 / E; gbuffer.h vsgl__gbuffer_pattern): the trace and the deferred
+ * inputs of the rays kept must take the same, to the bit. */
 static inline void edge_ray_at(uint32_t x, uint32_t y, uint32_t s, uint32_t E, float inv, float *rx, float *ry)
 {
-    *rx = (float)x + ((float)(s % E) + 0.5f) * inv;
-    *ry = (float)y + ((float)(s / E) + 0.5f) * inv;
+    float ox, oy;
+    vsgl__gbuffer_pattern(s, E, inv, &ox, &oy);
+    *rx = (float)x + ox;
+    *ry = (float)y + oy;
 }
 
 /* Refine pixel (x, y): trace E x E rays into `sub` and rewrite its slots. */

@@ -1,9 +1,9 @@
 /* Camera G-buffer: aa x aa stratified primary rays per pixel, traced in
  * parallel over rows (Embree ray streams), surface attributes per sample.
  *
- * Sample s = j * aa + i of pixel (col, row) is at raster position
- * (col + (i + 0.5) / aa, row + (j + 0.5) / aa), row 0 = top; aa = 1 gives
- * the pixel centre. Positions depend only on (col, row, s): the buffer is
+ * Sample s of pixel (col, row) is at raster position (col, row) +
+ * vsgl__gbuffer_pattern(s, aa) (a sheared aa x aa grid, gbuffer.h), row
+ * 0 = top; aa = 1 gives the pixel centre. Positions depend only on (col, row, s): the buffer is
  * bit-identical for any thread count. */
 #include "gbuffer/gbuffer.h"
 #include "gbuffer/trace.h"
@@ -189,8 +189,10 @@ static int32_t trace_rows(void *user, size_t chunk, size_t begin, size_t end)
                 size_t idx = b + k;
                 /* (one sample per pixel: no integer division per sample) */
                 uint32_t col = grid == 1 ? (uint32_t)idx : (uint32_t)(idx / grid), s = grid == 1 ? 0u : (uint32_t)(idx % grid);
-                rx[k] = (float)col + ((float)(s % aa) + 0.5f) * inv;
-                ry[k] = (float)row + ((float)(s / aa) + 0.5f) * inv;
+                float ox, oy;
+                vsgl__gbuffer_pattern(s, aa, inv, &ox, &oy);
+                rx[k] = (float)col + ox;
+                ry[k] = (float)row + oy;
                 dst[k] = base + (size_t)col * spp + s;
             }
             vsgl__gbuffer_trace(j, g, m, rx, ry, dst, vsgl__texture_footprint(inv), NULL);

@@ -9,13 +9,14 @@
 #define VSGL__GBUFFER_MAX_SPP 256 /* 16 x 16 samples per pixel */
 
 /* Structure of arrays; sample index = (row * width + col) * spp + s,
- * row 0 = top of the image, samples on a stratified aa x aa grid. */
+ * row 0 = top of the image, samples on a stratified aa x aa pattern
+ * (vsgl__gbuffer_pattern). */
 typedef struct vsgl_gbuffer {
     uint32_t width, height, spp;   /* slots per pixel: vsgl__gbuffer_slots (aa * aa, or 3 at aa = 1
                                       with edge refinement: slots 1 and 2 empty misses of weight 0
                                       unless an edge fills them) */
-    uint32_t aa;                   /* the stratified grid's side: slot s < aa * aa of pixel (col, row) was
-                                      traced at (col + (s % aa + 0.5) / aa, row + (s / aa + 0.5) / aa) */
+    uint32_t aa;                   /* the stratified pattern's side: slot s < aa * aa of pixel (col, row)
+                                      was traced at (col, row) + vsgl__gbuffer_pattern(s, aa) */
     size_t count;                  /* width * height * spp */
     float *pos[3];                 /* world position */
     float *nrm[3];                 /* unit shading normal on the camera's side of the surface: flipped
@@ -46,6 +47,26 @@ typedef struct vsgl_gbuffer {
     size_t edge_pixels;            /* pixels refined */
 } vsgl_gbuffer;
 
+/* Position of sample s of an n x n pattern within its pixel, in [0, 1)^2
+ * (x right, y down): the first pass's aa x aa samples (n = aa) and an edge
+ * pixel's edge_aa x edge_aa rays (n = edge_aa). Not the square grid
+ * ((i + 0.5) / n, (j + 0.5) / n) but that grid sheared by 1 / n of a cell
+ * both ways, ((i + (j + 0.5) / n) / n, (j + (i + 0.5) / n) / n): still a
+ * lattice (the rays s + 1 and s + n are s's neighbours) and still one
+ * sample per 1 / n stratum, but all n^2 samples have distinct x and
+ * distinct y, so the coverage of a horizontal or vertical edge takes n^2
+ * values instead of n. On the square grid a room's vertical edges crept
+ * across a pixel in steps of 1 / n: the corridor's end wall (an edge
+ * moving 0.09 px a frame, 8 x 8 edge rays) jumped in some frames and
+ * stood still in others (docs/accuracy.md, "Edges that move in steps").
+ * For n = 2 this is the rotated-grid pattern of 4x supersampling. */
+static inline void vsgl__gbuffer_pattern(uint32_t s, uint32_t n, float inv_n, float *ox, float *oy)
+{
+    const float i = (float)(s % n), j = (float)(s / n);
+    *ox = (i + (j + 0.5f) * inv_n) * inv_n;
+    *oy = (j + (i + 0.5f) * inv_n) * inv_n;
+}
+
 /* Slots per pixel for aa x aa samples, with or without edge refinement. At
  * aa = 1 an edge pixel has three slots, one per surface it sees, so that a
  * corner, where two faces of a cabinet meet the floor, keeps all three:
@@ -65,12 +86,29 @@ static inline float vsgl__gbuffer_weight(const vsgl_gbuffer *g, size_t i)
     return g->weight ? g->weight[i] : 1.0f / (float)g->spp;
 }
 
+/* Did edge refinement rewrite pixel px's slots (edges.c)? Then each slot
+ * stands for a group of rays anywhere in the pixel, not for its sample of
+ * the aa x aa grid: its weight is its group's share, where a pixel left
+ * alone keeps the grid's 1 / (aa * aa) (vsgl__gbuffer_build). */
+static inline int vsgl__gbuffer_refined(const vsgl_gbuffer *g, size_t px)
+{
+    if (!g->weight)
+        return 0;
+    const size_t n = (size_t)g->aa * g->aa;
+    const float w = 1.0f / (float)(g->aa * g->aa); /* the build's expression, to the bit */
+    const float *p = g->weight + px * g->spp;
+    for (size_t k = 0; k < g->spp; ++k)
+        if (p[k] != (k < n ? w : 0.0f))
+            return 1;
+    return 0;
+}
+
 /* Material of sample i with its own inputs (textured scenes), else its
  * material's constants. The sample must be a hit. */
 void vsgl__gbuffer_material(const vsgl_gbuffer *g, const vsgl_material *materials, size_t i, vsgl_material *out);
 
 /* Trace the camera's primary rays (aa x aa per pixel, aa in 1..16, 0 means 1;
- * sample s = j*aa + i at raster (col + (i+0.5)/aa, row + (j+0.5)/aa)) in
+ * sample s at raster (col, row) + vsgl__gbuffer_pattern(s, aa)) in
  * parallel. With edge_aa > aa, pixels whose samples (or whose
  * neighbours' nearest samples) lie on different surfaces are traced again
  * with edge_aa x edge_aa rays, and their aa x aa slots hold one sample per

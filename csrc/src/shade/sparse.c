@@ -17,7 +17,13 @@
  *     the edge of a glossy floor's reflection of a lit wall, which bilinear
  *     weights blurred (the spot room's glossy structured error 3.6x, its
  *     diffuse 2x what these samples give, docs/quality.md)
- *     (vsgl__shade_sparse_batch).
+ *     (vsgl__shade_sparse_batch). So is every slot of a pixel that edge
+ *     refinement rewrote (gbuffer.h vsgl__gbuffer_refined): a slot there
+ *     stands for a group of rays anywhere in the pixel, not for a
+ *     position in the anchor cell, and interpolated at its grid position
+ *     it took the anchors' light in some frames and its own in others (the
+ *     corridor's end-wall edges as the camera moved; docs/accuracy.md,
+ *     "Edges that move in steps"). That shades ~3 % more pairs.
  * The light of a sample, not its colour, is interpolated: DiffCol and
  * GlossCol stay per pixel. The shading work falls by about S^2 except at
  * edges and where the light bends (at S = 2 and 2 x 2 samples, 320 x 240:
@@ -242,14 +248,14 @@ static inline unsigned sparse_touching(unsigned same, unsigned other, const floa
 }
 
 /* The anchor cell around sample si: its raster position against the
- * anchors' (each shaded at its pixel's first sample); sample k of pixel
- * (x, y) lies at (x + (k % aa + 0.5) / aa, ...). */
+ * anchors' (each shaded at its pixel's first sample; sparse_slot_offset). */
 static inline void sample_cell(const shade_job *j, size_t si, size_t spp, uint32_t aa, float inv_aa, uint32_t *ax,
                                uint32_t *ay, float *tx, float *ty)
 {
     const size_t W = j->g->width, px = si / spp, k = si % spp;
     const float inv_s = 1.0f / (float)j->stride;
-    float ox = k < aa * aa ? (float)(k % aa) * inv_aa : 0.0f, oy = k < aa * aa ? (float)(k / aa) * inv_aa : 0.0f;
+    float ox, oy;
+    sparse_slot_offset(k, aa, inv_aa, &ox, &oy);
     float fx = ((float)(px % W) + ox) * inv_s, fy = ((float)(px / W) + oy) * inv_s;
     *ax = (uint32_t)fx;
     *ay = (uint32_t)fy;
@@ -336,7 +342,7 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
             if (!(t < 1.0f))
                 t = 1.0f;
         }
-        if (t < 1.0f && sparse_junction(same, sparse_touching(same, other, ad2)))
+        if (t < 1.0f && (sparse_junction(same, sparse_touching(same, other, ad2)) || vsgl__gbuffer_refined(g, si / spp)))
             t = 1.0f;
         if (t < 1.0f)
             for (int c = 0; c < 6; ++c)
@@ -648,8 +654,10 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
                     wsum += wa;
                     w[dy * 2 + dx] = wa;
                 }
-            plan->direct[si] =
-                wsum > 0.05f && !sparse_junction(same, sparse_touching(same, other, ad2)) ? PLAN_NEAR : PLAN_ALONE;
+            plan->direct[si] = wsum > 0.05f && !sparse_junction(same, sparse_touching(same, other, ad2)) &&
+                                       !vsgl__gbuffer_refined(g, px)
+                                   ? PLAN_NEAR
+                                   : PLAN_ALONE;
             float t = 1.0f;
             if (plan->direct[si] == PLAN_ALONE ||
                 !vsgl__sparse_interp(j, plan->pack, w, ax, ay, tx, ty, bt->interp + bi * 6, &t) || t > 0.0f)

@@ -45,6 +45,22 @@ static inline float sparse_normal_cos(const shade_job *j, uint32_t m, float *inv
     return SPARSE_NORMAL_COS;
 }
 #define SPARSE_PLANE_REL 0.05f
+
+/* Slot k's raster offset from its pixel's first sample (the anchors are
+ * shaded at their pixels' first samples), for k on the aa x aa pattern
+ * (vsgl__gbuffer_pattern); 0 for the slots beyond it. sparse.c's
+ * sample_cell and sparse_plan.c's cell tables take it alike, to the bit. */
+static inline void sparse_slot_offset(size_t k, uint32_t aa, float inv_aa, float *ox, float *oy)
+{
+    *ox = *oy = 0.0f;
+    if (k < (size_t)aa * aa) {
+        float x0, y0;
+        vsgl__gbuffer_pattern((uint32_t)k, aa, inv_aa, ox, oy);
+        vsgl__gbuffer_pattern(0u, aa, inv_aa, &x0, &y0);
+        *ox -= x0;
+        *oy -= y0;
+    }
+}
 /* Interpolate only where bilinear interpolation is accurate: its error at
  * (tx, ty) in a cell is about (tx (1 - tx) d2x + ty (1 - ty) d2y) / 2, d2
  * the anchors' second differences along x and y (from the anchors around

@@ -38,8 +38,9 @@ static void cell_table(uint32_t n, size_t spp, uint32_t aa, uint32_t stride, uin
     const float inv_aa = 1.0f / (float)aa, inv_s = 1.0f / (float)stride;
     for (uint32_t x = 0; x < n; ++x)
         for (size_t k = 0; k < spp; ++k) {
-            float o = k < (size_t)aa * aa ? (float)(rows ? k / aa : k % aa) * inv_aa : 0.0f;
-            float f = ((float)x + o) * inv_s;
+            float ox, oy;
+            sparse_slot_offset(k, aa, inv_aa, &ox, &oy);
+            float f = ((float)x + (rows ? oy : ox)) * inv_s;
             uint32_t c = (uint32_t)f;
             cell[(size_t)x * spp + k] = c;
             t[(size_t)x * spp + k] = f - (float)c;
