@@ -181,6 +181,59 @@ VT_TEST(fit_lattice_keeps_a_face_of_the_bounds_in_one_slab)
     lroom_close(&rm);
 }
 
+/* A cluster's cut (cell_lo, cell_hi: where its VPLs end) lies within the
+ * scene's bounds, whatever the texels' footprints: a floor's VPLs shifted
+ * by a fraction of a texel towards the wall x = 1 reach past it by that
+ * fraction, and the cut there wandered with them (the sphere room's
+ * preview: the back wall's corner cell cut at x = -2.504, -2.499, -2.519
+ * around the wall at -2.5 in three frames, its reflection in the floor
+ * 27 % darker in one of them). */
+VT_TEST(fit_lattice_keeps_its_cuts_within_the_scene)
+{
+    static lroom rm;
+    if (!lroom_open(&rm))
+        return;
+    v3 blo, bhi;
+    vsgl__scene_bounds(rm.scene, &blo, &bhi);
+    const float lo[3] = {blo.x, blo.y, blo.z}, hi[3] = {bhi.x, bhi.y, bhi.z};
+    const uint32_t res = 64;
+    size_t outside = 0;
+    float reach[3];
+    for (int i = 0; i < 3; ++i) {
+        const float shift = (0.25f + 0.25f * (float)i) / (float)res; /* the last texels' centres stay inside */
+        plane_rsm h;
+        make_plane_rsm(&h, res, 0, shift, 3);
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        s.vsgl_count = 64;
+        vsgl_vsgl_set lat = {0};
+        VT_REQUIRE(vsgl__fit_lattice(rm.ctx, rm.scene, &h.r, &s, &lat) == VSGL_OK, "%s",
+                   vsgl_context_last_error(rm.ctx));
+        reach[i] = -INFINITY;
+        for (size_t k = 0; k < lat.count; ++k) {
+            const vsgl_vsgl *v = &lat.items[k];
+            for (int c = 0; c < 2; ++c) {
+                const int a = ((int)v->cell_axis + 1 + c) % 3;
+                if (v->cell_lo[c] < lo[a] - 1e-6f || v->cell_hi[c] > hi[a] + 1e-6f) {
+                    if (outside++ < 3)
+                        VT_REPORT("shift %g: VSGL %zu cut at [%g, %g] on axis %d, bounds [%g, %g]", (double)shift, k,
+                                  (double)v->cell_lo[c], (double)v->cell_hi[c], a, (double)lo[a], (double)hi[a]);
+                }
+                if (v->cell_axis == 2 && a == 0)
+                    reach[i] = fmaxf(reach[i], v->cell_hi[c]);
+            }
+        }
+        vsgl__vsgl_set_free(&lat);
+        free_plane_rsm(&h);
+    }
+    printf("    the floor's cut at the wall x = %g: %.5f %.5f %.5f for shifts of 1/4, 1/2, 3/4 texel\n", (double)hi[0],
+           (double)reach[0], (double)reach[1], (double)reach[2]);
+    VT_CHECK(outside == 0, "%zu cuts outside the scene's bounds", outside);
+    VT_CHECK(reach[0] == hi[0] && reach[1] == hi[0] && reach[2] == hi[0], "the cut at the wall moved: %g %g %g",
+             (double)reach[0], (double)reach[1], (double)reach[2]);
+    lroom_close(&rm);
+}
+
 /* Light at receiver x (normal n) from a set, through the reference path's
  * formulas (the kernel is checked against them in test_kernel.c). */
 /* clip: 0 no clip (the papers' model but for the plane spread, shade.h), 1 the emitter clip, 2 the clip and the near

@@ -456,8 +456,21 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
                     v.part_out = (float)fmin(fmax(pw[0] / f[0], 0.0), 1.0);
                     v.part_in = (float)fmin(fmax(pw[1] / f[0], 0.0), 1.0 - v.part_out);
                 }
-                const double *e = map.ext + c * 4;
                 int ax = (cc[0] & 7) >> 1, au = (ax + 1) % 3, av = (ax + 2) % 3;
+                /* The VPLs' extent, within the scene's bounds (0 at the
+                 * anchor, the bounds' low corner). The texels' footprints
+                 * reach past a wall by up to half a texel, by an amount that
+                 * changes as the light moves: the sphere room's back-wall
+                 * corner cell was cut at x = -2.504, -2.499, -2.519 around
+                 * the wall at -2.5 in three frames, and its reflection in the
+                 * floor lost 27 % in one of them (the preview's glossy light
+                 * flicker 0.0101 -> 0.0089). No surface lies there; the near
+                 * field's cells, which ended past the walls too, now give the
+                 * junctions the light of the brute force on a converged RSM
+                 * (test_near_field.c). */
+                const double *ex = map.ext + c * 4;
+                const double e[4] = {fmax(ex[0], 0.0), fmin(ex[1], (far[au] - anchor[au]) / hc), fmax(ex[2], 0.0),
+                                     fmin(ex[3], (far[av] - anchor[av]) / hc)};
                 v.cell_h = (float)hc;
                 v.cell_axis = (uint32_t)ax;
                 v.cell_side = (uint32_t)(cc[0] & 1);
