@@ -90,6 +90,17 @@ static void lroom_close(lroom *r)
     vsgl_context_destroy(r->ctx);
 }
 
+/* The balanced preset's lattice of `count` clusters over RSM r in the room;
+ * 0 (the context says why) if the fit failed. */
+static int fit_balanced(lroom *rm, const vsgl_rsm *r, uint32_t count, vsgl_vsgl_set *lat)
+{
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.vsgl_count = count;
+    memset(lat, 0, sizeof *lat);
+    return vsgl__fit_lattice(rm->ctx, rm->scene, r, &s, lat) == VSGL_OK;
+}
+
 static double set_power(const vsgl_vsgl_set *s)
 {
     double w = 0;
@@ -156,12 +167,8 @@ VT_TEST(fit_lattice_keeps_a_face_of_the_bounds_in_one_slab)
             h.r.pos[2][t] = face + ((t * 7u + t / 64u) % 3u == 0 ? -ulp : (t % 3u == 1 ? ulp : 0.0f));
             h.r.nrm[2][t] = h.r.wi[2][t] = ceiling ? -1.0f : 1.0f;
         }
-        vsgl_render_settings s;
-        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
-        s.vsgl_count = 64;
-        vsgl_vsgl_set lat = {0};
-        VT_REQUIRE(vsgl__fit_lattice(rm.ctx, rm.scene, &h.r, &s, &lat) == VSGL_OK, "%s",
-                   vsgl_context_last_error(rm.ctx));
+        vsgl_vsgl_set lat;
+        VT_REQUIRE(fit_balanced(&rm, &h.r, 64, &lat), "%s", vsgl_context_last_error(rm.ctx));
         int twins = 0;
         for (size_t a = 0; a < lat.count; ++a)
             for (size_t b = a + 1; b < lat.count; ++b) {
@@ -203,12 +210,8 @@ VT_TEST(fit_lattice_keeps_its_cuts_within_the_scene)
         const float shift = (0.25f + 0.25f * (float)i) / (float)res; /* the last texels' centres stay inside */
         plane_rsm h;
         make_plane_rsm(&h, res, 0, shift, 3);
-        vsgl_render_settings s;
-        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
-        s.vsgl_count = 64;
-        vsgl_vsgl_set lat = {0};
-        VT_REQUIRE(vsgl__fit_lattice(rm.ctx, rm.scene, &h.r, &s, &lat) == VSGL_OK, "%s",
-                   vsgl_context_last_error(rm.ctx));
+        vsgl_vsgl_set lat;
+        VT_REQUIRE(fit_balanced(&rm, &h.r, 64, &lat), "%s", vsgl_context_last_error(rm.ctx));
         reach[i] = -INFINITY;
         for (size_t k = 0; k < lat.count; ++k) {
             const vsgl_vsgl *v = &lat.items[k];

@@ -565,6 +565,14 @@ VT_TEST(render_shade_stride_cuts_pairs_at_small_error)
     free(dc_full);
 }
 
+/* The balanced preset without visibility rays, on RSM 64: the stride tests' model. */
+static void balanced_without_rays(vsgl_render_settings *s)
+{
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, s);
+    s->visibility = VSGL_VISIBILITY_NONE;
+    s->rsm_resolution = 64;
+}
+
 /* At shade_stride 2 every pixel that edge refinement rewrote is shaded
  * itself, as at stride 1: its slots stand for groups of rays anywhere in
  * the pixel, which no anchor cell describes. Interpolated at its slots'
@@ -575,9 +583,7 @@ VT_TEST(render_shade_stride_shades_edge_pixels_themselves)
 {
     enum { SW = 160, SH = 120 };
     vsgl_render_settings s;
-    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
-    s.visibility = VSGL_VISIBILITY_NONE;
-    s.rsm_resolution = 64;
+    balanced_without_rays(&s);
     float *dc[2], *img[2];
     for (int k = 0; k < 2; ++k) {
         s.shade_stride = k ? 2 : 1;
@@ -626,9 +632,7 @@ VT_TEST(render_shade_stride_interpolates_a_mirror_floor)
 {
     enum { SW = 120, SH = 90 };
     vsgl_render_settings s;
-    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
-    s.visibility = VSGL_VISIBILITY_NONE;
-    s.rsm_resolution = 64;
+    balanced_without_rays(&s);
     s.aa_samples = 1;
     s.edge_samples = 0;
     vsgl_render_stats st[2] = {{.size = sizeof st[0]}, {.size = sizeof st[1]}};
