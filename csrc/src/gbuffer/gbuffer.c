@@ -3,8 +3,8 @@
  *
  * Sample s of pixel (col, row) is at raster position (col, row) +
  * vsgl__gbuffer_pattern(s, aa) (a sheared aa x aa grid, gbuffer.h), row
- * 0 = top; aa = 1 gives the pixel centre. Positions depend only on (col, row, s): the buffer is
- * bit-identical for any thread count. */
+ * 0 = top; aa = 1 gives the pixel centre. Positions depend only on (col,
+ * row, s): the buffer is bit-identical for any thread count. */
 #include "gbuffer/gbuffer.h"
 #include "gbuffer/trace.h"
 #include "core/context.h"
