@@ -208,18 +208,11 @@ VT_TEST(near_field_index_lists_every_cell_that_reaches_a_point)
 }
 
 /* The diffuse plane of the fixture room's scene, shaded every pixel without
- * visibility rays (a convex room), by `method` with leak correction `leak`;
+ * visibility rays (a convex room), by `method` with leak correction `leak`
+ * on RSMs of `rsm` texels a side;
  * NULL if the render failed. *count: the VSGLs shaded. */
-static float *render_diffuse_rsm(vsgl_context *ctx, vsgl_scene *scene, uint32_t W, uint32_t H, int32_t method,
-                                 int32_t leak, uint32_t rsm, uint32_t *count);
 static float *render_diffuse(vsgl_context *ctx, vsgl_scene *scene, uint32_t W, uint32_t H, int32_t method,
-                             int32_t leak, uint32_t *count)
-{
-    return render_diffuse_rsm(ctx, scene, W, H, method, leak, 64, count);
-}
-
-static float *render_diffuse_rsm(vsgl_context *ctx, vsgl_scene *scene, uint32_t W, uint32_t H, int32_t method,
-                                 int32_t leak, uint32_t rsm, uint32_t *count)
+                             int32_t leak, uint32_t rsm, uint32_t *count)
 {
     float *img = calloc((size_t)W * H * 3, sizeof(float));
     vsgl_render_settings s;
@@ -273,7 +266,7 @@ VT_TEST(near_field_junctions_against_brute_force)
     const uint32_t rsm[4] = {256, 64, 64, 64};
     float *img[4];
     for (int k = 0; k < 4; ++k) {
-        img[k] = render_diffuse_rsm(ctx, scene, W, H, method[k], leak[k], rsm[k], NULL);
+        img[k] = render_diffuse(ctx, scene, W, H, method[k], leak[k], rsm[k], NULL);
         VT_REQUIRE(img[k], "render %d: %s", k, vsgl_context_last_error(ctx));
     }
     double e_near = acc_relmse(img[1], img[0], n), e_far = acc_relmse(img[2], img[0], n);
@@ -322,7 +315,8 @@ VT_TEST(lattice_specular_tail_against_brute_force)
     float *img[2];
     uint32_t count = 0;
     for (int k = 0; k < 2; ++k) {
-        img[k] = render_diffuse(ctx, scene, W, H, k ? VSGL_METHOD_VSGL : VSGL_METHOD_BRUTE_FORCE, VSGL_LEAK_CLIP, &count);
+        img[k] = render_diffuse(ctx, scene, W, H, k ? VSGL_METHOD_VSGL : VSGL_METHOD_BRUTE_FORCE, VSGL_LEAK_CLIP, 64,
+                                &count);
         VT_REQUIRE(img[k], "render %d: %s", k, vsgl_context_last_error(ctx));
     }
     double e = acc_relmse(img[1], img[0], n);

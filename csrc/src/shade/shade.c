@@ -452,8 +452,8 @@ static int same_rays(const vsgl_vsgl *a, const vsgl_kernel_light *ka, const vsgl
     return a->mean.x == b->mean.x && a->mean.y == b->mean.y && a->mean.z == b->mean.z &&
            a->normal.x == b->normal.x && a->normal.y == b->normal.y && a->normal.z == b->normal.z &&
            a->coherence == b->coherence && a->variance == b->variance && ka->clip == kb->clip &&
-           ka->ibehind == kb->ibehind && ka->boff == kb->boff && ka->mx == kb->mx && ka->my == kb->my && ka->mz == kb->mz &&
-           ka->nx == kb->nx && ka->ny == kb->ny && ka->nz == kb->nz;
+           ka->ibehind == kb->ibehind && ka->boff == kb->boff && ka->mx == kb->mx && ka->my == kb->my &&
+           ka->mz == kb->mz && ka->nx == kb->nx && ka->ny == kb->ny && ka->nz == kb->nz;
 }
 
 /* The bits of lanes [0, n). */

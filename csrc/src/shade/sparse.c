@@ -277,8 +277,11 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
     const size_t first = (j->base + b0) * spp, ns = (e0 - b0) * spp;
     const uint32_t aa = g->aa;
     const float inv_aa = 1.0f / (float)aa;
+    int refined = 0; /* the sample's pixel's, once per pixel (first is a pixel's first sample) */
     for (size_t i = 0; i < ns; ++i) {
         size_t si = first + i, bi = si - bt->first;
+        if (i % spp == 0)
+            refined = vsgl__gbuffer_refined(g, si / spp);
         bt->direct_of[bi] = SIZE_MAX;
         if (g->material[si] == VSGL__GBUFFER_MISS)
             continue;
@@ -342,7 +345,7 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
             if (!(t < 1.0f))
                 t = 1.0f;
         }
-        if (t < 1.0f && (sparse_junction(same, sparse_touching(same, other, ad2)) || vsgl__gbuffer_refined(g, si / spp)))
+        if (t < 1.0f && (refined || sparse_junction(same, sparse_touching(same, other, ad2))))
             t = 1.0f;
         if (t < 1.0f)
             for (int c = 0; c < 6; ++c)
@@ -618,6 +621,7 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
             continue;
         }
 #endif
+        const int refined = vsgl__gbuffer_refined(g, px);
         for (size_t k = 0; k < spp; ++k) {
             const size_t si = px * spp + k, bi = si - bt->first;
             float *w = plan->w4 + si * 4;
@@ -654,8 +658,7 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
                     wsum += wa;
                     w[dy * 2 + dx] = wa;
                 }
-            plan->direct[si] = wsum > 0.05f && !sparse_junction(same, sparse_touching(same, other, ad2)) &&
-                                       !vsgl__gbuffer_refined(g, px)
+            plan->direct[si] = wsum > 0.05f && !refined && !sparse_junction(same, sparse_touching(same, other, ad2))
                                    ? PLAN_NEAR
                                    : PLAN_ALONE;
             float t = 1.0f;
