@@ -13,6 +13,28 @@ static float smith_term(float ci, float co, float a2)
     return ci / (ci * so + co * si);
 }
 
+/* Row e of the slope's Jacobian at half vector h, |o + l| = m: ds_e =
+ * row . dl, row = (I - h h^T)(e - s_e n) / (h.n m). */
+static v3 hv_row(v3 h, float m, v3 n, v3 e, float se)
+{
+    v3 a = v3_sub(e, v3_scale(n, se));
+    return v3_scale(v3_sub(a, v3_scale(h, v3_dot(h, a))), 1.0f / (v3_dot(h, n) * m));
+}
+
+/* The slope s of h in the frame (t, u, n) and the slope covariance cov of
+ * a cluster of directions about w (variance sv per axis, off w and off its
+ * projected normal p) through the Jacobian at h. */
+static void hv_linearise(v3 h, float m, v3 n, v3 t, v3 u, v3 w, v3 p, float sv, float s[2], float cov[2][2])
+{
+    float hn = v3_dot(h, n);
+    s[0] = v3_dot(h, t) / hn;
+    s[1] = v3_dot(h, u) / hn;
+    v3 a[2] = {hv_row(h, m, n, t, s[0]), hv_row(h, m, n, u, s[1])};
+    for (int i = 0; i < 2; ++i)
+        for (int k = 0; k < 2; ++k)
+            cov[i][k] = sv * (v3_dot(a[i], a[k]) - v3_dot(a[i], w) * v3_dot(a[k], w) - v3_dot(a[i], p) * v3_dot(a[k], p));
+}
+
 float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float alpha, int lobes,
                            const float fres[3], float *weight)
 {
@@ -37,32 +59,47 @@ float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float 
         return 0.0f;
     v3 t, u;
     v3_basis(n, &t, &u);
-    float s[2] = {v3_dot(h, t) / hn, v3_dot(h, u) / hn};
-    v3 e[2] = {v3_sub(t, v3_scale(n, s[0])), v3_sub(u, v3_scale(n, s[1]))};
-    v3 a[2];
-    for (int i = 0; i < 2; ++i)
-        a[i] = v3_scale(v3_sub(e[i], v3_scale(h, v3_dot(h, e[i]))), 1.0f / (hn * m));
     v3 p = v3_sub(v->normal, v3_scale(w, v3_dot(v->normal, w)));
-    float cov[2][2];
-    for (int i = 0; i < 2; ++i)
-        for (int k = 0; k < 2; ++k)
-            cov[i][k] = sv * (v3_dot(a[i], a[k]) - v3_dot(a[i], w) * v3_dot(a[k], w) - v3_dot(a[i], p) * v3_dot(a[k], p));
+    float s[2], cov[2][2];
+    hv_linearise(h, m, n, t, u, w, p, sv, s, cov);
+    /* Linearised at w alone, a wide cluster seen at a grazing view was
+     * wrong by orders of magnitude: the slope is (o + l).t / (o + l).n, and
+     * where (o + l).n is small the cluster's spread moves it a lot and not
+     * linearly (a corridor floor at cos_o 0.04 took 100-700x the light of a
+     * wall's cluster 10 degrees to the side). Each sharp lobe (the first
+     * VSGL__HV_RELIN) linearises again where its product with the
+     * cluster's slope Gaussian peaks, se = al2 (al2 I + cov)^-1 s: w itself
+     * for a cluster small against the lobe, the mirror direction for a
+     * wide one; D's 1/h.n^4, G and F are taken there. */
     const float *K, *C;
     const int nl = vsgl__hv_lobe_set(lobes, &K, &C);
-    float ed = 0.0f; /* E[D] h.n^4 */
+    const float a2 = alpha * alpha, co = fmaxf(v3_dot(o, n), 1e-4f), ca = fmaxf(v3_dot(axis, n), 1e-4f);
+    float sum = 0.0f; /* E[D] G F over G and F at the axis */
     for (int q = 0; q < nl; ++q) {
-        float al2 = alpha * alpha * 0.5f / K[q];
-        float c11 = al2 + cov[0][0], c22 = al2 + cov[1][1], c12 = cov[0][1];
+        float al2 = a2 * 0.5f / K[q];
+        float m11 = al2 + cov[0][0], m22 = al2 + cov[1][1], m12 = cov[0][1], md = m11 * m22 - m12 * m12;
+        float se0 = al2 * (m22 * s[0] - m12 * s[1]) / md, se1 = al2 * (m11 * s[1] - m12 * s[0]) / md;
+        v3 he = v3_normalize(v3_add(n, v3_add(v3_scale(t, se0), v3_scale(u, se1))));
+        float oh = v3_dot(o, he), sl[2] = {s[0], s[1]}, cl[2][2] = {{cov[0][0], cov[0][1]}, {cov[1][0], cov[1][1]}};
+        v3 hl = h, le = w;
+        if (q < VSGL__HV_RELIN && md > 1e-30f && oh > 1e-4f) {
+            float me = 2.0f * oh, sw[2];
+            hl = he;
+            le = v3_sub(v3_scale(he, me), o); /* the mirror of o about he */
+            hv_linearise(he, me, n, t, u, w, p, sv, sw, cl);
+            v3 dl = v3_sub(w, le); /* w's slope through the linearisation at le */
+            sl[0] = sw[0] + v3_dot(hv_row(he, me, n, t, sw[0]), dl);
+            sl[1] = sw[1] + v3_dot(hv_row(he, me, n, u, sw[1]), dl);
+        }
+        float c11 = al2 + cl[0][0], c22 = al2 + cl[1][1], c12 = cl[0][1];
         float det = c11 * c22 - c12 * c12;
         if (!(det > 0.0f))
             continue;
-        float qf = (c22 * s[0] * s[0] - 2.0f * c12 * s[0] * s[1] + c11 * s[1] * s[1]) / det;
-        ed += C[q] / K[q] * expf(-0.5f * fmaxf(qf, 0.0f)) / (VSGL__2PI * sqrtf(det));
+        float qf = (c22 * sl[0] * sl[0] - 2.0f * c12 * sl[0] * sl[1] + c11 * sl[1] * sl[1]) / det;
+        float hnl = v3_dot(hl, n), ci = fmaxf(v3_dot(le, n), 0.0f);
+        sum += C[q] / K[q] * expf(-0.5f * fmaxf(qf, 0.0f)) / (VSGL__2PI * sqrtf(det)) / (hnl * hnl * hnl * hnl) *
+               smith_term(ci, co, a2) * (fres[1] + fres[2] * vsgl__fresnel_dielectric(v3_dot(le, hl), fres[0]));
     }
-    float a2 = alpha * alpha;
-    float co = fmaxf(v3_dot(o, n), 1e-4f), ci = fmaxf(v3_dot(w, n), 0.0f), ca = fmaxf(v3_dot(axis, n), 1e-4f);
-    float g = smith_term(ci, co, a2) / smith_term(ca, co, a2);
     *weight = wgt;
-    return (1.0f / VSGL__PI) * hgt * r * r * r * ed / (hn * hn * hn * hn) * g *
-           (fres[1] + fres[2] * vsgl__fresnel_dielectric(v3_dot(w, h), fres[0]));
+    return (1.0f / VSGL__PI) * hgt * r * r * r * sum / smith_term(ca, co, a2);
 }

@@ -236,6 +236,12 @@ typedef struct k_scratch {
      * cluster's slope covariance, and the factor common to its lobes */
     float hvw[VSGL__KERNEL_BLOCK], hs1[VSGL__KERNEL_BLOCK], hs2[VSGL__KERNEL_BLOCK];
     float hc11[VSGL__KERNEL_BLOCK], hc12[VSGL__KERNEL_BLOCK], hc22[VSGL__KERNEL_BLOCK], hpre[VSGL__KERNEL_BLOCK];
+    /* D's 1 / h.n^4 x G x F at w (a lobe linearised there), Smith's view term */
+    float hfw[VSGL__KERNEL_BLOCK], hso[VSGL__KERNEL_BLOCK];
+    /* w, the cluster's projected normal p and the view o in the frame (t, u, n), the spread var/d^2 */
+    float hwt[VSGL__KERNEL_BLOCK], hwu[VSGL__KERNEL_BLOCK], hwn[VSGL__KERNEL_BLOCK], hpt[VSGL__KERNEL_BLOCK],
+        hpu[VSGL__KERNEL_BLOCK], hpn[VSGL__KERNEL_BLOCK], hot[VSGL__KERNEL_BLOCK], hou[VSGL__KERNEL_BLOCK],
+        hon[VSGL__KERNEL_BLOCK], hsv[VSGL__KERNEL_BLOCK];
 } k_scratch;
 
 /* Stage 1: the incident radiance as one SG (Eq. 7), all but the exp.
@@ -600,6 +606,17 @@ k_hv_shared(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_lig
     t->hc12[i] = sv * (a1x * a2x + a1y * a2y + a1z * a2z - a1w * a2w - a1p * a2p);
     t->hs1[i] = s1;
     t->hs2[i] = s2;
+    /* w, p and o in the frame (t, u, n), and the spread, for k_hv_lobe */
+    t->hwt[i] = wx * tx + wy * ty + wz * tz;
+    t->hwu[i] = wx * ux + wy * uy + wz * uz;
+    t->hwn[i] = wx * nx + wy * ny + wz * nz;
+    t->hpt[i] = px * tx + py * ty + pz * tz;
+    t->hpu[i] = px * ux + py * uy + pz * uz;
+    t->hpn[i] = px * nx + py * ny + pz * nz;
+    t->hot[i] = b->ox[i] * tx + b->oy[i] * ty + b->oz[i] * tz;
+    t->hou[i] = b->ox[i] * ux + b->oy[i] * uy + b->oz[i] * uz;
+    t->hon[i] = b->ox[i] * nx + b->oy[i] * ny + b->oz[i] * nz;
+    t->hsv[i] = sv;
     /* the weight: small spread, half vector well above the horizon, a lane with alpha */
     float ws = (VSGL__HV_SPREAD_HI - sv) * (1.0f / (VSGL__HV_SPREAD_HI - VSGL__HV_SPREAD_LO));
     ws = ws < 0.0f ? 0.0f : (ws > 1.0f ? 1.0f : ws);
@@ -610,8 +627,9 @@ k_hv_shared(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_lig
     float h = t->h[i];
     w = a > 0.0f && h > 0.0f ? w : 0.0f;
     t->hvw[i] = w;
-    /* Smith's shadowing-masking with the cluster's direction over the one
-     * with the lobe's axis, where M (f0r..) is taken */
+    /* Smith's shadowing-masking with the light's direction over the one
+     * with the lobe's axis, where M (f0r..) is taken: here at w (a lobe
+     * that linearises elsewhere takes its own, k_hv_lobe) */
     float a2 = a * a;
     float co = b->ox[i] * nx + b->oy[i] * ny + b->oz[i] * nz;
     co = co > 1e-4f ? co : 1e-4f;
@@ -623,27 +641,75 @@ k_hv_shared(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_lig
     float gc = ci / (ci * so + co * sqrtf(a2 + (1.0f - a2) * ci * ci));
     float ga = ca / (ca * so + co * sqrtf(a2 + (1.0f - a2) * ca * ca));
     float ih2 = ihn * ihn;
-    /* radiance N / pi, the emitter's cos / d^2 = h r^3, and D's 1 / h.n^4 */
-    /* the dielectric Fresnel towards the cluster over M's at the axis */
+    /* D's 1 / h.n^4, G and the dielectric Fresnel towards w over M's at the axis */
     float fr = b->fa[i] + b->fb[i] * vsgl__fresnel_dielectric(wx * hx + wy * hy + wz * hz, b->fe[i]);
-    float pre = w * t->vis[i] * h * r * r * r * (1.0f / VSGL__PI) * ih2 * ih2 * (gc / ga) * fr;
+    t->hfw[i] = ih2 * ih2 * gc * fr;
+    t->hso[i] = so;
+    /* radiance N / pi, the emitter's cos / d^2 = h r^3, over G at the axis */
+    float pre = w * t->vis[i] * h * r * r * r * (1.0f / VSGL__PI) / ga;
     t->hpre[i] = w > 0.0f ? pre : 0.0f; /* a select: r^3 overflows where w is 0 (a receiver at the mean) */
 }
 
 /* One lobe (k, c) of the half-vector model: the lobe's slope covariance
- * alpha^2 / 2k plus the cluster's, evaluated at s: into ppre, pexpo. */
+ * alpha^2 / 2k plus the cluster's, evaluated at s: into ppre, pexpo.
+ * Linearised at w alone, a wide cluster seen at a grazing view was wrong
+ * by orders of magnitude (the slope (o + l).t / (o + l).n changes fast and
+ * not linearly across it where (o + l).n is small: halfvec.c). The lobe
+ * linearises again where its product with the cluster's slope Gaussian
+ * peaks: slope q = al2 (al2 I + C)^-1 s, half vector g = (n + q1 t + q2
+ * u) / |.|, light direction le = 2 (o.g) g - o. The Jacobian's rows there
+ * are (t - q1 n) and (u - q2 n) over g.n |o + le| = 2 (o.g) / |n + q1 t +
+ * q2 u|^2 (g is orthogonal to both), so everything is a dot product in the
+ * frame (t, u, n) that k_hv_shared stored: w's slope through it q + J (w -
+ * le) (J le's rows reduce to q_e o.n - o.e), the cluster's covariance,
+ * and D's 1 / g.n^4 = |n + q t|^4, G and F at le (le.n = 2 (o.g) g.n -
+ * o.n, le.g = o.g). Where o.g is not positive (no such mirror direction),
+ * w's stand, as they do for the broad lobes past VSGL__HV_RELIN (relin 0):
+ * their product peaks near w but for the widest clusters, and they hold
+ * a sixth of GGX's energy. */
 static inline __attribute__((always_inline)) void
-k_hv_lobe(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t, float kb, float kc)
+k_hv_lobe(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t, float kb, float kc, const int relin)
 {
     float a = b->alpha[i];
     float al2 = a * a * (0.5f / kb);
-    float c11 = al2 + t->hc11[i], c22 = al2 + t->hc22[i], c12 = t->hc12[i];
+    float s1 = t->hs1[i], s2 = t->hs2[i], c11 = t->hc11[i], c22 = t->hc22[i], c12 = t->hc12[i];
+    float m11 = al2 + c11, m22 = al2 + c22, md = m11 * m22 - c12 * c12;
+    float imd = al2 / (md > 1e-30f ? md : 1e-30f);
+    float q1 = (m22 * s1 - c12 * s2) * imd, q2 = (m11 * s2 - c12 * s1) * imd;
+    float gg = 1.0f + q1 * q1 + q2 * q2, ig = k_rsqrt(gg); /* |n + q1 t + q2 u|^2, g.n */
+    float ot = t->hot[i], ou = t->hou[i], on = t->hon[i];
+    float oh = (on + q1 * ot + q2 * ou) * ig;
+    int moved = relin & (oh > 1e-4f) & (md > 1e-30f);
+    float ohc = oh > 1e-4f ? oh : 1e-4f;
+    float k2 = 2.0f * ohc * ig; /* g.n |o + le| */
+    float sce = 1.0f / k2;
+    float wn = t->hwn[i], pn = t->hpn[i];
+    float bw1 = (t->hwt[i] - q1 * wn) * sce, bw2 = (t->hwu[i] - q2 * wn) * sce;
+    float bp1 = (t->hpt[i] - q1 * pn) * sce, bp2 = (t->hpu[i] - q2 * pn) * sce;
+    float bl1 = (q1 * on - ot) * sce, bl2 = (q2 * on - ou) * sce;
+    float sv = t->hsv[i], sc2 = sce * sce;
+    c11 = moved ? sv * (sc2 * (1.0f + q1 * q1) - bw1 * bw1 - bp1 * bp1) : c11;
+    c22 = moved ? sv * (sc2 * (1.0f + q2 * q2) - bw2 * bw2 - bp2 * bp2) : c22;
+    c12 = moved ? sv * (sc2 * q1 * q2 - bw1 * bw2 - bp1 * bp2) : c12;
+    s1 = moved ? q1 + bw1 - bl1 : s1;
+    s2 = moved ? q2 + bw2 - bl2 : s2;
+    /* D's 1 / g.n^4, G and F at le (k_hv_shared's at w where not moved) */
+    float co = on > 1e-4f ? on : 1e-4f;
+    float ci = k2 - on;
+    ci = ci > 0.0f ? ci : 0.0f;
+    float a2 = a * a;
+    float gc = ci / (ci * t->hso[i] + co * sqrtf(a2 + (1.0f - a2) * ci * ci));
+    float fr = b->fa[i] + b->fb[i] * vsgl__fresnel_dielectric(ohc, b->fe[i]);
+    float fw = t->hfw[i]; /* loaded unconditionally: a load in a select stops GCC's if-conversion */
+    float f = moved ? gg * gg * gc * fr : fw;
+    c11 += al2;
+    c22 += al2;
     float det = c11 * c22 - c12 * c12;
     det = det > 1e-30f ? det : 1e-30f;
-    float s1 = t->hs1[i], s2 = t->hs2[i];
     float q = (c22 * s1 * s1 - 2.0f * c12 * s1 * s2 + c11 * s2 * s2) / det;
     t->pexpo[i] = q > 0.0f ? -0.5f * q : 0.0f;
-    t->ppre[i] = t->hpre[i] * (kc / kb) * (0.5f / VSGL__PI) * k_rsqrt(det);
+    float pp = t->hpre[i] * f * (kc / kb) * (0.5f / VSGL__PI) * k_rsqrt(det);
+    t->ppre[i] = t->hpre[i] > 0.0f ? pp : 0.0f; /* a select: lanes of weight 0 may hold inf (k_hv_shared) */
 }
 
 /* The planar model's share where the half-vector model takes over. */
@@ -945,7 +1011,10 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
         const float *hk, *hc;
         const int nhv = vsgl__hv_lobe_set(lobes & VSGL__KERNEL_HV5 ? VSGL__HV5_LOBES : VSGL__HV_LOBES, &hk, &hc);
         for (int q = 0; q < nhv; ++q) {
-            K_FORN(k_hv_lobe(b, i, t + j, hk[q], hc[q]));
+            if (q < VSGL__HV_RELIN)
+                K_FORN(k_hv_lobe(b, i, t + j, hk[q], hc[q], 1));
+            else
+                K_FORN(k_hv_lobe(b, i, t + j, hk[q], hc[q], 0));
             K_FORN(k_glossy_sum(b, i, L + j, t + j, 3));
         }
     }
