@@ -77,19 +77,22 @@ float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float 
     float sum = 0.0f; /* E[D] G F over G and F at the axis */
     for (int q = 0; q < nl; ++q) {
         float al2 = a2 * 0.5f / K[q];
-        float m11 = al2 + cov[0][0], m22 = al2 + cov[1][1], m12 = cov[0][1], md = m11 * m22 - m12 * m12;
-        float se0 = al2 * (m22 * s[0] - m12 * s[1]) / md, se1 = al2 * (m11 * s[1] - m12 * s[0]) / md;
-        v3 he = v3_normalize(v3_add(n, v3_add(v3_scale(t, se0), v3_scale(u, se1))));
-        float oh = v3_dot(o, he), sl[2] = {s[0], s[1]}, cl[2][2] = {{cov[0][0], cov[0][1]}, {cov[1][0], cov[1][1]}};
+        float sl[2] = {s[0], s[1]}, cl[2][2] = {{cov[0][0], cov[0][1]}, {cov[1][0], cov[1][1]}};
         v3 hl = h, le = w;
-        if (q < VSGL__HV_RELIN && md > 1e-30f && oh > 1e-4f) {
-            float me = 2.0f * oh, sw[2];
-            hl = he;
-            le = v3_sub(v3_scale(he, me), o); /* the mirror of o about he */
-            hv_linearise(he, me, n, t, u, w, p, sv, sw, cl);
-            v3 dl = v3_sub(w, le); /* w's slope through the linearisation at le */
-            sl[0] = sw[0] + v3_dot(hv_row(he, me, n, t, sw[0]), dl);
-            sl[1] = sw[1] + v3_dot(hv_row(he, me, n, u, sw[1]), dl);
+        float m11 = al2 + cov[0][0], m22 = al2 + cov[1][1], m12 = cov[0][1], md = m11 * m22 - m12 * m12;
+        if (q < VSGL__HV_RELIN && md > 1e-30f) {
+            float se0 = al2 * (m22 * s[0] - m12 * s[1]) / md, se1 = al2 * (m11 * s[1] - m12 * s[0]) / md;
+            v3 he = v3_normalize(v3_add(n, v3_add(v3_scale(t, se0), v3_scale(u, se1))));
+            float oh = v3_dot(o, he);
+            if (oh > 1e-4f) {
+                float me = 2.0f * oh, sw[2];
+                hl = he;
+                le = v3_sub(v3_scale(he, me), o); /* the mirror of o about he */
+                hv_linearise(he, me, n, t, u, w, p, sv, sw, cl);
+                v3 dl = v3_sub(w, le); /* w's slope through the linearisation at le */
+                sl[0] = sw[0] + v3_dot(hv_row(he, me, n, t, sw[0]), dl);
+                sl[1] = sw[1] + v3_dot(hv_row(he, me, n, u, sw[1]), dl);
+            }
         }
         float c11 = al2 + cl[0][0], c22 = al2 + cl[1][1], c12 = cl[0][1];
         float det = c11 * c22 - c12 * c12;

@@ -35,11 +35,12 @@
  * it keeps GGX's tail, where a metal floor shows the haze around a
  * reflected wall. Valid where the cluster subtends little and the half
  * vector stands well above the horizon: the weight blends it out beyond
- * (kernel.h). Each lobe linearises the map where its product with the
- * cluster's slope Gaussian peaks (w for a cluster small against the lobe,
- * the mirror direction for a wide one) and takes D's 1/h.n^4, G and F
- * there: at a grazing view (o + l).n is small and the slope's change
- * across a wide cluster is far from linear. */
+ * (kernel.h). Each sharp lobe (the first VSGL__HV_RELIN) linearises the
+ * map again where its product with the cluster's slope Gaussian peaks (w
+ * for a cluster small against the lobe, the mirror direction for a wide
+ * one) and takes D's 1/h.n^4, G and F there: at a grazing view (o + l).n
+ * is small and the slope's change across a wide cluster is far from
+ * linear. */
 float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float alpha, int lobes,
                            const float fres[3], float *weight);
 

@@ -413,8 +413,9 @@ static inline int vsgl__hv_lobe_set(int count, const float **k, const float **c)
 /* The lobes (the first, sharpest, of either set) that the model linearises
  * again where each one's product with the cluster peaks (halfvec.c); the
  * broader ones keep the linearisation at the cluster's direction. Two of
- * four: the corridor's grazing floor within 11 % of quadrature where all
- * four are within 2 % and none 110 % off; the kernel's cost half of it. */
+ * four: the half-vector light at the corridor's grazing floor pixel is
+ * 10 % over quadrature (all four: 2 %; none: 111 %) for half the cost of
+ * all four (docs/accuracy.md). */
 #define VSGL__HV_RELIN 2
 #define VSGL__HV_SPREAD_LO 0.003f
 #define VSGL__HV_SPREAD_HI 0.01f

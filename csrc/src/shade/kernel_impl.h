@@ -661,9 +661,9 @@ k_hv_shared(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_lig
  * are (t - q1 n) and (u - q2 n) over g.n |o + le| = 2 (o.g) / |n + q1 t +
  * q2 u|^2 (g is orthogonal to both), so everything is a dot product in the
  * frame (t, u, n) that k_hv_shared stored: w's slope through it q + J (w -
- * le) (J le's rows reduce to q_e o.n - o.e), the cluster's covariance,
- * and D's 1 / g.n^4 = |n + q t|^4, G and F at le (le.n = 2 (o.g) g.n -
- * o.n, le.g = o.g). Where o.g is not positive (no such mirror direction),
+ * le) (a row e's dot product with le is q_e o.n - o.e, over g.n |o + le|),
+ * the cluster's covariance, and D's 1 / g.n^4 = |n + q1 t + q2 u|^4, G and
+ * F at le (le.n = 2 (o.g) g.n - o.n, le.g = o.g). Where o.g is not positive (no such mirror direction),
  * w's stand, as they do for the broad lobes past VSGL__HV_RELIN (relin 0):
  * their product peaks near w but for the widest clusters, and they hold
  * a sixth of GGX's energy. */
