@@ -16,7 +16,6 @@ Needs the cached 80 x 60 camera references (`make test` renders them).
 """
 import argparse
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -24,22 +23,14 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "quality"))
 sys.path.insert(0, os.path.join(ROOT, "addon"))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
 
-FRAMES = 12
-CHILD = """import sys, numpy as np
-sys.path[:0] = [{q!r}, {a!r}]
-import evaluate as E, scenes
-r = E.Renderer(); b = scenes.case({scene!r}, 'test'); c = E.parse_config({config!r})
-np.save({out!r}, np.array([r.render(scenes.animate(b, 'camera', f), c)[0][{plane!r}] for f in range({n})]))
-"""
+from camera_dense_excess import FRAMES, run  # noqa: E402  (its camera animation, rendered in a child)
 
 
 def render(lib, scene, config, plane, out):
-    """The animation's frames (FRAMES x H x W x 3) through library lib, in a child process."""
-    code = CHILD.format(q=os.path.join(ROOT, "tests", "quality"), a=os.path.join(ROOT, "addon"), scene=scene,
-                        config=config, plane=plane, out=out, n=FRAMES)
-    subprocess.run([sys.executable, "-c", code], env=dict(os.environ, VSGL_LIBRARY=lib), check=True)
-    return np.load(out)
+    """The animation's frames (FRAMES x H x W x 3) of one pass through library lib."""
+    return np.array([f[plane] for f in run(scene, config, (80, 60), out, lib)])
 
 
 def main():
@@ -58,9 +49,9 @@ def main():
     os.makedirs(tmp, exist_ok=True)
     seq = {"cycles": np.array([0.5 * sum(M.coloured(img)[args.plane] for img, _ in refs.ensure_frame(
         [args.scene], (80, 60, 1024), "camera", f, refs.DEFAULT_DIR)[args.scene]) for f in range(FRAMES)])}
-    seq["before"] = render(args.before, args.scene, args.config, args.plane, os.path.join(tmp, "before.npy"))
+    seq["before"] = render(args.before, args.scene, args.config, args.plane, os.path.join(tmp, "before.npz"))
     seq["after"] = render(os.path.join(ROOT, "build", "libvsgl.so"), args.scene, args.config, args.plane,
-                          os.path.join(tmp, "after.npy"))
+                          os.path.join(tmp, "after.npz"))
     lum = {k: v.sum(-1) for k, v in seq.items()}
     top = np.percentile(lum["cycles"][0], 99)
     exposure = imgutil.exposure_for(seq["cycles"][0])

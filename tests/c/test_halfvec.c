@@ -52,6 +52,34 @@ static double quadrature(double alpha, const double x[3], const double o[3], dou
     return sum;
 }
 
+/* A planar diffuse cluster of unit power: a Gaussian patch about mean
+ * (variance var per axis) on the plane of the given normal. */
+static vsgl_vsgl patch(v3 mean, v3 normal, float var)
+{
+    vsgl_vsgl v;
+    memset(&v, 0, sizeof v);
+    v.mean = mean;
+    v.variance = var;
+    v.normal = normal;
+    v.coherence = 1.0f;
+    v.power[0] = v.power[1] = v.power[2] = 1.0f;
+    v.lobe = VSGL__LOBE_DIFFUSE;
+    return v;
+}
+
+/* An isotropic GGX receiver of roughness alpha at the origin, normal +z,
+ * seen from ov: its warped lobe and the lobe's axis, and M there with
+ * Fresnel 1 (returned). */
+static float receiver_lobe(float alpha, vsgl_vec3 ov, vsgl_asg *lobe, v3 *axis)
+{
+    vsgl_vec3 n = {0.0f, 0.0f, 1.0f}, t = {1.0f, 0.0f, 0.0f};
+    vsgl_asg ndf;
+    vsgl_ndf_aniso_to_asg(&n, &t, alpha, alpha, &ndf);
+    vsgl_warp_ndf_asg(&ndf, &ov, lobe);
+    *axis = v3_make(lobe->z.x, lobe->z.y, lobe->z.z);
+    return vsgl_specular_factor(&n, &ov, &lobe->z, alpha, 1.0f);
+}
+
 VT_TEST(halfvec_glossy_follows_ggx_into_its_tail)
 {
     const float alphas[2] = {0.04f, 0.09f};
@@ -66,20 +94,11 @@ VT_TEST(halfvec_glossy_follows_ggx_into_its_tail)
              * sits offs alphas above it (in half-vector terms: 2 offs alpha in l) */
             double el = atan2(mz, wy) + 2.0 * offs[k] * alpha;
             double o[3] = {0.0, -cos(el), sin(el)};
-            vsgl_vsgl v;
-            memset(&v, 0, sizeof v);
-            v.mean = v3_make(0.0f, (float)wy, (float)mz);
-            v.variance = (float)var;
-            v.normal = v3_make(0.0f, -1.0f, 0.0f);
-            v.coherence = 1.0f;
-            v.power[0] = v.power[1] = v.power[2] = 1.0f;
-            v.lobe = VSGL__LOBE_DIFFUSE;
-            vsgl_vec3 n = {0.0f, 0.0f, 1.0f}, t = {1.0f, 0.0f, 0.0f}, ov = {(float)o[0], (float)o[1], (float)o[2]};
-            vsgl_asg ndf, lobe;
-            vsgl_ndf_aniso_to_asg(&n, &t, (float)alpha, (float)alpha, &ndf);
-            vsgl_warp_ndf_asg(&ndf, &ov, &lobe);
-            v3 axis = v3_make(lobe.z.x, lobe.z.y, lobe.z.z);
-            float M = vsgl_specular_factor(&n, &ov, &lobe.z, (float)alpha, 1.0f);
+            vsgl_vsgl v = patch(v3_make(0.0f, (float)wy, (float)mz), v3_make(0.0f, -1.0f, 0.0f), (float)var);
+            vsgl_vec3 ov = {(float)o[0], (float)o[1], (float)o[2]};
+            vsgl_asg lobe;
+            v3 axis;
+            float M = receiver_lobe((float)alpha, ov, &lobe, &axis);
             float w;
             const float none[3] = {0.0f, 1.0f, 0.0f}; /* no Fresnel ratio: M's Fresnel is 1 here */
             double hv = vsgl__halfvec_glossy(&v, v3_make(0, 0, 0), v3_make(0, 0, 1), v3_make(ov.x, ov.y, ov.z), axis,
@@ -175,14 +194,8 @@ static void grazing_case(uint32_t flags, double *worst_out, double *worst_withou
                 l[q] = 2.0 * oh * hs[q] - o[q];
                 cen[q] = dist * l[q];
             }
-            vsgl_vsgl v;
-            memset(&v, 0, sizeof v);
-            v.mean = v3_make((float)cen[0], (float)cen[1], (float)cen[2]);
-            v.variance = (float)var;
-            v.normal = v3_make((float)-l[0], (float)-l[1], (float)-l[2]);
-            v.coherence = 1.0f;
-            v.power[0] = v.power[1] = v.power[2] = 1.0f;
-            v.lobe = VSGL__LOBE_DIFFUSE;
+            vsgl_vsgl v = patch(v3_make((float)cen[0], (float)cen[1], (float)cen[2]),
+                                v3_make((float)-l[0], (float)-l[1], (float)-l[2]), (float)var);
             v3 n = v3_make(0, 0, 1), ov = v3_make((float)o[0], (float)o[1], (float)o[2]);
             vsgl_vec3 nn = {0, 0, 1}, t = {1, 0, 0}, ovv = {ov.x, ov.y, ov.z};
             vsgl_asg ndf, lobe;
@@ -240,26 +253,18 @@ VT_TEST(halfvec_glossy_holds_wide_clusters_at_grazing_views)
     const double alpha = 0.09, wy = 4.44, co = 0.04;
     const double x[3] = {0.0, 0.0, 0.0}, o[3] = {0.0, -sqrt(1.0 - co * co), co};
     const double mzs[3] = {0.5, 0.76, 1.49}, mxs[5] = {0.0, 0.37, -0.55, 0.74, -0.92}, vars[2] = {0.061, 0.09};
-    vsgl_vec3 n = {0.0f, 0.0f, 1.0f}, t = {1.0f, 0.0f, 0.0f}, ov = {(float)o[0], (float)o[1], (float)o[2]};
-    vsgl_asg ndf, lobe;
-    vsgl_ndf_aniso_to_asg(&n, &t, (float)alpha, (float)alpha, &ndf);
-    vsgl_warp_ndf_asg(&ndf, &ov, &lobe);
-    v3 axis = v3_make(lobe.z.x, lobe.z.y, lobe.z.z);
-    const float M = vsgl_specular_factor(&n, &ov, &lobe.z, (float)alpha, 1.0f);
+    vsgl_vec3 ov = {(float)o[0], (float)o[1], (float)o[2]};
+    vsgl_asg lobe;
+    v3 axis;
+    const float M = receiver_lobe((float)alpha, ov, &lobe, &axis);
     const float none[3] = {0.0f, 1.0f, 0.0f};
     double worst = 0.0, worst_sum = 0.0;
     for (int vi = 0; vi < 2; ++vi)
         for (int zi = 0; zi < 3; ++zi) {
             double centre = 0.0, sum_hv = 0.0, sum_q = 0.0;
             for (int xi = 0; xi < 5; ++xi) {
-                vsgl_vsgl v;
-                memset(&v, 0, sizeof v);
-                v.mean = v3_make((float)mxs[xi], (float)wy, (float)mzs[zi]);
-                v.variance = (float)vars[vi];
-                v.normal = v3_make(0.0f, -1.0f, 0.0f);
-                v.coherence = 1.0f;
-                v.power[0] = v.power[1] = v.power[2] = 1.0f;
-                v.lobe = VSGL__LOBE_DIFFUSE;
+                vsgl_vsgl v = patch(v3_make((float)mxs[xi], (float)wy, (float)mzs[zi]), v3_make(0.0f, -1.0f, 0.0f),
+                                    (float)vars[vi]);
                 float w;
                 double hv = vsgl__halfvec_glossy(&v, v3_make(0, 0, 0), v3_make(0, 0, 1), v3_make(ov.x, ov.y, ov.z),
                                                  axis, (float)alpha, VSGL__HV_LOBES, none, &w) * M;
