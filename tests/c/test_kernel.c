@@ -231,6 +231,19 @@ static void random_light(vt_rng *r, vsgl_kernel_light *o, int sharp)
     o->part = part < 0 ? -2.0f : (float)part;
     o->pout = (float)(0.6 * vt_uniform(r));
     o->pin = (float)((1.0 - o->pout) * vt_uniform(r));
+    /* half the specular ones sheared (vsgl_vsgl.shear): shifts of up to a
+     * few sigma per unit of direction, the variance given the direction a
+     * share of the cluster's */
+    if (o->conv == 0.0f && o->planar == 0.0f && vt_uniform(r) < 0.5) {
+        const float sigma = sqrtf(o->var);
+        for (int e = 0; e < 9; ++e)
+            o->sh[e] = (float)(3.0 * (2.0 * vt_uniform(r) - 1.0)) * sigma;
+        o->ishift = 0.25f / o->var;
+        o->shear = 1.0f;
+        o->var *= (float)(0.05 + 0.95 * vt_uniform(r));
+        o->var2 = 2.0f * o->var;
+        o->ivar = 1.0f / o->var;
+    }
 }
 
 /* Every ISA copy (AVX-512, AVX2, baseline) and the library's scalar build

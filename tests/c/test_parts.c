@@ -8,7 +8,9 @@
 #include "fit/vsgl_set.h"
 #include "rsm/rsm.h"
 #include "scene/scene_internal.h"
+#include "vsgl/reference.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -330,4 +332,115 @@ VT_TEST(lattice_clusters_carry_their_parts_shares)
     free(cn);
     mesh_free(&m);
     vsgl_context_destroy(ctx);
+}
+
+/* The glossy light of balanced (brute 0) or of the brute force (RSM 128,
+ * one sample per pixel, shadow rays) in the quality suite's sphere room
+ * (tests/quality/scenes.py, glossy_sphere_floor): a 5 x 5 x 3 m box with
+ * a polished floor (Lambert + GGX layer, roughness 0.2) and a glossy
+ * plastic sphere (roughness 0.3, radius 0.5) lit by a spot from above. */
+static void sheared_room_render(int brute, float *gl, uint32_t w, uint32_t h)
+{
+    vsgl_context *ctx = fx_context(0);
+    VT_REQUIRE(ctx, "context");
+    fx_scene fx;
+    memset(&fx, 0, sizeof fx);
+    mesh m = {0};
+    const float x0 = -2.5f, x1 = 2.5f, y0 = -2.5f, y1 = 2.5f, z1 = 3.0f;
+    const float q[6][4][3] = {
+        {{x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0}, {x0, y1, 0}},     /* floor */
+        {{x0, y0, z1}, {x0, y1, z1}, {x1, y1, z1}, {x1, y0, z1}}, /* ceiling */
+        {{x0, y0, 0}, {x0, y1, 0}, {x0, y1, z1}, {x0, y0, z1}},   /* left */
+        {{x1, y0, 0}, {x1, y0, z1}, {x1, y1, z1}, {x1, y1, 0}},   /* right */
+        {{x0, y1, 0}, {x1, y1, 0}, {x1, y1, z1}, {x0, y1, z1}},   /* back */
+        {{x0, y0, 0}, {x0, y0, z1}, {x1, y0, z1}, {x1, y0, 0}},   /* front */
+    };
+    for (int k = 0; k < 6; ++k)
+        mesh_quad(&m, q[k], k == 0 ? 0 : 1);
+    uint32_t first = m.nt;
+    const float c[3] = {0.0f, 0.6f, 0.6f};
+    mesh_sphere(&m, c[0], c[1], c[2], 0.5f, 48, 24, 0, 2);
+    vsgl_material *mt = fx.materials;
+    const float col[3][3] = {{0.5f, 0.5f, 0.5f}, {0.8f, 0.8f, 0.8f}, {0.8f, 0.35f, 0.1f}};
+    const float rough[3] = {0.2f, 1.0f, 0.3f}, f0[3] = {0.04f, 0.0f, 0.04f};
+    for (int k = 0; k < 3; ++k) {
+        memcpy(mt[k].base_color, col[k], sizeof col[k]);
+        mt[k].roughness = rough[k];
+        mt[k].specular_f0 = f0[k];
+    }
+    const float eye[3] = {1.2f, -0.7f, 2.7f}, at[3] = {0.0f, 0.6f, 0.5f};
+    fx_spot(&fx, eye, at, 2500.0f, 0.8727f, 0.3f);
+    /* the suite's camera, zoomed in on the floor's reflection of the sphere's highlight */
+    const float ceye[3] = {0.3137f, -2.3f, 1.3f}, cat[3] = {0.2f, -0.67f, 0.0f};
+    fx_camera(&fx, ceye, cat, 100.0f, w, h);
+    float *cn = mesh_normals(&m, first, c[0], c[1], c[2]);
+    VT_REQUIRE(cn, "memory");
+    vsgl_scene *scene = mesh_scene(ctx, &m, cn, &fx);
+    VT_REQUIRE(scene, "%s", vsgl_context_last_error(ctx));
+    if (brute) {
+        VT_CHECK(vsgl_reference_render(ctx, scene, 128, 2, 1, NULL, gl, NULL, NULL, NULL) == VSGL_OK, "%s",
+                 vsgl_context_last_error(ctx));
+    } else {
+        vsgl_render_settings s;
+        vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+        vsgl_render_output o;
+        memset(&o, 0, sizeof o);
+        o.width = w;
+        o.height = h;
+        o.glossy_light = gl;
+        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    }
+    free(cn);
+    vsgl_scene_destroy(scene);
+    mesh_free(&m);
+    vsgl_context_destroy(ctx);
+}
+
+VT_TEST(sheared_highlight_of_a_sphere_in_a_glossy_floor)
+{
+    enum { W = 32, H = 24 };
+    float *a = calloc(W * H * 3, sizeof *a), *b = calloc(W * H * 3, sizeof *b);
+    VT_REQUIRE(a && b, "memory");
+    sheared_room_render(0, a, W, H);
+    sheared_room_render(1, b, W, H);
+    if (getenv("VSGL_TEST_VERBOSE"))
+        for (int y = 0; y < H; ++y) {
+            for (int x = 0; x < W; ++x)
+                fprintf(stderr, "%4.0f", 100.0 * (a[3 * (y * W + x)] + a[3 * (y * W + x) + 1] + a[3 * (y * W + x) + 2]));
+            fprintf(stderr, "   |");
+            for (int x = 0; x < W; ++x)
+                fprintf(stderr, "%4.0f", 100.0 * (b[3 * (y * W + x)] + b[3 * (y * W + x) + 1] + b[3 * (y * W + x) + 2]));
+            fprintf(stderr, "\n");
+        }
+    /* the highlight: the pixels where the brute force has more than half its peak */
+    float peak_b = 0.0f, peak_a = 0.0f;
+    int at_b = 0, at_a = 0;
+    for (int k = 0; k < W * H; ++k) {
+        float va = a[3 * k] + a[3 * k + 1] + a[3 * k + 2], vb = b[3 * k] + b[3 * k + 1] + b[3 * k + 2];
+        if (vb > peak_b)
+            peak_b = vb, at_b = k;
+        if (va > peak_a)
+            peak_a = va, at_a = k;
+    }
+    double sa = 0.0, sb = 0.0;
+    int n = 0;
+    for (int k = 0; k < W * H; ++k) {
+        float vb = b[3 * k] + b[3 * k + 1] + b[3 * k + 2];
+        if (vb > 0.5f * peak_b) {
+            sa += a[3 * k] + a[3 * k + 1] + a[3 * k + 2];
+            sb += vb;
+            ++n;
+        }
+    }
+    const int dx = at_a % W - at_b % W, dy = at_a / W - at_b / W;
+    if (getenv("VSGL_TEST_VERBOSE"))
+        fprintf(stderr, "highlight: %d pixels, light over the brute force's %.3f, peak %.3f / %.3f at (%d, %d) / (%d, %d)\n",
+                n, sa / sb, (double)peak_a, (double)peak_b, at_a % W, at_a / W, at_b % W, at_b / W);
+    VT_CHECK(n >= 6, "the highlight has %d pixels: the view misses it", n);
+    VT_CHECK(fabs(sa / sb - 1.0) < 0.1, "the highlight's light over the brute force's: %.3f (%d pixels)", sa / sb, n);
+    VT_CHECK(fabs(peak_a / peak_b - 1.0f) < 0.1f, "its peak %.3f, the brute force's %.3f", (double)peak_a,
+             (double)peak_b);
+    VT_CHECK(dx * dx + dy * dy <= 2, "its peak at (%d, %d), the brute force's at (%d, %d)", at_a % W, at_a / W,
+             at_b % W, at_b / W);
+    free(a), free(b);
 }

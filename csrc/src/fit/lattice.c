@@ -75,6 +75,10 @@
  * 500 x the request; usual scenes stay at 1.6-6.5 x and never reach it). */
 #define VSGL__LATTICE_MAX_PER_VSGL 16.0
 
+/* The least share of a sheared cluster's variance left given the
+ * direction (shear_of): the linear model's floor. */
+#define VSGL__SHEAR_MIN_VAR 0.05
+
 /* Open-addressing map from a packed lattice key to a cluster's sums. */
 typedef struct cell_map {
     uint64_t *keys;      /* 0 = empty (packed keys are never 0) */
@@ -85,6 +89,7 @@ typedef struct cell_map {
     int32_t *cell;       /* count * 3: bin, i, j */
     uint32_t *part;      /* count: the convex part its shares are of (the smallest seen), VSGL__PART_NONE */
     double *pw;          /* count * 4: that part's weight outside, inside, for the diffuse then specular lobe */
+    double *xd;          /* count * 9: the specular lobe's sum of w (x - origin) d^T (shear_of) */
     size_t sums_cap;
 } cell_map;
 
@@ -159,6 +164,7 @@ static double *map_get(cell_map *m, uint64_t key)
         MAP_GROW(m->cell, 3);
         MAP_GROW(m->part, 1);
         MAP_GROW(m->pw, 4);
+        MAP_GROW(m->xd, 9);
 #undef MAP_GROW
         m->sums_cap = cap;
     }
@@ -171,6 +177,7 @@ static double *map_get(cell_map *m, uint64_t key)
     e[1] = e[3] = -INFINITY;
     m->part[m->count] = VSGL__PART_NONE;
     memset(m->pw + m->count * 4, 0, 4 * sizeof *m->pw);
+    memset(m->xd + m->count * 9, 0, 9 * sizeof *m->xd);
     ++m->count;
     return s;
 }
@@ -184,6 +191,7 @@ static void map_free(cell_map *m)
     free(m->cell);
     free(m->part);
     free(m->pw);
+    free(m->xd);
     memset(m, 0, sizeof *m);
 }
 
@@ -288,6 +296,7 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_scene *scene, const 
         if (!(m[0] + m[VSGL__GRID_FIELDS] > 0.0f))
             continue;
         const double p[3] = {rsm->pos[0][t], rsm->pos[1][t], rsm->pos[2][t]};
+        const double po[3] = {p[0] - g.origin.x, p[1] - g.origin.y, p[2] - g.origin.z};
         const double nrm[3] = {rsm->nrm[0][t], rsm->nrm[1][t], rsm->nrm[2][t]};
         const uint32_t key = rsm->part ? rsm->part[t] : VSGL__PART_NONE;
         const uint32_t fine = key != VSGL__PART_NONE && !(key & 1u) && vsgl__scene_part_curved(scene, key >> 1)
@@ -339,6 +348,13 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_scene *scene, const 
                     cc[1] = (int32_t)fu + du;
                     cc[2] = (int32_t)fv + dv;
                     add_part(&map, slot, key, w, m);
+                    if (fine) { /* the shear's cross moments (shear_of): curved parts only */
+                        const float *sd = m + VSGL__GRID_FIELDS + 4; /* the specular lobe's sum w d */
+                        double *xd = map.xd + slot * 9;
+                        for (int ra = 0; ra < 3; ++ra)
+                            for (int rc = 0; rc < 3; ++rc)
+                                xd[3 * ra + rc] += w * po[ra] * sd[rc];
+                    }
                     double *e = map.ext + slot * 4;
                     double half = 0.5 * sqrt(rsm->area[t] > 0.0f ? (double)rsm->area[t] : 0.0) * inv_h;
                     e[0] = fmin(e[0], q[u] - half);
@@ -352,6 +368,31 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_scene *scene, const 
         map_free(&map);
     *out = map;
     return r;
+}
+
+/* The shear of specular cluster v (vsgl_vsgl.shear) from its sums f (the
+ * specular lobe's, VSGL__GRID_FIELDS) and cross moments xd = sum w (x -
+ * origin) d^T: Cov(x, d) = xd / W - mean d_mean^T, shear = lambda Cov, and
+ * the variance left given the direction, variance - lambda |Cov|^2 / 2,
+ * kept to at least VSGL__SHEAR_MIN_VAR of it. */
+static void shear_of(vsgl_vsgl *v, const double *f, const double *xd)
+{
+    const double W = f[0];
+    if (!(W > 0.0) || !(v->variance > 0.0f) || !(v->sharpness > 0.0f))
+        return;
+    double c[9], c2 = 0.0;
+    for (int a = 0; a < 3; ++a)
+        for (int d = 0; d < 3; ++d) {
+            c[3 * a + d] = xd[3 * a + d] / W - (f[7 + a] / W) * (f[4 + d] / W);
+            c2 += c[3 * a + d] * c[3 * a + d];
+        }
+    const double lam = v->sharpness;
+    const double left = (double)v->variance - 0.5 * lam * c2;
+    const double floor_var = VSGL__SHEAR_MIN_VAR * v->variance;
+    for (int e = 0; e < 9; ++e)
+        v->shear[e] = (float)(lam * c[e]);
+    v->shear_variance = (float)(left > floor_var ? left : floor_var);
+    v->sheared = 1;
 }
 
 /* How far inside the cut a probe starts and how far above the plane it
@@ -450,6 +491,8 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
             const double hc = (cc[0] & (int32_t)VSGL__BIN_FINE) ? h_fine : h; /* the cell's spacing */
             if (vsgl__moments_to_vsgl(&mo, g.origin, s->sharpness_estimator, rsm->light, lobe, &v)) {
                 v.widen = (float)(VSGL__LATTICE_OVERLAP * hc * hc);
+                if (lobe == VSGL__LOBE_SPECULAR && (cc[0] & (int32_t)VSGL__BIN_FINE))
+                    shear_of(&v, f, map.xd + c * 9);
                 if (map.part[c] != VSGL__PART_NONE) {
                     const double *pw = map.pw + c * 4 + lobe * 2;
                     v.part = map.part[c];

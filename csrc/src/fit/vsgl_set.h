@@ -51,6 +51,21 @@ typedef struct vsgl_vsgl {
      * VSGL__PART_NONE (shares 0) for the fits other than the lattice. */
     uint32_t part;
     float part_out, part_in;
+    /* The shear of a specular cluster on a curved part (the lattice's fine
+     * cells; 0 elsewhere): its VPLs' mirror directions turn with their
+     * positions, so a receiver is lit by the part of the cluster whose
+     * emission points at it, not by all of it (a sphere's highlight in a
+     * glossy floor). With positions x and mean vectors d of the VPLs
+     * jointly Gaussian, the VPLs that send towards unit direction e (from
+     * the mean) lie about mean + shear (e - axis), shear = lambda Cov(x, d)
+     * (m per unit of direction, row-major), with positional variance
+     * shear_variance = variance - lambda |Cov(x, d)|^2 / 2 (the variance
+     * left given the direction; lambda/lambda_0 of it for a VPL lobe of
+     * sharpness lambda_0), and the cluster's radiant intensity towards e
+     * is its lobe's, as without the shear. fit/lattice.c, shear_of. */
+    float shear[9];
+    float shear_variance;
+    uint32_t sheared; /* 1 where shear and shear_variance apply */
 } vsgl_vsgl;
 
 /* The lattice's overlap, in units of h^2 (vsgl_vsgl.widen): a sum of the

@@ -306,6 +306,11 @@ typedef struct vsgl_kernel_light {
      * the leak correction is off, and its shares outside and inside */
     float part, pout, pin;
     float freach; /* (sqrt(50) + 2 |farthest cut| + |fs|)^2 / 2: where the fold can matter (k_shade) */
+    /* vsgl_vsgl.shear (var then its shear_variance): the source a receiver
+     * sees moves by sh (e - axis), e the direction from the mean to the
+     * receiver, by at most about 2 sigma (ishift = 1 / (4 variance));
+     * shear 1 where sh is not 0 */
+    float sh[9], ishift, shear;
 } vsgl_kernel_light;
 
 /* The share of VSGL L's light that lane i of block b receives by the

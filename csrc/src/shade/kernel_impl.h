@@ -242,7 +242,41 @@ typedef struct k_scratch {
     float hwt[VSGL__KERNEL_BLOCK], hwu[VSGL__KERNEL_BLOCK], hwn[VSGL__KERNEL_BLOCK], hpt[VSGL__KERNEL_BLOCK],
         hpu[VSGL__KERNEL_BLOCK], hpn[VSGL__KERNEL_BLOCK], hot[VSGL__KERNEL_BLOCK], hou[VSGL__KERNEL_BLOCK],
         hon[VSGL__KERNEL_BLOCK], hsv[VSGL__KERNEL_BLOCK];
+    /* a sheared cluster's shift of its mean towards the lane (k_shift) */
+    float sx[VSGL__KERNEL_BLOCK], sy[VSGL__KERNEL_BLOCK], sz[VSGL__KERNEL_BLOCK];
 } k_scratch;
+
+/* Stage 0 (sheared clusters, vsgl_vsgl.shear): where the part of the
+ * cluster that sends towards the lane lies, as a shift of its mean: sh (e
+ * - axis), e the unit direction from the mean to the lane, kept within
+ * about 2 sigma (|y| / sqrt(1 + |y|^2 / 4 var): the linear model holds
+ * near the lobe's axis, and far from it the lobe sends little). */
+static inline __attribute__((always_inline)) void
+k_shift(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
+{
+    float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
+    float d2 = dx * dx + dy * dy + dz * dz;
+    float r = k_rsqrt(d2 > 1e-24f ? d2 : 1e-24f);
+    /* e - axis = -d r + L->a (L->a is -axis) */
+    float ex = L->ax - dx * r, ey = L->ay - dy * r, ez = L->az - dz * r;
+    float yx = L->sh[0] * ex + L->sh[1] * ey + L->sh[2] * ez;
+    float yy = L->sh[3] * ex + L->sh[4] * ey + L->sh[5] * ez;
+    float yz = L->sh[6] * ex + L->sh[7] * ey + L->sh[8] * ez;
+    float c = k_rsqrt(1.0f + (yx * yx + yy * yy + yz * yz) * L->ishift);
+    t->sx[i] = yx * c;
+    t->sy[i] = yy * c;
+    t->sz[i] = yz * c;
+}
+
+/* The vector from lane i to the source it sees: the mean, shifted where
+ * the call has sheared clusters (`shear` a constant). */
+#define K_SOURCE(shear)                                                                \
+    float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];            \
+    if (shear) {                                                                       \
+        dx += t->sx[i];                                                                \
+        dy += t->sy[i];                                                                \
+        dz += t->sz[i];                                                                \
+    }
 
 /* Stage 1: the incident radiance as one SG (Eq. 7), all but the exp.
  * Written with the fewest reciprocals (three square-root reciprocals and
@@ -255,9 +289,9 @@ typedef struct k_scratch {
  * falloff (L->conv 0: specular lobes), which then leave its exp out */
 static inline __attribute__((always_inline)) void
 k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, float vis,
-           k_scratch *restrict t, const int conv)
+           k_scratch *restrict t, const int conv, const int shear)
 {
-    float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
+    K_SOURCE(shear);
     float d2 = dx * dx + dy * dy + dz * dz;
     float r = k_rsqrt(d2 > 1e-24f ? d2 : 1e-24f);
     t->r[i] = r;
@@ -292,9 +326,9 @@ k_geometry(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
  * (fore 0: specular lobes), which then take the round product alone */
 static inline __attribute__((always_inline)) void
 k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t,
-       const int plane)
+       const int plane, const int shear)
 {
-    float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
+    K_SOURCE(shear);
     float r = t->r[i], d2 = t->d2[i];
     float rfloor = K_SHARP_MAX * r * r;
     float ivar = L->ivar < rfloor ? L->ivar : rfloor;
@@ -333,10 +367,17 @@ k_axis(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
 }
 
 static inline __attribute__((always_inline)) void
-k_exponent(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t)
+k_exponent(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, k_scratch *restrict t,
+           const int shear)
 {
+    /* the radiant intensity towards the lane: the lobe's, from the mean
+     * (a sheared cluster's shifted source is where that light comes from) */
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
     float r = t->r[i], ls = t->ls[i];
+    if (shear) {
+        float d2 = dx * dx + dy * dy + dz * dz;
+        r = k_rsqrt(d2 > 1e-24f ? d2 : 1e-24f);
+    }
     float ddx = L->ax - dx * r, ddy = L->ay - dy * r, ddz = L->az - dz * r;
     float diff2 = ddx * ddx + ddy * ddy + ddz * ddz;
     t->expo[i] = (t->xnum[i] - L->lv * ls * diff2) / (t->lden[i] + VSGL__TINY);
@@ -1024,24 +1065,43 @@ static inline __attribute__((always_inline)) int
 k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, const int NL,
         const float *restrict visibility, int32_t mode, int32_t lobes, float lcut, k_scratch *restrict t)
 {
-    int plane = 0, conv = 0;
+    int plane = 0, conv = 0, shear = 0;
     for (int j = 0; j < NL; ++j) {
         plane |= L[j].fore > 0.0f;
         conv |= L[j].conv > 0.0f;
+        shear |= L[j].shear > 0.0f;
     }
-    if (visibility && conv)
-        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 1));
-    else if (visibility)
-        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 0));
-    else if (conv)
-        K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 1));
-    else
-        K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 0));
-    if (plane)
-        K_FORN(k_axis(b, i, L + j, t + j, 1));
-    else
-        K_FORN(k_axis(b, i, L + j, t + j, 0));
-    K_FORN(k_exponent(b, i, L + j, t + j));
+    /* one loop per form, each flag a constant in it */
+    if (shear) { /* sheared clusters: specular lobes of curved parts (conv 0, plane 0) */
+        K_FORN(k_shift(b, i, L + j, t + j));
+        if (visibility && conv)
+            K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 1, 1));
+        else if (visibility)
+            K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 0, 1));
+        else if (conv)
+            K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 1, 1));
+        else
+            K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 0, 1));
+        if (plane)
+            K_FORN(k_axis(b, i, L + j, t + j, 1, 1));
+        else
+            K_FORN(k_axis(b, i, L + j, t + j, 0, 1));
+        K_FORN(k_exponent(b, i, L + j, t + j, 1));
+    } else {
+        if (visibility && conv)
+            K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 1, 0));
+        else if (visibility)
+            K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 0, 0));
+        else if (conv)
+            K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 1, 0));
+        else
+            K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 0, 0));
+        if (plane)
+            K_FORN(k_axis(b, i, L + j, t + j, 1, 0));
+        else
+            K_FORN(k_axis(b, i, L + j, t + j, 0, 0));
+        K_FORN(k_exponent(b, i, L + j, t + j, 0));
+    }
     K_FORN(k_amplitude(i, t + j));
     /* VSGLs whose light is negligible at every lane of the block (k_faint)
      * skip the stages after this; the others take them one or two at a

@@ -1359,12 +1359,19 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             const vsgl_vsgl *v = &set->items[k];
             vsgl_kernel_light *o = &kl[k];
             o->mx = v->mean.x; o->my = v->mean.y; o->mz = v->mean.z;
-            o->var = v->variance;
-            o->var2 = 2.0f * v->variance;
+            /* a sheared cluster: the part a receiver sees, about a shifted mean */
+            const int sheared = v->sheared && v->variance > 0.0f && v->shear_variance > 0.0f;
+            const float var = sheared ? v->shear_variance : v->variance;
+            o->var = var;
+            o->var2 = 2.0f * var;
             /* a single-texel cluster has variance 0: 1e30, not FLT_MAX, so that
              * d^2 / var stays finite in the kernel (FLT_MAX x d^2 > 1 m^2 overflowed
              * to inf and inf / inf gave NaN pixels beside a light 5 mm from a wall) */
-            o->ivar = 1.0f / fmaxf(v->variance, VSGL__TINY);
+            o->ivar = 1.0f / fmaxf(var, VSGL__TINY);
+            for (int e = 0; e < 9; ++e)
+                o->sh[e] = sheared ? v->shear[e] : 0.0f;
+            o->ishift = sheared ? 0.25f / v->variance : 0.0f;
+            o->shear = sheared ? 1.0f : 0.0f;
             o->valid = v->variance > 0.0f ? 1.0f : 0.0f;
             o->ax = -v->axis.x; o->ay = -v->axis.y; o->az = -v->axis.z;
             o->lv = v->sharpness;
