@@ -15,6 +15,7 @@ over the frames beside Cycles' and writes the excess map as a PNG.
     python3 tools/camera_excess.py balanced
     python3 tools/camera_excess.py "x:aa_samples=4 edge_samples=16" --pixels 46,29 45,31
     python3 tools/camera_excess.py balanced --map /tmp/excess.png
+    python3 tools/camera_excess.py balanced --top 8
 
 Needs the cached 80 x 60 camera references (`make test` renders them with
 Blender 3.4 when they are missing) and numpy; --map writes a false-colour PNG.
@@ -60,6 +61,8 @@ def main():
     ap.add_argument("--pass", dest="plane", default="Gloss", choices=("Diff", "Gloss"))
     ap.add_argument("--frames", type=int, default=12)
     ap.add_argument("--pixels", nargs="*", default=[], help="x,y pixels whose values over the frames to print")
+    ap.add_argument("--top", type=int, default=0,
+                    help="print the N pixels that carry the most excess, with their share and values over the frames")
     ap.add_argument("--map", help="write the excess map (sqrt of the summed excess) to this PNG")
     args = ap.parse_args()
 
@@ -100,8 +103,15 @@ def main():
     for name, m in (("  shared", mixed), ("  object", on_obj), ("  floor", on_floor)):
         print("%-8s " % name + "  ".join("%s %.3f" % (DIRECTIONS[s], acc[m & (sector == s)].sum() / max(total, 1e-30))
                                          for s in range(8)))
-    for spec in args.pixels:
-        x, y = (int(v) for v in spec.split(","))
+    pixels = [tuple(int(v) for v in spec.split(",")) for spec in args.pixels]
+    cum = 0.0
+    for k in np.argsort(-acc.ravel())[:max(args.top, 0)]:
+        y, x = divmod(int(k), acc.shape[1])
+        cum += acc[y, x]
+        print("(%d,%d) carries %.3f of the excess (the %d pixels so far %.3f)"
+              % (x, y, acc[y, x] / max(total, 1e-30), len(pixels) - len(args.pixels) + 1, cum / max(total, 1e-30)))
+        pixels.append((x, y))
+    for x, y in pixels:
         cyc = [0.5 * (s[0][y, x].sum() + s[1][y, x].sum()) for s in seq]
         print("(%d,%d) Cycles %s" % (x, y, " ".join("%.3f" % v for v in cyc)))
         print("(%d,%d) ours   %s" % (x, y, " ".join("%.3f" % o[y, x].sum() for o in ours)))
