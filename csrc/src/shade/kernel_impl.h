@@ -1061,6 +1061,31 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
     }
 }
 
+/* Stages 0-3 of VSGLs L[0, NL): the source each lane sees (k_shift, with
+ * `shear`, a constant: some VSGL of the pass is sheared), the geometry,
+ * the incident SG's axis and its amplitude's exponent; one loop per form,
+ * each flag a constant in it. */
+static inline __attribute__((always_inline)) void
+k_source(const vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, const int NL,
+         const float *restrict visibility, int conv, int plane, k_scratch *restrict t, const int shear)
+{
+    if (shear)
+        K_FORN(k_shift(b, i, L + j, t + j));
+    if (visibility && conv)
+        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 1, shear));
+    else if (visibility)
+        K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 0, shear));
+    else if (conv)
+        K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 1, shear));
+    else
+        K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 0, shear));
+    if (plane)
+        K_FORN(k_axis(b, i, L + j, t + j, 1, shear));
+    else
+        K_FORN(k_axis(b, i, L + j, t + j, 0, shear));
+    K_FORN(k_exponent(b, i, L + j, t + j, shear));
+}
+
 static inline __attribute__((always_inline)) int
 k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, const int NL,
         const float *restrict visibility, int32_t mode, int32_t lobes, float lcut, k_scratch *restrict t)
@@ -1072,36 +1097,10 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
         shear |= L[j].shear > 0.0f;
     }
     /* one loop per form, each flag a constant in it */
-    if (shear) { /* sheared clusters: specular lobes of curved parts (conv 0, plane 0) */
-        K_FORN(k_shift(b, i, L + j, t + j));
-        if (visibility && conv)
-            K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 1, 1));
-        else if (visibility)
-            K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 0, 1));
-        else if (conv)
-            K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 1, 1));
-        else
-            K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 0, 1));
-        if (plane)
-            K_FORN(k_axis(b, i, L + j, t + j, 1, 1));
-        else
-            K_FORN(k_axis(b, i, L + j, t + j, 0, 1));
-        K_FORN(k_exponent(b, i, L + j, t + j, 1));
-    } else {
-        if (visibility && conv)
-            K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 1, 0));
-        else if (visibility)
-            K_FORN(k_geometry(b, i, L + j, visibility[(size_t)j * VSGL__KERNEL_BLOCK + i], t + j, 0, 0));
-        else if (conv)
-            K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 1, 0));
-        else
-            K_FORN(k_geometry(b, i, L + j, 1.0f, t + j, 0, 0));
-        if (plane)
-            K_FORN(k_axis(b, i, L + j, t + j, 1, 0));
-        else
-            K_FORN(k_axis(b, i, L + j, t + j, 0, 0));
-        K_FORN(k_exponent(b, i, L + j, t + j, 0));
-    }
+    if (shear)
+        k_source(b, L, NL, visibility, conv, plane, t, 1);
+    else
+        k_source(b, L, NL, visibility, conv, plane, t, 0);
     K_FORN(k_amplitude(i, t + j));
     /* VSGLs whose light is negligible at every lane of the block (k_faint)
      * skip the stages after this; the others take them one or two at a
