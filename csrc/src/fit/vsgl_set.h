@@ -62,7 +62,10 @@ typedef struct vsgl_vsgl {
      * shear_variance = variance - lambda |Cov(x, d)|^2 / 2 (the variance
      * left given the direction; lambda/lambda_0 of it for a VPL lobe of
      * sharpness lambda_0), and the cluster's radiant intensity towards e
-     * is its lobe's, as without the shear. fit/lattice.c, shear_of. */
+     * is its lobe's, as without the shear. fit/lattice.c, shear_of. The
+     * kernel applies it (k_shift); the reference path (glossy mode SG),
+     * the near field and the visibility rays' targets take the cluster
+     * unsheared. */
     float shear[9];
     float shear_variance;
     uint32_t sheared; /* 1 where shear and shear_variance apply */
