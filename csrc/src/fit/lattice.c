@@ -349,7 +349,7 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_scene *scene, const 
                     cc[2] = (int32_t)fv + dv;
                     add_part(&map, slot, key, w, m);
                     if (fine) { /* the shear's cross moments (shear_of): curved parts only */
-                        const float *sd = m + VSGL__GRID_FIELDS + 4; /* the specular lobe's sum w d */
+                        const float *sd = m + VSGL__GRID_FIELDS + 4; /* the specular lobe's sum w d (its dir, vsgl__grid_moments) */
                         double *xd = map.xd + slot * 9;
                         for (int ra = 0; ra < 3; ++ra)
                             for (int rc = 0; rc < 3; ++rc)
@@ -370,20 +370,20 @@ static vsgl_result bin_texels(vsgl_context *ctx, const vsgl_scene *scene, const 
     return r;
 }
 
-/* The shear of specular cluster v (vsgl_vsgl.shear) from its sums f (the
- * specular lobe's, VSGL__GRID_FIELDS) and cross moments xd = sum w (x -
- * origin) d^T: Cov(x, d) = xd / W - mean d_mean^T, shear = lambda Cov, and
- * the variance left given the direction, variance - lambda |Cov|^2 / 2,
- * kept to at least VSGL__SHEAR_MIN_VAR of it. */
-static void shear_of(vsgl_vsgl *v, const double *f, const double *xd)
+/* The shear of specular cluster v (vsgl_vsgl.shear) from its moments mo
+ * (positions relative to the grid's origin) and cross moments xd = sum w
+ * (x - origin) d^T: Cov(x, d) = xd / W - mean d_mean^T, shear = lambda
+ * Cov, and the variance left given the direction, variance - lambda |Cov|^2
+ * / 2, kept to at least VSGL__SHEAR_MIN_VAR of it. */
+static void shear_of(vsgl_vsgl *v, const vsgl_moments *mo, const double *xd)
 {
-    const double W = f[0];
+    const double W = mo->weight;
     if (!(W > 0.0) || !(v->variance > 0.0f) || !(v->sharpness > 0.0f))
         return;
     double c[9], c2 = 0.0;
     for (int a = 0; a < 3; ++a)
         for (int d = 0; d < 3; ++d) {
-            c[3 * a + d] = xd[3 * a + d] / W - (f[7 + a] / W) * (f[4 + d] / W);
+            c[3 * a + d] = xd[3 * a + d] / W - (mo->pos[a] / W) * (mo->dir[d] / W);
             c2 += c[3 * a + d] * c[3 * a + d];
         }
     const double lam = v->sharpness;
@@ -492,7 +492,7 @@ vsgl_result vsgl__fit_lattice_n(vsgl_context *ctx, const vsgl_scene *scene, cons
             if (vsgl__moments_to_vsgl(&mo, g.origin, s->sharpness_estimator, rsm->light, lobe, &v)) {
                 v.widen = (float)(VSGL__LATTICE_OVERLAP * hc * hc);
                 if (lobe == VSGL__LOBE_SPECULAR && (cc[0] & (int32_t)VSGL__BIN_FINE))
-                    shear_of(&v, f, map.xd + c * 9);
+                    shear_of(&v, &mo, map.xd + c * 9);
                 if (map.part[c] != VSGL__PART_NONE) {
                     const double *pw = map.pw + c * 4 + lobe * 2;
                     v.part = map.part[c];

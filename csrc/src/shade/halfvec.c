@@ -21,15 +21,17 @@ static v3 hv_row(v3 h, float m, v3 n, v3 e, float se)
     return v3_scale(v3_sub(a, v3_scale(h, v3_dot(h, a))), 1.0f / (v3_dot(h, n) * m));
 }
 
-/* The slope s of h in the frame (t, u, n) and the slope covariance cov of
- * a cluster of directions about w (variance sv per axis, off w and off its
- * projected normal p) through the Jacobian at h. */
-static void hv_linearise(v3 h, float m, v3 n, v3 t, v3 u, v3 w, v3 p, float sv, float s[2], float cov[2][2])
+/* The slope s of h in the frame (t, u, n), the Jacobian's rows a there and
+ * the slope covariance cov of a cluster of directions about w (variance sv
+ * per axis, off w and off its projected normal p) through them. */
+static void hv_linearise(v3 h, float m, v3 n, v3 t, v3 u, v3 w, v3 p, float sv, float s[2], v3 a[2],
+                         float cov[2][2])
 {
     float hn = v3_dot(h, n);
     s[0] = v3_dot(h, t) / hn;
     s[1] = v3_dot(h, u) / hn;
-    v3 a[2] = {hv_row(h, m, n, t, s[0]), hv_row(h, m, n, u, s[1])};
+    a[0] = hv_row(h, m, n, t, s[0]);
+    a[1] = hv_row(h, m, n, u, s[1]);
     for (int i = 0; i < 2; ++i)
         for (int k = 0; k < 2; ++k)
             cov[i][k] = sv * (v3_dot(a[i], a[k]) - v3_dot(a[i], w) * v3_dot(a[k], w) - v3_dot(a[i], p) * v3_dot(a[k], p));
@@ -61,7 +63,8 @@ float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float 
     v3_basis(n, &t, &u);
     v3 p = v3_sub(v->normal, v3_scale(w, v3_dot(v->normal, w)));
     float s[2], cov[2][2];
-    hv_linearise(h, m, n, t, u, w, p, sv, s, cov);
+    v3 rows[2];
+    hv_linearise(h, m, n, t, u, w, p, sv, s, rows, cov);
     /* Linearised at w alone, a wide cluster seen at a grazing view was
      * wrong by orders of magnitude: the slope is (o + l).t / (o + l).n, and
      * where (o + l).n is small the cluster's spread moves it a lot and not
@@ -86,12 +89,13 @@ float vsgl__halfvec_glossy(const vsgl_vsgl *v, v3 x, v3 n, v3 o, v3 axis, float 
             float oh = v3_dot(o, he);
             if (oh > 1e-4f) {
                 float me = 2.0f * oh, sw[2];
+                v3 ae[2];
                 hl = he;
                 le = v3_sub(v3_scale(he, me), o); /* the mirror of o about he */
-                hv_linearise(he, me, n, t, u, w, p, sv, sw, cl);
+                hv_linearise(he, me, n, t, u, w, p, sv, sw, ae, cl);
                 v3 dl = v3_sub(w, le); /* w's slope through the linearisation at le */
-                sl[0] = sw[0] + v3_dot(hv_row(he, me, n, t, sw[0]), dl);
-                sl[1] = sw[1] + v3_dot(hv_row(he, me, n, u, sw[1]), dl);
+                sl[0] = sw[0] + v3_dot(ae[0], dl);
+                sl[1] = sw[1] + v3_dot(ae[1], dl);
             }
         }
         float c11 = al2 + cl[0][0], c22 = al2 + cl[1][1], c12 = cl[0][1];

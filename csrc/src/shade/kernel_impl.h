@@ -242,8 +242,8 @@ typedef struct k_scratch {
     float hwt[VSGL__KERNEL_BLOCK], hwu[VSGL__KERNEL_BLOCK], hwn[VSGL__KERNEL_BLOCK], hpt[VSGL__KERNEL_BLOCK],
         hpu[VSGL__KERNEL_BLOCK], hpn[VSGL__KERNEL_BLOCK], hot[VSGL__KERNEL_BLOCK], hou[VSGL__KERNEL_BLOCK],
         hon[VSGL__KERNEL_BLOCK], hsv[VSGL__KERNEL_BLOCK];
-    /* a sheared cluster's shift of its mean towards the lane (k_shift) */
-    float sx[VSGL__KERNEL_BLOCK], sy[VSGL__KERNEL_BLOCK], sz[VSGL__KERNEL_BLOCK];
+    /* a sheared cluster's shift of its mean towards the lane, and 1 / the lane's distance from the mean (k_shift) */
+    float sx[VSGL__KERNEL_BLOCK], sy[VSGL__KERNEL_BLOCK], sz[VSGL__KERNEL_BLOCK], sr[VSGL__KERNEL_BLOCK];
 } k_scratch;
 
 /* Stage 0 (sheared clusters, vsgl_vsgl.shear): where the part of the
@@ -263,6 +263,7 @@ k_shift(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *
     float yy = L->sh[3] * ex + L->sh[4] * ey + L->sh[5] * ez;
     float yz = L->sh[6] * ex + L->sh[7] * ey + L->sh[8] * ez;
     float c = k_rsqrt(1.0f + (yx * yx + yy * yy + yz * yz) * L->ishift);
+    t->sr[i] = r;
     t->sx[i] = yx * c;
     t->sy[i] = yy * c;
     t->sz[i] = yz * c;
@@ -373,11 +374,7 @@ k_exponent(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_ligh
     /* the radiant intensity towards the lane: the lobe's, from the mean
      * (a sheared cluster's shifted source is where that light comes from) */
     float dx = L->mx - b->x[i], dy = L->my - b->y[i], dz = L->mz - b->z[i];
-    float r = t->r[i], ls = t->ls[i];
-    if (shear) {
-        float d2 = dx * dx + dy * dy + dz * dz;
-        r = k_rsqrt(d2 > 1e-24f ? d2 : 1e-24f);
-    }
+    float r = shear ? t->sr[i] : t->r[i], ls = t->ls[i];
     float ddx = L->ax - dx * r, ddy = L->ay - dy * r, ddz = L->az - dz * r;
     float diff2 = ddx * ddx + ddy * ddy + ddz * ddz;
     t->expo[i] = (t->xnum[i] - L->lv * ls * diff2) / (t->lden[i] + VSGL__TINY);
