@@ -12,6 +12,7 @@ from . import textures
 MATERIAL_UNSUPPORTED = 1  # VSGL_MATERIAL_UNSUPPORTED
 MATERIAL_FLAG_BLENDER_4 = 2  # VSGL_MATERIAL_FLAG_BLENDER_4: Cycles 4.x+ GGX shadowing
 MATERIAL_FLAG_MULTISCATTER = 4  # VSGL_MATERIAL_FLAG_MULTISCATTER: "Multiscatter GGX"
+MATERIAL_FLAG_BURLEY = 8  # VSGL_MATERIAL_FLAG_BURLEY: Blender 3.x's Principled diffuse (Burley's)
 
 # Node kinds the bpy glue reports.
 PRINCIPLED = "PRINCIPLED"
@@ -183,6 +184,8 @@ def map_material(desc):
         tw = "Transmission" if desc.version < (4, 0, 0) else "Transmission Weight"
         if float(inp.get(tw, 0.0)) > 0.0:
             warnings.append("%s: transmission is not modelled (treated as opaque)" % who)
+        if desc.version < (4, 0, 0):  # Cycles 3.x's Principled diffuse is Burley's, 4.x's Lambert
+            m["flags"] = int(m.get("flags", 0)) | MATERIAL_FLAG_BURLEY
     elif desc.kind == EMISSION:
         # pure emission reflects nothing; its light is exported as area lights
         m.update(base_color=(0.0, 0.0, 0.0), metallic=0.0, roughness=1.0, specular_f0=0.0)

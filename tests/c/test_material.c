@@ -430,3 +430,90 @@ VT_TEST(material_ms_scale3_equals_ms_scale_per_channel)
     }
     VT_CHECK(bad == 0, "%zu channels differ", bad);
 }
+
+/* Blender 3.x's Principled diffuse (VSGL_MATERIAL_FLAG_BURLEY), written from
+ * Cycles' split form (bsdf_principled_diffuse: the Lambert part darkened by
+ * (1 - FL/2)(1 - FV/2) plus the retro-reflection RR (FL + FV + FL FV (RR -
+ * 1)), RR = 2 r (l.h)^2), which the library computes as Burley's 2012
+ * product; over Lambert's 1/pi. */
+static double ref_burley(double r, const double l[3], const double v[3])
+{
+    double h[3] = {l[0] + v[0], l[1] + v[1], l[2] + v[2]};
+    double hn = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+    double lh = (l[0] * h[0] + l[1] * h[1] + l[2] * h[2]) / hn;
+    double fl = pow(1.0 - l[2], 5.0), fv = pow(1.0 - v[2], 5.0), rr = 2.0 * r * lh * lh;
+    return (1.0 - 0.5 * fl) * (1.0 - 0.5 * fv) + rr * (fl + fv + fl * fv * (rr - 1.0));
+}
+
+/* vsgl__brdf_eval's diffuse part with the flag is base (1 - metallic) / pi
+ * cos_i times that reference, and reciprocal; without the flag, Lambert. */
+VT_TEST(material_burley_diffuse_matches_cycles_split_form)
+{
+    vt_rng rng = {777};
+    double worst = 0.0;
+    for (int k = 0; k < 4000; ++k) {
+        vsgl_material m;
+        memset(&m, 0, sizeof m);
+        m.base_color[0] = 0.8f, m.base_color[1] = 0.5f, m.base_color[2] = 0.2f;
+        m.metallic = (float)(0.5 * vt_uniform(&rng));
+        m.roughness = (float)vt_uniform(&rng);
+        m.specular_f0 = 0.04f;
+        m.flags = VSGL_MATERIAL_FLAG_BURLEY;
+        vsgl_brdf_params p;
+        vsgl__material_params(&m, &p);
+        v3 wi = rand_dir_hemi(&rng), wo = rand_dir_hemi(&rng), n = v3_make(0, 0, 1), t = v3_make(1, 0, 0);
+        double l[3] = {wi.x, wi.y, wi.z}, v[3] = {wo.x, wo.y, wo.z};
+        float d[3], g[3], d2[3], g2[3];
+        vsgl__brdf_eval(&p, n, t, wi, wo, d, g);
+        vsgl__brdf_eval(&p, n, t, wo, wi, d2, g2);
+        for (int c = 0; c < 3; ++c) {
+            double want = m.base_color[c] * (1.0 - m.metallic) / PI * wi.z * ref_burley(m.roughness, l, v);
+            worst = fmax(worst, fabs(d[c] - want) / fmax(want, 1e-6));
+            /* reciprocal: f(i, o) = f(o, i), so d / cos_i = d2 / cos_o */
+            VT_CHECK_REL(d[c] / wi.z, d2[c] / wo.z, 1e-4, "reciprocity, sample %d", k);
+        }
+    }
+    VT_CHECK(worst < 2e-4, "worst relative error %.3g against the split form", worst);
+    vsgl_material m;
+    memset(&m, 0, sizeof m);
+    m.base_color[0] = m.base_color[1] = m.base_color[2] = 0.5f;
+    m.roughness = 0.9f;
+    vsgl_brdf_params p;
+    vsgl__material_params(&m, &p);
+    float d[3], g[3];
+    v3 wi = v3_normalize(v3_make(0.9f, 0.0f, 0.2f)), wo = v3_normalize(v3_make(-0.9f, 0.1f, 0.25f));
+    vsgl__brdf_eval(&p, v3_make(0, 0, 1), v3_make(1, 0, 0), wi, wo, d, g);
+    VT_CHECK_REL(d[0], 0.5 / PI * wi.z, 1e-6, "without the flag the diffuse base is Lambert's");
+}
+
+/* vsgl__burley_albedo(r, mu), the cosine-weighted mean of the reference over
+ * the hemisphere seen from mu, against 2-D quadrature (midpoint in cos_l
+ * and azimuth), over roughness and view; and its range (Burley darkens
+ * smooth surfaces at grazing views and brightens rough ones). */
+VT_TEST(material_burley_albedo_matches_quadrature)
+{
+    const int NC = 200, NP = 128;
+    double worst = 0.0;
+    for (int ir = 0; ir <= 10; ++ir) {
+        double r = ir / 10.0;
+        for (int im = 0; im <= 20; ++im) {
+            double mu = im == 0 ? 0.02 : im / 20.0, sv = sqrt(1.0 - mu * mu);
+            double v[3] = {sv, 0.0, mu}, acc = 0.0;
+            for (int i = 0; i < NC; ++i) {
+                /* cos_l = sqrt(u): cosine-weighted strata */
+                double u = (i + 0.5) / NC, c = sqrt(u), s = sqrt(1.0 - u);
+                for (int k = 0; k < NP; ++k) {
+                    double ph = 2.0 * PI * (k + 0.5) / NP;
+                    double l[3] = {s * cos(ph), s * sin(ph), c};
+                    acc += ref_burley(r, l, v);
+                }
+            }
+            double want = acc / ((double)NC * NP), got = vsgl__burley_albedo((float)r, (float)mu);
+            worst = fmax(worst, fabs(got - want) / want);
+        }
+    }
+    VT_CHECK(worst < 5e-4, "worst relative error %.3g against quadrature", worst);
+    VT_CHECK(vsgl__burley_albedo(0.9f, 0.2f) > 1.15f && vsgl__burley_albedo(0.9f, 0.2f) < 1.25f,
+             "a rough surface seen at grazing reflects more than Lambert's: %.4f", vsgl__burley_albedo(0.9f, 0.2f));
+    VT_CHECK(vsgl__burley_albedo(0.0f, 0.2f) < 0.9f, "a smooth one less: %.4f", vsgl__burley_albedo(0.0f, 0.2f));
+}

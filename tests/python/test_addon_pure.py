@@ -21,7 +21,12 @@ def test_principled_3x_specular_to_f0():
     assert m["base_color"] == pytest.approx((0.2, 0.4, 0.6))
     assert (m["metallic"], m["roughness"]) == pytest.approx((0.25, 0.7))
     assert (m["anisotropy"], m["anisotropic_rotation"]) == pytest.approx((0.3, 0.1))
-    assert m["flags"] == 0 and w == []
+    # Cycles 3.x's Principled diffuse is Burley's (retro-reflection), 4.x's Lambert
+    assert m["flags"] == materials.MATERIAL_FLAG_BURLEY and w == []
+    m4, _ = materials.map_material(desc(materials.PRINCIPLED, {"Roughness": 0.7}, (4, 2, 0)))
+    assert not m4["flags"] & materials.MATERIAL_FLAG_BURLEY
+    d, _ = materials.map_material(desc(materials.DIFFUSE, {"Color": (0.1, 0.2, 0.3, 1)}, (3, 4, 1)))
+    assert not d["flags"] & materials.MATERIAL_FLAG_BURLEY  # the Diffuse BSDF stays Lambert
 
 
 @pytest.mark.parametrize("ior,level", [(1.5, 0.5), (1.45, 0.5), (2.0, 1.0), (1.5, 0.0)])

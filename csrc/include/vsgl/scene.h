@@ -35,8 +35,17 @@ extern "C" {
  *  E1(mu), E1 the lobe's single-scatter albedo with F = 1, F_ms =
  *  F_avg E_avg / (1 - F_avg (1 - E_avg)) (E_avg the mean of E1, F_avg of F). */
 #define VSGL_MATERIAL_FLAG_MULTISCATTER 4u
+/** The diffuse base as Blender 3.x's Principled BSDF reflects it (Burley's
+ *  2012 "Disney" diffuse: retro-reflection on rough surfaces, darkening on
+ *  smooth ones at grazing angles): base (1 - metallic) / pi times
+ *  (1 + k (1 - cos_i)^5)(1 + k (1 - cos_o)^5), k = 2 roughness (i.h)^2 - 1/2.
+ *  Without it the diffuse base is Lambert's (Blender 4.x+, and the Diffuse
+ *  BSDF). DiffCol stays the base colour either way, as Cycles 3.x writes it. */
+#define VSGL_MATERIAL_FLAG_BURLEY 8u
 /** Every material flag this version knows; other bits are rejected. */
-#define VSGL_MATERIAL_FLAGS_KNOWN (VSGL_MATERIAL_UNSUPPORTED | VSGL_MATERIAL_FLAG_BLENDER_4 | VSGL_MATERIAL_FLAG_MULTISCATTER)
+#define VSGL_MATERIAL_FLAGS_KNOWN                                                                 \
+    (VSGL_MATERIAL_UNSUPPORTED | VSGL_MATERIAL_FLAG_BLENDER_4 | VSGL_MATERIAL_FLAG_MULTISCATTER | \
+     VSGL_MATERIAL_FLAG_BURLEY)
 
 /**
  * The Principled BSDF subset the method models. Zero-initialised is black.

@@ -105,10 +105,14 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
     /* (Blender 4.x+ materials: the dielectric layer dims the diffuse
      * reflection in each direction; the lobe keeps its shape, its power
      * takes the cosine-weighted mean of the dimming) */
+    /* (Blender 3.x's Burley diffuse, VSGL_MATERIAL_FLAG_BURLEY: the power
+     * it reflects from light arriving at cos_i, vsgl__burley_albedo; the
+     * lobe keeps Lambert's shape) */
     const vsgl_albedo_table *alb = vsgl__scene_glossy_albedo(scene, mat);
+    const double kd = alb->diffuse_power * vsgl__diffuse_albedo_ratio(&bp, v3_dot(wi, n));
     double pd[3];
     for (int c = 0; c < 3; ++c)
-        pd[c] = flux[c] * bp.diffuse[c] * alb->diffuse_power;
+        pd[c] = flux[c] * bp.diffuse[c] * kd;
     if (pd[0] + pd[1] + pd[2] > 0.0) {
         float ld = vsgl_sg_cosine_sharpness();
         fill(&out[VSGL__LOBE_DIFFUSE], pd, n, vsgl_mean_length_from_sharpness(ld, estimator), rel, n, foot);

@@ -14,10 +14,11 @@
  *   L(o)) of Cycles 4.x; the two agree at normal view and differ in
  *   directional albedo by < 0.1 % at alpha 0.09, 1 % at alpha 0.25, 16 % at
  *   alpha 1 (view cosine 0.3).
- * - Diffuse: Lambert, base_color (1 - metallic), not attenuated by the
- *   specular layer (3.x). Blender 3.x's Principled diffuse is Burley's
- *   (retro-reflection, grazing darkening), 4.x's is Lambert attenuated by
- *   the specular albedo; a Diffuse BSDF with roughness 0 is Lambert.
+ * - Diffuse: base_color (1 - metallic), not attenuated by the specular
+ *   layer (3.x); Lambert, or with VSGL_MATERIAL_FLAG_BURLEY Burley's
+ *   (Blender 3.x's Principled: retro-reflection, grazing darkening; Cycles'
+ *   bsdf_principled_diffuse). 4.x's is Lambert attenuated by the specular
+ *   albedo; a Diffuse BSDF with roughness 0 is Lambert.
  * - Single-scatter GGX only ("GGX" distribution). Multiscatter GGX adds the
  *   energy single scattering loses (up to ~25 % at roughness 1).
  */
@@ -65,6 +66,34 @@ void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out)
     }
     float s0 = sqrtf(fminf(f0, 0.99f));
     out->eta = (1.0f + s0) / (1.0f - s0);
+    out->burley = (m->flags & VSGL_MATERIAL_FLAG_BURLEY) ? rough : -1.0f;
+}
+
+float vsgl__burley_factor(float r, float ci, float co, float cio)
+{
+    float fl = 1.0f - clampf(ci, 0.0f, 1.0f), fv = 1.0f - clampf(co, 0.0f, 1.0f);
+    fl *= fl * fl * fl * fl;
+    fv *= fv * fv * fv * fv;
+    const float k = r * (1.0f + clampf(cio, -1.0f, 1.0f)) - 0.5f;
+    return (1.0f + k * fl) * (1.0f + k * fv);
+}
+
+/* E[.] over the other direction l, cosine-weighted (pdf cos_l / pi), with
+ * s = l.v: E[FL] = 1/21, E[s] = 2 mu / 3, E[s FL] = mu / 84, E[s^2 FL] =
+ * mu^2 / 252 + (1 - mu^2) 11 / 504 (Beta integrals of c^j (1 - c)^5 and
+ * the azimuthal mean of s^2, c^2 mu^2 + (1 - c^2)(1 - mu^2) / 2). With
+ * k = a + r s, a = r - 1/2: E[Fd] = 1 + FV E[k] + E[k FL] + FV E[k^2 FL]. */
+float vsgl__burley_albedo(float r, float mu)
+{
+    mu = clampf(mu, 0.0f, 1.0f);
+    const float a = r - 0.5f, m2 = mu * mu;
+    float fv = 1.0f - mu;
+    fv *= fv * fv * fv * fv;
+    const float ek = a + r * (2.0f / 3.0f) * mu;
+    const float ekl = a * (1.0f / 21.0f) + r * mu * (1.0f / 84.0f);
+    const float ek2l = a * a * (1.0f / 21.0f) + a * r * mu * (1.0f / 42.0f) +
+                       r * r * (m2 * (1.0f / 252.0f) + (1.0f - m2) * (11.0f / 504.0f));
+    return 1.0f + fv * ek + ekl + fv * ek2l;
 }
 
 /* Unpolarised Fresnel reflectance of a dielectric interface (Cycles'
@@ -102,6 +131,8 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
     if (!(ci > 0.0f && co > 0.0f))
         return;
     float kd = ci * (1.0f / VSGL__PI);
+    if (p->burley >= 0.0f) /* Blender 3.x's Principled diffuse */
+        kd *= vsgl__burley_factor(p->burley, ci, co, v3_dot(wi, wo));
     for (int c = 0; c < 3; ++c)
         diffuse_out[c] = p->diffuse[c] * kd;
     if (!p->glossy)

@@ -19,6 +19,7 @@ typedef struct vsgl_brdf_params {
     float favg[3];      /* cosine-weighted mean Fresnel per channel (Schlick: f0 + (1 - f0) / 21) */
     float metallic, base[3], f0_dielectric; /* the Principled inputs (GlossCol of Blender 4.x+) */
     float fms[3];       /* the compensation's Fresnel: F_avg E_avg / (1 - F_avg (1 - E_avg)) (Kulla & Conty) */
+    float burley;       /* VSGL_MATERIAL_FLAG_BURLEY: the roughness of Blender 3.x's Burley diffuse; < 0: Lambert */
 } vsgl_brdf_params;
 
 void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out);
@@ -32,6 +33,24 @@ void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out);
  * Fresnel); choices and differences to Cycles in docs/units.md. */
 void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
                      float diffuse_out[3], float glossy_out[3]);
+
+/* Burley's diffuse over Lambert's (VSGL_MATERIAL_FLAG_BURLEY): (1 + k FL)
+ * (1 + k FV), k = r (1 + cos_io) - 1/2 (= 2 r (i.h)^2 - 1/2), F = (1 - cos)^5,
+ * for cosines ci, co of the two directions with the normal and cos_io
+ * between them; vsgl__brdf_eval's diffuse part takes it. */
+float vsgl__burley_factor(float r, float ci, float co, float cio);
+/* Its cosine-weighted mean over the other direction's hemisphere, seen from
+ * a direction of cosine mu: the diffuse base's directional albedo over
+ * Lambert's, in closed form (docs/units.md; e.g. 1.20 at mu = 0.2 and 1.03
+ * at mu = 1 for roughness 0.9, 0.78 and 0.98 for roughness 0). The VSGL
+ * path takes it for both ends of a bounce: a VPL's diffuse power at its
+ * light's incidence, and a receiver's diffuse light at its view. */
+float vsgl__burley_albedo(float r, float mu);
+/* vsgl__burley_albedo of p at mu, 1 for a Lambert diffuse base. */
+static inline float vsgl__diffuse_albedo_ratio(const vsgl_brdf_params *p, float mu)
+{
+    return p->burley >= 0.0f ? vsgl__burley_albedo(p->burley, mu) : 1.0f;
+}
 
 /* Directional albedo of the glossy lobe, int f(wi, wo) cos(wo) dwo: the
  * fraction of the power arriving from wi that the lobe reflects (Fresnel,

@@ -748,8 +748,10 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                     }
                 }
             }
+            /* Blender 3.x's Burley diffuse: the light it reflects towards o (DiffCol stays) */
+            const float bu = vsgl__diffuse_albedo_ratio(&r.bp, v3_dot(r.n, r.o));
             for (int c = 0; c < 3; ++c) {
-                acc_d[c] += w * r.bp.diffuse[c] * wd * ld[c];
+                acc_d[c] += w * r.bp.diffuse[c] * wd * bu * ld[c];
                 acc_g[c] += w * ls[c];
             }
         }
@@ -1205,13 +1207,15 @@ void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls, fl
         const float *L = Ls[k];
         const float w = vsgl__gbuffer_weight(g, si);
         float wd = w * vsgl__scene_diffuse_weight(j->scene, g->material[si], v3_dot(n, o));
-        if (cd) {
+        /* Blender 3.x's Burley diffuse: the light it reflects towards o (DiffCol stays) */
+        const float bu = vsgl__diffuse_albedo_ratio(&bp, v3_dot(n, o));
+        if (cd) { /* a replay's light weights (sparse_replay.c), Burley's included */
             for (int c = 0; c < 3; ++c)
-                cd[k * 4 + c] = bp.diffuse[c] * wd;
+                cd[k * 4 + c] = bp.diffuse[c] * wd * bu;
             cd[k * 4 + 3] = w;
         }
         for (int c = 0; c < 3; ++c) {
-            acc[c] += bp.diffuse[c] * wd * L[c];
+            acc[c] += bp.diffuse[c] * wd * bu * L[c];
             acc[3 + c] += w * L[3 + c];
             acc[6 + c] += bp.diffuse[c] * wd;
             acc[9 + c] += w * gcol[c];
