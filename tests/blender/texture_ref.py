@@ -47,6 +47,7 @@ DIFFCOL_SPP = 1024   # Cycles' own noise at texture edges stays below the tolera
 DIFFCOL_AA = 16      # the library: 16 x 16 samples per pixel (edges of stripes and texels)
 TOL_BLEED = 0.05
 TOL_EMISSION = 0.10
+TOL_PRINCIPLED = 0.03
 
 
 def args():
@@ -329,12 +330,18 @@ def build_bleed(textured=True):
     return sc
 
 
-def build_emission():
+def build_emission(principled=False):
     """A room lit only by an emissive ceiling panel (Emission shader) and a
-    small emissive Principled box on the floor."""
+    small emissive Principled box on the floor; its walls Lambert (Diffuse
+    BSDF) or, with ``principled``, rough Principled BSDFs without a specular
+    layer (Burley's diffuse in Blender 3.x, Lambert's in 4.x+)."""
     sc = reset()
-    white = lambert("white", (0.8, 0.8, 0.8))
-    red = lambert("red", (0.8, 0.1, 0.05))
+    if principled:
+        white = material("white", flat((0.8, 0.8, 0.8), 0.9))
+        red = material("red", flat((0.8, 0.1, 0.05), 0.9))
+    else:
+        white = lambert("white", (0.8, 0.8, 0.8))
+        red = lambert("red", (0.8, 0.1, 0.05))
 
     def emit(nodes, links, bsdf):
         e = nodes.new("ShaderNodeEmission")
@@ -374,6 +381,35 @@ def check_emission(out_dir, report):
     print(line)
     report.append(line)
     save_pair(out_dir, "emission", got * 4, ref * 4)
+    return ok
+
+
+def check_principled_diffuse(out_dir, report):
+    """The emission room with rough Principled walls against the same room
+    with Lambert walls, each against Cycles: the panel's own modelling error
+    (check_emission) cancels in the ratio of the two ratios, which is the
+    Principled diffuse's. Blender 3.4's is Burley's (VSGL_MATERIAL_FLAG_BURLEY):
+    Cycles' room is ~10 % brighter than a Lambert model gives at these
+    grazing views; 4.x+'s is Lambert's."""
+    passes = ["DiffInd", "DiffCol"]
+    ratios = []
+    for principled in (False, True):
+        name = "emission_principled" if principled else "emission"
+        cyc, _ = cycles(name, lambda: build_emission(principled), passes, 1024, 1.0, out_dir)
+        ref = cyc["DiffInd"] * cyc["DiffCol"]
+        build_emission(principled)
+        lib, _, sd = library(bpy.context.scene, preset("QUALITY"))
+        got = lib["diffuse"]
+        m = (ref.max(-1) > 0) & (got.max(-1) >= 0)
+        ratios.append(got[m].mean(0) / ref[m].mean(0))
+    rr = ratios[1] / ratios[0]
+    ok = bool((np.abs(rr - 1.0) < TOL_PRINCIPLED).all())
+    line = ("%s principled diffuse: (lib / Cycles) with rough Principled walls over the same with Lambert walls "
+            "%s (tol %.0f %%; lib / Cycles %s and %s)" % ("PASS" if ok else "FAIL", np.round(rr, 4),
+                                                         100 * TOL_PRINCIPLED, np.round(ratios[1], 4),
+                                                         np.round(ratios[0], 4)))
+    print(line)
+    report.append(line)
     return ok
 
 
@@ -612,7 +648,7 @@ def main():
     os.makedirs(out_dir, exist_ok=True)
     report = ["# Textures vs Cycles (%s)" % bpy.app.version_string, ""]
     checks = [("diffcol", check_diffcol), ("bleed", check_bleed), ("emission", check_emission),
-              ("emission_units", check_emission_units)]
+              ("emission_units", check_emission_units), ("principled_diffuse", check_principled_diffuse)]
     extra = globals().get("EXTRA_CHECKS", [])
     p = f = 0
     for name, fn in checks + extra:

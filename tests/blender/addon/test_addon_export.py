@@ -178,6 +178,9 @@ def test_materials_from_nodes_both_versions(scene):
     # a Principled BSDF's distribution: Multiscatter GGX is 4.x's default
     ms = by["P"]["flags"] & materials.MATERIAL_FLAG_MULTISCATTER
     assert bool(ms) == (VERSION >= (4, 0, 0) and m1.node_tree.nodes["Principled BSDF"].distribution == "MULTI_GGX")
+    # Cycles 3.x's Principled diffuse is Burley's, 4.x's and the Diffuse BSDF's Lambert
+    assert bool(by["P"]["flags"] & materials.MATERIAL_FLAG_BURLEY) == (VERSION < (4, 0, 0))
+    assert not by["Diff"]["flags"] & materials.MATERIAL_FLAG_BURLEY
     # Per-triangle material: polygon i -> material i % 3 (two triangles each).
     names = [sd.material_names[i] for i in sd.material_indices]
     assert names.count("P") == names.count("Emit") == names.count("Diff") == 4
