@@ -57,6 +57,7 @@ TOL_BLEED = 0.05
 TOL_BLEED_VSGL = 0.07
 TOL_EMISSION = 0.10
 TOL_PRINCIPLED = 0.03
+TOL_BURLEY_FLAT = 0.01
 
 
 def args():
@@ -422,6 +423,81 @@ def check_principled_diffuse(out_dir, report):
     return ok
 
 
+def burley_direct_ratio(rough, out_dir):
+    """Cycles' DiffDir of a Principled floor (roughness ``rough``,
+    no specular layer) under a low point light, seen from 45 degrees, over
+    the library's exact diffuse BRDF (vsgl_reference_brdf, with and
+    without VSGL_MATERIAL_FLAG_BURLEY) times the light's irradiance, in
+    bins of the light's incidence cosine: (bin means with the flag,
+    without). A model that is Cycles' own is the same constant in every bin
+    (the light unit's factor); Lambert's drifts with the incidence."""
+    sc = reset()
+    quad("Floor", (-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0), material("p", flat((0.5, 0.5, 0.5), rough)))
+    L, P = (2.5, 0.0, 0.6), 100.0
+    lo = bpy.data.objects.new("L", bpy.data.lights.new("L", "POINT"))
+    lo.location, lo.data.energy, lo.data.shadow_soft_size = L, P, 0.0
+    sc.collection.objects.link(lo)
+    cam = bpy.data.objects.new("C", bpy.data.cameras.new("C"))
+    cam.data.type, cam.data.ortho_scale = "ORTHO", 3.0
+    cam.location, cam.rotation_euler = (-3.0, 0.0, 3.0), (math.radians(45), 0.0, math.radians(-90))
+    sc.collection.objects.link(cam)
+    sc.camera = cam
+    W = 64
+    sc.render.resolution_x = sc.render.resolution_y = W
+    sc.render.resolution_percentage = 100
+    cyc, _ = cycles("burley_direct_%.2f" % rough, lambda: None, ["DiffDir", "DiffCol"], 64, 1.0, out_dir)
+    M = np.array(cam.matrix_world, np.float64)
+    c = (np.arange(W) + 0.5) / W * 3.0 - 1.5
+    U, V = np.meshgrid(c, -c)
+    org = M[:3, 0][None] * U.reshape(-1, 1) + M[:3, 1][None] * V.reshape(-1, 1) + M[:3, 3][None]
+    fwd = -M[:3, 2] / np.linalg.norm(M[:3, 2])
+    pos = org - (org[:, 2:3] / fwd[2]) * fwd[None]
+    d = np.array(L)[None] - pos
+    d2 = (d * d).sum(1)
+    wi = (d / np.sqrt(d2)[:, None]).astype(np.float32)
+    n = len(pos)
+    N = np.tile(np.float32([0, 0, 1]), (n, 1))
+    T = np.tile(np.float32([1, 0, 0]), (n, 1))
+    WO = np.tile((-fwd).astype(np.float32), (n, 1))
+    got = cyc["DiffDir"][..., 0].reshape(-1)  # Cycles' DiffDir has the colour (DiffCol) divided out
+    ok = (cyc["DiffCol"][..., 0].reshape(-1) > 0.1) & (wi[:, 2] > 0.05)
+    out = []
+    for flags in (libvsgl.MATERIAL_FLAG_BURLEY, 0):
+        m = libvsgl.vsgl_material()
+        m.base_color[:] = (1.0, 1.0, 1.0)
+        m.roughness, m.flags = rough, flags
+        fd, _ = libvsgl.reference_brdf(m, N, T, wi, WO)
+        r = got / np.maximum(fd[:, 0] * P / (4 * math.pi * d2), 1e-12)
+        out.append([float(r[ok & (wi[:, 2] >= a) & (wi[:, 2] < b)].mean())
+                    for a, b in ((0.05, 0.15), (0.15, 0.3), (0.3, 1.01))])
+    return out
+
+
+def check_burley_direct(out_dir, report):
+    """Blender 3.4's Principled diffuse is the library's Burley form: Cycles'
+    direct light over the library's BRDF is flat across the incidence (the
+    bins' spread, and each bin's distance from 1, within TOL_BURLEY_FLAT),
+    where Lambert's is not (its spread is printed beside). In 4.x+ the Principled diffuse is Lambert's:
+    skipped there."""
+    if bpy.app.version >= (4, 0, 0):
+        report.append("SKIP burley direct: Blender %s's Principled diffuse is Lambert's" % bpy.app.version_string)
+        return True
+    ok = True
+    for rough in (0.0, 0.5, 1.0):
+        with_flag, lambert = burley_direct_ratio(rough, out_dir)
+        spread = max(with_flag) / min(with_flag) - 1.0
+        spread_l = max(lambert) / min(lambert) - 1.0
+        good = spread < TOL_BURLEY_FLAT and all(abs(r - 1.0) < TOL_BURLEY_FLAT for r in with_flag)
+        ok &= good
+        line = ("%s burley direct, roughness %.1f: Cycles DiffDir over the library's BRDF x E in incidence bins "
+                "0.05-0.15 / 0.15-0.3 / 0.3-1: %s, spread %.2f %% (tol %.1f %%); Lambert's %s, spread %.1f %%"
+                % ("PASS" if good else "FAIL", rough, np.round(with_flag, 4), 100 * spread, 100 * TOL_BURLEY_FLAT,
+                   np.round(lambert, 4), 100 * spread_l))
+        print(line)
+        report.append(line)
+    return ok
+
+
 EMIT_S, EMIT_C = 8.0, (1.0, 0.9, 0.7)
 
 
@@ -658,7 +734,8 @@ def main():
     os.makedirs(out_dir, exist_ok=True)
     report = ["# Textures vs Cycles (%s)" % bpy.app.version_string, ""]
     checks = [("diffcol", check_diffcol), ("bleed", check_bleed), ("emission", check_emission),
-              ("emission_units", check_emission_units), ("principled_diffuse", check_principled_diffuse)]
+              ("emission_units", check_emission_units), ("principled_diffuse", check_principled_diffuse),
+              ("burley_direct", check_burley_direct)]
     extra = globals().get("EXTRA_CHECKS", [])
     p = f = 0
     for name, fn in checks + extra:
