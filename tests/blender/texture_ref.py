@@ -415,9 +415,9 @@ def check_principled_diffuse(out_dir, report):
     rr = ratios[1] / ratios[0]
     ok = bool((np.abs(rr - 1.0) < TOL_PRINCIPLED).all())
     line = ("%s principled diffuse: (lib / Cycles) with rough Principled walls over the same with Lambert walls "
-            "%s (tol %.0f %%; lib / Cycles %s and %s)" % ("PASS" if ok else "FAIL", np.round(rr, 4),
-                                                         100 * TOL_PRINCIPLED, np.round(ratios[1], 4),
-                                                         np.round(ratios[0], 4)))
+            "%s (tol %.0f %%; lib / Cycles %s and %s)"
+            % ("PASS" if ok else "FAIL", np.round(rr, 4), 100 * TOL_PRINCIPLED, np.round(ratios[1], 4),
+               np.round(ratios[0], 4)))
     print(line)
     report.append(line)
     return ok
