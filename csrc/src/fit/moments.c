@@ -109,7 +109,7 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
      * it reflects from light arriving at cos_i, vsgl__burley_albedo; the
      * lobe keeps Lambert's shape) */
     const vsgl_albedo_table *alb = vsgl__scene_glossy_albedo(scene, mat);
-    const double kd = alb->diffuse_power * vsgl__diffuse_albedo_ratio(&bp, v3_dot(wi, n));
+    const double kd = vsgl__scene_diffuse_power(scene, mat, &bp, v3_dot(wi, n));
     double pd[3];
     for (int c = 0; c < 3; ++c)
         pd[c] = flux[c] * bp.diffuse[c] * kd;

@@ -259,8 +259,8 @@ void vsgl__mrp_proxies_add_rsm(vsgl__mrp_proxy_set *set, const vsgl_scene *scene
             /* the diffuse power the texel reflects, as the VSGL fit takes it
              * (fit/moments.c): Blender 4.x+'s dimming, 3.x's Burley albedo */
             const v3 wi = v3_make(rsm->wi[0][i], rsm->wi[1][i], rsm->wi[2][i]);
-            const float kd = vsgl__scene_glossy_albedo(scene, rsm->material[i])->diffuse_power *
-                             vsgl__diffuse_albedo_ratio(&bp, v3_dot(wi, v3_make((float)nt.x, (float)nt.y, (float)nt.z)));
+            const float kd = vsgl__scene_diffuse_power(scene, rsm->material[i], &bp,
+                                                       v3_dot(wi, v3_make((float)nt.x, (float)nt.y, (float)nt.z)));
             for (int c = 0; c < 3; ++c)
                 cell[c] += rsm->flux[c][i] * bp.diffuse[c] * kd;
             break;

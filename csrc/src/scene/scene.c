@@ -448,6 +448,13 @@ float vsgl__scene_diffuse_weight(const vsgl_scene *scene, uint32_t material, flo
     return vsgl__diffuse_view_weight(vsgl__scene_glossy_albedo(scene, material), cos_view);
 }
 
+float vsgl__scene_diffuse_power(const vsgl_scene *scene, uint32_t material, const vsgl_brdf_params *bp,
+                                float cos_i)
+{
+    const vsgl_albedo_table *t = vsgl__scene_glossy_albedo(scene, material);
+    return (t ? t->diffuse_power : 1.0f) * vsgl__diffuse_albedo_ratio(bp, cos_i);
+}
+
 const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count)
 {
     if (count)

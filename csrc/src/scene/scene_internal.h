@@ -109,6 +109,15 @@ const struct vsgl_albedo_table *vsgl__scene_glossy_albedo(const vsgl_scene *scen
 /* The DiffCol weight of a material seen from a direction of cosine cos_view
  * (vsgl__diffuse_view_weight: 1 unless it is a Blender 4.x+ material). */
 float vsgl__scene_diffuse_weight(const vsgl_scene *scene, uint32_t material, float cos_view);
+/* The diffuse power a VPL of that material (parameters bp, its textures
+ * applied) reflects from light arriving at cosine cos_i, over Lambert's
+ * base (1 - metallic): Blender 4.x+'s cosine-weighted mean dimming by the
+ * specular layer, times Blender 3.x's Burley albedo at cos_i
+ * (vsgl__diffuse_albedo_ratio); 1 for a Lambert material. The VSGL fit
+ * (fit/moments.c) and the MRP proxies (mrp/proxies.c) take it alike. */
+struct vsgl_brdf_params;
+float vsgl__scene_diffuse_power(const vsgl_scene *scene, uint32_t material, const struct vsgl_brdf_params *bp,
+                                float cos_i);
 const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count);
 const vsgl_camera *vsgl__scene_camera(const vsgl_scene *scene);
 /* With the scene's address, distinguishes scenes whose geometry or
