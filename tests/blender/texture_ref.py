@@ -46,15 +46,6 @@ TOL_DIFFCOL = 0.01
 DIFFCOL_SPP = 1024   # Cycles' own noise at texture edges stays below the tolerance
 DIFFCOL_AA = 16      # the library: 16 x 16 samples per pixel (edges of stripes and texels)
 TOL_BLEED = 0.05
-# The quality preset's floor in the bleed room: its Principled walls and
-# floor are Burley's in Blender 3.4, which the VSGL path takes by its
-# directional albedo at both ends of the bounce (docs/units.md). Here the
-# light runs forward at both ends (the spot's wall lights the floor in
-# front of it, seen from behind), where that mean overstates Burley's
-# retro-reflection: +4.6-5.6 % of Cycles where the exact brute force at
-# RSM 256 is within 0.3 % (at RSM 96, below, 2.4-3.4 %); Lambert's model
-# gave -2.0 to -3.1 %.
-TOL_BLEED_VSGL = 0.07
 TOL_EMISSION = 0.10
 TOL_PRINCIPLED = 0.03
 TOL_BURLEY_FLAT = 0.01
@@ -705,12 +696,11 @@ def check_bleed(out_dir, report):
         lib, secs, sd = library(sc, settings)
         got = lib["diffuse"][m].mean(0)
         rel = np.abs(got - want) / want
-        tol = TOL_BLEED_VSGL if label == "quality" else TOL_BLEED
-        ok = bool((rel < tol).all())
+        ok = bool((rel < TOL_BLEED).all())
         ok_all &= ok
         line = "%s bleed %s: floor mean RGB lib %s Cycles %s rel %s %% (tol %.0f %%), %.2f s" % (
             "PASS" if ok else "FAIL", label, np.round(got, 5), np.round(want, 5), np.round(100 * rel, 2),
-            100 * tol, secs)
+            100 * TOL_BLEED, secs)
         print(line)
         report.append(line)
         if label == "quality":

@@ -73,10 +73,12 @@ typedef struct bundle {
     fx_scene fx;
 } bundle;
 
-static int setup(bundle *b, float roughness, uint32_t vsgls, int32_t fit, int32_t leak)
+static int setup_as(bundle *b, float roughness, uint32_t vsgls, int32_t fit, int32_t leak, uint32_t flags)
 {
     memset(b, 0, sizeof *b);
     fx_room(&b->fx, 40, 30, roughness, 100.0f);
+    for (int m = 0; m < 4; ++m)
+        b->fx.materials[m].flags |= flags;
     vsgl_render_settings in;
     vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &in);
     in.shade_stride = 1; /* every pixel shaded, no visibility rays: the model alone */
@@ -93,6 +95,11 @@ static int setup(bundle *b, float roughness, uint32_t vsgls, int32_t fit, int32_
     int ok = (fit == VSGL_FIT_LATTICE ? vsgl__fit_lattice : vsgl__fit_fis)(b->ctx, b->scene, &rsm, &b->s, &b->set) == VSGL_OK;
     vsgl__rsm_free(&rsm);
     return ok;
+}
+
+static int setup(bundle *b, float roughness, uint32_t vsgls, int32_t fit, int32_t leak)
+{
+    return setup_as(b, roughness, vsgls, fit, leak, 0u);
 }
 
 static void teardown(bundle *b)
@@ -128,7 +135,9 @@ VT_TEST(kernel_shading_matches_reference_path)
     for (int k = 0; k < 6; ++k) {
         bundle b;
         int clip = k >= 3;
-        VT_CHECK(setup(&b, rough[k % 3], 32, clip ? VSGL_FIT_LATTICE : VSGL_FIT_FIS, clip ? VSGL_LEAK_ON : VSGL_LEAK_OFF),
+        /* Blender 3.x's Burley diffuse (per pair in both paths) in half the rooms */
+        VT_CHECK(setup_as(&b, rough[k % 3], 32, clip ? VSGL_FIT_LATTICE : VSGL_FIT_FIS, clip ? VSGL_LEAK_ON : VSGL_LEAK_OFF,
+                          k % 2 ? VSGL_MATERIAL_FLAG_BURLEY : 0u),
                  "setup: %s", b.ctx ? vsgl_context_last_error(b.ctx) : "");
         size_t px = (size_t)b.g.width * b.g.height;
         for (int mode = 0; mode < 3; ++mode) {
@@ -179,6 +188,13 @@ static void random_block(vt_rng *r, vsgl_kernel_block *b)
         vsgl_vec3 y = {z.y * x.z - z.z * x.y, z.z * x.x - z.x * x.z, z.x * x.y - z.y * x.x};
         b->nx[k] = z.x; b->ny[k] = z.y; b->nz[k] = z.z;
         b->diffuse[k] = vt_uniform(r) < 0.8 ? 1.0f : 0.0f;
+        /* Blender 3.x's Burley diffuse on half the lanes (VSGL__KERNEL_BURLEY blocks) */
+        b->burley[k] = vt_uniform(r) < 0.5 ? (float)vt_uniform(r) : -1.0f;
+        { /* a view above the lane's plane (Burley's factor reads it) */
+            float ox = z.x + (float)(1.6 * vt_uniform(r) - 0.8), oy = z.y + (float)(1.6 * vt_uniform(r) - 0.8);
+            float oz = z.z + (float)(1.6 * vt_uniform(r) - 0.8), on = sqrtf(ox * ox + oy * oy + oz * oz);
+            b->ox[k] = ox / on; b->oy[k] = oy / on; b->oz[k] = oz / on;
+        }
         b->Xx[k] = x.x; b->Xy[k] = x.y; b->Xz[k] = x.z;
         b->Yx[k] = y.x; b->Yy[k] = y.y; b->Yz[k] = y.z;
         b->Zx[k] = z.x; b->Zy[k] = z.y; b->Zz[k] = z.z;
@@ -273,7 +289,8 @@ VT_TEST(kernel_isa_clones_agree_with_scalar_build)
         int plain = trial % 4 < 2;
         /* every third trial with the glossy lobe as GGX's core and tail */
         const int32_t lob = VSGL__KERNEL_DIFFUSE | VSGL__KERNEL_GLOSSY | (trial % 3 == 0 ? VSGL__KERNEL_GGX_TAIL : 0) |
-                            (trial % 2 ? VSGL__KERNEL_GRAZE : 0); /* the horizon cut in half the trials */
+                            (trial % 2 ? VSGL__KERNEL_GRAZE : 0) | /* the horizon cut in half the trials */
+                            (trial % 5 < 2 ? VSGL__KERNEL_BURLEY : 0); /* Burley's diffuse in two of five */
         for (int k = 0; k < 8; ++k) {
             random_light(&r, &L[k], trial % 2);
             if (plain)

@@ -43,8 +43,9 @@ float vsgl__burley_factor(float r, float ci, float co, float cio);
  * a direction of cosine mu: the diffuse base's directional albedo over
  * Lambert's, in closed form (docs/units.md; e.g. 1.20 at mu = 0.2 and 1.03
  * at mu = 1 for roughness 0.9, 0.78 and 0.98 for roughness 0). The VSGL
- * path takes it for both ends of a bounce: a VPL's diffuse power at its
- * light's incidence, and a receiver's diffuse light at its view. */
+ * fit takes it for a VPL's diffuse power at its light's incidence (the
+ * lobe keeps Lambert's shape); receivers take the factor itself per pair
+ * (the kernel's k_burley). */
 float vsgl__burley_albedo(float r, float mu);
 /* vsgl__burley_albedo of p at mu, 1 for a Lambert diffuse base. */
 static inline float vsgl__diffuse_albedo_ratio(const vsgl_brdf_params *p, float mu)

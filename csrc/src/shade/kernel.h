@@ -244,6 +244,8 @@ typedef struct vsgl_kernel_block {
     float nx[VSGL__KERNEL_BLOCK], ny[VSGL__KERNEL_BLOCK], nz[VSGL__KERNEL_BLOCK];
     float ox[VSGL__KERNEL_BLOCK], oy[VSGL__KERNEL_BLOCK], oz[VSGL__KERNEL_BLOCK];
     float diffuse[VSGL__KERNEL_BLOCK];   /* 1 if the diffuse lobe is shaded, else 0 */
+    /* Blender 3.x's Burley diffuse (VSGL_MATERIAL_FLAG_BURLEY): its roughness, < 0 for Lambert */
+    float burley[VSGL__KERNEL_BLOCK];
     /* its convex part (scene_internal.h) as a float, -1 if none, and 1 on
      * the part's outside, 0 inside (vsgl__part_keep) */
     float part[VSGL__KERNEL_BLOCK], pouter[VSGL__KERNEL_BLOCK];
@@ -354,6 +356,9 @@ static inline float vsgl__graze_ramp(float zn)
 /* Some glossy lane's lobe grazes its tangent plane (vsgl__graze_ramp > 0):
  * the planar model's horizon cut runs for this block (kernel.h above) */
 #define VSGL__KERNEL_GRAZE  16
+/* Some diffuse lane is Blender 3.x's Burley diffuse (vsgl_kernel_block.burley
+ * >= 0): the diffuse stage takes its factor per pair (kernel_impl.h, k_burley) */
+#define VSGL__KERNEL_BURLEY 32
 /* The glossy lobe as GGX's core and tail: two ASGs of the lane's frame with
  * bandwidths x VSGL_GGX_{CORE,TAIL}_K and amplitudes x _C, fitted to GGX's
  * 1/(1 + x^2)^2, x = tan / alpha, at equal integral, minimising the relative

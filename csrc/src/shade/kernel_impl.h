@@ -212,6 +212,7 @@ typedef struct k_scratch {
     float mx[VSGL__KERNEL_BLOCK], my[VSGL__KERNEL_BLOCK], mz[VSGL__KERNEL_BLOCK]; /* lin times the incident axis */
     float lin[VSGL__KERNEL_BLOCK], ilin[VSGL__KERNEL_BLOCK];                    /* its sharpness and 1/it */
     float amp[VSGL__KERNEL_BLOCK];                                             /* its amplitude */
+    float bfac[VSGL__KERNEL_BLOCK];                                            /* Burley's factor (k_burley) */
     float expo[VSGL__KERNEL_BLOCK];                                            /* an exp's argument */
     float gpre[VSGL__KERNEL_BLOCK];                                            /* the glossy integral's factor */
     float r[VSGL__KERNEL_BLOCK], d2[VSGL__KERNEL_BLOCK], ls[VSGL__KERNEL_BLOCK];
@@ -400,7 +401,36 @@ static inline __attribute__((always_inline)) void k_cosine_stage_sharp(size_t i,
     t->low[i] = o.low; t->u[i] = o.u; t->t[i] = o.t; t->it[i] = o.it; t->kappa[i] = o.kappa; t->ct[i] = o.ct;
 }
 
-/* Stage 3: diffuse, the integral of the incident SG times max(w.n, 0), / pi. */
+/* Stage 3a (VSGL__KERNEL_BURLEY blocks): Blender 3.x's Burley diffuse over
+ * Lambert's for the pair, at the incident SG's mean direction l and the
+ * lane's view o (scene/material.h vsgl__burley_factor): (1 + k FL)(1 + k FV),
+ * k = r (1 + l.o) - 1/2, F = (1 - cos)^5; 1 for Lambert lanes. Taken per
+ * pair, it follows where the light comes from: the hemisphere's mean
+ * (vsgl__burley_albedo) overstated the retro-reflection of light arriving
+ * from in front of a receiver seen from behind it (docs/units.md). */
+static inline __attribute__((always_inline)) void
+k_burley(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t)
+{
+    const float ilin = t->ilin[i], mx = t->mx[i], my = t->my[i], mz = t->mz[i];
+    const float ox = b->ox[i], oy = b->oy[i], oz = b->oz[i];
+    float cl = (mx * b->nx[i] + my * b->ny[i] + mz * b->nz[i]) * ilin;
+    float cv = b->nx[i] * ox + b->ny[i] * oy + b->nz[i] * oz;
+    float s = (mx * ox + my * oy + mz * oz) * ilin;
+    cl = cl < 0.0f ? 0.0f : (cl > 1.0f ? 1.0f : cl);
+    cv = cv < 0.0f ? 0.0f : (cv > 1.0f ? 1.0f : cv);
+    s = s < -1.0f ? -1.0f : (s > 1.0f ? 1.0f : s);
+    float fl = 1.0f - cl, fv = 1.0f - cv;
+    const float fl2 = fl * fl, fv2 = fv * fv;
+    fl = fl2 * fl2 * fl;
+    fv = fv2 * fv2 * fv;
+    const float r = b->burley[i];
+    const float k = r * (1.0f + s) - 0.5f;
+    const float f = (1.0f + k * fl) * (1.0f + k * fv);
+    t->bfac[i] = r >= 0.0f ? f : 1.0f;
+}
+
+/* Stage 3: diffuse, the integral of the incident SG times max(w.n, 0), / pi,
+ * times Burley's factor (1 unless k_burley ran: the kernel's entry sets it). */
 static inline __attribute__((always_inline)) void
 k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, int32_t mode,
           const k_scratch *restrict t, float ld_sharp, float ld_norm)
@@ -432,7 +462,7 @@ k_diffuse(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *rest
         k_cos_l o = {t->low[i], t->u[i], t->t[i], t->it[i], t->kappa[i], t->ct[i]};
         cosint = k_cosine_cpart_s(lin, c, o, mode == K_COSINE_ACCURATE_SHARP);
     }
-    float ed = t->amp[i] * cosint * (1.0f / VSGL__PI) * b->diffuse[i];
+    float ed = t->amp[i] * cosint * (1.0f / VSGL__PI) * b->diffuse[i] * t->bfac[i];
     b->ld[0][i] += L->pr * ed;
     b->ld[1][i] += L->pg * ed;
     b->ld[2][i] += L->pb * ed;
@@ -916,8 +946,10 @@ static inline __attribute__((always_inline)) int k_faint(const vsgl_kernel_light
 /* The diffuse stages of VSGLs L[0, NL) (k_shade). */
 static inline __attribute__((always_inline)) void
 k_diffuse_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, const int NL, int32_t mode,
-                 k_scratch *restrict t)
+                 k_scratch *restrict t, const int burley)
 {
+    if (burley)
+        K_FORN(k_burley(b, i, t + j));
     /* the poster's SG-cosine lobe: constants (no call on the hot path) */
     const float ld_sharp = VSGL__COSINE_SHARPNESS;
     const float ld_norm = VSGL__PI / k_sg_integral(VSGL__COSINE_SHARPNESS);
@@ -1111,12 +1143,12 @@ k_shade(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict L, cons
     const int off = live == 2; /* the one live VSGL of a pass */
     if (nlive == 2) {
         if (lobes & VSGL__KERNEL_DIFFUSE)
-            k_diffuse_lights(b, L, 2, mode, t);
+            k_diffuse_lights(b, L, 2, mode, t, (lobes & VSGL__KERNEL_BURLEY) != 0);
         if (lobes & VSGL__KERNEL_GLOSSY)
             k_glossy_lights(b, L, 2, lobes, t);
     } else {
         if (lobes & VSGL__KERNEL_DIFFUSE)
-            k_diffuse_lights(b, L + off, 1, mode, t + off);
+            k_diffuse_lights(b, L + off, 1, mode, t + off, (lobes & VSGL__KERNEL_BURLEY) != 0);
         if (lobes & VSGL__KERNEL_GLOSSY)
             k_glossy_lights(b, L + off, 1, lobes, t + off);
     }
@@ -1129,6 +1161,10 @@ KERNEL_ATTR size_t KERNEL_NAME(vsgl_kernel_block *restrict b, const vsgl_kernel_
     const float lcut = faint > 0.0f ? logf(faint) : 0.0f;
     size_t skipped = 0;
     k_scratch t[2];
+    /* Burley's factor: 1 unless a VSGL__KERNEL_BURLEY block's k_burley sets it per pair */
+    for (int j = 0; j < 2; ++j)
+        for (size_t i = 0; i < VSGL__KERNEL_BLOCK; ++i)
+            t[j].bfac[i] = 1.0f;
     vsgl_kernel_light local[2]; /* copies: no aliasing with the block */
     size_t v = 0;
     for (; v + 2 <= count; v += 2) {

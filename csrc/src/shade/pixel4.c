@@ -88,14 +88,13 @@ void vsgl__write_pixels4(const shade_job *j, size_t px, const float *const Ls[4]
         }
         const float w = vsgl__gbuffer_weight(g, si);
         const float wd = w * vsgl__scene_diffuse_weight(j->scene, g->material[si], dot[k]);
-        const float bu = vsgl__diffuse_albedo_ratio(p, dot[k]); /* Burley (3.x): DiffCol stays */
-        if (cd) { /* a replay's light weights (sparse_replay.c), Burley's included */
+        if (cd) {
             for (int ch = 0; ch < 3; ++ch)
-                cd[k * 4 + ch] = p->diffuse[ch] * wd * bu;
+                cd[k * 4 + ch] = p->diffuse[ch] * wd;
             cd[k * 4 + 3] = w;
         }
         for (int ch = 0; ch < 3; ++ch) {
-            D[ch] = 0.0f + p->diffuse[ch] * wd * bu * L[ch];
+            D[ch] = 0.0f + p->diffuse[ch] * wd * L[ch];
             G[ch] = 0.0f + w * L[3 + ch];
             DC[ch] = 0.0f + p->diffuse[ch] * wd;
             GC[ch] = 0.0f + w * gcol[ch];

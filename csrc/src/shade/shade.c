@@ -728,11 +728,22 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                         continue;
                 }
                 if (has_diffuse) {
-                    float e_d = vsgl_sg_cosine_integral(&in, &r.n, j->s->diffuse_mode) * VSGL__INV_PI;
+                    const float e_sg = vsgl_sg_cosine_integral(&in, &r.n, j->s->diffuse_mode) * VSGL__INV_PI;
+                    float e_d = e_sg;
                     if (j->near->cell_of && j->near->cell_of[k] >= 0) {
                         float wn, q = vsgl__near_diffuse(&j->near->cells[j->near->cell_of[k]], r.x, r.n, &wn);
                         if (wn > 0.0f)
                             e_d = (1.0f - wn) * e_d + wn * q;
+                    }
+                    if (r.bp.burley >= 0.0f) {
+                        /* Blender 3.x's Burley diffuse as the kernel takes it: the SG's
+                         * part at its axis (k_burley), the near field's towards the
+                         * cluster's mean (near_correct) */
+                        v3 l = v3_normalize(v3_sub(v->mean, r.x));
+                        float fa = vsgl__burley_factor(r.bp.burley, v3_dot(r.n, in.axis), v3_dot(r.n, r.o),
+                                                       v3_dot(in.axis, r.o));
+                        float fm = vsgl__burley_factor(r.bp.burley, v3_dot(r.n, l), v3_dot(r.n, r.o), v3_dot(l, r.o));
+                        e_d = e_sg * fa + (e_d - e_sg) * fm;
                     }
                     for (int c = 0; c < 3; ++c)
                         ld[c] += v->power[c] * e_d;
@@ -748,10 +759,8 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                     }
                 }
             }
-            /* Blender 3.x's Burley diffuse: the light it reflects towards o (DiffCol stays) */
-            const float bu = vsgl__diffuse_albedo_ratio(&r.bp, v3_dot(r.n, r.o));
             for (int c = 0; c < 3; ++c) {
-                acc_d[c] += w * r.bp.diffuse[c] * wd * bu * ld[c];
+                acc_d[c] += w * r.bp.diffuse[c] * wd * ld[c];
                 acc_g[c] += w * ls[c];
             }
         }
@@ -785,6 +794,7 @@ static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z
     b->ox[k] = b->oy[k] = 0.0f;
     b->oz[k] = 1.0f;
     b->diffuse[k] = 0.0f;
+    b->burley[k] = -1.0f;
     b->part[k] = -1.0f;
     b->pouter[k] = 0.0f;
     b->Xx[k] = 1.0f; b->Xy[k] = b->Xz[k] = 0.0f;
@@ -812,6 +822,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     b->ox[k] = r->o.x; b->oy[k] = r->o.y; b->oz[k] = r->o.z;
     part_lane(r->part, &b->part[k], &b->pouter[k]);
     b->diffuse[k] = r->bp.diffuse[0] + r->bp.diffuse[1] + r->bp.diffuse[2] > 0.0f ? 1.0f : 0.0f;
+    b->burley[k] = b->diffuse[k] > 0.0f ? r->bp.burley : -1.0f; /* Blender 3.x's Burley diffuse, per pair */
     /* VSGL_GLOSSY_MRP replaces the glossy plane (mrp/pass.c): the kernel
      * skips the glossy lobe of lanes with camp 0 */
     if (r->glossy && j->s->glossy_mode != VSGL_GLOSSY_MRP) {
@@ -885,6 +896,7 @@ static void lane_get(const vsgl_kernel_block *b, size_t k, const receiver *r, vs
     *v++ = b->nx[k]; *v++ = b->ny[k]; *v++ = b->nz[k];
     *v++ = b->ox[k]; *v++ = b->oy[k]; *v++ = b->oz[k];
     *v++ = b->diffuse[k];
+    *v++ = b->burley[k];
     *v++ = b->Xx[k]; *v++ = b->Xy[k]; *v++ = b->Xz[k];
     *v++ = b->Yx[k]; *v++ = b->Yy[k]; *v++ = b->Yz[k];
     *v++ = b->Zx[k]; *v++ = b->Zy[k]; *v++ = b->Zz[k];
@@ -907,6 +919,7 @@ static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, r
     b->nx[k] = *v++; b->ny[k] = *v++; b->nz[k] = *v++;
     b->ox[k] = *v++; b->oy[k] = *v++; b->oz[k] = *v++;
     b->diffuse[k] = *v++;
+    b->burley[k] = *v++;
     b->Xx[k] = *v++; b->Xy[k] = *v++; b->Xz[k] = *v++;
     b->Yx[k] = *v++; b->Yy[k] = *v++; b->Yz[k] = *v++;
     b->Zx[k] = *v++; b->Zy[k] = *v++; b->Zz[k] = *v++;
@@ -930,8 +943,11 @@ static float far_diffuse(const shade_job *j, const vsgl_vsgl *v, v3 x, v3 n)
 
 /* The near field of the lattice clusters around receiver r (near_field.h):
  * within it the kernel's far-field term gives way to the cell's form
- * factor. ld: the kernel's diffuse light, corrected in place. */
-static void near_correct(const shade_job *j, const receiver *r, float *ld0, float *ld1, float *ld2)
+ * factor. ld: the kernel's diffuse light, corrected in place. burley, o:
+ * the lane's Burley roughness (< 0: Lambert) and view (a replay's receiver
+ * has only the lane's fields). */
+static void near_correct(const shade_job *j, const receiver *r, float burley, v3 o, float *ld0, float *ld1,
+                         float *ld2)
 {
     size_t n;
     const uint32_t *c = vsgl__near_candidates(j->near, r->x, &n);
@@ -947,6 +963,10 @@ static void near_correct(const shade_job *j, const receiver *r, float *ld0, floa
         float e = w * (q - far_diffuse(j, v, r->x, r->n)) * (j->leak ? vsgl__vsgl_part_keep(v, r->part) : 1.0f);
         if (e == 0.0f)
             continue;
+        if (burley >= 0.0f) { /* Blender 3.x's Burley diffuse towards the cluster, as the kernel's */
+            v3 l = v3_normalize(v3_sub(v->mean, r->x));
+            e *= vsgl__burley_factor(burley, v3_dot(r->n, l), v3_dot(r->n, o), v3_dot(l, o));
+        }
         if (j->s->visibility == VSGL_VISIBILITY_RAY) {
             if (!visible_from(j, v, r))
                 e = 0.0f;
@@ -1047,7 +1067,8 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
     uint64_t pairs = 0;
     int32_t lobes = 0;
     for (size_t k = 0; k < n; ++k)
-        lobes |= (blk->diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk->camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0);
+        lobes |= (blk->diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk->camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0) |
+                 (blk->diffuse[k] > 0.0f && blk->burley[k] >= 0.0f ? VSGL__KERNEL_BURLEY : 0);
     if ((lobes & VSGL__KERNEL_GLOSSY) && two_lobes(j->s->glossy_mode))
         lobes |= VSGL__KERNEL_GGX_TAIL | (j->s->glossy_lobes == VSGL__HV5_LOBES ? VSGL__KERNEL_HV5 : 0);
     for (size_t k = 0; k < n && !(lobes & VSGL__KERNEL_GRAZE); ++k)
@@ -1108,7 +1129,8 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
         if ((lobes & VSGL__KERNEL_DIFFUSE) && j->near->start)
             for (size_t k = 0; k < n; ++k)
                 if (blk->diffuse[k] > 0.0f)
-                    near_correct(j, &rec[k], &blk->ld[0][k], &blk->ld[1][k], &blk->ld[2][k]);
+                    near_correct(j, &rec[k], blk->burley[k], v3_make(blk->ox[k], blk->oy[k], blk->oz[k]),
+                                 &blk->ld[0][k], &blk->ld[1][k], &blk->ld[2][k]);
     }
     for (size_t k = 0; k < n; ++k)
         for (int c = 0; c < 3; ++c) {
@@ -1207,15 +1229,13 @@ void vsgl__write_pixel(const shade_job *j, size_t px, const float *const *Ls, fl
         const float *L = Ls[k];
         const float w = vsgl__gbuffer_weight(g, si);
         float wd = w * vsgl__scene_diffuse_weight(j->scene, g->material[si], v3_dot(n, o));
-        /* Blender 3.x's Burley diffuse: the light it reflects towards o (DiffCol stays) */
-        const float bu = vsgl__diffuse_albedo_ratio(&bp, v3_dot(n, o));
-        if (cd) { /* a replay's light weights (sparse_replay.c), Burley's included */
+        if (cd) {
             for (int c = 0; c < 3; ++c)
-                cd[k * 4 + c] = bp.diffuse[c] * wd * bu;
+                cd[k * 4 + c] = bp.diffuse[c] * wd;
             cd[k * 4 + 3] = w;
         }
         for (int c = 0; c < 3; ++c) {
-            acc[c] += bp.diffuse[c] * wd * bu * L[c];
+            acc[c] += bp.diffuse[c] * wd * L[c];
             acc[3 + c] += w * L[3 + c];
             acc[6 + c] += bp.diffuse[c] * wd;
             acc[9 + c] += w * gcol[c];

@@ -16,7 +16,7 @@
  * (a replay has no G-buffer sample to read them from: without the lift its
  * rays in a smooth-shaded scene started from uninitialised memory). */
 typedef struct vsgl__plan_lane {
-    float v[29];
+    float v[30];
     float lift[3];
     uint32_t key;
     uint32_t part;     /* the receiver's convex part key (scene_internal.h) */
