@@ -436,6 +436,7 @@ def burley_direct_ratio(rough, out_dir):
     W = 64
     sc.render.resolution_x = sc.render.resolution_y = W
     sc.render.resolution_percentage = 100
+    bpy.context.view_layer.update()  # matrix_world from the transforms (a cached render evaluates nothing)
     cyc, _ = cycles("burley_direct_%.2f" % rough, lambda: None, ["DiffDir", "DiffCol"], 64, 1.0, out_dir)
     M = np.array(cam.matrix_world, np.float64)
     c = (np.arange(W) + 0.5) / W * 3.0 - 1.5
