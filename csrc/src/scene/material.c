@@ -69,15 +69,6 @@ void vsgl__material_params(const vsgl_material *m, vsgl_brdf_params *out)
     out->burley = (m->flags & VSGL_MATERIAL_FLAG_BURLEY) ? rough : -1.0f;
 }
 
-float vsgl__burley_factor(float r, float ci, float co, float cio)
-{
-    float fl = 1.0f - clampf(ci, 0.0f, 1.0f), fv = 1.0f - clampf(co, 0.0f, 1.0f);
-    fl *= fl * fl * fl * fl;
-    fv *= fv * fv * fv * fv;
-    const float k = r * (1.0f + clampf(cio, -1.0f, 1.0f)) - 0.5f;
-    return (1.0f + k * fl) * (1.0f + k * fv);
-}
-
 /* E[.] over the other direction l, cosine-weighted (pdf cos_l / pi), with
  * s = l.v: E[FL] = 1/21, E[s] = 2 mu / 3, E[s FL] = mu / 84, E[s^2 FL] =
  * mu^2 / 252 + (1 - mu^2) 11 / 504 (Beta integrals of c^j (1 - c)^5 and

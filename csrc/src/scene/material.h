@@ -37,8 +37,17 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
 /* Burley's diffuse over Lambert's (VSGL_MATERIAL_FLAG_BURLEY): (1 + k FL)
  * (1 + k FV), k = r (1 + cos_io) - 1/2 (= 2 r (i.h)^2 - 1/2), F = (1 - cos)^5,
  * for cosines ci, co of the two directions with the normal and cos_io
- * between them; vsgl__brdf_eval's diffuse part takes it. */
-float vsgl__burley_factor(float r, float ci, float co, float cio);
+ * between them; vsgl__brdf_eval's diffuse part takes it, and per pair the
+ * shading kernel (shade/kernel_impl.h, k_burley: inline, vectorised). */
+static inline float vsgl__burley_factor(float r, float ci, float co, float cio)
+{
+    float fl = 1.0f - clampf(ci, 0.0f, 1.0f), fv = 1.0f - clampf(co, 0.0f, 1.0f);
+    const float fl2 = fl * fl, fv2 = fv * fv;
+    fl = fl2 * fl2 * fl;
+    fv = fv2 * fv2 * fv;
+    const float k = r * (1.0f + clampf(cio, -1.0f, 1.0f)) - 0.5f;
+    return (1.0f + k * fl) * (1.0f + k * fv);
+}
 /* Its cosine-weighted mean over the other direction's hemisphere, seen from
  * a direction of cosine mu: the diffuse base's directional albedo over
  * Lambert's, in closed form (docs/units.md; e.g. 1.20 at mu = 0.2 and 1.03

@@ -9,6 +9,7 @@
 #include "math/constants.h"
 #include "vsgl/sg.h"
 #include "math/sg_internal.h" /* the accurate cosine form's fitted constants */
+#include "scene/material.h"     /* vsgl__burley_factor */
 
 #include <math.h>
 #include <string.h>
@@ -413,19 +414,11 @@ k_burley(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t)
 {
     const float ilin = t->ilin[i], mx = t->mx[i], my = t->my[i], mz = t->mz[i];
     const float ox = b->ox[i], oy = b->oy[i], oz = b->oz[i];
-    float cl = (mx * b->nx[i] + my * b->ny[i] + mz * b->nz[i]) * ilin;
-    float cv = b->nx[i] * ox + b->ny[i] * oy + b->nz[i] * oz;
-    float s = (mx * ox + my * oy + mz * oz) * ilin;
-    cl = cl < 0.0f ? 0.0f : (cl > 1.0f ? 1.0f : cl);
-    cv = cv < 0.0f ? 0.0f : (cv > 1.0f ? 1.0f : cv);
-    s = s < -1.0f ? -1.0f : (s > 1.0f ? 1.0f : s);
-    float fl = 1.0f - cl, fv = 1.0f - cv;
-    const float fl2 = fl * fl, fv2 = fv * fv;
-    fl = fl2 * fl2 * fl;
-    fv = fv2 * fv2 * fv;
+    const float cl = (mx * b->nx[i] + my * b->ny[i] + mz * b->nz[i]) * ilin;
+    const float cv = b->nx[i] * ox + b->ny[i] * oy + b->nz[i] * oz;
+    const float s = (mx * ox + my * oy + mz * oz) * ilin;
     const float r = b->burley[i];
-    const float k = r * (1.0f + s) - 0.5f;
-    const float f = (1.0f + k * fl) * (1.0f + k * fv);
+    const float f = vsgl__burley_factor(r, cl, cv, s);
     t->bfac[i] = r >= 0.0f ? f : 1.0f;
 }
 

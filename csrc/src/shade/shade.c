@@ -739,11 +739,14 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                         /* Blender 3.x's Burley diffuse as the kernel takes it: the SG's
                          * part at its axis (k_burley), the near field's towards the
                          * cluster's mean (near_correct) */
-                        v3 l = v3_normalize(v3_sub(v->mean, r.x));
-                        float fa = vsgl__burley_factor(r.bp.burley, v3_dot(r.n, in.axis), v3_dot(r.n, r.o),
-                                                       v3_dot(in.axis, r.o));
-                        float fm = vsgl__burley_factor(r.bp.burley, v3_dot(r.n, l), v3_dot(r.n, r.o), v3_dot(l, r.o));
-                        e_d = e_sg * fa + (e_d - e_sg) * fm;
+                        const float near = e_d - e_sg;
+                        e_d = e_sg * vsgl__burley_factor(r.bp.burley, v3_dot(r.n, in.axis), v3_dot(r.n, r.o),
+                                                         v3_dot(in.axis, r.o));
+                        if (near != 0.0f) {
+                            v3 l = v3_normalize(v3_sub(v->mean, r.x));
+                            e_d += near * vsgl__burley_factor(r.bp.burley, v3_dot(r.n, l), v3_dot(r.n, r.o),
+                                                              v3_dot(l, r.o));
+                        }
                     }
                     for (int c = 0; c < 3; ++c)
                         ld[c] += v->power[c] * e_d;
