@@ -97,11 +97,6 @@ static int setup_as(bundle *b, float roughness, uint32_t vsgls, int32_t fit, int
     return ok;
 }
 
-static int setup(bundle *b, float roughness, uint32_t vsgls, int32_t fit, int32_t leak)
-{
-    return setup_as(b, roughness, vsgls, fit, leak, 0u);
-}
-
 static void teardown(bundle *b)
 {
     vsgl__vsgl_set_free(&b->set);

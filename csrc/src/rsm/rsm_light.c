@@ -341,19 +341,51 @@ static double area_texel_mask(const vsgl_rsm_light *l, uint32_t row, uint32_t co
     return mk / (SUB * SUB);
 }
 
-/* A texel's ray origin on the area light's shape: the centre of stratum
- * (bitrev(col & 7), bitrev(row & 7)) of an 8x8 grid on the light. Every
- * aligned 2x2, 4x4 and 8x8 block of texels (nearly one direction) then
- * covers a 2x2, 4x4 and 8x8 sub-grid of the light, and neighbours
- * alternate at the finest scale. Alternatives measured against Cycles
- * (kernel 0.3 m): origins marching monotonically with the direction in 8x8
- * blocks made a comb in the VPL density of period 8 texels, 1.6 % off near
- * a light's horizon; random jitter or per-block scrambling left 0.6-2.7 %
- * noise. */
+/* A texel's ray origin on the area light's shape: point k of the first two
+ * Sobol dimensions (a (0,2)-sequence in base 2: van der Corput and the Pascal
+ * matrix), k the texel's Morton index within its aligned 16x16 block. Any
+ * aligned 2^j x 2^j block of texels (nearly one direction) holds 4^j
+ * consecutive points, a (0,2j,2)-net: one origin in every elementary
+ * rectangle of area 4^-j of the light (2^j x 2^j strata, and 4^j distinct
+ * coordinates along either axis), and neighbours alternate at the finest
+ * scale. Alternatives measured against Cycles (kernel 0.3 m): an R2
+ * sequence over the texel index made a 2 % density modulation; origins
+ * marching monotonically with the direction in 8x8 blocks a comb of period
+ * 8 texels, 1.6 % off near a light's horizon; random jitter or per-block
+ * scrambling 0.6-2.7 % noise. The strata (bitrev(col & 7), bitrev(row & 7))
+ * of an 8x8 grid, separable, gave the light's axes only 8 distinct
+ * coordinates: on a wall far off near the light's horizon, where an
+ * origin's offset moves its hit by several texel spacings, the hits piled
+ * up in 8 shifted copies of every 8th texel's grid, bands of 0 to 3x the
+ * density 0.1 m apart (the demo room's lamp panel on the window wall, RSM
+ * 128), which a glossy floor reflected as dark and bright stripes. */
+#define VSGL__AREA_BLOCK_BITS 3 /* 8x8 blocks */
+static uint32_t morton2(uint32_t row, uint32_t col)
+{
+    uint32_t k = 0;
+    for (int b = 0; b < VSGL__AREA_BLOCK_BITS; ++b)
+        k |= ((col >> b) & 1u) << (2 * b) | ((row >> b) & 1u) << (2 * b + 1);
+    return k;
+}
+
+static void sobol02(uint32_t k, double *s, double *t)
+{
+    uint32_t a = 0, c = 0;
+    for (uint32_t v = 1u << 31, i = k; i; i >>= 1, v ^= v >> 1)
+        if (i & 1u)
+            c ^= v;
+    for (int b = 0; b < 32; ++b) /* van der Corput: k's bits reversed */
+        a |= ((k >> b) & 1u) << (31 - b);
+    const int bits = 2 * VSGL__AREA_BLOCK_BITS; /* k < 2^bits: that many bits of each */
+    *s = ((double)(a >> (32 - bits)) + 0.5) / (double)(1u << bits);
+    *t = ((double)(c >> (32 - bits)) + 0.5) / (double)(1u << bits);
+}
+
 static v3 area_texel_origin(const vsgl_rsm_light *l, uint32_t row, uint32_t col)
 {
-    static const unsigned char rev3[8] = {0, 4, 2, 6, 1, 5, 3, 7};
-    double s = (rev3[col & 7u] + 0.5) / 8.0, t = (rev3[row & 7u] + 0.5) / 8.0;
+    double s, t;
+    const uint32_t m = (1u << VSGL__AREA_BLOCK_BITS) - 1u;
+    sobol02(morton2(row & m, col & m), &s, &t);
     double px, py;
     if (l->shape == VSGL_AREA_DISK || l->shape == VSGL_AREA_ELLIPSE) {
         concentric(s, t, &px, &py);
