@@ -464,7 +464,7 @@ VT_TEST(rsm_light_row_equals_texel_by_texel)
 }
 
 /* A large area light's RSM lights a wall near the light's horizon evenly.
- * The demo room's lamp panel (1.4 x 0.8 m, 13 cm under a 2.8 m ceiling)
+ * A panel like the demo room's lamp (1.4 x 0.8 m, 2.67 m up, facing down)
  * and a wall 2.8-4.2 m off: an origin's offset on the panel moves its
  * texel's hit on the wall by up to ~0.8 m, several texel spacings, so the
  * origins' pattern decides the density of hits there. Separable 8 x 8
@@ -480,7 +480,7 @@ VT_TEST(rsm_area_light_lights_a_far_wall_evenly)
     vsgl_context_create(NULL, &ctx);
     fx_scene s;
     floor_only(&s, 1.0f);
-    s.vertex_count = s.triangle_count = 0;
+    s.vertex_count = s.triangle_count = 0; /* the fixture's materials and light; the wall alone */
     const float wall[4][3] = {{3, -2.5f, 0}, {3, -2.5f, 2.8f}, {3, 2.5f, 2.8f}, {3, 2.5f, 0}};
     fx_quad(&s, wall, 3);
     vsgl_light *L = &s.lights[0];

@@ -343,22 +343,24 @@ static double area_texel_mask(const vsgl_rsm_light *l, uint32_t row, uint32_t co
 
 /* A texel's ray origin on the area light's shape: point k of the first two
  * Sobol dimensions (a (0,2)-sequence in base 2: van der Corput and the Pascal
- * matrix), k the texel's Morton index within its aligned 16x16 block. Any
- * aligned 2^j x 2^j block of texels (nearly one direction) holds 4^j
+ * matrix), k the texel's Morton index within its aligned 8x8 block. An
+ * aligned 2^j x 2^j block of texels (j <= 3; nearly one direction) holds 4^j
  * consecutive points, a (0,2j,2)-net: one origin in every elementary
- * rectangle of area 4^-j of the light (2^j x 2^j strata, and 4^j distinct
- * coordinates along either axis), and neighbours alternate at the finest
- * scale. Alternatives measured against Cycles (kernel 0.3 m): an R2
- * sequence over the texel index made a 2 % density modulation; origins
- * marching monotonically with the direction in 8x8 blocks a comb of period
- * 8 texels, 1.6 % off near a light's horizon; random jitter or per-block
- * scrambling 0.6-2.7 % noise. The strata (bitrev(col & 7), bitrev(row & 7))
- * of an 8x8 grid, separable, gave the light's axes only 8 distinct
+ * rectangle of area 4^-j of the light (2^j x 2^j strata, 4^j distinct
+ * coordinates along either axis: 64 per 8x8 block), and neighbours
+ * alternate at the finest scale. Alternatives measured against Cycles
+ * (kernel 0.3 m): an R2 sequence over the texel index made a 2 % density
+ * modulation; origins marching monotonically with the direction in 8x8
+ * blocks a comb of period 8 texels, 1.6 % off near a light's horizon;
+ * random jitter or per-block scrambling 0.6-2.7 % noise; 16x16 blocks
+ * (period 16) 1.0 % at a corner. The strata (bitrev(col & 7), bitrev(row &
+ * 7)) of an 8x8 grid, separable, gave the light's axes only 8 distinct
  * coordinates: on a wall far off near the light's horizon, where an
  * origin's offset moves its hit by several texel spacings, the hits piled
  * up in 8 shifted copies of every 8th texel's grid, bands of 0 to 3x the
  * density 0.1 m apart (the demo room's lamp panel on the window wall, RSM
- * 128), which a glossy floor reflected as dark and bright stripes. */
+ * 128), which a glossy floor reflected as dark and bright stripes
+ * (docs/validation.md; tests/c/test_rsm.c rsm_area_light_lights_a_far_wall_evenly). */
 #define VSGL__AREA_BLOCK_BITS 3 /* 8x8 blocks */
 static uint32_t morton2(uint32_t row, uint32_t col)
 {
