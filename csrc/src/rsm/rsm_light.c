@@ -372,15 +372,15 @@ static uint32_t morton2(uint32_t row, uint32_t col)
 
 static void sobol02(uint32_t k, double *s, double *t)
 {
+    const int bits = 2 * VSGL__AREA_BLOCK_BITS; /* k < 2^bits: that many bits of each coordinate */
     uint32_t a = 0, c = 0;
-    for (uint32_t v = 1u << 31, i = k; i; i >>= 1, v ^= v >> 1)
+    for (int b = 0; b < bits; ++b) /* van der Corput: k's bits reversed */
+        a |= ((k >> b) & 1u) << (bits - 1 - b);
+    for (uint32_t v = 1u << (bits - 1), i = k; i; i >>= 1, v ^= v >> 1) /* the Pascal matrix, column by column */
         if (i & 1u)
             c ^= v;
-    for (int b = 0; b < 32; ++b) /* van der Corput: k's bits reversed */
-        a |= ((k >> b) & 1u) << (31 - b);
-    const int bits = 2 * VSGL__AREA_BLOCK_BITS; /* k < 2^bits: that many bits of each */
-    *s = ((double)(a >> (32 - bits)) + 0.5) / (double)(1u << bits);
-    *t = ((double)(c >> (32 - bits)) + 0.5) / (double)(1u << bits);
+    *s = ((double)a + 0.5) / (double)(1u << bits);
+    *t = ((double)c + 0.5) / (double)(1u << bits);
 }
 
 static v3 area_texel_origin(const vsgl_rsm_light *l, uint32_t row, uint32_t col)

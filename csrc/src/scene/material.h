@@ -48,6 +48,12 @@ static inline float vsgl__burley_factor(float r, float ci, float co, float cio)
     const float k = r * (1.0f + clampf(cio, -1.0f, 1.0f)) - 0.5f;
     return (1.0f + k * fl) * (1.0f + k * fv);
 }
+/* vsgl__burley_factor for a receiver of normal n seen from o, lit from the
+ * unit direction l (the shading path's SG axis, or towards a cluster). */
+static inline float vsgl__burley_towards(float r, v3 n, v3 o, v3 l)
+{
+    return vsgl__burley_factor(r, v3_dot(n, l), v3_dot(n, o), v3_dot(l, o));
+}
 /* Its cosine-weighted mean over the other direction's hemisphere, seen from
  * a direction of cosine mu: the diffuse base's directional albedo over
  * Lambert's, in closed form (docs/units.md; e.g. 1.20 at mu = 0.2 and 1.03
@@ -56,11 +62,6 @@ static inline float vsgl__burley_factor(float r, float ci, float co, float cio)
  * lobe keeps Lambert's shape); receivers take the factor itself per pair
  * (the kernel's k_burley). */
 float vsgl__burley_albedo(float r, float mu);
-/* vsgl__burley_albedo of p at mu, 1 for a Lambert diffuse base. */
-static inline float vsgl__diffuse_albedo_ratio(const vsgl_brdf_params *p, float mu)
-{
-    return p->burley >= 0.0f ? vsgl__burley_albedo(p->burley, mu) : 1.0f;
-}
 
 /* Directional albedo of the glossy lobe, int f(wi, wo) cos(wo) dwo: the
  * fraction of the power arriving from wi that the lobe reflects (Fresnel,

@@ -452,7 +452,7 @@ float vsgl__scene_diffuse_power(const vsgl_scene *scene, uint32_t material, cons
                                 float cos_i)
 {
     const vsgl_albedo_table *t = vsgl__scene_glossy_albedo(scene, material);
-    return (t ? t->diffuse_power : 1.0f) * vsgl__diffuse_albedo_ratio(bp, cos_i);
+    return (t ? t->diffuse_power : 1.0f) * (bp->burley >= 0.0f ? vsgl__burley_albedo(bp->burley, cos_i) : 1.0f);
 }
 
 const vsgl_light *vsgl__scene_lights(const vsgl_scene *scene, uint32_t *count)

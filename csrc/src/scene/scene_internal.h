@@ -113,7 +113,7 @@ float vsgl__scene_diffuse_weight(const vsgl_scene *scene, uint32_t material, flo
  * applied) reflects from light arriving at cosine cos_i, over Lambert's
  * base (1 - metallic): Blender 4.x+'s cosine-weighted mean dimming by the
  * specular layer, times Blender 3.x's Burley albedo at cos_i
- * (vsgl__diffuse_albedo_ratio); 1 for a Lambert material. The VSGL fit
+ * (vsgl__burley_albedo); 1 for a Lambert material. The VSGL fit
  * (fit/moments.c) and the MRP proxies (mrp/proxies.c) take it alike. */
 struct vsgl_brdf_params;
 float vsgl__scene_diffuse_power(const vsgl_scene *scene, uint32_t material, const struct vsgl_brdf_params *bp,

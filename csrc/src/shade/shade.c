@@ -740,13 +740,10 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                          * part at its axis (k_burley), the near field's towards the
                          * cluster's mean (near_correct) */
                         const float near = e_d - e_sg;
-                        e_d = e_sg * vsgl__burley_factor(r.bp.burley, v3_dot(r.n, in.axis), v3_dot(r.n, r.o),
-                                                         v3_dot(in.axis, r.o));
-                        if (near != 0.0f) {
-                            v3 l = v3_normalize(v3_sub(v->mean, r.x));
-                            e_d += near * vsgl__burley_factor(r.bp.burley, v3_dot(r.n, l), v3_dot(r.n, r.o),
-                                                              v3_dot(l, r.o));
-                        }
+                        e_d = e_sg * vsgl__burley_towards(r.bp.burley, r.n, r.o, in.axis);
+                        if (near != 0.0f)
+                            e_d += near * vsgl__burley_towards(r.bp.burley, r.n, r.o,
+                                                               v3_normalize(v3_sub(v->mean, r.x)));
                     }
                     for (int c = 0; c < 3; ++c)
                         ld[c] += v->power[c] * e_d;
@@ -966,10 +963,8 @@ static void near_correct(const shade_job *j, const receiver *r, float burley, v3
         float e = w * (q - far_diffuse(j, v, r->x, r->n)) * (j->leak ? vsgl__vsgl_part_keep(v, r->part) : 1.0f);
         if (e == 0.0f)
             continue;
-        if (burley >= 0.0f) { /* Blender 3.x's Burley diffuse towards the cluster, as the kernel's */
-            v3 l = v3_normalize(v3_sub(v->mean, r->x));
-            e *= vsgl__burley_factor(burley, v3_dot(r->n, l), v3_dot(r->n, o), v3_dot(l, o));
-        }
+        if (burley >= 0.0f) /* Blender 3.x's Burley diffuse towards the cluster, as the kernel's */
+            e *= vsgl__burley_towards(burley, r->n, o, v3_normalize(v3_sub(v->mean, r->x)));
         if (j->s->visibility == VSGL_VISIBILITY_RAY) {
             if (!visible_from(j, v, r))
                 e = 0.0f;
