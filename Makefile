@@ -42,6 +42,7 @@ help:
 	@echo "make bench      speed/memory benchmarks, reported as ratios"
 	@echo "make screenshots  the add-on's panels in Blender's UI under Xvfb -> docs/img/"
 	@echo "make lint       flake8 (setup.cfg), cppcheck over the sources, the kernel's loops vectorised"
+	@echo "make broad-lobe-table  regenerate csrc/src/math/broad_lobe_table.c (rough receivers' lobes)"
 	@echo "make abi        regenerate the binding's ABI mirror (addon/vsgl_indirect/_libvsgl_abi.py) from the headers"
 
 deps:
@@ -122,6 +123,14 @@ lint:
 	cppcheck --quiet --error-exitcode=1 --std=c11 --enable=warning,portability,performance --inline-suppr \
 	  -D__GNUC__ -I csrc/include -I csrc/src csrc/src csrc/cli
 	$(PYTHON) tools/check_vectorised.py --cc $(CC)
+
+# The broad-lobe tables (csrc/src/math/broad_lobe_table.c, docs/math.md
+# §5.4.4) from the library's own lobe and BRDF: about 1.5 min.
+.PHONY: broad-lobe-table
+$(BUILD)/gen_broad_lobe: tools/gen_broad_lobe.c $(LIB_OBJ)
+	$(CC) $(CFLAGS_COMMON) $(OPT) -o $@ $^ $(LDLIBS)
+broad-lobe-table: $(BUILD)/gen_broad_lobe
+	$(BUILD)/gen_broad_lobe --write
 
 # The binding's ABI mirror (enums, constants, structs, prototypes) from the
 # public headers; tests/python/test_layout.py fails when it is not current.

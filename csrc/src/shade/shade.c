@@ -4,6 +4,7 @@
  * smooth Fresnel/shadowing factor at the integrand's lobe axis. */
 #include "shade/shade.h"
 #include "shade/halfvec.h"
+#include "math/broad_lobe.h"
 #include "math/constants.h"
 #include "math/normal.h"
 #include "math/sg_internal.h"
@@ -394,6 +395,12 @@ static void widen_by_spread(vsgl_brdf_params *bp, float R)
     bp->alpha_y = ay < 1.0f ? ay : 1.0f;
 }
 
+/* GGX as two lobes, core and tail (kernel.h): ASG2 and the hybrid's VSGL term. */
+static int two_lobes(int32_t mode)
+{
+    return mode == VSGL_GLOSSY_ASG2 || mode == VSGL_GLOSSY_HYBRID;
+}
+
 static void setup_receiver(const shade_job *j, size_t i, receiver *r)
 {
     const vsgl_gbuffer *g = j->g;
@@ -423,7 +430,16 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
         vsgl_asg ndf;
         vsgl_ndf_aniso_to_asg(&r->n, &t, r->bp.alpha_x, r->bp.alpha_y, &ndf);
         vsgl_warp_ndf_asg(&ndf, &r->o, &r->asg);
+        /* a rough lobe of GGX's two parts widened and scaled to be closest
+         * to GGX's (math/broad_lobe.h; fitted for the two parts alone) */
+        float bscale = 1.0f, bamp = 1.0f;
+        if (two_lobes(j->s->glossy_mode))
+            vsgl__broad_lobe(r->alpha, (r->bp.f0[0] + r->bp.f0[1] + r->bp.f0[2]) * (1.0f / 3.0f), v3_dot(r->n, r->o),
+                             &bscale, &bamp);
+        r->asg.lambda *= bscale;
+        r->asg.mu *= bscale;
         vsgl__asg_cut_at_horizon(&r->asg, &r->n, &r->o);
+        r->asg.log_amplitude += logf(bamp);
         vsgl__fresnel_ratio(&r->bp, r->n, r->o, r->asg.z, r->fres);
     }
 }
@@ -612,12 +628,6 @@ static int visible_from(const shade_job *j, const vsgl_vsgl *v, const receiver *
     ray_origins o;
     origins_of(j, r, 1, &o);
     return (int)(visibility_rays(j, (size_t)(v - j->set->items), NULL, r, &o, 1, 1) & 1u);
-}
-
-/* GGX as two lobes, core and tail (kernel.h): ASG2 and the hybrid's VSGL term. */
-static int two_lobes(int32_t mode)
-{
-    return mode == VSGL_GLOSSY_ASG2 || mode == VSGL_GLOSSY_HYBRID;
 }
 
 /* Part q (0 core, 1 tail) of a GGX lobe's ASG (kernel.h, VSGL__KERNEL_GGX_TAIL). */

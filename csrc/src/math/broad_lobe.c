@@ -1,0 +1,34 @@
+/* Broad receiver lobes: the tables' lookup (math/broad_lobe.h). */
+#include "math/broad_lobe.h"
+
+/* bilinear in (row y, column x) of one table */
+static void lookup(const vsgl_broad_table *t, int j, int k, float fy, float fx, float *scale, float *amplitude)
+{
+    const float *a = t->amplitude[j], *b = t->amplitude[j + 1];
+    *scale = t->scale[j] + fy * (t->scale[j + 1] - t->scale[j]);
+    *amplitude = (1.0f - fy) * ((1.0f - fx) * a[k] + fx * a[k + 1]) + fy * ((1.0f - fx) * b[k] + fx * b[k + 1]);
+}
+
+void vsgl__broad_lobe(float alpha, float f0, float cos_o, float *scale, float *amplitude)
+{
+    float r = sqrtf(alpha > 0.0f ? alpha : 0.0f);
+    if (!(r > VSGL__BROAD_R0)) { /* also a NaN */
+        *scale = *amplitude = 1.0f;
+        return;
+    }
+    float y = (r - VSGL__BROAD_R0) / (1.0f - VSGL__BROAD_R0) * (VSGL__BROAD_ROWS - 1);
+    y = y < (float)(VSGL__BROAD_ROWS - 1) ? y : (float)(VSGL__BROAD_ROWS - 1);
+    float u0 = sqrtf(VSGL__BROAD_C0), c = cos_o < VSGL__BROAD_C0 ? VSGL__BROAD_C0 : (cos_o < 1.0f ? cos_o : 1.0f);
+    float x = (sqrtf(c) - u0) / (1.0f - u0) * (VSGL__BROAD_COLS - 1);
+    int j = (int)y, k = (int)x;
+    j = j < VSGL__BROAD_ROWS - 2 ? j : VSGL__BROAD_ROWS - 2;
+    k = k < VSGL__BROAD_COLS - 2 ? k : VSGL__BROAD_COLS - 2;
+    float fy = y - (float)j, fx = x - (float)k;
+    float d = (1.0f - f0) / (1.0f - VSGL__BROAD_DIELECTRIC_F0);
+    d = d > 0.0f ? (d < 1.0f ? d : 1.0f) : 0.0f; /* also a NaN f0 */
+    float sc, sd, ac, ad;
+    lookup(&vsgl__broad_tables[0], j, k, fy, fx, &sc, &ac);
+    lookup(&vsgl__broad_tables[1], j, k, fy, fx, &sd, &ad);
+    *scale = sc + d * (sd - sc);
+    *amplitude = ac + d * (ad - ac);
+}

@@ -1,0 +1,49 @@
+/* Broad receiver lobes (docs/math.md §5.4.4). The shade stage's glossy lobe
+ * (Xu et al.'s ASG of GGX's NDF, warped to light directions and cut at the
+ * horizon) holds GGX's light while it is sharp, but a rough one loses it:
+ * its smooth term max(l.z, 0) falls off across a broad lobe and its
+ * Gaussian is in sin(theta), not GGX's tan(theta); at roughness 0.8 it held
+ * 0.58-0.72 of GGX's albedo under a uniform sky, 0.46-0.68 at 0.9. Above
+ * roughness VSGL__BROAD_R0 the lobe's sharpness is scaled (before the cut)
+ * and its amplitude set to be closest to GGX's lobe (L2), per roughness
+ * and view: tools/gen_broad_lobe.c's tables for a conductor and a
+ * dielectric, faded in up to VSGL__BROAD_R1. */
+#ifndef VSGL_MATH_BROAD_LOBE_H
+#define VSGL_MATH_BROAD_LOBE_H
+
+#include <math.h>
+
+#define VSGL__BROAD_R0 0.4f   /* Blender roughness below which lobes are unchanged */
+#define VSGL__BROAD_R1 0.6f   /* ... and above which the fit is taken whole */
+#define VSGL__BROAD_ROWS 13   /* roughness VSGL__BROAD_R0 .. 1 in steps of 0.05 */
+#define VSGL__BROAD_COLS 16   /* views: sqrt(cos_o) evenly from sqrt(VSGL__BROAD_C0) to 1 */
+#define VSGL__BROAD_C0 0.02f  /* the most grazing view in the table (clamped below) */
+
+#define VSGL__BROAD_DIELECTRIC_F0 0.04f /* the dielectric table's F0 */
+
+typedef struct vsgl_broad_table {
+    float scale[VSGL__BROAD_ROWS];
+    float amplitude[VSGL__BROAD_ROWS][VSGL__BROAD_COLS];
+} vsgl_broad_table;
+/* [0] a white conductor (F = 1), [1] a dielectric of F0 VSGL__BROAD_DIELECTRIC_F0 */
+extern const vsgl_broad_table vsgl__broad_tables[2];
+
+static inline float vsgl__broad_row_roughness(int j)
+{
+    return VSGL__BROAD_R0 + (1.0f - VSGL__BROAD_R0) * (float)j / (VSGL__BROAD_ROWS - 1);
+}
+
+static inline float vsgl__broad_col_cosine(int k)
+{
+    float u0 = sqrtf(VSGL__BROAD_C0), u = u0 + (1.0f - u0) * (float)k / (VSGL__BROAD_COLS - 1);
+    return u * u;
+}
+
+/* The sharpness scale (for the warped lobe's lambda and mu, before the cut
+ * at the horizon) and amplitude factor of a receiver of GGX alpha (the
+ * geometric mean of an anisotropic pair) and mean F0 f0 seen at cosine
+ * cos_o: the two tables mixed by how much the Fresnel varies, (1 - f0) /
+ * (1 - VSGL__BROAD_DIELECTRIC_F0); {1, 1} below roughness VSGL__BROAD_R0. */
+void vsgl__broad_lobe(float alpha, float f0, float cos_o, float *scale, float *amplitude);
+
+#endif

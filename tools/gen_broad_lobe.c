@@ -1,0 +1,217 @@
+/* Generate csrc/src/math/broad_lobe_table.c: how a rough receiver's glossy
+ * lobe is widened and scaled to be closest to GGX's (docs/math.md §5.4.4,
+ * "Broad lobes").
+ *
+ *   make broad-lobe-table          (builds this and rewrites the table)
+ *   build/gen_broad_lobe [--write] (prints the C file, or writes it)
+ *
+ * The shade stage's lobe (shade.c setup_receiver: the NDF as an ASG, its
+ * warp to light directions, the cut at the horizon, GGX's core and tail,
+ * the specular factor F G / (4 cos_o) at its axis) is Xu et al.'s ASG,
+ * whose smooth term max(l.z, 0) is about 1 across a sharp lobe but falls
+ * off across a broad one, and whose Gaussian is in sin(theta), not GGX's
+ * tan(theta): at roughness 0.8 it held 0.58-0.72 of GGX's albedo under a
+ * uniform sky, 0.46-0.68 at 0.9. For each roughness row this program
+ * searches the sharpness scale s (applied to the warped lobe before the
+ * cut) whose lobe, at the amplitude closest to the exact lobe f cos at
+ * each view (L2 over the hemisphere), is closest summed over the views;
+ * each entry holds that amplitude. Both are faded in from roughness 0.4
+ * (unchanged) to 0.6, so sharp lobes are left as they were. Two tables: a
+ * white conductor (F = 1) and a dielectric of F0 0.04, whose Fresnel rises
+ * towards grazing light while the lobe takes it at its axis (widening
+ * moves its light towards the normal, where F is small: the dielectric's
+ * rows stay sharper). Exact: vsgl__brdf_eval, quadrature of the upper
+ * hemisphere crowded at the horizon. */
+#include "math/broad_lobe.h"
+#include "math/sg_internal.h"
+#include "scene/material.h"
+#include "shade/kernel.h"
+#include "vsgl/lobes.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define PI_D 3.14159265358979323846
+#define NT 192
+#define NP 192
+
+typedef double (*hemi_fn)(const void *user, v3 l);
+static double hemisphere(hemi_fn f, const void *user)
+{
+    double sum = 0.0;
+    for (int i = 0; i < NT; ++i) {
+        double u = (i + 0.5) / NT, th = 0.5 * PI_D * (1.0 - (1.0 - u) * (1.0 - u));
+        double dth = PI_D * (1.0 - u) / NT;
+        for (int k = 0; k < NP; ++k) {
+            double ph = 2.0 * PI_D * (k + 0.5) / NP;
+            v3 l = v3_make((float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)), (float)cos(th));
+            sum += f(user, l) * sin(th) * dth * (2.0 * PI_D / NP);
+        }
+    }
+    return sum;
+}
+
+typedef struct lobe_q {
+    const vsgl_brdf_params *bp;
+    v3 o;
+    vsgl_asg a;
+    double sf, amp; /* the specular factor at the axis, the amplitude tried */
+} lobe_q;
+
+static double exact_f(const lobe_q *q, v3 l)
+{
+    float d[3], g[3];
+    vsgl__brdf_eval(q->bp, v3_make(0, 0, 1), v3_make(1, 0, 0), l, q->o, d, g);
+    return g[0];
+}
+
+static double model_f(const lobe_q *q, v3 l)
+{
+    double x = q->a.x.x * l.x + q->a.x.y * l.y + q->a.x.z * l.z, y = q->a.y.x * l.x + q->a.y.y * l.y + q->a.y.z * l.z,
+           z = q->a.z.x * l.x + q->a.z.y * l.y + q->a.z.z * l.z;
+    if (!(z > 0.0))
+        return 0.0;
+    double sum = 0.0;
+    for (int p = 0; p < 2; ++p) {
+        double k = p ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K, c = p ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C;
+        sum += c * exp(q->a.log_amplitude - k * (q->a.lambda * x * x + q->a.mu * y * y));
+    }
+    return sum * z * q->sf;
+}
+
+static double exact_h(const void *u, v3 l) { return exact_f(u, l); }
+static double mm_h(const void *u, v3 l)
+{
+    double m = model_f(u, l);
+    return m * m;
+}
+static double me_h(const void *u, v3 l) { return model_f(u, l) * exact_f(u, l); }
+/* the amplitude closest to the exact lobe (L2): <m, e> / <m, m> */
+static double amplitude(const lobe_q *q)
+{
+    return hemisphere(me_h, q) / hemisphere(mm_h, q);
+}
+static double l2_h(const void *u, v3 l)
+{
+    const lobe_q *q = u;
+    double d = q->amp * model_f(q, l) - exact_f(q, l);
+    return d * d;
+}
+
+/* The shade stage's lobe seen from o, its sharpness scaled by s before the cut */
+static void lobe(lobe_q *q, float s)
+{
+    vsgl_vec3 n = {0, 0, 1}, t = {1, 0, 0}, ov = {q->o.x, q->o.y, q->o.z};
+    vsgl_asg ndf;
+    vsgl_ndf_aniso_to_asg(&n, &t, q->bp->alpha_x, q->bp->alpha_y, &ndf);
+    vsgl_warp_ndf_asg(&ndf, &ov, &q->a);
+    q->a.lambda *= s;
+    q->a.mu *= s;
+    vsgl__asg_cut_at_horizon(&q->a, &n, &ov);
+    float sf[3];
+    vsgl__specular_factor(q->bp, v3_make(0, 0, 1), q->o, v3_make(q->a.z.x, q->a.z.y, q->a.z.z),
+                          sqrtf(q->bp->alpha_x * q->bp->alpha_y), sf);
+    q->sf = sf[0];
+}
+
+static v3 view(int k)
+{
+    float c = vsgl__broad_col_cosine(k);
+    return v3_make(sqrtf(1.0f - c * c), 0.0f, c);
+}
+
+static double fade(double r)
+{
+    double w = (r - VSGL__BROAD_R0) / (VSGL__BROAD_R1 - VSGL__BROAD_R0);
+    w = w < 0.0 ? 0.0 : (w > 1.0 ? 1.0 : w);
+    return w * w * (3.0 - 2.0 * w);
+}
+
+/* One table: the sharpness scale per row and the amplitude per row and view
+ * for the material of F0 f0 (1: a white conductor, whose Fresnel is 1;
+ * 0.04: a dielectric, whose Fresnel rises towards grazing light) */
+static void fit_table(float f0, float s_row[VSGL__BROAD_ROWS], float amp[VSGL__BROAD_ROWS][VSGL__BROAD_COLS])
+{
+    float s_opt[VSGL__BROAD_ROWS];
+    for (int j = 0; j < VSGL__BROAD_ROWS; ++j) {
+        double r = vsgl__broad_row_roughness(j), w = fade(r);
+        vsgl_material m = {{1.0f, 1.0f, 1.0f}, f0 >= 1.0f ? 1.0f : 0.0f, (float)r, f0, 0, 0, 0, 0};
+        vsgl_brdf_params bp;
+        vsgl__material_params(&m, &bp);
+        double ex[VSGL__BROAD_COLS];
+        for (int k = 0; k < VSGL__BROAD_COLS; ++k) {
+            lobe_q q = {.bp = &bp, .o = view(k)};
+            ex[k] = hemisphere(exact_h, &q);
+        }
+        /* the sharpness scale: least L2 over the views (each relative to its
+         * albedo, weighted by the views' spacing in cos_o, 2 u du), never
+         * sharper than the smoother row's */
+        double best = INFINITY;
+        s_opt[j] = 1.0f;
+        for (float s = j ? s_opt[j - 1] : 1.0f; w > 0.0 && s >= 0.199f; s -= 0.025f) {
+            double sum = 0.0;
+            for (int k = 0; k < VSGL__BROAD_COLS; ++k) {
+                lobe_q q = {.bp = &bp, .o = view(k)};
+                lobe(&q, s);
+                q.amp = amplitude(&q);
+                sum += sqrt(vsgl__broad_col_cosine(k)) * sqrt(hemisphere(l2_h, &q)) / ex[k];
+            }
+            if (sum < best) {
+                best = sum;
+                s_opt[j] = s;
+            }
+        }
+        s_row[j] = (float)(1.0 + w * (s_opt[j] - 1.0));
+        for (int k = 0; k < VSGL__BROAD_COLS; ++k) {
+            lobe_q q = {.bp = &bp, .o = view(k)};
+            lobe(&q, s_row[j]);
+            amp[j][k] = (float)pow(amplitude(&q), w);
+        }
+        fprintf(stderr, "F0 %.2f roughness %.3f: scale %.3f, amplitude %.3f (grazing) .. %.3f (head-on)\n", f0, r,
+                s_row[j], amp[j][0], amp[j][VSGL__BROAD_COLS - 1]);
+    }
+}
+
+static void print_table(FILE *f, float s_row[VSGL__BROAD_ROWS],
+                        float amp[VSGL__BROAD_ROWS][VSGL__BROAD_COLS], const char *what)
+{
+    fprintf(f, "    /* %s */\n    {{", what);
+    for (int j = 0; j < VSGL__BROAD_ROWS; ++j)
+        fprintf(f, "%s%.4ff", j ? ", " : "", s_row[j]);
+    fprintf(f, "},\n     {\n");
+    for (int j = 0; j < VSGL__BROAD_ROWS; ++j) {
+        fprintf(f, "         {");
+        for (int k = 0; k < VSGL__BROAD_COLS; ++k)
+            fprintf(f, "%s%.4ff", k ? ", " : "", amp[j][k]);
+        fprintf(f, "},\n");
+    }
+    fprintf(f, "     }},\n");
+}
+
+int main(int argc, char **argv)
+{
+    int write = argc > 1 && !strcmp(argv[1], "--write");
+    static float s_row[2][VSGL__BROAD_ROWS], amp[2][VSGL__BROAD_ROWS][VSGL__BROAD_COLS];
+    fit_table(1.0f, s_row[0], amp[0]);
+    fit_table(VSGL__BROAD_DIELECTRIC_F0, s_row[1], amp[1]);
+    FILE *f = write ? fopen("csrc/src/math/broad_lobe_table.c", "w") : stdout;
+    if (!f) {
+        perror("csrc/src/math/broad_lobe_table.c");
+        return 1;
+    }
+    fprintf(f, "/* Broad receiver lobes: the sharpness scale per roughness row and the\n"
+               " * amplitude per row and view, for a conductor and a dielectric\n"
+               " * (math/broad_lobe.h). Generated by tools/gen_broad_lobe.c\n"
+               " * (`make broad-lobe-table`; do not edit). */\n"
+               "#include \"math/broad_lobe.h\"\n\n"
+               "const vsgl_broad_table vsgl__broad_tables[2] = {\n");
+    print_table(f, s_row[0], amp[0], "a white conductor (F = 1)");
+    print_table(f, s_row[1], amp[1], "a dielectric of F0 VSGL__BROAD_DIELECTRIC_F0");
+    fprintf(f, "};\n");
+    if (write && fclose(f) != 0) {
+        perror("csrc/src/math/broad_lobe_table.c");
+        return 1;
+    }
+    return 0;
+}
