@@ -125,7 +125,7 @@ lint:
 	$(PYTHON) tools/check_vectorised.py --cc $(CC)
 
 # The broad-lobe tables (csrc/src/math/broad_lobe_table.c, docs/math.md
-# §5.4.4) from the library's own lobe and BRDF: about 1.5 min.
+# §5.4.4) from the library's own lobe and BRDF: about 2.5 min.
 .PHONY: broad-lobe-table
 $(BUILD)/gen_broad_lobe: tools/gen_broad_lobe.c $(LIB_OBJ)
 	$(CC) $(CFLAGS_COMMON) $(OPT) -o $@ $^ $(LDLIBS)

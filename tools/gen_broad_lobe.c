@@ -20,7 +20,8 @@
  * white conductor (F = 1) and a dielectric of F0 0.04, whose Fresnel rises
  * towards grazing light while the lobe takes it at its axis (widening
  * moves its light towards the normal, where F is small: the dielectric's
- * rows stay sharper). Exact: vsgl__brdf_eval, quadrature of the upper
+ * rows stay sharper). Both for the presets' lobe (GGX's core and tail as
+ * two ASGs) and for one ASG (VSGL_GLOSSY_ASG). Exact: vsgl__brdf_eval, quadrature of the upper
  * hemisphere crowded at the horizon. */
 #include "math/broad_lobe.h"
 #include "math/sg_internal.h"
@@ -55,6 +56,7 @@ static double hemisphere(hemi_fn f, const void *user)
 typedef struct lobe_q {
     const vsgl_brdf_params *bp;
     v3 o;
+    int parts; /* 2: GGX's core and tail (ASG2, the presets), 1: one ASG */
     vsgl_asg a;
     double sf, amp; /* the specular factor at the axis, the amplitude tried */
 } lobe_q;
@@ -73,8 +75,9 @@ static double model_f(const lobe_q *q, v3 l)
     if (!(z > 0.0))
         return 0.0;
     double sum = 0.0;
-    for (int p = 0; p < 2; ++p) {
-        double k = p ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K, c = p ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C;
+    for (int p = 0; p < q->parts; ++p) {
+        double k = q->parts == 1 ? 1.0 : p ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K;
+        double c = q->parts == 1 ? 1.0 : p ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C;
         sum += c * exp(q->a.log_amplitude - k * (q->a.lambda * x * x + q->a.mu * y * y));
     }
     return sum * z * q->sf;
@@ -131,7 +134,7 @@ static double fade(double r)
 /* One table: the sharpness scale per row and the amplitude per row and view
  * for the material of F0 f0 (1: a white conductor, whose Fresnel is 1;
  * 0.04: a dielectric, whose Fresnel rises towards grazing light) */
-static void fit_table(float f0, float s_row[VSGL__BROAD_ROWS], float amp[VSGL__BROAD_ROWS][VSGL__BROAD_COLS])
+static void fit_table(int parts, float f0, float s_row[VSGL__BROAD_ROWS], float amp[VSGL__BROAD_ROWS][VSGL__BROAD_COLS])
 {
     float s_opt[VSGL__BROAD_ROWS];
     for (int j = 0; j < VSGL__BROAD_ROWS; ++j) {
@@ -141,7 +144,7 @@ static void fit_table(float f0, float s_row[VSGL__BROAD_ROWS], float amp[VSGL__B
         vsgl__material_params(&m, &bp);
         double ex[VSGL__BROAD_COLS];
         for (int k = 0; k < VSGL__BROAD_COLS; ++k) {
-            lobe_q q = {.bp = &bp, .o = view(k)};
+            lobe_q q = {.bp = &bp, .o = view(k), .parts = parts};
             ex[k] = hemisphere(exact_h, &q);
         }
         /* the sharpness scale: least L2 over the views (each relative to its
@@ -152,7 +155,7 @@ static void fit_table(float f0, float s_row[VSGL__BROAD_ROWS], float amp[VSGL__B
         for (float s = j ? s_opt[j - 1] : 1.0f; w > 0.0 && s >= 0.199f; s -= 0.025f) {
             double sum = 0.0;
             for (int k = 0; k < VSGL__BROAD_COLS; ++k) {
-                lobe_q q = {.bp = &bp, .o = view(k)};
+                lobe_q q = {.bp = &bp, .o = view(k), .parts = parts};
                 lobe(&q, s);
                 q.amp = amplitude(&q);
                 sum += sqrt(vsgl__broad_col_cosine(k)) * sqrt(hemisphere(l2_h, &q)) / ex[k];
@@ -164,11 +167,12 @@ static void fit_table(float f0, float s_row[VSGL__BROAD_ROWS], float amp[VSGL__B
         }
         s_row[j] = (float)(1.0 + w * (s_opt[j] - 1.0));
         for (int k = 0; k < VSGL__BROAD_COLS; ++k) {
-            lobe_q q = {.bp = &bp, .o = view(k)};
+            lobe_q q = {.bp = &bp, .o = view(k), .parts = parts};
             lobe(&q, s_row[j]);
             amp[j][k] = (float)pow(amplitude(&q), w);
         }
-        fprintf(stderr, "F0 %.2f roughness %.3f: scale %.3f, amplitude %.3f (grazing) .. %.3f (head-on)\n", f0, r,
+        fprintf(stderr, "%s, F0 %.2f, roughness %.3f: scale %.3f, amplitude %.3f (grazing) .. %.3f (head-on)\n",
+                parts == 2 ? "two ASGs" : "one ASG", f0, r,
                 s_row[j], amp[j][0], amp[j][VSGL__BROAD_COLS - 1]);
     }
 }
@@ -176,25 +180,27 @@ static void fit_table(float f0, float s_row[VSGL__BROAD_ROWS], float amp[VSGL__B
 static void print_table(FILE *f, float s_row[VSGL__BROAD_ROWS],
                         float amp[VSGL__BROAD_ROWS][VSGL__BROAD_COLS], const char *what)
 {
-    fprintf(f, "    /* %s */\n    {{", what);
+    fprintf(f, "        /* %s */\n        {{", what);
     for (int j = 0; j < VSGL__BROAD_ROWS; ++j)
         fprintf(f, "%s%.4ff", j ? ", " : "", s_row[j]);
-    fprintf(f, "},\n     {\n");
+    fprintf(f, "},\n         {\n");
     for (int j = 0; j < VSGL__BROAD_ROWS; ++j) {
-        fprintf(f, "         {");
+        fprintf(f, "             {");
         for (int k = 0; k < VSGL__BROAD_COLS; ++k)
             fprintf(f, "%s%.4ff", k ? ", " : "", amp[j][k]);
         fprintf(f, "},\n");
     }
-    fprintf(f, "     }},\n");
+    fprintf(f, "         }},\n");
 }
 
 int main(int argc, char **argv)
 {
     int write = argc > 1 && !strcmp(argv[1], "--write");
-    static float s_row[2][VSGL__BROAD_ROWS], amp[2][VSGL__BROAD_ROWS][VSGL__BROAD_COLS];
-    fit_table(1.0f, s_row[0], amp[0]);
-    fit_table(VSGL__BROAD_DIELECTRIC_F0, s_row[1], amp[1]);
+    static float s_row[2][2][VSGL__BROAD_ROWS], amp[2][2][VSGL__BROAD_ROWS][VSGL__BROAD_COLS];
+    for (int l = 0; l < 2; ++l) {
+        fit_table(2 - l, 1.0f, s_row[l][0], amp[l][0]);
+        fit_table(2 - l, VSGL__BROAD_DIELECTRIC_F0, s_row[l][1], amp[l][1]);
+    }
     FILE *f = write ? fopen("csrc/src/math/broad_lobe_table.c", "w") : stdout;
     if (!f) {
         perror("csrc/src/math/broad_lobe_table.c");
@@ -205,9 +211,13 @@ int main(int argc, char **argv)
                " * (math/broad_lobe.h). Generated by tools/gen_broad_lobe.c\n"
                " * (`make broad-lobe-table`; do not edit). */\n"
                "#include \"math/broad_lobe.h\"\n\n"
-               "const vsgl_broad_table vsgl__broad_tables[2] = {\n");
-    print_table(f, s_row[0], amp[0], "a white conductor (F = 1)");
-    print_table(f, s_row[1], amp[1], "a dielectric of F0 VSGL__BROAD_DIELECTRIC_F0");
+               "const vsgl_broad_table vsgl__broad_tables[2][2] = {\n");
+    for (int l = 0; l < 2; ++l) {
+        fprintf(f, "    {\n");
+        print_table(f, s_row[l][0], amp[l][0], l ? "one ASG, a white conductor (F = 1)" : "GGX's core and tail, a white conductor (F = 1)");
+        print_table(f, s_row[l][1], amp[l][1], l ? "one ASG, a dielectric of F0 VSGL__BROAD_DIELECTRIC_F0" : "GGX's core and tail, a dielectric of F0 VSGL__BROAD_DIELECTRIC_F0");
+        fprintf(f, "    },\n");
+    }
     fprintf(f, "};\n");
     if (write && fclose(f) != 0) {
         perror("csrc/src/math/broad_lobe_table.c");

@@ -9,7 +9,7 @@ static void lookup(const vsgl_broad_table *t, int j, int k, float fy, float fx, 
     *amplitude = (1.0f - fy) * ((1.0f - fx) * a[k] + fx * a[k + 1]) + fy * ((1.0f - fx) * b[k] + fx * b[k + 1]);
 }
 
-void vsgl__broad_lobe(float alpha, float f0, float cos_o, float *scale, float *amplitude)
+void vsgl__broad_lobe(float alpha, float f0, float cos_o, int two, float *scale, float *amplitude)
 {
     float r = sqrtf(alpha > 0.0f ? alpha : 0.0f);
     if (!(r > VSGL__BROAD_R0)) { /* also a NaN */
@@ -27,8 +27,9 @@ void vsgl__broad_lobe(float alpha, float f0, float cos_o, float *scale, float *a
     float d = (1.0f - f0) / (1.0f - VSGL__BROAD_DIELECTRIC_F0);
     d = d > 0.0f ? (d < 1.0f ? d : 1.0f) : 0.0f; /* also a NaN f0 */
     float sc, sd, ac, ad;
-    lookup(&vsgl__broad_tables[0], j, k, fy, fx, &sc, &ac);
-    lookup(&vsgl__broad_tables[1], j, k, fy, fx, &sd, &ad);
+    const vsgl_broad_table *t = vsgl__broad_tables[two ? 0 : 1];
+    lookup(&t[0], j, k, fy, fx, &sc, &ac);
+    lookup(&t[1], j, k, fy, fx, &sd, &ad);
     *scale = sc + d * (sd - sc);
     *amplitude = ac + d * (ad - ac);
 }

@@ -25,8 +25,10 @@ typedef struct vsgl_broad_table {
     float scale[VSGL__BROAD_ROWS];
     float amplitude[VSGL__BROAD_ROWS][VSGL__BROAD_COLS];
 } vsgl_broad_table;
-/* [0] a white conductor (F = 1), [1] a dielectric of F0 VSGL__BROAD_DIELECTRIC_F0 */
-extern const vsgl_broad_table vsgl__broad_tables[2];
+/* [lobe][material]: lobe 0 GGX's core and tail as two ASGs (VSGL_GLOSSY_ASG2
+ * and the hybrid's VSGLs), 1 one ASG (VSGL_GLOSSY_ASG); material 0 a white
+ * conductor (F = 1), 1 a dielectric of F0 VSGL__BROAD_DIELECTRIC_F0 */
+extern const vsgl_broad_table vsgl__broad_tables[2][2];
 
 static inline float vsgl__broad_row_roughness(int j)
 {
@@ -42,8 +44,9 @@ static inline float vsgl__broad_col_cosine(int k)
 /* The sharpness scale (for the warped lobe's lambda and mu, before the cut
  * at the horizon) and amplitude factor of a receiver of GGX alpha (the
  * geometric mean of an anisotropic pair) and mean F0 f0 seen at cosine
- * cos_o: the two tables mixed by how much the Fresnel varies, (1 - f0) /
- * (1 - VSGL__BROAD_DIELECTRIC_F0); {1, 1} below roughness VSGL__BROAD_R0. */
-void vsgl__broad_lobe(float alpha, float f0, float cos_o, float *scale, float *amplitude);
+ * cos_o, its lobe GGX's two parts (two != 0) or one ASG: the material's
+ * two tables mixed by how much the Fresnel varies, (1 - f0) / (1 -
+ * VSGL__BROAD_DIELECTRIC_F0); {1, 1} below roughness VSGL__BROAD_R0. */
+void vsgl__broad_lobe(float alpha, float f0, float cos_o, int two, float *scale, float *amplitude);
 
 #endif

@@ -430,12 +430,10 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
         vsgl_asg ndf;
         vsgl_ndf_aniso_to_asg(&r->n, &t, r->bp.alpha_x, r->bp.alpha_y, &ndf);
         vsgl_warp_ndf_asg(&ndf, &r->o, &r->asg);
-        /* a rough lobe of GGX's two parts widened and scaled to be closest
-         * to GGX's (math/broad_lobe.h; fitted for the two parts alone) */
-        float bscale = 1.0f, bamp = 1.0f;
-        if (two_lobes(j->s->glossy_mode))
-            vsgl__broad_lobe(r->alpha, (r->bp.f0[0] + r->bp.f0[1] + r->bp.f0[2]) * (1.0f / 3.0f), v3_dot(r->n, r->o),
-                             &bscale, &bamp);
+        /* a rough lobe widened and scaled to be closest to GGX's (math/broad_lobe.h) */
+        float bscale, bamp;
+        vsgl__broad_lobe(r->alpha, (r->bp.f0[0] + r->bp.f0[1] + r->bp.f0[2]) * (1.0f / 3.0f), v3_dot(r->n, r->o),
+                         two_lobes(j->s->glossy_mode), &bscale, &bamp);
         r->asg.lambda *= bscale;
         r->asg.mu *= bscale;
         vsgl__asg_cut_at_horizon(&r->asg, &r->n, &r->o);
