@@ -191,6 +191,13 @@ def feature_checks(name, ref, cnt):
                   "95th percentiles, > 0.3), its red bleeds onto the white ceiling (Diff R/G %.2f, > 1.3) and the "
                   "varnished planks reflect it (floor Gloss R/G %.2f, > 1.3; Gloss %.2f x the floor's Diff, > 0.2)"
                   % (name, spread, ce, rg, gl))
+    elif name == "rough_room":
+        wl = np.isin(m, [idx["wall"], idx["back_wall"], idx["ceiling"]])
+        sp = m == idx["sphere"]
+        share = float(ref["Gloss"][wl].sum() / max(ref["Diff"][wl].sum(), 1e-9))
+        cnt.check(share > 0.03 and sp.sum() >= 50,
+                  "feature %s: the rough walls and ceiling have a glossy pass (Gloss %.3f x their Diff, > 0.03) and "
+                  "the rough sphere is in view (%d px, >= 50)" % (name, share, sp.sum()))
     print("INFO %s: %d wall/ceiling and %d wall/floor junction pixels in view" % (name, junction_ceiling,
                                                                                   junction_floor))
 
