@@ -128,7 +128,7 @@ lint:
 # §5.4.4) from the library's own lobe and BRDF: about 2.5 min.
 .PHONY: broad-lobe-table
 $(BUILD)/gen_broad_lobe: tools/gen_broad_lobe.c $(LIB_OBJ)
-	$(CC) $(CFLAGS_COMMON) $(OPT) -o $@ $^ $(LDLIBS)
+	$(CC) $(CFLAGS_COMMON) -Itests/c $(OPT) -o $@ $^ $(LDLIBS)
 broad-lobe-table: $(BUILD)/gen_broad_lobe
 	$(BUILD)/gen_broad_lobe --write
 

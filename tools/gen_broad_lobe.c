@@ -29,6 +29,7 @@
  * presets' lobe (GGX's core and tail as two ASGs) and for one ASG
  * (VSGL_GLOSSY_ASG). Exact: vsgl__brdf_eval, quadrature of the upper
  * hemisphere crowded at the horizon. */
+#include "hemi_quad.h"
 #include "math/broad_lobe.h"
 #include "math/sg_internal.h"
 #include "scene/material.h"
@@ -39,24 +40,10 @@
 #include <stdio.h>
 #include <string.h>
 
-#define PI_D 3.14159265358979323846
-#define NT 192
-#define NP 192
-
-typedef double (*hemi_fn)(const void *user, v3 l);
+/* the sum of f(l) dl over the upper hemisphere (tests/c/hemi_quad.h) */
 static double hemisphere(hemi_fn f, const void *user)
 {
-    double sum = 0.0;
-    for (int i = 0; i < NT; ++i) {
-        double u = (i + 0.5) / NT, th = 0.5 * PI_D * (1.0 - (1.0 - u) * (1.0 - u));
-        double dth = PI_D * (1.0 - u) / NT;
-        for (int k = 0; k < NP; ++k) {
-            double ph = 2.0 * PI_D * (k + 0.5) / NP;
-            v3 l = v3_make((float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)), (float)cos(th));
-            sum += f(user, l) * sin(th) * dth * (2.0 * PI_D / NP);
-        }
-    }
-    return sum;
+    return hemi_quad(f, user, 192, 192);
 }
 
 typedef struct lobe_q {

@@ -5,6 +5,7 @@
  * the lobe's own integral times the specular factor at its axis, as the
  * shade stage takes them (GGX's core and tail as two ASGs). */
 #include "harness.h"
+#include "hemi_quad.h"
 #include "math/broad_lobe.h"
 #include "math/sg_internal.h"
 #include "scene/material.h"
@@ -14,26 +15,11 @@
 #include <math.h>
 #include <stdlib.h>
 
-#define PI_D 3.14159265358979323846
 
-/* The upper hemisphere (normal +z) in theta rows crowded at the horizon,
- * where a grazing view's lobe lies (theta = (pi / 2) (1 - (1 - u)^2), u in
- * NT midpoint rows), and NP phi columns: the sum of f(l) dl. */
-typedef double (*hemi_fn)(const void *user, v3 l);
+/* the sum of f(l) dl over the upper hemisphere (hemi_quad.h) */
 static double hemisphere(hemi_fn f, const void *user)
 {
-    const int NT = 768, NP = 768;
-    double sum = 0.0;
-    for (int i = 0; i < NT; ++i) {
-        double u = (i + 0.5) / NT, th = 0.5 * PI_D * (1.0 - (1.0 - u) * (1.0 - u));
-        double dth = PI_D * (1.0 - u) / NT;
-        for (int k = 0; k < NP; ++k) {
-            double ph = 2.0 * PI_D * (k + 0.5) / NP;
-            v3 l = v3_make((float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)), (float)cos(th));
-            sum += f(user, l) * sin(th) * dth * (2.0 * PI_D / NP);
-        }
-    }
-    return sum;
+    return hemi_quad(f, user, 768, 768);
 }
 
 typedef struct exact_q { const vsgl_brdf_params *bp; v3 o; } exact_q;
