@@ -4,10 +4,11 @@
  * its smooth term max(l.z, 0) falls off across a broad lobe and its
  * Gaussian is in sin(theta), not GGX's tan(theta); at roughness 0.8 it held
  * 0.58-0.72 of GGX's albedo under a uniform sky, 0.46-0.68 at 0.9. Above
- * roughness VSGL__BROAD_R0 the lobe's sharpness is scaled (before the cut)
- * and its amplitude set to be closest to GGX's lobe (L2), per roughness
- * and view: tools/gen_broad_lobe.c's tables for a conductor and a
- * dielectric, faded in up to VSGL__BROAD_R1. */
+ * roughness VSGL__BROAD_R0 the lobe's amplitude is set to be closest to
+ * GGX's lobe (L2), per roughness and view, and a dielectric's sharpness
+ * scaled (before the cut) where that is closer still (above roughness
+ * 0.85; a conductor's is left: tools/gen_broad_lobe.c says why): the
+ * generator's tables, faded in up to VSGL__BROAD_R1. */
 #ifndef VSGL_MATH_BROAD_LOBE_H
 #define VSGL_MATH_BROAD_LOBE_H
 
