@@ -98,13 +98,7 @@ static double l2_h(const void *u, v3 l)
 /* The shade stage's lobe seen from o, its sharpness scaled by s before the cut */
 static void lobe(lobe_q *q, float s)
 {
-    vsgl_vec3 n = {0, 0, 1}, t = {1, 0, 0}, ov = {q->o.x, q->o.y, q->o.z};
-    vsgl_asg ndf;
-    vsgl_ndf_aniso_to_asg(&n, &t, q->bp->alpha_x, q->bp->alpha_y, &ndf);
-    vsgl_warp_ndf_asg(&ndf, &ov, &q->a);
-    q->a.lambda *= s;
-    q->a.mu *= s;
-    vsgl__asg_cut_at_horizon(&q->a, &n, &ov);
+    vsgl__receiver_asg(v3_make(0, 0, 1), v3_make(1, 0, 0), q->o, q->bp->alpha_x, q->bp->alpha_y, s, 1.0f, &q->a);
     float sf[3];
     vsgl__specular_factor(q->bp, v3_make(0, 0, 1), q->o, v3_make(q->a.z.x, q->a.z.y, q->a.z.z),
                           sqrtf(q->bp->alpha_x * q->bp->alpha_y), sf);

@@ -138,17 +138,10 @@ static double l2_f(const void *user, v3 l)
 static void rough_lobe(const vsgl_brdf_params *bp, v3 o, int broad, int one, model_q *q)
 {
     q->one = one;
-    vsgl_vec3 n = {0, 0, 1}, t = {1, 0, 0}, ov = {o.x, o.y, o.z};
-    vsgl_asg ndf;
-    vsgl_ndf_aniso_to_asg(&n, &t, bp->alpha_x, bp->alpha_y, &ndf);
-    vsgl_warp_ndf_asg(&ndf, &ov, &q->a);
     float scale = 1.0f, amp = 1.0f, alpha = sqrtf(bp->alpha_x * bp->alpha_y);
     if (broad)
         vsgl__broad_lobe(alpha, (bp->f0[0] + bp->f0[1] + bp->f0[2]) / 3.0f, o.z, !one, &scale, &amp);
-    q->a.lambda *= scale;
-    q->a.mu *= scale;
-    vsgl__asg_cut_at_horizon(&q->a, &n, &ov);
-    q->a.log_amplitude += logf(amp);
+    vsgl__receiver_asg(v3_make(0, 0, 1), v3_make(1, 0, 0), o, bp->alpha_x, bp->alpha_y, scale, amp, &q->a);
     float sf[3];
     vsgl__specular_factor(bp, v3_make(0, 0, 1), o, v3_make(q->a.z.x, q->a.z.y, q->a.z.z), alpha, sf);
     q->sf = sf[0];

@@ -1,5 +1,7 @@
 /* Broad receiver lobes: the tables' lookup (math/broad_lobe.h). */
 #include "math/broad_lobe.h"
+#include "math/sg_internal.h"
+#include "vsgl/lobes.h"
 
 /* bilinear in (row y, column x) of one table */
 static void lookup(const vsgl_broad_table *t, int j, int k, float fy, float fx, float *scale, float *amplitude)
@@ -32,4 +34,19 @@ void vsgl__broad_lobe(float alpha, float f0, float cos_o, int two, float *scale,
     lookup(&t[1], j, k, fy, fx, &sd, &ad);
     *scale = sc + d * (sd - sc);
     *amplitude = ac + d * (ad - ac);
+}
+
+void vsgl__receiver_asg(v3 n, v3 t, v3 o, float alpha_x, float alpha_y, float scale, float amplitude,
+                        vsgl_asg *out)
+{
+    vsgl_asg ndf;
+    vsgl_ndf_aniso_to_asg(&n, &t, alpha_x, alpha_y, &ndf);
+    vsgl_warp_ndf_asg(&ndf, &o, out);
+    if (scale != 1.0f) {
+        out->lambda *= scale;
+        out->mu *= scale;
+    }
+    vsgl__asg_cut_at_horizon(out, &n, &o);
+    if (amplitude != 1.0f) /* no logf for the sharp lobes, most receivers */
+        out->log_amplitude += logf(amplitude);
 }

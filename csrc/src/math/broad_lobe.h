@@ -12,6 +12,9 @@
 #ifndef VSGL_MATH_BROAD_LOBE_H
 #define VSGL_MATH_BROAD_LOBE_H
 
+#include "math/vec.h"
+#include "vsgl/asg.h"
+
 #include <math.h>
 
 #define VSGL__BROAD_R0 0.4f   /* Blender roughness below which lobes are unchanged */
@@ -49,5 +52,14 @@ static inline float vsgl__broad_col_cosine(int k)
  * two tables mixed by how much the Fresnel varies, (1 - f0) / (1 -
  * VSGL__BROAD_DIELECTRIC_F0); {1, 1} below roughness VSGL__BROAD_R0. */
 void vsgl__broad_lobe(float alpha, float f0, float cos_o, int two, float *scale, float *amplitude);
+
+/* A receiver's glossy lobe as the shade stage takes it (shade.c
+ * setup_receiver): GGX's NDF of alpha_x, alpha_y about normal n (tangent
+ * t) as an ASG, warped to light directions seen from view o, its
+ * sharpness times scale, cut at the horizon (vsgl__asg_cut_at_horizon
+ * with the view), its amplitude times amplitude; {1, 1}: the plain lobe.
+ * tools/gen_broad_lobe.c fits the tables to this very lobe. */
+void vsgl__receiver_asg(v3 n, v3 t, v3 o, float alpha_x, float alpha_y, float scale, float amplitude,
+                        vsgl_asg *out);
 
 #endif

@@ -427,17 +427,11 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
         vsgl_warp_ndf_sg(&ndf, &r->o, &r->sg);
     } else {
         v3 t = v3_make(g->tan[0][i], g->tan[1][i], g->tan[2][i]);
-        vsgl_asg ndf;
-        vsgl_ndf_aniso_to_asg(&r->n, &t, r->bp.alpha_x, r->bp.alpha_y, &ndf);
-        vsgl_warp_ndf_asg(&ndf, &r->o, &r->asg);
         /* a rough lobe widened and scaled to be closest to GGX's (math/broad_lobe.h) */
         float bscale, bamp;
         vsgl__broad_lobe(r->alpha, (r->bp.f0[0] + r->bp.f0[1] + r->bp.f0[2]) * (1.0f / 3.0f), v3_dot(r->n, r->o),
                          two_lobes(j->s->glossy_mode), &bscale, &bamp);
-        r->asg.lambda *= bscale;
-        r->asg.mu *= bscale;
-        vsgl__asg_cut_at_horizon(&r->asg, &r->n, &r->o);
-        r->asg.log_amplitude += logf(bamp);
+        vsgl__receiver_asg(r->n, t, r->o, r->bp.alpha_x, r->bp.alpha_y, bscale, bamp, &r->asg);
         vsgl__fresnel_ratio(&r->bp, r->n, r->o, r->asg.z, r->fres);
     }
 }
