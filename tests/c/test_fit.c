@@ -89,12 +89,14 @@ static void reference_two(const vsgl_scene *scene, const vsgl_rsm *r, int32_t es
             } else {
                 if (!bp.glossy || cosi <= 0)
                     continue;
-                /* the emitted lobe: the warped NDF cut at the horizon (tested against
-                 * quadrature in test_lobes.c) */
+                /* the emitted lobe: the warped NDF cut at the horizon, with the
+                 * material's Fresnel along it (tested against quadrature in
+                 * test_lobes.c) */
                 vsgl_vec3 nf = {(float)n[0], (float)n[1], (float)n[2]}, wf = {(float)wi[0], (float)wi[1], (float)wi[2]};
                 vsgl_sg ndf, em;
                 vsgl_ndf_to_sg(&nf, sqrtf(bp.alpha_x * bp.alpha_y), VSGL_NDF_GGX, &ndf);
-                vsgl__warp_ndf_sg_emitted(&ndf, &wf, &em);
+                vsgl__warp_ndf_sg_emitted_fresnel(&ndf, &wf, bp.eta, (bp.f0[0] + bp.f0[1] + bp.f0[2]) * (1.0f / 3.0f),
+                                                  &em);
                 double ea[3] = {em.axis.x, em.axis.y, em.axis.z};
                 for (int c = 0; c < 3; ++c) {
                     /* R_s: the lobe's directional albedo (its table is tested in test_material.c) */

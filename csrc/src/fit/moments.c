@@ -136,7 +136,8 @@ int vsgl__vpl_moments(const vsgl_scene *scene, const vsgl_rsm *rsm, size_t t, v3
             float alpha = sqrtf(bp.alpha_x * bp.alpha_y);
             vsgl_sg ndf, warped;
             vsgl_ndf_to_sg(&n, alpha, VSGL_NDF_GGX, &ndf);
-            vsgl__warp_ndf_sg_emitted(&ndf, &wi, &warped);
+            float f0 = (bp.f0[0] + bp.f0[1] + bp.f0[2]) * (1.0f / 3.0f);
+            vsgl__warp_ndf_sg_emitted_fresnel(&ndf, &wi, bp.eta, f0, &warped);
             fill(&out[VSGL__LOBE_SPECULAR], ps, warped.axis,
                  vsgl_mean_length_from_sharpness(warped.sharpness, estimator), rel, n, foot);
             any = 1;

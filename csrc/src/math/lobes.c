@@ -3,6 +3,7 @@
  * factor, Ward and Ashikhmin-Shirley. */
 #include "vsgl/lobes.h"
 #include "math/normal.h"
+#include "math/fresnel.h"
 #include "math/sg_internal.h"
 #include "math/asg_internal.h"
 
@@ -154,6 +155,57 @@ void vsgl_warp_ndf_sg(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_sg *out)
  * elevation and points into the horizon. */
 void vsgl__warp_ndf_sg_emitted(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_sg *out)
 {
+    vsgl__warp_ndf_sg_emitted_fresnel(ndf, view, 1.0f, 1.0f, out);
+}
+
+/* The profile's mean and second moment (in units of its spread) with the
+ * Fresnel weight taken along: f(x) = phi(x) (1 + k x) R(x) on lo < x < hi,
+ * R the blend f0 + (1 - f0) FH(o.h) (up to a constant), o.h =
+ * sin(phi0 + se x / 2) in the plane of incidence (phi0 the mirror
+ * direction's elevation; past the normal it falls again, up to the far
+ * horizon at x = (pi - phi0) / se). Midpoint rule on 16 nodes, the
+ * Gaussian and the sine stepped by recurrence (two sincos and three exp a
+ * texel, not sixteen). Returns 0 (moments untouched) where o.h stays
+ * above 0.9 over the profile: there the curve is flat to 1e-4 of F0. */
+static int fresnel_profile(float phi0, float se, float lo, float k, float eta, float f0,
+                           float *mu, float *second)
+{
+    enum { N = 16 };
+    float hi = fminf(5.0f, (3.14159265f - phi0) / se);
+    if (!(hi > lo))
+        return 0;
+    float h = (hi - lo) / N, x = lo + 0.5f * h;
+    /* sin is concave on [0, pi]: its least value over the range at an end */
+    if (fminf(sinf(phi0 + 0.5f * se * lo), sinf(phi0 + 0.5f * se * hi)) > 0.9f)
+        return 0;
+    float t0 = phi0 + 0.5f * se * x, s = sinf(t0), c = cosf(t0), ds = sinf(0.5f * se * h), dc = cosf(0.5f * se * h);
+    float F0 = vsgl__fresnel_dielectric(1.0f, eta), scale = (1.0f - f0) / (1.0f - F0);
+    /* g = exp(-x^2 / 2) stepped by r = exp(-x h - h^2 / 2), r by exp(-h^2) */
+    float g = expf(-0.5f * x * x), r = expf(-x * h - 0.5f * h * h), rr = expf(-h * h);
+    float w0 = 0.0f, w1 = 0.0f, w2 = 0.0f;
+    for (int j = 0; j < N; ++j) {
+        float fh = fmaxf(vsgl__fresnel_dielectric(fmaxf(s, 0.0f), eta) - F0, 0.0f);
+        float w = g * fmaxf(1.0f + k * x, 0.0f) * (f0 + scale * fh);
+        w0 += w;
+        w1 += w * x;
+        w2 += w * x * x;
+        float sn = s * dc + c * ds;
+        c = c * dc - s * ds;
+        s = sn;
+        g *= r;
+        r *= rr;
+        x += h;
+    }
+    if (!(w0 > 0.0f))
+        return 0;
+    *mu = w1 / w0;
+    *second = w2 / w0;
+    return 1;
+}
+
+void vsgl__warp_ndf_sg_emitted_fresnel(const vsgl_sg *ndf, const vsgl_vec3 *view, float eta, float f0,
+                                       vsgl_sg *out)
+{
     vsgl_warp_ndf_sg(ndf, view, out);
     v3 n = v3_normalize(ndf->axis);
     float lam = vsgl__sg_clamp_sharpness(ndf->sharpness);
@@ -182,8 +234,10 @@ void vsgl__warp_ndf_sg_emitted(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_s
     float z = 1.0f - vsgl__normal_cdf_e(a, e);
     float m1 = pdf, m2 = z + a * pdf, m3 = (a * a + 2.0f) * pdf;
     float w0 = z + k * m1, w1 = m1 + k * m2, w2 = m2 + k * m3;
-    float mu = w1 / w0;
-    var *= fmaxf(w2 / w0 - mu * mu, 1e-4f);
+    float mu = w1 / w0, second = w2 / w0;
+    if (eta > 1.0f && f0 < 1.0f)
+        fresnel_profile(phi0, se, fmaxf(a, -5.0f), k, eta, f0, &mu, &second);
+    var *= fmaxf(second - mu * mu, 1e-4f);
     float phi = fminf(phi0 + se * mu, 1.5707963f);
     out->axis = v3_normalize(v3_add(v3_scale(u, cosf(phi) / ul), v3_scale(n, sinf(phi))));
     out->sharpness = clamp_band(1.0f / var);

@@ -42,6 +42,42 @@ float vsgl__sg_mean_length(float l)
     return (1.0f - 1.0f / l) + 2.0f * (1.0f - em) / em;
 }
 
+float vsgl__sg_fraction_above(float l, float c)
+{
+    enum { N = 24 };
+    c = c < -1.0f ? -1.0f : c > 1.0f ? 1.0f : c;
+    if (!(l > 1e-3f))
+        return 0.5f + 0.25f * c * (l > 0.0f ? l : 0.0f); /* density ~ (1 + l w.axis) / 4 pi */
+    /* a sharp lobe 4.5 of its spreads above (below) the plane: 1 (0) within 1e-5 */
+    if (l > 20.0f && fabsf(asinf(c)) * sqrtf(l) > 4.5f)
+        return c > 0.0f ? 1.0f : 0.0f;
+    /* f(-c) = 1 - f(c): with c >= 0, in t = w.axis the rings t > s (s the
+     * sine of the axis's angle to the normal) lie wholly above the plane,
+     * t < -s wholly below, and between a ring's part above is
+     * acos(-t c / (sqrt(1 - t^2) s)) / pi. Over u = exp(l (t - 1)), uniform
+     * in the lobe's density, the rings above are 1 - u(s) of 1 - e^-2l;
+     * the band between is integrated in u = u(-s) .. u(s) clustered at its
+     * ends, where the ring's part has a square-root corner (a midpoint rule
+     * in cos on 24 nodes, its weights normalised). */
+    double cd = fabs((double)c), sd = sqrt(fmax(1.0 - cd * cd, 0.0)), ld = l;
+    double lo = exp(-2.0 * ld), ua = exp(-ld * (1.0 + sd)), ub = exp(-ld * (1.0 - sd)), acc = 1.0 - ub;
+    if (sd > 1e-7) {
+        double band = 0.0, weights = 0.0;
+        for (int j = 0; j < N; ++j) {
+            double ph = (j + 0.5) * (3.141592653589793 / N), u = ua + 0.5 * (ub - ua) * (1.0 - cos(ph));
+            double t = 1.0 + log(u) / ld, r = sqrt(fmax(1.0 - t * t, 0.0));
+            double x = r > 0.0 ? -t * cd / (r * sd) : (t > 0.0 ? -1.0 : 1.0);
+            double q = x <= -1.0 ? 1.0 : x >= 1.0 ? 0.0 : acos(x) * 0.3183098861837907;
+            band += q * sin(ph);
+            weights += sin(ph);
+        }
+        acc += (ub - ua) * band / weights; /* the weights sum to the band's mass: 1/2 at c = 0 exactly */
+    }
+    double f = acc / (1.0 - lo);
+    f = f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f;
+    return (float)(c < 0.0f ? 1.0 - f : f);
+}
+
 /* Unit axis of an SG, or zero if the axis is zero/non-finite. */
 static v3 sg_axis(const vsgl_sg *g)
 {

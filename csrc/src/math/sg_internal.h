@@ -34,6 +34,11 @@
 float vsgl__sg_clamp_sharpness(float lambda);
 /* A(lambda) / (2 pi) = (1 - e^{-2 lambda}) / lambda (2 at 0); lambda >= 0. */
 float vsgl__sg_integral_over_2pi(float lambda);
+/* The part of a unit-integral SG of sharpness l whose axis is at cosine c to
+ * a plane's normal that lies above the plane (1/2 at c = 0, 1 / (1 + e^-l)
+ * at c = 1, 1 - f(l, -c) below); quadrature in the lobe's own density,
+ * |error| < 3e-4 (tests/c/test_sg.c). */
+float vsgl__sg_fraction_above(float l, float c);
 /* log A(lambda); lambda >= 0. */
 float vsgl__sg_log_integral(float lambda);
 /* Exact vMF mean resultant length coth(l) - 1/l (Taylor below 0.5); l >= 0. */
@@ -49,6 +54,12 @@ float vsgl__sg_cosine_accurate(float lambda, float c);
  * the horizon (lobes.c, docs/math.md §5.4.1). Same amplitude as
  * vsgl_warp_ndf_sg. */
 void vsgl__warp_ndf_sg_emitted(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_sg *out);
+/* The same with the Fresnel of a Principled dielectric layer along the
+ * profile: the blend f0 + (1 - f0) FH(o.h) (FH Cycles 3.x's normalised
+ * dielectric curve for `eta`), which sends a rough dielectric's light
+ * towards grazing. eta <= 1 or f0 >= 1: the constant f0 (the call above). */
+void vsgl__warp_ndf_sg_emitted_fresnel(const vsgl_sg *ndf, const vsgl_vec3 *view, float eta, float f0,
+                                       vsgl_sg *out);
 
 /* A receiver's reflection ASG cut at the horizon of `normal`: its part
  * above n.i > 0 as one ASG of the same moments and integral (lobes.c,

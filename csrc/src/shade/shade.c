@@ -31,6 +31,20 @@ float vsgl__foreshortening_weight(const vsgl_vsgl *v)
     return v->lobe == VSGL__LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
 }
 
+float vsgl__vsgl_lobe_integral(const vsgl_vsgl *v)
+{
+    float a = vsgl_sg_integral(v->sharpness);
+    if (v->lobe != VSGL__LOBE_SPECULAR)
+        return a;
+    /* a glossy emitter sends all its power above its surface: the SG's
+     * part that dips below the mean normal's plane (a rough or grazing
+     * lobe's, 10-40 %) is light no receiver gets, so the lobe is scaled to
+     * carry the power above it. A cluster's normals spread as its coherence
+     * falls: the plane holds that much. */
+    float f = vsgl__sg_fraction_above(v->sharpness, v3_dot(v->axis, v->normal));
+    return a * (1.0f - v->coherence * (1.0f - fmaxf(f, 0.25f)));
+}
+
 int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
 {
     v3 d = v3_sub(v->mean, x);
@@ -58,7 +72,7 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
     }
     sg->sharpness = round;
     /* c_v / (2 pi var) with c_v = power / A(lambda_v); power applied by the caller */
-    sg->log_amplitude -= logf(VSGL__2PI * var) + logf(vsgl_sg_integral(v->sharpness));
+    sg->log_amplitude -= logf(VSGL__2PI * var) + logf(vsgl__vsgl_lobe_integral(v));
     return 1;
 }
 
@@ -1400,7 +1414,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             o->ax = -v->axis.x; o->ay = -v->axis.y; o->az = -v->axis.z;
             o->lv = v->sharpness;
             o->lax = o->lv * o->ax; o->lay = o->lv * o->ay; o->laz = o->lv * o->az;
-            o->c0 = 1.0f / (VSGL__2PI * vsgl_sg_integral(v->sharpness));
+            o->c0 = 1.0f / (VSGL__2PI * vsgl__vsgl_lobe_integral(v));
             o->pr = v->power[0]; o->pg = v->power[1]; o->pb = v->power[2];
             o->nx = v->normal.x; o->ny = v->normal.y; o->nz = v->normal.z;
             o->clip = leak ? v->coherence * v->coherence : 0.0f;

@@ -20,6 +20,12 @@ typedef struct vsgl_pixel_planes {
     float *coverage;
 } vsgl_pixel_planes;
 
+/* The integral the VSGL's lobe is normalised by, power / it its amplitude:
+ * A(sharpness), and for a specular lobe only its part above the cluster's
+ * plane (vsgl__sg_fraction_above, blended to all of it as the coherence
+ * falls). */
+float vsgl__vsgl_lobe_integral(const vsgl_vsgl *v);
+
 /* Incident radiance of VSGL v at receiver point x as one SG (Eq. 7):
  * L_in(w) = v->power * sg(w) (sg's log_amplitude carries 1/(2 pi var A)).
  * Returns 0 if the VSGL cannot be seen as a lobe from x (x at its centre
