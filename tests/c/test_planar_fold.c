@@ -408,3 +408,43 @@ VT_TEST(planar_glossy_lobe_does_not_reach_back_past_its_receiver)
      * both ways); before vsgl__planar_reach 0.123 */
     VT_CHECK(worst_brushed < 0.08, "brushed lobes: the largest error is %.4f of a lit plane's light", worst_brushed);
 }
+
+VT_TEST(planar_glossy_broad_lobe_sees_nothing_behind_its_receiver)
+{
+    /* A rough metal sphere's side turned away from a lit floor (the sphere
+     * room with a roughness-0.7 metal sphere, docs/accuracy.md): a receiver
+     * 0.5 m above the floor, in front of the lit half-plane y >= 0, its
+     * normal turned away from it (and a little up), its broad lobe aimed
+     * 70 degrees off the normal, down at the floor: not grazing its
+     * tangent plane (n.z 0.32 > VSGL__HORIZON_HI), yet the lobe reaches the
+     * lit half-plane, all of which lies behind that plane. Truth:
+     * quadrature of the same radiance through the same ASG from above the
+     * tangent plane only, 0 here; the model must stay a small part of what
+     * the lobe gathers from the whole plane. */
+    const v3 x = v3_make(0.0f, -0.3f, 0.5f), nr = v3_normalize(v3_make(0.0f, -1.0f, 0.2f));
+    const v3 z = v3_normalize(v3_make(0.0f, -0.5f, -0.866f));
+    const double step = getenv("VSGL_TEST_QUICK") ? 0.02 : 0.01;
+    const float bands[4][2] = {{2.0f, 2.0f}, {2.0f, 6.0f}, {6.0f, 2.0f}, {6.0f, 6.0f}};
+    double worst = 0.0, seen = 1e30;
+    for (int l = 0; l < 4; ++l) {
+        vsgl_asg lobe = lobe_about(z, v3_make(1.0f, 0.0f, 0.0f), bands[l][0], bands[l][1]);
+        const v3 centre = v3_make(0.0f, 1.0f, 0.0f);
+        double want = quadrature(x, &nr, &lobe, centre, 3.5, step);
+        double all = quadrature(x, NULL, &lobe, centre, 3.5, step);
+        double got = 0.0;
+        for (int i = -16; i <= 16; ++i)
+            for (int j = -2; j <= 16; ++j) {
+                vsgl_vsgl v;
+                if (make_cell(i, j, 1, &v))
+                    got += v.power[0] * vsgl__planar_glossy(&v, x, nr, &lobe);
+            }
+        if (getenv("VSGL_TEST_VERBOSE"))
+            printf("    bands %g/%g: from above the tangent plane %.5f, from the whole plane %.5f, model %.5f "
+                   "(%.3f of the whole)\n", bands[l][0], bands[l][1], want, all, got, got / all);
+        VT_CHECK(isfinite(got) && got >= 0.0, "bands %g/%g: %g", bands[l][0], bands[l][1], got);
+        worst = fmax(worst, fabs(got - want) / all);
+        seen = fmin(seen, all);
+    }
+    VT_CHECK(worst < 0.15, "the model gathers %.3f of the whole plane's light from behind the receiver", worst);
+    VT_CHECK(seen > 1e-4, "the lobe gathers only %g from the plane (the test would not fail)", seen);
+}

@@ -499,14 +499,14 @@ def _textured_interior():
 def _rough_room():
     # 5 x 4 x 2.8 m room whose walls, ceiling and floor are rough glossy
     # dielectrics (Lambert + a GGX specular layer, roughness 0.7-0.9) around
-    # a rough glossy sphere (the same, roughness 0.7), lit by a spot on the
-    # back wall: every receiver's glossy lobe is broad, as the demo's walls
-    # (docs/math.md §5.4.4, "Broad lobes"). Lambert + layer rather than a
-    # Principled BSDF: Blender 3.4's Principled diffuse is Burley's, which
-    # this builder does not flag (the add-on does). A rough *metal* sphere
-    # (roughness 0.7) was tried here: its Gloss came out 1.17-1.25x Cycles'
-    # (the brute force 1.01), 81 % of the room's glossy structured error
-    # (docs/accuracy.md, "A rough metal sphere")
+    # a rough metal sphere (roughness 0.7), lit by a spot on the back wall:
+    # every receiver's glossy lobe is broad, as the demo's walls (docs/math.md
+    # §5.4.4, "Broad lobes"). Lambert + layer rather than a Principled BSDF:
+    # Blender 3.4's Principled diffuse is Burley's, which this builder does
+    # not flag (the add-on does). The sphere was a rough dielectric until
+    # 2026-12-07; as a metal its side away from the lit wall and floor had
+    # 3.5x Cycles' glossy light (the planar model's footprint reaching
+    # clusters behind the receiver, docs/accuracy.md "A rough metal sphere")
     mats = dict(floor="rough_floor", ceiling="ceiling", left="wall", right="wall", back="back_wall", front="wall")
     centre = (-0.8, 0.9, 0.55)
     spot_loc, spot_target = (0.8, -1.2, 2.5), (0.3, 2.0, 1.0)
@@ -514,13 +514,13 @@ def _rough_room():
     return dict(
         name="rough_room",
         feature="a room of rough glossy dielectrics (Lambert + GGX layer: walls 0.9, back wall 0.85, floor 0.7) "
-                "and a rough glossy sphere (0.7) lit by a spot on the back wall: every receiver's glossy lobe is "
-                "broad",
+                "and a rough metal sphere (0.7) lit by a spot on the back wall: every receiver's glossy lobe is "
+                "broad (issue 9: the sphere's dark side 3.5x too bright in Gloss before 2026-12-07)",
         materials=dict(rough_floor=dict(kind="lambert_spec", color=(0.45, 0.35, 0.25), roughness=0.7),
                        back_wall=dict(kind="lambert_spec", color=(0.75, 0.75, 0.7), roughness=0.85),
                        wall=dict(kind="lambert_spec", color=(0.3, 0.55, 0.5), roughness=0.9),
                        ceiling=dict(kind="lambert_spec", color=(0.8, 0.8, 0.8), roughness=0.9),
-                       sphere=dict(kind="lambert_spec", color=(0.9, 0.5, 0.2), roughness=0.7)),
+                       sphere=dict(kind="glossy", color=(0.9, 0.6, 0.3), roughness=0.7)),
         geometry=box_room(-2.5, 2.5, -2.0, 2.0, 0, 2.8, mats) + [uv_sphere(centre, 0.55, 48, 24, "sphere")],
         lights=[dict(type="SPOT", energy=2000.0, loc=spot_loc, rot=look_rot(spot_loc, spot_target),
                      spot_size=60.0, spot_blend=0.3)],

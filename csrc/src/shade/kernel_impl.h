@@ -494,7 +494,8 @@ static inline __attribute__((always_inline)) float k_ncdf(float z)
 /* The share of a planar cluster x footprint product above the receiver's
  * tangent plane (k_planar): d = mean - x, d1, e2 the footprint's offset and
  * s11.. idet its covariance S, all in sigma units; weighted in by how
- * close the lobe's axis is to the tangent plane (kernel.h VSGL__HORIZON_*). */
+ * close the lobe's axis is to the tangent plane or how far the cluster's
+ * mean lies behind it (kernel.h VSGL__HORIZON_*, vsgl__behind_ramp). */
 static inline __attribute__((always_inline)) float
 k_horizon(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *restrict L, float dx, float dy,
           float dz, float d1, float e2, float s11, float s22, float s12, float idet)
@@ -506,6 +507,8 @@ k_horizon(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light
     float gv = nu1 * nu1 + nu2 * nu2 - (s22 * nu1 * nu1 - 2.0f * s12 * nu1 * nu2 + s11 * nu2 * nu2) * idet;
     gv = gv > 1e-12f ? gv : 1e-12f;
     float gw = vsgl__graze_ramp(b->Zx[i] * b->nx[i] + b->Zy[i] * b->ny[i] + b->Zz[i] * b->nz[i]);
+    float gb = vsgl__behind_ramp(b->nx[i] * dx + b->ny[i] * dy + b->nz[i] * dz);
+    gw = gw > gb ? gw : gb;
     return 1.0f - (1.0f - k_ncdf(g0 * k_rsqrt(gv))) * gw * gw * (3.0f - 2.0f * gw);
 }
 
@@ -1020,6 +1023,16 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
             K_FORN(k_planar_geom(b, i, L + j, t + j, 0, NULL, NULL));
         }
     }
+    /* and for a VSGL whose mean lies behind some lane's tangent plane
+     * (vsgl__behind_ramp > 0: n . (mean - x) < 0) */
+    int graze_of[2]; /* NL <= 2 (vsgl__kernel_run: k_scratch t[2]) */
+    for (int j = 0; j < NL; ++j) {
+        int any = graze;
+        for (size_t i = 0; !any && !none_planar && !skip_lobes && i < VSGL__KERNEL_BLOCK; ++i)
+            any = (b->nx[i] * (L[j].mx - b->x[i]) + b->ny[i] * (L[j].my - b->y[i]) +
+                   b->nz[i] * (L[j].mz - b->z[i])) < 0.0f;
+        graze_of[j] = any;
+    }
     for (int q = 0; q < (skip_lobes ? 0 : 1 + two); ++q) {
         const float kb = two ? (q ? VSGL__GGX_TAIL_K : VSGL__GGX_CORE_K) : 1.0f;
         const float kc = two ? (q ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C) : 1.0f;
@@ -1030,7 +1043,12 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
             if (graze)
                 K_FORN(k_planar_lobe(b, i, L + j, t + j, kb, kc, 1));
             else
-                K_FORN(k_planar_lobe(b, i, L + j, t + j, kb, kc, 0));
+                for (int j = 0; j < NL; ++j) {
+                    if (graze_of[j])
+                        K_FORI(k_planar_lobe(b, i, L + j, t + j, kb, kc, 1));
+                    else
+                        K_FORI(k_planar_lobe(b, i, L + j, t + j, kb, kc, 0));
+                }
             /* the fold only where some lane sees the cell: an image lies
              * at most 2 |b| + |fs| (sigma units) from the mean, so where
              * every lane's planar exponent is below -freach = -(sqrt(50)

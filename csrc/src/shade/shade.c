@@ -213,8 +213,9 @@ static float fold_image(float m0, float lo, float hi, float al, float ah, int im
     return img == 0 ? wl * wh : img == 1 ? al * tl * wh : ah * th * wl;
 }
 
-/* The receiver's horizon in the planar model where its lobe grazes it
- * (kernel.h, VSGL__HORIZON_*): the share of the product of the cluster's
+/* The receiver's horizon in the planar model where its lobe grazes it or
+ * the cluster's mean lies behind it (kernel.h, VSGL__HORIZON_*,
+ * vsgl__behind_ramp): the share of the product of the cluster's
  * Gaussian and the footprint's (S = var I + footprint; mean var S^-1 d
  * from the cluster's, covariance var I - var^2 S^-1) above the receiver's
  * tangent plane, n_r . (y - x) > 0, taken along nu, the normal's part in
@@ -222,7 +223,8 @@ static float fold_image(float m0, float lo, float hi, float al, float ah, int im
 static float planar_horizon(const vsgl_vsgl *v, v3 x, v3 nr, vsgl_vec3 z, float var, float d1, float d2, float s11,
                             float s22, float s12, float det, v3 u1, v3 u2)
 {
-    float gw = smoothstep01f(vsgl__graze_ramp(nr.x * z.x + nr.y * z.y + nr.z * z.z));
+    float gw = smoothstep01f(fmaxf(vsgl__graze_ramp(nr.x * z.x + nr.y * z.y + nr.z * z.z),
+                                   vsgl__behind_ramp(v3_dot(nr, v3_sub(v->mean, x)) / sqrtf(fmaxf(var, VSGL__TINY)))));
     if (!(gw > 0.0f))
         return 1.0f;
     float nu1 = v3_dot(nr, u1), nu2 = v3_dot(nr, u2);
