@@ -25,7 +25,10 @@
  * GGX's albedo under the uniform sky (0.54-0.91 unwidened) but made a
  * rough metal sphere reflecting a spot-lit wall brighter still than
  * Cycles (1.17 -> 1.25, unwidened 1.23) and a room of rough surfaces'
- * glossy structured error larger (0.00087 against 0.00063). Both for the
+ * glossy structured error larger (0.00087 against 0.00063); tried again
+ * once the planar model stopped lighting that sphere from behind
+ * (docs/accuracy.md, "A rough metal sphere"): still no gain (0.00016
+ * against 0.00015 in rough_room, whose sphere is that metal). Both for the
  * presets' lobe (GGX's core and tail as two ASGs) and for one ASG
  * (VSGL_GLOSSY_ASG). Exact: vsgl__brdf_eval, quadrature of the upper
  * hemisphere crowded at the horizon. */
