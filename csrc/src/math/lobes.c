@@ -164,9 +164,10 @@ void vsgl__warp_ndf_sg_emitted(const vsgl_sg *ndf, const vsgl_vec3 *view, vsgl_s
  * sin(phi0 + se x / 2) in the plane of incidence (phi0 the mirror
  * direction's elevation; past the normal it falls again, up to the far
  * horizon at x = (pi - phi0) / se). Midpoint rule on 16 nodes, the
- * Gaussian and the sine stepped by recurrence (two sincos and three exp a
- * texel, not sixteen). Returns 0 (moments untouched) where o.h stays
- * above 0.9 over the profile: there the curve is flat to 1e-4 of F0. */
+ * Gaussian and the sine stepped by recurrence (six sines or cosines and
+ * three exps a texel, not sixteen of each). Returns 0 (moments untouched)
+ * where o.h stays above 0.9 over the profile: there the curve is flat to
+ * 1e-4 of F0. */
 static int fresnel_profile(float phi0, float se, float lo, float k, float eta, float f0,
                            float *mu, float *second)
 {

@@ -71,7 +71,9 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
         vsgl_sg_product(sg, &dist, sg);
     }
     sg->sharpness = round;
-    /* c_v / (2 pi var) with c_v = power / A(lambda_v); power applied by the caller */
+    /* c_v / (2 pi var) with c_v = power / A(lambda_v) (a specular lobe's A
+     * its part above its surface, vsgl__vsgl_lobe_integral); power applied
+     * by the caller */
     sg->log_amplitude -= logf(VSGL__2PI * var) + logf(vsgl__vsgl_lobe_integral(v));
     return 1;
 }
