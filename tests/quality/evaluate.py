@@ -696,9 +696,13 @@ def before_after(before, after):
                  before.get("library", "?"), before.get("commit", "?"), before.get("command", "?")), "",
              "| scene | preset | time s before / after | bias D | bias G | struct D | struct G | flicker light D / G |",
              "|---|---|---|---|---|---|---|---|"]
+    changed = []
     for name, r in after["scenes"].items():
         b = before.get("scenes", {}).get(name)
         if not b:
+            continue
+        if b.get("feature") != r.get("feature"):  # the scene itself changed: no like-for-like comparison
+            changed.append(name)
             continue
         for label in ("preview", "balanced", "quality"):
             e1, e0 = r["configs"].get(label), b["configs"].get(label)
@@ -709,6 +713,9 @@ def before_after(before, after):
                 cell(e0, "Gloss", "bias"), cell(e1, "Gloss", "bias"), cell(e0, "Diff", "structured"),
                 cell(e1, "Diff", "structured"), cell(e0, "Gloss", "structured"), cell(e1, "Gloss", "structured"),
                 flk(e0), flk(e1)))
+    if changed:
+        lines += ["", "Not compared: %s (the scene changed since the earlier run; its description below says how)."
+                  % ", ".join(changed)]
     return "\n".join(lines) + "\n\n"
 
 
