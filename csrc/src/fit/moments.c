@@ -181,3 +181,17 @@ int vsgl__moments_to_vsgl(const vsgl_moments *m, v3 origin, int32_t estimator,
     out->lobe = lobe;
     return 1;
 }
+
+float vsgl__vsgl_lobe_integral(const vsgl_vsgl *v)
+{
+    float a = vsgl_sg_integral(v->sharpness);
+    if (v->lobe != VSGL__LOBE_SPECULAR)
+        return a;
+    /* a glossy emitter sends all its power above its surface: the SG's
+     * part that dips below the mean normal's plane (a rough or grazing
+     * lobe's, 10-40 %) is light no receiver gets, so the lobe is scaled to
+     * carry the power above it. A cluster's normals spread as its coherence
+     * falls: the plane holds that much. */
+    float f = vsgl__sg_fraction_above(v->sharpness, v3_dot(v->axis, v->normal));
+    return a * (1.0f - v->coherence * (1.0f - fmaxf(f, 0.25f)));
+}

@@ -108,6 +108,13 @@ typedef struct vsgl_vsgl_set {
     size_t count, capacity;
 } vsgl_vsgl_set;
 
+/* The integral a VSGL's lobe is normalised by (the shade stage's amplitude
+ * power / it): A(sharpness), and for a specular lobe only its part above
+ * the cluster's plane (vsgl__sg_fraction_above, blended to all of it as the
+ * coherence falls; docs/math.md §5.4.1). A quadrature: once per VSGL, not
+ * per receiver (moments.c). */
+float vsgl__vsgl_lobe_integral(const vsgl_vsgl *v);
+
 vsgl_result vsgl__vsgl_set_push(vsgl_vsgl_set *set, const vsgl_vsgl *v);
 void vsgl__vsgl_set_free(vsgl_vsgl_set *set);
 

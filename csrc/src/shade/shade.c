@@ -31,21 +31,12 @@ float vsgl__foreshortening_weight(const vsgl_vsgl *v)
     return v->lobe == VSGL__LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
 }
 
-float vsgl__vsgl_lobe_integral(const vsgl_vsgl *v)
+int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
 {
-    float a = vsgl_sg_integral(v->sharpness);
-    if (v->lobe != VSGL__LOBE_SPECULAR)
-        return a;
-    /* a glossy emitter sends all its power above its surface: the SG's
-     * part that dips below the mean normal's plane (a rough or grazing
-     * lobe's, 10-40 %) is light no receiver gets, so the lobe is scaled to
-     * carry the power above it. A cluster's normals spread as its coherence
-     * falls: the plane holds that much. */
-    float f = vsgl__sg_fraction_above(v->sharpness, v3_dot(v->axis, v->normal));
-    return a * (1.0f - v->coherence * (1.0f - fmaxf(f, 0.25f)));
+    return vsgl__vsgl_incident_sg_with(v, x, vsgl__vsgl_lobe_integral(v), sg);
 }
 
-int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
+int vsgl__vsgl_incident_sg_with(const vsgl_vsgl *v, v3 x, float lobe_integral, vsgl_sg *sg)
 {
     v3 d = v3_sub(v->mean, x);
     float dist2 = v3_dot(d, d);
@@ -74,7 +65,7 @@ int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg)
     /* c_v / (2 pi var) with c_v = power / A(lambda_v) (a specular lobe's A
      * its part above its surface, vsgl__vsgl_lobe_integral); power applied
      * by the caller */
-    sg->log_amplitude -= logf(VSGL__2PI * var) + logf(vsgl__vsgl_lobe_integral(v));
+    sg->log_amplitude -= logf(VSGL__2PI * var) + logf(lobe_integral);
     return 1;
 }
 
@@ -951,10 +942,10 @@ static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, r
 
 /* The far-field diffuse light per watt of VSGL v at (x, n), as the kernel
  * computes it: the incident SG, the emitter clip, the cosine integral. */
-static float far_diffuse(const shade_job *j, const vsgl_vsgl *v, v3 x, v3 n)
+static float far_diffuse(const shade_job *j, const vsgl_vsgl *v, float lobe_integral, v3 x, v3 n)
 {
     vsgl_sg in;
-    if (!vsgl__vsgl_incident_sg(v, x, &in))
+    if (!vsgl__vsgl_incident_sg_with(v, x, lobe_integral, &in))
         return 0.0f;
     if (j->leak)
         in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, x, n, 1), VSGL__TINY));
@@ -980,7 +971,7 @@ static void near_correct(const shade_job *j, const receiver *r, float burley, v3
             continue;
         const vsgl_vsgl *v = &j->set->items[cell->vsgl];
         /* the kernel's far field took the part's share (vsgl__part_keep): so does the near field */
-        float e = w * (q - far_diffuse(j, v, r->x, r->n)) * (j->leak ? vsgl__vsgl_part_keep(v, r->part) : 1.0f);
+        float e = w * (q - far_diffuse(j, v, cell->lobe_integral, r->x, r->n)) * (j->leak ? vsgl__vsgl_part_keep(v, r->part) : 1.0f);
         if (e == 0.0f)
             continue;
         if (burley >= 0.0f) /* Blender 3.x's Burley diffuse towards the cluster, as the kernel's */

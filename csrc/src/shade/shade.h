@@ -20,12 +20,6 @@ typedef struct vsgl_pixel_planes {
     float *coverage;
 } vsgl_pixel_planes;
 
-/* The integral the VSGL's lobe is normalised by, power / it its amplitude:
- * A(sharpness), and for a specular lobe only its part above the cluster's
- * plane (vsgl__sg_fraction_above, blended to all of it as the coherence
- * falls). */
-float vsgl__vsgl_lobe_integral(const vsgl_vsgl *v);
-
 /* Incident radiance of VSGL v at receiver point x as one SG (Eq. 7):
  * L_in(w) = v->power * sg(w) (sg's log_amplitude carries 1/(2 pi var A)).
  * Returns 0 if the VSGL cannot be seen as a lobe from x (x at its centre
@@ -57,6 +51,9 @@ float vsgl__vsgl_lobe_integral(const vsgl_vsgl *v);
  * -1.5..+0.1 %), a wall at its edge 30 cm up -2.0 % (-4.3 %), 10 cm up
  * -4.0 % (-3.2 %). */
 int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
+/* The same with the VSGL's vsgl__vsgl_lobe_integral given (computed once
+ * per VSGL where it is used per receiver: the near field's cells) */
+int vsgl__vsgl_incident_sg_with(const vsgl_vsgl *v, v3 x, float lobe_integral, vsgl_sg *sg);
 
 /* The weight of v's plane spread above: coherence^2 of a diffuse lobe, 0
  * for a specular one (kernel.h vsgl__plane_spread's fore). */
