@@ -147,7 +147,6 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c)
     c->za = axis_of(v->mean, a);
     c->centre = point_on(a, c->za, v->cell_centre[0], v->cell_centre[1]);
     c->vsgl = index;
-    c->lobe_integral = vsgl__vsgl_lobe_integral(v);
     static const float half[2] = {0.75f, 0.25f};
     float area = 0.0f, su = 0.0f, sv = 0.0f;
     for (int iu = 0; iu < 2; ++iu)

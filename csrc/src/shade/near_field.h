@@ -27,7 +27,6 @@ typedef struct vsgl_near_cell {
     uint32_t axis, side;  /* the plane faces +axis (side 0) or -axis (side 1) */
     uint32_t nrect;       /* steps with any area */
     uint32_t vsgl;        /* its VSGL in the set */
-    float lobe_integral;  /* its vsgl__vsgl_lobe_integral (fit/vsgl_set.h), for the far field it replaces */
     /* a specular cluster (a metal floor's reflection of a lit wall): its
      * lobe's axis and sharpness; lambda 0 for a Lambertian one */
     v3 lobe_axis;

@@ -729,7 +729,7 @@ static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
                 const vsgl_vsgl *v = &j->set->items[k];
                 vsgl_sg in;
                 ++pairs;
-                if (!vsgl__vsgl_incident_sg(v, r.x, &in))
+                if (!vsgl__vsgl_incident_sg_with(v, r.x, j->lobe_int[k], &in))
                     continue;
                 if (j->leak)
                     in.log_amplitude += logf(fmaxf(vsgl__emitter_clip(v, r.x, r.n, 1) *
@@ -971,7 +971,7 @@ static void near_correct(const shade_job *j, const receiver *r, float burley, v3
             continue;
         const vsgl_vsgl *v = &j->set->items[cell->vsgl];
         /* the kernel's far field took the part's share (vsgl__part_keep): so does the near field */
-        float e = w * (q - far_diffuse(j, v, cell->lobe_integral, r->x, r->n)) * (j->leak ? vsgl__vsgl_part_keep(v, r->part) : 1.0f);
+        float e = w * (q - far_diffuse(j, v, j->lobe_int[cell->vsgl], r->x, r->n)) * (j->leak ? vsgl__vsgl_part_keep(v, r->part) : 1.0f);
         if (e == 0.0f)
             continue;
         if (burley >= 0.0f) /* Blender 3.x's Burley diffuse towards the cluster, as the kernel's */
@@ -1360,8 +1360,16 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     size_t chunk = g->width ? g->width : 1; /* one row per chunk */
     size_t chunks = vsgl__chunk_count(pixels, chunk);
     uint64_t *per_chunk = calloc(chunks + 1, sizeof *per_chunk);
-    if (!per_chunk)
+    /* each VSGL's lobe integral (a quadrature for a specular lobe) once, for
+     * the kernel's amplitudes, the near field and the reference path alike */
+    float *lobe_int = malloc((set->count + 1) * sizeof *lobe_int);
+    if (!per_chunk || !lobe_int) {
+        free(per_chunk);
+        free(lobe_int);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
+    }
+    for (size_t k = 0; k < set->count; ++k)
+        lobe_int[k] = vsgl__vsgl_lobe_integral(&set->items[k]);
     /* a plan's colours stay in the planes only from its own record or replay to the next */
     const float *colours_in = plan && *plan ? (*plan)->colours_in : NULL;
     if (plan && *plan)
@@ -1386,6 +1394,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
         kl = malloc((set->count + 1) * sizeof *kl);
         if (!kl) {
             free(per_chunk);
+            free(lobe_int);
             return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
         }
         for (size_t k = 0; k < set->count; ++k) {
@@ -1409,7 +1418,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             o->ax = -v->axis.x; o->ay = -v->axis.y; o->az = -v->axis.z;
             o->lv = v->sharpness;
             o->lax = o->lv * o->ax; o->lay = o->lv * o->ay; o->laz = o->lv * o->az;
-            o->c0 = 1.0f / (VSGL__2PI * vsgl__vsgl_lobe_integral(v));
+            o->c0 = 1.0f / (VSGL__2PI * lobe_int[k]);
             o->pr = v->power[0]; o->pg = v->power[1]; o->pb = v->power[2];
             o->nx = v->normal.x; o->ny = v->normal.y; o->nz = v->normal.z;
             o->clip = leak ? v->coherence * v->coherence : 0.0f;
@@ -1469,6 +1478,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             free(sorted);
             free(kl);
             free(per_chunk);
+            free(lobe_int);
             return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
         }
         size_t n = 0;
@@ -1495,11 +1505,12 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
         free(korder);
         free(kl);
         free(per_chunk);
+        free(lobe_int);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
     }
     uint64_t faint_total = 0;
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
-                   eps, 0, per_chunk, &faint_total, kl, korder, path, leak,
+                   eps, 0, per_chunk, &faint_total, kl, korder, lobe_int, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
                    0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL, twin, &targets, 0u, NULL};
     for (size_t k = 0; kl && k < set->count; ++k) /* the axis planes the horizon tilt is taken against */
@@ -1577,6 +1588,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     for (size_t c = 0; c < chunks; ++c)
         total += per_chunk[c];
     free(per_chunk);
+    free(lobe_int);
     free(kl);
     free(korder);
     free(twin);

@@ -51,8 +51,8 @@ typedef struct vsgl_pixel_planes {
  * -1.5..+0.1 %), a wall at its edge 30 cm up -2.0 % (-4.3 %), 10 cm up
  * -4.0 % (-3.2 %). */
 int vsgl__vsgl_incident_sg(const vsgl_vsgl *v, v3 x, vsgl_sg *sg);
-/* The same with the VSGL's vsgl__vsgl_lobe_integral given (computed once
- * per VSGL where it is used per receiver: the near field's cells) */
+/* The same with the VSGL's vsgl__vsgl_lobe_integral given (the shade stage
+ * computes it once per VSGL, shade_job.lobe_int) */
 int vsgl__vsgl_incident_sg_with(const vsgl_vsgl *v, v3 x, float lobe_integral, vsgl_sg *sg);
 
 /* The weight of v's plane spread above: coherence^2 of a diffuse lobe, 0

@@ -79,6 +79,7 @@ typedef struct shade_job {
                              atomically by every thread */
     const vsgl_kernel_light *klights; /* the VSGLs, kernel layout, in kernel order */
     const size_t *korder;             /* per kernel light: its index in set->items */
+    const float *lobe_int;            /* per VSGL of the set: vsgl__vsgl_lobe_integral (fit/vsgl_set.h) */
     int path;             /* VSGL_SHADE_* */
     int leak;             /* apply the emitter-hemisphere correction */
     int merge;            /* share light between samples of one surface in a pixel */
