@@ -17,21 +17,20 @@
  * each view (L2 over the hemisphere), is closest summed over the views;
  * each entry holds that amplitude. Both are faded in from roughness 0.4
  * (unchanged) to 0.6, so sharp lobes are left as they were. Two tables: a
- * dielectric of F0 0.04, whose Fresnel rises towards grazing light while
- * the lobe takes it at its axis (widening moves its light towards the
- * normal, where F is small: its rows stay sharp up to roughness 0.85),
- * and a white conductor (F = 1), fitted by its amplitude alone: the
- * search widened it (s 0.40 at roughness 0.8), which held 0.81-0.98 of
- * GGX's albedo under the uniform sky (0.54-0.91 unwidened) but made a
+ * dielectric of F0 0.04, whose Fresnel rises towards grazing light, and a
+ * white conductor (F = 1). The model
+ * is the lobe as the shade stage takes it: with Smith's shadowing and the
+ * dielectric Fresnel towards each direction over their values at the axis
+ * (shade/kernel.h, vsgl__smooth_ratio). Until those ratios (2026-12-07)
+ * the conductor was fitted by its amplitude alone: widened, it made a
  * rough metal sphere reflecting a spot-lit wall brighter still than
- * Cycles (1.17 -> 1.25, unwidened 1.23) and a room of rough surfaces'
- * glossy structured error larger (0.00087 against 0.00063); tried again
- * once the planar model stopped lighting that sphere from behind
- * (docs/accuracy.md, "A rough metal sphere"): still no gain (0.00016
- * against 0.00015 in rough_room, whose sphere is that metal). Both for the
- * presets' lobe (GGX's core and tail as two ASGs) and for one ASG
- * (VSGL_GLOSSY_ASG). Exact: vsgl__brdf_eval, quadrature of the upper
- * hemisphere crowded at the horizon. */
+ * Cycles (1.17 -> 1.25), because the lobe kept the wall's light arriving
+ * at grazing incidence, which the shadowing ratio now takes out; widened
+ * with the ratios the sphere is 1.00 of Cycles' Gloss and the conductor's
+ * L2 distance to GGX x cos 0.10-0.16 at roughness 0.87 (0.14-0.25
+ * unwidened). Both for the presets' lobe (GGX's core and tail as two
+ * ASGs) and for one ASG (VSGL_GLOSSY_ASG). Exact: vsgl__brdf_eval,
+ * quadrature of the upper hemisphere crowded at the horizon. */
 #include "hemi_quad.h"
 #include "math/broad_lobe.h"
 #include "math/sg_internal.h"
@@ -55,6 +54,7 @@ typedef struct lobe_q {
     int parts; /* 2: GGX's core and tail (ASG2, the presets), 1: one ASG */
     vsgl_asg a;
     double sf, amp; /* the specular factor at the axis, the amplitude tried */
+    float fr[3];    /* its Fresnel towards each direction over the axis' (vsgl__fresnel_ratio) */
 } lobe_q;
 
 static double exact_f(const lobe_q *q, v3 l)
@@ -76,7 +76,12 @@ static double model_f(const lobe_q *q, v3 l)
         double c = q->parts == 1 ? 1.0 : p ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C;
         sum += c * exp(q->a.log_amplitude - k * (q->a.lambda * x * x + q->a.mu * y * y));
     }
-    return sum * z * q->sf;
+    /* and Smith's shadowing towards l over the axis' (kernel.h, vsgl__shadow_ratio), as the kernel takes it
+     * for light from a small source */
+    float a2, so, co, gia, w;
+    vsgl__shadow_lane(sqrtf(q->bp->alpha_x * q->bp->alpha_y), q->o.z, q->a.z.z, q->parts == 2, &a2, &so, &co, &gia, &w);
+    return sum * z * q->sf *
+           vsgl__smooth_ratio(a2, so, co, gia, w, q->fr[0], q->fr[1], q->fr[2], (float)l.z, (float)v3_dot(q->o, l));
 }
 
 static double exact_h(const void *u, v3 l) { return exact_f(u, l); }
@@ -106,6 +111,7 @@ static void lobe(lobe_q *q, float s)
     vsgl__specular_factor(q->bp, v3_make(0, 0, 1), q->o, v3_make(q->a.z.x, q->a.z.y, q->a.z.z),
                           sqrtf(q->bp->alpha_x * q->bp->alpha_y), sf);
     q->sf = sf[0];
+    vsgl__fresnel_ratio(q->bp, v3_make(0, 0, 1), q->o, v3_make(q->a.z.x, q->a.z.y, q->a.z.z), q->fr);
 }
 
 static v3 view(int k)
@@ -189,7 +195,7 @@ int main(int argc, char **argv)
     int write = argc > 1 && !strcmp(argv[1], "--write");
     static float s_row[2][2][VSGL__BROAD_ROWS], amp[2][2][VSGL__BROAD_ROWS][VSGL__BROAD_COLS];
     for (int l = 0; l < 2; ++l) {
-        fit_table(2 - l, 1.0f, 0, s_row[l][0], amp[l][0]);
+        fit_table(2 - l, 1.0f, 1, s_row[l][0], amp[l][0]);
         fit_table(2 - l, VSGL__BROAD_DIELECTRIC_F0, 1, s_row[l][1], amp[l][1]);
     }
     FILE *f = write ? fopen("csrc/src/math/broad_lobe_table.c", "w") : stdout;

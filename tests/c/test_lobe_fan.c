@@ -34,7 +34,16 @@ static double exact_f(const void *user, v3 l)
 /* GGX's core and tail as ASGs of the lobe a (shade.c ggx_part; one ASG
  * where one is set), times the specular factor sf at its axis: the glossy
  * radiance from direction l */
-typedef struct model_q { vsgl_asg a; double sf; int one; } model_q;
+typedef struct model_q {
+    vsgl_asg a;
+    double sf;
+    int one;
+    /* ratio: also the shadowing and Fresnel towards l over the axis'
+     * (kernel.h, vsgl__smooth_ratio), as the shade stage takes them */
+    int ratio;
+    float a2, so, co, gia, w, fr[3];
+    v3 o;
+} model_q;
 static double model_f(const void *user, v3 l)
 {
     const model_q *q = user;
@@ -48,6 +57,9 @@ static double model_f(const void *user, v3 l)
         double c = q->one ? 1.0 : p ? VSGL__GGX_TAIL_C : VSGL__GGX_CORE_C;
         sum += c * exp(q->a.log_amplitude - k * (q->a.lambda * x * x + q->a.mu * y * y));
     }
+    if (q->ratio)
+        sum *= vsgl__smooth_ratio(q->a2, q->so, q->co, q->gia, q->w, q->fr[0], q->fr[1], q->fr[2], (float)l.z,
+                                  (float)v3_dot(q->o, l));
     return sum * z * q->sf;
 }
 
@@ -65,7 +77,7 @@ static double model_albedo(const vsgl_brdf_params *bp, v3 o, const vsgl_vec3 *vi
 {
     vsgl_vec3 n = {0, 0, 1}, t = {1, 0, 0}, ov = {o.x, o.y, o.z};
     vsgl_asg ndf;
-    model_q q;
+    model_q q = {0};
     vsgl_ndf_aniso_to_asg(&n, &t, bp->alpha_x, bp->alpha_y, &ndf);
     vsgl_warp_ndf_asg(&ndf, &ov, &q.a);
     q.one = 0;
@@ -145,6 +157,11 @@ static void rough_lobe(const vsgl_brdf_params *bp, v3 o, int broad, int one, mod
     float sf[3];
     vsgl__specular_factor(bp, v3_make(0, 0, 1), o, v3_make(q->a.z.x, q->a.z.y, q->a.z.z), alpha, sf);
     q->sf = sf[0];
+    /* the fitted lobe as the shade stage takes it: with the ratios */
+    q->ratio = broad;
+    q->o = o;
+    vsgl__shadow_lane(alpha, o.z, q->a.z.z, !one, &q->a2, &q->so, &q->co, &q->gia, &q->w);
+    vsgl__fresnel_ratio(bp, v3_make(0, 0, 1), o, v3_make(q->a.z.x, q->a.z.y, q->a.z.z), q->fr);
 }
 
 VT_TEST(broad_lobe_holds_a_rough_receivers_light)
@@ -155,13 +172,17 @@ VT_TEST(broad_lobe_holds_a_rough_receivers_light)
      * off across a broad lobe; its Gaussian is in sin(theta)). With the fit
      * (tools/gen_broad_lobe.c: closest to the exact lobe in L2) at
      * roughness and views between the table's entries, for GGX as two ASGs
-     * and as one: its albedo above the unfitted one's and below 1.05 of
-     * GGX's everywhere, a dielectric's at least 0.78 of it, a conductor's
-     * (amplitude alone, unwidened: tools/gen_broad_lobe.c says why) at
-     * least 0.54 and 0.87 head-on, its L2 distance to the exact lobe below
-     * the unfitted one's, and the lobe unchanged below roughness 0.4.
-     * Measured: a dielectric of F0 0.04 0.82-0.91 of GGX's albedo
-     * (0.40-0.82 unfitted), a white conductor 0.54-0.92 (0.32-0.85). */
+     * and as one, the lobe as the shade stage takes it (with the shadowing
+     * and Fresnel ratios towards each direction, kernel.h
+     * vsgl__smooth_ratio): its L2 distance to the exact lobe below the
+     * unfitted one's, its albedo below 1.05 of GGX's everywhere, a
+     * dielectric's at least 0.78 of it, a conductor's at least 0.65 and
+     * 0.75 head-on, and the lobe unchanged below roughness 0.4. The fit
+     * is closest in L2, not in energy: where it reshapes a lobe its albedo
+     * may end below the unfitted one's (a dielectric at roughness 0.67
+     * seen at cos_o 0.15: 0.796 against 0.812, L2 0.255 against 0.453).
+     * Measured: a dielectric of F0 0.04 0.80-0.88 of GGX's albedo
+     * (0.40-0.81 unfitted), a white conductor 0.67-0.94 (0.32-0.85). */
     const float roughs[] = {0.67f, 0.77f, 0.87f, 0.97f}, cosines[] = {0.95f, 0.62f, 0.37f, 0.15f};
     double worst_before = 1.0, lo_d = 2.0, hi_d = 0.0, lo_m = 2.0, hi_m = 0.0;
     for (int one = 0; one < 2; ++one)
@@ -186,11 +207,9 @@ VT_TEST(broad_lobe_holds_a_rough_receivers_light)
                     printf("%s, roughness %.2f %s cos_o %.2f: albedo %.3f -> %.3f of GGX's, L2 %.3f -> %.3f\n",
                            one ? "one ASG" : "two ASGs", roughs[ir], metal ? "metal" : "dielectric", c, e0, e1, d0,
                            d1);
-                VT_CHECK(e1 > e0, "one %d roughness %g metal %d cos_o %g: albedo %.3f, unfitted %.3f", one, roughs[ir],
-                         metal, c, e1, e0);
                 /* a dielectric's albedo within 0.78-1.05 of GGX's; a conductor's
-                 * (fitted by its amplitude alone) at least 0.54, 0.87 head-on */
-                const double lo_ok = metal ? (c > 0.9f ? 0.87 : 0.54) : 0.78;
+                 * at least 0.65, 0.75 head-on */
+                const double lo_ok = metal ? (c > 0.9f ? 0.75 : 0.65) : 0.78;
                 VT_CHECK(e1 > lo_ok && e1 < 1.05, "one %d roughness %g metal %d cos_o %g: %.3f of GGX's albedo", one,
                          roughs[ir], metal, c, e1);
                 if (metal) {

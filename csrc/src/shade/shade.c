@@ -270,12 +270,24 @@ static void tilt_table(vsgl_kernel_block *b, unsigned dirs)
     }
 }
 
+static float planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe, const vsgl_asg *whole,
+                           const receiver *rs, int two);
+
 float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe)
 {
-    return vsgl__planar_glossy_part(v, x, nr, lobe, lobe);
+    return planar_glossy(v, x, nr, lobe, lobe, NULL, 0);
 }
 
 float vsgl__planar_glossy_part(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe, const vsgl_asg *whole)
+{
+    return planar_glossy(v, x, nr, lobe, whole, NULL, 0);
+}
+
+/* rs: NULL, or the receiver whose shadowing ratio (kernel.h,
+ * vsgl__shadow_ratio) is taken towards the product's mean, as the kernel's
+ * k_planar_lobe (lobe->z its axis there) */
+static float planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe, const vsgl_asg *whole,
+                           const receiver *rs, int two)
 {
     v3 n = v->normal;
     float h = v3_dot(n, v3_sub(x, v->mean));
@@ -341,6 +353,16 @@ float vsgl__planar_glossy_part(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *
     /* lobe amplitude x its integral pi / sqrt(lam mu) x the radiance density N / pi */
     float scale = reach * expf(lobe->log_amplitude) / (VSGL__2PI * sqrtf(fmaxf(det * lam * mu, VSGL__TINY)));
     scale *= planar_horizon(v, x, nr, lobe->z, var, d1, d2, s11, s22, s12, det, u1, u2) * fade;
+    if (rs) { /* towards the product's mean, mean + var S^-1 d */
+        const v3 ym = v3_add(v3_sub(v->mean, x), v3_add(v3_scale(u1, var * (s22 * d1 - s12 * d2) / det),
+                                                        v3_scale(u2, var * (s11 * d2 - s12 * d1) / det)));
+        float ga2, so, co, gia, gw;
+        vsgl__shadow_lane(rs->alpha, v3_dot(rs->n, rs->o), v3_dot(rs->n, v3_make(lobe->z.x, lobe->z.y, lobe->z.z)),
+                          two, &ga2, &so, &co, &gia, &gw);
+        const float iy = 1.0f / sqrtf(v3_dot(ym, ym) + 1e-30f);
+        scale *= vsgl__smooth_ratio(ga2, so, co, gia, gw, rs->fres[0], rs->fres[1], rs->fres[2], v3_dot(nr, ym) * iy,
+                                    v3_dot(rs->o, ym) * iy);
+    }
     float q0 = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
     if (!(wf > 0.0f))
         return scale * expf(-0.5f * q0);
@@ -653,17 +675,29 @@ static float hv_alpha(const receiver *r)
 /* Glossy integral of the receiver's lobe with the incident SG, and the
  * axis where the smooth factor is evaluated: the receiver's lobe axis
  * (Xu et al. Eq. 30), the same for every VSGL, as in the kernel. */
+/* The receiver's shadowing ratio (kernel.h, vsgl__shadow_ratio) towards
+ * where its lobe (axis z, sharpness lr) times light of direction p and
+ * sharpness lin peaks, lr z + lin p, as the kernel's k_glossy. */
+static float shadow_towards(const receiver *r, int two, v3 z, float lr, v3 p, float lin)
+{
+    float a2, so, co, gia, w;
+    vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, z), two, &a2, &so, &co, &gia, &w);
+    v3 q = v3_add(v3_scale(z, lr), v3_scale(p, lin));
+    const float il = 1.0f / sqrtf(v3_dot(q, q) + VSGL__TINY);
+    return vsgl__smooth_ratio(a2, so, co, gia, w, r->fres[0], r->fres[1], r->fres[2], v3_dot(r->n, q) * il,
+                              v3_dot(r->o, q) * il);
+}
+
 static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_sg *in, v3 *axis, int part)
 {
     if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
         *axis = r->sg.axis;
-        return vsgl_sg_product_integral(&r->sg, in);
+        return vsgl_sg_product_integral(&r->sg, in) *
+               shadow_towards(r, 0, r->sg.axis, r->sg.sharpness, in->axis, in->sharpness);
     }
     *axis = r->asg.z;
-    if (!two_lobes(j->s->glossy_mode))
-        return vsgl_asg_sg_product_integral(&r->asg, in);
-    vsgl_asg a = ggx_part(&r->asg, part);
-    return vsgl_asg_sg_product_integral(&a, in);
+    vsgl_asg a = two_lobes(j->s->glossy_mode) ? ggx_part(&r->asg, part) : r->asg;
+    return vsgl_asg_sg_product_integral(&a, in) * shadow_towards(r, two_lobes(j->s->glossy_mode), r->asg.z, a.lambda + a.mu, in->axis, in->sharpness);
 }
 
 /* The glossy light of VSGL v through the receiver's lobe (each part of it
@@ -689,7 +723,7 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
             if (j->s->glossy_mode != VSGL_GLOSSY_SG && parts == 2)
                 lobe = ggx_part(&r->asg, q);
             float k2 = v->coherence * v->coherence;
-            gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * vsgl__planar_glossy_part(v, r->x, r->n, &lobe, &whole);
+            gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * planar_glossy(v, r->x, r->n, &lobe, &whole, r, parts == 2);
         }
         sum += gi;
     }
@@ -795,6 +829,16 @@ static void part_lane(uint32_t key, float *part, float *outer)
     *outer = key == VSGL__PART_NONE ? 0.0f : (float)(1u - (key & 1u));
 }
 
+/* Lane k's shadowing constants (kernel.h, vsgl__shadow_lane) from its
+ * fields: |alpha| (negative for an anisotropic receiver, which the
+ * half-vector model does not take), the normal, the view, the lobe's axis. */
+static void shadow_lane(vsgl_kernel_block *b, size_t k, int two)
+{
+    vsgl__shadow_lane(fabsf(b->alpha[k]), b->nx[k] * b->ox[k] + b->ny[k] * b->oy[k] + b->nz[k] * b->oz[k],
+                      b->nx[k] * b->Zx[k] + b->ny[k] * b->Zy[k] + b->nz[k] * b->Zz[k], two, &b->ga2[k], &b->gso[k],
+                      &b->gco[k], &b->gia[k], &b->gw[k]);
+}
+
 /* Lane `k` of a kernel block as a receiver at (x, y, z) with no lobe: finite
  * everywhere, contributes nothing (misses, and the padding of a last block). */
 static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z)
@@ -816,6 +860,7 @@ static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z
     b->fe[k] = 0.0f;
     b->fa[k] = 1.0f;
     b->fb[k] = 0.0f;
+    b->ga2[k] = b->gso[k] = b->gco[k] = b->gia[k] = b->gw[k] = 0.0f;
 }
 
 /* Fill lane `k` of a kernel block from G-buffer sample i; returns 0 for a miss. */
@@ -843,7 +888,9 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
         b->lam[k] = r->asg.lambda;
         b->mu[k] = r->asg.mu;
         b->camp[k] = expf(r->asg.log_amplitude);
-        b->alpha[k] = hv_alpha(r);
+        /* the half-vector model's alpha; negative (its magnitude for the
+         * shadowing ratio, shadow_lane) where that model does not apply */
+        b->alpha[k] = hv_alpha(r) > 0.0f ? hv_alpha(r) : -r->alpha;
     } else {
         b->Xx[k] = 1.0f; b->Xy[k] = b->Xz[k] = 0.0f;
         b->Yy[k] = 1.0f; b->Yx[k] = b->Yz[k] = 0.0f;
@@ -862,6 +909,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     b->fe[k] = r->fres[0];
     b->fa[k] = r->fres[1];
     b->fb[k] = r->fres[2];
+    shadow_lane(b, k, two_lobes(j->s->glossy_mode));
     return 1;
 }
 
@@ -918,7 +966,7 @@ static void lane_get(const vsgl_kernel_block *b, size_t k, const receiver *r, vs
 
 /* The inverse, and the receiver fields visibility rays read (position,
  * normal, lift, key; a replay has no G-buffer sample to read them from). */
-static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, receiver *r)
+static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, receiver *r, int two)
 {
     r->x = v3_make(o->v[0], o->v[1], o->v[2]);
     r->n = v3_make(o->v[3], o->v[4], o->v[5]);
@@ -937,6 +985,7 @@ static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, r
     b->lam[k] = *v++; b->mu[k] = *v++; b->camp[k] = *v++; b->alpha[k] = *v++;
     b->f0r[k] = *v++; b->f0g[k] = *v++; b->f0b[k] = *v++;
     b->fe[k] = *v++; b->fa[k] = *v++; b->fb[k] = *v;
+    shadow_lane(b, k, two);
     part_lane(o->part, &b->part[k], &b->pouter[k]);
 }
 
@@ -1206,7 +1255,7 @@ uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lan
     for (size_t s0 = 0; s0 < n_total; s0 += VSGL__KERNEL_BLOCK) {
         size_t n = n_total - s0 < VSGL__KERNEL_BLOCK ? n_total - s0 : VSGL__KERNEL_BLOCK;
         for (size_t k = 0; k < n; ++k) {
-            lane_put(&blk, k, lanes[s0 + k], &rec[k]);
+            lane_put(&blk, k, lanes[s0 + k], &rec[k], two_lobes(j->s->glossy_mode));
         }
         pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
     }
