@@ -22,6 +22,21 @@ static double hemisphere(hemi_fn f, const void *user)
     return hemi_quad(f, user, 768, 768);
 }
 
+/* A receiver's BRDF of colour (r, g, b), metallic 0 or 1, F0 0.04 */
+static vsgl_brdf_params lobe_material(float r, float g, float b, int metal, float rough)
+{
+    vsgl_material m = {{r, g, b}, metal ? 1.0f : 0.0f, rough, 0.04f, 0, 0, 0, 0};
+    vsgl_brdf_params bp;
+    vsgl__material_params(&m, &bp);
+    return bp;
+}
+
+/* The view in the xz plane at cosine c to the normal +z */
+static v3 view_at(float c)
+{
+    return v3_make(sqrtf(1.0f - c * c), 0.0f, c);
+}
+
 typedef struct exact_q { const vsgl_brdf_params *bp; v3 o; } exact_q;
 static double exact_f(const void *user, v3 l)
 {
@@ -106,14 +121,12 @@ VT_TEST(lobe_fan_keeps_a_grazing_views_light)
     double worst_alone = 1.0;
     for (int metal = 0; metal < 2; ++metal)
         for (int ir = 0; ir < 2; ++ir) {
-            vsgl_material m = {{0.8f, 0.35f, 0.1f}, metal ? 1.0f : 0.0f, roughs[ir], 0.04f, 0, 0, 0, 0};
-            vsgl_brdf_params bp;
-            vsgl__material_params(&m, &bp);
+            const vsgl_brdf_params bp = lobe_material(0.8f, 0.35f, 0.1f, metal, roughs[ir]);
             for (int ic = 0; ic < 7; ++ic) {
                 float c = cosines[ic];
                 if (getenv("VSGL_TEST_QUICK") && ic % 2 && ic != 5)
                     continue;
-                v3 o = v3_make(sqrtf(1.0f - c * c), 0.0f, c);
+                v3 o = view_at(c);
                 vsgl_vec3 ov = {o.x, o.y, o.z};
                 double ex = exact_albedo(&bp, o), with = model_albedo(&bp, o, &ov) / ex,
                        alone = model_albedo(&bp, o, NULL) / ex;
@@ -188,14 +201,12 @@ VT_TEST(broad_lobe_holds_a_rough_receivers_light)
     for (int one = 0; one < 2; ++one)
     for (int metal = 0; metal < 2; ++metal)
         for (int ir = one; ir < 4; ir += 1 + one) { /* one ASG (VSGL_GLOSSY_ASG): roughness 0.77, 0.97 */
-            vsgl_material m = {{1.0f, 1.0f, 1.0f}, metal ? 1.0f : 0.0f, roughs[ir], 0.04f, 0, 0, 0, 0};
-            vsgl_brdf_params bp;
-            vsgl__material_params(&m, &bp);
+            const vsgl_brdf_params bp = lobe_material(1.0f, 1.0f, 1.0f, metal, roughs[ir]);
             for (int ic = 0; ic < 4; ++ic) {
                 if (getenv("VSGL_TEST_QUICK") && (ir + ic) % 2)
                     continue;
                 float c = cosines[ic];
-                v3 o = v3_make(sqrtf(1.0f - c * c), 0.0f, c);
+                v3 o = view_at(c);
                 double ex = exact_albedo(&bp, o);
                 l2_q before, after;
                 before.e = after.e = (exact_q){&bp, o};
@@ -263,12 +274,10 @@ VT_TEST(broad_lobe_takes_little_light_from_its_horizon)
     double lo = 1e9, hi = 0.0, hi_without = 0.0;
     for (int metal = 0; metal < 2; ++metal)
         for (int ir = 0; ir < 2; ++ir) {
-            vsgl_material m = {{1.0f, 1.0f, 1.0f}, metal ? 1.0f : 0.0f, roughs[ir], 0.04f, 0, 0, 0, 0};
-            vsgl_brdf_params bp;
-            vsgl__material_params(&m, &bp);
+            const vsgl_brdf_params bp = lobe_material(1.0f, 1.0f, 1.0f, metal, roughs[ir]);
             for (int ic = 0; ic < 5; ++ic) {
                 float c = cosines[ic];
-                v3 o = v3_make(sqrtf(1.0f - c * c), 0.0f, c);
+                v3 o = view_at(c);
                 exact_q e = {&bp, o};
                 model_q with, without;
                 rough_lobe(&bp, o, 1, 0, &with);

@@ -263,11 +263,12 @@ typedef struct vsgl_kernel_block {
      * axis, fa + fb F(l.h, fe) (scene/material.h vsgl__fresnel_ratio;
      * fe 0: the ratio 1) */
     float fe[VSGL__KERNEL_BLOCK], fa[VSGL__KERNEL_BLOCK], fb[VSGL__KERNEL_BLOCK];
-    /* Smith's shadowing towards the light over M's at the axis
-     * (vsgl__shadow_lane, vsgl__shadow_ratio): alpha^2, S(cos_o), cos_o and
-     * 1 / g(cos of the axis); gia 0: the ratio 1 */
+    /* Smith's shadowing and the Fresnel towards the light over M's at the
+     * axis (vsgl__shadow_lane, vsgl__smooth_ratio): alpha^2, S(cos_o),
+     * cos_o, 1 / g(cos of the axis) and how far the ratio applies (gw 0:
+     * the ratio 1, as for a lane without a lobe) */
     float ga2[VSGL__KERNEL_BLOCK], gso[VSGL__KERNEL_BLOCK], gco[VSGL__KERNEL_BLOCK], gia[VSGL__KERNEL_BLOCK];
-    float gw[VSGL__KERNEL_BLOCK]; /* how far the ratio applies (vsgl__smooth_ratio) */
+    float gw[VSGL__KERNEL_BLOCK];
     /* the planar model's horizon tilt against the six planes facing +-x,
      * +-y, +-z (index 2 axis + side; kernel.h, vsgl__planar_tilt), per
      * lane: Phi and D, 1 and 0 where the lane needs no tilt

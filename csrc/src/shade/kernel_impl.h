@@ -480,8 +480,8 @@ k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t, f
     float hx = lam * mun * w2;
     float hy = mu * lamn * w2;
     t->expo[i] = -hx * gx * gx - hy * gy * gy;
-    /* the shadowing ratio (kernel.h, vsgl__shadow_ratio) towards where the
-     * product peaks: the lobe's axis weighted by its sharpness (an ASG is
+    /* the smooth-factor ratio (kernel.h, vsgl__smooth_ratio) towards where
+     * the product peaks: the lobe's axis weighted by its sharpness (an ASG is
      * an SG of sharpness lam + mu about its axis, on average) and the
      * light's by its own, m = lin p */
     float lr = lam + mu;
@@ -489,7 +489,8 @@ k_glossy(const vsgl_kernel_block *restrict b, size_t i, k_scratch *restrict t, f
     float ql = k_rsqrt(qx * qx + qy * qy + qz * qz + VSGL__TINY);
     float qn = (b->nx[i] * qx + b->ny[i] * qy + b->nz[i] * qz) * ql;
     float qo = (b->ox[i] * qx + b->oy[i] * qy + b->oz[i] * qz) * ql;
-    float sh = vsgl__smooth_ratio(b->ga2[i], b->gso[i], b->gco[i], b->gia[i], b->gw[i], b->fe[i], b->fa[i], b->fb[i], qn, qo);
+    float sh = vsgl__smooth_ratio(b->ga2[i], b->gso[i], b->gco[i], b->gia[i], b->gw[i], b->fe[i], b->fa[i], b->fb[i],
+                                  qn, qo);
     t->gpre[i] = kc * b->camp[i] * (gz > 0.0f ? gz : 0.0f) * (VSGL__PI * rp * ilin) * t->amp[i] * sh;
 }
 
@@ -624,7 +625,7 @@ k_planar_lobe(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_l
     float dx = (L->mx - b->x[i]) * is, dy = (L->my - b->y[i]) * is, dz = (L->mz - b->z[i]) * is;
     if (graze)
         hz = k_horizon(b, i, L, dx, dy, dz, d1, e2, s11, s22, s12, idet);
-    /* the shadowing ratio (kernel.h, vsgl__shadow_ratio) towards the
+    /* the smooth-factor ratio (kernel.h, vsgl__smooth_ratio) towards the
      * product's mean on the plane, mean + S^-1 d (sigma units) */
     float pm1 = (s22 * d1 - s12 * e2) * idet, pm2 = (s11 * e2 - s12 * d1) * idet;
     float yx = dx + pm1 * L->u1x + pm2 * L->u2x, yy = dy + pm1 * L->u1y + pm2 * L->u2y,
@@ -632,7 +633,8 @@ k_planar_lobe(const vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_l
     float yl = k_rsqrt(yx * yx + yy * yy + yz * yz + 1e-30f);
     float yn = (b->nx[i] * yx + b->ny[i] * yy + b->nz[i] * yz) * yl;
     float yo = (b->ox[i] * yx + b->oy[i] * yy + b->oz[i] * yz) * yl;
-    float sh = vsgl__smooth_ratio(b->ga2[i], b->gso[i], b->gco[i], b->gia[i], b->gw[i], b->fe[i], b->fa[i], b->fb[i], yn, yo);
+    float sh = vsgl__smooth_ratio(b->ga2[i], b->gso[i], b->gco[i], b->gia[i], b->gw[i], b->fe[i], b->fa[i], b->fb[i],
+                                  yn, yo);
     t->ppre[i] = t->pok[i] * reach * hz * sh * kc * (1.0f / VSGL__2PI) * k_rsqrt(det * lam * mu);
     t->ps11[i] = s11;
     t->ps22[i] = s22;

@@ -672,9 +672,6 @@ static float hv_alpha(const receiver *r)
     return r->glossy && fabsf(ax - ay) <= 1e-3f * fmaxf(ax, ay) ? r->alpha : 0.0f;
 }
 
-/* Glossy integral of the receiver's lobe with the incident SG, and the
- * axis where the smooth factor is evaluated: the receiver's lobe axis
- * (Xu et al. Eq. 30), the same for every VSGL, as in the kernel. */
 /* The receiver's shadowing ratio (kernel.h, vsgl__shadow_ratio) towards
  * where its lobe (axis z, sharpness lr) times light of direction p and
  * sharpness lin peaks, lr z + lin p, as the kernel's k_glossy. */
@@ -688,6 +685,10 @@ static float shadow_towards(const receiver *r, int two, v3 z, float lr, v3 p, fl
                               v3_dot(r->o, q) * il);
 }
 
+/* Glossy integral of the receiver's lobe with the incident SG, and the
+ * axis where the smooth factor is evaluated: the receiver's lobe axis
+ * (Xu et al. Eq. 30), the same for every VSGL, as in the kernel; times
+ * the smooth-factor ratio towards the light (shadow_towards). */
 static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_sg *in, v3 *axis, int part)
 {
     if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
@@ -696,8 +697,10 @@ static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_s
                shadow_towards(r, 0, r->sg.axis, r->sg.sharpness, in->axis, in->sharpness);
     }
     *axis = r->asg.z;
-    vsgl_asg a = two_lobes(j->s->glossy_mode) ? ggx_part(&r->asg, part) : r->asg;
-    return vsgl_asg_sg_product_integral(&a, in) * shadow_towards(r, two_lobes(j->s->glossy_mode), r->asg.z, a.lambda + a.mu, in->axis, in->sharpness);
+    const int two = two_lobes(j->s->glossy_mode);
+    vsgl_asg a = two ? ggx_part(&r->asg, part) : r->asg;
+    return vsgl_asg_sg_product_integral(&a, in) *
+           shadow_towards(r, two, r->asg.z, a.lambda + a.mu, in->axis, in->sharpness);
 }
 
 /* The glossy light of VSGL v through the receiver's lobe (each part of it

@@ -133,7 +133,9 @@ v3 vsgl__ray_aim(v3 x, v3 n, v3 c, v3 t);
  * fold, docs/quality.md).
  * Where the lobe meets the plane's horizon, only its share that points
  * into the plane counts, about an axis tilted towards the plane (kernel.h,
- * vsgl__planar_tilt). */
+ * vsgl__planar_tilt). The shade stage also multiplies it by the
+ * receiver's smooth-factor ratio towards the product's mean (kernel.h,
+ * vsgl__smooth_ratio), which this lobe-only form leaves out. */
 float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe);
 
 /* The same for one part of a lobe (GGX's core or tail, of the same axes)
