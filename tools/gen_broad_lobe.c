@@ -78,10 +78,8 @@ static double model_f(const lobe_q *q, v3 l)
     }
     /* and Smith's shadowing towards l over the axis' (kernel.h, vsgl__shadow_ratio), as the kernel takes it
      * for light from a small source */
-    float a2, so, co, gia, w;
-    vsgl__shadow_lane(sqrtf(q->bp->alpha_x * q->bp->alpha_y), q->o.z, q->a.z.z, q->parts == 2, &a2, &so, &co, &gia, &w);
-    return sum * z * q->sf *
-           vsgl__smooth_ratio(a2, so, co, gia, w, q->fr[0], q->fr[1], q->fr[2], (float)l.z, (float)v3_dot(q->o, l));
+    const vsgl_smooth_lane sm = vsgl__shadow_lane(sqrtf(q->bp->alpha_x * q->bp->alpha_y), q->o.z, q->a.z.z, q->parts == 2);
+    return sum * z * q->sf * vsgl__smooth_ratio_of(&sm, q->fr, (float)l.z, (float)v3_dot(q->o, l));
 }
 
 static double exact_h(const void *u, v3 l) { return exact_f(u, l); }

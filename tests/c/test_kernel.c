@@ -209,9 +209,9 @@ static void random_block(vt_rng *r, vsgl_kernel_block *b)
             }
             /* the smooth-factor ratio (kernel.h vsgl__smooth_ratio) at a
              * random alpha, as for GGX's two lobes or one */
-            vsgl__shadow_lane((float)(0.01 + 0.99 * vt_uniform(r)), b->nx[k] * b->ox[k] + b->ny[k] * b->oy[k] +
-                              b->nz[k] * b->oz[k], 1.0f, vt_uniform(r) < 0.5, &b->ga2[k], &b->gso[k], &b->gco[k],
-                              &b->gia[k], &b->gw[k]);
+            const float a = (float)(0.01 + 0.99 * vt_uniform(r));
+            vsgl__kernel_set_smooth(b, k, vsgl__shadow_lane(a, b->nx[k] * b->ox[k] + b->ny[k] * b->oy[k] +
+                                                               b->nz[k] * b->oz[k], 1.0f, vt_uniform(r) < 0.5));
         }
         /* convex parts (kernel.h vsgl__part_keep): none, 0 or 1, outside or in */
         b->part[k] = (float)((int)(3.0 * vt_uniform(r)) - 1);
@@ -378,7 +378,7 @@ VT_TEST(kernel_receiver_at_a_planar_clusters_mean_is_finite)
         b.alpha[k] = 0.05f;
         b.f0r[k] = b.f0g[k] = b.f0b[k] = 0.5f;
         b.fa[k] = 1.0f; /* no Fresnel ratio (scene/material.h vsgl__fresnel_ratio) */
-        vsgl__shadow_lane(b.alpha[k], b.oz[k], b.Zz[k], 1, &b.ga2[k], &b.gso[k], &b.gco[k], &b.gia[k], &b.gw[k]);
+        vsgl__kernel_set_smooth(&b, k, vsgl__shadow_lane(b.alpha[k], b.oz[k], b.Zz[k], 1));
         b.diffuse[k] = 1.0f;
     }
     const int32_t lob = VSGL__KERNEL_DIFFUSE | VSGL__KERNEL_GLOSSY | VSGL__KERNEL_GGX_TAIL;

@@ -56,7 +56,8 @@ typedef struct model_q {
     /* ratio: also the shadowing and Fresnel towards l over the axis'
      * (kernel.h, vsgl__smooth_ratio), as the shade stage takes them */
     int ratio;
-    float a2, so, co, gia, w, fr[3];
+    vsgl_smooth_lane sm;
+    float fr[3];
     v3 o;
 } model_q;
 static double model_f(const void *user, v3 l)
@@ -73,7 +74,7 @@ static double model_f(const void *user, v3 l)
         sum += c * exp(q->a.log_amplitude - k * (q->a.lambda * x * x + q->a.mu * y * y));
     }
     if (q->ratio)
-        sum *= vsgl__smooth_ratio(q->a2, q->so, q->co, q->gia, q->w, q->fr[0], q->fr[1], q->fr[2], (float)l.z,
+        sum *= vsgl__smooth_ratio_of(&q->sm, q->fr, (float)l.z,
                                   (float)v3_dot(q->o, l));
     return sum * z * q->sf;
 }
@@ -173,7 +174,7 @@ static void rough_lobe(const vsgl_brdf_params *bp, v3 o, int broad, int one, mod
     /* the fitted lobe as the shade stage takes it: with the ratios */
     q->ratio = broad;
     q->o = o;
-    vsgl__shadow_lane(alpha, o.z, q->a.z.z, !one, &q->a2, &q->so, &q->co, &q->gia, &q->w);
+    q->sm = vsgl__shadow_lane(alpha, o.z, q->a.z.z, !one);
     vsgl__fresnel_ratio(bp, v3_make(0, 0, 1), o, v3_make(q->a.z.x, q->a.z.y, q->a.z.z), q->fr);
 }
 

@@ -34,6 +34,17 @@ typedef struct vsgl_broad_table {
  * conductor (F = 1), 1 a dielectric of F0 VSGL__BROAD_DIELECTRIC_F0 */
 extern const vsgl_broad_table vsgl__broad_tables[2][2];
 
+/* How far a lobe of Blender roughness r takes a broad-lobe correction: 0
+ * up to VSGL__BROAD_R0, 1 from VSGL__BROAD_R1, a smoothstep between (the
+ * tables' rows are faded in so; the shade stage fades one ASG's
+ * smooth-factor ratio the same way, shade/kernel.h vsgl__shadow_lane). */
+static inline float vsgl__broad_fade(float r)
+{
+    float t = (r - VSGL__BROAD_R0) * (1.0f / (VSGL__BROAD_R1 - VSGL__BROAD_R0));
+    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    return t * t * (3.0f - 2.0f * t);
+}
+
 static inline float vsgl__broad_row_roughness(int j)
 {
     return VSGL__BROAD_R0 + (1.0f - VSGL__BROAD_R0) * (float)j / (VSGL__BROAD_ROWS - 1);

@@ -7,6 +7,7 @@
 #ifndef VSGL_SHADE_KERNEL_H
 #define VSGL_SHADE_KERNEL_H
 
+#include "math/broad_lobe.h"
 #include "math/fresnel.h"
 #include "math/normal.h"
 #include "math/vec.h"
@@ -264,9 +265,8 @@ typedef struct vsgl_kernel_block {
      * fe 0: the ratio 1) */
     float fe[VSGL__KERNEL_BLOCK], fa[VSGL__KERNEL_BLOCK], fb[VSGL__KERNEL_BLOCK];
     /* Smith's shadowing and the Fresnel towards the light over M's at the
-     * axis (vsgl__shadow_lane, vsgl__smooth_ratio): alpha^2, S(cos_o),
-     * cos_o, 1 / g(cos of the axis) and how far the ratio applies (gw 0:
-     * the ratio 1, as for a lane without a lobe) */
+     * axis: the lane's vsgl_smooth_lane (vsgl__shadow_lane,
+     * vsgl__smooth_ratio; gw 0: the ratio 1, as for a lane without a lobe) */
     float ga2[VSGL__KERNEL_BLOCK], gso[VSGL__KERNEL_BLOCK], gco[VSGL__KERNEL_BLOCK], gia[VSGL__KERNEL_BLOCK];
     float gw[VSGL__KERNEL_BLOCK];
     /* the planar model's horizon tilt against the six planes facing +-x,
@@ -334,13 +334,6 @@ static inline __attribute__((always_inline)) float vsgl__part_keep(const vsgl_ke
     return 1.0f - same * (L->pout + b->pouter[i] * L->pin);
 }
 
-/* The Blender roughness over which one ASG (VSGL_GLOSSY_ASG) takes the
- * ratios below, faded in: at roughness 0.3 they made the corridor's and the
- * textured room's Gloss worse in that mode (structured error +66 % / +30 %)
- * while they made the presets' two-lobe GGX better or kept it. */
-#define VSGL__SHADOW_R0 0.4f
-#define VSGL__SHADOW_R1 0.6f
-
 /* Smith's height-correlated shadowing-masking as it changes with the
  * light's direction l (math.md 5.6: M = F G2 / (4 cos_o), G2 / (4 cos_o) =
  * g(cos_l) / 2 with g(c) = c / (c S(cos_o) + cos_o S(c)), S(c) = sqrt(a^2 +
@@ -350,24 +343,42 @@ static inline __attribute__((always_inline)) float vsgl__part_keep(const vsgl_ke
  * horizon, where G2 takes it to 0 (a rough metal sphere's rim facing a lit
  * wall at grazing: 1.3x Cycles' Gloss). The SG and planar models take the
  * ratio at the direction their product with the light peaks towards; the
- * half-vector model has it per lobe already (k_hv_shared). One lane's
- * constants: a the receiver's alpha (sqrt(ax ay)), co = n.o, ca = n.z the
- * lobe axis' cosine. */
-static inline void vsgl__shadow_lane(float a, float co, float ca, int two, float *a2, float *so, float *cok, float *gia,
-                                     float *w)
+ * half-vector model has it per lobe already (k_hv_shared). One receiver's
+ * constants: a2 = alpha^2, so = S(cos_o), co = cos_o, gia = 1 / g(cos of
+ * the lobe's axis), w how far the ratio applies (0: the ratio 1). */
+typedef struct vsgl_smooth_lane {
+    float a2, so, co, gia, w;
+} vsgl_smooth_lane;
+
+/* Those of a receiver of alpha a (sqrt(ax ay)) seen at co = n.o, its lobe's
+ * axis at ca = n.z; two: GGX as two lobes (the presets), which take the
+ * ratio at every roughness. One ASG takes it only for broad lobes, faded
+ * in as the broad-lobe tables (vsgl__broad_fade): at roughness 0.3 it made
+ * the corridor's and the textured room's Gloss worse in that mode
+ * (structured error +66 % / +30 %) while it made the presets' two-lobe GGX
+ * better or kept it. */
+static inline vsgl_smooth_lane vsgl__shadow_lane(float a, float co, float ca, int two)
 {
+    vsgl_smooth_lane s;
     co = co > 1e-4f ? co : 1e-4f;
     ca = ca > 1e-4f ? ca : 1e-4f;
-    *a2 = a * a;
-    *so = sqrtf(*a2 + (1.0f - *a2) * co * co);
-    *cok = co;
-    const float ga = ca / (ca * *so + co * sqrtf(*a2 + (1.0f - *a2) * ca * ca));
-    *gia = 1.0f / ga;
-    /* one ASG: only for broad lobes, faded in as the broad-lobe tables
-     * (VSGL__SHADOW_R0 .. R1 in Blender roughness sqrt(a)) */
-    float t = (sqrtf(a) - VSGL__SHADOW_R0) * (1.0f / (VSGL__SHADOW_R1 - VSGL__SHADOW_R0));
-    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-    *w = two ? 1.0f : t * t * (3.0f - 2.0f * t);
+    s.a2 = a * a;
+    s.so = sqrtf(s.a2 + (1.0f - s.a2) * co * co);
+    s.co = co;
+    const float ga = ca / (ca * s.so + co * sqrtf(s.a2 + (1.0f - s.a2) * ca * ca));
+    s.gia = 1.0f / ga;
+    s.w = two ? 1.0f : vsgl__broad_fade(sqrtf(a));
+    return s;
+}
+
+/* Lane k of block b takes the constants s. */
+static inline void vsgl__kernel_set_smooth(vsgl_kernel_block *b, size_t k, vsgl_smooth_lane s)
+{
+    b->ga2[k] = s.a2;
+    b->gso[k] = s.so;
+    b->gco[k] = s.co;
+    b->gia[k] = s.gia;
+    b->gw[k] = s.w;
 }
 
 /* The ratio at a light direction of cosine ci to the normal (0 at and
@@ -389,6 +400,13 @@ static inline __attribute__((always_inline)) float vsgl__smooth_ratio(float a2, 
     float lh = 0.5f + 0.5f * ov;
     lh = sqrtf(lh > 1e-8f ? lh : 1e-8f);
     return 1.0f + w * (vsgl__shadow_ratio(a2, so, co, gia, ci) * (fa + fb * vsgl__fresnel_dielectric(lh, fe)) - 1.0f);
+}
+
+/* The same for a receiver's constants s and Fresnel ratio fres (scalar
+ * callers; the kernel passes its lanes' fields). */
+static inline float vsgl__smooth_ratio_of(const vsgl_smooth_lane *s, const float fres[3], float ci, float ov)
+{
+    return vsgl__smooth_ratio(s->a2, s->so, s->co, s->gia, s->w, fres[0], fres[1], fres[2], ci, ov);
 }
 
 /* The planar model's receiver horizon (shade.h, vsgl__planar_glossy): where

@@ -271,23 +271,23 @@ static void tilt_table(vsgl_kernel_block *b, unsigned dirs)
 }
 
 static float planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe, const vsgl_asg *whole,
-                           const receiver *rs, int two);
+                           const receiver *rs);
 
 float vsgl__planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe)
 {
-    return planar_glossy(v, x, nr, lobe, lobe, NULL, 0);
+    return planar_glossy(v, x, nr, lobe, lobe, NULL);
 }
 
 float vsgl__planar_glossy_part(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe, const vsgl_asg *whole)
 {
-    return planar_glossy(v, x, nr, lobe, whole, NULL, 0);
+    return planar_glossy(v, x, nr, lobe, whole, NULL);
 }
 
-/* rs: NULL, or the receiver whose shadowing ratio (kernel.h,
- * vsgl__shadow_ratio) is taken towards the product's mean, as the kernel's
- * k_planar_lobe (lobe->z its axis there) */
+/* rs: NULL, or the receiver whose smooth-factor ratio (kernel.h,
+ * vsgl__smooth_ratio; its constants rs->sm) is taken towards the
+ * product's mean, as the kernel's k_planar_lobe */
 static float planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe, const vsgl_asg *whole,
-                           const receiver *rs, int two)
+                           const receiver *rs)
 {
     v3 n = v->normal;
     float h = v3_dot(n, v3_sub(x, v->mean));
@@ -356,12 +356,8 @@ static float planar_glossy(const vsgl_vsgl *v, v3 x, v3 nr, const vsgl_asg *lobe
     if (rs) { /* towards the product's mean, mean + var S^-1 d */
         const v3 ym = v3_add(v3_sub(v->mean, x), v3_add(v3_scale(u1, var * (s22 * d1 - s12 * d2) / det),
                                                         v3_scale(u2, var * (s11 * d2 - s12 * d1) / det)));
-        float ga2, so, co, gia, gw;
-        vsgl__shadow_lane(rs->alpha, v3_dot(rs->n, rs->o), v3_dot(rs->n, v3_make(lobe->z.x, lobe->z.y, lobe->z.z)),
-                          two, &ga2, &so, &co, &gia, &gw);
         const float iy = 1.0f / sqrtf(v3_dot(ym, ym) + 1e-30f);
-        scale *= vsgl__smooth_ratio(ga2, so, co, gia, gw, rs->fres[0], rs->fres[1], rs->fres[2], v3_dot(nr, ym) * iy,
-                                    v3_dot(rs->o, ym) * iy);
+        scale *= vsgl__smooth_ratio_of(&rs->sm, rs->fres, v3_dot(nr, ym) * iy, v3_dot(rs->o, ym) * iy);
     }
     float q0 = fmaxf((s22 * d1 * d1 - 2.0f * s12 * d1 * d2 + s11 * d2 * d2) / det, 0.0f);
     if (!(wf > 0.0f))
@@ -456,6 +452,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
         vsgl_sg ndf;
         vsgl_ndf_to_sg(&r->n, r->alpha, VSGL_NDF_GGX, &ndf);
         vsgl_warp_ndf_sg(&ndf, &r->o, &r->sg);
+        r->sm = vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, r->sg.axis), 0);
     } else {
         v3 t = v3_make(g->tan[0][i], g->tan[1][i], g->tan[2][i]);
         /* a rough lobe widened and scaled to be closest to GGX's (math/broad_lobe.h) */
@@ -464,6 +461,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
                          two_lobes(j->s->glossy_mode), &bscale, &bamp);
         vsgl__receiver_asg(r->n, t, r->o, r->bp.alpha_x, r->bp.alpha_y, bscale, bamp, &r->asg);
         vsgl__fresnel_ratio(&r->bp, r->n, r->o, r->asg.z, r->fres);
+        r->sm = vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, r->asg.z), two_lobes(j->s->glossy_mode));
     }
 }
 
@@ -672,17 +670,14 @@ static float hv_alpha(const receiver *r)
     return r->glossy && fabsf(ax - ay) <= 1e-3f * fmaxf(ax, ay) ? r->alpha : 0.0f;
 }
 
-/* The receiver's shadowing ratio (kernel.h, vsgl__shadow_ratio) towards
- * where its lobe (axis z, sharpness lr) times light of direction p and
- * sharpness lin peaks, lr z + lin p, as the kernel's k_glossy. */
-static float shadow_towards(const receiver *r, int two, v3 z, float lr, v3 p, float lin)
+/* The receiver's smooth-factor ratio (kernel.h, vsgl__smooth_ratio)
+ * towards where its lobe (axis z, sharpness lr) times light of direction p
+ * and sharpness lin peaks, lr z + lin p, as the kernel's k_glossy. */
+static float shadow_towards(const receiver *r, v3 z, float lr, v3 p, float lin)
 {
-    float a2, so, co, gia, w;
-    vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, z), two, &a2, &so, &co, &gia, &w);
     v3 q = v3_add(v3_scale(z, lr), v3_scale(p, lin));
     const float il = 1.0f / sqrtf(v3_dot(q, q) + VSGL__TINY);
-    return vsgl__smooth_ratio(a2, so, co, gia, w, r->fres[0], r->fres[1], r->fres[2], v3_dot(r->n, q) * il,
-                              v3_dot(r->o, q) * il);
+    return vsgl__smooth_ratio_of(&r->sm, r->fres, v3_dot(r->n, q) * il, v3_dot(r->o, q) * il);
 }
 
 /* Glossy integral of the receiver's lobe with the incident SG, and the
@@ -694,13 +689,11 @@ static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_s
     if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
         *axis = r->sg.axis;
         return vsgl_sg_product_integral(&r->sg, in) *
-               shadow_towards(r, 0, r->sg.axis, r->sg.sharpness, in->axis, in->sharpness);
+               shadow_towards(r, r->sg.axis, r->sg.sharpness, in->axis, in->sharpness);
     }
     *axis = r->asg.z;
-    const int two = two_lobes(j->s->glossy_mode);
-    vsgl_asg a = two ? ggx_part(&r->asg, part) : r->asg;
-    return vsgl_asg_sg_product_integral(&a, in) *
-           shadow_towards(r, two, r->asg.z, a.lambda + a.mu, in->axis, in->sharpness);
+    vsgl_asg a = two_lobes(j->s->glossy_mode) ? ggx_part(&r->asg, part) : r->asg;
+    return vsgl_asg_sg_product_integral(&a, in) * shadow_towards(r, r->asg.z, a.lambda + a.mu, in->axis, in->sharpness);
 }
 
 /* The glossy light of VSGL v through the receiver's lobe (each part of it
@@ -726,7 +719,7 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
             if (j->s->glossy_mode != VSGL_GLOSSY_SG && parts == 2)
                 lobe = ggx_part(&r->asg, q);
             float k2 = v->coherence * v->coherence;
-            gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * planar_glossy(v, r->x, r->n, &lobe, &whole, r, parts == 2);
+            gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * planar_glossy(v, r->x, r->n, &lobe, &whole, r);
         }
         sum += gi;
     }
@@ -837,9 +830,9 @@ static void part_lane(uint32_t key, float *part, float *outer)
  * half-vector model does not take), the normal, the view, the lobe's axis. */
 static void shadow_lane(vsgl_kernel_block *b, size_t k, int two)
 {
-    vsgl__shadow_lane(fabsf(b->alpha[k]), b->nx[k] * b->ox[k] + b->ny[k] * b->oy[k] + b->nz[k] * b->oz[k],
-                      b->nx[k] * b->Zx[k] + b->ny[k] * b->Zy[k] + b->nz[k] * b->Zz[k], two, &b->ga2[k], &b->gso[k],
-                      &b->gco[k], &b->gia[k], &b->gw[k]);
+    vsgl__kernel_set_smooth(b, k, vsgl__shadow_lane(fabsf(b->alpha[k]), b->nx[k] * b->ox[k] + b->ny[k] * b->oy[k] +
+                                                    b->nz[k] * b->oz[k], b->nx[k] * b->Zx[k] + b->ny[k] * b->Zy[k] +
+                                                    b->nz[k] * b->Zz[k], two));
 }
 
 /* Lane `k` of a kernel block as a receiver at (x, y, z) with no lobe: finite
@@ -863,7 +856,7 @@ static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z
     b->fe[k] = 0.0f;
     b->fa[k] = 1.0f;
     b->fb[k] = 0.0f;
-    b->ga2[k] = b->gso[k] = b->gco[k] = b->gia[k] = b->gw[k] = 0.0f;
+    vsgl__kernel_set_smooth(b, k, (vsgl_smooth_lane){0.0f, 0.0f, 0.0f, 0.0f, 0.0f});
 }
 
 /* Fill lane `k` of a kernel block from G-buffer sample i; returns 0 for a miss. */
@@ -1023,7 +1016,8 @@ static void near_correct(const shade_job *j, const receiver *r, float burley, v3
             continue;
         const vsgl_vsgl *v = &j->set->items[cell->vsgl];
         /* the kernel's far field took the part's share (vsgl__part_keep): so does the near field */
-        float e = w * (q - far_diffuse(j, v, j->lobe_int[cell->vsgl], r->x, r->n)) * (j->leak ? vsgl__vsgl_part_keep(v, r->part) : 1.0f);
+        float e = w * (q - far_diffuse(j, v, j->lobe_int[cell->vsgl], r->x, r->n)) *
+                  (j->leak ? vsgl__vsgl_part_keep(v, r->part) : 1.0f);
         if (e == 0.0f)
             continue;
         if (burley >= 0.0f) /* Blender 3.x's Burley diffuse towards the cluster, as the kernel's */

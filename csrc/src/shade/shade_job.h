@@ -121,6 +121,7 @@ typedef struct receiver {
     float fres[3];       /* the half-vector model's Fresnel ratio (material.h vsgl__fresnel_ratio) */
     vsgl_asg asg;        /* warped NDF (ASG mode) */
     vsgl_sg sg;          /* warped NDF (SG mode) */
+    vsgl_smooth_lane sm; /* its smooth-factor ratio's constants (kernel.h vsgl__shadow_lane), glossy only */
 } receiver;
 
 uint64_t vsgl__shade_list(const shade_job *j, const size_t *list, size_t n, const float *centroid, float *light,
