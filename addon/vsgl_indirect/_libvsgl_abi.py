@@ -21,7 +21,7 @@ else:  # a top-level module (the tests, tools/)
 # --------------------------------------------------------------------------
 
 BINDING_VERSION = (0, 3)
-BUNDLE_VERSION = (1, 10)
+BUNDLE_VERSION = (1, 11)
 
 
 class Result(enum.IntEnum):
@@ -210,6 +210,8 @@ AA_PIXEL_LIMIT_PRESETS = 76800
 STRIDE_PIXELS_PRESETS = 76800
 VISIBILITY_SPREAD_DEFAULT = 2.0
 VISIBILITY_SPREAD_MAX = 4.0
+DOMINANT_RAYS_MAX = 16
+DOMINANT_SHARE = 0.02
 VISIBILITY_BUDGET_DEFAULT = 0.02
 MRP_MIN_AREA_DEFAULT = 0.25
 REUSED_GBUFFER = 1
@@ -410,6 +412,7 @@ class vsgl_render_settings(_Struct):
         ("aa_pixel_limit", c_uint32),
         ("stride_pixels", c_uint32),
         ("visibility_spread", c_float),
+        ("dominant_rays", c_uint32),
     ]
     _enums = {
         "method": Method, "fit_mode": FitMode, "sharpness_estimator": SharpnessEstimator,
@@ -662,10 +665,11 @@ __all__ = [
     "LIGHT_FLAGS_KNOWN", "AUTO_OFF", "AUTO_BALANCED", "AA_SAMPLES_MAX", "RSM_RESOLUTION_MIN",
     "RSM_RESOLUTION_MAX", "VSGL_COUNT_MAX", "FIS_ITERATIONS_MAX", "SHADE_STRIDE_MAX",
     "AA_PIXEL_LIMIT_PRESETS", "STRIDE_PIXELS_PRESETS", "VISIBILITY_SPREAD_DEFAULT", "VISIBILITY_SPREAD_MAX",
-    "VISIBILITY_BUDGET_DEFAULT", "MRP_MIN_AREA_DEFAULT", "REUSED_GBUFFER", "REUSED_FIT",
-    "EXR_COMPRESSION_COUNT", "EXR_MAX_CHANNELS", "EXR_ZIP_LEVEL_DEFAULT", "vsgl_log_fn", "vsgl_progress_fn",
-    "vsgl_vec3", "vsgl_context_desc", "vsgl_sg", "vsgl_asg", "vsgl_material", "vsgl_texture",
-    "vsgl_texture_slot", "vsgl_material_textures", "vsgl_light", "vsgl_camera", "vsgl_scene_desc",
-    "vsgl_scene_info", "vsgl_render_settings", "vsgl_render_output", "vsgl_render_stats",
-    "vsgl_memory_estimate", "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options", "vsgl_bundle_options",
-    "vsgl_bundle_info", "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS", "FIELD_C_NAMES", "PROTOTYPES"]
+    "DOMINANT_RAYS_MAX", "DOMINANT_SHARE", "VISIBILITY_BUDGET_DEFAULT", "MRP_MIN_AREA_DEFAULT",
+    "REUSED_GBUFFER", "REUSED_FIT", "EXR_COMPRESSION_COUNT", "EXR_MAX_CHANNELS", "EXR_ZIP_LEVEL_DEFAULT",
+    "vsgl_log_fn", "vsgl_progress_fn", "vsgl_vec3", "vsgl_context_desc", "vsgl_sg", "vsgl_asg",
+    "vsgl_material", "vsgl_texture", "vsgl_texture_slot", "vsgl_material_textures", "vsgl_light",
+    "vsgl_camera", "vsgl_scene_desc", "vsgl_scene_info", "vsgl_render_settings", "vsgl_render_output",
+    "vsgl_render_stats", "vsgl_memory_estimate", "vsgl_exr_pass", "vsgl_exr_metadata", "vsgl_exr_options",
+    "vsgl_bundle_options", "vsgl_bundle_info", "vsgl_debug_vsgl", "vsgl_reference_stats", "STRUCTS",
+    "FIELD_C_NAMES", "PROTOTYPES"]

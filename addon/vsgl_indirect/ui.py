@@ -11,7 +11,8 @@ from . import checks, config, engine, runner
 
 #: Knobs per subpanel, in drawing order.
 QUALITY_KNOBS = ("method", "aa_samples", "aa_pixel_limit", "edge_samples", "shade_stride", "stride_pixels",
-                 "sample_merging", "visibility", "visibility_budget", "visibility_spread", "seed")
+                 "sample_merging", "visibility", "visibility_budget", "visibility_spread",
+                 "dominant_rays", "seed")
 LIGHT_KNOBS = ("rsm_resolution", "fit_mode", "vsgl_count", "fis_iterations",
                "sharpness_estimator", "leak_correction")
 MATERIAL_KNOBS = ("diffuse_mode", "glossy_mode", "glossy_lobes", "mrp_min_area")

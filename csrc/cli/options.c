@@ -41,6 +41,8 @@ const char cli_usage[] =
     "                        stride by sqrt(pixels / N), up to 8; 0 = the stride at every size (the\n"
     "                        presets: 76800 = 320 x 240)\n"
     "  --edge-samples N      0..16             (N x N rays in pixels a geometric edge crosses; 0 = off)\n"
+    "  --dominant-rays N     1..16             (--visibility ray: rays per pair where a VSGL carries 2 % or\n"
+    "                        more of a pixel's light; preview: 8, the others: 1)\n"
     "  --method NAME         vsgl | brute-force   (brute-force: every RSM texel, the reference)\n"
     "  --threads N           worker threads (0 = all cores)\n"
     "  --max-memory SIZE     refuse a render estimated to need more (e.g. 8G, 512M;\n"
@@ -178,6 +180,7 @@ static const num_opt num_opts[] = {
     {"--stride-pixels", 0, offsetof(cli_options, stride_pixels)},
     {"--zip-level", 1, offsetof(cli_options, zip_level)},
     {"--edge-samples", 0, offsetof(cli_options, edge)},
+    {"--dominant-rays", 0, offsetof(cli_options, dominant)},
     {"--glossy-lobes", 0, offsetof(cli_options, lobes)},
     {"--threads", 0, offsetof(cli_options, threads)},
     {"--seed", 0, offsetof(cli_options, seed)},
@@ -403,6 +406,7 @@ void cli_settings(const cli_options *o, const vsgl_render_settings *base, vsgl_r
     if (o->vsgls.set) s->vsgl_count = o->vsgls.value;
     if (o->stride.set) s->shade_stride = o->stride.value;
     if (o->edge.set) s->edge_samples = o->edge.value;
+    if (o->dominant.set) s->dominant_rays = o->dominant.value;
     if (o->lobes.set) s->glossy_lobes = o->lobes.value;
     if (o->seed.set) s->seed = o->seed.value;
     if (o->fit >= 0) s->fit_mode = o->fit;
@@ -426,11 +430,11 @@ static const char *name_of(const char *const *names, const int *values, int v)
 
 void cli_describe_settings(const vsgl_render_settings *s, char *buf, size_t size)
 {
-    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u mrp_min_area=%g glossy_lobes=%u aa_pixel_limit=%u stride_pixels=%u",
+    snprintf(buf, size, "method=%s aa=%u rsm=%u fit=%s vsgls=%u fis_iterations=%u sharpness=%s diffuse=%s glossy=%s visibility=%s seed=%u leak=%s merge=%s stride=%u edge=%u mrp_min_area=%g glossy_lobes=%u aa_pixel_limit=%u stride_pixels=%u dominant_rays=%u",
              name_of(method_names, method_values, s->method), s->aa_samples, s->rsm_resolution,
              name_of(fit_names, fit_values, s->fit_mode), s->vsgl_count, s->fis_iterations,
              name_of(sharp_names, sharp_values, s->sharpness_estimator), name_of(diffuse_names, diffuse_values, s->diffuse_mode),
              name_of(glossy_names, glossy_values, s->glossy_mode), name_of(vis_names, vis_values, s->visibility), s->seed,
              name_of(leak_names, leak_values, s->leak_correction), name_of(merge_names, merge_values, s->sample_merging), s->shade_stride, s->edge_samples,
-             (double)s->mrp_min_area, s->glossy_lobes, s->aa_pixel_limit, s->stride_pixels);
+             (double)s->mrp_min_area, s->glossy_lobes, s->aa_pixel_limit, s->stride_pixels, s->dominant_rays);
 }

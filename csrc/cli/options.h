@@ -27,7 +27,7 @@ typedef struct cli_options {
     const char *scene_path;   /* render/info: the bundle */
     const char *output_path;  /* -o; NULL = the bundle's output path */
     int preset;               /* VSGL_PRESET_*, -1 = not given */
-    cli_u32 aa, aa_limit, stride_pixels, rsm, vsgls, threads, seed, stride, edge, lobes, zip_level;
+    cli_u32 aa, aa_limit, stride_pixels, rsm, vsgls, threads, seed, stride, edge, lobes, zip_level, dominant;
     int fit, sharpness, diffuse, glossy, visibility, method;
     int leak, merge;          /* VSGL_LEAK_*, VSGL_MERGE_*; -1 = not given */
     int compression;          /* VSGL_EXR_*, default ZIP */

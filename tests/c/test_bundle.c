@@ -129,6 +129,7 @@ static void make_scene(test_scene *s, unsigned seed)
     s->settings.aa_pixel_limit = 1000u;            /* format 1.8 */
     s->settings.stride_pixels = 2000u;             /* format 1.9 */
     s->settings.visibility_spread = 1.5f;          /* format 1.10 */
+    s->settings.dominant_rays = 5u;                /* format 1.11 */
 }
 
 static int same_bytes(const void *a, const void *b, size_t n)
@@ -183,7 +184,7 @@ VT_TEST(bundle_roundtrip_memory_is_bit_exact)
     VT_CHECK(b != NULL, "write: %s", vsgl_context_last_error(ctx));
     /* Documented size: 40 + sum over sections of 24 + bytes padded to 8. */
     size_t want = 40 + (24 + 88) + (24 + 64) + (24 + 184) + (24 + 120) + (24 + 240) + (24 + 24) + (24 + 80) + (24 + 312) +
-                  (24 + 104) + (24 + 88) + (24 + 32) + (24 + 8); /* settings: 88 bytes */
+                  (24 + 104) + (24 + 96) + (24 + 32) + (24 + 8); /* settings: 92 bytes, padded to 96 */
     VT_CHECK(n == want, "bundle size %zu, documented layout gives %zu", n, want);
     vsgl_bundle *bd = NULL;
     vsgl_result r = vsgl_bundle_read_memory(ctx, b, n, &bd);
@@ -281,7 +282,7 @@ VT_TEST(bundle_file_matches_independent_python_reader)
     snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s '%s'", script, path);
     int rc = run_capture(cmd, out, sizeof out);
     VT_CHECK(rc == 0 && strstr(out, "\nok\n"), "reference reader exit %d:\n%s", rc, out);
-    VT_CHECK(strstr(out, "version 1.10\n") && strstr(out, "section POS  esize 12 count 7 crc ok") &&
+    VT_CHECK(strstr(out, "version 1.11\n") && strstr(out, "section POS  esize 12 count 7 crc ok") &&
                  strstr(out, "section IDX  esize 12 count 5 crc ok") && strstr(out, "section LGHT esize 104 count 3 crc ok") &&
                  strstr(out, "camera type 0 fit 0 lens 50 size 320x240") && strstr(out, "light 2 type 2 power 300") &&
                  strstr(out, "output out.exr") && strstr(out, "frame 12") && strstr(out, "seed 1234567"),
@@ -377,9 +378,9 @@ VT_TEST(bundle_bad_headers_give_clear_errors)
 
     memcpy(t, b, n);
     wr32(t + 8, 2);
-    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 2.10, this library reads 1.x", "major 2");
+    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 2.11, this library reads 1.x", "major 2");
     wr32(t + 8, 0);
-    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 0.10", "major 0");
+    EXPECT_READ(t, n, VSGL_ERROR_VERSION_MISMATCH, "version 0.11", "major 0");
 
     memcpy(t, b, n);
     memset(t + n, 0, 16);

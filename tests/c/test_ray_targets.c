@@ -105,7 +105,8 @@ VT_TEST(ray_targets_spread_over_the_cluster_and_stop_before_a_wall)
 }
 
 /* A cluster on the floor under the plate's edge, receivers in lines above
- * the plate at x = u R (R: the disk's radius), the plate halfway up: a
+ * the plate at x = u R (R: the disk's radius), each receiver with the key
+ * of one pixel of a 32 x 32 image, the plate halfway up: a
  * receiver's ray to point p of the disk passes the plate's plane at
  * x = (u R + p.x) / 2, so the share that gets through is the disk's share
  * beyond x = -u R. Measured over 1024 receivers a line: within binomial
@@ -139,7 +140,8 @@ VT_TEST(ray_targets_give_an_edge_the_cluster_penumbra)
                 points += t.xyz[3 * k] >= c.x - (float)us[q] * R ? 1.0 / VSGL__RAY_TARGETS : 0.0;
             for (int i = 0; i < N; ++i) {
                 v3 x = v3_make((float)us[q] * R, -0.5f + (float)i / N, zr);
-                const float *p = vsgl__ray_target_for(&t, 0, vsgl__hash32((uint32_t)(q * N + i)));
+                /* the receivers of a 32 x 32-pixel image, one line of it per pixel's key */
+                const float *p = vsgl__ray_target_for(&t, 0, vsgl__ray_key((size_t)i, 32u, 1u, 1u), 0, 1);
                 ox[i] = x.x, oy[i] = x.y, oz[i] = x.z;
                 tx[i] = p[0], ty[i] = p[1], tz[i] = p[2];
                 lane[i] = (uint32_t)i;
@@ -163,6 +165,73 @@ VT_TEST(ray_targets_give_an_edge_the_cluster_penumbra)
         }
         vsgl__ray_targets_free(&t);
     }
+    vsgl_scene_destroy(sc);
+    vsgl_context_destroy(ctx);
+}
+
+/* Which of a cluster's 16 points the receivers pick (vsgl__ray_key,
+ * vsgl__ray_target_for), from the targets' own table:
+ *  - the picks come from a blue-noise mask: any 4 x 4 pixels of an image
+ *    take at least 10 of a cluster's points and 12.5 on average (a
+ *    white-noise hash of the pixel: 6 and 10.3), so a dithered shadow edge
+ *    has little grain left at the scale of a few pixels;
+ *  - a pair's n dominant rays (vsgl_render_settings.dominant_rays) take n
+ *    different points, every one of the 16 at n = 16;
+ *  - a pixel's slots on the aa x aa grid read the mask at their own place
+ *    on the image's sample grid (2 x 2 slots of one pixel: 4 points). */
+VT_TEST(ray_targets_picks_are_blue_noise_and_rays_distinct)
+{
+    vsgl_context *ctx = fx_context(1);
+    VT_REQUIRE(ctx, "context");
+    fx_scene fx;
+    vsgl_vsgl items[2] = {floor_cluster(0.0f, 0.0f, 0.05f), floor_cluster(0.3f, 0.2f, 0.05f)};
+    vsgl_scene *sc = room_with_plate(ctx, &fx, 0.5f);
+    VT_REQUIRE(sc, "%s", vsgl_context_last_error(ctx));
+    vsgl_vsgl_set set = {items, 2, 2};
+    vsgl_ray_targets t;
+    VT_REQUIRE(vsgl__ray_targets_build(sc, &set, 2.0f, 0.25f, &t) == VSGL_OK, "build");
+    enum { W = 96, H = 80 };
+    for (size_t item = 0; item < 2; ++item) {
+        int least = 16;
+        double mean = 0.0;
+        size_t windows = 0;
+        for (uint32_t y0 = 0; y0 + 4 <= H; ++y0)
+            for (uint32_t x0 = 0; x0 + 4 <= W; ++x0) {
+                unsigned seen = 0;
+                for (uint32_t y = y0; y < y0 + 4; ++y)
+                    for (uint32_t x = x0; x < x0 + 4; ++x) {
+                        const float *p = vsgl__ray_target_for(&t, item, vsgl__ray_key((size_t)y * W + x, W, 1u, 1u),
+                                                              0, 1);
+                        seen |= 1u << ((size_t)(p - t.xyz) / 3 - item * VSGL__RAY_TARGETS);
+                    }
+                const int c = __builtin_popcount(seen);
+                least = c < least ? c : least;
+                mean += c;
+                ++windows;
+            }
+        mean /= (double)windows;
+        VT_CHECK(least >= 10 && mean >= 12.5, "cluster %zu: 4 x 4 pixels pick at least %d of 16 points, %.2f on "
+                 "average (want >= 10, >= 12.5: blue noise)", item, least, mean);
+        for (uint32_t n = 2; n <= VSGL__RAY_TARGETS; n *= 2)
+            for (size_t i = 0; i < 200; ++i) {
+                const uint32_t key = vsgl__ray_key(i * 37u, W, 1u, 1u);
+                unsigned seen = 0;
+                for (uint32_t r = 0; r < n; ++r)
+                    seen |= 1u << ((size_t)(vsgl__ray_target_for(&t, item, key, r, n) - t.xyz) / 3 -
+                                   item * VSGL__RAY_TARGETS);
+                VT_CHECK((unsigned)__builtin_popcount(seen) == n, "cluster %zu, key %u: %u rays take %d points",
+                         item, key, n, __builtin_popcount(seen));
+            }
+    }
+    /* aa 2: pixel (5, 7)'s four slots sit at (10..11, 14..15) of the sample grid */
+    for (uint32_t s = 0; s < 4; ++s) {
+        const uint32_t key = vsgl__ray_key((size_t)(7 * W + 5) * 4 + s, W, 4u, 2u);
+        VT_CHECK((key & 63u) == 10u + s % 2u && ((key >> 6) & 63u) == 14u + s / 2u && key >> 12 == 0,
+                 "slot %u: key %u", s, key);
+    }
+    /* an edge pixel's third slot (aa 1, 3 slots): the pixel's place, turned */
+    VT_CHECK(vsgl__ray_key((size_t)(7 * W + 5) * 3 + 2, W, 3u, 1u) == (5u | 7u << 6 | 2u << 12), "edge slot key");
+    vsgl__ray_targets_free(&t);
     vsgl_scene_destroy(sc);
     vsgl_context_destroy(ctx);
 }

@@ -140,6 +140,7 @@ VT_TEST(render_rejects_bad_settings_and_sizes_without_touching_output)
         {"visibility_spread", 1, "settings: visibility_spread is 4.5 (valid: at most 4; 0 = 2, negative = rays"},
         {"visibility_spread", 2, "settings: visibility_spread is inf (valid: at most 4"},
         {"visibility_spread", 3, "settings: visibility_spread is nan (valid: at most 4"},
+        {"dominant_rays", 17, "settings: dominant_rays is 17 (valid: 1..16; 0 = 1)"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         vsgl_render_settings bad = s;
@@ -153,6 +154,7 @@ VT_TEST(render_rejects_bad_settings_and_sizes_without_touching_output)
         if (i == 7) bad.visibility_spread = 4.5f;
         if (i == 8) bad.visibility_spread = INFINITY;
         if (i == 9) bad.visibility_spread = NAN;
+        if (i == 10) bad.dominant_rays = (uint32_t)cases[i].value;
         memset(&p, 0x7f, sizeof p);
         err[0] = 0;
         VT_CHECK(render_room(0, &bad, &p, NULL, err, sizeof err) == VSGL_ERROR_INVALID_ARGUMENT, "%s", cases[i].field);

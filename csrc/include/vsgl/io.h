@@ -166,7 +166,7 @@ VSGL_API vsgl_result vsgl_exr_write_render(vsgl_context *ctx, const char *path,
 
 /** Bundle format version this library writes. Readers accept the same major and any minor. */
 #define VSGL_BUNDLE_VERSION_MAJOR 1
-#define VSGL_BUNDLE_VERSION_MINOR 10
+#define VSGL_BUNDLE_VERSION_MINOR 11
 
 /** Opaque bundle read from a file or memory; owns every array its views point to. */
 typedef struct vsgl_bundle vsgl_bundle;

@@ -136,6 +136,8 @@ static const field settings_fields[] = {
     F(vsgl_render_settings, stride_pixels, 'u', 1),
     /* format 1.10: where visibility rays aim, in cluster sigmas */
     F(vsgl_render_settings, visibility_spread, 'f', 1),
+    /* format 1.11: rays per pair for a receiver's dominant pairs */
+    F(vsgl_render_settings, dominant_rays, 'u', 1),
 };
 #define SLOT(m) F(vsgl_material_textures, m.texture, 'u', 1), F(vsgl_material_textures, m.filter, 'i', 1), \
     F(vsgl_material_textures, m.wrap, 'i', 1), F(vsgl_material_textures, m.channel, 'i', 1), \
@@ -250,7 +252,7 @@ static const section_kind kinds[S_COUNT] = {
     {"MATL", "materials", "material", 40, 1, 0, 0},
     {"LGHT", "lights", "light", 104, 1, 0, 0},
     {"CAM ", "camera", "camera", 104, 1, 0, 0},
-    {"RSET", "render settings", "settings", 88, 1, 0, 44},
+    {"RSET", "render settings", "settings", 92, 1, 0, 44},
     {"OUTP", "output path", "byte", 1, 0, 0, 0},
     {"FRME", "frame", "frame", 4, 0, 0, 0},
     /* format 1.2: textures */

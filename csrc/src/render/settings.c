@@ -21,6 +21,7 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
     out->glossy_lobes = 4;                         /* the same */
     out->visibility_budget = VSGL_VISIBILITY_BUDGET_DEFAULT; /* the same */
     out->visibility_spread = VSGL_VISIBILITY_SPREAD_DEFAULT; /* the same */
+    out->dominant_rays = 1;                                   /* the same */
     /* Every preset fits on the lattice: the importance-drawn fits flicker
      * as a light moves (0.1-0.75 of the AOV per 1/1000-extent step, docs/
      * quality.md) and break a reflection into blotches; with the emitter
@@ -97,6 +98,15 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
          * time in the rooms that are not convex. The viewport's Live quality
          * leaves them out (addon/vsgl_indirect/live.py). */
         out->visibility = VSGL_VISIBILITY_RAY;
+        /* Its 32-cell lattice makes few large clusters, and a receiver half
+         * hidden from one took 0 or 1 of its light by one ray: grain in every
+         * indirect shadow (rough_room's floor beside the sphere, 320 x 240:
+         * the pixel-scale noise 0.068 of the light, balanced's 0.020). Eight
+         * rays for the pairs that carry 2 % or more of a receiver's light:
+         * 0.018, at 0.89-1.23x the time at 960 x 540 (docs/pipeline.md).
+         * Balanced's finer clusters need them less (0.020 -> 0.018 for
+         * 1.06-1.09x its time): one ray. */
+        out->dominant_rays = 8;
         out->glossy_mode = VSGL_GLOSSY_ASG2;
         break;
     case VSGL_PRESET_QUALITY: /* finer cells, RSMs, samples and GGX lobes than balanced: lower
@@ -208,6 +218,11 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
         return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: visibility_spread is %g (valid: at most "
                           "%g; 0 = %g, negative = rays at each cluster's centre)", (double)s->visibility_spread,
                           (double)VSGL_VISIBILITY_SPREAD_MAX, (double)VSGL_VISIBILITY_SPREAD_DEFAULT);
+    if (s->dominant_rays > VSGL_DOMINANT_RAYS_MAX)
+        return vsgl__fail(ctx, VSGL_ERROR_INVALID_ARGUMENT, "settings: dominant_rays is %u (valid: 1..%u; 0 = 1)",
+                          s->dominant_rays, VSGL_DOMINANT_RAYS_MAX);
+    if (s->dominant_rays == 0)
+        s->dominant_rays = 1;
     if (s->visibility_spread == 0.0f)
         s->visibility_spread = VSGL_VISIBILITY_SPREAD_DEFAULT;
     else if (s->visibility_spread < 0.0f)

@@ -435,7 +435,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->n = v3_make(g->nrm[0][i], g->nrm[1][i], g->nrm[2][i]);
     r->o = v3_make(g->view[0][i], g->view[1][i], g->view[2][i]);
     r->lift = g->lift[0] ? v3_make(g->lift[0][i], g->lift[1][i], g->lift[2][i]) : v3_make(0.0f, 0.0f, 0.0f);
-    r->key = vsgl__hash32((uint32_t)i ^ vsgl__hash32((uint32_t)((uint64_t)i >> 32)));
+    r->key = vsgl__ray_key(i, g->width, g->spp, g->aa);
     r->part = g->part ? g->part[i] : VSGL__PART_NONE;
     sample_params(j, i, &r->bp);
     if (g->spread && g->spread[i] < 1.0f)
@@ -592,7 +592,7 @@ v3 vsgl__ray_aim(v3 x, v3 n, v3 c, v3 t)
 }
 
 /* Visibility of VSGL `item` (set order; each receiver aims at its own
- * point of the cluster, ray_targets.h) from the receivers k <
+ * point of the cluster, ray `ray` of `rays`, ray_targets.h) from the receivers k <
  * n <= VSGL__KERNEL_BLOCK whose bit is set in `lanes`: one batched
  * occlusion query (an Embree ray stream) of just those, each from the
  * receiver's origin in org. Returns their visible bits (a blocked
@@ -605,7 +605,7 @@ v3 vsgl__ray_aim(v3 x, v3 n, v3 c, v3 t)
  * receivers, a wall's cluster and the wall beside it); visible. */
 _Static_assert(VSGL__KERNEL_BLOCK <= 64, "a block's lanes are kept in 64-bit masks");
 static uint64_t visibility_rays(const shade_job *j, size_t item, const vsgl_kernel_light *L, const receiver *rec,
-                                const ray_origins *org, size_t n, uint64_t lanes)
+                                const ray_origins *org, size_t n, uint64_t lanes, uint32_t ray, uint32_t rays)
 {
     unsigned char blocked[VSGL__KERNEL_BLOCK];
     uint32_t idx[VSGL__KERNEL_BLOCK], m = 0;
@@ -627,7 +627,7 @@ static uint64_t visibility_rays(const shade_job *j, size_t item, const vsgl_kern
         const v3 c = vsgl__ray_centre(&j->set->items[item]);
         for (uint32_t i = 0; i < m; ++i) {
             const receiver *r = &rec[idx[i]];
-            const float *p = vsgl__ray_target_for(j->targets, item, org->key[idx[i]]);
+            const float *p = vsgl__ray_target_for(j->targets, item, org->key[idx[i]], ray, rays);
             v3 t = vsgl__ray_aim(r->x, r->n, c, v3_make(p[0], p[1], p[2]));
             to.x[idx[i]] = t.x;
             to.y[idx[i]] = t.y;
@@ -648,7 +648,7 @@ static int visible_from(const shade_job *j, const vsgl_vsgl *v, const receiver *
 {
     ray_origins o;
     origins_of(j, r, 1, &o);
-    return (int)(visibility_rays(j, (size_t)(v - j->set->items), NULL, r, &o, 1, 1) & 1u);
+    return (int)(visibility_rays(j, (size_t)(v - j->set->items), NULL, r, &o, 1, 1, 0, 1) & 1u);
 }
 
 /* Part q (0 core, 1 tail) of a GGX lobe's ASG (kernel.h, VSGL__KERNEL_GGX_TAIL). */
@@ -1035,15 +1035,32 @@ static void near_correct(const shade_job *j, const receiver *r, float burley, v3
 }
 
 
+/* A receiver's dominant pairs (vsgl_render_settings.dominant_rays): from
+ * half of VSGL_DOMINANT_SHARE of its light up, a pair's visibility is
+ * (1 - t) x its first ray's + t x the mean of all its rays, t rising
+ * linearly to 1 at the share: a pair whose weight crosses the share as a
+ * light or the camera moves changes its estimate smoothly, not from 0 or
+ * 1 to a fraction in one frame. */
+static float dominant_mix(float w, float total)
+{
+    const float lo = 0.5f * VSGL_DOMINANT_SHARE * total;
+    const float t = (w - lo) / (VSGL_DOMINANT_SHARE * total - lo);
+    return t < 1.0f ? t : 1.0f;
+}
+
 /* Visibility of every (VSGL, receiver) pair of a block: bit k of vis[v] and
  * skip[v] for receiver k and kernel light v; the pairs under each
  * receiver's budget (vsgl_render_settings.visibility_budget: the VSGLs
  * whose light there, vsgl__kernel_pair_weights, sums to at most that fraction of all of
  * theirs, the weakest first; glossy_sphere_floor at 320 x 240: 26.4 M rays
  * -> 4.5 M at 0.02) are skipped and get share[k], the traced pairs' mean
- * visibility weighted by their light. w: count x VSGL__KERNEL_BLOCK floats. */
+ * visibility weighted by their light. w: count x VSGL__KERNEL_BLOCK floats
+ * (the weights; NULL without a budget or dominant rays). With dominant
+ * rays, bit k of dom[v] marks a receiver whose pair with v traced them
+ * (dominant_mix above) and frac[v * VSGL__KERNEL_BLOCK + k] holds its
+ * visibility in [0, 1] (vis[v]'s bit: above 0). */
 static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, const receiver *rec, size_t n,
-                             uint64_t *vis, uint64_t *skip, float *w, float *share)
+                             uint64_t *vis, uint64_t *skip, uint64_t *dom, float *w, float *frac, float *share)
 {
     const size_t count = j->set->count, B = VSGL__KERNEL_BLOCK;
     ray_origins org_s, *org = &org_s;
@@ -1054,55 +1071,101 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
     for (size_t k = 0; k < B; ++k)
         seen[k] = lit[k] = 0.0;
     const float budget = j->s->visibility_budget;
-    if (budget > 0.0f) { /* the highest cut whose pairs' light fits the budget */
+    const uint32_t rays = frac ? j->s->dominant_rays : 1u;
+    if (w) /* every pair's light: the budget's cut, the dominant pairs */
         vsgl__kernel_pair_weights(blk, j->klights, count, w, total);
+    if (budget > 0.0f) /* the highest cut whose pairs' light fits the budget */
         vsgl__kernel_weight_cut(w, count, total, budget, cut);
-    }
     for (size_t v = 0; v < count; ++v) {
-        const float *wv = budget > 0.0f ? w + v * B : NULL; /* weights exist only under a budget */
-        uint64_t sbits = wv ? vsgl__kernel_lanes_within(wv, cut) & lanes_of(n) : 0;
+        const float *wv = w ? w + v * B : NULL;
+        uint64_t sbits = budget > 0.0f ? vsgl__kernel_lanes_within(wv, cut) & lanes_of(n) : 0;
         skip[v] = sbits;
         vis[v] = 0;
+        if (dom)
+            dom[v] = 0;
         if (sbits == lanes_of(n))
             continue; /* no ray for this VSGL at any receiver of the block */
         uint64_t want = lanes_of(n) & ~sbits, vbits = 0;
-        if (v > 0 && j->ray_twin && j->ray_twin[v]) { /* the light before's rays, where it traced them */
+        const int twin = v > 0 && j->ray_twin && j->ray_twin[v];
+        if (twin) { /* the light before's rays, where it traced them */
             uint64_t have = want & ~skip[v - 1];
             vbits = vis[v - 1] & have;
             want &= ~have;
+            if (rays > 1) { /* and its dominant rays, with its mix */
+                dom[v] = dom[v - 1] & have;
+                for (uint64_t r = dom[v]; r; r &= r - 1)
+                    frac[v * B + (size_t)__builtin_ctzll(r)] = frac[(v - 1) * B + (size_t)__builtin_ctzll(r)];
+            }
         }
         if (want)
-            vbits |= visibility_rays(j, j->korder[v], &j->klights[v], rec, org, n, want);
-        vis[v] = vbits;
-        if (wv)
+            vbits |= visibility_rays(j, j->korder[v], &j->klights[v], rec, org, n, want, 0, rays);
+        if (budget > 0.0f)
             vsgl__kernel_vis_accumulate(wv, lanes_of(n) & ~sbits, vbits, seen, lit);
+        if (rays > 1) {
+            uint64_t more = 0; /* the receivers for which this pair is dominant */
+            for (uint64_t r = want; r; r &= r - 1) {
+                size_t k = (size_t)__builtin_ctzll(r);
+                if (wv[k] > 0.5f * VSGL_DOMINANT_SHARE * total[k])
+                    more |= (uint64_t)1 << k;
+            }
+            if (more) {
+                float hits[VSGL__KERNEL_BLOCK];
+                for (uint64_t r = more; r; r &= r - 1) {
+                    size_t k = (size_t)__builtin_ctzll(r);
+                    hits[k] = (float)((vbits >> k) & 1u);
+                }
+                for (uint32_t ray = 1; ray < rays; ++ray) {
+                    uint64_t b = visibility_rays(j, j->korder[v], &j->klights[v], rec, org, n, more, ray, rays);
+                    for (uint64_t r = more; r; r &= r - 1) {
+                        size_t k = (size_t)__builtin_ctzll(r);
+                        hits[k] += (float)((b >> k) & 1u);
+                    }
+                }
+                for (uint64_t r = more; r; r &= r - 1) {
+                    size_t k = (size_t)__builtin_ctzll(r);
+                    const float first = (float)((vbits >> k) & 1u), t = dominant_mix(wv[k], total[k]);
+                    frac[v * B + k] = first + t * (hits[k] / (float)rays - first);
+                    if (frac[v * B + k] > 0.0f)
+                        vbits |= (uint64_t)1 << k;
+                }
+                dom[v] |= more;
+            }
+        }
+        vis[v] = vbits;
     }
     for (size_t k = 0; k < B; ++k)
         share[k] = seen[k] > 0.0 ? (float)(lit[k] / seen[k]) : 1.0f;
 }
 
 /* The visibility budget's working memory, allocated once per list of
- * receivers (not per block): per VSGL its visibility and skip bits and,
- * under a budget, its light at each lane. bits NULL: no rays, or no memory
- * (then every pair traces its ray, as without a budget). */
+ * receivers (not per block): per VSGL its visibility, skip and dominant
+ * bits and, under a budget or with dominant rays, its light at each lane
+ * (and with dominant rays their visibility). bits NULL: no rays, or no
+ * memory (then every pair traces its ray, as without a budget). */
 typedef struct vis_scratch {
-    uint64_t *bits;  /* 2 x count: visible, skipped */
-    float *weights;  /* count x VSGL__KERNEL_BLOCK, or NULL without a budget */
+    uint64_t *bits;  /* 3 x count: visible, skipped, dominant */
+    float *weights;  /* count x VSGL__KERNEL_BLOCK, or NULL without a budget and dominant rays */
+    float *frac;     /* count x VSGL__KERNEL_BLOCK, or NULL without dominant rays */
 } vis_scratch;
 
 static void vis_scratch_init(const shade_job *j, vis_scratch *vs)
 {
     const size_t count = j->set->count ? j->set->count : 1;
+    const int dominant = j->s->dominant_rays > 1;
     vs->bits = NULL;
-    vs->weights = NULL;
+    vs->weights = vs->frac = NULL;
     if (j->s->visibility != VSGL_VISIBILITY_RAY)
         return;
-    vs->bits = malloc(2 * count * sizeof *vs->bits);
-    if (vs->bits && j->s->visibility_budget > 0.0f) {
+    vs->bits = malloc(3 * count * sizeof *vs->bits);
+    if (vs->bits && (j->s->visibility_budget > 0.0f || dominant)) {
         vs->weights = malloc(count * VSGL__KERNEL_BLOCK * sizeof *vs->weights);
-        if (!vs->weights) {
+        vs->frac = dominant ? malloc(count * VSGL__KERNEL_BLOCK * sizeof *vs->frac) : NULL;
+        if (!vs->weights || (dominant && !vs->frac)) {
             free(vs->bits);
+            free(vs->weights);
+            free(vs->frac);
             vs->bits = NULL;
+            vs->weights = vs->frac = NULL;
         }
     }
 }
@@ -1111,6 +1174,7 @@ static void vis_scratch_free(vis_scratch *vs)
 {
     free(vs->bits);
     free(vs->weights);
+    free(vs->frac);
 }
 
 /* Shade a filled block of n receivers (lanes [0, n) of blk, rec[k].x and
@@ -1149,7 +1213,7 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
         if (vs->bits) {
             uint64_t *bits = vs->bits;
             float share[VSGL__KERNEL_BLOCK];
-            block_visibility(j, blk, rec, n, bits, bits + count, vs->weights, share);
+            block_visibility(j, blk, rec, n, bits, bits + count, bits + 2 * count, vs->weights, vs->frac, share);
             /* two VSGLs per kernel call, the pairs it interleaves */
             for (size_t v = 0; v < count; v += 2) {
                 size_t m = count - v < 2 ? count - v : 2;
@@ -1158,8 +1222,14 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
                     any |= bits[count + v + q] | bits[v + q];
                 if (!any)
                     continue; /* both blocked at every receiver: they add nothing */
-                for (size_t q = 0; q < m; ++q)
+                for (size_t q = 0; q < m; ++q) {
                     vsgl__kernel_vis_fill(bits[count + v + q], bits[v + q], share, vis + q * VSGL__KERNEL_BLOCK);
+                    if (vs->frac) /* the dominant pairs' mean over their rays */
+                        for (uint64_t r = bits[2 * count + v + q]; r; r &= r - 1) {
+                            size_t k = (size_t)__builtin_ctzll(r);
+                            vis[q * VSGL__KERNEL_BLOCK + k] = vs->frac[(v + q) * VSGL__KERNEL_BLOCK + k];
+                        }
+                }
                 faint += kernel(blk, &j->klights[v], m, vis, j->s->diffuse_mode, lobes, VSGL__FAINT);
             }
         } else if (j->s->visibility == VSGL_VISIBILITY_RAY) { /* no memory for it: a ray for every pair */
@@ -1169,7 +1239,7 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
                 size_t m = count - v < 2 ? count - v : 2;
                 for (size_t q = 0; q < m; ++q) {
                     uint64_t bits = visibility_rays(j, j->korder[v + q],
-                                                    &j->klights[v + q], rec, &org, n, lanes_of(n));
+                                                    &j->klights[v + q], rec, &org, n, lanes_of(n), 0, 1);
                     for (size_t k = 0; k < n; ++k)
                         vis[q * VSGL__KERNEL_BLOCK + k] = (float)((bits >> k) & 1u);
                 }
