@@ -1043,8 +1043,8 @@ static void near_correct(const shade_job *j, const receiver *r, float burley, v3
  * 1 to a fraction in one frame. */
 static float dominant_mix(float w, float total)
 {
-    const float lo = 0.5f * VSGL_DOMINANT_SHARE * total;
-    const float t = (w - lo) / (VSGL_DOMINANT_SHARE * total - lo);
+    /* 0 < w <= total here (the pair is dominant): the share is in (0, 1] */
+    const float t = (w / total - 0.5f * VSGL_DOMINANT_SHARE) / (0.5f * VSGL_DOMINANT_SHARE);
     return t < 1.0f ? t : 1.0f;
 }
 
