@@ -4,11 +4,11 @@
     python3 tools/dominant_rays.py [--size 320x240] [--spp 256] [--out docs/img/dominant_rays.png]
 
 Renders rough_room at --size: the preview preset with one visibility ray
-per (pixel, VSGL) pair (dominant_rays 1), the preview as it is (8 rays for
-the pairs that carry 2 % or more of a pixel's light), and balanced, beside
+per (pixel, VSGL) pair (dominant_rays 1), the preview as it is (4 rays for
+the pairs that carry 2 % or more of a pixel's light), with 8, and balanced, beside
 the Cycles one-bounce reference (two seeds of --spp, rendered and cached
 by tests/quality/refs.py if missing). Writes a crop of the floor beside the
-sphere, Cycles | preview, one ray | preview | balanced, tone-mapped alike,
+sphere, Cycles | preview, one ray | preview | preview, 8 | balanced, tone-mapped alike,
 and prints each render's time, structured error (4 x 4 box relMSE of the
 combined pass), FLIP against the reference and the pixel-scale noise of
 the floor below the sphere: the RMS of each pixel minus the mean of its 8
@@ -32,7 +32,8 @@ import refs  # noqa: E402
 import scenes  # noqa: E402
 
 SCENE = "rough_room"
-CONFIGS = (("preview, one ray", "preview:dominant_rays=1"), ("preview", "preview"), ("balanced", "balanced"))
+CONFIGS = (("preview, one ray", "preview:dominant_rays=1"), ("preview", "preview"),
+           ("preview, 8 rays", "preview:dominant_rays=8"), ("balanced", "balanced"))
 # the floor beside and in front of the sphere, as fractions of the image (rows, columns)
 CROP = ((0.62, 0.98), (0.04, 0.62))
 # where the noise is measured: the crop's floor below the sphere (no edges)

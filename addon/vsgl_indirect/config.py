@@ -46,7 +46,7 @@ _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", 
                aa_pixel_limit=76800, stride_pixels=76800)
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="RAY",
-                    shade_stride=2, edge_samples=8, glossy_mode="ASG2", dominant_rays=8),
+                    shade_stride=2, edge_samples=8, glossy_mode="ASG2", dominant_rays=4),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
                      shade_stride=2, edge_samples=12, glossy_mode="ASG2"),
     "QUALITY": dict(_COMMON, aa_samples=3, rsm_resolution=512, vsgl_count=256, visibility="RAY",

@@ -42,7 +42,7 @@ const char cli_usage[] =
     "                        presets: 76800 = 320 x 240)\n"
     "  --edge-samples N      0..16             (N x N rays in pixels a geometric edge crosses; 0 = off)\n"
     "  --dominant-rays N     1..16             (--visibility ray: rays per pair where a VSGL carries 2 % or\n"
-    "                        more of a pixel's light; preview: 8, the others: 1)\n"
+    "                        more of a pixel's light; preview: 4, the others: 1)\n"
     "  --method NAME         vsgl | brute-force   (brute-force: every RSM texel, the reference)\n"
     "  --threads N           worker threads (0 = all cores)\n"
     "  --max-memory SIZE     refuse a render estimated to need more (e.g. 8G, 512M;\n"

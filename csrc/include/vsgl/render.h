@@ -198,8 +198,9 @@ typedef struct vsgl_render_settings {
                                       visibility is the mean over that many of the cluster's points, not
                                       one point's 0 or 1. A few large clusters half hidden from a
                                       receiver otherwise turn a soft indirect shadow into grain (the
-                                      preview's floor beside a sphere: the pixel-scale noise 4x smaller
-                                      at 8, for 0.9-1.2x its time at 960 x 540; docs/pipeline.md). 0
+                                      preview's floor beside a sphere: the pixel-scale noise 3x smaller
+                                      at 4, the preview's, for up to 1.1x its time at 960 x 540;
+                                      docs/pipeline.md). 0
                                       means 1 (one ray per pair); at most VSGL_DOMINANT_RAYS_MAX */
 } vsgl_render_settings;
 

@@ -101,12 +101,12 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
         /* Its 32-cell lattice makes few large clusters, and a receiver half
          * hidden from one took 0 or 1 of its light by one ray: grain in every
          * indirect shadow (rough_room's floor beside the sphere, 320 x 240:
-         * the pixel-scale noise 0.068 of the light, balanced's 0.020). Eight
+         * the pixel-scale noise 0.068 of the light, balanced's 0.020). Four
          * rays for the pairs that carry 2 % or more of a receiver's light:
-         * 0.018, at 0.89-1.23x the time at 960 x 540 (docs/pipeline.md).
-         * Balanced's finer clusters need them less (0.020 -> 0.018 for
-         * 1.06-1.09x its time): one ray. */
-        out->dominant_rays = 8;
+         * 0.023, about balanced's, at 1.07-1.09x the time of the rooms they
+         * cost most at 960 x 540 (8: 0.013 at 1.23-1.26x; docs/pipeline.md).
+         * Balanced's finer clusters carry under 2 % each: one ray. */
+        out->dominant_rays = 4;
         out->glossy_mode = VSGL_GLOSSY_ASG2;
         break;
     case VSGL_PRESET_QUALITY: /* finer cells, RSMs, samples and GGX lobes than balanced: lower
