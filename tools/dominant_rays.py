@@ -55,11 +55,7 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "img", "dominant_rays.png"))
     args = ap.parse_args()
     w, h = (int(v) for v in args.size.split("x"))
-    pairs = refs.ensure([SCENE], (w, h, args.spp), refs.DEFAULT_DIR)[SCENE]
-    seeds = [M.coloured(p) for p, _ in pairs]
-    ref = 0.5 * (seeds[0]["Combined"] + seeds[1]["Combined"])
-    (r0, r1), (c0, c1) = CROP
-    ys, xs = slice(int(r0 * h), int(r1 * h)), slice(int(c0 * w), int(c1 * w))
+    ref = refs.mean_combined(SCENE, (w, h, args.spp))
     (n0, n1), (m0, m1) = NOISE
     ny, nx = slice(int(n0 * h), int(n1 * h)), slice(int(m0 * w), int(m1 * w))
     print("%-17s %-26s %s" % ("Cycles", "2 x %d spp" % args.spp, "pixel-scale noise %.4f" % pixel_noise(ref[ny, nx])))
@@ -77,12 +73,7 @@ def main():
               (label, spec, best, M.structured(c, ref), "-" if flip is None else "%.4f" % flip,
                pixel_noise(c[ny, nx])))
         outs.append(c)
-    scale = np.percentile(ref[ys, xs], 99)
-    panels = [np.clip(a[ys, xs] / scale * 1.5, 0, 1) ** (1 / 2.2) for a in [ref] + outs]
-    panels = [np.repeat(np.repeat(p, 2, 0), 2, 1) for p in panels]  # 2x: the grain is a pixel's
-    gap = np.ones((panels[0].shape[0], 4, 3))
-    row = np.concatenate(sum(([p, gap] for p in panels), [])[:-1], 1)
-    imgutil.save_png(args.out, row)
+    imgutil.save_png(args.out, imgutil.crop_row([ref] + outs, CROP, 1.5, zoom=2))  # 2x: the grain is a pixel's
     print("wrote", os.path.relpath(args.out, ROOT))
 
 

@@ -16,8 +16,6 @@ import argparse
 import os
 import sys
 
-import numpy as np
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, ".."))
 sys.path.insert(0, os.path.join(ROOT, "tests", "quality"))
@@ -41,9 +39,7 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "img", "penumbra.png"))
     args = ap.parse_args()
     w, h = (int(v) for v in args.size.split("x"))
-    pairs = refs.ensure([SCENE], (w, h, args.spp), refs.DEFAULT_DIR)[SCENE]
-    seeds = [M.coloured(p) for p, _ in pairs]
-    ref = 0.5 * (seeds[0]["Combined"] + seeds[1]["Combined"])
+    ref = refs.mean_combined(SCENE, (w, h, args.spp))
     rend = evaluate.Renderer()
     s = scenes.case(SCENE, (w, h))
     outs = []
@@ -55,13 +51,7 @@ def main():
               (label, spec, secs, stats["shading_pairs"], M.structured(c, ref),
                "-" if flip is None else "%.4f" % flip))
         outs.append(c)
-    (r0, r1), (c0, c1) = CROP
-    ys, xs = slice(int(r0 * h), int(r1 * h)), slice(int(c0 * w), int(c1 * w))
-    scale = np.percentile(ref[ys, xs], 99)
-    panels = [np.clip(a[ys, xs] / scale * 1.8, 0, 1) ** (1 / 2.2) for a in [ref] + outs]
-    gap = np.ones((panels[0].shape[0], 4, 3))
-    row = np.concatenate(sum(([p, gap] for p in panels), [])[:-1], 1)
-    imgutil.save_png(args.out, row)
+    imgutil.save_png(args.out, imgutil.crop_row([ref] + outs, CROP, 1.8))
     print("wrote", os.path.relpath(args.out, ROOT))
 
 

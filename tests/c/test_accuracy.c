@@ -45,6 +45,18 @@ VT_TEST(accuracy_fis_error_falls_with_vsgl_count_on_three_scenes)
     }
 }
 
+/* Render scene's diffuse plane (W x H x 3 floats) with settings s. */
+static int render_diffuse(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s, uint32_t W,
+                          uint32_t H, float *diffuse)
+{
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = W;
+    o.height = H;
+    o.diffuse = diffuse;
+    return vsgl_render(ctx, scene, s, &o, NULL) == VSGL_OK;
+}
+
 /* A partition between the lit red wall and the green wall: with visibility
  * rays the VSGL render moves towards the brute-force reference with
  * visibility (indirect shadows), and the green wall loses red light. The
@@ -77,12 +89,7 @@ VT_TEST(accuracy_visibility_casts_indirect_shadows)
         s.method = k == 0 ? VSGL_METHOD_BRUTE_FORCE : VSGL_METHOD_VSGL;
         s.visibility = k == 2 ? VSGL_VISIBILITY_NONE : VSGL_VISIBILITY_RAY;
         s.visibility_budget = k == 3 ? -1.0f : (k == 4 ? 0.5f : 0.0f); /* every pair; half; the default */
-        vsgl_render_output o;
-        memset(&o, 0, sizeof o);
-        o.width = W;
-        o.height = H;
-        o.diffuse = planes[k];
-        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "render %d: %s", k, vsgl_context_last_error(ctx));
+        VT_CHECK(render_diffuse(ctx, scene, &s, W, H, planes[k]), "render %d: %s", k, vsgl_context_last_error(ctx));
     }
     double e_on = acc_relmse(on, bf, W * H * 3), e_off = acc_relmse(off, bf, W * H * 3);
     VT_CHECK(e_on < 0.5 * e_off, "relMSE with visibility %.4g, without %.4g (reference with visibility)", e_on, e_off);
@@ -150,12 +157,7 @@ VT_TEST(accuracy_dominant_rays_smooth_a_soft_shadow)
         s.method = k == 0 ? VSGL_METHOD_BRUTE_FORCE : VSGL_METHOD_VSGL;
         s.visibility = k == 1 ? VSGL_VISIBILITY_NONE : VSGL_VISIBILITY_RAY;
         s.dominant_rays = k == 3 ? 8u : 1u;
-        vsgl_render_output o;
-        memset(&o, 0, sizeof o);
-        o.width = W;
-        o.height = H;
-        o.diffuse = img[k];
-        VT_CHECK(vsgl_render(ctx, scene, &s, &o, NULL) == VSGL_OK, "render %d: %s", k, vsgl_context_last_error(ctx));
+        VT_CHECK(render_diffuse(ctx, scene, &s, W, H, img[k]), "render %d: %s", k, vsgl_context_last_error(ctx));
         for (size_t i = 0; i < (size_t)W * H * 3; ++i)
             sum[k] += img[k][i];
     }

@@ -143,3 +143,18 @@ def text_strip(lines, width, scale=2, pad=2):
             out[y0:y0 + glyph.shape[0], x:x + glyph.shape[1]] = glyph[..., None]
             x += 4 * scale
     return out
+
+
+def crop_row(images, crop, gain, zoom=1):
+    """A row of the same crop of each image, side by side with 4-pixel white
+    gaps: crop ((r0, r1), (c0, c1)) as fractions of the image, each tile
+    scaled alike so that the first image's 99th percentile maps to `gain`
+    (clipped at 1), gamma 2.2, each pixel repeated zoom x zoom times."""
+    h, w = images[0].shape[:2]
+    (r0, r1), (c0, c1) = crop
+    ys, xs = slice(int(r0 * h), int(r1 * h)), slice(int(c0 * w), int(c1 * w))
+    scale = np.percentile(images[0][ys, xs], 99)
+    tiles = [np.clip(a[ys, xs] / scale * gain, 0, 1) ** (1 / 2.2) for a in images]
+    tiles = [np.repeat(np.repeat(t, zoom, 0), zoom, 1) for t in tiles]
+    gap = np.ones((tiles[0].shape[0], 4, 3))
+    return np.concatenate(sum(([t, gap] for t in tiles), [])[:-1], 1)

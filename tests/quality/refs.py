@@ -166,6 +166,14 @@ def ensure(names, size, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=
     return ensure_frame(names, size, "light", 0, refdir, seeds, log, quiet)
 
 
+def mean_combined(name, size, refdir=DEFAULT_DIR):
+    """The mean of scene `name`'s two seeds' coloured Combined pass at size
+    (w, h, spp), rendered in Blender if missing (ensure)."""
+    import metrics  # noqa: E402 (tests/quality, beside this file)
+    pairs = ensure([name], size, refdir)[name]
+    return 0.5 * sum(metrics.coloured(p)["Combined"] for p, _ in pairs)
+
+
 def ensure_frames(names, size, anim, frames, refdir=DEFAULT_DIR, seeds=scenes.SEEDS, log=None, quiet=False):
     """Render the missing references of frames `frames` of animation `anim`,
     every scene's in one Blender session (a session's start and scene build
