@@ -5,10 +5,12 @@
 
 Renders rough_room at --size: the preview preset with one visibility ray
 per (pixel, VSGL) pair (dominant_rays 1), the preview as it is (4 rays for
-the pairs that carry 2 % or more of a pixel's light), with 8, and balanced, beside
+the pairs that carry 0.5 % or more of a pixel's light near a shadow's
+edge), with 8, and balanced with one ray and as it is (4), beside
 the Cycles one-bounce reference (two seeds of --spp, rendered and cached
 by tests/quality/refs.py if missing). Writes a crop of the floor beside the
-sphere, Cycles | preview, one ray | preview | preview, 8 | balanced, tone-mapped alike,
+sphere, Cycles | preview, one ray | preview | preview, 8 | balanced, one ray |
+balanced, tone-mapped alike,
 and prints each render's time, structured error (4 x 4 box relMSE of the
 combined pass), FLIP against the reference and the pixel-scale noise of
 the floor below the sphere: the RMS of each pixel minus the mean of its 8
@@ -33,7 +35,8 @@ import scenes  # noqa: E402
 
 SCENE = "rough_room"
 CONFIGS = (("preview, one ray", "preview:dominant_rays=1"), ("preview", "preview"),
-           ("preview, 8 rays", "preview:dominant_rays=8"), ("balanced", "balanced"))
+           ("preview, 8 rays", "preview:dominant_rays=8"), ("balanced, one ray", "balanced:dominant_rays=1"),
+           ("balanced", "balanced"))
 # the floor beside and in front of the sphere, as fractions of the image (rows, columns)
 CROP = ((0.62, 0.98), (0.04, 0.62))
 # where the noise is measured: the crop's floor below the sphere (no edges)
@@ -58,7 +61,7 @@ def main():
     ref = refs.mean_combined(SCENE, (w, h, args.spp))
     (n0, n1), (m0, m1) = NOISE
     ny, nx = slice(int(n0 * h), int(n1 * h)), slice(int(m0 * w), int(m1 * w))
-    print("%-17s %-26s %s" % ("Cycles", "2 x %d spp" % args.spp, "pixel-scale noise %.4f" % pixel_noise(ref[ny, nx])))
+    print("%-18s %-26s %s" % ("Cycles", "2 x %d spp" % args.spp, "pixel-scale noise %.4f" % pixel_noise(ref[ny, nx])))
     rend = evaluate.Renderer()
     s = scenes.case(SCENE, (w, h))
     outs = []
@@ -69,7 +72,7 @@ def main():
             best = secs if best is None else min(best, secs)
         c = out["Combined"]
         flip = M.flip(c, ref)
-        print("%-17s %-26s %.3f s  struct C %.6f  FLIP %s  pixel-scale noise %.4f" %
+        print("%-18s %-26s %.3f s  struct C %.6f  FLIP %s  pixel-scale noise %.4f" %
               (label, spec, best, M.structured(c, ref), "-" if flip is None else "%.4f" % flip,
                pixel_noise(c[ny, nx])))
         outs.append(c)

@@ -22,7 +22,7 @@ KNOBS = {
     "visibility": (("NONE", "RAY"), "RAY"),
     "visibility_budget": (None, 0.02),
     "visibility_spread": (None, 2.0),
-    "dominant_rays": (None, 1),
+    "dominant_rays": (None, 4),
     "seed": (None, 0),
     "rsm_resolution": (None, 256),
     "fit_mode": (("TWO", "FIS", "KMEANS", "LATTICE"), "LATTICE"),
@@ -42,11 +42,11 @@ KNOBS = {
 _COMMON = dict(method="VSGL", sharpness_estimator="TOKSVIG", glossy_mode="ASG", fis_iterations=8,
                seed=0, leak_correction="AUTO", sample_merging="AUTO", fit_mode="LATTICE",
                diffuse_mode="PULLED_OUT", mrp_min_area=0.25, glossy_lobes=4, visibility_budget=0.02,
-               visibility_spread=2.0, dominant_rays=1,
+               visibility_spread=2.0, dominant_rays=4,
                aa_pixel_limit=76800, stride_pixels=76800)
 PRESET_VALUES = {
     "PREVIEW": dict(_COMMON, aa_samples=1, rsm_resolution=128, vsgl_count=32, visibility="RAY",
-                    shade_stride=2, edge_samples=8, glossy_mode="ASG2", dominant_rays=4),
+                    shade_stride=2, edge_samples=8, glossy_mode="ASG2"),
     "BALANCED": dict(_COMMON, aa_samples=2, rsm_resolution=256, vsgl_count=192, visibility="RAY",
                      shade_stride=2, edge_samples=12, glossy_mode="ASG2"),
     "QUALITY": dict(_COMMON, aa_samples=3, rsm_resolution=512, vsgl_count=256, visibility="RAY",
@@ -144,7 +144,7 @@ class Options:
     visibility: str = "RAY"
     visibility_budget: float = 0.02  # Visibility Rays: the weakest VSGLs' share of a receiver's light without a ray
     visibility_spread: float = 2.0  # Visibility Rays: the disk each VSGL's rays aim over, in its sigmas
-    dominant_rays: int = 1          # Visibility Rays: rays per pair where a VSGL carries >= 2 % of a pixel's light
+    dominant_rays: int = 4          # Visibility Rays: rays per pair where a VSGL carries >= 0.5 % of a pixel's light
     seed: int = 0
     leak_correction: str = "AUTO"
     sample_merging: str = "AUTO"

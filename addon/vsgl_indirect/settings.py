@@ -326,11 +326,10 @@ class VSGLIndirectSettings(bpy.types.PropertyGroup):
                     "spread); 0 = 2; negative: rays at each cluster's centre (hard edges)")
     dominant_rays: IntProperty(
         name="Dominant Rays", default=config.KNOBS["dominant_rays"][1], min=1, max=16,
-        description="Visibility Rays only: rays per pixel and VSGL where that VSGL carries 2 % or more of "
-                    "the pixel's light: its visibility is their mean instead of one ray's 0 or 1, so a "
-                    "soft indirect shadow from a few large lit patches is smooth instead of grainy. 4 in "
-                    "the preview (its few large clusters; up to 1.1x its time; 8: smoother, up to 1.26x), "
-                    "1 in the others")
+        description="Visibility Rays only: rays per pixel and VSGL where that VSGL carries 0.5 % or more of "
+                    "the pixel's light and a shadow's edge is near (a nearby pixel found it hidden): its "
+                    "visibility is their mean instead of one ray's 0 or 1, so a soft indirect shadow is "
+                    "smooth instead of grainy. 4 in every preset (0.9-1.1x the time); 1: one ray per pair")
     seed: IntProperty(
         name="Seed", default=0, min=0,
         description="Seed of the FIS and k-means cluster draws: moves where their clusters fall, "

@@ -192,16 +192,17 @@ typedef struct vsgl_render_settings {
                                       occluder), at one ray per pair as before. 0 means
                                       VSGL_VISIBILITY_SPREAD_DEFAULT; negative: every ray aims at the
                                       cluster's centre (hard edges); at most VSGL_VISIBILITY_SPREAD_MAX */
-    uint32_t dominant_rays;      /**< visibility RAY: rays per pair for the pairs that carry a large share
-                                      of a receiver's light (at least VSGL_DOMINANT_SHARE of it by the
-                                      visibility budget's weights, faded in from half that): their
+    uint32_t dominant_rays;      /**< visibility RAY: rays per pair for the pairs that carry a share of a
+                                      receiver's light (at least VSGL_DOMINANT_SHARE of it by the
+                                      visibility budget's weights, faded in from half that) where another
+                                      receiver of its block of 64 found that VSGL blocked: their
                                       visibility is the mean over that many of the cluster's points, not
-                                      one point's 0 or 1. A few large clusters half hidden from a
-                                      receiver otherwise turn a soft indirect shadow into grain (the
-                                      preview's floor beside a sphere: the pixel-scale noise 3x smaller
-                                      at 4, the preview's, for up to 1.1x its time at 960 x 540;
-                                      docs/pipeline.md). 0
-                                      means 1 (one ray per pair); at most VSGL_DOMINANT_RAYS_MAX */
+                                      one point's 0 or 1. Without them a soft indirect shadow is grain
+                                      (the preview's floor beside a sphere: the pixel-scale noise 3x
+                                      smaller at 4; balanced's wall behind a sun room's cabinet 4.5x;
+                                      every preset: 4, for 0.9-1.1x the time at 960 x 540;
+                                      docs/pipeline.md). 0 means 1 (one ray per pair); at most
+                                      VSGL_DOMINANT_RAYS_MAX */
 } vsgl_render_settings;
 
 /** vsgl_render_settings.aa_pixel_limit of every preset: 320 x 240. */
@@ -216,7 +217,7 @@ typedef struct vsgl_render_settings {
 /** vsgl_render_settings.dominant_rays: its largest value, and the share of a receiver's light from
  *  which a pair takes them all (from half of it, a mix of one ray and all of them). */
 #define VSGL_DOMINANT_RAYS_MAX 16u
-#define VSGL_DOMINANT_SHARE 0.02f
+#define VSGL_DOMINANT_SHARE 0.005f
 
 /** vsgl_render_settings.visibility_budget when it is 0. */
 #define VSGL_VISIBILITY_BUDGET_DEFAULT 0.02f

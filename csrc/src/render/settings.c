@@ -21,7 +21,14 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
     out->glossy_lobes = 4;                         /* the same */
     out->visibility_budget = VSGL_VISIBILITY_BUDGET_DEFAULT; /* the same */
     out->visibility_spread = VSGL_VISIBILITY_SPREAD_DEFAULT; /* the same */
-    out->dominant_rays = 1;                                   /* the same */
+    /* Every preset traces 4 rays for a pair that carries 0.5 % or more of a
+     * receiver's light where its block holds a receiver that VSGL is hidden
+     * from (render.h): with one, a soft indirect shadow was grain (rough_room's
+     * floor beside the sphere at 320 x 240, the pixel-scale noise 0.068 of
+     * the light in the preview, 0.020 in balanced; the wall behind the sun
+     * room's cabinet in balanced at 960 x 540, 0.032); with 4, 0.022, 0.007
+     * and 0.007, at 0.9-1.1x the time at 960 x 540 (docs/pipeline.md). */
+    out->dominant_rays = 4;
     /* Every preset fits on the lattice: the importance-drawn fits flicker
      * as a light moves (0.1-0.75 of the AOV per 1/1000-extent step, docs/
      * quality.md) and break a reflection into blotches; with the emitter
@@ -98,15 +105,6 @@ void vsgl_render_settings_preset(int32_t preset, vsgl_render_settings *out)
          * time in the rooms that are not convex. The viewport's Live quality
          * leaves them out (addon/vsgl_indirect/live.py). */
         out->visibility = VSGL_VISIBILITY_RAY;
-        /* Its 32-cell lattice makes few large clusters, and a receiver half
-         * hidden from one took 0 or 1 of its light by one ray: grain in every
-         * indirect shadow (rough_room's floor beside the sphere, 320 x 240:
-         * the pixel-scale noise 0.068 of the light, balanced's 0.020). Four
-         * rays for the pairs that carry 2 % or more of a receiver's light:
-         * 0.023, about balanced's, at 1.07-1.09x the time of the rooms they
-         * cost most at 960 x 540 (8: 0.013 at 1.23-1.26x; docs/pipeline.md).
-         * Balanced's finer clusters carry under 2 % each: one ray. */
-        out->dominant_rays = 4;
         out->glossy_mode = VSGL_GLOSSY_ASG2;
         break;
     case VSGL_PRESET_QUALITY: /* finer cells, RSMs, samples and GGX lobes than balanced: lower

@@ -1102,10 +1102,18 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
         if (budget > 0.0f)
             vsgl__kernel_vis_accumulate(wv, lanes_of(n) & ~sbits, vbits, seen, lit);
         if (rays > 1) {
-            uint64_t more = 0; /* the receivers for which this pair is dominant */
+            /* the receivers for which this pair is dominant and whose block
+             * holds another receiver its first ray found blocked: where every
+             * other receiver sees the cluster, the shadow's edge is seldom
+             * near, and the rays would buy nothing (the sphere room's open
+             * floor). The test reads only the other receivers' rays, so the
+             * choice does not depend on this receiver's own: its estimate
+             * keeps its expectation either way. */
+            const uint64_t blocked = want & ~vbits;
+            uint64_t more = 0;
             for (uint64_t r = want; r; r &= r - 1) {
                 size_t k = (size_t)__builtin_ctzll(r);
-                if (wv[k] > 0.5f * VSGL_DOMINANT_SHARE * total[k])
+                if (wv[k] > 0.5f * VSGL_DOMINANT_SHARE * total[k] && (blocked & ~((uint64_t)1 << k)))
                     more |= (uint64_t)1 << k;
             }
             if (more) {
