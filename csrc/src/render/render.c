@@ -542,7 +542,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
         return r;
     /* a convex shell (an empty closed room): visibility rays cannot find anything */
     int rays_skipped = 0;
-    uint64_t faint_pairs = 0; /* the shade stage's (VSGL__FAINT) */
+    vsgl_shade_counts counts = {0, 0, 0}; /* the shade stage's faint pairs (VSGL__FAINT) and dominant rays */
     if (s.method == VSGL_METHOD_VSGL && s.visibility == VSGL_VISIBILITY_RAY && vsgl__scene_convex_shell(scene)) {
         s.visibility = VSGL_VISIBILITY_NONE;
         rays_skipped = 1;
@@ -617,7 +617,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
             vsgl__progress_window(ctx, 0.4f, 0.6f);
             /* through a cache: a light edit replays the shading plan of the G-buffer */
             r = vsgl__shade_planned(ctx, scene, gb, vs, &s, &planes, VSGL__SHADE_KERNEL, &st.shading_pairs,
-                                    &faint_pairs, !cache ? NULL : built_g ? &plan : &cache->plan);
+                                    &counts, !cache ? NULL : built_g ? &plan : &cache->plan);
             if (r == VSGL_OK && s.glossy_mode == VSGL_GLOSSY_MRP) /* the glossy plane from rectangle proxies */
                 r = vsgl__mrp_glossy_pass(ctx, scene, s.rsm_resolution, s.mrp_min_area, VSGL__MRP_CELLS, gb,
                                           &planes, NULL, mrp_lit ? &mrp_set : NULL);
@@ -653,12 +653,18 @@ done:
         if (built_set)
             vsgl__cache_keep_fit(cache, scene, &s, &set, &st);
     }
-    if (r == VSGL_OK && faint_pairs)
+    if (r == VSGL_OK && counts.faint)
         note_skip(ctx, &st, "faint pairs: %llu of %llu (%.1f %%) shaded nothing: a specular VSGL whose radiant "
                   "intensity towards every receiver of a block of %d is below %g of its peak skips its diffuse and "
-                  "glossy stages there", (unsigned long long)faint_pairs, (unsigned long long)st.shading_pairs,
-                  100.0 * (double)faint_pairs / (double)(st.shading_pairs ? st.shading_pairs : 1),
+                  "glossy stages there", (unsigned long long)counts.faint, (unsigned long long)st.shading_pairs,
+                  100.0 * (double)counts.faint / (double)(st.shading_pairs ? st.shading_pairs : 1),
                   VSGL__KERNEL_BLOCK, (double)VSGL__FAINT);
+    if (r == VSGL_OK && counts.dominant_pairs)
+        note_budget(ctx, &st, "visibility: %llu of %llu pairs (%.2f %%) carry %g %% or more of their receiver's "
+                    "light near a shadow's edge and traced %u rays, not one (dominant_rays): %llu rays more",
+                    (unsigned long long)counts.dominant_pairs, (unsigned long long)st.shading_pairs,
+                    100.0 * (double)counts.dominant_pairs / (double)(st.shading_pairs ? st.shading_pairs : 1),
+                    100.0 * (double)VSGL_DOMINANT_SHARE, s.dominant_rays, (unsigned long long)counts.dominant_rays);
     if (r == VSGL_OK && rays_skipped) /* after the cache kept the fit's notes: said on every render */
         note_skip(ctx, &st, "visibility rays: every surface lies on the scene's convex hull (an empty closed "
                   "room), so nothing can block light between two surfaces: %llu rays saved",

@@ -1137,6 +1137,9 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
                         vbits |= (uint64_t)1 << k;
                 }
                 dom[v] |= more;
+                const uint64_t np = (uint64_t)__builtin_popcountll(more);
+                __atomic_fetch_add(&j->counts->dominant_pairs, np, __ATOMIC_RELAXED);
+                __atomic_fetch_add(&j->counts->dominant_rays, np * (rays - 1u), __ATOMIC_RELAXED);
             }
         }
         vis[v] = vbits;
@@ -1258,7 +1261,7 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
         }
         pairs += (uint64_t)n * j->set->count;
         if (faint)
-            __atomic_fetch_add(j->faint, (uint64_t)n * faint, __ATOMIC_RELAXED);
+            __atomic_fetch_add(&j->counts->faint, (uint64_t)n * faint, __ATOMIC_RELAXED);
         if ((lobes & VSGL__KERNEL_DIFFUSE) && j->near->start)
             for (size_t k = 0; k < n; ++k)
                 if (blk->diffuse[k] > 0.0f)
@@ -1477,7 +1480,7 @@ vsgl_result vsgl__shade(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_g
 
 vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
                                 const vsgl_vsgl_set *set, const vsgl_render_settings *s,
-                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs, uint64_t *faint,
+                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs, vsgl_shade_counts *counts,
                                 vsgl_shade_plan **plan)
 {
     size_t pixels = (size_t)g->width * g->height;
@@ -1632,9 +1635,9 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
         free(lobe_int);
         return vsgl__fail(ctx, VSGL_ERROR_OUT_OF_MEMORY, "shade: out of memory");
     }
-    uint64_t faint_total = 0;
+    vsgl_shade_counts totals = {0, 0, 0};
     shade_job j = {scene, g, set, s, planes, vsgl__scene_materials(scene, &material_count),
-                   eps, 0, per_chunk, &faint_total, kl, korder, lobe_int, path, leak,
+                   eps, 0, per_chunk, &totals, kl, korder, lobe_int, path, leak,
                    s->sample_merging != VSGL_MERGE_OFF && g->spp > 1, (extent > 0.0f ? extent : 1.0f) * 1e-3f,
                    0, 0, 0, NULL, NULL, NULL, NULL, NULL, {0.0f, 0.0f}, NULL, 0, NULL, NULL, twin, &targets, 0u, NULL};
     for (size_t k = 0; kl && k < set->count; ++k) /* the axis planes the horizon tilt is taken against */
@@ -1737,7 +1740,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
     }
     if (pairs)
         *pairs = total;
-    if (faint)
-        *faint = faint_total;
+    if (counts)
+        *counts = totals;
     return r;
 }

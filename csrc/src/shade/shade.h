@@ -158,11 +158,17 @@ void vsgl__shade_plan_free(vsgl_shade_plan *plan);
  * the G-buffer changes). With shade_stride > 1 it replays a plan made
  * with the same stride and glossy mode, else records one into `*plan`
  * (replacing the old one; left as it was if memory is short). The planes
- * are bit-identical to vsgl__shade's either way. `faint` (NULL or) receives
- * how many of the pairs were faint (vsgl__kernel_shade, VSGL__FAINT). */
+ * are bit-identical to vsgl__shade's either way. `counts` (NULL or)
+ * receives what the call counts besides its pairs (below). */
+typedef struct vsgl_shade_counts {
+    uint64_t faint;          /* pairs whose VSGL was faint (vsgl__kernel_shade, VSGL__FAINT) */
+    uint64_t dominant_pairs; /* pairs that traced dominant rays (vsgl_render_settings.dominant_rays) */
+    uint64_t dominant_rays;  /* the rays those pairs traced beyond their first */
+} vsgl_shade_counts;
+
 vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_gbuffer *g,
                                 const vsgl_vsgl_set *set, const vsgl_render_settings *s,
-                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs, uint64_t *faint,
+                                const vsgl_pixel_planes *planes, int path, uint64_t *pairs, vsgl_shade_counts *counts,
                                 vsgl_shade_plan **plan);
 
 #endif

@@ -75,8 +75,8 @@ typedef struct shade_job {
     float eps;            /* ray offset, metres */
     size_t base;          /* first pixel of the current batch */
     uint64_t *pairs;      /* per chunk of the current batch */
-    uint64_t *faint;      /* pairs whose VSGL was faint at every receiver of their block (k_faint), summed
-                             atomically by every thread */
+    vsgl_shade_counts *counts; /* pairs whose VSGL was faint at every receiver of their block (k_faint),
+                                  and the dominant rays' pairs and rays: summed atomically by every thread */
     const vsgl_kernel_light *klights; /* the VSGLs, kernel layout, in kernel order */
     const size_t *korder;             /* per kernel light: its index in set->items */
     const float *lobe_int;            /* per VSGL of the set: vsgl__vsgl_lobe_integral (fit/vsgl_set.h) */
