@@ -93,9 +93,10 @@ static inline uint32_t vsgl__ray_key(size_t i, uint32_t width, uint32_t spp, uin
  * tail, which share their centre, share their rays). Each cluster reads
  * the blue-noise mask shifted by its seed (so that one receiver's picks of
  * different clusters are independent), at 16 levels turned by the seed:
- * any 4 x 4 camera samples pick 13 of a cluster's 16 points on average (10
- * at least), where a white-noise hash of the pixel picked 10 (6 at least).
- * A pair's n rays take levels 16 / n apart (n = 8: every other point). An
+ * any 4 x 4 camera samples pick 12.5 of a cluster's 16 points on average
+ * (10 at least), where a white-noise hash of the pixel picked 10.3 (6 at
+ * least). A pair's n rays take levels 16 / n apart (n = 4, the presets':
+ * every fourth point). An
  * edge pixel's extra slots turn the levels further. */
 static inline const float *vsgl__ray_target_for(const vsgl_ray_targets *t, size_t item, uint32_t key, uint32_t ray,
                                                 uint32_t n)

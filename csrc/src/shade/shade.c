@@ -1056,7 +1056,7 @@ static float dominant_mix(float w, float total)
  * -> 4.5 M at 0.02) are skipped and get share[k], the traced pairs' mean
  * visibility weighted by their light. w: count x VSGL__KERNEL_BLOCK floats
  * (the weights; NULL without a budget or dominant rays). With dominant
- * rays, bit k of dom[v] marks a receiver whose pair with v traced them
+ * rays (frac not NULL), bit k of dom[v] marks a receiver whose pair with v traced them
  * (dominant_mix above) and frac[v * VSGL__KERNEL_BLOCK + k] holds its
  * visibility in [0, 1] (vis[v]'s bit: above 0). */
 static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, const receiver *rec, size_t n,
@@ -1081,8 +1081,7 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
         uint64_t sbits = budget > 0.0f ? vsgl__kernel_lanes_within(wv, cut) & lanes_of(n) : 0;
         skip[v] = sbits;
         vis[v] = 0;
-        if (dom)
-            dom[v] = 0;
+        dom[v] = 0;
         if (sbits == lanes_of(n))
             continue; /* no ray for this VSGL at any receiver of the block */
         uint64_t want = lanes_of(n) & ~sbits, vbits = 0;
@@ -1093,15 +1092,18 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
             want &= ~have;
             if (rays > 1) { /* and its dominant rays, with its mix */
                 dom[v] = dom[v - 1] & have;
-                for (uint64_t r = dom[v]; r; r &= r - 1)
-                    frac[v * B + (size_t)__builtin_ctzll(r)] = frac[(v - 1) * B + (size_t)__builtin_ctzll(r)];
+                for (uint64_t r = dom[v]; r; r &= r - 1) {
+                    size_t k = (size_t)__builtin_ctzll(r);
+                    frac[v * B + k] = frac[(v - 1) * B + k];
+                }
             }
         }
         if (want)
             vbits |= visibility_rays(j, j->korder[v], &j->klights[v], rec, org, n, want, 0, rays);
         if (budget > 0.0f)
             vsgl__kernel_vis_accumulate(wv, lanes_of(n) & ~sbits, vbits, seen, lit);
-        if (rays > 1) {
+        const uint64_t blocked = want & ~vbits;
+        if (rays > 1 && blocked) { /* (every traced receiver sees it: no receiver takes more rays) */
             /* the receivers for which this pair is dominant and whose block
              * holds another receiver its first ray found blocked: where every
              * other receiver sees the cluster, the shadow's edge is seldom
@@ -1109,7 +1111,6 @@ static void block_visibility(const shade_job *j, const vsgl_kernel_block *blk, c
              * floor). The test reads only the other receivers' rays, so the
              * choice does not depend on this receiver's own: its estimate
              * keeps its expectation either way. */
-            const uint64_t blocked = want & ~vbits;
             uint64_t more = 0;
             for (uint64_t r = want; r; r &= r - 1) {
                 size_t k = (size_t)__builtin_ctzll(r);
