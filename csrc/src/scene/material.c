@@ -156,7 +156,21 @@ void vsgl__brdf_eval(const vsgl_brdf_params *p, v3 n, v3 t, v3 wi, v3 wo,
         glossy_out[c] = (p->f0[c] * (1.0f - FH) + FH) * common;
 }
 
+float vsgl__fresnel_shape_at(const vsgl_brdf_params *p, v3 o, v3 i)
+{
+    return fresnel_shape(p, v3_dot(i, v3_normalize(v3_add(i, o))));
+}
+
 void vsgl__specular_factor(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float alpha, float out[3])
+{
+    if (!(v3_dot(n, o) > 0.0f) || !(v3_dot(n, i) > 0.0f) || !p->glossy) {
+        out[0] = out[1] = out[2] = 0.0f;
+        return;
+    }
+    vsgl__specular_factor_fh(p, n, o, i, alpha, vsgl__fresnel_shape_at(p, o, i), out);
+}
+
+void vsgl__specular_factor_fh(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float alpha, float fh, float out[3])
 {
     out[0] = out[1] = out[2] = 0.0f;
     float co = v3_dot(n, o), ci = v3_dot(n, i);
@@ -168,12 +182,22 @@ void vsgl__specular_factor(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float al
     float so = sqrtf(a2 + (1.0f - a2) * co * co), si = sqrtf(a2 + (1.0f - a2) * ci * ci);
     /* G / (4 co): height-correlated 2 ci co / (ci so + co si), separable G1(i) G1(o), G1(c) = 2c / (c + s) */
     float g4 = p->height_correlated ? ci / (2.0f * (ci * so + co * si)) : ci / ((ci + si) * (co + so));
-    float FH = fresnel_shape(p, v3_dot(i, v3_normalize(v3_add(i, o))));
     for (int c = 0; c < 3; ++c)
-        out[c] = (p->f0[c] * (1.0f - FH) + FH) * g4;
+        out[c] = (p->f0[c] * (1.0f - fh) + fh) * g4;
 }
 
 void vsgl__fresnel_ratio(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float out[3])
+{
+    if (!p->glossy || !(p->eta > 1.0f) || !(v3_dot(n, o) > 0.0f) || !(v3_dot(n, i) > 0.0f)) {
+        out[0] = 0.0f;
+        out[1] = 1.0f;
+        out[2] = 0.0f;
+        return;
+    }
+    vsgl__fresnel_ratio_fh(p, n, o, i, vsgl__fresnel_shape_at(p, o, i), out);
+}
+
+void vsgl__fresnel_ratio_fh(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float fh, float out[3])
 {
     out[0] = 0.0f;
     out[1] = 1.0f;
@@ -184,8 +208,7 @@ void vsgl__fresnel_ratio(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float out[
     float F0 = fresnel_dielectric(1.0f, p->eta);
     if (!(F0 < 1.0f))
         return;
-    float FH = fresnel_shape(p, v3_dot(i, v3_normalize(v3_add(i, o))));
-    float fa = f0 * (1.0f - FH) + FH; /* the factor at the axis */
+    float fa = f0 * (1.0f - fh) + fh; /* the factor at the axis */
     if (!(fa > 1e-6f))
         return;
     /* f0 (1 - FH(l)) + FH(l) with FH(l) = (F(l.h) - F0) / (1 - F0), over fa */

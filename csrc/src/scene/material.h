@@ -138,4 +138,12 @@ void vsgl__specular_factor(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float al
  * the directions far out in GGX's tail. */
 void vsgl__fresnel_ratio(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float out[3]);
 
+/* The Fresnel shape both take at i seen from o (0 for eta <= 1), so that a
+ * receiver that needs both computes it once (shade.c: two dielectric
+ * Fresnels, a square root and a normalisation less per glossy receiver);
+ * the _fh forms take it and give the same values bit for bit. */
+float vsgl__fresnel_shape_at(const vsgl_brdf_params *p, v3 o, v3 i);
+void vsgl__specular_factor_fh(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float alpha, float fh, float out[3]);
+void vsgl__fresnel_ratio_fh(const vsgl_brdf_params *p, v3 n, v3 o, v3 i, float fh, float out[3]);
+
 #endif

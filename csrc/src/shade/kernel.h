@@ -381,6 +381,12 @@ static inline void vsgl__kernel_set_smooth(vsgl_kernel_block *b, size_t k, vsgl_
     b->gw[k] = s.w;
 }
 
+/* Lanes [0, n) of block b take their constants from their fields: |alpha|
+ * (negative for an anisotropic receiver, which the half-vector model does
+ * not take), n . o and n . Z (shadow4.c: vsgl__shadow_lane, four lanes at
+ * a time, bit for bit). */
+void vsgl__shadow_lanes(vsgl_kernel_block *b, size_t n, int two);
+
 /* The ratio at a light direction of cosine ci to the normal (0 at and
  * below the horizon). */
 static inline __attribute__((always_inline)) float vsgl__shadow_ratio(float a2, float so, float co, float gia, float ci)

@@ -460,7 +460,9 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
         vsgl__broad_lobe(r->alpha, (r->bp.f0[0] + r->bp.f0[1] + r->bp.f0[2]) * (1.0f / 3.0f), v3_dot(r->n, r->o),
                          two_lobes(j->s->glossy_mode), &bscale, &bamp);
         vsgl__receiver_asg(r->n, t, r->o, r->bp.alpha_x, r->bp.alpha_y, bscale, bamp, &r->asg);
-        vsgl__fresnel_ratio(&r->bp, r->n, r->o, r->asg.z, r->fres);
+        /* the Fresnel shape at the axis, once for the ratio and fill_lane's specular factor */
+        r->fh = v3_dot(r->n, r->asg.z) > 0.0f ? vsgl__fresnel_shape_at(&r->bp, r->o, r->asg.z) : 0.0f;
+        vsgl__fresnel_ratio_fh(&r->bp, r->n, r->o, r->asg.z, r->fh, r->fres);
         r->sm = vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, r->asg.z), two_lobes(j->s->glossy_mode));
     }
 }
@@ -825,16 +827,6 @@ static void part_lane(uint32_t key, float *part, float *outer)
     *outer = key == VSGL__PART_NONE ? 0.0f : (float)(1u - (key & 1u));
 }
 
-/* Lane k's shadowing constants (kernel.h, vsgl__shadow_lane) from its
- * fields: |alpha| (negative for an anisotropic receiver, which the
- * half-vector model does not take), the normal, the view, the lobe's axis. */
-static void shadow_lane(vsgl_kernel_block *b, size_t k, int two)
-{
-    vsgl__kernel_set_smooth(b, k, vsgl__shadow_lane(fabsf(b->alpha[k]), b->nx[k] * b->ox[k] + b->ny[k] * b->oy[k] +
-                                                    b->nz[k] * b->oz[k], b->nx[k] * b->Zx[k] + b->ny[k] * b->Zy[k] +
-                                                    b->nz[k] * b->Zz[k], two));
-}
-
 /* Lane `k` of a kernel block as a receiver at (x, y, z) with no lobe: finite
  * everywhere, contributes nothing (misses, and the padding of a last block). */
 static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z)
@@ -895,7 +887,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     }
     float m[3] = {0.0f, 0.0f, 0.0f};
     if (r->glossy && j->s->glossy_mode != VSGL_GLOSSY_MRP) {
-        vsgl__specular_factor(&r->bp, r->n, r->o, r->asg.z, r->alpha, m);
+        vsgl__specular_factor_fh(&r->bp, r->n, r->o, r->asg.z, r->alpha, r->fh, m);
         for (int c = 0; c < 3; ++c)
             m[c] *= r->ms[c];
     }
@@ -905,8 +897,7 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
     b->fe[k] = r->fres[0];
     b->fa[k] = r->fres[1];
     b->fb[k] = r->fres[2];
-    shadow_lane(b, k, two_lobes(j->s->glossy_mode));
-    return 1;
+    return 1; /* its shadowing constants: run_block, for the whole block (shadow4.c) */
 }
 
 /* Sample merging: within a pixel, a sample on the same surface as an
@@ -962,7 +953,7 @@ static void lane_get(const vsgl_kernel_block *b, size_t k, const receiver *r, vs
 
 /* The inverse, and the receiver fields visibility rays read (position,
  * normal, lift, key; a replay has no G-buffer sample to read them from). */
-static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, receiver *r, int two)
+static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, receiver *r)
 {
     r->x = v3_make(o->v[0], o->v[1], o->v[2]);
     r->n = v3_make(o->v[3], o->v[4], o->v[5]);
@@ -981,7 +972,6 @@ static void lane_put(vsgl_kernel_block *b, size_t k, const vsgl__plan_lane *o, r
     b->lam[k] = *v++; b->mu[k] = *v++; b->camp[k] = *v++; b->alpha[k] = *v++;
     b->f0r[k] = *v++; b->f0g[k] = *v++; b->f0b[k] = *v++;
     b->fe[k] = *v++; b->fa[k] = *v++; b->fb[k] = *v;
-    shadow_lane(b, k, two);
     part_lane(o->part, &b->part[k], &b->pouter[k]);
 }
 
@@ -1197,6 +1187,7 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
     float vis[2 * VSGL__KERNEL_BLOCK]; /* visibility of two VSGLs */
     uint64_t pairs = 0;
     int32_t lobes = 0;
+    vsgl__shadow_lanes(blk, n, two_lobes(j->s->glossy_mode));
     for (size_t k = 0; k < n; ++k)
         lobes |= (blk->diffuse[k] > 0.0f ? VSGL__KERNEL_DIFFUSE : 0) | (blk->camp[k] > 0.0f ? VSGL__KERNEL_GLOSSY : 0) |
                  (blk->diffuse[k] > 0.0f && blk->burley[k] >= 0.0f ? VSGL__KERNEL_BURLEY : 0);
@@ -1334,7 +1325,7 @@ uint64_t vsgl__shade_lanes(const shade_job *j, const vsgl__plan_lane *const *lan
     for (size_t s0 = 0; s0 < n_total; s0 += VSGL__KERNEL_BLOCK) {
         size_t n = n_total - s0 < VSGL__KERNEL_BLOCK ? n_total - s0 : VSGL__KERNEL_BLOCK;
         for (size_t k = 0; k < n; ++k) {
-            lane_put(&blk, k, lanes[s0 + k], &rec[k], two_lobes(j->s->glossy_mode));
+            lane_put(&blk, k, lanes[s0 + k], &rec[k]);
         }
         pairs += run_block(j, &vs, &blk, rec, n, light + s0 * 6);
     }

@@ -122,6 +122,7 @@ typedef struct receiver {
     vsgl_asg asg;        /* warped NDF (ASG mode) */
     vsgl_sg sg;          /* warped NDF (SG mode) */
     vsgl_smooth_lane sm; /* its smooth-factor ratio's constants (kernel.h vsgl__shadow_lane), glossy only */
+    float fh;            /* the Fresnel shape at its lobe's axis (vsgl__fresnel_shape_at), glossy ASG modes only */
 } receiver;
 
 uint64_t vsgl__shade_list(const shade_job *j, const size_t *list, size_t n, const float *centroid, float *light,
