@@ -6,6 +6,7 @@
 #include "harness.h"
 #include "scene_fixture.h"
 #include "rsm/rsm.h"
+#include "scene/scene_data.h"
 #include "scene/scene_internal.h"
 
 #include <string.h>
@@ -56,7 +57,7 @@ static double uniform(uint32_t *x) { return (next(x) >> 8) * (1.0 / 16777216.0);
  * clear (with the walls alone, every segment inside). End points outside
  * the bounds are never called clear. */
 /* Scene arrays with room for the blocks' many small triangles. */
-#define OCC_TRIS 256
+#define OCC_TRIS 5120
 static float occ_pos[OCC_TRIS * 9];
 static uint32_t occ_idx[OCC_TRIS * 3], occ_mat[OCC_TRIS];
 
@@ -174,7 +175,9 @@ VT_TEST(occluders_never_call_a_blocked_segment_clear)
  * VSGL__OCC_FEW) or none (walls only), a segment strictly inside the bounds
  * is tested against the occluders alone (scene/occlude_few.c) or is clear;
  * the rest, and every segment of a scene with more occluders (two blocks:
- * 24), are traced by Embree. Each answer against the exact test in double
+ * 24), are traced by Embree: as a coherent stream, and with the blocks'
+ * faces cut into 14 x 14 pieces (4716 triangles, at least
+ * VSGL__RAY_INCOHERENT_MIN) as an incoherent one. Each answer against the exact test in double
  * over every triangle, for segments from a point just off a wall (as a
  * shading ray starts) or inside the room to one inside or past the bounds.
  * They may differ only for a segment grazing a triangle's edge or ending
@@ -184,10 +187,12 @@ VT_TEST(visibility_rays_route_inside_segments_to_the_occluders)
     vsgl_context *ctx = fx_context(1);
     VT_REQUIRE(ctx, "context");
     const float lo[2][3] = {{-0.6f, -0.2f, 0.0f}, {0.4f, 0.5f, 1.2f}}, hi[2][3] = {{-0.2f, 0.3f, 0.7f}, {0.8f, 0.9f, 1.5f}};
-    for (int blocks = 0; blocks < 3; ++blocks) { /* none, one, two */
+    for (int blocks = 0; blocks < 4; ++blocks) { /* none, one, two, two of many triangles */
         uint32_t tris;
-        vsgl_scene *sc = room_with_blocks(ctx, lo, hi, blocks, 1, &tris);
+        vsgl_scene *sc = room_with_blocks(ctx, lo, hi, blocks < 3 ? blocks : 2, blocks < 3 ? 1 : 14, &tris);
         VT_REQUIRE(sc, "blocks %d: no scene", blocks);
+        if (blocks == 3)
+            VT_CHECK(tris >= VSGL__RAY_INCOHERENT_MIN, "%u triangles: the incoherent stream is not tested", tris);
         enum { N = 20000, B = 64 };
         static float ox[N], oy[N], oz[N], tx[N], ty[N], tz[N];
         static int want[N];

@@ -195,7 +195,8 @@ void vsgl__scene_occluded_towards_each(const vsgl_scene *scene, uint32_t n, cons
     struct RTCRayNp rays = {rx, ry, rz, t0, dx, dy, dz, tm, t1, mask, id, flags};
     struct RTCIntersectContext ic;
     rtcInitIntersectContext(&ic);
-    ic.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    ic.flags = scene->triangle_count >= VSGL__RAY_INCOHERENT_MIN ? RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT
+                                                                 : RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     for (uint32_t b = 0; b < n;) {
         uint32_t c = n - b < BATCH ? n - b : BATCH, m = 0;
         /* the segments longer than eps, packed to the front */

@@ -70,6 +70,18 @@ static inline int vsgl__scene_strictly_inside(const vsgl_scene *s, float x, floa
     return (x > lo.x) & (y > lo.y) & (z > lo.z) & (x < hi.x) & (y < hi.y) & (z < hi.z);
 }
 
+/* From this many triangles on, visibility rays go to Embree as an
+ * incoherent stream (raytrace.c, vsgl__scene_occluded_towards_each): one
+ * ray at a time through the BVH rather than packets. A block's rays to one
+ * cluster share a target but part ways at the leaves of a fine mesh, where
+ * packets trace the union of their paths. Balanced at 960 x 540 (shade
+ * stage, coherent -> incoherent, this machine): a bumpy floor of 968
+ * triangles 2.08 -> 2.14 s, 9.8k 3.44 -> 3.09 s, 97k 3.11 -> 2.16 s, 500k
+ * 3.63 -> 2.15 s; the 2.2k-triangle sphere room 1.85 -> 1.77 s; the 52-
+ * triangle thick sun room 8-10 % slower incoherent. The images are the
+ * same bit for bit either way. */
+#define VSGL__RAY_INCOHERENT_MIN 2048u
+
 /* Segments per visibility batch (raytrace.c, occlude_few.c). */
 #define VSGL__OCC_STREAM 64
 /* At most this many occluders are tested one by one (occlude_few.c). */
