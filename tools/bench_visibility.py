@@ -4,7 +4,9 @@ pays for itself": at most 2x the shading time without them, with a measured
 error gain on a scene with indirect shadows).
 
 On the bundled rooms that have indirect shadows (tests/quality/scenes.py:
-a sphere over a floor, the two sun rooms), the balanced preset four ways:
+a sphere over a floor, the two sun rooms, and the bumpy floor of 500k
+triangles, where every ray crosses a fine mesh), the balanced preset four
+ways:
 without visibility, with the ray budget (vsgl_render_settings.
 visibility_budget, the default), the same with every ray at its VSGL's
 centre (visibility_spread -1: hard edges, the penumbra's samples left to
@@ -26,7 +28,7 @@ import metrics as M  # noqa: E402
 import refs  # noqa: E402
 import scenes  # noqa: E402
 
-SCENES = ("glossy_sphere_floor", "sun_opening", "sun_opening_thick")
+SCENES = ("glossy_sphere_floor", "sun_opening", "sun_opening_thick", "dense_floor")
 WAYS = (("no visibility", dict(visibility=0)), ("ray budget", dict()),
         ("rays at centres", dict(visibility_spread=-1.0)), ("every pair", dict(visibility_budget=-1.0)))
 TARGET = 2.0
