@@ -445,6 +445,7 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
     r->fres[0] = 0.0f;
     r->fres[1] = 1.0f;
     r->fres[2] = 0.0f;
+    r->fh = 0.0f;
     if (!r->glossy)
         return;
     vsgl__ms_scale3(&r->bp, v3_dot(r->n, r->o), r->ms);
