@@ -177,9 +177,10 @@ VT_TEST(occluders_never_call_a_blocked_segment_clear)
  * the rest, and every segment of a scene with more occluders (two blocks:
  * 24), are traced by Embree: as a coherent stream, and with the blocks'
  * faces cut into 14 x 14 pieces (4716 triangles, at least
- * VSGL__RAY_INCOHERENT_MIN) as an incoherent one. Each answer against the exact test in double
- * over every triangle, for segments from a point just off a wall (as a
- * shading ray starts) or inside the room to one inside or past the bounds.
+ * VSGL__RAY_INCOHERENT_MIN) as an incoherent one. Each answer against the
+ * exact test in double over every triangle, for segments from a point just
+ * off a wall (as a shading ray starts) or inside the room to one inside or
+ * past the bounds.
  * They may differ only for a segment grazing a triangle's edge or ending
  * on it: none of these 20000 does within 1e-4. */
 VT_TEST(visibility_rays_route_inside_segments_to_the_occluders)
