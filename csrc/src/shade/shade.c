@@ -464,7 +464,11 @@ static void setup_receiver(const shade_job *j, size_t i, receiver *r)
         /* the Fresnel shape at the axis, once for the ratio and fill_lane's specular factor */
         r->fh = v3_dot(r->n, r->asg.z) > 0.0f ? vsgl__fresnel_shape_at(&r->bp, r->o, r->asg.z) : 0.0f;
         vsgl__fresnel_ratio_fh(&r->bp, r->n, r->o, r->asg.z, r->fh, r->fres);
-        r->sm = vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, r->asg.z), two_lobes(j->s->glossy_mode));
+        /* the scalar reference path's (glossy_light); the kernel's lanes
+         * take the same constants per block (run_block, shadow4.c) */
+        if (j->path == VSGL__SHADE_REFERENCE)
+            r->sm = vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, r->asg.z),
+                                      two_lobes(j->s->glossy_mode));
     }
 }
 

@@ -121,7 +121,7 @@ typedef struct receiver {
     float fres[3];       /* the half-vector model's Fresnel ratio (material.h vsgl__fresnel_ratio) */
     vsgl_asg asg;        /* warped NDF (ASG mode) */
     vsgl_sg sg;          /* warped NDF (SG mode) */
-    vsgl_smooth_lane sm; /* its smooth-factor ratio's constants (kernel.h vsgl__shadow_lane), glossy only */
+    vsgl_smooth_lane sm; /* its smooth-factor ratio's constants (kernel.h vsgl__shadow_lane), glossy, reference path only */
     float fh;            /* the Fresnel shape at its lobe's axis (vsgl__fresnel_shape_at), glossy ASG modes only */
 } receiver;
 
