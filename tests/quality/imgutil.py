@@ -155,6 +155,6 @@ def crop_row(images, crop, gain, zoom=1):
     ys, xs = slice(int(r0 * h), int(r1 * h)), slice(int(c0 * w), int(c1 * w))
     scale = np.percentile(images[0][ys, xs], 99)
     tiles = [np.clip(a[ys, xs] / scale * gain, 0, 1) ** (1 / 2.2) for a in images]
-    tiles = [np.repeat(np.repeat(t, zoom, 0), zoom, 1) for t in tiles]
+    tiles = [upscale(t, zoom) for t in tiles]
     gap = np.ones((tiles[0].shape[0], 4, 3))
     return np.concatenate(sum(([t, gap] for t in tiles), [])[:-1], 1)
