@@ -588,3 +588,65 @@ VT_TEST(budget_stride_pixels_scales_the_stride_and_says_so)
              "stride 1 was scaled: %s", st.skipped);
     vsgl_context_destroy(ctx);
 }
+
+/* glossy sg shades through the scalar reference path, which has no
+ * sparse shading: a stride asked for is not taken (the same pixels and
+ * pairs as stride 1) and the render does not claim it; it warns before
+ * the wait, naming the path. The kernel path at the same stride shades
+ * fewer pairs (what the check would miss if the stride never applied). */
+typedef struct sg_log { char warn[2][512]; int n; } sg_log;
+static void sg_capture(void *user, int32_t level, const char *message)
+{
+    sg_log *c = user;
+    if (level == VSGL_LOG_WARNING && strstr(message, "glossy sg") && c->n < 2)
+        snprintf(c->warn[c->n++], sizeof c->warn[0], "%s", message);
+}
+
+VT_TEST(budget_glossy_sg_shades_every_pixel_and_says_so)
+{
+    static float a[120 * 90 * 3], b[120 * 90 * 3];
+    sg_log cap;
+    memset(&cap, 0, sizeof cap);
+    vsgl_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.size = sizeof cd;
+    cd.thread_count = 2;
+    cd.log = sg_capture;
+    cd.log_user = &cap;
+    vsgl_context *ctx = NULL;
+    VT_REQUIRE(vsgl_context_create(&cd, &ctx) == VSGL_OK, "context");
+    fx_scene fx;
+    fx_room(&fx, 120, 90, 0.3f, 150.0f);
+    vsgl_render_settings s;
+    vsgl_render_settings_preset(VSGL_PRESET_BALANCED, &s);
+    s.vsgl_count = 16;
+    s.rsm_resolution = 64;
+    s.visibility = VSGL_VISIBILITY_NONE;
+    s.stride_pixels = 0;
+    vsgl_render_stats st[4];
+    for (int i = 0; i < 4; ++i) {
+        memset(&st[i], 0, sizeof st[i]);
+        st[i].size = sizeof st[i];
+    }
+    s.glossy_mode = VSGL_GLOSSY_SG;
+    s.shade_stride = 3;
+    VT_REQUIRE(render_with(ctx, &fx, &s, a, &st[0]) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    s.shade_stride = 1;
+    VT_REQUIRE(render_with(ctx, &fx, &s, b, &st[1]) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(memcmp(a, b, sizeof a) == 0 && st[0].shading_pairs == st[1].shading_pairs,
+             "glossy sg at stride 3 is not its render at stride 1: pairs %llu vs %llu",
+             (unsigned long long)st[0].shading_pairs, (unsigned long long)st[1].shading_pairs);
+    VT_CHECK(!strstr(st[0].skipped, "shading: one pixel in"), "claims a stride it did not take: %s", st[0].skipped);
+    VT_CHECK(cap.n == 2 && strstr(cap.warn[0], "reference path") && strstr(cap.warn[0], "shade_stride ignored") &&
+                 !strstr(cap.warn[1], "shade_stride ignored"),
+             "warnings (%d): '%s' / '%s'", cap.n, cap.warn[0], cap.warn[1]);
+    s.glossy_mode = VSGL_GLOSSY_ASG2;
+    s.shade_stride = 3;
+    VT_REQUIRE(render_with(ctx, &fx, &s, a, &st[2]) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    s.shade_stride = 1;
+    VT_REQUIRE(render_with(ctx, &fx, &s, b, &st[3]) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    VT_CHECK(st[2].shading_pairs * 2 < st[3].shading_pairs && cap.n == 2,
+             "asg2: stride 3 %llu pairs, stride 1 %llu; sg warnings %d",
+             (unsigned long long)st[2].shading_pairs, (unsigned long long)st[3].shading_pairs, cap.n);
+    vsgl_context_destroy(ctx);
+}

@@ -16,6 +16,8 @@ vsgl_result vsgl__settings_resolve(vsgl_context *ctx, const vsgl_render_settings
 typedef struct vsgl__image_rules {
     uint32_t aa_asked;     /* aa_samples that aa_pixel_limit lowered to 1 */
     uint32_t stride_asked; /* shade_stride that stride_pixels raised */
+    uint32_t stride_ignored; /* shade_stride > 1 that glossy sg does not take: the scalar reference path
+                                (shade.c) shades every pixel */
 } vsgl__image_rules;
 
 /* vsgl__settings_resolve, then the rules for the scene camera's image:
