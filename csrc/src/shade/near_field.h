@@ -22,6 +22,8 @@ typedef struct vsgl_near_cell {
     float h;              /* lattice spacing, m */
     float za;             /* the plane: x[axis] = za */
     float fit;            /* how far the model applies: coherence^2 x facing x uniformity, [0, 1] */
+    float flat;           /* how far it applies to receivers that face the cell's way too (a floor's
+                             own points): 1 for a plane, 0 for a cell that bends (near_field.c) */
     float inv_area;       /* 1 / (pi x the steps' total area) */
     float rect[4][4];     /* the steps: u0 u1 v0 v1 (u = axis + 1, v = axis + 2 mod 3) */
     uint32_t axis, side;  /* the plane faces +axis (side 0) or -axis (side 1) */
