@@ -314,6 +314,8 @@ float vsgl__near_diffuse(const vsgl_near_cell *c, v3 x, v3 n, float *weight)
                                            (VSGL__NEAR_ACROSS_HI - VSGL__NEAR_ACROSS_LO));
         *weight *= c->flat + (1.0f - c->flat) * across;
     }
+    if (!(*weight > 0.0f)) /* callers skip it: no form factor (a bumpy floor's own points) */
+        return 0.0f;
     float front = smoothstep01f(height / (VSGL__NEAR_BEHIND * c->h));
     if (c->lambda > 0.0f)
         return front * near_specular(c, x, n, height);
