@@ -56,9 +56,12 @@ int vsgl__near_cell(const vsgl_vsgl *v, uint32_t index, vsgl_near_cell *c);
 /* The diffuse light per watt (irradiance / pi per W of the cluster's
  * power) at x, normal n, and in *weight how much of the pair the model
  * takes, in [0, 1]: the cell's fit, 1 within VSGL__NEAR_FULL spacings of
- * its centre and 0 beyond VSGL__NEAR_NONE, smooth between. 0 and weight
- * 0 behind or in the cell's plane (where the far-field term is ~0 too:
- * the emitter clip).
+ * its centre and 0 beyond VSGL__NEAR_NONE, smooth between; for a cell
+ * that bends (flat < 1), only for receivers turned across its plane (a
+ * wall's foot, not its own floor's bumps: near_field.c
+ * VSGL__NEAR_ACROSS_*). 0 and weight 0 behind or in the cell's plane
+ * (where the far-field term is ~0 too: the emitter clip), and 0 wherever
+ * the weight is 0.
  * A specular cell is its steps of uniform irradiance reflected through
  * its lobe G(w) = e^{lambda (w.axis - 1)}: x sees the lobe's mass that
  * falls in the steps as seen from x, the lobe's footprint on the plane
