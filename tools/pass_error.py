@@ -10,9 +10,9 @@ of the image's rows (top to bottom), printed.
     python3 tools/pass_error.py dense_floor --size 320x240x2048 \\
         --configs balanced,brute -o docs/img/accuracy/dense_floor_passes.png
 
-The references must be in the cache (tests/quality/refs.py renders them:
-`python3 tests/quality/evaluate.py --size ... --scenes ...` does); the
-library is the one evaluate.py loads (VSGL_LIBRARY to choose another).
+The references come from the cache (tests/quality/refs.py), rendered in
+Blender where missing; the library is the one evaluate.py loads
+(VSGL_LIBRARY to choose another).
 """
 import argparse
 import os
@@ -42,41 +42,32 @@ def main(argv=None):
     args = ap.parse_args(argv)
 
     case = scenes.case(args.scene, args.size)
-    ver = refs.blender_version()
-    paths = [refs.path(refs.DEFAULT_DIR, args.scene, args.size, s, ver) for s in (1, 2)]
-    missing = [p for p in paths if not os.path.exists(p)]
-    if missing:
-        raise SystemExit("no cached reference: %s (render it with tests/quality/evaluate.py --size %s --scenes %s)"
-                         % (missing[0], args.size, args.scene))
-    ref = [M.coloured(refs.load(p)[0]) for p in paths]
+    # the cached references, rendered in Blender where missing
+    ref = [M.coloured(p) for p, _ in refs.ensure([args.scene], scenes.size_of(args.size))[args.scene]]
     cfgs = [E.parse_config(c) for c in E.split_configs(args.configs)]
     rend = E.Renderer()
     imgs = [rend.render(case, c)[0] for c in cfgs]
+    passes = args.passes.split(",")
     rows = []
-    for P in args.passes.split(","):
+    for P in passes:
         r = 0.5 * (ref[0][P] + ref[1][P])
         lr = I.luminance(r)
         ex = I.exposure_for(r)
         scale = args.gain / max(float(np.percentile(lr, 99)), 1e-30)
-        tiles = [(I.tonemap(r, ex), "%s reference" % P)]
-        errs = []
         h = lr.shape[0]
+        shaded, errs = [], []
         for c, img in zip(cfgs, imgs):
-            a = img[P]
-            la = I.luminance(a)
+            la = I.luminance(img[P])
             sixths = " ".join("%.3f" % (la[y:y + h // 6].sum() / max(lr[y:y + h // 6].sum(), 1e-30))
                               for y in range(0, h - h // 6 + 1, h // 6))
             print("%-10s %-5s sum %.4f  by sixths of rows: %s" % (c.label, P, la.sum() / lr.sum(), sixths))
-            tiles.append((I.tonemap(a, ex), "%s %s" % (P, c.label)))
-            errs.append((I.signed_error(la - lr, scale), "error x%g %s" % (args.gain, c.label)))
-        tiles += errs
-        k = max(1, 320 // lr.shape[1])
-        labelled = [np.concatenate([I.text_strip([t[1]], lr.shape[1] * k), I.upscale(t[0], k)], 0) for t in tiles]
-        gap = np.ones((labelled[0].shape[0], 2, 3))
-        rows.append(np.concatenate(sum(([t, gap] for t in labelled), [])[:-1], 1))
-    gap = np.ones((2, rows[0].shape[1], 3))
+            shaded.append(I.tonemap(img[P], ex))
+            errs.append(I.signed_error(la - lr, scale))
+        rows.append([I.tonemap(r, ex)] + shaded + errs)
+    heads = ([["reference", "rows: " + ", ".join(passes)]] + [[c.label] for c in cfgs] +
+             [["error x%g" % args.gain, c.label] for c in cfgs])
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    I.save_png(args.out, np.concatenate(sum(([r_, gap] for r_ in rows), [])[:-1], 0))
+    I.save_png(args.out, I.grid(rows, heads, max(1, 320 // rows[0][0].shape[1])))
     print("wrote", args.out)
 
 

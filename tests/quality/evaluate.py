@@ -735,21 +735,7 @@ def still_image(name, r, images, up):
         top.append(imgutil.tonemap(img, e))
         bot.append(imgutil.signed_error(lum(img) - lum(ref), 4 * e))
         heads.append([label, "bias d %.2f g %.2f" % (c["still"]["Diff"]["bias"], c["still"]["Gloss"]["bias"])])
-    return _grid([top, bot], heads, up)
-
-
-def _grid(rows, heads, up):
-    """Tiles (rows of equal-size images) upscaled, 1-px white gaps, a label strip above each column."""
-    rows = [[imgutil.upscale(t, up) for t in row] for row in rows]
-    h, w = rows[0][0].shape[:2]
-    cols = []
-    for j in range(len(rows[0])):
-        parts = [imgutil.text_strip(heads[j], w)]
-        for row in rows:
-            parts += [np.ones((1, w, 3)), row[j]]
-        cols.append(np.concatenate(parts, axis=0))
-    sep = np.ones((cols[0].shape[0], 1, 3))
-    return np.concatenate(sum([[c, sep] for c in cols], [])[:-1], axis=1)
+    return imgutil.grid([top, bot], heads, up)
 
 
 def flicker_image(images, up, ref, r):
@@ -767,7 +753,7 @@ def flicker_image(images, up, ref, r):
         heads.append([label, "d %.3f g %.3f" % (f["Diff"]["median"], f["Gloss"]["median"])])
     if not heads:
         return None
-    return _grid(rows, heads, up)
+    return imgutil.grid(rows, heads, up)
 
 
 def git_commit():

@@ -145,6 +145,22 @@ def text_strip(lines, width, scale=2, pad=2):
     return out
 
 
+def grid(rows, heads, up):
+    """Tiles (rows of equal-size images) upscaled, 1-px white gaps, a label
+    strip above each column (heads[j]: its lines, the shorter padded)."""
+    rows = [[upscale(t, up) for t in row] for row in rows]
+    w = rows[0][0].shape[1]
+    lines = max(len(h) for h in heads)
+    cols = []
+    for j in range(len(rows[0])):
+        parts = [text_strip(list(heads[j]) + [""] * (lines - len(heads[j])), w)]
+        for row in rows:
+            parts += [np.ones((1, w, 3)), row[j]]
+        cols.append(np.concatenate(parts, axis=0))
+    sep = np.ones((cols[0].shape[0], 1, 3))
+    return np.concatenate(sum([[c, sep] for c in cols], [])[:-1], axis=1)
+
+
 def crop_row(images, crop, gain, zoom=1):
     """A row of the same crop of each image, side by side with 4-pixel white
     gaps: crop ((r0, r1), (c0, c1)) as fractions of the image, each tile
