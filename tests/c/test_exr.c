@@ -2,6 +2,7 @@
  * of the writer's packing code), with OpenImageIO's oiiotool, and with
  * Blender 3.4; atomicity and failure cases. */
 #include "harness.h"
+#include "log_capture.h"
 #include "io/half.h"
 #include "vsgl.h"
 #include "io/atomic.h"
@@ -660,16 +661,6 @@ VT_TEST(exr_failed_write_keeps_previous_file_and_deletes_temp)
  * run removed. The next write into the folder deletes this host's temporary
  * files whose process is gone, and logs each; live writers', other hosts'
  * and unrelated files stay. */
-typedef struct warn_capture { int n; char text[1024]; } warn_capture;
-static void capture_warnings(void *user, int32_t level, const char *message)
-{
-    warn_capture *w = user;
-    if (level != VSGL_LOG_WARNING)
-        return;
-    ++w->n;
-    size_t used = strlen(w->text);
-    snprintf(w->text + used, sizeof w->text - used, "%s\n", message);
-}
 
 static void this_host(char *buf, size_t n)
 {
@@ -720,11 +711,11 @@ VT_TEST(exr_write_removes_stale_temp_files_of_dead_writers)
     touch(dir, alive, 10);
     touch(dir, other, 10);
     touch(dir, unrelated, 10);
-    warn_capture w;
+    vt_warnings w;
     memset(&w, 0, sizeof w);
     vsgl_context_desc cd;
     memset(&cd, 0, sizeof cd);
-    cd.log = capture_warnings;
+    cd.log = vt_capture_warnings;
     cd.log_user = &w;
     vsgl_context *ctx = NULL;
     vsgl_context_create(&cd, &ctx);

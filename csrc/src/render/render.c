@@ -535,7 +535,7 @@ vsgl_result vsgl_render_cached(vsgl_context *ctx, const vsgl_scene *scene, const
     if (r != VSGL_OK)
         return r;
     /* before the wait, not after it */
-    if (s.method == VSGL_METHOD_VSGL && s.glossy_mode == VSGL_GLOSSY_SG)
+    if (vsgl__shades_by_reference(&s))
         vsgl__log(ctx, VSGL_LOG_WARNING, "render: glossy sg shades through the scalar reference path (a check of "
                   "the vectorised kernel, which models ASG lobes): every pixel%s, every pair in scalar code%s; "
                   "balanced with it took 45-85x balanced's time on the bundled rooms at 960 x 540 "

@@ -2,6 +2,7 @@
 #include "render/render_internal.h"
 #include "core/versioned.h"
 #include "core/context.h"
+#include "shade/shade.h"
 
 #include <string.h>
 
@@ -261,10 +262,9 @@ vsgl_result vsgl__settings_resolve_for(vsgl_context *ctx, const vsgl_render_sett
         rules->stride_asked = s->shade_stride;
         s->shade_stride = stride;
     }
-    /* glossy sg shades through the scalar reference path (shade.c: the
-     * vectorised kernel models ASG lobes), which has no sparse shading:
-     * every pixel, whatever the stride. Said as it is, not as asked. */
-    if (s->method == VSGL_METHOD_VSGL && s->glossy_mode == VSGL_GLOSSY_SG && s->shade_stride > 1) {
+    /* the reference path has no sparse shading: every pixel, whatever the
+     * stride. Said as it is, not as asked. */
+    if (vsgl__shades_by_reference(s) && s->shade_stride > 1) {
         rules->stride_ignored = s->shade_stride;
         rules->stride_asked = 0;
         s->shade_stride = 1;

@@ -1507,8 +1507,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
                           fmaxf(fabsf(lo.z), fabsf(hi.z)));
     float eps = fmaxf((extent > 0.0f ? extent : 1.0f) * 1e-5f, max_abs * 1e-6f);
     uint32_t material_count;
-    /* The kernel models the ASG glossy lobe; the SG lobe uses the reference path. */
-    if (s->glossy_mode == VSGL_GLOSSY_SG)
+    if (vsgl__shades_by_reference(s))
         path = VSGL__SHADE_REFERENCE;
     int leak = s->leak_correction == VSGL_LEAK_ON || s->leak_correction == VSGL_LEAK_AUTO ||
                s->leak_correction == VSGL_LEAK_CLIP;

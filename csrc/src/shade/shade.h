@@ -66,6 +66,14 @@ float vsgl__foreshortening_weight(const vsgl_vsgl *v);
 #define VSGL__SHADE_KERNEL_SCALAR 1
 #define VSGL__SHADE_REFERENCE     2
 
+/* 1 if settings s shade through the reference path whatever path is
+ * asked: the kernel models ASG lobes, so glossy SG lobes take the scalar
+ * path (every pixel, no stride: render/settings.c says so, render.c warns). */
+static inline int vsgl__shades_by_reference(const vsgl_render_settings *s)
+{
+    return s->method == VSGL_METHOD_VSGL && s->glossy_mode == VSGL_GLOSSY_SG;
+}
+
 /* Emitter-hemisphere clip (the leak correction). A cluster's VPLs lie on
  * a surface and emit only in front of it, with a clamped cosine; the
  * papers' model emits an SG (lambda 2.29 for a diffuse lobe) with ~9 % of
