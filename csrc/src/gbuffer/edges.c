@@ -303,6 +303,126 @@ static uint32_t group_rays(const gb_job *job, const vsgl_gbuffer *sub, size_t *f
     return groups;
 }
 
+/* A group of rays on a curved surface (its normals' mean resultant length
+ * below 1 - SPLIT_SPREAD) is split in two, again and again, while its pixel
+ * has slots to spare: the shade stage shades one point per slot, and across
+ * a glossy sphere's rim one point with the group's mean normal (its lobe
+ * widened by the spread, shade.c) is not the mean of the light over the
+ * rim. Against 16 x 16 samples shaded one by one, a glossy cylinder's rim
+ * pixels were off by 13.8 % of their glossy light, split 6.3 %
+ * (tests/c/test_render.c); the sphere room's glossy change as the camera
+ * moves, above Cycles' own, 0.0145 -> 0.0105 at 80 x 60 (docs/accuracy.md,
+ * "A curved rim shaded at several points"). Flat groups are not split
+ * (their slot already takes their rays' mean point): splitting them too
+ * lowered the camera animations' excess in the flat rooms a little more,
+ * but at 960 x 540 balanced, where one pixel in 5 x 5 is shaded and every
+ * edge pixel is, the extra slots cost the sun room 17-35 % of its render. */
+#define SPLIT_SPREAD 1e-3f
+
+/* 1 - the mean resultant length of group q's normals, or -1 if it holds a
+ * miss; *count its rays. */
+static float group_spread(const vsgl_gbuffer *sub, const uint8_t *group, uint32_t q, uint32_t n, uint32_t *count)
+{
+    v3 sum = v3_make(0.0f, 0.0f, 0.0f);
+    uint32_t c = 0;
+    int hit = 1;
+    for (uint32_t s = 0; s < n; ++s)
+        if (group[s] == q) {
+            hit &= sub->material[s] != VSGL__GBUFFER_MISS;
+            sum = v3_add(sum, at3(sub->nrm, s));
+            ++c;
+        }
+    *count = c;
+    return hit && c > 0 ? 1.0f - v3_length(sum) / (float)c : -1.0f;
+}
+
+/* Cut curved group q (m rays, listed in member) into `parts` runs of
+ * equal count along the grid direction in which its normal turns fastest
+ * (the principal axis of sum_s (r_s - r_mean) (x) n_s): the first run
+ * keeps label q, the others take first, first + 1, ... As the edge moves by
+ * one ray the cuts move by a fraction of one. */
+static void cut_group(const gb_job *job, const vsgl_gbuffer *sub, uint8_t *group, uint16_t *member, uint32_t m,
+                      uint32_t parts, uint32_t first)
+{
+    const uint32_t E = job->edge_aa;
+    float key[VSGL__GBUFFER_MAX_SPP];
+    float xm = 0.0f, ym = 0.0f;
+    for (uint32_t k = 0; k < m; ++k) {
+        xm += (float)(member[k] % E);
+        ym += (float)(member[k] / E);
+    }
+    xm /= (float)m;
+    ym /= (float)m;
+    v3 cx = v3_make(0.0f, 0.0f, 0.0f), cy = cx;
+    for (uint32_t k = 0; k < m; ++k) {
+        const uint32_t s = member[k];
+        const v3 ns = at3(sub->nrm, s);
+        cx = v3_add(cx, v3_scale(ns, (float)(s % E) - xm));
+        cy = v3_add(cy, v3_scale(ns, (float)(s / E) - ym));
+    }
+    const float a = v3_dot(cx, cx), b = v3_dot(cx, cy), c = v3_dot(cy, cy);
+    const float th = 0.5f * atan2f(2.0f * b, a - c), dx = cosf(th), dy = sinf(th);
+    /* the members by their position along it (insertion sort, stable: ties keep the ray order) */
+    for (uint32_t k = 0; k < m; ++k) {
+        const uint32_t s = member[k];
+        const float t = ((float)(s % E) - xm) * dx + ((float)(s / E) - ym) * dy;
+        uint32_t j = k;
+        while (j > 0 && key[j - 1] > t) {
+            key[j] = key[j - 1];
+            member[j] = member[j - 1];
+            --j;
+        }
+        key[j] = t;
+        member[j] = (uint16_t)s;
+    }
+    for (uint32_t k = 0; k < m; ++k) {
+        const uint32_t run = k * parts / m;
+        if (run > 0)
+            group[member[k]] = (uint8_t)(first + run - 1);
+    }
+}
+
+/* Give an edge pixel's free slots to its curved groups, one at a time to
+ * the group whose runs would hold the most rays each (ties: the first),
+ * and cut each into that many runs (cut_group). One rim in a pixel takes
+ * every free slot, so its runs do not change as its ray count does (halving
+ * the larger half again, the third slot went to one half or the other as
+ * the count's parity changed, and the rim's normals jumped by a fifth of
+ * their turn in a 1/16-pixel step). Returns the new number of groups. */
+static uint32_t split_curved(const gb_job *job, const vsgl_gbuffer *sub, uint8_t *group, uint32_t groups)
+{
+    const uint32_t n = job->edge_aa * job->edge_aa, spp = job->g->spp;
+    uint32_t count[VSGL__GBUFFER_MAX_SPP], parts[VSGL__GBUFFER_MAX_SPP];
+    int curved[VSGL__GBUFFER_MAX_SPP];
+    for (uint32_t q = 0; q < groups; ++q) {
+        curved[q] = group_spread(sub, group, q, n, &count[q]) > SPLIT_SPREAD;
+        parts[q] = 1;
+    }
+    for (uint32_t free_slots = spp - groups; free_slots > 0; --free_slots) {
+        uint32_t best = groups;
+        for (uint32_t q = 0; q < groups; ++q)
+            if (curved[q] && count[q] > parts[q] &&
+                (best == groups || (uint64_t)count[q] * parts[best] > (uint64_t)count[best] * parts[q]))
+                best = q;
+        if (best == groups)
+            break;
+        ++parts[best];
+    }
+    uint16_t member[VSGL__GBUFFER_MAX_SPP];
+    const uint32_t before = groups;
+    for (uint32_t q = 0; q < before; ++q) {
+        if (parts[q] < 2)
+            continue;
+        uint32_t m = 0;
+        for (uint32_t s = 0; s < n; ++s)
+            if (group[s] == q)
+                member[m++] = (uint16_t)s;
+        cut_group(job, sub, group, member, m, parts[q], groups);
+        groups += parts[q] - 1;
+    }
+    return groups;
+}
+
 /* Raster position of edge ray s of pixel (x, y) on its E x E pattern (inv
  * = 1 / E; gbuffer.h vsgl__gbuffer_pattern): the trace and the deferred
  * inputs of the rays kept must take the same, to the bit. */
@@ -337,7 +457,8 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, vsgl_hit *hits, u
     uint32_t count[VSGL__GBUFFER_MAX_SPP];
     float cx[VSGL__GBUFFER_MAX_SPP], cy[VSGL__GBUFFER_MAX_SPP];
     uint8_t group[VSGL__GBUFFER_MAX_SPP];
-    uint32_t groups = group_rays(job, sub, founder, group);
+    const uint32_t pieces = group_rays(job, sub, founder, group);
+    const uint32_t groups = split_curved(job, sub, group, pieces);
     for (uint32_t q = 0; q < groups; ++q) {
         count[q] = 0;
         cx[q] = cy[q] = 0.0f;
@@ -352,7 +473,7 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, vsgl_hit *hits, u
     for (uint32_t q = 0; q < groups; ++q) {
         /* the member nearest the group's centre (ties: the first) */
         float mx = cx[q] / (float)count[q], my = cy[q] / (float)count[q], best = 1e30f;
-        uint32_t rep = (uint32_t)founder[q];
+        uint32_t rep = 0; /* (every group has a member: split_curved cuts a group into at most as many runs as it has rays) */
         for (uint32_t s = 0; s < n; ++s) {
             if (group[s] != q)
                 continue;
@@ -378,6 +499,13 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, vsgl_hit *hits, u
     }
     for (uint32_t q = groups; q < spp; ++q)
         vsgl__gbuffer_clear_slot(g, base + q, base);
+    /* unsplit slots with the grid's weights (one surface over the whole
+     * pixel at aa 1): not refined for the shade stage (gbuffer.h refined) */
+    int grid = groups == pieces;
+    for (uint32_t q = 0; q < spp && grid; ++q)
+        grid = g->weight[base + q] == (q < job->aa * job->aa ? 1.0f / (float)(job->aa * job->aa) : 0.0f);
+    if (grid)
+        job->edge[(size_t)y * g->width + x] = VSGL__GBUFFER_TRACED;
 }
 
 int32_t vsgl__gbuffer_refine_edges(void *user, size_t chunk, size_t begin, size_t end)

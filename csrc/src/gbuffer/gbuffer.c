@@ -220,6 +220,7 @@ void vsgl__gbuffer_free(vsgl_gbuffer *g)
     free(g->part);
     free(g->weight);
     free(g->spread);
+    free(g->refined);
     for (int k = 0; k < VSGL__SURF_N; ++k)
         free(g->surf[k]);
     memset(g, 0, sizeof *g);
@@ -333,12 +334,14 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
         r = for_rows(ctx, &job, vsgl__gbuffer_mark_edges, 0.6f, 0.65f, "finding edges in");
         if (r == VSGL_OK)
             r = for_rows(ctx, &job, vsgl__gbuffer_refine_edges, 0.65f, 1.0f, "refining the edges of");
+        out->refined = job.edge; /* the buffer's from here (freed with it) */
         if (r == VSGL_OK)
             for (size_t p = 0; p < (size_t)out->width * out->height; ++p)
-                out->edge_pixels += job.edge[p];
-        free(job.edge);
-        if (r != VSGL_OK)
+                out->edge_pixels += job.edge[p] != 0;
+        if (r != VSGL_OK) {
+            vsgl__gbuffer_free(out);
             return r;
+        }
         vsgl__log(ctx, VSGL_LOG_INFO, "gbuffer: %zu edge pixels (%.1f %%) traced again with %u x %u rays each",
                   out->edge_pixels, 100.0 * (double)out->edge_pixels / (double)((size_t)out->width * out->height),
                   (unsigned)edge_aa, (unsigned)edge_aa);

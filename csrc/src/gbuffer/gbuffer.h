@@ -7,6 +7,8 @@
 
 #define VSGL__GBUFFER_MISS 0xFFFFFFFFu
 #define VSGL__GBUFFER_MAX_SPP 256 /* 16 x 16 samples per pixel */
+#define VSGL__GBUFFER_REFINED 1u   /* vsgl_gbuffer.refined */
+#define VSGL__GBUFFER_TRACED 2u
 
 /* Structure of arrays; sample index = (row * width + col) * spp + s,
  * row 0 = top of the image, samples on a stratified aa x aa pattern
@@ -44,6 +46,11 @@ typedef struct vsgl_gbuffer {
                                       shades it too) up to the smooth surface its normals describe
                                       (vsgl__scene_smooth_point), where its visibility rays start:
                                       from the triangle they would hit the sample's own mesh */
+    unsigned char *refined;        /* with weight: per pixel, VSGL__GBUFFER_REFINED where edge
+                                      refinement rewrote its slots (edges.c), VSGL__GBUFFER_TRACED
+                                      where it traced the pixel again but its slots came out as the
+                                      grid's (weights 1 / (aa * aa), no surface split), else 0; NULL
+                                      without edge refinement */
     size_t edge_pixels;            /* pixels refined */
 } vsgl_gbuffer;
 
@@ -88,19 +95,14 @@ static inline float vsgl__gbuffer_weight(const vsgl_gbuffer *g, size_t i)
 
 /* Did edge refinement rewrite pixel px's slots (edges.c)? Then each slot
  * stands for a group of rays anywhere in the pixel, not for its sample of
- * the aa x aa grid: its weight is its group's share, where a pixel left
- * alone keeps the grid's 1 / (aa * aa) (vsgl__gbuffer_build). */
+ * the aa x aa grid, even where the groups' shares happen to be the grid's
+ * 1 / (aa * aa) each (a rim cut into as many runs as the pixel has slots,
+ * edges.c split_curved). A pixel traced again whose slots came out as the
+ * grid's, unsplit, is not (its slots are read as grid samples, as before
+ * rims were cut). */
 static inline int vsgl__gbuffer_refined(const vsgl_gbuffer *g, size_t px)
 {
-    if (!g->weight)
-        return 0;
-    const size_t n = (size_t)g->aa * g->aa;
-    const float w = 1.0f / (float)(g->aa * g->aa); /* the build's expression, to the bit */
-    const float *p = g->weight + px * g->spp;
-    for (size_t k = 0; k < g->spp; ++k)
-        if (p[k] != (k < n ? w : 0.0f))
-            return 1;
-    return 0;
+    return g->refined && g->refined[px] == VSGL__GBUFFER_REFINED;
 }
 
 /* Material of sample i with its own inputs (textured scenes), else its
