@@ -790,9 +790,10 @@ static void fx_room_cylinder(fx_scene *fx, float *cn, uint32_t w, uint32_t h, fl
                 n[1] = dy / l;
                 n[2] = 0.0f;
             } else { /* the quad's face normal */
-                const float *a = fx->positions + 3 * fx->indices[3 * t], *b = fx->positions + 3 * fx->indices[3 * t + 1],
-                            *d = fx->positions + 3 * fx->indices[3 * t + 2];
-                const float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+                const uint32_t *ix = fx->indices + 3 * t;
+                const float *a = fx->positions + 3 * ix[0], *b = fx->positions + 3 * ix[1], *d = fx->positions + 3 * ix[2];
+                const float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+                const float v[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
                 float f[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
                 const float l = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
                 for (int i = 0; i < 3; ++i)

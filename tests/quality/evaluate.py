@@ -75,10 +75,14 @@ STILL_IMAGE_CONFIGS = ("preview", "balanced", "quality", "brute")
 ACCEPT = dict(flicker=0.01, bias=0.05, bias_preview=0.30, structured_x=3.0)
 # The camera animation's own change: consecutive frames differ because the view moved (silhouettes
 # slide, glossy highlights move), and at 80x60 that alone exceeds 0.01 in some rooms. --camera-truth
-# renders the camera animation densely (8 x 8 samples, every pixel shaded, no edge refinement, no
+# renders the camera animation densely (12 x 12 samples, every pixel shaded, no edge rays, no
 # visibility rays, for time) and reports for each configuration the change in excess of it: the median
-# over frames of |(f[t+1] - f[t]) - (g[t+1] - g[t])| / |f[t]| (RMS form), g the dense frames.
-CAMERA_TRUTH = ("balanced", dict(aa_samples=8, shade_stride=1, edge_samples=0, visibility=0))
+# over frames of |(f[t+1] - f[t]) - (g[t+1] - g[t])| / |f[t]| (RMS form), g the dense frames. Each
+# render's own change above Cycles' motion (Gloss in the sphere room / Diff in the textured room / Gloss
+# in the rough room): 8 x 8 samples 0.0168 / 0.0032 / 0.0192 (aliasing at the sphere's glossy rim);
+# 8 x 8 with 16 x 16 edge rays 0.0082 / 0.0153 / 0.0215 (an edge pixel's flat group takes one texture
+# sample); 12 x 12 0.0063 / 0.0025 / 0.0126 (docs/accuracy.md, "A curved rim shaded at several points").
+CAMERA_TRUTH = ("balanced", dict(aa_samples=12, shade_stride=1, edge_samples=0, visibility=0))
 # The motion's own change in Cycles (--motion-truth), rendered with both reference seeds; the product of
 # the two seeds' frame differences gives the per-frame change without their noise. Every frame of both
 # animations (metrics.motion_steps, the median over the steps): a silhouette crossing a pixel changes it
@@ -543,9 +547,9 @@ def markdown(results, args, img_rel):
              "Cycles' own, frame by frame, without Cycles' noise (metrics.excess_over_seeds: the median over steps "
              "of sqrt((df - d1) . (df - d2)) / |f[t]|): a moving view changes some rooms by more than 0.01 a frame "
              "by itself, and this is what a renderer adds to it; **above the dense render** (with --camera-truth) "
-             "= the same against the method's own frames rendered with 8 x 8 samples and every pixel shaded "
-             "(median of |(f[t+1] - f[t]) - (g[t+1] - g[t])| / |f[t]|; a diagnostic: the dense render shares the "
-             "model's errors, and at 80x60 it is itself not converged at silhouettes); **jitter** = the median "
+             "= the same against the method's own frames rendered with 12 x 12 samples and every pixel shaded "
+             "(median of |(f[t+1] - f[t]) - (g[t+1] - g[t])| / |f[t]|; a diagnostic: the dense "
+             "render shares the model's errors); **jitter** = the median "
              "relative RMS of "
              "(f[t+1] - f[t]) - (f[n] - f[0]) / n, the change in excess of the sequence's own straight-line trend "
              "(a smooth motion's is ~0; a reshuffling fit's, or an edge jumping across pixels, is not), checked "
@@ -780,7 +784,7 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="one scene, one configuration, numbers only")
     ap.add_argument("--camera-truth", action="store_true",
                     help="also render the camera animation densely and report each configuration's camera flicker "
-                         "above the motion's own change (slow: 8 x 8 samples, every pixel shaded)")
+                         "above the motion's own change (slow: 12 x 12 samples, every pixel shaded)")
     ap.add_argument("--motion-truth", action="store_true",
                     help="also render the first and last frame of each animation in Cycles (both seeds, cached) and "
                          "report the motion's own change per frame")

@@ -304,15 +304,15 @@ static uint32_t group_rays(const gb_job *job, const vsgl_gbuffer *sub, size_t *f
 }
 
 /* A group of rays on a curved surface (its normals' mean resultant length
- * below 1 - SPLIT_SPREAD) is split in two, again and again, while its pixel
- * has slots to spare: the shade stage shades one point per slot, and across
- * a glossy sphere's rim one point with the group's mean normal (its lobe
- * widened by the spread, shade.c) is not the mean of the light over the
- * rim. Against 16 x 16 samples shaded one by one, a glossy cylinder's rim
- * pixels were off by 13.8 % of their glossy light, split 6.3 %
+ * below 1 - SPLIT_SPREAD) takes the slots its pixel has to spare, cut into
+ * runs (split_curved): the shade stage shades one point per slot, and
+ * across a glossy sphere's rim one point with the group's mean normal (its
+ * lobe widened by the spread, shade.c) is not the mean of the light over
+ * the rim. Against 16 x 16 samples shaded one by one, a glossy cylinder's
+ * rim pixels were off by 13.8 % of their glossy light, cut 5.9 %
  * (tests/c/test_render.c); the sphere room's glossy change as the camera
- * moves, above Cycles' own, 0.0145 -> 0.0105 at 80 x 60 (docs/accuracy.md,
- * "A curved rim shaded at several points"). Flat groups are not split
+ * moves, above Cycles' own, 0.0145 -> 0.0099 at 80 x 60 (docs/accuracy.md,
+ * "A curved rim shaded at several points"). Flat groups are not cut
  * (their slot already takes their rays' mean point): splitting them too
  * lowered the camera animations' excess in the flat rooms a little more,
  * but at 960 x 540 balanced, where one pixel in 5 x 5 is shaded and every
@@ -473,7 +473,7 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, vsgl_hit *hits, u
     for (uint32_t q = 0; q < groups; ++q) {
         /* the member nearest the group's centre (ties: the first) */
         float mx = cx[q] / (float)count[q], my = cy[q] / (float)count[q], best = 1e30f;
-        uint32_t rep = 0; /* (every group has a member: split_curved cuts a group into at most as many runs as it has rays) */
+        uint32_t rep = 0; /* (every group has a member: split_curved makes no more runs than rays) */
         for (uint32_t s = 0; s < n; ++s) {
             if (group[s] != q)
                 continue;
