@@ -917,10 +917,13 @@ k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
         gint = t->gpre[i] * k_exp(t->expo[i]);
     else if (form == 1)  /* the planar model alone */
         gint = t->ppre[i] * k_exp(t->pexpo[i]);
-    else if (form == 3) /* the half-vector model (its weight in ppre) */
-        gint = L->planar * t->ppre[i] * k_exp(t->pexpo[i]);
-    else
-        gint = (1.0f - L->planar) * t->gpre[i] * k_exp(t->expo[i]) + L->planar * t->ppre[i] * k_exp(t->pexpo[i]);
+    else {
+        const float P = vsgl__planar_weight(L->planar, L->bump, b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz);
+        if (form == 3) /* the half-vector model (its weight in ppre) */
+            gint = P * t->ppre[i] * k_exp(t->pexpo[i]);
+        else
+            gint = (1.0f - P) * t->gpre[i] * k_exp(t->expo[i]) + P * t->ppre[i] * k_exp(t->pexpo[i]);
+    }
     b->ls[0][i] += L->pr * gint * b->f0r[i];
     b->ls[1][i] += L->pg * gint * b->f0g[i];
     b->ls[2][i] += L->pb * gint * b->f0b[i];

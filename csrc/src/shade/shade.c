@@ -725,12 +725,14 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
             const vsgl_asg whole = lobe; /* its spread sets the tilt of every part (the kernel's b->lam, b->mu) */
             if (j->s->glossy_mode != VSGL_GLOSSY_SG && parts == 2)
                 lobe = ggx_part(&r->asg, q);
-            float k2 = v->coherence * v->coherence;
+            float k2 = vsgl__planar_weight(v->coherence * v->coherence, vsgl__planar_bump(v->coherence),
+                                           v3_dot(r->n, v->normal));
             gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * planar_glossy(v, r->x, r->n, &lobe, &whole, r);
         }
         sum += gi;
     }
-    return sum + v->coherence * v->coherence * hw * hv;
+    return sum + vsgl__planar_weight(v->coherence * v->coherence, vsgl__planar_bump(v->coherence),
+                                     v3_dot(r->n, v->normal)) * hw * hv;
 }
 
 static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
@@ -1555,6 +1557,7 @@ vsgl_result vsgl__shade_planned(vsgl_context *ctx, const vsgl_scene *scene, cons
             o->ibehind = 1.0f / (fw + VSGL__TINY);
             o->boff = fs * o->ibehind;
             o->planar = leak && v->lobe == VSGL__LOBE_DIFFUSE ? v->coherence * v->coherence : 0.0f;
+            o->bump = o->planar > 0.0f ? vsgl__planar_bump(v->coherence) : 0.0f;
             o->pvar = v->variance + v->widen;
             v3 u1, u2;
             cell_cuts cuts;
