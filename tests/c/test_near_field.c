@@ -360,13 +360,21 @@ VT_TEST(lattice_specular_tail_against_brute_force)
 
 /* The fixture room with its floor a gentle heightfield: z = A sin(2 pi x /
  * L) sin(2 pi y / L), A = 2 cm, L = 0.5 m (slopes up to 14 degrees), a
- * grid of 2 x 32 x 32 triangles. *fx keeps the walls; the floor's arrays
- * are the caller's (positions 3 x (4 x 4 walls + 33 x 33), indices 3 x
- * (8 + 2048)). */
+ * grid of 2 x 32 x 32 triangles, its material the fixture floor's of the
+ * given roughness. fx keeps the walls; desc is the whole scene. */
 #define BUMPY_N 32
-static void bumpy_room_rough(fx_scene *fx, uint32_t W, uint32_t H, float *pos, uint32_t *idx, uint32_t *mat,
-                             vsgl_scene_desc *d, float floor_roughness)
+typedef struct bumpy_scene {
+    fx_scene fx;
+    float pos[3 * (16 + (BUMPY_N + 1) * (BUMPY_N + 1))];
+    uint32_t idx[3 * (8 + 2 * BUMPY_N * BUMPY_N)], mat[8 + 2 * BUMPY_N * BUMPY_N];
+    vsgl_scene_desc desc;
+} bumpy_scene;
+
+static void bumpy_room(bumpy_scene *s, uint32_t W, uint32_t H, float floor_roughness)
 {
+    fx_scene *fx = &s->fx;
+    float *pos = s->pos;
+    uint32_t *idx = s->idx, *mat = s->mat;
     fx_room(fx, W, H, floor_roughness, 150.0f);
     /* the walls and ceiling: vertices 4.., triangles 2.. of the fixture */
     uint32_t nv = 0, nt = 0;
@@ -397,6 +405,7 @@ static void bumpy_room_rough(fx_scene *fx, uint32_t W, uint32_t H, float *pos, u
             }
         }
     fx_desc(fx);
+    vsgl_scene_desc *d = &s->desc;
     *d = fx->desc;
     d->vertex_count = nv;
     d->positions = pos;
@@ -405,13 +414,19 @@ static void bumpy_room_rough(fx_scene *fx, uint32_t W, uint32_t H, float *pos, u
     d->material_indices = mat;
 }
 
-static void bumpy_room(fx_scene *fx, uint32_t W, uint32_t H, float *pos, uint32_t *idx, uint32_t *mat,
-                       vsgl_scene_desc *d)
+/* bumpy_room's scene, in a context of all cores (*ctx); NULL if either
+ * cannot be made (*ctx then says why, or is NULL). */
+static vsgl_scene *bumpy_create(bumpy_scene *room, uint32_t W, uint32_t H, float floor_roughness, vsgl_context **ctx)
 {
-    bumpy_room_rough(fx, W, H, pos, idx, mat, d, 1.0f);
+    bumpy_room(room, W, H, floor_roughness);
+    vsgl_scene *scene = NULL;
+    *ctx = fx_context(0);
+    if (!*ctx || vsgl_scene_create(*ctx, &room->desc, &scene) != VSGL_OK)
+        return NULL;
+    return scene;
 }
 
-/* A gently bumped floor (bumpy_room) lit by the spot beside a wall: its
+/* A gently bumped floor (bumpy_room, matte) lit by the spot beside a wall: its
  * clusters are nearly planar, and the near field takes them for the
  * receivers across their plane (VSGL__NEAR_FACING_*, _ACROSS_*: the
  * wall's foot): the lattice's diffuse relMSE against the brute force at
@@ -421,15 +436,10 @@ static void bumpy_room(fx_scene *fx, uint32_t W, uint32_t H, float *pos, uint32_
 VT_TEST(near_field_takes_a_gently_bumped_floor)
 {
     const uint32_t W = 64, H = 48;
-    static fx_scene fx;
-    static float pos[3 * (16 + (BUMPY_N + 1) * (BUMPY_N + 1))];
-    static uint32_t idx[3 * (8 + 2 * BUMPY_N * BUMPY_N)], mat[8 + 2 * BUMPY_N * BUMPY_N];
-    vsgl_scene_desc d;
-    bumpy_room(&fx, W, H, pos, idx, mat, &d);
-    vsgl_context *ctx = fx_context(0);
-    VT_REQUIRE(ctx, "context");
-    vsgl_scene *scene;
-    VT_REQUIRE(vsgl_scene_create(ctx, &d, &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    static bumpy_scene room;
+    vsgl_context *ctx;
+    vsgl_scene *scene = bumpy_create(&room, W, H, 1.0f, &ctx);
+    VT_REQUIRE(scene, "scene: %s", ctx ? vsgl_context_last_error(ctx) : "no context");
     size_t n = (size_t)W * H * 3;
     const int32_t method[3] = {VSGL_METHOD_BRUTE_FORCE, VSGL_METHOD_VSGL, VSGL_METHOD_VSGL};
     const int32_t leak[3] = {VSGL_LEAK_AUTO, VSGL_LEAK_AUTO, VSGL_LEAK_CLIP};
@@ -464,15 +474,10 @@ VT_TEST(near_field_takes_a_gently_bumped_floor)
 VT_TEST(planar_glossy_lets_a_bumpy_floor_reflect_itself)
 {
     const uint32_t W = 64, H = 48;
-    static fx_scene fx;
-    static float pos[3 * (16 + (BUMPY_N + 1) * (BUMPY_N + 1))];
-    static uint32_t idx[3 * (8 + 2 * BUMPY_N * BUMPY_N)], mat[8 + 2 * BUMPY_N * BUMPY_N];
-    vsgl_scene_desc d;
-    bumpy_room_rough(&fx, W, H, pos, idx, mat, &d, 0.3f);
-    vsgl_context *ctx = fx_context(0);
-    VT_REQUIRE(ctx, "context");
-    vsgl_scene *scene;
-    VT_REQUIRE(vsgl_scene_create(ctx, &d, &scene) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
+    static bumpy_scene room;
+    vsgl_context *ctx;
+    vsgl_scene *scene = bumpy_create(&room, W, H, 0.3f, &ctx);
+    VT_REQUIRE(scene, "scene: %s", ctx ? vsgl_context_last_error(ctx) : "no context");
     float *brute = render_pass(ctx, scene, W, H, VSGL_METHOD_BRUTE_FORCE, VSGL_LEAK_AUTO, 128, NULL, 1);
     float *vsgl = render_pass(ctx, scene, W, H, VSGL_METHOD_VSGL, VSGL_LEAK_AUTO, 256, NULL, 1);
     VT_REQUIRE(brute && vsgl, "render: %s", vsgl_context_last_error(ctx));
