@@ -81,7 +81,8 @@ ACCEPT = dict(flicker=0.01, bias=0.05, bias_preview=0.30, structured_x=3.0)
 # render's own change above Cycles' motion (Gloss in the sphere room / Diff in the textured room / Gloss
 # in the rough room): 8 x 8 samples 0.0168 / 0.0032 / 0.0192 (aliasing at the sphere's glossy rim);
 # 8 x 8 with 16 x 16 edge rays 0.0082 / 0.0153 / 0.0215 (an edge pixel's flat group takes one texture
-# sample); 12 x 12 0.0063 / 0.0025 / 0.0126 (docs/accuracy.md, "A curved rim shaded at several points").
+# lookup filtered over a quarter pixel); 12 x 12 0.0063 / 0.0025 / 0.0126 (docs/accuracy.md, "A curved rim
+# shaded at several points").
 CAMERA_TRUTH = ("balanced", dict(aa_samples=12, shade_stride=1, edge_samples=0, visibility=0))
 # The motion's own change in Cycles (--motion-truth), rendered with both reference seeds; the product of
 # the two seeds' frame differences gives the per-frame change without their noise. Every frame of both

@@ -705,8 +705,9 @@ static float glossy_integral(const shade_job *j, const receiver *r, const vsgl_s
 
 /* The glossy light of VSGL v through the receiver's lobe (each part of it
  * for GGX's core and tail): the SG model, and for a coherent diffuse
- * cluster with the clip the planar model blended in by coherence^2, as the
- * kernel does. */
+ * cluster with the clip the planar model blended in by coherence^2 (less
+ * for a receiver on the same bumpy surface: kernel.h vsgl__planar_weight),
+ * as the kernel does. */
 static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl *v, const vsgl_sg *in, v3 *axis)
 {
     int parts = two_lobes(j->s->glossy_mode) ? 2 : 1;
@@ -714,6 +715,9 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
     /* with GGX as lobes, a planar cluster that subtends little through the
      * half-vector model (halfvec.h), the planar one taking the rest */
     float hw = 0.0f, hv = 0.0f;
+    /* the planar model's weight for this receiver (kernel.h vsgl__planar_weight) */
+    const float k2 = vsgl__planar_weight(v->coherence * v->coherence, vsgl__planar_bump(v->coherence),
+                                         v3_dot(r->n, v->normal));
     if (parts == 2 && j->leak && v->lobe == VSGL__LOBE_DIFFUSE && v->coherence > 0.0f)
         hv = vsgl__halfvec_glossy(v, r->x, r->n, r->o, r->asg.z, hv_alpha(r), (int)j->s->glossy_lobes, r->fres, &hw);
     for (int q = 0; q < parts; ++q) {
@@ -725,14 +729,11 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
             const vsgl_asg whole = lobe; /* its spread sets the tilt of every part (the kernel's b->lam, b->mu) */
             if (j->s->glossy_mode != VSGL_GLOSSY_SG && parts == 2)
                 lobe = ggx_part(&r->asg, q);
-            float k2 = vsgl__planar_weight(v->coherence * v->coherence, vsgl__planar_bump(v->coherence),
-                                           v3_dot(r->n, v->normal));
             gi = (1.0f - k2) * gi + k2 * (1.0f - hw) * planar_glossy(v, r->x, r->n, &lobe, &whole, r);
         }
         sum += gi;
     }
-    return sum + vsgl__planar_weight(v->coherence * v->coherence, vsgl__planar_bump(v->coherence),
-                                     v3_dot(r->n, v->normal)) * hw * hv;
+    return sum + k2 * hw * hv;
 }
 
 static int32_t shade_chunk(void *user, size_t chunk, size_t b, size_t e)
