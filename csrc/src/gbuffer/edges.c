@@ -503,7 +503,7 @@ static void refine_pixel(const gb_job *job, vsgl_gbuffer *sub, vsgl_hit *hits, u
      * pixel at aa 1): not refined for the shade stage (gbuffer.h refined) */
     int grid = groups == pieces;
     for (uint32_t q = 0; q < spp && grid; ++q)
-        grid = g->weight[base + q] == (q < job->aa * job->aa ? 1.0f / (float)(job->aa * job->aa) : 0.0f);
+        grid = g->weight[base + q] == vsgl__gbuffer_grid_weight(job->aa, q);
     if (grid)
         job->edge[(size_t)y * g->width + x] = VSGL__GBUFFER_TRACED;
 }

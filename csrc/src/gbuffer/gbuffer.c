@@ -323,7 +323,7 @@ vsgl_result vsgl__gbuffer_build(vsgl_context *ctx, const vsgl_scene *scene, uint
         return r;
     if (refine) {
         for (size_t i = 0; i < out->count; ++i) {
-            out->weight[i] = i % spp < aa * aa ? 1.0f / (float)(aa * aa) : 0.0f;
+            out->weight[i] = vsgl__gbuffer_grid_weight(aa, i % spp);
             out->spread[i] = 1.0f;
         }
         job.edge = calloc((size_t)out->width * out->height + 1, 1);

@@ -87,6 +87,13 @@ static inline uint32_t vsgl__gbuffer_slots(uint32_t aa, int refine)
     return refine && aa == 1 ? 3u : aa * aa;
 }
 
+/* Slot k's share of its pixel as the aa x aa grid leaves it (before any
+ * edge refinement): 1 / (aa * aa) for the grid's samples, 0 beyond. */
+static inline float vsgl__gbuffer_grid_weight(uint32_t aa, size_t k)
+{
+    return k < (size_t)aa * aa ? 1.0f / (float)(aa * aa) : 0.0f;
+}
+
 /* Sample i's share of its pixel. */
 static inline float vsgl__gbuffer_weight(const vsgl_gbuffer *g, size_t i)
 {

@@ -237,6 +237,7 @@ typedef struct k_scratch {
     /* the half-vector model: its weight, the slope of the half vector, the
      * cluster's slope covariance, and the factor common to its lobes */
     float hvw[VSGL__KERNEL_BLOCK], hs1[VSGL__KERNEL_BLOCK], hs2[VSGL__KERNEL_BLOCK];
+    float pw[VSGL__KERNEL_BLOCK]; /* the planar model's weight per lane (kernel.h vsgl__planar_weight) */
     float hc11[VSGL__KERNEL_BLOCK], hc12[VSGL__KERNEL_BLOCK], hc22[VSGL__KERNEL_BLOCK], hpre[VSGL__KERNEL_BLOCK];
     /* D's 1 / h.n^4 x G x F at w (a lobe linearised there), Smith's view term */
     float hfw[VSGL__KERNEL_BLOCK], hso[VSGL__KERNEL_BLOCK];
@@ -917,13 +918,10 @@ k_glossy_sum(vsgl_kernel_block *restrict b, size_t i, const vsgl_kernel_light *r
         gint = t->gpre[i] * k_exp(t->expo[i]);
     else if (form == 1)  /* the planar model alone */
         gint = t->ppre[i] * k_exp(t->pexpo[i]);
-    else {
-        const float P = vsgl__planar_weight(L->planar, L->bump, b->nx[i] * L->nx + b->ny[i] * L->ny + b->nz[i] * L->nz);
-        if (form == 3) /* the half-vector model (its weight in ppre) */
-            gint = P * t->ppre[i] * k_exp(t->pexpo[i]);
-        else
-            gint = (1.0f - P) * t->gpre[i] * k_exp(t->expo[i]) + P * t->ppre[i] * k_exp(t->pexpo[i]);
-    }
+    else if (form == 3) /* the half-vector model (its weight in ppre) */
+        gint = t->pw[i] * t->ppre[i] * k_exp(t->pexpo[i]);
+    else
+        gint = (1.0f - t->pw[i]) * t->gpre[i] * k_exp(t->expo[i]) + t->pw[i] * t->ppre[i] * k_exp(t->pexpo[i]);
     b->ls[0][i] += L->pr * gint * b->f0r[i];
     b->ls[1][i] += L->pg * gint * b->f0g[i];
     b->ls[2][i] += L->pb * gint * b->f0b[i];
@@ -1022,6 +1020,16 @@ k_glossy_lights(vsgl_kernel_block *restrict b, const vsgl_kernel_light *restrict
                 hv_all &= t[j].hvw[i] == 1.0f;
             }
     }
+    /* the planar model's weight per lane, once per block and VSGL: the
+     * cluster's own (coherence^2) but on a bumpy surface's own receivers */
+    if (!none_planar)
+        for (int j = 0; j < NL; ++j) {
+            if (L[j].bump > 0.0f)
+                K_FORI(t[j].pw[i] = vsgl__planar_weight(L[j].planar, L[j].bump,
+                                                        b->nx[i] * L[j].nx + b->ny[i] * L[j].ny + b->nz[i] * L[j].nz));
+            else
+                K_FORI(t[j].pw[i] = L[j].planar);
+        }
     /* planar clusters that every lane sees through the half-vector
      * model alone: the lobes' pass would add zeros */
     const int skip_lobes = hv && hv_all && all_planar;

@@ -715,14 +715,17 @@ static float glossy_light(const shade_job *j, const receiver *r, const vsgl_vsgl
     /* with GGX as lobes, a planar cluster that subtends little through the
      * half-vector model (halfvec.h), the planar one taking the rest */
     float hw = 0.0f, hv = 0.0f;
-    /* the planar model's weight for this receiver (kernel.h vsgl__planar_weight) */
-    const float k2 = vsgl__planar_weight(v->coherence * v->coherence, vsgl__planar_bump(v->coherence),
-                                         v3_dot(r->n, v->normal));
-    if (parts == 2 && j->leak && v->lobe == VSGL__LOBE_DIFFUSE && v->coherence > 0.0f)
+    /* the planar model (a diffuse cluster, the clip on) and its weight for this receiver (kernel.h
+     * vsgl__planar_weight) */
+    const int planar = j->leak && v->lobe == VSGL__LOBE_DIFFUSE;
+    const float k2 = planar ? vsgl__planar_weight(v->coherence * v->coherence, vsgl__planar_bump(v->coherence),
+                                                  v3_dot(r->n, v->normal))
+                            : 0.0f;
+    if (parts == 2 && planar && v->coherence > 0.0f)
         hv = vsgl__halfvec_glossy(v, r->x, r->n, r->o, r->asg.z, hv_alpha(r), (int)j->s->glossy_lobes, r->fres, &hw);
     for (int q = 0; q < parts; ++q) {
         float gi = glossy_integral(j, r, in, axis, q);
-        if (j->leak && v->lobe == VSGL__LOBE_DIFFUSE) {
+        if (planar) {
             vsgl_asg lobe = r->asg;
             if (j->s->glossy_mode == VSGL_GLOSSY_SG)
                 vsgl_sg_to_asg(&r->sg, &lobe);
