@@ -919,6 +919,8 @@ static int fill_lane(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t 
  * so with aa x aa samples this shades about one sample per pixel except at
  * edges. */
 #define MERGE_COS 0.996f
+/* floats per merged group (vsgl__shade_list): position sum, count, members whose normal is not the first's */
+#define VSGL__CENTROID 5
 
 static int same_surface(const vsgl_gbuffer *g, const vsgl_material *materials, size_t a, size_t b, float plane_tol)
 {
@@ -1280,9 +1282,11 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
 }
 
 /* Shade G-buffer samples list[0..n) through the kernel, VSGL__KERNEL_BLOCK at
- * a time, each at its own position or, where centroid (4 floats per entry:
- * a position sum and a count) has a count above 1, at the centroid of a
- * merged group; writes 6 floats per entry (diffuse light RGB, glossy RGB).
+ * a time, each at its own position or, where centroid (VSGL__CENTROID
+ * floats per entry: a position sum, a count and how many members' normals
+ * differ from the first's) has a count above 1, at the centroid of a
+ * merged group; writes 6 floats per entry (diffuse light RGB, glossy
+ * RGB).
  * Every listed sample must be a hit. lanes: NULL, or n entries that
  * receive each receiver's kernel lane (a shading plan's record). Returns
  * the number of pairs. */
@@ -1298,13 +1302,23 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
         size_t n = nshaded - s0 < VSGL__KERNEL_BLOCK ? nshaded - s0 : VSGL__KERNEL_BLOCK;
         for (size_t k = 0; k < n; ++k) {
             fill_lane(j, shaded[s0 + k], &blk, k, &rec[k]); /* every shaded sample is a hit */
-            const float *cg = centroid ? centroid + (s0 + k) * 4 : NULL;
+            const float *cg = centroid ? centroid + (s0 + k) * VSGL__CENTROID : NULL;
             if (cg && cg[3] > 1.0f) { /* a merged group is shaded at its centroid: its mean light to first order */
                 float inv = 1.0f / cg[3];
-                rec[k].x = v3_make(cg[0] * inv, cg[1] * inv, cg[2] * inv);
-                blk.x[k] = rec[k].x.x;
-                blk.y[k] = rec[k].x.y;
-                blk.z[k] = rec[k].x.z;
+                v3 xc = v3_make(cg[0] * inv, cg[1] * inv, cg[2] * inv);
+                /* on a curved or faceted surface (its members' normals not
+                 * all the same) the centroid of points on two facets of a
+                 * convex mesh lies inside it, below both, and visibility
+                 * rays from there hit the mesh (the rough room's metal
+                 * sphere lost a third of its glossy light at stride 1):
+                 * there the receiver (its rays, its near field) stays at
+                 * its first sample, on the surface; the kernel takes the
+                 * centroid */
+                if (!(cg[4] > 0.0f))
+                    rec[k].x = xc;
+                blk.x[k] = xc.x;
+                blk.y[k] = xc.y;
+                blk.z[k] = xc.z;
             }
             if (lanes)
                 lane_get(&blk, k, &rec[k], &lanes[s0 + k]);
@@ -1410,7 +1424,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
     size_t *shaded = malloc((ns + 1) * sizeof *shaded);
     uint32_t *slot = malloc((ns + 1) * sizeof *slot);
     float *light = malloc((ns + 1) * 6 * sizeof *light);
-    float *centroid = calloc((ns + 1) * 4, sizeof *centroid); /* per slot: position sum, count */
+    float *centroid = calloc((ns + 1) * VSGL__CENTROID, sizeof *centroid); /* per slot (vsgl__shade_list) */
     if (!shaded || !slot || !light || !centroid) {
         free(shaded);
         free(slot);
@@ -1435,11 +1449,13 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             slot[i] = (uint32_t)nshaded;
             shaded[nshaded++] = si;
         }
-        float *cg = centroid + (size_t)slot[i] * 4;
+        float *cg = centroid + (size_t)slot[i] * VSGL__CENTROID;
         cg[0] += g->pos[0][si];
         cg[1] += g->pos[1][si];
         cg[2] += g->pos[2][si];
         cg[3] += 1.0f;
+        const size_t f = shaded[slot[i]]; /* the group's first sample */
+        cg[4] += g->nrm[0][si] != g->nrm[0][f] || g->nrm[1][si] != g->nrm[1][f] || g->nrm[2][si] != g->nrm[2][f];
     }
     pairs += vsgl__shade_list(j, shaded, nshaded, centroid, light, NULL);
     /* every covered sample: its own colours, the light of its slot */
