@@ -575,6 +575,75 @@ static void balanced_without_rays(vsgl_render_settings *s)
     s->rsm_resolution = 64;
 }
 
+/* The anchors sit at S c and on the last pixel (sparse.c): where the
+ * image's side minus one is not a multiple of S, the last cell is narrower
+ * than S, and its samples must be weighted across its own width (weighted
+ * as if it were S wide, the last column's samples took half their light
+ * from the anchor a pixel before it); and with more than one sample per
+ * pixel, the last pixel's later samples lie past the last anchor (shaded
+ * at the pixel's first), where interpolation would extrapolate: they are
+ * shaded themselves. The fixture room seen from inside (every pixel on a
+ * wall) at stride 4 without visibility rays: 242 x 182 and 244 x 184 at
+ * 1 x 1 samples (the last cells 1 and 3 pixels wide), 243 x 183 at 3 x 3
+ * (2 pixels). The relative RMS difference of the diffuse light from every
+ * pixel shaded, in the last cells against the two rings of full cells
+ * before them (0.0023-0.0024): weighted as if S wide 0.0054 / 0.0047 /
+ * 0.0076, by their width 0.0009 / 0.0024 / 0.0035, with the samples past
+ * the anchor shaded 0.0012 at 3 x 3. Asks < 1.5x the cells before. */
+VT_TEST(render_shade_stride_weights_the_last_cell_by_its_width)
+{
+    vsgl_render_settings s;
+    balanced_without_rays(&s);
+    const uint32_t sizes[3][3] = {{242, 182, 1}, {244, 184, 1}, {243, 183, 3}}; /* width, height, aa */
+    for (int z = 0; z < 3; ++z) {
+        const uint32_t SW = sizes[z][0], SH = sizes[z][1];
+        s.aa_samples = sizes[z][2];
+        static fx_scene fx;
+        fx_room(&fx, SW, SH, 0.25f, 200.0f);
+        const float eye[3] = {0.0f, -0.95f, 1.0f}, at[3] = {0.0f, 1.0f, 0.7f};
+        fx_camera(&fx, eye, at, 20.0f, SW, SH);
+        vsgl_context *ctx = fx_context(0);
+        vsgl_scene *scene = NULL;
+        VT_REQUIRE(ctx && vsgl_scene_create(ctx, fx_desc(&fx), &scene) == VSGL_OK, "scene: %s",
+                   ctx ? vsgl_context_last_error(ctx) : "no context");
+        float *dl[2];
+        for (int k = 0; k < 2; ++k) {
+            vsgl_render_settings t = s;
+            t.shade_stride = k ? 4 : 1;
+            dl[k] = calloc((size_t)SW * SH * 3, sizeof(float));
+            vsgl_render_output o;
+            memset(&o, 0, sizeof o);
+            o.width = SW;
+            o.height = SH;
+            o.diffuse_light = dl[k];
+            VT_REQUIRE(vsgl_render(ctx, scene, &t, &o, NULL) == VSGL_OK, "render: %s", vsgl_context_last_error(ctx));
+        }
+        /* the columns and rows past the last anchor at a multiple of 4, in
+         * the narrow last cells, against those of the full cells before */
+        const uint32_t lx = (SW - 1) / 4 * 4, ly = (SH - 1) / 4 * 4;
+        double e[2] = {0, 0}, r[2] = {0, 0};
+        for (uint32_t y = 0; y < SH; ++y)
+            for (uint32_t x = 0; x < SW; ++x) {
+                const int q = x > lx || y > ly ? 0 : (x + 8 > lx || y + 8 > ly ? 1 : -1);
+                for (int c = 0; c < 3 && q >= 0; ++c) {
+                    const size_t i = ((size_t)y * SW + x) * 3 + (size_t)c;
+                    const double d = (double)dl[1][i] - dl[0][i];
+                    e[q] += d * d;
+                    r[q] += (double)dl[0][i] * dl[0][i];
+                }
+            }
+        const double eb = r[0] > 0.0 ? sqrt(e[0] / r[0]) : 1.0, ec = r[1] > 0.0 ? sqrt(e[1] / r[1]) : 1.0;
+        printf("    %u x %u, aa %u, stride 4: relative RMS difference from every pixel shaded %.4f in the last cells, "
+               "%.4f in the two rings of cells before\n", SW, SH, s.aa_samples, eb, ec);
+        VT_CHECK(r[0] > 0.0 && r[1] > 0.0, "%u x %u: no light on the border", SW, SH);
+        VT_CHECK(eb < 1.5 * ec, "%u x %u: the last cells' %.4f against the cells before %.4f", SW, SH, eb, ec);
+        free(dl[0]);
+        free(dl[1]);
+        vsgl_scene_destroy(scene);
+        vsgl_context_destroy(ctx);
+    }
+}
+
 /* At shade_stride 2 every pixel that edge refinement rewrote is shaded
  * itself, as at stride 1: its slots stand for groups of rays anywhere in
  * the pixel, which no anchor cell describes. Interpolated at its slots'

@@ -253,14 +253,10 @@ static inline void sample_cell(const shade_job *j, size_t si, size_t spp, uint32
                                uint32_t *ay, float *tx, float *ty)
 {
     const size_t W = j->g->width, px = si / spp, k = si % spp;
-    const float inv_s = 1.0f / (float)j->stride;
     float ox, oy;
     sparse_slot_offset(k, aa, inv_aa, &ox, &oy);
-    float fx = ((float)(px % W) + ox) * inv_s, fy = ((float)(px / W) + oy) * inv_s;
-    *ax = (uint32_t)fx;
-    *ay = (uint32_t)fy;
-    *tx = fx - (float)*ax;
-    *ty = fy - (float)*ay;
+    sparse_axis_cell((uint32_t)(px % W), ox, j->stride, j->g->width, ax, tx);
+    sparse_axis_cell((uint32_t)(px / W), oy, j->stride, j->g->height, ay, ty);
 }
 
 /* Rows [b0, e0) of the batch (one row per chunk) of a render without a
@@ -297,7 +293,8 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
                 if (cx >= j->aw || cy >= j->ah)
                     continue;
                 size_t a = (size_t)cy * j->aw + cx, as = j->anchor_sample[a];
-                float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
+                float wb = (dx ? sparse_t_weight(tx) : 1.0f - sparse_t_weight(tx)) *
+                           (dy ? sparse_t_weight(ty) : 1.0f - sparse_t_weight(ty));
                 if (as == SIZE_MAX || !(wb > 0.0f))
                     continue;
                 float w = wb * (as == si ? 1.0f : same_surface_weight(j, si, as));
@@ -345,7 +342,7 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
             if (!(t < 1.0f))
                 t = 1.0f;
         }
-        if (t < 1.0f && (refined || sparse_junction(same, sparse_touching(same, other, ad2))))
+        if (t < 1.0f && (refined || sparse_past_anchor(tx, ty) || sparse_junction(same, sparse_touching(same, other, ad2))))
             t = 1.0f;
         if (t < 1.0f)
             for (int c = 0; c < 6; ++c)
@@ -643,7 +640,8 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
                     if (cx >= aw || cy >= ah)
                         continue;
                     size_t a = (size_t)cy * aw + cx, as = j->anchor_sample[a];
-                    float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
+                    float wb = (dx ? sparse_t_weight(tx) : 1.0f - sparse_t_weight(tx)) *
+                               (dy ? sparse_t_weight(ty) : 1.0f - sparse_t_weight(ty));
                     if (as == SIZE_MAX || !(wb > 0.0f))
                         continue;
                     float wa = wb * (as == si ? 1.0f : packed_surface_weight(j, n, xs, m, plan->geo + a * 8));

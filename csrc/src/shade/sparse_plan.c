@@ -35,15 +35,12 @@ void vsgl__shade_plan_free(vsgl_shade_plan *p)
 /* The anchor cell of slot k of column x (or row y): as sample_cell. */
 static void cell_table(uint32_t n, size_t spp, uint32_t aa, uint32_t stride, uint32_t *cell, float *t, int rows)
 {
-    const float inv_aa = 1.0f / (float)aa, inv_s = 1.0f / (float)stride;
+    const float inv_aa = 1.0f / (float)aa;
     for (uint32_t x = 0; x < n; ++x)
         for (size_t k = 0; k < spp; ++k) {
             float ox, oy;
             sparse_slot_offset(k, aa, inv_aa, &ox, &oy);
-            float f = ((float)x + (rows ? oy : ox)) * inv_s;
-            uint32_t c = (uint32_t)f;
-            cell[(size_t)x * spp + k] = c;
-            t[(size_t)x * spp + k] = f - (float)c;
+            sparse_axis_cell(x, rows ? oy : ox, stride, n, &cell[(size_t)x * spp + k], &t[(size_t)x * spp + k]);
         }
 }
 

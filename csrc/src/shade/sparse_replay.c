@@ -93,6 +93,10 @@ void vsgl__sparse_anchor_pack(shade_job *j)
 static inline int replay_sample(const shade_job *j, const float *pack, const float *w, uint32_t ax, uint32_t ay,
                                 float tx, float ty, float *out, float *t)
 {
+    if (sparse_past_anchor(tx, ty)) { /* extrapolated: shaded itself */
+        *t = 1.0f;
+        return 0;
+    }
     const size_t a0 = (size_t)ay * j->aw + ax;
     const size_t sx = ax + 1 < j->aw ? 1 : 0, sy = ay + 1 < j->ah ? j->aw : 0; /* (off the lattice: weight 0) */
     const float *q[4] = {pack + a0 * 12, pack + (a0 + sx) * 12, pack + (a0 + sy) * 12, pack + (a0 + sx + sy) * 12};
