@@ -28,6 +28,20 @@ static vsgl_render_output bind(planes *p)
     return o;
 }
 
+/* Render w x h of scene with settings s into the diffuse and glossy light
+ * planes dl, gl (either NULL: not asked for). */
+static vsgl_result render_light(vsgl_context *ctx, const vsgl_scene *scene, const vsgl_render_settings *s, uint32_t w,
+                                uint32_t h, float *dl, float *gl)
+{
+    vsgl_render_output o;
+    memset(&o, 0, sizeof o);
+    o.width = w;
+    o.height = h;
+    o.diffuse_light = dl;
+    o.glossy_light = gl;
+    return vsgl_render(ctx, scene, s, &o, NULL);
+}
+
 static vsgl_result render_room_flags(uint32_t threads, const vsgl_render_settings *s, planes *p,
                                      vsgl_render_stats *st, char *err, size_t errlen, uint32_t material_flags)
 {
@@ -611,12 +625,8 @@ VT_TEST(render_shade_stride_weights_the_last_cell_by_its_width)
             vsgl_render_settings t = s;
             t.shade_stride = k ? 4 : 1;
             dl[k] = calloc((size_t)SW * SH * 3, sizeof(float));
-            vsgl_render_output o;
-            memset(&o, 0, sizeof o);
-            o.width = SW;
-            o.height = SH;
-            o.diffuse_light = dl[k];
-            VT_REQUIRE(vsgl_render(ctx, scene, &t, &o, NULL) == VSGL_OK, "render: %s", vsgl_context_last_error(ctx));
+            VT_REQUIRE(render_light(ctx, scene, &t, SW, SH, dl[k], NULL) == VSGL_OK, "render: %s",
+                       vsgl_context_last_error(ctx));
         }
         /* the columns and rows past the last anchor at a multiple of 4, in
          * the narrow last cells, against those of the full cells before */
@@ -871,6 +881,19 @@ static void fx_room_cylinder(fx_scene *fx, float *cn, uint32_t w, uint32_t h, fl
         }
 }
 
+/* Scene of fx (its corner normals cn) in ctx; NULL (and a failed check) if
+ * it cannot be made. */
+static vsgl_scene *scene_with_normals(vsgl_context *ctx, fx_scene *fx, const float *cn)
+{
+    vsgl_scene *scene = NULL;
+    fx_desc(fx);
+    fx->desc.corner_normals = cn;
+    VT_CHECK(ctx && vsgl_scene_create(ctx, &fx->desc, &scene) == VSGL_OK, "scene: %s",
+             ctx ? vsgl_context_last_error(ctx) : "no context");
+    return scene;
+}
+
+
 /* An edge pixel on a curved surface's silhouette is shaded at more than
  * one point when it has slots to spare (edges.c split_curved): across a
  * glossy cylinder's rim the normal turns by tens of degrees within a
@@ -891,11 +914,8 @@ VT_TEST(render_edge_pixels_shade_a_curved_rim_at_several_points)
     balanced_without_rays(&s);
     s.shade_stride = 1;
     vsgl_context *ctx = fx_context(0);
-    vsgl_scene *scene = NULL;
-    fx_desc(&fx);
-    fx.desc.corner_normals = cn;
-    VT_REQUIRE(ctx && vsgl_scene_create(ctx, &fx.desc, &scene) == VSGL_OK, "scene: %s",
-               ctx ? vsgl_context_last_error(ctx) : "no context");
+    vsgl_scene *scene = scene_with_normals(ctx, &fx, cn);
+    VT_REQUIRE(scene != NULL, "no scene");
     float *gl[2];
     for (int k = 0; k < 2; ++k) {
         vsgl_render_settings t = s;
@@ -905,12 +925,8 @@ VT_TEST(render_edge_pixels_shade_a_curved_rim_at_several_points)
             t.aa_pixel_limit = 0;
         }
         gl[k] = calloc((size_t)SW * SH * 3, sizeof(float));
-        vsgl_render_output o;
-        memset(&o, 0, sizeof o);
-        o.width = SW;
-        o.height = SH;
-        o.glossy_light = gl[k];
-        VT_REQUIRE(vsgl_render(ctx, scene, &t, &o, NULL) == VSGL_OK, "render %d: %s", k, vsgl_context_last_error(ctx));
+        VT_REQUIRE(render_light(ctx, scene, &t, SW, SH, NULL, gl[k]) == VSGL_OK, "render %d: %s", k,
+                   vsgl_context_last_error(ctx));
     }
     /* the rim: refined pixels with a slot on the cylinder (horizontal normal, material 0) */
     vsgl_gbuffer g;
@@ -971,11 +987,8 @@ VT_TEST(render_merged_samples_see_past_their_own_mesh)
     s.rsm_resolution = 64;
     s.shade_stride = 1;
     vsgl_context *ctx = fx_context(0);
-    vsgl_scene *scene = NULL;
-    fx_desc(&fx);
-    fx.desc.corner_normals = cn;
-    VT_REQUIRE(ctx && vsgl_scene_create(ctx, &fx.desc, &scene) == VSGL_OK, "scene: %s",
-               ctx ? vsgl_context_last_error(ctx) : "no context");
+    vsgl_scene *scene = scene_with_normals(ctx, &fx, cn);
+    VT_REQUIRE(scene != NULL, "no scene");
     vsgl_gbuffer g;
     memset(&g, 0, sizeof g);
     VT_REQUIRE(vsgl__gbuffer_build(ctx, scene, s.aa_samples, 0, &g) == VSGL_OK, "G-buffer: %s",
@@ -989,12 +1002,8 @@ VT_TEST(render_merged_samples_see_past_their_own_mesh)
             vsgl_render_settings t = s;
             t.visibility = r ? VSGL_VISIBILITY_NONE : VSGL_VISIBILITY_RAY;
             t.sample_merging = k ? VSGL_MERGE_OFF : VSGL_MERGE_AUTO;
-            vsgl_render_output o;
-            memset(&o, 0, sizeof o);
-            o.width = SW;
-            o.height = SH;
-            o.diffuse_light = dl;
-            VT_REQUIRE(vsgl_render(ctx, scene, &t, &o, NULL) == VSGL_OK, "render: %s", vsgl_context_last_error(ctx));
+            VT_REQUIRE(render_light(ctx, scene, &t, SW, SH, dl, NULL) == VSGL_OK, "render: %s",
+                       vsgl_context_last_error(ctx));
             on = 0;
             for (size_t px = 0; px < (size_t)SW * SH; ++px) { /* pixels whose samples all lie on the cylinder */
                 int all = 1;
