@@ -972,8 +972,10 @@ VT_TEST(render_edge_pixels_shade_a_curved_rim_at_several_points)
  * not merge). Here a smooth white cylinder of 24 facets (diffuse: it
  * merges) in the fixture room, 2 x 2 samples, every pixel shaded: its
  * diffuse light merged over every sample shaded, with visibility rays and
- * without. Merging alone (without rays) gives 1.0126; with rays from the
- * centroid it was 0.9430, from the group's first sample it is 1.0139. */
+ * without. With rays from the centroid it was 0.9430 (1.0126 without
+ * rays: the group took its first sample's normal, off to one side); from
+ * the group's first sample 1.0139; with the group's mean normal too,
+ * 1.0003 with and without. */
 VT_TEST(render_merged_samples_see_past_their_own_mesh)
 {
     enum { SW = 80, SH = 60 };
@@ -1019,7 +1021,7 @@ VT_TEST(render_merged_samples_see_past_their_own_mesh)
     printf("    %zu pixels on the cylinder: diffuse light merged / every sample shaded %.4f with visibility rays, "
            "%.4f without\n", on, ratio[0], ratio[1]);
     VT_CHECK(on >= 200, "%zu pixels on the cylinder: the test cannot tell", on);
-    VT_CHECK(fabs(ratio[1] - 1.0) < 0.03, "merging alone changes the light by %.4f", ratio[1]);
+    VT_CHECK(fabs(ratio[1] - 1.0) < 0.005, "merging alone changes the light by %.4f", ratio[1]);
     VT_CHECK(fabs(ratio[0] - ratio[1]) < 0.005, "merged samples' rays change their light by %.4f (%.4f / %.4f)",
              ratio[0] / ratio[1], ratio[0], ratio[1]);
     vsgl__gbuffer_free(&g);
