@@ -1308,8 +1308,8 @@ static uint64_t run_block(const shade_job *j, const vis_scratch *vs, vsgl_kernel
  * a time, each at its own position or, where centroid (VSGL__CENTROID
  * floats per entry: a position sum, a count, how many members' normals
  * differ from the first's and their sum) has a count above 1, at the
- * centroid of a merged group; writes 6 floats per entry (diffuse light RGB, glossy
- * RGB).
+ * centroid of a merged group; writes 6 floats per entry (diffuse light
+ * RGB, glossy RGB).
  * Every listed sample must be a hit. lanes: NULL, or n entries that
  * receive each receiver's kernel lane (a shading plan's record). Returns
  * the number of pairs. */
@@ -1330,9 +1330,9 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
              * sample's is off to one side (a smooth diffuse cylinder's
              * merged light was 1.3 % over every sample shaded, a rough
              * metal sphere's ~3 % under) */
-            v3 nm = cg && cg[3] > 1.0f && cg[4] > 0.0f ? v3_normalize(v3_make(cg[5], cg[6], cg[7])) : v3_make(0, 0, 0);
-            fill_lane_n(j, shaded[s0 + k], &blk, k, &rec[k], /* every shaded sample is a hit */
-                        cg && cg[3] > 1.0f && cg[4] > 0.0f ? &nm : NULL);
+            const int curved = cg && cg[3] > 1.0f && cg[4] > 0.0f;
+            v3 nm = curved ? v3_normalize(v3_make(cg[5], cg[6], cg[7])) : v3_make(0.0f, 0.0f, 0.0f);
+            fill_lane_n(j, shaded[s0 + k], &blk, k, &rec[k], curved ? &nm : NULL); /* every shaded sample is a hit */
             if (cg && cg[3] > 1.0f) { /* a merged group is shaded at its centroid: its mean light to first order */
                 float inv = 1.0f / cg[3];
                 v3 xc = v3_make(cg[0] * inv, cg[1] * inv, cg[2] * inv);
@@ -1344,7 +1344,7 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
                  * there the receiver (its rays, its near field) stays at
                  * its first sample, on the surface; the kernel takes the
                  * centroid */
-                if (!(cg[4] > 0.0f))
+                if (!curved)
                     rec[k].x = xc;
                 blk.x[k] = xc.x;
                 blk.y[k] = xc.y;
