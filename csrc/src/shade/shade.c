@@ -457,15 +457,9 @@ static void setup_receiver_n(const shade_job *j, size_t i, receiver *r, const v3
         vsgl_warp_ndf_sg(&ndf, &r->o, &r->sg);
         r->sm = vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, r->sg.axis), 0);
     } else {
+        /* (with a normal nm the tangent is not orthogonal to it: the lobe's
+         * frame makes it so, math/lobes.c make_frame) */
         v3 t = v3_make(g->tan[0][i], g->tan[1][i], g->tan[2][i]);
-        if (nm) { /* the tangent made orthogonal to the normal taken */
-            v3 tt = v3_sub(t, v3_scale(r->n, v3_dot(t, r->n)));
-            float l = v3_length(tt);
-            if (l > 1e-6f)
-                t = v3_scale(tt, 1.0f / l);
-            else
-                v3_basis(r->n, &t, &tt);
-        }
         /* a rough lobe widened and scaled to be closest to GGX's (math/broad_lobe.h) */
         float bscale, bamp;
         vsgl__broad_lobe(r->alpha, (r->bp.f0[0] + r->bp.f0[1] + r->bp.f0[2]) * (1.0f / 3.0f), v3_dot(r->n, r->o),

@@ -293,8 +293,7 @@ static int32_t sparse_classify(void *user, size_t chunk, size_t b0, size_t e0)
                 if (cx >= j->aw || cy >= j->ah)
                     continue;
                 size_t a = (size_t)cy * j->aw + cx, as = j->anchor_sample[a];
-                float wb = (dx ? sparse_t_weight(tx) : 1.0f - sparse_t_weight(tx)) *
-                           (dy ? sparse_t_weight(ty) : 1.0f - sparse_t_weight(ty));
+                float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
                 if (as == SIZE_MAX || !(wb > 0.0f))
                     continue;
                 float w = wb * (as == si ? 1.0f : same_surface_weight(j, si, as));
@@ -640,8 +639,7 @@ static int32_t record_rows(void *user, size_t chunk, size_t b0, size_t e0)
                     if (cx >= aw || cy >= ah)
                         continue;
                     size_t a = (size_t)cy * aw + cx, as = j->anchor_sample[a];
-                    float wb = (dx ? sparse_t_weight(tx) : 1.0f - sparse_t_weight(tx)) *
-                               (dy ? sparse_t_weight(ty) : 1.0f - sparse_t_weight(ty));
+                    float wb = (dx ? tx : 1.0f - tx) * (dy ? ty : 1.0f - ty);
                     if (as == SIZE_MAX || !(wb > 0.0f))
                         continue;
                     float wa = wb * (as == si ? 1.0f : packed_surface_weight(j, n, xs, m, plan->geo + a * 8));

@@ -92,19 +92,13 @@ static inline void sparse_axis_cell(uint32_t x, float o, uint32_t stride, uint32
     *t = w;
 }
 
-/* The next anchor's bilinear weight for a sample at t (sparse_axis_cell):
- * t, at most 1. */
-static inline float sparse_t_weight(float t)
-{
-    return t < 1.0f ? t : 1.0f;
-}
-
 /* A sample past the last anchor of its row or column (sparse_axis_cell's
  * t above 1): its light would be extrapolated; it is shaded itself. Taken
  * from the last anchor, the floor's reflected ellipse in the spot room's
  * last row at 80 x 60 (quality: 3 x 3 samples, the anchor shaded at the
  * pixel's first, where the reflection falls by a quarter per pixel) was
- * 12 % too bright. */
+ * 12 % too bright. (Its bilinear weights, one of them negative and
+ * skipped, are computed like any sample's but never used.) */
 static inline int sparse_past_anchor(float tx, float ty)
 {
     return tx > 1.0f || ty > 1.0f;
