@@ -594,7 +594,9 @@ VT_TEST(budget_stride_pixels_scales_the_stride_and_says_so)
  * sparse shading: a stride asked for is not taken (the same pixels and
  * pairs as stride 1) and the render does not claim it; it warns before
  * the wait, naming the path. The kernel path at the same stride shades
- * fewer pairs (what the check would miss if the stride never applied). */
+ * fewer pairs (what the check would miss if the stride never applied):
+ * 0.73x here, a small room seen whole, most of its cells beside a junction
+ * (0.44x before the cells beside one were tested, sparse.c). */
 /* The glossy sg warnings among those captured. */
 static int sg_warnings(const vt_warnings *w)
 {
@@ -649,7 +651,7 @@ VT_TEST(budget_glossy_sg_shades_every_pixel_and_says_so)
     VT_REQUIRE(render_with(ctx, &fx, &s, a, &st[2]) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
     s.shade_stride = 1;
     VT_REQUIRE(render_with(ctx, &fx, &s, b, &st[3]) == VSGL_OK, "%s", vsgl_context_last_error(ctx));
-    VT_CHECK(st[2].shading_pairs * 2 < st[3].shading_pairs && sg_warnings(&cap) == 1,
+    VT_CHECK(st[2].shading_pairs * 5 < st[3].shading_pairs * 4 && sg_warnings(&cap) == 1,
              "asg2: stride 3 %llu pairs, stride 1 %llu; sg warnings %d",
              (unsigned long long)st[2].shading_pairs, (unsigned long long)st[3].shading_pairs, sg_warnings(&cap));
     vsgl_context_destroy(ctx);

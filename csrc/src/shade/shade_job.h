@@ -51,7 +51,9 @@ struct vsgl_shade_plan {
     uint32_t *cell_x, *cell_y;      /* per (column, slot) and (row, slot): the anchor cell of a sample */
     float *cell_tx, *cell_ty;       /* its position in that cell, as sample_cell computes it */
     unsigned char *d2_ok;           /* per anchor: bit 0 (x), 1 (y): a second difference through its two
-                                       neighbours on its surface is taken */
+                                       neighbours on its surface is taken; bit 2 (x), 3 (y): it is beside a
+                                       junction (sparse.h), and bit 4 (x), 5 (y): its neighbour on its
+                                       surface is the next anchor, not the one before */
     float *geo;                     /* per anchor: 8 floats: its sample's normal, position, material (bits) */
     /* a replay's working memory, kept between renders (no page faults per render) */
     float *pack;                    /* per anchor: 12 floats: light (6), its sum per lobe (2), d2 (4) */

@@ -23,7 +23,10 @@
  *     position in the anchor cell, and interpolated at its grid position
  *     it took the anchors' light in some frames and its own in others (the
  *     corridor's end-wall edges as the camera moved; docs/accuracy.md,
- *     "Edges that move in steps"). That shades ~3 % more pairs.
+ *     "Edges that move in steps"). That shades ~3 % more pairs. Beside a
+ *     junction, where no anchor sees the light bend, an anchor's second
+ *     difference is taken from its light's step towards the junction
+ *     (sparse.h, SPARSE_JUNCTION_SLOPE).
  * The light of a sample, not its colour, is interpolated: DiffCol and
  * GlossCol stay per pixel. The shading work falls by about S^2 except at
  * edges and where the light bends (at S = 2 and 2 x 2 samples, 320 x 240:
@@ -134,7 +137,8 @@ vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
         return VSGL_OK;
     }
     const int record = plan != NULL;
-    /* each anchor's second differences along x and y through its neighbours on its surface */
+    /* each anchor's second differences along x and y through its neighbours on its surface;
+     * beside a junction, a bend from its light's step (SPARSE_JUNCTION_SLOPE) */
     for (uint32_t ay = 0; ay < j->ah; ++ay)
         for (uint32_t ax = 0; ax < j->aw; ++ax) {
             size_t a = (size_t)ay * j->aw + ax, as = j->anchor_sample[a];
@@ -147,8 +151,19 @@ vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
                     continue;
                 size_t step = axis == 0 ? 1 : j->aw, m = a - step, p = a + step;
                 size_t ms = j->anchor_sample[m], ps = j->anchor_sample[p];
-                if (ms == SIZE_MAX || ps == SIZE_MAX || !(same_surface_weight(j, as, ms) > 0.0f) ||
-                    !(same_surface_weight(j, as, ps) > 0.0f))
+                if (ms == SIZE_MAX || ps == SIZE_MAX)
+                    continue;
+                const int sm = same_surface_weight(j, as, ms) > 0.0f, sp = same_surface_weight(j, as, ps) > 0.0f;
+                if (sm != sp && sparse_beside_junction(g, as, sm ? ms : ps, sm ? ps : ms)) {
+                    if (record) /* bit 2 + axis: beside a junction; 4 + axis: its same-surface neighbour is p */
+                        plan->d2_ok[a] |= (unsigned char)((4u | (sp ? 16u : 0u)) << axis);
+                    for (int l = 0; l < 2; ++l) {
+                        const float *A = j->anchor_light + a * 6 + 3 * l, *S = j->anchor_light + (sm ? m : p) * 6 + 3 * l;
+                        D[2 * l + axis] = SPARSE_JUNCTION_SLOPE * fabsf((A[0] + A[1] + A[2]) - (S[0] + S[1] + S[2]));
+                    }
+                    continue;
+                }
+                if (!sm || !sp)
                     continue;
                 if (record)
                     plan->d2_ok[a] |= (unsigned char)(1u << axis);
@@ -224,7 +239,6 @@ static float same_surface_weight(const shade_job *j, size_t s, size_t a)
  * surface, and on another surface within SPARSE_JUNCTION times the
  * farthest same-surface anchor's distance (further away it is an
  * occluder's or a background's edge: a depth step, no near field). */
-#define SPARSE_JUNCTION 3.0f
 static inline int sparse_junction(unsigned same, unsigned other)
 {
     const unsigned row0 = 0x3u, row1 = 0xcu, col0 = 0x5u, col1 = 0xau;

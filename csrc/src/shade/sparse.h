@@ -115,6 +115,49 @@ static inline int sparse_past_anchor(float tx, float ty)
  * taken (fewer than three anchors in a row on the surface), anchors that
  * differ by more than SPARSE_CONTRAST of their sum. */
 #define SPARSE_TOL 0.04f
+/* Beside a junction. Where an anchor's neighbour along an axis lies on
+ * another surface that touches its own (a wall's foot, a room's corner),
+ * the light bends towards the junction within the cell before it, and no
+ * second difference through the anchors sees that: the red-wall room's
+ * ceiling row next to the back wall, interpolated, was 3-12 % darker than
+ * every pixel shaded (80 x 60, stride 2: a dark seam). The anchor's second
+ * difference along that axis is then taken as SPARSE_JUNCTION_SLOPE times
+ * the step of its light from its neighbour on its own surface: a bend
+ * proportional to the light's change there, none where the light is flat
+ * (1: half the pairs' rise at 80 x 60 for about half the gain, and
+ * test_render.c's seam 10 pixels long, not 5; every sample there shaded:
+ * 1.2-2x the pairs at 80 x 60; docs/accuracy.md, "Seams beside a
+ * junction"). */
+#ifndef SPARSE_JUNCTION_SLOPE
+#define SPARSE_JUNCTION_SLOPE 2.0f
+#endif
+/* How far an anchor on another surface may lie and still touch the
+ * sample's (times the distance of an anchor on the sample's own surface:
+ * the farthest of the cell's, or the neighbour's along the axis): further
+ * away it is an occluder's or a background's edge, a depth step with no
+ * near field (sparse.c's junction tests). */
+#define SPARSE_JUNCTION 3.0f
+/* ... and it is a junction only where the surfaces meet at a crease (the
+ * normals more than ~25 degrees apart) or the material changes: not at a
+ * bump of one bumpy surface (the 500k-triangle floor's pairs at 960 x 540
+ * +23 % without this, +3 % with it). */
+#define SPARSE_JUNCTION_CREASE_COS 0.9f
+/* Anchor as (its sample) beside a junction along one axis: its neighbour s
+ * there shares its surface, the one on the other side, o, does not, and
+ * touches it at a crease. */
+static inline int sparse_beside_junction(const vsgl_gbuffer *g, size_t as, size_t s, size_t o)
+{
+    float ds = 0.0f, dO = 0.0f;
+    for (int c = 0; c < 3; ++c) {
+        const float u = g->pos[c][s] - g->pos[c][as], v = g->pos[c][o] - g->pos[c][as];
+        ds += u * u;
+        dO += v * v;
+    }
+    const float c = g->nrm[0][as] * g->nrm[0][o] + g->nrm[1][as] * g->nrm[1][o] + g->nrm[2][as] * g->nrm[2][o];
+    return dO <= SPARSE_JUNCTION * SPARSE_JUNCTION * ds &&
+           (g->material[o] != g->material[as] || c < SPARSE_JUNCTION_CREASE_COS);
+}
+
 #define SPARSE_CONTRAST 0.1f
 #define SPARSE_FLOOR 0.002f
 /* The verdict is soft: a sample whose estimated error e is up to
