@@ -115,6 +115,8 @@ static inline int sparse_past_anchor(float tx, float ty)
  * taken (fewer than three anchors in a row on the surface), anchors that
  * differ by more than SPARSE_CONTRAST of their sum. */
 #define SPARSE_TOL 0.04f
+#define SPARSE_CONTRAST 0.1f
+#define SPARSE_FLOOR 0.002f
 /* Beside a junction. Where an anchor's neighbour along an axis lies on
  * another surface that touches its own (a wall's foot, a room's corner),
  * the light bends towards the junction within the cell before it, and no
@@ -157,9 +159,6 @@ static inline int sparse_beside_junction(const vsgl_gbuffer *g, size_t as, size_
     return dO <= SPARSE_JUNCTION * SPARSE_JUNCTION * ds &&
            (g->material[o] != g->material[as] || c < SPARSE_JUNCTION_CREASE_COS);
 }
-
-#define SPARSE_CONTRAST 0.1f
-#define SPARSE_FLOOR 0.002f
 /* The verdict is soft: a sample whose estimated error e is up to
  * SPARSE_BLEND of the bound is interpolated, one beyond the bound shaded,
  * and one in between shaded too and given (1 - t) x its interpolated light
