@@ -70,6 +70,19 @@ static vsgl_result render_room(uint32_t threads, const vsgl_render_settings *s, 
     return render_room_flags(threads, s, p, st, err, errlen, 0);
 }
 
+/* Relative RMS difference of a from ref over n floats: sqrt(sum (a - ref)^2
+ * / sum ref^2). */
+static double rel_rms(const float *a, const float *ref, size_t n)
+{
+    double e = 0.0, r = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double d = (double)a[i] - ref[i];
+        e += d * d;
+        r += (double)ref[i] * ref[i];
+    }
+    return sqrt(e / (r > 0.0 ? r : 1.0));
+}
+
 /* Mean of channel c of plane v over pixel rectangle [x0,x1) x [y0,y1). */
 static double region_mean(const float *v, int c, int x0, int x1, int y0, int y1)
 {
@@ -481,13 +494,7 @@ VT_TEST(render_sample_merging_cuts_pairs_at_small_error)
     VT_CHECK(render_room(0, &s, &on, &st_on, err, sizeof err) == VSGL_OK, "%s", err);
     s.sample_merging = VSGL_MERGE_OFF;
     VT_CHECK(render_room(0, &s, &off, &st_off, err, sizeof err) == VSGL_OK, "%s", err);
-    double e = 0, ref = 0;
-    for (int i = 0; i < W * H * 3; ++i) {
-        double d = (double)on.comb[i] - off.comb[i];
-        e += d * d;
-        ref += (double)off.comb[i] * off.comb[i];
-    }
-    double rel_rmse = sqrt(e / (ref > 0 ? ref : 1));
+    double rel_rmse = rel_rms(on.comb, off.comb, (size_t)W * H * 3);
     if (getenv("VSGL_TEST_VERBOSE"))
         printf("    merging: %llu pairs vs %llu, relative RMSE %.3g\n", (unsigned long long)st_on.shading_pairs,
                (unsigned long long)st_off.shading_pairs, rel_rmse);
@@ -554,13 +561,7 @@ VT_TEST(render_shade_stride_cuts_pairs_at_small_error)
     for (int k = 0; k < 2; ++k) {
         s.shade_stride = strides[k];
         float *sparse = render_room_size(SW, SH, 0, &s, &st_sparse, &dc_sparse);
-        double e = 0, ref = 0;
-        for (int i = 0; i < SW * SH * 3; ++i) {
-            double d = (double)sparse[i] - full[i];
-            e += d * d;
-            ref += (double)full[i] * full[i];
-        }
-        double rel = sqrt(e / (ref > 0 ? ref : 1));
+        double rel = rel_rms(sparse, full, (size_t)SW * SH * 3);
         if (getenv("VSGL_TEST_VERBOSE"))
             printf("    stride %u: %llu pairs vs %llu, relative RMSE %.3g\n", strides[k],
                    (unsigned long long)st_sparse.shading_pairs, (unsigned long long)st_full.shading_pairs, rel);
@@ -715,13 +716,7 @@ VT_TEST(render_shade_stride_leaves_no_seam_beside_a_junction)
     float *dl[2];
     room_at_strides_1_and_4(SW, SH, &s, eye, at, 14.0f, dl);
     const int seam = longest_seam(dl[1], dl[0], SW, SH, 0.02);
-    double e = 0.0, r = 0.0;
-    for (size_t i = 0; i < (size_t)SW * SH * 3; ++i) {
-        const double d = (double)dl[1][i] - dl[0][i];
-        e += d * d;
-        r += (double)dl[0][i] * dl[0][i];
-    }
-    const double rms = sqrt(e / (r > 0.0 ? r : 1.0));
+    const double rms = rel_rms(dl[1], dl[0], (size_t)SW * SH * 3);
     printf("    stride 4 against every pixel shaded: relative RMS difference %.4f, the longest run of pixels off by "
            "more than 2 %%: %d\n", rms, seam);
     VT_CHECK(rms < 0.0075, "relative RMS difference %.4f", rms);
