@@ -153,6 +153,8 @@ $(BUILD)/obj/csrc/src/shade/kernel.o: OPT += -O3 $(KERNEL_MATH)
 $(BUILD)/obj/csrc/src/shade/kernel_scalar.o: OPT += -fno-math-errno -fno-trapping-math
 # Visibility against a few occluders (scene/occlude_few.c): vectorised over a batch's segments.
 $(BUILD)/obj/csrc/src/scene/occlude_few.o: OPT += -O3 -fno-math-errno -fno-trapping-math
+# Receivers' glossy lobes (math/warp_lanes.c): vectorised over a block's receivers, the same flags.
+$(BUILD)/obj/csrc/src/math/warp_lanes.o: OPT += -O3 -fno-math-errno -fno-trapping-math
 # The tests' per-ISA copies of the kernel (tests/c/kernel_isa*.c) take the
 # library kernel's flags, so that they check the arithmetic that ships.
 $(BUILD)/obj/tests/c/kernel_isa%.o: OPT += -O3 $(KERNEL_MATH)

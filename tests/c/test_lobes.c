@@ -7,6 +7,7 @@
 #include "sphere_quad.h"
 #include "vsgl/lobes.h"
 #include "math/sg_internal.h"
+#include "math/warp_lanes.h"
 
 #include <float.h>
 #include <stdlib.h>
@@ -456,57 +457,105 @@ static void draw_warp(vt_rng *r, double lmin, double lmax, double cmin, vsgl_asg
     *view = f3(o);
 }
 
+/* The warped lobe wa of ndf seen from view: its quadratic form l_i
+ * (v.x_i)^2 + m_i (v.y_i)^2 equals half the Hessian of the exact warped
+ * exponent at z_i, differentiated numerically (central differences in
+ * double) in a random tangent frame; tolerance 1e-4 of the largest
+ * eigenvalue. */
+static void check_warp_hessian(const vsgl_asg *ndf, vsgl_vec3 view, const vsgl_asg *wa)
+{
+    VT_CHECK(frame_ok(wa, 1e-5), "warped frame orthonormal");
+    warp w;
+    dasg_of(ndf, &w.h);
+    d3of(view, w.o);
+    dunit(w.o);
+    double z[3], zh[3], t1[3], t2[3];
+    d3of(wa->z, z);
+    d3of(ndf->z, zh);
+    double c = ddot(w.o, zh), zi[3];
+    for (int k = 0; k < 3; ++k)
+        zi[k] = 2 * c * zh[k] - w.o[k];
+    VT_CHECK(ddot(z, zi) > 1 - 1e-6, "z_i = reflect(o, z_h): %g", ddot(z, zi));
+    sq_basis(zi, t1, t2);
+    double step = 1e-3 / sqrt(1.0 + (double)fmax(wa->lambda, wa->mu));
+    double H[2][2];
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+            double p[3], s = 0.0;
+            for (int sa = -1; sa <= 1; sa += 2)
+                for (int sb = -1; sb <= 1; sb += 2) {
+                    double da = 0, db = 0;
+                    if (a == 0) da += sa * step; else db += sa * step;
+                    if (b == 0) da += sb * step; else db += sb * step;
+                    tangent_point(zi, t1, t2, da, db, p);
+                    s += sa * sb * warp_g(&w, p);
+                }
+            H[a][b] = s / (4 * step * step); /* d2g/da db */
+        }
+    double xi[3], yi[3];
+    d3of(wa->x, xi); d3of(wa->y, yi);
+    double tt[2][3] = {{t1[0], t1[1], t1[2]}, {t2[0], t2[1], t2[2]}};
+    double scale = fmax(wa->lambda, wa->mu);
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+            double q = wa->lambda * ddot(xi, tt[a]) * ddot(xi, tt[b]) + wa->mu * ddot(yi, tt[a]) * ddot(yi, tt[b]);
+            VT_CHECK(fabs(q - 0.5 * H[a][b]) <= 1e-4 * scale, "Q[%d][%d] = %g, FD %g (l=%g m=%g c=%g)", a, b, q,
+                     0.5 * H[a][b], w.h.l, w.h.m, c);
+        }
+}
+
 VT_TEST(lobes_warp_asg_hessian_matches_finite_differences)
 {
-    /* The fitted ASG's quadratic form l_i (v.x_i)^2 + m_i (v.y_i)^2 equals
-     * half the Hessian of the exact warped exponent at z_i, differentiated
-     * numerically (central differences in double) in a random tangent
-     * frame. Tolerance 1e-4 of the largest eigenvalue. */
     vt_rng r = {23};
     for (int it = 0; it < 3000; ++it) {
         vsgl_asg ndf, wa;
         vsgl_vec3 view;
         draw_warp(&r, 0.1, 1e4, 0.05, &ndf, &view);
         vsgl_warp_ndf_asg(&ndf, &view, &wa);
-        VT_CHECK(frame_ok(&wa, 1e-5), "warped frame orthonormal");
-        warp w;
-        dasg_of(&ndf, &w.h);
-        d3of(view, w.o);
-        dunit(w.o);
-        double z[3], zh[3], t1[3], t2[3];
-        d3of(wa.z, z);
-        d3of(ndf.z, zh);
-        double c = ddot(w.o, zh), zi[3];
-        for (int k = 0; k < 3; ++k)
-            zi[k] = 2 * c * zh[k] - w.o[k];
-        VT_CHECK(ddot(z, zi) > 1 - 1e-6, "z_i = reflect(o, z_h): %g", ddot(z, zi));
-        sq_basis(zi, t1, t2);
-        double step = 1e-3 / sqrt(1.0 + (double)fmax(wa.lambda, wa.mu));
-        double H[2][2];
-        for (int a = 0; a < 2; ++a)
-            for (int b = 0; b < 2; ++b) {
-                double p[3], s = 0.0;
-                for (int sa = -1; sa <= 1; sa += 2)
-                    for (int sb = -1; sb <= 1; sb += 2) {
-                        double da = 0, db = 0;
-                        if (a == 0) da += sa * step; else db += sa * step;
-                        if (b == 0) da += sb * step; else db += sb * step;
-                        tangent_point(zi, t1, t2, da, db, p);
-                        s += sa * sb * warp_g(&w, p);
-                    }
-                H[a][b] = s / (4 * step * step); /* d2g/da db */
-            }
-        double xi[3], yi[3];
-        d3of(wa.x, xi); d3of(wa.y, yi);
-        double tt[2][3] = {{t1[0], t1[1], t1[2]}, {t2[0], t2[1], t2[2]}};
-        double scale = fmax(wa.lambda, wa.mu);
-        for (int a = 0; a < 2; ++a)
-            for (int b = 0; b < 2; ++b) {
-                double q = wa.lambda * ddot(xi, tt[a]) * ddot(xi, tt[b]) + wa.mu * ddot(yi, tt[a]) * ddot(yi, tt[b]);
-                VT_CHECK(fabs(q - 0.5 * H[a][b]) <= 1e-4 * scale, "Q[%d][%d] = %g, FD %g (l=%g m=%g c=%g)", a, b, q,
-                         0.5 * H[a][b], w.h.l, w.h.m, c);
-            }
+        check_warp_hessian(&ndf, view, &wa);
     }
+}
+
+VT_TEST(lobes_warp_lanes_match_finite_differences_and_one_lane_alone)
+{
+    /* The shade stage's float warp of a block of receivers
+     * (math/warp_lanes.h): each lane passes the Hessian check above (its
+     * NDF given as a normal, a tangent and alphas), keeps the NDF's
+     * amplitude, agrees with the double warp, and comes out bit for bit the
+     * same when warped alone (n = 1: the scalar tail of the vectorised
+     * loop) as among 64 lanes (the AVX-512 / AVX2 / SSE body). */
+    vt_rng r = {29};
+    double worst_rel = 0.0;
+    for (int it = 0; it < 50; ++it) {
+        vsgl_warp_lanes w;
+        vsgl_asg ndf[VSGL__WARP_LANES];
+        vsgl_vec3 view[VSGL__WARP_LANES];
+        for (int k = 0; k < VSGL__WARP_LANES; ++k) {
+            draw_warp(&r, 1.0, 1e4, 0.05, &ndf[k], &view[k]); /* GGX: alpha <= 1 */
+            /* the lanes' alphas give sharpnesses 1 / alpha^2: take back the ones they give */
+            float ax = 1.0f / sqrtf(ndf[k].lambda), ay = 1.0f / sqrtf(ndf[k].mu);
+            ndf[k].lambda = 1.0f / (ax * ax);
+            ndf[k].mu = 1.0f / (ay * ay);
+            ndf[k].log_amplitude = -(float)log(SQ_PI) - logf(ax) - logf(ay);
+            vsgl__warp_lane_set(&w, (size_t)k, ndf[k].z, ndf[k].x, view[k], ax, ay);
+        }
+        vsgl__warp_lanes(&w, VSGL__WARP_LANES);
+        for (int k = 0; k < VSGL__WARP_LANES; ++k) {
+            vsgl_asg wa, wd, one;
+            vsgl__warp_lane_get(&w, (size_t)k, &wa);
+            check_warp_hessian(&ndf[k], view[k], &wa);
+            VT_CHECK_REL(wa.log_amplitude, ndf[k].log_amplitude, 1e-6, "lane %d amplitude", k);
+            vsgl_warp_ndf_asg(&ndf[k], &view[k], &wd);
+            double rel = fmax(fabs((double)wa.lambda - wd.lambda) / wd.lambda, fabs((double)wa.mu - wd.mu) / wd.mu);
+            worst_rel = fmax(worst_rel, rel);
+            vsgl_warp_lanes w1;
+            vsgl__warp_lane_set(&w1, 0, ndf[k].z, ndf[k].x, view[k], w.ax[k], w.ay[k]);
+            vsgl__warp_lanes(&w1, 1);
+            vsgl__warp_lane_get(&w1, 0, &one);
+            VT_CHECK(memcmp(&one, &wa, sizeof one) == 0, "lane %d alone differs from the block's", k);
+        }
+    }
+    VT_CHECK(worst_rel < 2e-5, "sharpnesses against the double warp: worst relative difference %g (4e-6 measured)", worst_rel);
 }
 
 VT_TEST(lobes_warp_asg_isotropic_closed_form)

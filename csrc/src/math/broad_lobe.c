@@ -1,6 +1,7 @@
 /* Broad receiver lobes: the tables' lookup (math/broad_lobe.h). */
 #include "math/broad_lobe.h"
 #include "math/sg_internal.h"
+#include "math/warp_lanes.h"
 #include "vsgl/lobes.h"
 
 /* bilinear in (row y, column x) of one table */
@@ -36,17 +37,23 @@ void vsgl__broad_lobe(float alpha, float f0, float cos_o, int two, float *scale,
     *amplitude = ac + d * (ad - ac);
 }
 
+void vsgl__receiver_asg_finish(v3 n, v3 o, float scale, float amplitude, vsgl_asg *a)
+{
+    if (scale != 1.0f) {
+        a->lambda *= scale;
+        a->mu *= scale;
+    }
+    vsgl__asg_cut_at_horizon(a, &n, &o);
+    if (amplitude != 1.0f) /* no logf for the sharp lobes, most receivers */
+        a->log_amplitude += logf(amplitude);
+}
+
 void vsgl__receiver_asg(v3 n, v3 t, v3 o, float alpha_x, float alpha_y, float scale, float amplitude,
                         vsgl_asg *out)
 {
-    vsgl_asg ndf;
-    vsgl_ndf_aniso_to_asg(&n, &t, alpha_x, alpha_y, &ndf);
-    vsgl_warp_ndf_asg(&ndf, &o, out);
-    if (scale != 1.0f) {
-        out->lambda *= scale;
-        out->mu *= scale;
-    }
-    vsgl__asg_cut_at_horizon(out, &n, &o);
-    if (amplitude != 1.0f) /* no logf for the sharp lobes, most receivers */
-        out->log_amplitude += logf(amplitude);
+    vsgl_warp_lanes w;
+    vsgl__warp_lane_set(&w, 0, n, t, o, alpha_x, alpha_y);
+    vsgl__warp_lanes(&w, 1);
+    vsgl__warp_lane_get(&w, 0, out);
+    vsgl__receiver_asg_finish(n, o, scale, amplitude, out);
 }

@@ -66,11 +66,16 @@ void vsgl__broad_lobe(float alpha, float f0, float cos_o, int two, float *scale,
 
 /* A receiver's glossy lobe as the shade stage takes it (shade.c
  * setup_receiver): GGX's NDF of alpha_x, alpha_y about normal n (tangent
- * t) as an ASG, warped to light directions seen from view o, its
+ * t) as an ASG, warped to light directions seen from view o (in float,
+ * math/warp_lanes.h, as the shade stage warps a block's receivers), its
  * sharpness times scale, cut at the horizon (vsgl__asg_cut_at_horizon
  * with the view), its amplitude times amplitude; {1, 1}: the plain lobe.
  * tools/gen_broad_lobe.c fits the tables to this very lobe. */
 void vsgl__receiver_asg(v3 n, v3 t, v3 o, float alpha_x, float alpha_y, float scale, float amplitude,
                         vsgl_asg *out);
+/* The steps of vsgl__receiver_asg after the warp (a lobe from
+ * math/warp_lanes.h, many receivers at a time): sharpness times scale, the
+ * cut at the horizon, amplitude times amplitude. */
+void vsgl__receiver_asg_finish(v3 n, v3 o, float scale, float amplitude, vsgl_asg *a);
 
 #endif

@@ -43,10 +43,13 @@ void vsgl__write_pixels4(const shade_job *j, size_t px, const float *const Ls[4]
     const vsgl_gbuffer *g = j->g;
     const vsgl_pixel_planes *pl = j->planes;
     const vsgl_brdf_params *bp[4];
-    float dot[4], fd[4], m5[4];
+    float dot[4], fd[4] = {0.0f, 0.0f, 0.0f, 0.0f}, m5[4];
+    int fresnel = 0; /* some lane's GlossCol takes the dielectric Fresnel (below) */
     for (int k = 0; k < 4; ++k) {
         const uint32_t mat = g->material[px + (size_t)k];
         bp[k] = mat == VSGL__GBUFFER_MISS ? NULL : &j->params[mat];
+        fresnel |= bp[k] && bp[k]->glossy && bp[k]->height_correlated && bp[k]->f0_dielectric > 0.0f &&
+                   bp[k]->eta > 1.0f;
     }
     /* eta's lanes built in registers: four scalar stores read back as one
      * vector cannot be forwarded, and stalled every call */
@@ -62,7 +65,8 @@ void vsgl__write_pixels4(const shade_job *j, size_t px, const float *const Ls[4]
     const __m128 c = clamp01_4(d);
     const __m128 m = _mm_sub_ps(_mm_set1_ps(1.0f), c);
     _mm_storeu_ps(dot, d);
-    _mm_storeu_ps(fd, fresnel4(c, eta));
+    if (fresnel) /* a square root and two divisions per lane: only where a lane uses them */
+        _mm_storeu_ps(fd, fresnel4(c, eta));
     _mm_storeu_ps(m5, _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(m, m), m), m), m));
     for (int k = 0; k < 4; ++k) {
         const size_t si = px + (size_t)k;

@@ -5,6 +5,7 @@
 #include "shade/shade.h"
 #include "shade/halfvec.h"
 #include "math/broad_lobe.h"
+#include "math/warp_lanes.h"
 #include "math/constants.h"
 #include "math/normal.h"
 #include "math/sg_internal.h"
@@ -428,9 +429,13 @@ static int two_lobes(int32_t mode)
     return mode == VSGL_GLOSSY_ASG2 || mode == VSGL_GLOSSY_HYBRID;
 }
 
-/* Receiver of G-buffer sample i; nm: NULL, or the unit normal to take
- * instead of the sample's (a merged group's mean, vsgl__shade_list). */
-static void setup_receiver_n(const shade_job *j, size_t i, receiver *r, const v3 *nm)
+/* Receiver of G-buffer sample i up to its glossy ASG lobe; nm: NULL, or
+ * the unit normal to take instead of the sample's (a merged group's mean,
+ * vsgl__shade_list). Returns 1 where that lobe is still to be made (the
+ * glossy ASG modes): the receiver's warp inputs are then lane `lane` of
+ * w, and *bscale, *bamp its broad-lobe factors (setup_receiver_lobe). */
+static int setup_receiver_base(const shade_job *j, size_t i, receiver *r, const v3 *nm, vsgl_warp_lanes *w,
+                               size_t lane, float *bscale, float *bamp)
 {
     const vsgl_gbuffer *g = j->g;
     r->x = v3_make(g->pos[0][i], g->pos[1][i], g->pos[2][i]);
@@ -449,31 +454,51 @@ static void setup_receiver_n(const shade_job *j, size_t i, receiver *r, const v3
     r->fres[2] = 0.0f;
     r->fh = 0.0f;
     if (!r->glossy)
-        return;
+        return 0;
     vsgl__ms_scale3(&r->bp, v3_dot(r->n, r->o), r->ms);
     if (j->s->glossy_mode == VSGL_GLOSSY_SG) {
         vsgl_sg ndf;
         vsgl_ndf_to_sg(&r->n, r->alpha, VSGL_NDF_GGX, &ndf);
         vsgl_warp_ndf_sg(&ndf, &r->o, &r->sg);
         r->sm = vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, r->sg.axis), 0);
-    } else {
-        /* (with a normal nm the tangent is not orthogonal to it: the lobe's
-         * frame makes it so, math/lobes.c make_frame) */
-        v3 t = v3_make(g->tan[0][i], g->tan[1][i], g->tan[2][i]);
-        /* a rough lobe widened and scaled to be closest to GGX's (math/broad_lobe.h) */
-        float bscale, bamp;
-        vsgl__broad_lobe(r->alpha, (r->bp.f0[0] + r->bp.f0[1] + r->bp.f0[2]) * (1.0f / 3.0f), v3_dot(r->n, r->o),
-                         two_lobes(j->s->glossy_mode), &bscale, &bamp);
-        vsgl__receiver_asg(r->n, t, r->o, r->bp.alpha_x, r->bp.alpha_y, bscale, bamp, &r->asg);
-        /* the Fresnel shape at the axis, once for the ratio and fill_lane's specular factor */
-        r->fh = v3_dot(r->n, r->asg.z) > 0.0f ? vsgl__fresnel_shape_at(&r->bp, r->o, r->asg.z) : 0.0f;
-        vsgl__fresnel_ratio_fh(&r->bp, r->n, r->o, r->asg.z, r->fh, r->fres);
-        /* the scalar reference path's (glossy_light); the kernel's lanes
-         * take the same constants per block (run_block, shadow4.c) */
-        if (j->path == VSGL__SHADE_REFERENCE)
-            r->sm = vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, r->asg.z),
-                                      two_lobes(j->s->glossy_mode));
+        return 0;
     }
+    /* (with a normal nm the tangent is not orthogonal to it: the warp
+     * makes it so, math/warp_lanes.c) */
+    vsgl__warp_lane_set(w, lane, r->n, v3_make(g->tan[0][i], g->tan[1][i], g->tan[2][i]), r->o, r->bp.alpha_x,
+                        r->bp.alpha_y);
+    /* a rough lobe widened and scaled to be closest to GGX's (math/broad_lobe.h) */
+    vsgl__broad_lobe(r->alpha, (r->bp.f0[0] + r->bp.f0[1] + r->bp.f0[2]) * (1.0f / 3.0f), v3_dot(r->n, r->o),
+                     two_lobes(j->s->glossy_mode), bscale, bamp);
+    return 1;
+}
+
+/* The rest of a glossy ASG receiver's set-up, its warped NDF in lane k
+ * of w (vsgl__receiver_asg's steps, a block's receivers warped at once). */
+static void setup_receiver_lobe(const shade_job *j, receiver *r, const vsgl_warp_lanes *w, size_t k, float bscale,
+                                float bamp)
+{
+    vsgl__warp_lane_get(w, k, &r->asg);
+    vsgl__receiver_asg_finish(r->n, r->o, bscale, bamp, &r->asg);
+    /* the Fresnel shape at the axis, once for the ratio and fill_lane's specular factor */
+    r->fh = v3_dot(r->n, r->asg.z) > 0.0f ? vsgl__fresnel_shape_at(&r->bp, r->o, r->asg.z) : 0.0f;
+    vsgl__fresnel_ratio_fh(&r->bp, r->n, r->o, r->asg.z, r->fh, r->fres);
+    /* the scalar reference path's (glossy_light); the kernel's lanes
+     * take the same constants per block (run_block, shadow4.c) */
+    if (j->path == VSGL__SHADE_REFERENCE)
+        r->sm = vsgl__shadow_lane(r->alpha, v3_dot(r->n, r->o), v3_dot(r->n, r->asg.z),
+                                  two_lobes(j->s->glossy_mode));
+}
+
+/* Receiver of G-buffer sample i, alone (nm as setup_receiver_base). */
+static void setup_receiver_n(const shade_job *j, size_t i, receiver *r, const v3 *nm)
+{
+    vsgl_warp_lanes w;
+    float bscale, bamp;
+    if (!setup_receiver_base(j, i, r, nm, &w, 0, &bscale, &bamp))
+        return;
+    vsgl__warp_lanes(&w, 1);
+    setup_receiver_lobe(j, r, &w, 0, bscale, bamp);
 }
 
 static void setup_receiver(const shade_job *j, size_t i, receiver *r)
@@ -871,18 +896,9 @@ static void clear_lane(vsgl_kernel_block *b, size_t k, float x, float y, float z
     vsgl__kernel_set_smooth(b, k, (vsgl_smooth_lane){0.0f, 0.0f, 0.0f, 0.0f, 0.0f});
 }
 
-/* Fill lane `k` of a kernel block from G-buffer sample i (nm: NULL, or the
- * normal to take instead of its own, setup_receiver_n); returns 0 for a
- * miss. */
-static int fill_lane_n(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t k, receiver *r, const v3 *nm)
+/* Lane `k` of a kernel block from receiver r (set up). */
+static void put_lane(const shade_job *j, vsgl_kernel_block *b, size_t k, const receiver *r)
 {
-    if (j->g->material[i] == VSGL__GBUFFER_MISS) {
-        memset(r, 0, sizeof *r);
-        r->part = VSGL__PART_NONE;
-        clear_lane(b, k, 0.0f, 0.0f, 0.0f);
-        return 0;
-    }
-    setup_receiver_n(j, i, r, nm);
     b->x[k] = r->x.x; b->y[k] = r->x.y; b->z[k] = r->x.z;
     b->nx[k] = r->n.x; b->ny[k] = r->n.y; b->nz[k] = r->n.z;
     b->ox[k] = r->o.x; b->oy[k] = r->o.y; b->oz[k] = r->o.z;
@@ -919,6 +935,21 @@ static int fill_lane_n(const shade_job *j, size_t i, vsgl_kernel_block *b, size_
     b->fe[k] = r->fres[0];
     b->fa[k] = r->fres[1];
     b->fb[k] = r->fres[2];
+}
+
+/* Fill lane `k` of a kernel block from G-buffer sample i (nm: NULL, or the
+ * normal to take instead of its own, setup_receiver_n); returns 0 for a
+ * miss. */
+static int fill_lane_n(const shade_job *j, size_t i, vsgl_kernel_block *b, size_t k, receiver *r, const v3 *nm)
+{
+    if (j->g->material[i] == VSGL__GBUFFER_MISS) {
+        memset(r, 0, sizeof *r);
+        r->part = VSGL__PART_NONE;
+        clear_lane(b, k, 0.0f, 0.0f, 0.0f);
+        return 0;
+    }
+    setup_receiver_n(j, i, r, nm);
+    put_lane(j, b, k, r);
     return 1; /* its shadowing constants: run_block, for the whole block (shadow4.c) */
 }
 
@@ -1315,8 +1346,13 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
     uint64_t pairs = 0;
     vis_scratch vs;
     vis_scratch_init(j, &vs);
+    /* the block's glossy receivers' lobes are warped together (math/warp_lanes.h) */
+    _Static_assert(VSGL__WARP_LANES >= VSGL__KERNEL_BLOCK, "a block's receivers fit the warp's lanes");
+    vsgl_warp_lanes warp;
+    float bscale[VSGL__KERNEL_BLOCK], bamp[VSGL__KERNEL_BLOCK];
+    uint8_t wlane[VSGL__KERNEL_BLOCK];
     for (size_t s0 = 0; s0 < nshaded; s0 += VSGL__KERNEL_BLOCK) {
-        size_t n = nshaded - s0 < VSGL__KERNEL_BLOCK ? nshaded - s0 : VSGL__KERNEL_BLOCK;
+        size_t n = nshaded - s0 < VSGL__KERNEL_BLOCK ? nshaded - s0 : VSGL__KERNEL_BLOCK, nw = 0;
         for (size_t k = 0; k < n; ++k) {
             const float *cg = centroid ? centroid + (s0 + k) * VSGL__CENTROID : NULL;
             /* a merged group on a curved or faceted surface (its members'
@@ -1326,7 +1362,18 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
              * metal sphere's ~3 % under) */
             const int curved = cg && cg[3] > 1.0f && cg[4] > 0.0f;
             v3 nm = curved ? v3_normalize(v3_make(cg[5], cg[6], cg[7])) : v3_make(0.0f, 0.0f, 0.0f);
-            fill_lane_n(j, shaded[s0 + k], &blk, k, &rec[k], curved ? &nm : NULL); /* every shaded sample is a hit */
+            /* every shaded sample is a hit */
+            wlane[k] = UINT8_MAX;
+            if (setup_receiver_base(j, shaded[s0 + k], &rec[k], curved ? &nm : NULL, &warp, nw, &bscale[k], &bamp[k]))
+                wlane[k] = (uint8_t)nw++;
+        }
+        vsgl__warp_lanes(&warp, nw);
+        for (size_t k = 0; k < n; ++k) {
+            const float *cg = centroid ? centroid + (s0 + k) * VSGL__CENTROID : NULL;
+            const int curved = cg && cg[3] > 1.0f && cg[4] > 0.0f;
+            if (wlane[k] != UINT8_MAX)
+                setup_receiver_lobe(j, &rec[k], &warp, wlane[k], bscale[k], bamp[k]);
+            put_lane(j, &blk, k, &rec[k]);
             if (cg && cg[3] > 1.0f) { /* a merged group is shaded at its centroid: its mean light to first order */
                 float inv = 1.0f / cg[3];
                 v3 xc = v3_make(cg[0] * inv, cg[1] * inv, cg[2] * inv);
@@ -1448,8 +1495,11 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
     size_t *shaded = malloc((ns + 1) * sizeof *shaded);
     uint32_t *slot = malloc((ns + 1) * sizeof *slot);
     float *light = malloc((ns + 1) * 6 * sizeof *light);
-    float *centroid = calloc((ns + 1) * VSGL__CENTROID, sizeof *centroid); /* per slot (vsgl__shade_list) */
-    if (!shaded || !slot || !light || !centroid) {
+    /* per slot (vsgl__shade_list); only where samples can merge: a slot of
+     * one sample is shaded at its own position and normal */
+    const int merging = j->merge && spp > 1;
+    float *centroid = merging ? calloc((ns + 1) * VSGL__CENTROID, sizeof *centroid) : NULL;
+    if (!shaded || !slot || !light || (merging && !centroid)) {
         free(shaded);
         free(slot);
         free(light);
@@ -1465,7 +1515,7 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
         slot[i] = UINT32_MAX;
         if (g->material[si] == VSGL__GBUFFER_MISS)
             continue;
-        if (j->merge)
+        if (merging)
             for (size_t k = i - i % spp; k < i && slot[i] == UINT32_MAX; ++k)
                 if (slot[k] != UINT32_MAX && shaded[slot[k]] == first + k && same_surface(g, j->materials, first + k, si, j->plane_tol))
                     slot[i] = slot[k];
@@ -1473,6 +1523,8 @@ static int32_t shade_chunk_kernel(void *user, size_t chunk, size_t b0, size_t e0
             slot[i] = (uint32_t)nshaded;
             shaded[nshaded++] = si;
         }
+        if (!merging)
+            continue;
         float *cg = centroid + (size_t)slot[i] * VSGL__CENTROID;
         cg[0] += g->pos[0][si];
         cg[1] += g->pos[1][si];
