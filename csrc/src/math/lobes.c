@@ -46,10 +46,11 @@ static void make_frame(v3 n, v3 t, v3 *x, v3 *y, v3 *z)
 {
     /* n and t already unit and orthogonal to float precision (the
      * G-buffer's normal and tangent, a frame this file made): they are the
-     * frame, and y = n x t. Every receiver's glossy lobe is built from
-     * such a pair twice (vsgl_ndf_aniso_to_asg, vsgl_warp_ndf_asg), and
-     * re-normalising it cost 10 % of a 1080p frame's per-receiver work for
-     * a change of a few ulps. */
+     * frame, and y = n x t. A lobe is built from such a pair twice
+     * (vsgl_ndf_aniso_to_asg, vsgl_warp_ndf_asg), and re-normalising it
+     * cost 10 % of a 1080p frame's per-receiver work for a change of a few
+     * ulps when the shade stage's receivers still took this path (they now
+     * warp in math/warp_lanes.c). */
     if (is_unit(n) && is_unit(t) && fabsf(v3_dot(n, t)) < 1e-6f) {
         *x = t;
         *y = v3_cross(n, t);
