@@ -1350,7 +1350,7 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
     _Static_assert(VSGL__WARP_LANES >= VSGL__KERNEL_BLOCK, "a block's receivers fit the warp's lanes");
     vsgl_warp_lanes warp;
     float bscale[VSGL__KERNEL_BLOCK], bamp[VSGL__KERNEL_BLOCK];
-    uint8_t wlane[VSGL__KERNEL_BLOCK];
+    uint8_t wlane[VSGL__KERNEL_BLOCK], curved[VSGL__KERNEL_BLOCK];
     for (size_t s0 = 0; s0 < nshaded; s0 += VSGL__KERNEL_BLOCK) {
         size_t n = nshaded - s0 < VSGL__KERNEL_BLOCK ? nshaded - s0 : VSGL__KERNEL_BLOCK, nw = 0;
         for (size_t k = 0; k < n; ++k) {
@@ -1360,17 +1360,16 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
              * sample's is off to one side (a smooth diffuse cylinder's
              * merged light was 1.3 % over every sample shaded, a rough
              * metal sphere's ~3 % under) */
-            const int curved = cg && cg[3] > 1.0f && cg[4] > 0.0f;
-            v3 nm = curved ? v3_normalize(v3_make(cg[5], cg[6], cg[7])) : v3_make(0.0f, 0.0f, 0.0f);
+            curved[k] = cg && cg[3] > 1.0f && cg[4] > 0.0f;
+            v3 nm = curved[k] ? v3_normalize(v3_make(cg[5], cg[6], cg[7])) : v3_make(0.0f, 0.0f, 0.0f);
             /* every shaded sample is a hit */
             wlane[k] = UINT8_MAX;
-            if (setup_receiver_base(j, shaded[s0 + k], &rec[k], curved ? &nm : NULL, &warp, nw, &bscale[k], &bamp[k]))
+            if (setup_receiver_base(j, shaded[s0 + k], &rec[k], curved[k] ? &nm : NULL, &warp, nw, &bscale[k], &bamp[k]))
                 wlane[k] = (uint8_t)nw++;
         }
         vsgl__warp_lanes(&warp, nw);
         for (size_t k = 0; k < n; ++k) {
             const float *cg = centroid ? centroid + (s0 + k) * VSGL__CENTROID : NULL;
-            const int curved = cg && cg[3] > 1.0f && cg[4] > 0.0f;
             if (wlane[k] != UINT8_MAX)
                 setup_receiver_lobe(j, &rec[k], &warp, wlane[k], bscale[k], bamp[k]);
             put_lane(j, &blk, k, &rec[k]);
@@ -1385,7 +1384,7 @@ uint64_t vsgl__shade_list(const shade_job *j, const size_t *shaded, size_t nshad
                  * there the receiver (its rays, its near field) stays at
                  * its first sample, on the surface; the kernel takes the
                  * centroid */
-                if (!curved)
+                if (!curved[k])
                     rec[k].x = xc;
                 blk.x[k] = xc.x;
                 blk.y[k] = xc.y;

@@ -159,7 +159,7 @@ vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
                         plan->d2_ok[a] |= (unsigned char)((4u | (sp ? 16u : 0u)) << axis);
                     for (int l = 0; l < 2; ++l) {
                         const float *A = j->anchor_light + a * 6 + 3 * l, *S = j->anchor_light + (sm ? m : p) * 6 + 3 * l;
-                        D[2 * l + axis] = SPARSE_JUNCTION_SLOPE * fabsf((A[0] + A[1] + A[2]) - (S[0] + S[1] + S[2]));
+                        D[2 * l + axis] = sparse_junction_bend(A[0] + A[1] + A[2], S[0] + S[1] + S[2]);
                     }
                     continue;
                 }
@@ -170,7 +170,7 @@ vsgl_result vsgl__shade_anchors(vsgl_context *ctx, shade_job *j)
                 for (int l = 0; l < 2; ++l) {
                     const float *A = j->anchor_light + a * 6 + 3 * l, *M = j->anchor_light + m * 6 + 3 * l,
                                 *P = j->anchor_light + p * 6 + 3 * l;
-                    D[2 * l + axis] = fabsf((M[0] + M[1] + M[2]) - 2.0f * (A[0] + A[1] + A[2]) + (P[0] + P[1] + P[2]));
+                    D[2 * l + axis] = sparse_d2(M[0] + M[1] + M[2], A[0] + A[1] + A[2], P[0] + P[1] + P[2]);
                 }
             }
         }

@@ -7,6 +7,7 @@
 #include "shade/shade_job.h"
 #include "core/context.h"
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -133,6 +134,14 @@ static inline int sparse_past_anchor(float tx, float ty)
 #ifndef SPARSE_JUNCTION_SLOPE
 #define SPARSE_JUNCTION_SLOPE 2.0f
 #endif
+/* An anchor's second difference along an axis from the light sums (per
+ * lobe: R + G + B) of its neighbours m, p and itself a; beside a junction,
+ * the bend from its own sum a and its same-surface neighbour's s. The
+ * record (sparse.c, from the anchors' light) and a replay (sparse_replay.c,
+ * from the packed sums) take these same functions of the same sums: their
+ * verdicts agree bit for bit. */
+static inline float sparse_d2(float m, float a, float p) { return fabsf(m - 2.0f * a + p); }
+static inline float sparse_junction_bend(float a, float s) { return SPARSE_JUNCTION_SLOPE * fabsf(a - s); }
 /* How far an anchor on another surface may lie and still touch the
  * sample's (times the distance of an anchor on the sample's own surface:
  * the farthest of the cell's, or the neighbour's along the axis): further

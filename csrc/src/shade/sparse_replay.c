@@ -75,15 +75,13 @@ void vsgl__sparse_anchor_pack(shade_job *j)
                 if (bits >> (2 + axis) & 1u) { /* beside a junction (vsgl__shade_anchors) */
                     size_t step = axis == 0 ? 1 : j->aw, o = bits >> (4 + axis) & 1u ? a + step : a - step;
                     for (int l = 0; l < 2; ++l)
-                        P[a * 12 + 8 + 2 * l + axis] =
-                            SPARSE_JUNCTION_SLOPE * fabsf(P[a * 12 + 6 + l] - P[o * 12 + 6 + l]);
+                        P[a * 12 + 8 + 2 * l + axis] = sparse_junction_bend(P[a * 12 + 6 + l], P[o * 12 + 6 + l]);
                 }
                 if (!(bits >> axis & 1u))
                     continue;
                 size_t step = axis == 0 ? 1 : j->aw, m = a - step, p = a + step;
                 for (int l = 0; l < 2; ++l)
-                    P[a * 12 + 8 + 2 * l + axis] =
-                        fabsf(P[m * 12 + 6 + l] - 2.0f * P[a * 12 + 6 + l] + P[p * 12 + 6 + l]);
+                    P[a * 12 + 8 + 2 * l + axis] = sparse_d2(P[m * 12 + 6 + l], P[a * 12 + 6 + l], P[p * 12 + 6 + l]);
             }
         }
     for (int l = 0; l < 2; ++l)
